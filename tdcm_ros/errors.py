@@ -1,0 +1,52 @@
+"""The package's error tree.
+
+``TdcmError`` is the root. Two categories cross all subpackages and decide how the
+CLI exits:
+
+- :class:`InputError` (exit status 2): a bad parameter, value or file; the message names the
+  parameter, the value and the allowed range.
+- :class:`PhysicsError` (exit status 3): a physical limit of the model or a numerical failure.
+
+Each subpackage defines one ``XxxError`` of its own (e.g. ``tdcm_ros.model.ModelError``) and
+its specific errors derive from it and from one of the categories.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class TdcmError(Exception):
+    """Root of every error raised on purpose by tdcm_ros."""
+
+    kind: str = "error"
+    exit_code: int = 1
+
+
+class InputError(TdcmError, ValueError):
+    """Bad input: names the parameter, the value and the allowed range."""
+
+    kind = "input"
+    exit_code = 2
+
+    def __init__(self, message: str, *, parameter: str | None = None, value: Any = None,
+                 allowed: str | None = None) -> None:
+        super().__init__(message)
+        self.parameter = parameter
+        self.value = value
+        self.allowed = allowed
+
+
+class PhysicsError(TdcmError):
+    """A physical limit of the model was reached, or the numerics did not converge."""
+
+    kind = "physics"
+    exit_code = 3
+
+
+def out_of_range(parameter: str, value: Any, allowed: str, *, unit: str = "",
+                 error: type[InputError] = InputError) -> InputError:
+    """Build an :class:`InputError` (or subclass) with the standard one-line message."""
+    shown = f"{value!r} {unit}".rstrip()
+    return error(f"{parameter} = {shown} is out of range; allowed: {allowed}",
+                 parameter=parameter, value=value, allowed=allowed)
