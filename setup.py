@@ -1,0 +1,44 @@
+"""ament_python package setup; also a plain ``pip install`` on machines without ROS."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+PACKAGE = "tdcm_ros"
+
+setup(
+    name=PACKAGE,
+    version="0.1.0",
+    packages=find_packages(exclude=["test", "test.*", "bench"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
+        (f"share/{PACKAGE}", ["package.xml"]),
+        (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
+        (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+    ],
+    package_data={PACKAGE: ["py.typed"]},
+    include_package_data=True,
+    python_requires=">=3.10",
+    install_requires=[
+        "numpy>=1.24",
+        "scipy>=1.10",
+        "rosbags>=0.10.4",
+        "mcap>=1.1",
+        "PyYAML>=6",
+    ],
+    extras_require={
+        "plot": ["matplotlib>=3.7"],
+        "test": ["pytest>=7", "hypothesis>=6.80", "ruff>=0.5", "matplotlib>=3.7"],
+    },
+    zip_safe=True,
+    maintainer="tdcm_ros developers",
+    maintainer_email="dev@tdcm.invalid",
+    description="Shape estimation of notched tendon-driven continuum manipulators, with ROS 2 nodes.",
+    license="Apache-2.0",
+    tests_require=["pytest"],
+    entry_points={
+        "console_scripts": [
+            "tdcm = tdcm_ros.cli.main:main",
+        ],
+    },
+)

@@ -1,0 +1,1 @@
+"""The ``tdcm`` command line: thin shells over library functions."""
