@@ -1,0 +1,32 @@
+"""One message model for every carrier: the rosbags Jazzy typestore plus ``msg_defs/``.
+
+``serialize``/``deserialize`` move CDR bytes; ``type_hash`` gives the REP-2016 RIHS01 hash
+that rmw_zenoh puts in its key expressions.
+"""
+
+from tdcm_ros.bagio.convert import from_dict, to_dict
+from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio.typestore import (
+    deserialize,
+    message_definition,
+    msg_class,
+    normalize_type_name,
+    serialize,
+    type_hash,
+    type_name_of,
+    typestore,
+)
+
+__all__ = [
+    "BagError",
+    "deserialize",
+    "from_dict",
+    "message_definition",
+    "msg_class",
+    "normalize_type_name",
+    "serialize",
+    "to_dict",
+    "type_hash",
+    "type_name_of",
+    "typestore",
+]

@@ -1,0 +1,107 @@
+"""The one message model: the ``rosbags`` Jazzy typestore plus the ``.msg`` files of ``msg_defs/``.
+
+Every carrier (bags, the zenoh runtime, the rclpy adapter) moves the CDR bytes produced here.
+``msg_defs`` is searched, in order, in the directories of ``TDCM_MSG_DEFS`` (``os.pathsep``
+separated), the source checkout (``<repo>/msg_defs``) and ``<prefix>/share/tdcm_ros/msg_defs``;
+each holds ``<pkg>/msg/<Name>.msg``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys.store import Typestore
+
+from tdcm_ros.bagio.errors import BagError
+
+STORE = Stores.ROS2_JAZZY
+MSG_DEFS_ENV = "TDCM_MSG_DEFS"
+
+
+def msg_defs_dirs() -> list[Path]:
+    """Existing ``msg_defs`` directories, in search order."""
+    candidates = [Path(p) for p in os.environ.get(MSG_DEFS_ENV, "").split(os.pathsep) if p]
+    candidates.append(Path(__file__).resolve().parents[2] / "msg_defs")
+    candidates.append(Path(sys.prefix) / "share" / "tdcm_ros" / "msg_defs")
+    return [p for p in candidates if p.is_dir()]
+
+
+def _msg_files() -> dict[str, Path]:
+    """Type name -> ``.msg`` file; the first directory that defines a type wins."""
+    found: dict[str, Path] = {}
+    for root in msg_defs_dirs():
+        for path in sorted(root.glob("*/msg/*.msg")):
+            found.setdefault(f"{path.parent.parent.name}/msg/{path.stem}", path)
+    return found
+
+
+@cache
+def typestore() -> Typestore:
+    """The process-wide typestore: Jazzy plus every ``msg_defs`` type, built once."""
+    store = get_typestore(STORE)
+    types: dict[str, Any] = {}
+    for name, path in _msg_files().items():
+        try:
+            types.update(get_types_from_msg(path.read_text(encoding="utf-8"), name))
+        except Exception as error:  # rosbags raises several parser error types
+            raise BagError(f"cannot parse message definition {path}: {error}") from error
+    store.register(types)
+    return store
+
+
+def _check(type_name: str) -> str:
+    if type_name not in typestore().types:
+        raise BagError(f"unknown message type {type_name!r}; expected 'pkg/msg/Name' from the "
+                       f"Jazzy typestore or msg_defs/")
+    return type_name
+
+
+def normalize_type_name(type_name: str) -> str:
+    """Accept ``pkg/msg/Name`` or ``pkg/Name``; return the canonical ``pkg/msg/Name``."""
+    parts = type_name.strip().split("/")
+    if len(parts) == 2:
+        parts = [parts[0], "msg", parts[1]]
+    return _check("/".join(parts))
+
+
+def msg_class(type_name: str) -> type:
+    """The rosbags message class of ``type_name``."""
+    return typestore().types[normalize_type_name(type_name)]
+
+
+def type_name_of(message: Any) -> str:
+    """The ``pkg/msg/Name`` of a rosbags message object."""
+    return _check(str(message.__msgtype__))
+
+
+def serialize(message: Any, type_name: str | None = None) -> bytes:
+    """CDR bytes (little endian, with the 4-byte encapsulation header) of ``message``."""
+    name = normalize_type_name(type_name) if type_name else type_name_of(message)
+    try:
+        return bytes(typestore().serialize_cdr(message, name))
+    except Exception as error:  # rosbags raises struct/attribute/serde errors
+        raise BagError(f"cannot serialise {type(message).__name__} as {name}: {error}") from error
+
+
+def deserialize(data: bytes | memoryview, type_name: str) -> Any:
+    """The rosbags message decoded from CDR ``data`` of type ``type_name``."""
+    name = normalize_type_name(type_name)
+    try:
+        return typestore().deserialize_cdr(data, name)
+    except Exception as error:  # truncated or mistyped payloads raise several error types
+        raise BagError(f"cannot deserialise {len(data)} bytes as {name}: {error}") from error
+
+
+def type_hash(type_name: str) -> str:
+    """The REP-2016 type hash, ``RIHS01_<64 hex digits>``."""
+    return typestore().hash_rihs01(normalize_type_name(type_name))
+
+
+def message_definition(type_name: str) -> str:
+    """The concatenated ``.msg`` definition text (as stored in bags) of ``type_name``."""
+    return typestore().generate_msgdef(normalize_type_name(type_name))[0]
