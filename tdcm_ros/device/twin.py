@@ -1,0 +1,219 @@
+"""Device twin: the firmware's logic (:class:`~tdcm_ros.device.core.TensionCore`) on a simulated
+bench (:class:`~tdcm_ros.device.plant.Plant`), served behind a real pty.
+
+:class:`DeviceTwin` has no I/O and runs in simulated time (1 ms steps). :class:`PtyTwin` puts it
+behind ``os.openpty``: either pumped by the caller (:meth:`PtyTwin.pump`, lock-step tests) or by
+its own thread (:meth:`PtyTwin.start`) at ``speed`` times real time. Command line::
+
+    python -m tdcm_ros.device.twin --print-port [--link PATH] [--speed 1.0] [--stiffness 2000]
+
+prints the port path (the symlink if ``--link`` is given) on stdout and serves until SIGINT or
+SIGTERM.
+"""
+
+from __future__ import annotations
+
+import argparse
+import errno
+import os
+import select
+import signal
+import sys
+import threading
+import time
+import tty
+from collections.abc import Sequence
+from dataclasses import fields
+from typing import Self
+
+from tdcm_ros.device.core import TensionCore, pack_calibration
+from tdcm_ros.device.errors import DeviceInputError
+from tdcm_ros.device.plant import Plant, PlantConfig
+from tdcm_ros.errors import out_of_range
+
+
+class DeviceTwin:
+    """Firmware core + plant in simulated time; ``output`` collects the bytes it sends.
+
+    The EEPROM starts with a calibration matching the plant's load cell unless ``storage``
+    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given.
+    """
+
+    def __init__(self, plant: PlantConfig | None = None, *, cell: str = "TWIN",
+                 storage: bytearray | None = None) -> None:
+        self.plant = Plant(plant or PlantConfig())
+        cfg = self.plant.config
+        self.storage = storage if storage is not None else bytearray(
+            pack_calibration(cfg.tare_counts, cfg.scale_mcpn))
+        self.output = bytearray()
+        self.core = TensionCore(self.storage, cell=cell, send=self.output.extend)
+        self.now_ms = 0
+        self._next_sample_ms = 0.0
+        self.core.boot(self.now_ms)
+
+    @property
+    def time(self) -> float:
+        """Simulated time, in s."""
+        return self.now_ms / 1000
+
+    def receive(self, data: bytes) -> None:
+        """Bytes from the host arrive now."""
+        self.core.receive(data, self.now_ms)
+
+    def advance(self, seconds: float) -> None:
+        """Run the bench and the firmware for ``seconds`` of simulated time (1 ms steps)."""
+        period_ms = self.plant.config.sample_period * 1000
+        for _ in range(round(seconds * 1000)):
+            self.now_ms += 1
+            self.plant.step(self.core.pulse_us, 0.001)
+            if self.now_ms >= self._next_sample_ms:
+                self._next_sample_ms += period_ms
+                self.core.sample(self.plant.read_counts(), self.now_ms)
+            self.core.tick(self.now_ms)
+
+    def take_output(self) -> bytes:
+        """Bytes sent since the last call."""
+        data = bytes(self.output)
+        self.output.clear()
+        return data
+
+
+class PtyTwin:
+    """A :class:`DeviceTwin` behind a pty; :attr:`port` is the path a host opens.
+
+    With ``link`` the port is a symlink to the current pty, kept pointing at the new one by
+    :meth:`reopen` (a cable pulled and plugged back). Bytes the twin sends while nobody reads
+    are dropped once the pty buffer is full, as a UART would.
+    """
+
+    def __init__(self, twin: DeviceTwin, *, speed: float = 1.0, link: str | None = None) -> None:
+        if not speed > 0:
+            raise out_of_range("speed", speed, "> 0", error=DeviceInputError)
+        self.twin = twin
+        self.speed = speed
+        self.link = link
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._master = -1
+        self._slave = -1
+        self.pty_path = ""
+        self._open()
+
+    @property
+    def port(self) -> str:
+        """Path to open: the symlink if one was asked for, else the pty itself."""
+        return self.link or self.pty_path
+
+    def _open(self) -> None:
+        self._master, self._slave = os.openpty()
+        tty.setraw(self._slave)  # no echo, no line editing before the host configures it
+        os.set_blocking(self._master, False)
+        self.pty_path = os.ttyname(self._slave)
+        if self.link:
+            temporary = f"{self.link}.{os.getpid()}.tmp"
+            os.symlink(self.pty_path, temporary)
+            os.replace(temporary, self.link)
+
+    def _close_fds(self) -> None:
+        for fd in (self._master, self._slave):
+            if fd >= 0:
+                os.close(fd)
+        self._master = self._slave = -1
+
+    def reopen(self) -> None:
+        """Close the pty (the host's reads fail) and open a new one behind the same link."""
+        with self._lock:
+            self._close_fds()
+            self._open()
+
+    def _exchange(self) -> None:
+        try:
+            data = os.read(self._master, 4096)
+        except BlockingIOError:
+            data = b""
+        if data:
+            self.twin.receive(data)
+
+    def _flush(self) -> None:
+        out = self.twin.take_output()
+        try:
+            os.write(self._master, out)
+        except BlockingIOError:
+            return  # nobody reading: the bytes are lost, as on a real UART
+        except OSError as error:
+            if error.errno != errno.EIO:
+                raise
+
+    def pump(self, seconds: float) -> None:
+        """Lock-step use: take the host's bytes, run ``seconds`` of simulated time, send output."""
+        with self._lock:
+            self._exchange()
+            self.twin.advance(seconds)
+            self._flush()
+
+    def _run(self) -> None:
+        start_wall, start_sim = time.monotonic(), self.twin.time
+        while not self._stop.is_set():
+            select.select([self._master], [], [], 0.002)
+            due = start_sim + (time.monotonic() - start_wall) * self.speed
+            with self._lock:
+                self._exchange()
+                self.twin.advance(max(0.0, due - self.twin.time))
+                self._flush()
+
+    def start(self) -> Self:
+        """Serve from a daemon thread at ``speed`` times real time."""
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name="tdcm-twin", daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        """Stop the thread (if any), close the pty and remove the link."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        with self._lock:
+            self._close_fds()
+        if self.link and os.path.islink(self.link):
+            os.unlink(self.link)
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m tdcm_ros.device.twin",
+                                     description="Serve the tension device twin on a pty.")
+    parser.add_argument("--print-port", action="store_true", help="print the port path on stdout")
+    parser.add_argument("--link", help="also expose the pty as this symlink")
+    parser.add_argument("--speed", type=float, default=1.0, help="simulated / real time")
+    for field in fields(PlantConfig):
+        parser.add_argument(f"--{field.name.replace('_', '-')}", type=type(field.default),
+                            default=field.default, help=f"plant {field.name} (SI)")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """CLI entry: serve until SIGINT/SIGTERM."""
+    args = _parser().parse_args(argv)
+    plant = PlantConfig(**{f.name: getattr(args, f.name) for f in fields(PlantConfig)})
+    server = PtyTwin(DeviceTwin(plant), speed=args.speed, link=args.link)
+    done = threading.Event()
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, lambda *_: done.set())
+    server.start()
+    if args.print_port:
+        print(server.port, flush=True)
+    done.wait()
+    server.stop()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
