@@ -1,0 +1,48 @@
+"""ROS-free physics of the notched TD-CM (never imports rclpy).
+
+Typical use::
+
+    from tdcm_ros.model import preset, solve
+    result = solve(preset("paper-experiment"), 20.0)
+    result.tip_position  # m, frame tdcm_base
+"""
+
+from tdcm_ros.model.design import FIELD_SPECS, PRESETS, Design, FieldSpec, parse_field, preset
+from tdcm_ros.model.errors import (
+    ConvergenceError,
+    InvalidDesignError,
+    InvalidSettingsError,
+    ModelError,
+    ModelLimitError,
+    NotchClosureError,
+    TendonSingularityError,
+    TensionRangeError,
+)
+from tdcm_ros.model.profiles import CircularProfile, CustomProfile, RectangularProfile
+from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
+
+__all__ = [
+    "DEFAULT_SETTINGS",
+    "FIELD_SPECS",
+    "PRESETS",
+    "CircularProfile",
+    "ConvergenceError",
+    "CustomProfile",
+    "Design",
+    "FieldSpec",
+    "InvalidDesignError",
+    "InvalidSettingsError",
+    "ModelError",
+    "ModelLimitError",
+    "NotchClosureError",
+    "RectangularProfile",
+    "SolveResult",
+    "SolverSettings",
+    "TendonSingularityError",
+    "TensionRangeError",
+    "parse_field",
+    "preset",
+    "solve",
+]

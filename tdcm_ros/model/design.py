@@ -1,0 +1,191 @@
+"""The TD-CM design: every geometric and material parameter of the paper, in SI units.
+
+Geometry (eq. 1): ``L = w_base + N w_n + (N-1) w_t + w_tip``; notch ``i`` (1-based) spans
+``[l_i, r_i]`` with ``l_i = w_base + (i-1)(w_n + w_t)`` and ``r_i = l_i + w_n``.
+
+``E`` defaults to 1.85 GPa (Formlabs Nylon 12 powder datasheet, tensile modulus). Thin SLS
+features are often softer: treat ``E`` as a calibration parameter (``tdcm calibrate``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.profiles import CircularProfile, NotchProfile, profile_from_name
+from tdcm_ros.model.section import tube_moment
+
+MM = 1e-3
+
+
+@dataclass(frozen=True)
+class FieldSpec:
+    """Unit, meaning and allowed range of one numeric design field."""
+
+    name: str
+    unit: str
+    description: str
+    low: float
+    high: float
+    low_inclusive: bool
+    integer: bool = False
+
+    def allowed(self) -> str:
+        """The allowed range as text, e.g. ``(0, 1] m``."""
+        bracket = "[" if self.low_inclusive else "("
+        return f"{bracket}{self.low:g}, {self.high:g}] {self.unit}".rstrip()
+
+    def check(self, value: Any) -> None:
+        """Raise :class:`InvalidDesignError` unless ``value`` is a finite number in range."""
+        if self.integer:
+            ok_type = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+        else:
+            ok_type = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+                value, bool
+            )
+        if not ok_type:
+            kind = "an integer" if self.integer else "a number"
+            raise InvalidDesignError(
+                f"{self.name} = {value!r} is not {kind}; allowed: {self.allowed()}",
+                parameter=self.name, value=value, allowed=self.allowed(),
+            )
+        v = float(value)
+        below = v < self.low if self.low_inclusive else v <= self.low
+        if not math.isfinite(v) or below or v > self.high:
+            raise out_of_range(self.name, value, self.allowed(), unit="", error=InvalidDesignError)
+
+
+FIELD_SPECS: dict[str, FieldSpec] = {
+    spec.name: spec
+    for spec in (
+        FieldSpec("w_base", "m", "length of the proximal tube segment", 0.0, 1.0, True),
+        FieldSpec("w_tip", "m", "length of the distal tube segment", 0.0, 1.0, True),
+        FieldSpec("w_n", "m", "notch width along the body", 0.0, 1.0, False),
+        FieldSpec("w_t", "m", "tube length between adjacent notches", 0.0, 1.0, True),
+        FieldSpec("w_d", "m", "backbone width (minimum, at the notch centre)", 0.0, 1.0, False),
+        FieldSpec("N", "", "number of notches", 1, 1000, True, integer=True),
+        FieldSpec("R_outer", "m", "outer radius of the tube", 0.0, 0.5, False),
+        FieldSpec("r_inner", "m", "inner radius of the tube (0 for a solid rod)", 0.0, 0.5, True),
+        FieldSpec("R_c", "m", "tendon offset from the midline, on the +x side", 0.0, 0.5, False),
+        FieldSpec("E", "Pa", "Young's modulus (calibration parameter)", 0.0, 1e12, False),
+    )
+}
+
+
+@dataclass(frozen=True)
+class Design:
+    """A notched TD-CM design in SI units (m, Pa), validated on construction."""
+
+    w_base: float
+    w_tip: float
+    w_n: float
+    w_t: float
+    w_d: float
+    N: int
+    R_outer: float
+    r_inner: float
+    R_c: float
+    E: float = 1.85e9
+    profile: NotchProfile = field(default_factory=CircularProfile)
+
+    def __post_init__(self) -> None:
+        for spec in FIELD_SPECS.values():
+            spec.check(getattr(self, spec.name))
+        if self.r_inner >= self.R_outer:
+            raise out_of_range("r_inner", self.r_inner, f"[0, R_outer = {self.R_outer:g}) m",
+                               error=InvalidDesignError)
+        if not hasattr(self.profile, "h1"):
+            raise InvalidDesignError(
+                f"profile = {self.profile!r} is not a notch profile; allowed: circular, "
+                "rectangular, or CustomProfile(h1)", parameter="profile", value=self.profile,
+                allowed="circular | rectangular | CustomProfile")
+        object.__setattr__(self, "N", int(self.N))
+        for name in FIELD_SPECS:
+            if name != "N":
+                object.__setattr__(self, name, float(getattr(self, name)))
+
+    @property
+    def length(self) -> float:
+        """Total length ``L`` (m), eq. 1."""
+        return self.w_base + self.N * self.w_n + (self.N - 1) * self.w_t + self.w_tip
+
+    def notch_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Arrays ``(l, r)`` (m) of notch start and end arc lengths, eq. 1."""
+        i = np.arange(self.N, dtype=float)
+        left = self.w_base + i * (self.w_n + self.w_t)
+        return left, left + self.w_n
+
+    @property
+    def tube_second_moment(self) -> float:
+        """``I0`` of the uncut tube (m^4)."""
+        return tube_moment(self.R_outer, self.r_inner)
+
+    def with_overrides(self, **overrides: Any) -> Design:
+        """A copy with fields replaced (validated); unknown names raise :class:`InvalidDesignError`."""
+        known = {f.name for f in fields(self)}
+        for name in overrides:
+            if name not in known:
+                raise InvalidDesignError(
+                    f"unknown design field {name!r}; allowed: {', '.join(sorted(known))}",
+                    parameter=name, value=overrides[name], allowed=", ".join(sorted(known)))
+        if isinstance(overrides.get("profile"), str):
+            overrides["profile"] = profile_from_name(overrides["profile"])
+        return replace(self, **overrides)
+
+    def to_dict(self) -> dict[str, Any]:
+        """All fields in SI units, plus the derived length ``L``; the profile by name."""
+        data = {k: v for k, v in asdict(self).items() if k != "profile"}
+        data["profile"] = self.profile.name
+        data["L"] = self.length
+        return data
+
+
+def parse_field(name: str, text: str) -> Any:
+    """Parse a ``NAME=VALUE`` override value from text in SI units (``N`` as an integer)."""
+    if name == "profile":
+        return text
+    spec = FIELD_SPECS.get(name)
+    if spec is None:
+        allowed = ", ".join([*FIELD_SPECS, "profile"])
+        raise InvalidDesignError(f"unknown design field {name!r}; allowed: {allowed}",
+                                 parameter=name, value=text, allowed=allowed)
+    try:
+        return int(text) if spec.integer else float(text)
+    except ValueError as exc:
+        raise InvalidDesignError(f"{name} = {text!r} is not a number; allowed: {spec.allowed()}",
+                                 parameter=name, value=text, allowed=spec.allowed()) from exc
+
+
+def _simulation_design(w_n_mm: float, w_d_mm: float) -> Design:
+    """Sec. III-A designs: L = 53 mm, w_base = 5, N = 8, w_t = w_tip = 6 - w_n (mm)."""
+    w_t = 6.0 - w_n_mm
+    return Design(w_base=5 * MM, w_tip=w_t * MM, w_n=w_n_mm * MM, w_t=w_t * MM, w_d=w_d_mm * MM,
+                  N=8, R_outer=3.92 * MM, r_inner=1.55 * MM, R_c=2.75 * MM)
+
+
+PRESETS: dict[str, Design] = {
+    "paper-experiment": Design(w_base=5 * MM, w_tip=4 * MM, w_n=2 * MM, w_t=4 * MM, w_d=1.4 * MM,
+                               N=8, R_outer=3.92 * MM, r_inner=1.55 * MM, R_c=2.75 * MM),
+    "fig2-wn-1": _simulation_design(1.0, 1.5),
+    "fig2-wn-1.9": _simulation_design(1.9, 1.5),
+    "fig2-wn-2.5": _simulation_design(2.5, 1.5),
+    "fig3-wd-1.2": _simulation_design(1.5, 1.2),
+    "fig3-wd-1.52": _simulation_design(1.5, 1.52),
+    "fig3-wd-2": _simulation_design(1.5, 2.0),
+}
+
+
+def preset(name: str) -> Design:
+    """A named design: ``paper-experiment`` (Sec. III-B) or a Sec. III-A figure design."""
+    try:
+        return PRESETS[name]
+    except KeyError:
+        raise InvalidDesignError(
+            f"unknown design preset {name!r}; allowed: {', '.join(PRESETS)}",
+            parameter="design", value=name, allowed=", ".join(PRESETS)) from None

@@ -1,0 +1,87 @@
+"""Physical limits of the model, checked explicitly so they surface as typed errors."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.errors import NotchClosureError, TendonSingularityError, TensionRangeError
+from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.kinematics import PlanarShape
+
+Array = NDArray[np.float64]
+
+
+def check_tension(tension: Any) -> float:
+    """Return ``tension`` (N) as a float, or raise :class:`TensionRangeError`."""
+    try:
+        value = float(tension)
+    except (TypeError, ValueError) as exc:
+        raise TensionRangeError(f"tension = {tension!r} is not a number; allowed: [0, inf) N",
+                                parameter="tension", value=tension, allowed="[0, inf) N") from exc
+    if not math.isfinite(value) or value < 0.0:
+        raise out_of_range("tension", value, "[0, inf) N (finite)", unit="N",
+                           error=TensionRangeError)
+    return value
+
+
+def check_singularity(grid: Grid, m_a: Array, m_b: Array) -> None:
+    """Raise :class:`TendonSingularityError` where the tendon follows the offset curve and
+    ``R_c * kappa`` reaches 1 (the curve ``p + R_c x_b`` cusps). ``kappa`` uses each cell's
+    peak compliance, so the check is pointwise, not a cell average."""
+    cells = grid.constrained_cells
+    if cells.size == 0:
+        return
+    moment = np.maximum(np.abs(m_a[cells]), np.abs(m_b[cells]))
+    rc_kappa = grid.design.R_c * moment * grid.peak_c[cells]
+    worst = int(np.argmax(rc_kappa))
+    if rc_kappa[worst] >= 1.0:
+        s = float(grid.peak_s[cells[worst]])
+        raise TendonSingularityError(
+            f"tendon-offset singularity: R_c*kappa = {rc_kappa[worst]:.3g} >= 1 at s = "
+            f"{s * 1e3:.3f} mm (the tendon path cusps); lower the tension or stiffen the notch",
+            arc_length_m=s, rc_kappa=float(rc_kappa[worst]))
+
+
+def notch_gaps(grid: Grid, shape: PlanarShape) -> Array:
+    """Smallest gap (m) between the two faces of every notch, on either side of the body.
+
+    The faces are the planes normal to the tangent at ``l_i`` and ``r_i``; the gap is the
+    signed distance of each face's outer corner (at ``R_outer``) from the other face.
+    """
+    left, right = grid.notch_left_node, grid.notch_right_node
+    t_l, t_r = shape.tangent[left], shape.tangent[right]
+    span = shape.p[right] - shape.p[left]
+    gaps = []
+    for side in (1.0, -1.0):
+        corner_offset = (1j * side * grid.design.R_outer) * (t_r - t_l)
+        delta = span + corner_offset
+        gaps.append((np.conj(t_l) * delta).real)
+        gaps.append((np.conj(t_r) * delta).real)
+    return np.minimum(np.minimum(gaps[0], gaps[1]), np.minimum(gaps[2], gaps[3]))
+
+
+def check_tendon_singularity(grid: Grid, tension: float) -> None:
+    """:func:`check_singularity` for the tendon's own moment ``R_c T`` (exact for the closed
+    form on the offset curve), in O(1) from the grid's peak compliance."""
+    if grid.constrained_cells.size == 0:
+        return
+    rc_kappa = grid.design.R_c ** 2 * tension * grid.constrained_peak_c
+    if rc_kappa >= 1.0:
+        moment = np.full(grid.n_cells, grid.design.R_c * tension)
+        check_singularity(grid, moment, moment)
+
+
+def check_closure(grid: Grid, shape: PlanarShape, tension: float) -> None:
+    """Raise :class:`NotchClosureError` if any notch's faces touch or overlap."""
+    gaps = notch_gaps(grid, shape)
+    worst = int(np.argmin(gaps))
+    if gaps[worst] <= 0.0:
+        raise NotchClosureError(
+            f"notch {worst + 1} closes at tension {tension:g} N (face gap {gaps[worst] * 1e3:.3f}"
+            " mm): its faces touch, which the base model does not include",
+            notch=worst + 1, gap_m=float(gaps[worst]))

@@ -1,0 +1,130 @@
+"""The solution of one solve: midline poses along ``s`` in frame ``tdcm_base`` (SI units)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.model.design import Design
+from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.kinematics import quaternions_y
+from tdcm_ros.model.settings import SolverSettings
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class SolveResult:
+    """Shape of the midline for one tension.
+
+    Node arrays (one entry per cell boundary, base to tip): ``s`` (m), ``positions`` (n, 3) m,
+    ``theta`` (rad, about +y), ``quaternions`` (n, 4) as ``(x, y, z, w)``. ``cell_moments``
+    (cells, 2) holds each cell's end moments (N m), the fixed point of Algorithm 1.
+    """
+
+    design: Design
+    settings: SolverSettings
+    tension_n: float
+    s: Array
+    positions: Array
+    theta: Array
+    cell_moments: Array
+    iterations: int
+    residual_history: tuple[float, ...]
+    converged: bool
+    strategy: str
+    solve_time_s: float
+    grid: Grid = field(repr=False)
+
+    @property
+    def curvature_profile(self) -> tuple[Array, Array]:
+        """``(s, kappa)``: curvature (1/m) inside every cell and one-sidedly at its ends (m),
+        so the jumps at ``l_i`` and ``r_i`` show."""
+        grid = self.grid
+        m_a = self.cell_moments[:, 0:1]
+        m_b = self.cell_moments[:, 1:2]
+        m_q = m_a * (1.0 - grid.xi_q) + m_b * grid.xi_q
+        s = np.concatenate([grid.s_nodes[:-1, None], grid.s_q, grid.s_nodes[1:, None]], axis=1)
+        kappa = np.concatenate([m_a * grid.c_start[:, None], m_q * grid.c_q,
+                                m_b * grid.c_end[:, None]], axis=1)
+        return s.ravel(), kappa.ravel()
+
+    @property
+    def quaternions(self) -> Array:
+        """Orientation of the body frame at each node, ``(x, y, z, w)``."""
+        return quaternions_y(self.theta)
+
+    @property
+    def tip_position(self) -> Array:
+        """Tip position ``(x, y, z)`` (m)."""
+        return self.positions[-1]
+
+    @property
+    def tip_quaternion(self) -> Array:
+        """Tip orientation ``(x, y, z, w)``."""
+        return self.quaternions[-1]
+
+    @property
+    def tip_angle_rad(self) -> float:
+        """Tip tangent angle from +z toward +x (rad)."""
+        return float(self.theta[-1])
+
+    @property
+    def tip_deflection_m(self) -> float:
+        """Distance of the tip from the undeformed axis (+z) (m)."""
+        return float(np.hypot(self.positions[-1, 0], self.positions[-1, 1]))
+
+    @property
+    def tip_displacement_m(self) -> float:
+        """Distance of the tip from the unloaded tip ``(0, 0, L)`` (m)."""
+        unloaded = np.array([0.0, 0.0, self.design.length])
+        return float(np.linalg.norm(self.positions[-1] - unloaded))
+
+    def pose_at(self, s: Any) -> tuple[Array, Array]:
+        """Positions (k, 3) m and quaternions (k, 4) at arc lengths ``s`` (m) in ``[0, L]``.
+
+        Exact within the solution's moment field: each query integrates eq. 2 from the start
+        of its cell with the same quadrature as the solve.
+        """
+        from tdcm_ros.errors import out_of_range
+
+        query = np.atleast_1d(np.asarray(s, dtype=float))
+        length = self.design.length
+        if not np.all(np.isfinite(query)) or np.any(query < 0.0) or np.any(query > length):
+            raise out_of_range("s", query.tolist(), f"[0, {length:g}] m")
+        grid = self.grid
+        cells = np.clip(np.searchsorted(grid.s_nodes, query, side="right") - 1, 0,
+                        grid.n_cells - 1)
+        m_a = self.cell_moments[cells, 0]
+        m_b = self.cell_moments[cells, 1]
+        a0_s, a1_s, a0_r, a1_r, w_r = grid.partial_integrals(cells, query)
+        phi_r = m_a[:, None] * a0_r + m_b[:, None] * a1_r
+        along = np.sum(w_r * np.cos(phi_r), axis=1)
+        across = np.sum(w_r * np.sin(phi_r), axis=1)
+        theta_a = self.theta[cells]
+        x = self.positions[cells, 0] + along * np.sin(theta_a) + across * np.cos(theta_a)
+        z = self.positions[cells, 2] + along * np.cos(theta_a) - across * np.sin(theta_a)
+        theta = theta_a + m_a * a0_s + m_b * a1_s
+        positions = np.stack([x, np.zeros_like(x), z], axis=1)
+        return positions, quaternions_y(theta)
+
+    def summary(self) -> dict[str, Any]:
+        """The JSON-ready summary used by ``tdcm solve --json`` (SI units)."""
+        return {
+            "converged": self.converged,
+            "iterations": self.iterations,
+            "strategy": self.strategy,
+            "tension_n": self.tension_n,
+            "tip_position_m": self.tip_position.tolist(),
+            "tip_quaternion_xyzw": self.tip_quaternion.tolist(),
+            "tip_angle_rad": self.tip_angle_rad,
+            "tip_deflection_m": self.tip_deflection_m,
+            "tip_displacement_m": self.tip_displacement_m,
+            "solve_time_s": self.solve_time_s,
+            "residual_history_m": list(self.residual_history),
+            "design": self.design.to_dict(),
+            "settings": self.settings.to_dict(),
+        }

@@ -1,0 +1,44 @@
+"""Second moment of area of the notched tube (eq. 12), in closed form.
+
+Inside a notch the section is the annulus ``r_inner <= rho <= R_outer`` restricted to
+``|y| <= h1``, where ``y`` is the distance from the neutral axis in the bending direction;
+the hole is removed only up to ``h2 = min(h1, r_inner)`` (eq. 13's clipping). Outside the
+notches ``I0 = pi/4 (R_outer^4 - r_inner^4)``. All lengths in m, ``I`` in m^4.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Array = NDArray[np.float64]
+
+
+def disc_strip_moment(h: ArrayLike, radius: float) -> Array:
+    """``J(h) = integral_0^h y^2 sqrt(radius^2 - y^2) dy`` with ``h`` clipped to [0, radius] (m^4).
+
+    Closed form: ``(h/8)(2h^2 - R^2) sqrt(R^2 - h^2) + (R^4/8) asin(h/R)``.
+    """
+    if radius <= 0.0:
+        return np.zeros_like(np.asarray(h, dtype=float))
+    hc = np.clip(np.asarray(h, dtype=float), 0.0, radius)
+    root = np.sqrt(np.maximum(radius * radius - hc * hc, 0.0))
+    return (hc / 8.0) * (2.0 * hc * hc - radius * radius) * root + (radius**4 / 8.0) * np.arcsin(
+        hc / radius
+    )
+
+
+def notched_moment(h1: ArrayLike, r_outer: float, r_inner: float) -> Array:
+    """Eq. 12 inside a notch: ``4 [J(h1, R_outer) - J(h2, r_inner)]``, ``h2 = min(h1, r_inner)`` (m^4).
+
+    For ``h1 >= R_outer`` nothing is removed and the result equals :func:`tube_moment`.
+    """
+    h1a = np.asarray(h1, dtype=float)
+    h2 = np.minimum(h1a, r_inner)
+    return 4.0 * (disc_strip_moment(h1a, r_outer) - disc_strip_moment(h2, r_inner))
+
+
+def tube_moment(r_outer: float, r_inner: float) -> float:
+    """Eq. 12 outside notches: ``pi/4 (R_outer^4 - r_inner^4)`` (m^4)."""
+    return float(np.pi / 4.0 * (r_outer**4 - r_inner**4))
+

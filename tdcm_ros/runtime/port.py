@@ -1,0 +1,118 @@
+"""The runtime port: the only interface node logic uses to talk to the world.
+
+A node is a :class:`NodeLogic` subclass. Its constructor receives a :class:`NodePort` and
+declares parameters, publishers, subscriptions and timers through it; it never imports rclpy or
+zenoh. The same class runs on the zenoh runtime (no ROS) or the rclpy runtime (ROS 2 Jazzy)::
+
+    class Talker(NodeLogic):
+        default_name = "talker"
+
+        def __init__(self, port: NodePort) -> None:
+            super().__init__(port)
+            self.period = port.declare_parameter("period", 0.5, description="s", range=(1e-3, 60))
+            self.pub = port.create_publisher("chatter", "std_msgs/msg/String", QoS(depth=10))
+            port.create_timer(self.period, self.tick)
+
+Messages are rosbags objects (:mod:`tdcm_ros.bagio`); both runtimes carry their CDR bytes.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, ClassVar, Literal, Protocol
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.parameters import ParamValue, SetCallback, Validator
+
+Reliability = Literal["reliable", "best_effort"]
+Durability = Literal["volatile", "transient_local"]
+
+
+@dataclass(frozen=True)
+class QoS:
+    """Keep-last QoS of an endpoint: history ``depth`` (messages), reliability, durability."""
+
+    depth: int = 10
+    reliability: Reliability = "reliable"
+    durability: Durability = "volatile"
+
+    def __post_init__(self) -> None:
+        if not 1 <= self.depth <= 10_000:
+            raise InputError(f"QoS depth = {self.depth} is out of range; allowed: [1, 10000]",
+                             parameter="depth", value=self.depth, allowed="[1, 10000]")
+        if self.reliability not in ("reliable", "best_effort"):
+            raise InputError(f"QoS reliability = {self.reliability!r} is invalid",
+                             parameter="reliability", value=self.reliability,
+                             allowed="reliable, best_effort")
+        if self.durability not in ("volatile", "transient_local"):
+            raise InputError(f"QoS durability = {self.durability!r} is invalid",
+                             parameter="durability", value=self.durability,
+                             allowed="volatile, transient_local")
+
+
+class Publisher(Protocol):
+    """A declared publisher."""
+
+    topic: str
+    type_name: str
+
+    def publish(self, message: Any) -> None:
+        """Serialise a rosbags message to CDR and send it."""
+
+    def publish_cdr(self, data: bytes) -> None:
+        """Send CDR bytes already serialised for ``type_name``."""
+
+
+class Timer(Protocol):
+    """A periodic timer."""
+
+    def cancel(self) -> None:
+        """Stop the timer; its callback is not called again."""
+
+
+class NodePort(Protocol):
+    """What a runtime offers a node. Callbacks run one at a time, never concurrently."""
+
+    node_name: str
+    namespace: str
+    logger: logging.Logger
+
+    def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
+                          range: tuple[float, float] | None = None,
+                          validator: Validator | None = None,
+                          read_only: bool = False) -> ParamValue:
+        """Declare a parameter; returns its value (YAML override or default), checked."""
+
+    def get_parameter(self, name: str) -> ParamValue:
+        """Current value of a declared parameter."""
+
+    def add_on_set_parameters(self, callback: SetCallback) -> None:
+        """Add a check run on each runtime change ``{name: value}``; raise ``InputError`` to reject."""
+
+    def create_publisher(self, topic: str, type_name: str, qos: QoS = QoS()) -> Publisher:
+        """Declare a publisher; relative topics resolve under the node's namespace."""
+
+    def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
+                            qos: QoS = QoS()) -> None:
+        """Subscribe; ``callback`` receives the deserialised rosbags message."""
+
+    def create_timer(self, period: float, callback: Callable[[], None]) -> Timer:
+        """Call ``callback`` every ``period`` seconds."""
+
+    def now_ns(self) -> int:
+        """Current time of the node's clock, ns since the UNIX epoch."""
+
+
+class NodeLogic:
+    """Base of every transport-agnostic node. Subclasses set ``default_name``."""
+
+    default_name: ClassVar[str] = "node"
+
+    def __init__(self, port: NodePort) -> None:
+        self.port = port
+
+    def close(self) -> None:
+        """Release resources before the runtime shuts down (default: nothing)."""
+

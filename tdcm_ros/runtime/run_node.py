@@ -1,0 +1,140 @@
+"""Run one node class on a chosen runtime; also the ``tdcm_node`` executable.
+
+``python -m tdcm_ros.runtime.run_node tdcm_ros.nodes.talker:Talker --params config.yaml``
+Runtime: ``--runtime`` if not ``auto``, else ``TDCM_RUNTIME`` if set, else rclpy when importable,
+else zenoh. Arguments after ``--ros-args`` go to rclpy unchanged.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import importlib.util
+import logging
+import os
+import signal
+import sys
+from collections.abc import Sequence
+from types import FrameType
+
+from tdcm_ros.errors import InputError, TdcmError
+from tdcm_ros.runtime.names import fully_qualified_node_name
+from tdcm_ros.runtime.params import node_parameters
+from tdcm_ros.runtime.port import NodeLogic
+
+RUNTIMES = ("auto", "zenoh", "rclpy")
+RUNTIME_ENV = "TDCM_RUNTIME"
+
+
+def resolve_runtime(choice: str = "auto") -> str:
+    """``zenoh`` or ``rclpy``: the flag, else ``TDCM_RUNTIME``, else rclpy if importable."""
+    for value, source in ((choice, "--runtime"), (os.environ.get(RUNTIME_ENV, "auto"), RUNTIME_ENV)):
+        if value not in RUNTIMES:
+            raise InputError(f"{source} = {value!r} is invalid; allowed: {', '.join(RUNTIMES)}",
+                             parameter=source, value=value, allowed=", ".join(RUNTIMES))
+        if value != "auto":
+            return value
+    return "rclpy" if importlib.util.find_spec("rclpy") is not None else "zenoh"
+
+
+def load_node_class(target: str) -> type[NodeLogic]:
+    """Import ``package.module:Class`` and check it is a :class:`NodeLogic`."""
+    module_name, _, class_name = target.partition(":")
+    try:
+        node_class = getattr(importlib.import_module(module_name), class_name)
+    except (ImportError, AttributeError, ValueError) as error:
+        raise InputError(f"cannot load node class {target!r}: {error}", parameter="node",
+                         value=target, allowed="package.module:Class") from error
+    if not (isinstance(node_class, type) and issubclass(node_class, NodeLogic)):
+        raise InputError(f"{target!r} is not a NodeLogic subclass", parameter="node", value=target)
+    return node_class
+
+
+def configure_logging(level: str = "INFO") -> None:
+    """ROS-like log lines on stderr: ``[LEVEL] [time] [logger]: message``."""
+    logging.basicConfig(level=level, stream=sys.stderr,
+                        format="[%(levelname)s] [%(created).6f] [%(name)s]: %(message)s")
+
+
+def run_zenoh(node_class: type[NodeLogic], *, name: str, namespace: str = "/",
+              params_file: str | None = None) -> int:
+    """Run ``node_class`` on the zenoh runtime until SIGINT/SIGTERM; returns the exit status."""
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    overrides = node_parameters(params_file, fully_qualified_node_name(namespace, name))
+    context = ZenohContext()
+
+    def stop(signum: int, frame: FrameType | None) -> None:
+        context.request_stop()
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        port = context.create_port(name, namespace, overrides)
+        node = node_class(port)
+        port.logger.info("running on zenoh (domain %d, session %s)", context.domain_id,
+                         context.zid)
+        try:
+            context.spin()
+        finally:
+            node.close()
+    finally:
+        context.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return 0
+
+
+def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file: str | None = None,
+             name: str | None = None, namespace: str = "/",
+             ros_args: Sequence[str] = ()) -> int:
+    """Run ``node_class`` on ``runtime`` (``auto``, ``zenoh`` or ``rclpy``) until shut down."""
+    node_name = name or node_class.default_name
+    chosen = resolve_runtime(runtime)
+    if chosen == "rclpy":
+        from tdcm_ros.runtime.rclpy_runtime import run_rclpy
+
+        return run_rclpy(node_class, name=node_name, namespace=namespace,
+                         params_file=params_file, ros_args=ros_args)
+    return run_zenoh(node_class, name=node_name, namespace=namespace, params_file=params_file)
+
+
+def build_parser(prog: str = "tdcm_node", *, with_target: bool = True) -> argparse.ArgumentParser:
+    """Arguments shared by ``tdcm_node`` and the per-node executables."""
+    parser = argparse.ArgumentParser(prog=prog, description="Run a tdcm_ros node.")
+    if with_target:
+        parser.add_argument("node", help="node class as package.module:Class")
+    parser.add_argument("--name", help="node name (default: the class's default_name)")
+    parser.add_argument("--namespace", default="/", help="node namespace (default /)")
+    parser.add_argument("--params", help="ROS 2 parameter YAML (ros__parameters layout)")
+    parser.add_argument("--runtime", default="auto", choices=RUNTIMES,
+                        help=f"auto: rclpy if importable, else zenoh; env {RUNTIME_ENV}")
+    parser.add_argument("--log-level", default="INFO", help="DEBUG, INFO, WARNING, ERROR")
+    return parser
+
+
+def main_for(node_class: type[NodeLogic] | None, argv: Sequence[str] | None = None) -> int:
+    """Entry point body; ``node_class=None`` takes the class from the command line."""
+    args_in = list(sys.argv[1:] if argv is None else argv)
+    ros_args: list[str] = []
+    if "--ros-args" in args_in:
+        cut = args_in.index("--ros-args")
+        args_in, ros_args = args_in[:cut], args_in[cut:]
+    parser = build_parser(with_target=node_class is None)
+    args = parser.parse_args(args_in)
+    configure_logging(args.log_level)
+    try:
+        target = node_class or load_node_class(args.node)
+        return run_node(target, runtime=args.runtime, params_file=args.params, name=args.name,
+                        namespace=args.namespace, ros_args=ros_args)
+    except TdcmError as error:
+        print(f"{parser.prog}: {error}", file=sys.stderr)
+        return error.exit_code
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``tdcm_node <package.module:Class> [--params FILE] [--runtime R]``."""
+    return main_for(None, argv)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,458 @@
+"""The embedded runtime: node logic on Zenoh, speaking rmw_zenoh's Jazzy conventions.
+
+One :class:`ZenohContext` per process = one zenoh session (peer mode, connected to a router at
+``TDCM_ZENOH_ENDPOINT``, default ``tcp/127.0.0.1:7447``; multicast scouting off, listening on
+loopback only). ``TDCM_ZENOH_CONFIG`` names a zenoh JSON5 config file that replaces these defaults.
+``ROS_DOMAIN_ID`` selects the domain (default 0). Callbacks of every node run one at a time on the
+thread that calls :meth:`ZenohContext.spin`.
+
+Parameters are served on ``@tdcm/<domain>/params/<mangled node fqn>/<get|set|list>`` (JSON);
+:func:`call_parameters` is the client ``tdcm param`` uses.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import json
+import logging
+import os
+import queue
+import threading
+import time
+from collections import deque
+from collections.abc import Callable, Iterator
+from concurrent.futures import Future
+from concurrent.futures import TimeoutError as FutureTimeout
+from dataclasses import dataclass, field
+from typing import Any
+
+import zenoh
+import zenoh.ext
+
+from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize, type_hash
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime import wire
+from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.names import fully_qualified_node_name, normalize_namespace, resolve_topic
+from tdcm_ros.runtime.parameters import ParameterStore, ParamSpec, ParamValue, SetCallback, Validator
+from tdcm_ros.runtime.port import QoS
+
+ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
+CONFIG_ENV = "TDCM_ZENOH_CONFIG"
+DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
+PARAM_SPACE = "@tdcm"
+PARAM_TIMEOUT_S = 5.0
+
+
+def domain_id() -> int:
+    """``ROS_DOMAIN_ID`` (default 0)."""
+    raw = os.environ.get("ROS_DOMAIN_ID", "0") or "0"
+    if not raw.isdigit() or int(raw) > 232:
+        raise InputError(f"ROS_DOMAIN_ID = {raw!r} is out of range; allowed: 0..232",
+                         parameter="ROS_DOMAIN_ID", value=raw, allowed="0..232")
+    return int(raw)
+
+
+def endpoint() -> str:
+    """The router endpoint: ``TDCM_ZENOH_ENDPOINT`` or ``tcp/127.0.0.1:7447``."""
+    return os.environ.get(ENDPOINT_ENV) or DEFAULT_ENDPOINT
+
+
+def session_config(*, mode: str = "peer", router_endpoint: str | None = None) -> zenoh.Config:
+    """Zenoh config: the ``TDCM_ZENOH_CONFIG`` file, else loopback defaults like rmw_zenoh's.
+
+    ``peer``: connect to the router, listen on an ephemeral loopback port. ``router``: listen on
+    the endpoint. Multicast scouting is off; gossip scouting (zenoh's default) finds peers.
+    """
+    path = os.environ.get(CONFIG_ENV)
+    if path:
+        try:
+            return zenoh.Config.from_file(path)
+        except zenoh.ZError as error:
+            raise RuntimePortError(f"cannot load zenoh config {path}: {error}") from error
+    target = router_endpoint or endpoint()
+    config = zenoh.Config()
+    config.insert_json5("mode", json.dumps(mode))
+    config.insert_json5("scouting/multicast/enabled", "false")
+    if mode == "router":
+        config.insert_json5("listen/endpoints", json.dumps([target]))
+    else:
+        config.insert_json5("connect/endpoints", json.dumps([target]))
+        config.insert_json5("listen/endpoints", json.dumps(["tcp/127.0.0.1:0"]))
+    return config
+
+
+def open_session(*, mode: str = "peer", router_endpoint: str | None = None) -> zenoh.Session:
+    """Open a zenoh session with :func:`session_config`."""
+    try:
+        return zenoh.open(session_config(mode=mode, router_endpoint=router_endpoint))
+    except zenoh.ZError as error:
+        raise RuntimePortError(f"cannot open zenoh session ({mode}, "
+                               f"{router_endpoint or endpoint()}): {error}") from error
+
+
+def param_key(domain: int, node_fqn: str, op: str) -> str:
+    """Key of the parameter queryable of node ``/ns/name`` for ``op`` (get, set, list)."""
+    return f"{PARAM_SPACE}/{domain}/params/{wire.mangle(node_fqn)}/{op}"
+
+
+@dataclass(order=True)
+class _Timer:
+    due_ns: int
+    seq: int
+    period_ns: int = field(compare=False)
+    callback: Callable[[], None] = field(compare=False)
+    cancelled: bool = field(default=False, compare=False)
+
+    def cancel(self) -> None:
+        self.cancelled = True
+
+
+class _Executor:
+    """Single-threaded callback loop fed by zenoh threads (tasks) and timers."""
+
+    def __init__(self) -> None:
+        self._tasks: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._timers: list[_Timer] = []
+        self._seq = itertools.count()
+        self.stop = threading.Event()
+
+    def post(self, task: Callable[[], None]) -> None:
+        self._tasks.put(task)
+
+    def call(self, task: Callable[[], Any], timeout: float) -> Any:
+        """Run ``task`` on the executor thread and wait for its result."""
+        future: Future[Any] = Future()
+
+        def run() -> None:
+            try:
+                future.set_result(task())
+            except Exception as error:  # handed to the waiting thread, which re-raises it
+                future.set_exception(error)
+
+        self.post(run)
+        try:
+            return future.result(timeout)
+        except FutureTimeout as error:
+            raise RuntimePortError(f"executor busy for more than {timeout} s") from error
+
+    def add_timer(self, period_s: float, callback: Callable[[], None]) -> _Timer:
+        period_ns = int(period_s * 1e9)
+        timer = _Timer(time.monotonic_ns() + period_ns, next(self._seq), period_ns, callback)
+        heapq.heappush(self._timers, timer)
+        self.post(lambda: None)
+        return timer
+
+    def spin_once(self, timeout: float) -> None:
+        now = time.monotonic_ns()
+        while self._timers and (self._timers[0].cancelled or self._timers[0].due_ns <= now):
+            timer = heapq.heappop(self._timers)
+            if timer.cancelled:
+                continue
+            timer.callback()
+            timer.due_ns = max(timer.due_ns + timer.period_ns, now)
+            heapq.heappush(self._timers, timer)
+            now = time.monotonic_ns()
+        wait = timeout
+        if self._timers:
+            wait = min(wait, max(0.0, (self._timers[0].due_ns - now) / 1e9))
+        try:
+            task = self._tasks.get(timeout=wait)
+        except queue.Empty:
+            return
+        task()
+        for _ in range(self._tasks.qsize()):
+            self._tasks.get_nowait()()
+
+    def spin(self) -> None:
+        while not self.stop.is_set():
+            self.spin_once(0.1)
+
+
+class _Publisher:
+    """A zenoh publisher on an rmw_zenoh key, with its liveliness token and attachment state."""
+
+    def __init__(self, context: ZenohContext, identity: wire.NodeIdentity, topic: str,
+                 type_name: str, qos: QoS) -> None:
+        self.topic, self.type_name = topic, type_name
+        rihs = type_hash(type_name)
+        self.key = wire.topic_key(identity.domain_id, topic, type_name, rihs)
+        self.token_key = wire.endpoint_token(identity, context.next_id(), wire.PUBLISHER, topic,
+                                             type_name, rihs, qos)
+        self._gid = wire.gid_of(self.token_key)
+        self._seq = 0
+        self._lock = threading.Lock()
+        if qos.durability == "transient_local":
+            self._pub: Any = zenoh.ext.declare_advanced_publisher(
+                context.session, self.key, cache=zenoh.ext.CacheConfig(qos.depth),
+                publisher_detection=True)
+        else:
+            self._pub = context.session.declare_publisher(self.key)
+        self._token = context.session.liveliness().declare_token(self.token_key)
+
+    def publish(self, message: Any) -> None:
+        """Serialise ``message`` as ``type_name`` and send it."""
+        self.publish_cdr(serialize(message, self.type_name))
+
+    def publish_cdr(self, data: bytes) -> None:
+        """Send CDR bytes with rmw_zenoh's attachment (sequence number from 1, time, GID)."""
+        with self._lock:
+            self._seq += 1
+            attachment = wire.encode_attachment(self._seq, time.time_ns(), self._gid)
+            self._pub.put(data, attachment=attachment)
+
+    def matched(self) -> bool:
+        """True when at least one subscriber's key matches."""
+        return bool(self._pub.matching_status.matching)
+
+    def close(self) -> None:
+        self._token.undeclare()
+        self._pub.undeclare()
+
+
+@dataclass(frozen=True)
+class RawSample:
+    """A received sample: fully qualified topic, type, CDR payload and decoded attachment."""
+
+    topic: str
+    type_name: str
+    data: bytes
+    attachment: wire.Attachment | None
+
+
+class _Subscription:
+    """A zenoh subscriber whose samples reach the executor through a keep-last queue."""
+
+    def __init__(self, context: ZenohContext, identity: wire.NodeIdentity, topic: str,
+                 type_name: str, callback: Callable[[RawSample], None], qos: QoS,
+                 any_type: bool = False) -> None:
+        self.topic, self.type_name = topic, type_name
+        self._callback = callback
+        self._executor = context.executor
+        self._queue: deque[RawSample] = deque(maxlen=qos.depth)
+        domain = identity.domain_id
+        if any_type:
+            self.key = f"{domain}/{topic.strip('/')}/*/*"
+            self._token = None
+        else:
+            rihs = type_hash(type_name)
+            self.key = wire.topic_key(domain, topic, type_name, rihs)
+            token = wire.endpoint_token(identity, context.next_id(), wire.SUBSCRIPTION, topic,
+                                        type_name, rihs, qos)
+            self._token = context.session.liveliness().declare_token(token)
+        if qos.durability == "transient_local":
+            self._sub: Any = zenoh.ext.declare_advanced_subscriber(
+                context.session, self.key, self._on_sample,
+                history=zenoh.ext.HistoryConfig(detect_late_publishers=True,
+                                                max_samples=qos.depth))
+        else:
+            self._sub = context.session.declare_subscriber(self.key, self._on_sample)
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        chunks = str(sample.key_expr).rsplit("/", 2)
+        try:
+            type_name = wire.ros_type_name(chunks[1])
+            attachment = (wire.decode_attachment(sample.attachment.to_bytes())
+                          if sample.attachment is not None else None)
+        except RuntimePortError:
+            logging.getLogger("tdcm.zenoh").warning("dropped sample on %s with a foreign key or "
+                                                    "attachment", sample.key_expr)
+            return
+        self._queue.append(RawSample(self.topic, type_name, sample.payload.to_bytes(), attachment))
+        self._executor.post(self._deliver)
+
+    def _deliver(self) -> None:
+        if self._queue:
+            self._callback(self._queue.popleft())
+
+    def close(self) -> None:
+        if self._token is not None:
+            self._token.undeclare()
+        self._sub.undeclare()
+
+
+class ZenohNodePort:
+    """:class:`tdcm_ros.runtime.port.NodePort` on a zenoh session."""
+
+    def __init__(self, context: ZenohContext, name: str, namespace: str = "/",
+                 overrides: dict[str, Any] | None = None) -> None:
+        self.namespace = normalize_namespace(namespace)
+        self.fqn = fully_qualified_node_name(self.namespace, name)
+        self.node_name = name
+        self.logger = logging.getLogger(self.fqn)
+        self._context = context
+        self._params = ParameterStore(overrides)
+        node_id = context.next_id()
+        self.identity = wire.NodeIdentity(context.domain_id, context.zid, node_id,
+                                          self.namespace, name)
+        self._entities: list[_Publisher | _Subscription] = []
+        self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
+        self._queryable = context.session.declare_queryable(
+            param_key(context.domain_id, self.fqn, "*"), self._on_param_query)
+
+    # parameters
+    def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
+                          range: tuple[float, float] | None = None,
+                          validator: Validator | None = None,
+                          read_only: bool = False) -> ParamValue:
+        """Declare a parameter; returns the YAML override or the default, validated."""
+        return self._params.declare(ParamSpec(name, default, description, range, validator,
+                                              read_only))
+
+    def get_parameter(self, name: str) -> ParamValue:
+        """Current value of a declared parameter."""
+        return self._params.get(name)
+
+    def add_on_set_parameters(self, callback: SetCallback) -> None:
+        """Add a check run on each runtime change; raising ``InputError`` rejects it."""
+        self._params.add_on_set(callback)
+
+    def _param_request(self, op: str, request: dict[str, Any]) -> dict[str, Any]:
+        if op == "list":
+            specs = self._params.specs
+            return {"parameters": {n: {"value": v, "description": specs[n].description,
+                                       "range": specs[n].range, "read_only": specs[n].read_only}
+                                   for n, v in self._params.values().items()}}
+        if op == "get":
+            return {"value": self._params.get(str(request.get("name")))}
+        if op == "set":
+            name = str(request.get("name"))
+            result = self._params.set({name: request.get("value")})
+            if result.successful:
+                self.logger.info("parameter %s set to %r", name, self._params.get(name))
+            else:
+                self.logger.warning("parameter change rejected: %s", result.reason)
+            return {"successful": result.successful, "reason": result.reason}
+        raise InputError(f"unknown parameter operation {op!r}; allowed: get, set, list")
+
+    def _on_param_query(self, query: zenoh.Query) -> None:
+        op = str(query.key_expr).rsplit("/", 1)[-1]
+        try:
+            request = json.loads(query.payload.to_bytes() or b"{}") if query.payload else {}
+            reply = self._context.executor.call(lambda: self._param_request(op, request),
+                                                PARAM_TIMEOUT_S)
+        except (InputError, RuntimePortError, ValueError) as error:
+            reply = {"error": str(error)}
+        query.reply(query.key_expr, json.dumps(reply))
+
+    # endpoints
+    def create_publisher(self, topic: str, type_name: str, qos: QoS = QoS()) -> _Publisher:
+        """Declare a publisher on the resolved topic."""
+        resolved = resolve_topic(topic, self.namespace, self.node_name)
+        publisher = _Publisher(self._context, self.identity, resolved,
+                               normalize_type_name(type_name), qos)
+        self._entities.append(publisher)
+        return publisher
+
+    def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
+                            qos: QoS = QoS()) -> None:
+        """Subscribe; ``callback`` gets rosbags messages (undecodable payloads are logged)."""
+        name = normalize_type_name(type_name)
+
+        def decode(sample: RawSample) -> None:
+            try:
+                message = deserialize(sample.data, name)
+            except BagError as error:
+                self.logger.warning("dropped message on %s: %s", sample.topic, error)
+                return
+            callback(message)
+
+        self.create_raw_subscription(topic, name, decode, qos)
+
+    def create_raw_subscription(self, topic: str, type_name: str | None,
+                                callback: Callable[[RawSample], None], qos: QoS = QoS()) -> None:
+        """Subscribe to CDR samples; ``type_name=None`` accepts any type (no liveliness token)."""
+        resolved = resolve_topic(topic, self.namespace, self.node_name)
+        name = normalize_type_name(type_name) if type_name else ""
+        self._entities.append(_Subscription(self._context, self.identity, resolved, name,
+                                            callback, qos, any_type=type_name is None))
+
+    def create_timer(self, period: float, callback: Callable[[], None]) -> _Timer:
+        """Call ``callback`` every ``period`` s on the executor thread."""
+        if not period > 0:
+            raise InputError(f"timer period = {period!r} s must be > 0", parameter="period",
+                             value=period, allowed="> 0 s")
+        return self._context.executor.add_timer(period, callback)
+
+    def now_ns(self) -> int:
+        """System time, ns since the UNIX epoch."""
+        return time.time_ns()
+
+    def close(self) -> None:
+        """Undeclare every endpoint, the parameter queryable and the node token."""
+        for entity in self._entities:
+            entity.close()
+        self._entities.clear()
+        self._queryable.undeclare()
+        self._token.undeclare()
+
+
+class ZenohContext:
+    """One zenoh session, its executor and the node/entity id counter of this process."""
+
+    def __init__(self, session: zenoh.Session | None = None) -> None:
+        self.session = session or open_session()
+        self.domain_id = domain_id()
+        self.zid = str(self.session.zid())
+        self.executor = _Executor()
+        self._ids = itertools.count()
+        self._ports: list[ZenohNodePort] = []
+
+    def next_id(self) -> int:
+        """Next node/entity id (one counter per context, as in rmw_zenoh)."""
+        return next(self._ids)
+
+    def create_port(self, name: str, namespace: str = "/",
+                    overrides: dict[str, Any] | None = None) -> ZenohNodePort:
+        """A node port named ``name`` in ``namespace``."""
+        port = ZenohNodePort(self, name, namespace, overrides)
+        self._ports.append(port)
+        return port
+
+    def spin(self) -> None:
+        """Run callbacks until :meth:`request_stop`."""
+        self.executor.spin()
+
+    def spin_for(self, seconds: float) -> None:
+        """Run callbacks for ``seconds`` s."""
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0 and not self.executor.stop.is_set():
+            self.executor.spin_once(min(left, 0.1))
+
+    def request_stop(self) -> None:
+        """Make :meth:`spin` return (safe from signal handlers and other threads)."""
+        self.executor.stop.set()
+        self.executor.post(lambda: None)
+
+    def close(self) -> None:
+        """Close every port, then the session."""
+        for port in self._ports:
+            port.close()
+        self._ports.clear()
+        self.session.close()
+
+
+def graph_tokens(session: zenoh.Session, domain: int, timeout: float = 1.0) -> Iterator[wire.TokenInfo]:
+    """Current rmw_zenoh liveliness tokens of ``domain`` (malformed ones skipped)."""
+    for reply in session.liveliness().get(f"{wire.ADMIN_SPACE}/{domain}/**", timeout=timeout):
+        if reply.ok is None:
+            continue
+        try:
+            yield wire.parse_token(str(reply.ok.key_expr))
+        except (RuntimePortError, ValueError):
+            continue
+
+
+def call_parameters(session: zenoh.Session, domain: int, node_fqn: str, op: str,
+                    request: dict[str, Any], timeout: float = PARAM_TIMEOUT_S) -> dict[str, Any]:
+    """Send a parameter request to a node; raises ``RuntimePortError`` if none answers."""
+    key = param_key(domain, node_fqn, op)
+    for reply in session.get(key, payload=json.dumps(request), timeout=timeout):
+        if reply.ok is not None:
+            answer: dict[str, Any] = json.loads(reply.ok.payload.to_bytes())
+            if "error" in answer:
+                raise InputError(f"{node_fqn}: {answer['error']}", parameter=request.get("name"))
+            return answer
+    raise RuntimePortError(f"node {node_fqn} did not answer on {key} within {timeout} s; "
+                           f"is it running on domain {domain}?")
