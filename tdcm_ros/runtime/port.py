@@ -52,6 +52,9 @@ class QoS:
                              allowed="volatile, transient_local")
 
 
+DEFAULT_QOS = QoS()
+
+
 class Publisher(Protocol):
     """A declared publisher."""
 
@@ -91,11 +94,11 @@ class NodePort(Protocol):
     def add_on_set_parameters(self, callback: SetCallback) -> None:
         """Add a check run on each runtime change ``{name: value}``; raise ``InputError`` to reject."""
 
-    def create_publisher(self, topic: str, type_name: str, qos: QoS = QoS()) -> Publisher:
+    def create_publisher(self, topic: str, type_name: str, qos: QoS = DEFAULT_QOS) -> Publisher:
         """Declare a publisher; relative topics resolve under the node's namespace."""
 
     def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
-                            qos: QoS = QoS()) -> None:
+                            qos: QoS = DEFAULT_QOS) -> None:
         """Subscribe; ``callback`` receives the deserialised rosbags message."""
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> Timer:

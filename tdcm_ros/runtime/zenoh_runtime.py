@@ -30,13 +30,29 @@ from typing import Any
 import zenoh
 import zenoh.ext
 
-from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize, type_hash
-from tdcm_ros.errors import InputError
+from tdcm_ros.bagio import (
+    BagError,
+    deserialize,
+    normalize_type_name,
+    serialize,
+    type_hash,
+)
+from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.runtime import wire
 from tdcm_ros.runtime.errors import RuntimePortError
-from tdcm_ros.runtime.names import fully_qualified_node_name, normalize_namespace, resolve_topic
-from tdcm_ros.runtime.parameters import ParameterStore, ParamSpec, ParamValue, SetCallback, Validator
-from tdcm_ros.runtime.port import QoS
+from tdcm_ros.runtime.names import (
+    fully_qualified_node_name,
+    normalize_namespace,
+    resolve_topic,
+)
+from tdcm_ros.runtime.parameters import (
+    ParameterStore,
+    ParamSpec,
+    ParamValue,
+    SetCallback,
+    Validator,
+)
+from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
 CONFIG_ENV = "TDCM_ZENOH_CONFIG"
@@ -128,7 +144,7 @@ class _Executor:
         def run() -> None:
             try:
                 future.set_result(task())
-            except Exception as error:  # handed to the waiting thread, which re-raises it
+            except TdcmError as error:  # handed to the waiting thread, which re-raises it
                 future.set_exception(error)
 
         self.post(run)
@@ -337,7 +353,7 @@ class ZenohNodePort:
         query.reply(query.key_expr, json.dumps(reply))
 
     # endpoints
-    def create_publisher(self, topic: str, type_name: str, qos: QoS = QoS()) -> _Publisher:
+    def create_publisher(self, topic: str, type_name: str, qos: QoS = DEFAULT_QOS) -> _Publisher:
         """Declare a publisher on the resolved topic."""
         resolved = resolve_topic(topic, self.namespace, self.node_name)
         publisher = _Publisher(self._context, self.identity, resolved,
@@ -346,7 +362,7 @@ class ZenohNodePort:
         return publisher
 
     def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
-                            qos: QoS = QoS()) -> None:
+                            qos: QoS = DEFAULT_QOS) -> None:
         """Subscribe; ``callback`` gets rosbags messages (undecodable payloads are logged)."""
         name = normalize_type_name(type_name)
 
@@ -361,7 +377,7 @@ class ZenohNodePort:
         self.create_raw_subscription(topic, name, decode, qos)
 
     def create_raw_subscription(self, topic: str, type_name: str | None,
-                                callback: Callable[[RawSample], None], qos: QoS = QoS()) -> None:
+                                callback: Callable[[RawSample], None], qos: QoS = DEFAULT_QOS) -> None:
         """Subscribe to CDR samples; ``type_name=None`` accepts any type (no liveliness token)."""
         resolved = resolve_topic(topic, self.namespace, self.node_name)
         name = normalize_type_name(type_name) if type_name else ""
