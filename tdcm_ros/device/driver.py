@@ -1,0 +1,387 @@
+"""Transport-free logic of the ``tension_driver`` node.
+
+:class:`TensionDriver` owns one device link. The caller supplies the clock (s) and, optionally,
+the port opener, then calls :meth:`TensionDriver.step` periodically (every 5-10 ms); each call
+reads what the device sent, runs the link state machine and returns a :class:`StepResult`: the
+telemetry frames received (publish each as ``tension``) and a :class:`DriverStatus` (device
+state and a diagnostics level + message). Nothing blocks and nothing sleeps.
+
+Link: open -> send ``I`` (repeated every 0.5 s) until a banner arrives (``handshake_timeout``);
+a banner of another protocol version raises :class:`ProtocolVersionError`. While connected the
+driver sends a heartbeat every ``heartbeat_period``, ramps the commanded setpoint toward the
+target at ``setpoint_rate`` N/s, and asks for mode T while enabled and the device is released
+without faults. Port failures, a missing banner or ``link_timeout`` s without telemetry close
+the port and retry after an exponential backoff (``backoff_initial`` doubling to
+``backoff_max``). Device faults (watchdog, over-tension, e-stop, sensor) are never cleared
+automatically: call :meth:`TensionDriver.clear_faults`.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+
+from tdcm_ros.device import constants as c
+from tdcm_ros.device.errors import (
+    DeviceInputError,
+    FrameError,
+    PortError,
+    ProtocolVersionError,
+)
+from tdcm_ros.device.protocol import (
+    DEVICE_TYPES,
+    Banner,
+    ClearFaults,
+    Command,
+    EStop,
+    Fault,
+    Heartbeat,
+    Info,
+    LineDecoder,
+    Mode,
+    Nack,
+    Reject,
+    SetMode,
+    SetSetpoint,
+    Telemetry,
+    encode,
+)
+from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.device.transport import Transport, open_transport
+from tdcm_ros.errors import out_of_range
+
+_LOG = logging.getLogger(__name__)
+INFO_RETRY = 0.5        #: s between banner requests during the handshake
+SETPOINT_PERIOD = 0.02  #: s, shortest interval between two setpoint commands
+MODE_RETRY = 0.2        #: s between two mode requests
+
+
+class LinkState(enum.Enum):
+    """State of the link to the device."""
+
+    DISCONNECTED = "disconnected"
+    HANDSHAKING = "handshaking"
+    CONNECTED = "connected"
+
+
+class Level(enum.IntEnum):
+    """Diagnostics level, numerically equal to ``diagnostic_msgs/DiagnosticStatus``."""
+
+    OK = 0
+    WARN = 1
+    ERROR = 2
+    STALE = 3
+
+
+@dataclass(frozen=True)
+class DriverConfig:
+    """Driver parameters (SI: N, N/s, s). ``port`` is a device path, pty path or pyserial URL."""
+
+    port: str = "/dev/ttyACM0"
+    baudrate: int = c.BAUD_RATE
+    tension_max: float = 20.0
+    setpoint_rate: float = 40.0
+    heartbeat_period: float = 0.1
+    handshake_timeout: float = 3.0
+    stale_timeout: float = 0.25
+    link_timeout: float = 2.0
+    backoff_initial: float = 0.5
+    backoff_max: float = 8.0
+
+    def __post_init__(self) -> None:
+        for field in fields(self):
+            value = getattr(self, field.name)
+            if field.name != "port" and not (math.isfinite(value) and value > 0):
+                raise out_of_range(field.name, value, "finite and > 0", error=DeviceInputError)
+        if self.tension_max > c.SETPOINT_MAX_MN / 1000:
+            raise out_of_range("tension_max", self.tension_max,
+                               f"(0, {c.SETPOINT_MAX_MN / 1000}]", unit="N", error=DeviceInputError)
+        if self.heartbeat_period >= c.WATCHDOG_MS / 1000 / 2:
+            raise out_of_range("heartbeat_period", self.heartbeat_period,
+                               f"< {c.WATCHDOG_MS / 2000} (half the device watchdog)", unit="s",
+                               error=DeviceInputError)
+        if self.backoff_max < self.backoff_initial:
+            raise out_of_range("backoff_max", self.backoff_max, f">= backoff_initial "
+                               f"({self.backoff_initial})", unit="s", error=DeviceInputError)
+
+
+@dataclass(frozen=True)
+class DriverStatus:
+    """Snapshot for the device-state topic and ``/diagnostics``."""
+
+    link: LinkState
+    level: Level
+    message: str
+    target: float                 #: N, requested setpoint after clamping
+    setpoint: float               #: N, setpoint last sent (ramped toward ``target``)
+    enabled: bool                 #: the driver wants the device in mode T
+    telemetry: Telemetry | None   #: latest frame
+    banner: Banner | None
+    reconnects: int               #: links lost since start
+    rejected_lines: int           #: malformed lines from the device
+    nacks: int                    #: commands the device refused
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """What one :meth:`TensionDriver.step` produced."""
+
+    telemetry: tuple[Telemetry, ...]
+    status: DriverStatus
+
+
+def fault_names(faults: Fault) -> str:
+    """``'WATCHDOG|ESTOP'`` style text for a fault set."""
+    return "|".join(flag.name or "" for flag in Fault if flag in faults)
+
+
+class TensionDriver:
+    """Link to one tension device; see the module docstring for the behaviour.
+
+    ``clock`` returns the time in s (monotonic); ``open_port`` opens a :class:`Transport` for
+    ``config.port`` (default: :func:`open_transport`); ``warn`` receives warnings (clamped
+    setpoints, refused commands, lost links; default: this module's logger).
+    """
+
+    def __init__(self, config: DriverConfig, *, clock: Callable[[], float],
+                 open_port: Callable[[str], Transport] | None = None,
+                 warn: Callable[[str], None] | None = None) -> None:
+        self.config = config
+        self._clock = clock
+        self._open_port = open_port or (lambda url: open_transport(url, baudrate=config.baudrate))
+        self._warn = warn or _LOG.warning
+        self._transport: Transport | None = None
+        self._decoder = LineDecoder(accept=DEVICE_TYPES)
+        self._link = LinkState.DISCONNECTED
+        self._link_error = "not opened yet"
+        self._next_attempt = clock()
+        self._backoff = config.backoff_initial
+        self._reconnects = 0
+        self._nacks = 0
+        self._rejected = 0
+        self._version_error: FrameError | None = None
+        self._banner: Banner | None = None
+        self._latest: Telemetry | None = None
+        self._enabled = False
+        self._target = 0.0
+        self._setpoint = 0.0
+        self._sent_setpoint: float | None = None
+        self._schedule: StepSchedule | None = None
+        self._schedule_start = 0.0
+        now = clock()
+        self._since = now  # start of the current link phase
+        self._last_rx = self._last_heartbeat = self._last_setpoint = self._last_mode = now
+        self._last_ramp = self._last_info = now
+
+    # --- public commands ------------------------------------------------------------------
+    @property
+    def tension_max(self) -> float:
+        """Largest setpoint, in N: the configured maximum or the device's, whichever is lower."""
+        if self._banner is None:
+            return self.config.tension_max
+        return min(self.config.tension_max, self._banner.setpoint_max)
+
+    def _clamp(self, newtons: float, what: str) -> float:
+        if not math.isfinite(newtons):
+            raise out_of_range(what, newtons, "a finite number", unit="N", error=DeviceInputError)
+        clamped = min(max(newtons, 0.0), self.tension_max)
+        if clamped != newtons:
+            self._warn(f"{what} = {newtons:g} N is out of range [0, {self.tension_max:g}] N; "
+                       f"clamped to {clamped:g} N")
+        return clamped
+
+    def set_setpoint(self, newtons: float) -> float:
+        """Request a tension (N); cancels a running schedule. Returns the clamped value."""
+        self._schedule = None
+        self._target = self._clamp(newtons, "setpoint")
+        return self._target
+
+    def run_schedule(self, schedule: StepSchedule) -> None:
+        """Follow ``schedule`` from now on (levels above the maximum are clamped, with a warning)."""
+        for level in sorted(set(schedule.levels)):
+            self._clamp(level, "schedule level")
+        self._schedule = schedule
+        self._schedule_start = self._clock()
+
+    @property
+    def schedule_running(self) -> bool:
+        """True while a schedule is being followed."""
+        return self._schedule is not None
+
+    def enable(self) -> None:
+        """Ask for closed-loop tension (mode T) whenever the device is released without faults."""
+        self._enabled = True
+
+    def release(self) -> None:
+        """Ask for mode R (tendon slack) now."""
+        self._enabled = False
+        self._send_now(SetMode(Mode.RELEASE))
+
+    def estop(self) -> None:
+        """Release at once: send ``E`` (latching the device's ESTOP fault), zero the setpoint,
+        stop any schedule and disable. Without a link the device's watchdog releases it."""
+        self._enabled = False
+        self._schedule = None
+        self._target = self._setpoint = 0.0
+        self._send_now(EStop())
+        self._warn("e-stop: tendon released")
+
+    def clear_faults(self) -> None:
+        """Clear the device's latched faults (the device refuses while over the trip)."""
+        self._send_now(ClearFaults())
+
+    def close(self) -> None:
+        """Release the tendon (best effort) and close the port."""
+        self._enabled = False
+        self._send_now(SetMode(Mode.RELEASE))
+        self._drop("closed by the host", reconnect=False)
+
+    # --- the step ---------------------------------------------------------------------------
+    def step(self) -> StepResult:
+        """Do everything due now; raises :class:`ProtocolVersionError` on a version mismatch."""
+        now = self._clock()
+        received: list[Telemetry] = []
+        if self._link is LinkState.DISCONNECTED and now >= self._next_attempt:
+            self._connect(now)
+        if self._transport is not None:
+            try:
+                self._service(now, received)
+            except PortError as error:
+                self._drop(str(error))
+        return StepResult(tuple(received), self._status(now))
+
+    def _connect(self, now: float) -> None:
+        try:
+            self._transport = self._open_port(self.config.port)
+        except PortError as error:
+            self._retry_later(now, str(error))
+            return
+        self._decoder = LineDecoder(accept=DEVICE_TYPES, on_reject=self._on_reject)
+        self._link, self._since = LinkState.HANDSHAKING, now
+        self._last_info = now
+        self._send(Info())
+
+    def _retry_later(self, now: float, reason: str) -> None:
+        self._link_error = reason
+        self._next_attempt = now + self._backoff
+        self._backoff = min(self._backoff * 2, self.config.backoff_max)
+
+    def _drop(self, reason: str, *, reconnect: bool = True) -> None:
+        if self._transport is not None:
+            self._transport.close()
+            self._transport = None
+        if self._link is LinkState.CONNECTED and reconnect:
+            self._reconnects += 1
+            self._warn(f"device link lost: {reason}")
+        self._link = LinkState.DISCONNECTED
+        self._sent_setpoint = None
+        self._retry_later(self._clock(), reason)
+
+    def _on_reject(self, error: FrameError) -> None:
+        self._rejected += 1
+        if error.reason is Reject.VER:
+            self._version_error = error
+
+    def _send(self, command: Command) -> None:
+        if self._transport is None:
+            raise PortError("no port open")
+        self._transport.write(encode(command))
+
+    def _send_now(self, command: Command) -> None:
+        if self._transport is None:
+            return
+        try:
+            self._send(command)
+        except PortError as error:
+            self._drop(str(error))
+
+    def _service(self, now: float, received: list[Telemetry]) -> None:
+        transport = self._transport
+        if transport is None:
+            return
+        for message in self._decoder.feed(transport.read()):
+            self._handle(message, now, received)
+        if self._version_error is not None:
+            error, self._version_error = self._version_error, None
+            self._drop(str(error), reconnect=False)
+            raise ProtocolVersionError(
+                f"protocol_version = {error.version} sent by {self.config.port!r}; allowed: "
+                f"{c.PROTOCOL_VERSION}", parameter="protocol_version", value=error.version,
+                allowed=str(c.PROTOCOL_VERSION)) from error
+        if self._link is LinkState.HANDSHAKING:
+            if now - self._since >= self.config.handshake_timeout:
+                self._drop(f"no banner within {self.config.handshake_timeout:g} s")
+            elif now - self._last_info >= INFO_RETRY:
+                self._last_info = now
+                self._send(Info())
+            return
+        if now - self._last_rx >= self.config.link_timeout:
+            self._drop(f"no telemetry for {now - self._last_rx:.2f} s")
+            return
+        self._keep_alive(now)
+
+    def _handle(self, message: object, now: float, received: list[Telemetry]) -> None:
+        if isinstance(message, Telemetry):
+            received.append(message)
+            self._latest, self._last_rx = message, now
+        elif isinstance(message, Banner):
+            if self._link is LinkState.CONNECTED:
+                self._warn("device sent a new banner: it rebooted")
+            self._banner, self._link = message, LinkState.CONNECTED
+            self._last_rx = self._last_ramp = now
+            self._backoff = self.config.backoff_initial
+            self._sent_setpoint = None
+        elif isinstance(message, Nack):
+            self._nacks += 1
+            self._warn(f"device refused command {message.command}: {message.reason.value}")
+
+    def _keep_alive(self, now: float) -> None:
+        if now - self._last_heartbeat >= self.config.heartbeat_period:
+            self._last_heartbeat = now
+            self._send(Heartbeat())
+        if self._schedule is not None:
+            level = self._schedule.setpoint(now - self._schedule_start)
+            if level is None:
+                self._schedule = None
+            self._target = min(level or 0.0, self.tension_max)
+        step = self.config.setpoint_rate * (now - self._last_ramp)
+        self._last_ramp = now
+        self._setpoint += max(-step, min(step, self._target - self._setpoint))
+        if self._sent_setpoint != self._setpoint and now - self._last_setpoint >= SETPOINT_PERIOD:
+            self._last_setpoint, self._sent_setpoint = now, self._setpoint
+            self._send(SetSetpoint(self._setpoint))
+        latest = self._latest
+        if latest is None or now - self._last_mode < MODE_RETRY:
+            return
+        if self._enabled and latest.mode is Mode.RELEASE and not latest.faults:
+            self._last_mode = now
+            self._send(SetMode(Mode.TENSION))
+        elif not self._enabled and latest.mode is Mode.TENSION:
+            self._last_mode = now
+            self._send(SetMode(Mode.RELEASE))
+
+    # --- status ------------------------------------------------------------------------------
+    def _status(self, now: float) -> DriverStatus:
+        latest = self._latest
+        if self._link is LinkState.DISCONNECTED:
+            level, text = Level.ERROR, (f"disconnected ({self._link_error}); retry in "
+                                        f"{max(0.0, self._next_attempt - now):.1f} s")
+        elif self._link is LinkState.HANDSHAKING:
+            level, text = Level.WARN, f"waiting for the banner on {self.config.port}"
+        elif now - self._last_rx > self.config.stale_timeout:
+            level, text = Level.STALE, f"no telemetry for {now - self._last_rx:.2f} s"
+        elif latest is not None and latest.faults:
+            level, text = Level.ERROR, f"device fault {fault_names(latest.faults)}; tendon released"
+        elif latest is not None:
+            mode = "tensioning" if latest.mode is Mode.TENSION else "released"
+            level, text = Level.OK, (f"{mode}: tension {latest.tension:.3f} N, setpoint "
+                                     f"{self._setpoint:.3f} N")
+        else:
+            level, text = Level.WARN, "connected, no telemetry yet"
+        return DriverStatus(link=self._link, level=level, message=text, target=self._target,
+                            setpoint=self._setpoint, enabled=self._enabled, telemetry=latest,
+                            banner=self._banner, reconnects=self._reconnects,
+                            rejected_lines=self._rejected, nacks=self._nacks)
