@@ -1,0 +1,128 @@
+"""Parameter specs and store, the ROS parameter YAML reader, names, runtime selection."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.names import resolve_topic
+from tdcm_ros.runtime.parameters import ParameterStore, ParamSpec
+from tdcm_ros.runtime.params import node_parameters, read_param_file
+from tdcm_ros.runtime.run_node import resolve_runtime
+
+YAML = """
+/**:
+  ros__parameters:
+    rate: 1.0
+talker:
+  ros__parameters:
+    rate: 2.0
+    solver: {tol: 1.0e-6}
+robot1:
+  talker:
+    ros__parameters:
+      rate: 5.0
+/*/model:
+  ros__parameters:
+    arc_lengths: [0.015, 0.033, 0.053]
+"""
+
+
+@pytest.fixture
+def param_file(tmp_path: Path) -> Path:
+    path = tmp_path / "params.yaml"
+    path.write_text(YAML)
+    return path
+
+
+def test_yaml_wildcards_exact_and_nested(param_file: Path) -> None:
+    assert [key for key, _ in read_param_file(param_file)] == [
+        "/**", "/talker", "/robot1/talker", "/*/model"]
+    assert node_parameters(param_file, "/talker") == {"rate": 2.0, "solver.tol": 1e-6}
+    assert node_parameters(param_file, "/robot1/talker") == {"rate": 5.0}
+    assert node_parameters(param_file, "/a/model")["arc_lengths"] == [0.015, 0.033, 0.053]
+    assert node_parameters(param_file, "/model") == {"rate": 1.0}
+    assert node_parameters(None, "/talker") == {}
+
+
+def test_bad_yaml_is_an_input_error(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("talker:\n  rate: 1\n")
+    with pytest.raises(InputError, match="not under ros__parameters"):
+        read_param_file(bad)
+
+
+def test_spec_types_ranges_and_validators() -> None:
+    def positive_list(values: Any) -> None:
+        if any(v <= 0 for v in values):
+            raise InputError("arc_lengths must be > 0 m", parameter="arc_lengths")
+
+    spec = ParamSpec("tension", 1.0, "N", range=(0.0, 50.0))
+    assert spec.coerce(3) == 3.0
+    with pytest.raises(InputError, match="out of range"):
+        spec.coerce(51.0)
+    with pytest.raises(InputError, match="expected float"):
+        spec.coerce("x")
+    with pytest.raises(InputError, match="not finite"):
+        spec.coerce(float("nan"))
+    lengths = ParamSpec("arc_lengths", [0.015], validator=positive_list)
+    assert lengths.coerce([1, 2]) == [1.0, 2.0]
+    with pytest.raises(InputError, match="> 0 m"):
+        lengths.coerce([0.01, -1.0])
+
+
+def test_rejected_change_keeps_old_value_and_reports_reason() -> None:
+    store = ParameterStore({"period": 0.2})
+    assert store.declare(ParamSpec("period", 0.5, range=(1e-3, 60.0))) == 0.2
+    seen: list[Mapping[str, Any]] = []
+    store.add_on_set(seen.append)
+    result = store.set({"period": -1.0})
+    assert not result.successful and "out of range" in result.reason
+    assert store.get("period") == 0.2 and seen == []
+    assert store.set({"period": 1.0}).successful and store.get("period") == 1.0
+    assert seen == [{"period": 1.0}]
+
+
+def test_node_check_can_reject() -> None:
+    store = ParameterStore()
+    store.declare(ParamSpec("low", 1.0))
+
+    def refuse(changes: Mapping[str, Any]) -> None:
+        raise InputError("low must stay below high", parameter="low")
+
+    store.add_on_set(refuse)
+    assert store.set({"low": 2.0}).reason == "low must stay below high"
+    assert store.get("low") == 1.0
+    with pytest.raises(InputError, match="declared twice"):
+        store.declare(ParamSpec("low", 1.0))
+
+
+@pytest.mark.parametrize(("topic", "namespace", "expected"), [
+    ("tension", "/", "/tension"),
+    ("tension", "/robot1", "/robot1/tension"),
+    ("/abs", "/robot1", "/abs"),
+    ("~/set_parameters", "/r", "/r/model/set_parameters"),
+])
+def test_topic_resolution(topic: str, namespace: str, expected: str) -> None:
+    assert resolve_topic(topic, namespace, "model") == expected
+
+
+def test_invalid_topic_names() -> None:
+    for bad in ("a//b", "1abc", "a b", "a/"):
+        with pytest.raises(InputError):
+            resolve_topic(bad)
+
+
+def test_runtime_selection(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("TDCM_RUNTIME", "zenoh")
+    assert resolve_runtime("auto") == "zenoh"
+    assert resolve_runtime("rclpy") == "rclpy"
+    monkeypatch.setenv("TDCM_RUNTIME", "bogus")
+    with pytest.raises(InputError, match="TDCM_RUNTIME"):
+        resolve_runtime("auto")
+    monkeypatch.delenv("TDCM_RUNTIME")
+    assert resolve_runtime("auto") in ("zenoh", "rclpy")
