@@ -17,6 +17,9 @@ from tdcm_ros.errors import TdcmError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.solve",
+    "tdcm_ros.cli.up",
+    "tdcm_ros.cli.topic",
+    "tdcm_ros.cli.param",
 )
 
 

@@ -1,6 +1,7 @@
 """Runtimes for transport-agnostic nodes: the port, the zenoh runtime, the rclpy adapter.
 
 Importing this package imports neither zenoh nor rclpy; each runtime module does on use.
+Run a node with :func:`tdcm_ros.runtime.run_node.run_node`.
 """
 
 from tdcm_ros.runtime.errors import RuntimePortError
@@ -13,7 +14,6 @@ from tdcm_ros.runtime.port import (
     QoS,
     Timer,
 )
-from tdcm_ros.runtime.run_node import resolve_runtime, run_node
 
 __all__ = [
     "DEFAULT_QOS",
@@ -25,6 +25,4 @@ __all__ = [
     "RuntimePortError",
     "SetResult",
     "Timer",
-    "resolve_runtime",
-    "run_node",
 ]

@@ -1,0 +1,19 @@
+"""Nodes ``tdcm up`` can start, by name. Add a node with one line: ``"name": "module:Class"``."""
+
+from __future__ import annotations
+
+from tdcm_ros.errors import InputError
+
+NODES: dict[str, str] = {
+    "talker": "tdcm_ros.nodes.talker:Talker",
+}
+
+DEFAULT_NODE_SET: tuple[str, ...] = ("talker",)
+
+
+def node_target(name: str) -> str:
+    """``module:Class`` of a registered node."""
+    if name not in NODES:
+        raise InputError(f"unknown node {name!r}; registered: {', '.join(sorted(NODES))}",
+                         parameter="nodes", value=name, allowed=", ".join(sorted(NODES)))
+    return NODES[name]
