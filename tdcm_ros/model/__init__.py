@@ -7,7 +7,14 @@ Typical use::
     result.tip_position  # m, frame tdcm_base
 """
 
-from tdcm_ros.model.design import FIELD_SPECS, PRESETS, Design, FieldSpec, parse_field, preset
+from tdcm_ros.model.design import (
+    FIELD_SPECS,
+    PRESETS,
+    Design,
+    FieldSpec,
+    parse_field,
+    preset,
+)
 from tdcm_ros.model.errors import (
     ConvergenceError,
     InvalidDesignError,

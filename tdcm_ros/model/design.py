@@ -106,8 +106,8 @@ class Design:
                 "rectangular, or CustomProfile(h1)", parameter="profile", value=self.profile,
                 allowed="circular | rectangular | CustomProfile")
         object.__setattr__(self, "N", int(self.N))
-        for name in FIELD_SPECS:
-            if name != "N":
+        for name, spec in FIELD_SPECS.items():
+            if not spec.integer:
                 object.__setattr__(self, name, float(getattr(self, name)))
 
     @property
@@ -129,11 +129,11 @@ class Design:
     def with_overrides(self, **overrides: Any) -> Design:
         """A copy with fields replaced (validated); unknown names raise :class:`InvalidDesignError`."""
         known = {f.name for f in fields(self)}
-        for name in overrides:
+        for name, value in overrides.items():
             if name not in known:
                 raise InvalidDesignError(
                     f"unknown design field {name!r}; allowed: {', '.join(sorted(known))}",
-                    parameter=name, value=overrides[name], allowed=", ".join(sorted(known)))
+                    parameter=name, value=value, allowed=", ".join(sorted(known)))
         if isinstance(overrides.get("profile"), str):
             overrides["profile"] = profile_from_name(overrides["profile"])
         return replace(self, **overrides)

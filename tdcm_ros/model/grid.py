@@ -133,10 +133,18 @@ class Grid:
         us = self.u_of_s(cells, s)[:, None]
         u_r = ua + (us - ua) * self.gauss_u[None, :]
         cells_r = np.broadcast_to(cells[:, None], u_r.shape)
-        w_r = (us - ua) * self.gauss_w[None, :] * self.jacobian(cells_r, u_r)
+        w_r = _exact_length((us - ua) * self.gauss_w[None, :] * self.jacobian(cells_r, u_r),
+                            s - self.s_nodes[cells])
         a0_r, a1_r = _nested(self, cells_r, ua, u_r)
         a0_s, a1_s = _nested(self, cells[:, None], ua, us)
         return a0_s[:, 0], a1_s[:, 0], a0_r, a1_r, w_r
+
+
+def _exact_length(weights: Array, length: Array) -> Array:
+    """Scale ds quadrature weights (m) so each row sums to its exact arc length (m): a straight
+    cell then integrates to its length exactly, whatever the profile's Jacobian."""
+    total = np.sum(weights, axis=-1, keepdims=True)
+    return weights * np.where(total > 0.0, length[..., None] / np.where(total > 0, total, 1.0), 0.0)
 
 
 def _nested(grid: Grid, cells: IntArray, ua: Array, u_end: Array) -> tuple[Array, Array]:
@@ -247,9 +255,9 @@ def _build_grid(design: Design, routing: str, cells_per_notch: int, cells_per_tu
     span = (u_b - u_a)[:, None]
     uq = u_a[:, None] + span * gauss_u[None, :]
     cq_cells = np.broadcast_to(cells[:, None], uq.shape)
-    w_q = span * gauss_w[None, :] * partial.jacobian(cq_cells, uq)
-    s_q = seg_start[:, None] + partial.local_sigma(cq_cells, uq)
     length = np.diff(s_nodes)
+    w_q = _exact_length(span * gauss_w[None, :] * partial.jacobian(cq_cells, uq), length)
+    s_q = seg_start[:, None] + partial.local_sigma(cq_cells, uq)
     xi_q = (s_q - s_nodes[:-1, None]) / length[:, None]
     c_q = partial.compliance(cq_cells, uq)
     big_c0 = np.sum(w_q * (1.0 - xi_q) * c_q, axis=1)

@@ -9,7 +9,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model.errors import NotchClosureError, TendonSingularityError, TensionRangeError
+from tdcm_ros.model.errors import (
+    NotchClosureError,
+    TendonSingularityError,
+    TensionRangeError,
+)
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
 

@@ -67,11 +67,11 @@ class SolverSettings:
     def with_overrides(self, **overrides: Any) -> SolverSettings:
         """A validated copy with fields replaced; unknown names raise."""
         known = {f.name for f in fields(self)}
-        for name in overrides:
+        for name, value in overrides.items():
             if name not in known:
                 raise InvalidSettingsError(
                     f"unknown solver setting {name!r}; allowed: {', '.join(sorted(known))}",
-                    parameter=name, value=overrides[name], allowed=", ".join(sorted(known)))
+                    parameter=name, value=value, allowed=", ".join(sorted(known)))
         return replace(self, **overrides)
 
     def to_dict(self) -> dict[str, Any]:

@@ -1,0 +1,77 @@
+"""``tdcm solve``: the shape for one design and tension, as a summary, JSON or a plot."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+from tdcm_ros.errors import InputError, TdcmError
+from tdcm_ros.model import PRESETS, SolverSettings, parse_field, preset, solve
+from tdcm_ros.model.profiles import PROFILE_NAMES
+from tdcm_ros.model.settings import ROUTINGS
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``solve`` subcommand."""
+    parser = subparsers.add_parser(
+        "solve", help="shape of the manipulator for one tension",
+        description="Solve Algorithm 1 for one design and tendon tension (SI units).")
+    parser.add_argument("--design", default="paper-experiment", choices=list(PRESETS),
+                        help="design preset (default: paper-experiment)")
+    parser.add_argument("--tension", required=True, type=str, help="tendon tension (N)")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a design field in SI units, e.g. --set E=1.2e9")
+    parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
+    parser.add_argument("--routing", choices=ROUTINGS, default="paper", help="tendon routing")
+    parser.add_argument("--loads", choices=("closed", "literal"), default="closed",
+                        help="tendon load form")
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    parser.add_argument("--plot", metavar="FILE.png", help="draw midline and curvature to a PNG")
+    parser.set_defaults(handler=run)
+
+
+def _overrides(pairs: list[str]) -> dict[str, Any]:
+    values: dict[str, Any] = {}
+    for pair in pairs:
+        name, sep, text = pair.partition("=")
+        if not sep or not name:
+            raise InputError(f"--set {pair!r} is not NAME=VALUE", parameter="--set", value=pair,
+                             allowed="NAME=VALUE with a design field name")
+        values[name.strip()] = parse_field(name.strip(), text.strip())
+    return values
+
+
+def run(args: argparse.Namespace) -> int:
+    """Solve and report; typed errors become exit status 2 (input) or 3 (physics)."""
+    try:
+        overrides = _overrides(args.set)
+        if args.profile:
+            overrides["profile"] = args.profile
+        design = preset(args.design).with_overrides(**overrides)
+        settings = SolverSettings(routing=args.routing, loads=args.loads)
+        result = solve(design, args.tension, settings=settings)
+    except TdcmError as error:
+        if args.json:
+            print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))
+        print(f"tdcm solve: {error}", file=sys.stderr)
+        return error.exit_code
+    if args.json:
+        print(json.dumps(result.summary()))
+    else:
+        x, _, z = result.tip_position * 1e3
+        print(f"design {args.design}: L = {design.length * 1e3:.3f} mm, E = {design.E:.4g} Pa, "
+              f"routing {settings.routing}, loads {settings.loads}")
+        print(f"tension {result.tension_n:g} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
+              f"angle {result.tip_angle_rad:.5f} rad, deflection "
+              f"{result.tip_deflection_m * 1e3:.4f} mm")
+        print(f"converged in {result.iterations} iterations ({result.strategy}), "
+              f"{result.solve_time_s * 1e6:.0f} us")
+    if args.plot:
+        from tdcm_ros.plotting import plot_solution
+
+        plot_solution(result, args.plot)
+        if not args.json:
+            print(f"plot written to {args.plot}")
+    return 0

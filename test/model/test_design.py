@@ -1,0 +1,68 @@
+"""Design validation, presets and overrides."""
+
+import math
+
+import pytest
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.model import (
+    FIELD_SPECS,
+    PRESETS,
+    InvalidDesignError,
+    InvalidSettingsError,
+    SolverSettings,
+    preset,
+)
+
+
+def test_presets_match_the_paper():
+    d = preset("paper-experiment")
+    assert d.length == pytest.approx(0.053)
+    assert (d.w_n, d.w_t, d.w_d, d.R_c, d.N) == (0.002, 0.004, 0.0014, 0.00275, 8)
+    assert d.E == 1.85e9
+    for name in ("fig2-wn-1", "fig2-wn-1.9", "fig2-wn-2.5", "fig3-wd-1.2", "fig3-wd-1.52",
+                 "fig3-wd-2"):
+        sim = PRESETS[name]
+        assert sim.length == pytest.approx(0.053)
+        assert sim.w_t == pytest.approx(0.006 - sim.w_n)
+        assert sim.w_tip == sim.w_t
+    assert PRESETS["fig2-wn-1.9"].w_n == pytest.approx(1.9e-3)
+    assert PRESETS["fig3-wd-1.52"].w_d == pytest.approx(1.52e-3)
+
+
+@pytest.mark.parametrize("name", list(FIELD_SPECS))
+@pytest.mark.parametrize("bad", [-1.0, math.nan, math.inf, 1e13, "x"])
+def test_every_field_rejects_bad_values_with_its_name_and_range(name, bad):
+    if name == "N" and isinstance(bad, float) and bad == 1e13:
+        bad = 10**6
+    with pytest.raises(InvalidDesignError) as info:
+        preset("paper-experiment").with_overrides(**{name: bad})
+    assert info.value.parameter == name
+    assert name in str(info.value) and "allowed" in str(info.value)
+    assert isinstance(info.value, InputError)
+
+
+def test_dependent_ranges_and_unknown_names():
+    with pytest.raises(InvalidDesignError, match="r_inner"):
+        preset("paper-experiment").with_overrides(r_inner=0.004)
+    with pytest.raises(InvalidDesignError, match="unknown design field"):
+        preset("paper-experiment").with_overrides(w_x=1.0)
+    with pytest.raises(InvalidDesignError, match="preset"):
+        preset("nope")
+    with pytest.raises(InvalidDesignError, match="N = 2.5"):
+        preset("paper-experiment").with_overrides(N=2.5)
+
+
+def test_settings_validation():
+    with pytest.raises(InvalidSettingsError, match="routing"):
+        SolverSettings(routing="tight")
+    with pytest.raises(InvalidSettingsError, match="tol"):
+        SolverSettings(tol=0.0)
+    with pytest.raises(InvalidSettingsError, match="cells_per_notch"):
+        SolverSettings(cells_per_notch=0)
+
+
+def test_to_dict_is_si_and_complete():
+    data = preset("paper-experiment").to_dict()
+    assert set(FIELD_SPECS) <= set(data)
+    assert data["profile"] == "circular" and data["L"] == pytest.approx(0.053)

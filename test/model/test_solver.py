@@ -1,0 +1,161 @@
+"""Algorithm 1 on the presets: physics trends, limits, load forms and grid convergence."""
+
+from itertools import pairwise
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from tdcm_ros.model import (
+    PRESETS,
+    ConvergenceError,
+    NotchClosureError,
+    SolverSettings,
+    TendonSingularityError,
+    TensionRangeError,
+    preset,
+    solve,
+)
+from tdcm_ros.model.section import notched_moment
+
+REFERENCE = SolverSettings(cells_per_notch=128, cells_per_tube=16, quad_order=12, tol=1e-14)
+
+
+def linear_tip_x(design, tension: float) -> float:
+    """Small-angle solution from first principles: x(L) = R_c T int_0^L (L - s) / (E I(s)) ds,
+    with I(s) from eqs. 12-13 written directly in s (independent of the solver's grid)."""
+    length = design.length
+
+    def compliance(s: float) -> float:
+        left, right = design.notch_bounds()
+        for lo, hi in zip(left, right):
+            if lo < s < hi:
+                centre = 0.5 * (lo + hi)
+                half = design.w_n / 2
+                h1 = (design.w_n + design.w_d) / 2 - np.sqrt(max(half**2 - (s - centre) ** 2, 0))
+                return 1.0 / (design.E * float(notched_moment(h1, design.R_outer, design.r_inner)))
+        return 1.0 / (design.E * design.tube_second_moment)
+
+    breaks = sorted({0.0, length, *design.notch_bounds()[0], *design.notch_bounds()[1]})
+    total = sum(quad(lambda s: (length - s) * compliance(s), a, b, limit=200, epsrel=1e-12)[0]
+                for a, b in pairwise(breaks))
+    return design.R_c * tension * total
+
+
+def test_zero_tension_is_exactly_straight():
+    result = solve(preset("paper-experiment"), 0.0)
+    assert np.all(result.positions[:, 0] == 0.0)
+    assert np.all(result.theta == 0.0)
+    assert np.allclose(result.positions[:, 2], result.s, rtol=0, atol=1e-15)
+    assert result.converged and result.tip_deflection_m == 0.0
+
+
+@pytest.mark.parametrize("name", list(PRESETS))
+def test_small_load_matches_linear_solution(name):
+    design = preset(name)
+    tension = 1e-3
+    expected = linear_tip_x(design, tension)
+    # The default grid is within 1e-4 (the 1 um budget at 20 N); a fine grid matches closely.
+    assert solve(design, tension).tip_position[0] == pytest.approx(expected, rel=1e-4)
+    assert solve(design, tension, settings=REFERENCE).tip_position[0] == pytest.approx(
+        expected, rel=1e-8)
+
+
+def test_deflection_grows_with_tension_and_notch_width_and_falls_with_backbone():
+    tensions = np.arange(0.0, 20.01, 2.0)
+    for name in PRESETS:
+        tips = [solve(preset(name), t).tip_deflection_m for t in tensions]
+        assert np.all(np.diff(tips) > 0), name
+    wn = [solve(preset(f"fig2-wn-{w}"), 20).tip_deflection_m for w in ("1", "1.9", "2.5")]
+    wd = [solve(preset(f"fig3-wd-{w}"), 20).tip_deflection_m for w in ("1.2", "1.52", "2")]
+    assert wn[0] < wn[1] < wn[2]
+    assert wd[0] > wd[1] > wd[2]
+
+
+@pytest.mark.parametrize("name", list(PRESETS))
+def test_default_setting_within_one_micron_of_converged_reference(name):
+    for tension in (4.0, 20.0):
+        default = solve(preset(name), tension).tip_position
+        reference = solve(preset(name), tension, settings=REFERENCE).tip_position
+        assert np.linalg.norm(default - reference) < 1e-6
+
+
+def test_tip_converges_at_second_order_where_moments_vary_inside_cells():
+    # Free routing: the chord moment varies inside notch cells, linear in each cell -> O(h^2).
+    design = preset("paper-experiment")
+    base = {"routing": "free", "cells_per_tube": 4, "quad_order": 8, "tol": 1e-14}
+    ref = solve(design, 20, settings=SolverSettings(cells_per_notch=512, **base)).tip_position
+    errors = [np.linalg.norm(solve(design, 20, settings=SolverSettings(cells_per_notch=c, **base))
+                             .tip_position - ref) for c in (16, 32, 64)]
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all((orders > 1.7) & (orders < 2.5)), orders
+
+
+def test_literal_loads_converge_to_closed_form_as_cells_refine():
+    design = preset("paper-experiment")
+    gaps = []
+    for cells in (1, 2, 4, 8):
+        st = SolverSettings(cells_per_notch=cells, cells_per_tube=cells, tol=1e-13)
+        closed = solve(design, 20, settings=st).tip_position
+        literal = solve(design, 20, settings=st.with_overrides(loads="literal")).tip_position
+        gaps.append(np.linalg.norm(closed - literal))
+    assert all(a > 4 * b for a, b in pairwise(gaps)), gaps
+    assert gaps[-1] < 1e-9
+
+
+def test_pose_at_agrees_with_nodes_and_quaternions_rotate_z_to_tangent():
+    result = solve(preset("fig2-wn-2.5"), 20)
+    positions, quats = result.pose_at(result.s)
+    assert np.allclose(positions, result.positions, atol=1e-12)
+    x, y, z, w = quats.T
+    tangent_x = 2 * (x * z + w * y)
+    tangent_z = 1 - 2 * (x * x + y * y)
+    assert np.allclose(tangent_x, np.sin(result.theta)) and np.allclose(tangent_z,
+                                                                        np.cos(result.theta))
+    # Finite differences of pose_at give the tangent of the quaternion (away from cell
+    # boundaries, where two quadratures meet with a ~1e-12 m mismatch).
+    s = np.linspace(1e-3, result.design.length - 1e-3, 37)
+    h = 1e-7
+    s = s[np.min(np.abs(s[:, None] - result.s[None, :]), axis=1) > 10 * h]
+    ahead, _ = result.pose_at(s + h)
+    behind, _ = result.pose_at(s - h)
+    _, q = result.pose_at(s)
+    derivative = (ahead - behind) / (2 * h)
+    assert np.allclose(derivative[:, 0], 2 * (q[:, 0] * q[:, 2] + q[:, 3] * q[:, 1]), atol=1e-6)
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf"), "abc", None])
+def test_bad_tension_is_a_typed_error(bad):
+    with pytest.raises(TensionRangeError) as info:
+        solve(preset("paper-experiment"), bad)
+    assert info.value.parameter == "tension"
+
+
+def test_singularity_and_closure_are_typed():
+    design = preset("paper-experiment")
+    with pytest.raises(TendonSingularityError) as info:
+        solve(design, 1000.0)
+    assert info.value.rc_kappa >= 1.0
+    # A rectangular notch bends uniformly, so its faces close before the tendon path cusps.
+    with pytest.raises(NotchClosureError) as closure:
+        solve(design.with_overrides(profile="rectangular"), 200.0)
+    assert closure.value.gap_m <= 0.0 and 1 <= closure.value.notch <= design.N
+
+
+def test_non_convergence_is_typed_and_keeps_a_finite_iterate():
+    design = preset("paper-experiment").with_overrides(w_d=0.01, E=1e7)
+    tight = SolverSettings(max_iter=2, tol=1e-14, acceleration="none")
+    with pytest.raises(ConvergenceError) as info:
+        solve(design, 20.0, settings=tight)
+    assert info.value.result is not None and not info.value.result.converged
+    assert np.all(np.isfinite(info.value.result.positions))
+    loose = solve(design, 20.0, settings=tight, strict=False)
+    assert not loose.converged and len(loose.residual_history) == 2
+
+
+def test_warm_start_reaches_the_same_shape():
+    design = preset("paper-experiment").with_overrides(w_d=0.01, E=1e7)
+    cold = solve(design, 20.0)
+    warm = solve(design, 21.0, warm_start=cold)
+    again = solve(design, 21.0)
+    assert np.allclose(warm.positions, again.positions, atol=1e-9)
