@@ -1,0 +1,127 @@
+"""Nodes in separate processes over a zenoh router on a private loopback port."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import stop, wait_for
+
+from tdcm_ros.bagio import from_dict, to_dict
+from tdcm_ros.runtime.port import QoS
+
+Spawn = Callable[..., subprocess.Popen[bytes]]
+TALKER = "tdcm_ros.nodes.talker:Talker"
+
+
+@pytest.fixture
+def context(router: subprocess.Popen[bytes]) -> Iterator[Any]:
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    ctx = ZenohContext()
+    yield ctx
+    ctx.close()
+
+
+def spin_until(ctx: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        ctx.spin_for(0.05)
+
+
+def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
+    values = ("{header: {frame_id: tdcm_base, stamp: {sec: 5, nanosec: 7}}, "
+              "wrench: {force: {z: 20.0}}}")
+    port = context.create_port("listener")
+    got: list[Any] = []
+    raw: list[Any] = []
+    port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", got.append)
+    port.create_raw_subscription("tension", "geometry_msgs/msg/WrenchStamped", raw.append)
+    spawn("tdcm_ros.cli.main", "topic", "pub", "tension", "geometry_msgs/msg/WrenchStamped",
+          values, "--rate", "20")
+    spin_until(context, lambda: len(got) >= 2 and len(raw) >= 2, 15.0, "tension messages")
+    expected = from_dict("geometry_msgs/msg/WrenchStamped",
+                         {"header": {"frame_id": "tdcm_base", "stamp": {"sec": 5, "nanosec": 7}},
+                          "wrench": {"force": {"z": 20.0}}})
+    assert to_dict(got[0]) == to_dict(expected)
+    first, second = raw[0].attachment, raw[1].attachment
+    assert second.sequence_number == first.sequence_number + 1 and first.gid == second.gid
+    assert abs(first.source_timestamp_ns - time.time_ns()) < 30e9
+
+    from tdcm_ros.runtime.zenoh_runtime import graph_tokens
+
+    def publishers() -> list[tuple[str, str, str]]:
+        return [(t.topic, t.type_name, t.node_name) for t in graph_tokens(context.session, 0)
+                if t.kind == "MP"]
+
+    wait_for(lambda: publishers() == [("/tension", "geometry_msgs/msg/WrenchStamped",
+                                       "_tdcm_topic")], 10.0, "the publisher's liveliness token")
+
+
+def test_parameter_change_at_runtime(context: Any, spawn: Spawn, tmp_path: Path) -> None:
+    from tdcm_ros.runtime.zenoh_runtime import call_parameters
+
+    params = tmp_path / "params.yaml"
+    params.write_text("talker:\n  ros__parameters:\n    period: 0.05\n    prefix: p1\n")
+    texts: list[str] = []
+    context.create_port("listener").create_subscription(
+        "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data), QoS(depth=50))
+    spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(params))
+    spin_until(context, lambda: any(t.startswith("p1 ") for t in texts), 15.0, "p1 messages")
+
+    answer = call_parameters(context.session, 0, "/talker", "set", {"name": "prefix",
+                                                                    "value": "p2"})
+    assert answer == {"successful": True, "reason": ""}
+    spin_until(context, lambda: texts[-1].startswith("p2 "), 5.0, "p2 messages")
+
+    bad = call_parameters(context.session, 0, "/talker", "set", {"name": "period",
+                                                                 "value": -1.0})
+    assert not bad["successful"] and "out of range" in bad["reason"]
+    assert call_parameters(context.session, 0, "/talker", "get", {"name": "period"}) == {
+        "value": 0.05}
+
+
+def test_subscriber_survives_publisher_restart(context: Any, spawn: Spawn) -> None:
+    texts: list[str] = []
+    context.create_port("listener").create_subscription(
+        "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
+    first = spawn("tdcm_ros.runtime.run_node", TALKER)
+    spin_until(context, lambda: len(texts) >= 1, 15.0, "the first talker")
+    assert stop(first) == 0
+    texts.clear()
+    spawn("tdcm_ros.runtime.run_node", TALKER)
+    spin_until(context, lambda: "hello 1" in texts or "hello 2" in texts, 15.0,
+               "the restarted talker")
+
+
+def _children(pid: int) -> list[int]:
+    found: list[int] = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        found += [int(p) for p in (task / "children").read_text().split()]
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+def test_tdcm_up_sigint_stops_every_child(zenoh_env: dict[str, str], spawn: Spawn) -> None:
+    launcher = spawn("tdcm_ros.cli.main", "up")
+    wait_for(lambda: len(_children(launcher.pid)) == 2, 15.0, "router and talker processes")
+    children = _children(launcher.pid)
+    echo = spawn("tdcm_ros.cli.main", "topic", "echo", "chatter", "--once")
+    assert b"data: hello" in echo.communicate(timeout=20)[0]
+    launcher.send_signal(signal.SIGINT)
+    assert launcher.wait(15) == 0
+    assert not [pid for pid in children if _alive(pid)]
