@@ -1,0 +1,66 @@
+"""The ``tdcm solve`` contract: exit codes, JSON keys, overrides and the plot."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from tdcm_ros.cli.main import main
+from tdcm_ros.model import preset, solve
+
+KEYS = {"converged", "iterations", "tension_n", "tip_position_m", "tip_angle_rad",
+        "tip_deflection_m", "tip_displacement_m", "solve_time_s", "design"}
+
+
+def run_json(capsys, *args):
+    status = main(["solve", *args, "--json"])
+    out = capsys.readouterr()
+    return status, json.loads(out.out), out.err
+
+
+def test_json_contract_matches_library(capsys):
+    status, data, _ = run_json(capsys, "--design", "paper-experiment", "--tension", "20")
+    assert status == 0 and KEYS <= set(data)
+    expected = solve(preset("paper-experiment"), 20.0)
+    assert data["tip_position_m"] == pytest.approx(expected.tip_position.tolist(), abs=1e-15)
+    assert data["tip_deflection_m"] == pytest.approx(expected.tip_deflection_m)
+    assert data["design"]["E"] == 1.85e9 and data["design"]["L"] == pytest.approx(0.053)
+
+
+def test_overrides_profile_and_routing(capsys):
+    _, base, _ = run_json(capsys, "--tension", "10")
+    _, soft, _ = run_json(capsys, "--tension", "10", "--set", "E=1.2e9", "--set", "w_d=0.0014")
+    _, rect, _ = run_json(capsys, "--tension", "10", "--profile", "rectangular")
+    _, free, _ = run_json(capsys, "--tension", "10", "--routing", "free")
+    assert soft["design"]["E"] == 1.2e9 and soft["tip_deflection_m"] > base["tip_deflection_m"]
+    assert rect["design"]["profile"] == "rectangular"
+    assert rect["tip_deflection_m"] > base["tip_deflection_m"]
+    assert free["tip_deflection_m"] != base["tip_deflection_m"]
+
+
+@pytest.mark.parametrize(("args", "status", "kind"), [
+    (["--tension", "-1"], 2, "tension_out_of_range"),
+    (["--tension", "nan"], 2, "tension_out_of_range"),
+    (["--tension", "inf"], 2, "tension_out_of_range"),
+    (["--tension", "20", "--set", "w_n=-1"], 2, "invalid_design"),
+    (["--tension", "20", "--set", "bogus=1"], 2, "invalid_design"),
+    (["--tension", "20", "--set", "novalue"], 2, "input"),
+    (["--tension", "5000"], 3, "tendon_singularity"),
+    (["--tension", "200", "--profile", "rectangular"], 3, "notch_closure"),
+])
+def test_errors_exit_codes_and_json(capsys, args, status, kind):
+    code = main(["solve", *args, "--json"])
+    out = capsys.readouterr()
+    assert code == status
+    assert json.loads(out.out)["error"]["kind"] == kind
+    assert len(out.err.strip().splitlines()) == 1 and out.err.startswith("tdcm solve:")
+
+
+def test_console_script_and_plot(tmp_path):
+    png = tmp_path / "shape.png"
+    proc = subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "solve", "--tension", "20",
+                           "--plot", str(png)], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "tip" in proc.stdout and png.stat().st_size > 10_000
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
