@@ -25,6 +25,7 @@ setup(
         "rosbags>=0.10.4",
         "mcap>=1.1",
         "PyYAML>=6",
+        "eclipse-zenoh==1.6.2",
     ],
     extras_require={
         "plot": ["matplotlib>=3.7"],
@@ -39,6 +40,8 @@ setup(
     entry_points={
         "console_scripts": [
             "tdcm = tdcm_ros.cli.main:main",
+            "tdcm_node = tdcm_ros.runtime.run_node:main",
+            "tdcm_talker = tdcm_ros.nodes.talker:main",
         ],
     },
 )

@@ -108,12 +108,15 @@ class ParameterStore:
         self._values: dict[str, ParamValue] = {}
         self._callbacks: list[SetCallback] = []
 
-    def declare(self, spec: ParamSpec) -> ParamValue:
-        """Declare ``spec``; the value is the override (YAML/CLI) if given, else the default."""
+    def declare(self, spec: ParamSpec, value: Any = None) -> ParamValue:
+        """Declare ``spec``; its value is ``value`` if given (a runtime resolved it), else the
+        override (YAML) if any, else the default; checked against the spec."""
         if spec.name in self._specs:
             raise InputError(f"parameter {spec.name!r} is declared twice", parameter=spec.name)
         spec.coerce(spec.default)
-        value = spec.coerce(self._overrides.get(spec.name, spec.default))
+        if value is None:
+            value = self._overrides.get(spec.name, spec.default)
+        value = spec.coerce(value)
         self._specs[spec.name] = spec
         self._values[spec.name] = value
         return value

@@ -18,7 +18,6 @@ Messages are rosbags objects (:mod:`tdcm_ros.bagio`); both runtimes carry their 
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar, Literal, Protocol
@@ -75,12 +74,28 @@ class Timer(Protocol):
         """Stop the timer; its callback is not called again."""
 
 
+class Logger(Protocol):
+    """%-style logger (``logging.Logger`` fits; the rclpy adapter wraps rclpy's)."""
+
+    def debug(self, msg: str, *args: object) -> None:
+        """Log at DEBUG."""
+
+    def info(self, msg: str, *args: object) -> None:
+        """Log at INFO."""
+
+    def warning(self, msg: str, *args: object) -> None:
+        """Log at WARNING."""
+
+    def error(self, msg: str, *args: object) -> None:
+        """Log at ERROR."""
+
+
 class NodePort(Protocol):
     """What a runtime offers a node. Callbacks run one at a time, never concurrently."""
 
     node_name: str
     namespace: str
-    logger: logging.Logger
+    logger: Logger
 
     def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
                           range: tuple[float, float] | None = None,
