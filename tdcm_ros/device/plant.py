@@ -74,9 +74,12 @@ class Plant:
     def step(self, pulse_us: int, dt: float) -> None:
         """Move the actuator toward the pulse's position for ``dt`` s."""
         cfg = self.config
-        speed = (self.target(pulse_us) - self.position) / cfg.lag
-        speed = min(max(speed, -cfg.rate), cfg.rate)
-        self.position += speed * min(dt, cfg.lag)
+        target = self.target(pulse_us)
+        substeps = max(1, math.ceil(dt / cfg.lag))  # explicit Euler stays stable for h <= lag
+        h = dt / substeps
+        for _ in range(substeps):
+            speed = min(max((target - self.position) / cfg.lag, -cfg.rate), cfg.rate)
+            self.position += speed * h
 
     @property
     def tension(self) -> float:

@@ -114,8 +114,8 @@ def mismatches(steps: Sequence[dict[str, Any]], output: str) -> list[str]:
     """Human-readable differences between the expectations and ``output`` (empty: all match)."""
     expected = [step["expect"] for step in steps if "expect" in step]
     got = segments(output)
-    problems = [] if len(got) == len(expected) else [f"{len(got)} segments, expected "
-                                                      f"{len(expected)}"]
+    problems = [] if len(got) == len(expected) else [
+        f"{len(got)} segments, expected {len(expected)}"]
     for index, (want, have) in enumerate(zip(expected, got, strict=False)):
         if want != have:
             problems.append(f"expect #{index + 1}: wanted {want}, got {have}")

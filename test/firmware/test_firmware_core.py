@@ -13,7 +13,13 @@ import pytest
 
 from tdcm_ros.device import constants
 from tdcm_ros.device.protocol import Mode, SetMode, SetSetpoint, encode
-from tdcm_ros.device.transcript import load, mismatches, run_core, run_harness, to_script
+from tdcm_ros.device.transcript import (
+    load,
+    mismatches,
+    run_core,
+    run_harness,
+    to_script,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 FIRMWARE = ROOT / "firmware"

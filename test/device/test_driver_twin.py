@@ -1,0 +1,165 @@
+"""Integration over a real pty: the driver core against the device twin, in lock-step simulated
+time (the twin advances, then the driver steps; no sleeping)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from tdcm_ros.device import constants as c
+from tdcm_ros.device.driver import (
+    DriverConfig,
+    Level,
+    LinkState,
+    StepResult,
+    TensionDriver,
+)
+from tdcm_ros.device.protocol import Fault, Mode, Telemetry
+from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+
+DT = 0.005  # s of simulated time per exchange
+
+
+class Bench:
+    """Twin behind a pty (exposed as a symlink) plus a driver reading its simulated clock."""
+
+    def __init__(self, tmp_path: Path, **config: float) -> None:
+        self.twin = DeviceTwin()
+        self.pty = PtyTwin(self.twin, link=str(tmp_path / "tdcm_port"))
+        self.warnings: list[str] = []
+        self.driver = TensionDriver(DriverConfig(port=self.pty.port, **config),
+                                    clock=lambda: self.twin.time, warn=self.warnings.append)
+        self.telemetry: list[Telemetry] = []
+        self.last: StepResult | None = None
+
+    def run(self, seconds: float, *, host: bool = True) -> None:
+        """Advance ``seconds``; with ``host=False`` the driver is silent (a crashed host)."""
+        end = self.twin.time + seconds
+        while self.twin.time < end - 1e-9:
+            self.pty.pump(DT)
+            if host:
+                self.last = self.driver.step()
+                self.telemetry.extend(self.last.telemetry)
+
+    def run_until_connected(self) -> None:
+        for _ in range(400):
+            self.run(DT)
+            if self.last is not None and self.last.status.link is LinkState.CONNECTED:
+                return
+        raise AssertionError(f"no handshake: {self.last}")
+
+
+@pytest.fixture
+def bench(tmp_path: Path) -> Iterator[Bench]:
+    made = Bench(tmp_path)
+    yield made
+    made.driver.close()
+    made.pty.stop()
+
+
+def test_handshake_reads_the_banner(bench: Bench) -> None:
+    bench.run_until_connected()
+    status = bench.driver.step().status
+    assert status.banner is not None and status.banner.cell == "TWIN"
+    assert status.banner.watchdog == c.WATCHDOG_MS / 1000
+
+
+def test_step_0_to_20_n_settles(bench: Bench) -> None:
+    """Band +-0.25 N, entered within 2.0 s of the step command and kept for 2 s."""
+    bench.run_until_connected()
+    bench.driver.enable()
+    bench.run(0.5)
+    assert bench.telemetry[-1].mode is Mode.TENSION and abs(bench.telemetry[-1].tension) < 0.1
+    start = bench.twin.time
+    bench.driver.set_setpoint(20.0)
+    bench.run(4.5)
+    after = [t for t in bench.telemetry if t.time > start]
+    outside = [t.time - start for t in after if abs(t.tension - 20.0) > 0.25]
+    settle = max(outside)
+    print(f"\n0->20 N step: settled into +-0.25 N after {settle:.2f} s, "
+          f"peak {max(t.tension for t in after):.3f} N")
+    assert settle <= 2.0
+    assert after[-1].time - start - settle >= 2.0
+    assert max(t.tension for t in after) < 20.25
+    assert bench.last is not None and bench.last.status.level is Level.OK
+
+
+def test_setpoint_above_max_is_clamped_with_a_warning(bench: Bench) -> None:
+    bench.run_until_connected()
+    bench.driver.enable()
+    assert bench.driver.set_setpoint(35.0) == 20.0
+    assert any("setpoint = 35 N" in w and "clamped to 20 N" in w for w in bench.warnings)
+    bench.run(3.0)
+    assert bench.twin.core.setpoint_mn == 20000
+    assert abs(bench.telemetry[-1].tension - 20.0) < 0.25
+    assert bench.driver.set_setpoint(-1.0) == 0.0
+
+
+def test_estop_releases_at_once(bench: Bench) -> None:
+    bench.run_until_connected()
+    bench.driver.enable()
+    bench.driver.set_setpoint(8.0)
+    bench.run(2.0)
+    assert bench.twin.plant.tension > 7.0
+    bench.driver.estop()
+    bench.pty.pump(0.001)  # the E frame is handled as soon as it arrives
+    assert bench.twin.core.pulse_us == c.PULSE_RELEASE_US
+    assert bench.twin.core.mode is Mode.RELEASE
+    bench.run(0.3)
+    assert bench.twin.plant.tension == 0.0
+    assert bench.telemetry[-1].faults & Fault.ESTOP
+    assert bench.last is not None and bench.last.status.level is Level.ERROR
+    bench.driver.clear_faults()
+    bench.run(0.1)
+    assert not bench.telemetry[-1].faults
+    assert bench.telemetry[-1].mode is Mode.RELEASE  # e-stop also disabled the driver
+
+
+def test_reopened_pty_triggers_a_reconnect(bench: Bench) -> None:
+    bench.run_until_connected()
+    old_path = bench.pty.pty_path
+    bench.pty.reopen()
+    assert bench.pty.pty_path != old_path
+    bench.run(0.05)
+    assert bench.last is not None and bench.last.status.link is LinkState.DISCONNECTED
+    assert any("link lost" in w for w in bench.warnings)
+    bench.run_until_connected()
+    count = len(bench.telemetry)
+    bench.run(0.2)
+    assert len(bench.telemetry) > count
+    assert bench.last.status.reconnects == 1
+
+
+def test_silent_host_releases_within_the_watchdog(bench: Bench) -> None:
+    """Released at the first control tick at least WATCHDOG_MS after the host's last byte."""
+    bench.run_until_connected()
+    bench.driver.enable()
+    bench.driver.set_setpoint(8.0)
+    bench.run(1.5)
+    core = bench.twin.core
+    assert core.mode is Mode.TENSION
+    while core.mode is Mode.TENSION and bench.twin.time < 5.0:
+        bench.pty.pump(0.001)  # the device runs on; the host says nothing
+    delay = (bench.twin.now_ms - core.last_rx_ms) / 1000
+    print(f"\nwatchdog: released {delay:.3f} s after the last host byte")
+    assert c.WATCHDOG_MS / 1000 <= delay <= (c.WATCHDOG_MS + c.CONTROL_PERIOD_MS) / 1000
+    assert core.faults & Fault.WATCHDOG and core.pulse_us == c.PULSE_RELEASE_US
+    bench.run(0.3, host=False)
+    assert bench.twin.plant.tension == 0.0
+
+
+def test_schedule_runs_the_staircase(bench: Bench) -> None:
+    bench.run_until_connected()
+    bench.driver.enable()
+    bench.driver.run_schedule(StepSchedule(hold=1.5, trials=2))
+    targets: list[float] = []
+    for _ in range(int(18.5 / 0.25)):
+        bench.run(0.25)
+        assert bench.last is not None
+        targets.append(bench.last.status.target)
+    assert [t for i, t in enumerate(targets) if i == 0 or t != targets[i - 1]] \
+        == [0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 0.0]
+    assert not bench.driver.schedule_running
