@@ -1,0 +1,152 @@
+"""The batch solver gives the single solve's answers and statuses, member by member."""
+
+import numpy as np
+import pytest
+
+from tdcm_ros.model import (
+    CustomProfile,
+    InvalidDesignError,
+    ModelError,
+    RectangularProfile,
+    SolverSettings,
+    TensionRangeError,
+    batch,
+    preset,
+    solve,
+)
+from tdcm_ros.model.batch import solve_batch
+from tdcm_ros.model.section import notched_moment
+
+STATUS_OF_KIND = {"tendon_singularity": "singularity", "notch_closure": "closure",
+                  "non_convergence": "non_convergence"}
+
+
+def random_designs(seed: int, count: int) -> list:
+    """Paper-like designs over wide ranges, several cell layouts (N, empty segments)."""
+    rng = np.random.default_rng(seed)
+    base = preset("paper-experiment")
+    designs = []
+    for _ in range(count):
+        designs.append(base.with_overrides(
+            N=int(rng.choice([2, 5, 8])), w_n=rng.uniform(0.4e-3, 3e-3),
+            w_t=float(rng.choice([0.0, rng.uniform(1e-3, 5e-3)])), w_d=rng.uniform(0.5e-3, 2.5e-3),
+            w_tip=float(rng.choice([0.0, rng.uniform(1e-3, 5e-3)])), w_base=rng.uniform(0, 6e-3),
+            R_c=rng.uniform(1.5e-3, 3.5e-3), E=rng.uniform(0.8e9, 2.5e9),
+            profile=RectangularProfile() if rng.random() < 0.3 else base.profile))
+    return designs
+
+
+def single(design, tension, settings):
+    """(status, tip position or None, iterations) of the single solve."""
+    try:
+        result = solve(design, tension, settings=settings)
+    except ModelError as error:
+        return STATUS_OF_KIND[error.kind], None
+    return "ok", result.tip_position
+
+
+SETTINGS = [
+    SolverSettings(),
+    SolverSettings(routing="free"),
+    SolverSettings(acceleration="none", max_iter=40),
+    SolverSettings(acceleration="relaxation"),
+    SolverSettings(acceleration="anderson"),
+    SolverSettings(cells_per_notch=3, quad_order=2, tol=1e-8),
+]
+
+
+@pytest.mark.parametrize("settings", SETTINGS, ids=lambda s: f"{s.routing}-{s.acceleration}")
+def test_batch_equals_single_solves_on_random_designs(settings):
+    designs = random_designs(seed=7, count=30)
+    tensions = np.random.default_rng(3).uniform(0.0, 60.0, (30, 4))
+    result = solve_batch(designs, tensions, settings=settings)
+    statuses = set()
+    for i, design in enumerate(designs):
+        for k in range(tensions.shape[1]):
+            status, tip = single(design, tensions[i, k], settings)
+            assert result.status[i, k] == status, (i, k, result.message[i, k])
+            statuses.add(status)
+            if tip is None:
+                assert np.all(np.isnan(result.tip_position[i, k]))
+            else:
+                np.testing.assert_allclose(result.tip_position[i, k], tip, rtol=0, atol=1e-12)
+    assert "ok" in statuses and len(statuses) >= 2  # the sample reaches a model limit too
+
+
+def test_literal_loads_fall_back_to_single_solves():
+    designs = [preset("paper-experiment"), preset("fig3-wd-1.2")]
+    settings = SolverSettings(loads="literal")
+    result = solve_batch(designs, [4.0, 12.0], settings=settings)
+    assert result.fallback.all() and result.ok.all()
+    for i, (design, tension) in enumerate(zip(designs, [4.0, 12.0])):
+        tip = solve(design, tension, settings=settings).tip_position
+        np.testing.assert_allclose(result.tip_position[i], tip, rtol=0, atol=1e-12)
+
+
+def test_chunking_and_grouping_do_not_change_answers(monkeypatch):
+    designs = random_designs(seed=11, count=12)
+    tensions = np.linspace(0.0, 25.0, 12 * 9).reshape(12, 9)
+    whole = solve_batch(designs, tensions)
+    monkeypatch.setattr(batch, "CHUNK", 5)
+    chunked = solve_batch(designs, tensions)
+    np.testing.assert_array_equal(whole.status, chunked.status)
+    np.testing.assert_allclose(whole.tip_position, chunked.tip_position, rtol=0, atol=1e-15)
+    pairs = solve_batch(designs[::-1], tensions[::-1, 4])
+    np.testing.assert_allclose(pairs.tip_deflection_m, whole.tip_deflection_m[::-1, 4],
+                               rtol=0, atol=1e-15)
+
+
+def test_outputs_match_single_result_fields():
+    design = preset("fig2-wn-1.9")
+    result = solve_batch([design], [[5.0, 20.0]])
+    assert result.tip_position.shape == (1, 2, 3)
+    one = solve(design, 20.0)
+    assert result.tip_angle_rad[0, 1] == pytest.approx(one.tip_angle_rad, abs=1e-13)
+    assert result.tip_deflection_m[0, 1] == pytest.approx(one.tip_deflection_m, abs=1e-13)
+    assert result.iterations[0, 1] == one.iterations
+    assert not result.fallback.any()
+
+
+def test_max_bending_strain_closed_form_for_rectangular_notch():
+    # Paper routing: the moment in a notch is exactly R_c T; a rectangular notch has
+    # h1 = w_d/2 and a uniform section, so the strain is R_c T (w_d/2) / (E I(w_d/2)).
+    design = preset("paper-experiment").with_overrides(profile=RectangularProfile())
+    tension = 12.0
+    result = solve_batch([design], [tension])
+    inertia = float(notched_moment(design.w_d / 2, design.R_outer, design.r_inner))
+    expected = design.R_c * tension * (design.w_d / 2) / (design.E * inertia)
+    assert result.max_bending_strain[0] == pytest.approx(expected, rel=1e-12)
+
+
+def test_max_bending_strain_bounds_curvature_profile():
+    design = preset("fig3-wd-1.2")
+    result = solve_batch([design], [20.0])
+    s, kappa = solve(design, 20.0).curvature_profile
+    left, right = design.notch_bounds()
+    inside = np.zeros_like(s, dtype=bool)
+    for lo, hi in zip(left, right):
+        inside |= (s >= lo) & (s <= hi)
+    # The smallest fibre distance in a notch is w_d/2 at its centre, which is a sample.
+    centre_strain = np.max(np.abs(kappa[inside])) * design.w_d / 2
+    assert result.max_bending_strain[0] == pytest.approx(centre_strain, rel=1e-9)
+
+
+def test_invalid_members_are_marked_not_raised():
+    design = preset("paper-experiment")
+    result = solve_batch([design, design, design], [-1.0, np.nan, 3.0])
+    assert list(result.status) == ["invalid", "invalid", "ok"]
+    assert "tension" in result.message[0] and np.isnan(result.tip_deflection_m[0])
+    bad_profile = design.with_overrides(profile=CustomProfile(lambda s: -1.0 + 0.0 * s))
+    result = solve_batch([bad_profile, design], [2.0, 2.0])
+    assert list(result.status) == ["invalid", "ok"]
+    assert "h1(s)" in result.message[0]
+
+
+def test_bad_arguments_raise_typed_errors():
+    design = preset("paper-experiment")
+    with pytest.raises(TensionRangeError, match="tensions"):
+        solve_batch([design, design], [1.0, 2.0, 3.0])
+    with pytest.raises(TensionRangeError, match="tensions"):
+        solve_batch([design], "abc")
+    with pytest.raises(InvalidDesignError, match=r"designs\[1\]"):
+        solve_batch([design, "paper-experiment"], [1.0, 2.0])
