@@ -25,6 +25,7 @@ setup(
         "rosbags>=0.10.4",
         "mcap>=1.1",
         "PyYAML>=6",
+        "pyserial>=3.5",
         "eclipse-zenoh==1.6.2",
     ],
     extras_require={
