@@ -79,7 +79,8 @@ def session_config(*, mode: str = "peer", router_endpoint: str | None = None) ->
     """Zenoh config: the ``TDCM_ZENOH_CONFIG`` file, else loopback defaults like rmw_zenoh's.
 
     ``peer``: connect to the router, listen on an ephemeral loopback port. ``router``: listen on
-    the endpoint. Multicast scouting is off; gossip scouting (zenoh's default) finds peers.
+    the endpoint. Multicast scouting is off; gossip scouting (zenoh's default) finds peers;
+    timestamping is on (as in rmw_zenoh's configs; transient-local publishers need it).
     """
     path = os.environ.get(CONFIG_ENV)
     if path:
@@ -91,6 +92,8 @@ def session_config(*, mode: str = "peer", router_endpoint: str | None = None) ->
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps(mode))
     config.insert_json5("scouting/multicast/enabled", "false")
+    config.insert_json5("timestamping/enabled",
+                        json.dumps({"router": True, "peer": True, "client": True}))
     if mode == "router":
         config.insert_json5("listen/endpoints", json.dumps([target]))
     else:

@@ -125,3 +125,20 @@ def test_tdcm_up_sigint_stops_every_child(zenoh_env: dict[str, str], spawn: Spaw
     launcher.send_signal(signal.SIGINT)
     assert launcher.wait(15) == 0
     assert not [pid for pid in children if _alive(pid)]
+
+
+def test_transient_local_reaches_late_subscriber(context: Any) -> None:
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    latched = QoS(depth=1, durability="transient_local")
+    publisher = context.create_port("latched").create_publisher("config", "std_msgs/msg/String",
+                                                                latched)
+    publisher.publish(from_dict("std_msgs/msg/String", {"data": "v1"}))
+    late = ZenohContext()
+    try:
+        got: list[str] = []
+        late.create_port("late").create_subscription("config", "std_msgs/msg/String",
+                                                     lambda m: got.append(m.data), latched)
+        spin_until(late, lambda: got == ["v1"], 10.0, "the cached sample")
+    finally:
+        late.close()
