@@ -150,3 +150,19 @@ def test_bad_arguments_raise_typed_errors():
         solve_batch([design], "abc")
     with pytest.raises(InvalidDesignError, match=r"designs\[1\]"):
         solve_batch([design, "paper-experiment"], [1.0, 2.0])
+
+
+def test_members_that_slow_down_are_handed_to_the_single_solve():
+    # A thin, soft tube under free routing: Picard contracts by 0.96 on its second step, so
+    # ``solve`` switches to Anderson; the batch must hand that member over, not keep going.
+    slow = preset("paper-experiment").with_overrides(
+        w_n=3.630792315e-3, w_t=0.0, w_d=1.5174998e-3, N=7, R_outer=1.0534322645e-3,
+        r_inner=0.8736510869e-3, R_c=0.5435634725e-3, E=1.0907326125e9)
+    settings = SolverSettings(routing="free")
+    fast = preset("paper-experiment")
+    result = solve_batch([slow, fast], [166.53792605525183, 5.0], settings=settings)
+    one = solve(slow, 166.53792605525183, settings=settings)
+    assert one.strategy == "picard+anderson" and one.iterations > 3
+    assert list(result.fallback) == [True, False]
+    assert result.iterations[0] == one.iterations
+    np.testing.assert_allclose(result.tip_position[0], one.tip_position, rtol=0, atol=1e-12)
