@@ -20,6 +20,7 @@ SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.up",
     "tdcm_ros.cli.topic",
     "tdcm_ros.cli.param",
+    "tdcm_ros.cli.bench",
 )
 
 

@@ -1,0 +1,44 @@
+"""``tdcm bench accuracy``: tip error against time for every method and accuracy knob."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``bench`` subcommand with its ``accuracy`` benchmark."""
+    parser = subparsers.add_parser("bench", help="benchmarks that print measured figures",
+                                   description="Benchmarks that print measured figures.")
+    benches = parser.add_subparsers(dest="bench", required=True, metavar="BENCH")
+    accuracy = benches.add_parser(
+        "accuracy", help="tip error vs time per solve for every method and setting",
+        description="Tip error against a converged reference and median time per solve, for "
+                    "Algorithm 1's settings and the baselines, on every preset and hard "
+                    "designs at 4-20 N (SI units).")
+    accuracy.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    accuracy.add_argument("--plot", metavar="FILE.png", help="write the Pareto plot to a PNG")
+    accuracy.add_argument("--quick", action="store_true",
+                          help="a small subset (3 designs, 2 tensions, fewer knobs) for tests")
+    accuracy.set_defaults(handler=run_accuracy)
+
+
+def run_accuracy(args: argparse.Namespace) -> int:
+    """Run the accuracy bench; the table (or JSON) on stdout, progress on stderr."""
+    from tdcm_ros.model.accuracy import format_table, plot_pareto, run_bench
+
+    def progress(label: str) -> None:
+        print(f"  running {label}", file=sys.stderr, flush=True)
+
+    report = run_bench(quick=args.quick, progress=progress)
+    if args.plot:
+        plot_pareto(report, args.plot)
+    if args.json:
+        print(json.dumps(report.to_json(), default=float))
+    else:
+        print(format_table(report))
+        if args.plot:
+            print(f"Pareto plot written to {args.plot}")
+    return 0
