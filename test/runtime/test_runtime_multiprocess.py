@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from conftest import stop, wait_for
+from runtime_helpers import stop, wait_for
 
 from tdcm_ros.bagio import from_dict, to_dict
 from tdcm_ros.runtime.port import QoS
