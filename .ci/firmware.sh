@@ -11,7 +11,7 @@ SKETCH="$ROOT/firmware/tdcm_tension"
 FLASH_MAX=32256
 RAM_MAX=2048
 STACK_MARGIN=${STACK_MARGIN:-512}
-PACKAGES=(arduino-mk arduino-core-avr gcc-avr avr-libc binutils-avr)
+PACKAGES=(arduino-mk arduino-core-avr gcc-avr avr-libc binutils-avr libsimavr-dev libelf-dev)
 
 missing=()
 for package in "${PACKAGES[@]}" simavr; do
