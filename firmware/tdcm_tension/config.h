@@ -1,5 +1,6 @@
 // Device constants: the one firmware place for them.
-// Python mirror: tdcm_ros/device/constants.py (test/firmware/test_constants_match.py checks
+// Python mirror: tdcm_ros/device/constants.py (test_constants_match in
+// test/firmware/test_firmware_core.py checks
 // that every value below equals its Python twin). Units are in the names: _MS milliseconds,
 // _MN millinewtons, _US microseconds of servo pulse, _MUS 1e-3 us, _MCPN 1e-3 counts per N.
 #ifndef TDCM_CONFIG_H

@@ -10,9 +10,8 @@
 from tdcm_ros.device.errors import (
     DeviceError,
     FrameError,
-    HandshakeError,
     PortError,
     ProtocolVersionError,
 )
 
-__all__ = ["DeviceError", "FrameError", "HandshakeError", "PortError", "ProtocolVersionError"]
+__all__ = ["DeviceError", "FrameError", "PortError", "ProtocolVersionError"]

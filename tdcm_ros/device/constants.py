@@ -1,7 +1,8 @@
 """Device constants shared by the protocol, the device twin and the driver.
 
 This is the one Python place for them; the firmware's twin of this file is
-``firmware/tdcm_tension/config.h`` and ``test/firmware/test_constants_match.py`` checks that the
+``firmware/tdcm_tension/config.h`` and ``test_constants_match`` in
+``test/firmware/test_firmware_core.py`` checks that the
 two agree. Names carry their unit: ``_MS`` milliseconds, ``_MN`` millinewtons, ``_US``
 microseconds of servo pulse. The control loop works in these integer units on both sides so the
 twin and the firmware compute bit-identical results.

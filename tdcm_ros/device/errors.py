@@ -38,7 +38,3 @@ class ProtocolVersionError(DeviceInputError):
 
 class PortError(DeviceError):
     """The serial port could not be opened, read or written (device gone, wrong path ...)."""
-
-
-class HandshakeError(DeviceError):
-    """The device did not send a valid banner within the handshake time."""
