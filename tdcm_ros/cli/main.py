@@ -21,6 +21,7 @@ SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.topic",
     "tdcm_ros.cli.param",
     "tdcm_ros.cli.bench",
+    "tdcm_ros.cli.figures",
 )
 
 
