@@ -1,6 +1,7 @@
 """ament_python package setup; also a plain ``pip install`` on machines without ROS."""
 
 from glob import glob
+from pathlib import Path
 
 from setuptools import find_packages, setup
 
@@ -15,6 +16,8 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
         (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+        *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.msg"))
+          for folder in sorted({str(Path(p).parent) for p in glob("msg_defs/*/msg/*.msg")})],
     ],
     package_data={PACKAGE: ["py.typed"]},
     include_package_data=True,
@@ -43,6 +46,7 @@ setup(
             "tdcm = tdcm_ros.cli.main:main",
             "tdcm_node = tdcm_ros.runtime.run_node:main",
             "tdcm_talker = tdcm_ros.nodes.talker:main",
+            "model_node = tdcm_ros.nodes.model_node:main",
         ],
     },
 )

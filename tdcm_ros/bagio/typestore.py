@@ -28,7 +28,23 @@ def msg_defs_dirs() -> list[Path]:
     candidates = [Path(p) for p in os.environ.get(MSG_DEFS_ENV, "").split(os.pathsep) if p]
     candidates.append(Path(__file__).resolve().parents[2] / "msg_defs")
     candidates.append(Path(sys.prefix) / "share" / "tdcm_ros" / "msg_defs")
+    candidates.extend(_ament_share())
     return [p for p in candidates if p.is_dir()]
+
+
+def _ament_share() -> list[Path]:
+    """``<share>/tdcm_ros/msg_defs`` of a colcon install, where ament_index is available."""
+    try:
+        from ament_index_python.packages import (
+            PackageNotFoundError,
+            get_package_share_directory,
+        )
+    except ImportError:
+        return []
+    try:
+        return [Path(get_package_share_directory("tdcm_ros")) / "msg_defs"]
+    except PackageNotFoundError:
+        return []
 
 
 def _msg_files() -> dict[str, Path]:

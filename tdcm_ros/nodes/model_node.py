@@ -93,7 +93,8 @@ class ModelNode(NodeLogic):
                                ("body_markers", "visualization_msgs/msg/MarkerArray"))}
         self.diagnostics = port.create_publisher("/diagnostics",
                                                  "diagnostic_msgs/msg/DiagnosticArray", qos)
-        port.create_subscription("tension", self.tension_type, self._on_tension, QoS(depth=1))
+        # A deep queue so every input is seen (and counted); the callback only stores the newest.
+        port.create_subscription("tension", self.tension_type, self._on_tension, QoS(depth=100))
         self.pending: tuple[float, int] | None = None
         self.previous: SolveResult | None = None
         self.counts: Counter[str] = Counter()

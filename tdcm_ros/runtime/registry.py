@@ -6,9 +6,10 @@ from tdcm_ros.errors import InputError
 
 NODES: dict[str, str] = {
     "talker": "tdcm_ros.nodes.talker:Talker",
+    "model_node": "tdcm_ros.nodes.model_node:ModelNode",
 }
 
-DEFAULT_NODE_SET: tuple[str, ...] = ("talker",)
+DEFAULT_NODE_SET: tuple[str, ...] = ("model_node",)
 
 
 def node_target(name: str) -> str:

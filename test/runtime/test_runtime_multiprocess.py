@@ -117,7 +117,7 @@ def _alive(pid: int) -> bool:
 
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
 def test_tdcm_up_sigint_stops_every_child(zenoh_env: dict[str, str], spawn: Spawn) -> None:
-    launcher = spawn("tdcm_ros.cli.main", "up")
+    launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker")
     wait_for(lambda: len(_children(launcher.pid)) == 2, 15.0, "router and talker processes")
     children = _children(launcher.pid)
     echo = spawn("tdcm_ros.cli.main", "topic", "echo", "chatter", "--once")
