@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from time import perf_counter
 
 import numpy as np
@@ -128,34 +129,13 @@ Strategy = Callable[[Grid, MomentMap, float, Array, SolverSettings, int], _Run]
 def _strategies(settings: SolverSettings) -> list[tuple[str, Strategy]]:
     """Strategies to try in order for ``settings.acceleration``."""
     if settings.acceleration == "auto":
-        out: list[tuple[str, Strategy]] = [("picard+anderson", _adaptive),
-                                           ("relaxation", _relaxed)]
+        out: list[tuple[str, Strategy]] = [("picard+anderson", partial(_iterate, mode="auto")),
+                                           ("relaxation", partial(_iterate, mode="relaxation"))]
         if settings.continuation_steps > 0:
             out.append(("continuation", _continuation))
         return out
-    single: dict[str, Strategy] = {"anderson": _anderson_only, "relaxation": _relaxed,
-                                   "none": _picard_only}
-    return [(settings.acceleration, single[settings.acceleration])]
-
-
-def _adaptive(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
-              settings: SolverSettings, budget: int) -> _Run:
-    return _iterate(grid, moment_map, tension, x0, settings, budget, mode="auto")
-
-
-def _anderson_only(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
-                   settings: SolverSettings, budget: int) -> _Run:
-    return _iterate(grid, moment_map, tension, x0, settings, budget, mode="anderson")
-
-
-def _relaxed(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
-             settings: SolverSettings, budget: int) -> _Run:
-    return _iterate(grid, moment_map, tension, x0, settings, budget, mode="relaxation")
-
-
-def _picard_only(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
-                 settings: SolverSettings, budget: int) -> _Run:
-    return _iterate(grid, moment_map, tension, x0, settings, budget, mode="picard")
+    mode = "picard" if settings.acceleration == "none" else settings.acceleration
+    return [(settings.acceleration, partial(_iterate, mode=mode))]
 
 
 def _continuation(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
