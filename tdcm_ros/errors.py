@@ -13,6 +13,7 @@ its specific errors derive from it and from one of the categories.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 
@@ -50,3 +51,14 @@ def out_of_range(parameter: str, value: Any, allowed: str, *, unit: str = "",
     shown = f"{value!r} {unit}".rstrip()
     return error(f"{parameter} = {shown} is out of range; allowed: {allowed}",
                  parameter=parameter, value=value, allowed=allowed)
+
+
+def reject_unknown(what: str, names: Mapping[str, Any], known: Iterable[str], *,
+                   error: type[InputError] = InputError) -> None:
+    """Raise ``error`` for the first key of ``names`` not in ``known``, listing the allowed ones."""
+    known_set = set(known)
+    allowed = ", ".join(sorted(known_set))
+    for name, value in names.items():
+        if name not in known_set:
+            raise error(f"unknown {what} {name!r}; allowed: {allowed}", parameter=name,
+                        value=value, allowed=allowed)

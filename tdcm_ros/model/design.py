@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.errors import out_of_range
+from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import CircularProfile, NotchProfile, profile_from_name
 from tdcm_ros.model.section import tube_moment
@@ -128,12 +128,8 @@ class Design:
 
     def with_overrides(self, **overrides: Any) -> Design:
         """A copy with fields replaced (validated); unknown names raise :class:`InvalidDesignError`."""
-        known = {f.name for f in fields(self)}
-        for name, value in overrides.items():
-            if name not in known:
-                raise InvalidDesignError(
-                    f"unknown design field {name!r}; allowed: {', '.join(sorted(known))}",
-                    parameter=name, value=value, allowed=", ".join(sorted(known)))
+        reject_unknown("design field", overrides, (f.name for f in fields(self)),
+                       error=InvalidDesignError)
         if isinstance(overrides.get("profile"), str):
             overrides["profile"] = profile_from_name(overrides["profile"])
         return replace(self, **overrides)

@@ -6,7 +6,7 @@ import math
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
-from tdcm_ros.errors import out_of_range
+from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidSettingsError
 
 ROUTINGS = ("paper", "free")
@@ -66,12 +66,8 @@ class SolverSettings:
 
     def with_overrides(self, **overrides: Any) -> SolverSettings:
         """A validated copy with fields replaced; unknown names raise."""
-        known = {f.name for f in fields(self)}
-        for name, value in overrides.items():
-            if name not in known:
-                raise InvalidSettingsError(
-                    f"unknown solver setting {name!r}; allowed: {', '.join(sorted(known))}",
-                    parameter=name, value=value, allowed=", ".join(sorted(known)))
+        reject_unknown("solver setting", overrides, (f.name for f in fields(self)),
+                       error=InvalidSettingsError)
         return replace(self, **overrides)
 
     def to_dict(self) -> dict[str, Any]:
