@@ -85,7 +85,11 @@ def run_echo(args: argparse.Namespace) -> int:
     received = 0
 
     def show(sample: Any) -> None:
+        # The executor runs every callback already queued after the one that requests the stop,
+        # so samples of a burst can still arrive here once the limit is reached.
         nonlocal received
+        if limit and received >= limit:
+            return
         try:
             message = deserialize(sample.data, sample.type_name)
         except BagError as error:
