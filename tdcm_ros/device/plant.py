@@ -2,11 +2,15 @@
 
 The actuator maps the servo pulse linearly onto ``stroke`` metres of travel between
 ``PULSE_MIN_US`` and ``PULSE_MAX_US``; its position follows the command through a first-order
-lag (``lag`` s) and a speed limit (``rate`` m/s). The tendon carries no load for the first
-``slack`` metres, then ``stiffness`` N per metre of further travel. The load cell reads
-``tare_counts + counts_per_newton * (tension + noise)`` rounded to a multiple of ``quantum``
-counts, every ``sample_period`` s; the noise is Gaussian with ``noise`` N standard deviation
-drawn from a generator seeded with ``seed``.
+lag (``lag`` s) and a speed limit (``rate`` m/s); within ``deadband`` m of the command it does
+not move (a dead zone: the lag acts on the error beyond the deadband, so the actuator stops
+``deadband`` short of the command). The tendon carries no load for the first ``slack`` metres,
+then ``stiffness`` N per metre of further travel. The load cell reads
+``tare_counts + counts_per_newton * (tension + bias + drift * t + noise)`` rounded to a multiple
+of ``quantum`` counts, every ``sample_period`` s, where ``t`` is the plant's running time (s),
+``bias`` an offset (N) and ``drift`` a linear drift (N/s); the noise is Gaussian with ``noise`` N
+standard deviation drawn from a generator seeded with ``seed``. :attr:`Plant.tension` is the true
+tendon tension, which bias, drift and noise do not touch.
 """
 
 from __future__ import annotations
@@ -37,6 +41,9 @@ class PlantConfig:
     quantum: int = 1
     sample_period: float = 0.0125
     seed: int = 0
+    deadband: float = 0.0
+    bias: float = 0.0
+    drift: float = 0.0
 
     def __post_init__(self) -> None:
         for field in fields(self):
@@ -45,9 +52,12 @@ class PlantConfig:
                 raise out_of_range(field.name, value, "a finite number", error=DeviceInputError)
             if field.name in _POSITIVE and value <= 0:
                 raise out_of_range(field.name, value, "> 0", error=DeviceInputError)
-        for name in ("slack", "noise"):
+        for name in ("slack", "noise", "deadband"):
             if getattr(self, name) < 0:
                 raise out_of_range(name, getattr(self, name), ">= 0", error=DeviceInputError)
+        if self.deadband >= self.stroke:
+            raise out_of_range("deadband", self.deadband, f"< stroke ({self.stroke} m)", unit="m",
+                               error=DeviceInputError)
         if self.quantum < 1:
             raise out_of_range("quantum", self.quantum, ">= 1 count", error=DeviceInputError)
 
@@ -63,6 +73,7 @@ class Plant:
     def __init__(self, config: PlantConfig) -> None:
         self.config = config
         self.position = 0.0
+        self.time = 0.0  #: s the plant has run
         self._random = random.Random(config.seed)
 
     def target(self, pulse_us: int) -> float:
@@ -78,17 +89,25 @@ class Plant:
         substeps = max(1, math.ceil(dt / cfg.lag))  # explicit Euler stays stable for h <= lag
         h = dt / substeps
         for _ in range(substeps):
-            speed = min(max((target - self.position) / cfg.lag, -cfg.rate), cfg.rate)
+            error = target - self.position
+            beyond = math.copysign(max(abs(error) - cfg.deadband, 0.0), error)
+            speed = min(max(beyond / cfg.lag, -cfg.rate), cfg.rate)
             self.position += speed * h
+        self.time += dt
 
     @property
     def tension(self) -> float:
         """True tendon tension, in N."""
         return self.config.stiffness * max(0.0, self.position - self.config.slack)
 
+    @property
+    def offset(self) -> float:
+        """What the load cell adds to the true tension now (bias + drift), in N."""
+        return self.config.bias + self.config.drift * self.time
+
     def read_counts(self) -> int:
         """One load-cell reading, in counts."""
         cfg = self.config
         noisy = self.tension + (self._random.gauss(0.0, cfg.noise) if cfg.noise else 0.0)
-        counts = cfg.tare_counts + cfg.counts_per_newton * noisy
+        counts = cfg.tare_counts + cfg.counts_per_newton * (noisy + self.offset)
         return round(counts / cfg.quantum) * cfg.quantum

@@ -22,6 +22,7 @@ import sys
 import threading
 import time
 import tty
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import fields
 from typing import Self
@@ -31,12 +32,15 @@ from tdcm_ros.device.errors import DeviceInputError
 from tdcm_ros.device.plant import Plant, PlantConfig
 from tdcm_ros.errors import out_of_range
 
+TRUTH_KEPT = 4096  #: ground-truth samples kept until taken (older ones are dropped)
+
 
 class DeviceTwin:
     """Firmware core + plant in simulated time; ``output`` collects the bytes it sends.
 
     The EEPROM starts with a calibration matching the plant's load cell unless ``storage``
-    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given.
+    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given. At every load-cell sample ``truth`` gets
+    ``(simulated time s, true tendon tension N)`` (the newest ``TRUTH_KEPT`` are kept).
     """
 
     def __init__(self, plant: PlantConfig | None = None, *, cell: str = "TWIN",
@@ -46,6 +50,7 @@ class DeviceTwin:
         self.storage = storage if storage is not None else bytearray(
             pack_calibration(cfg.tare_counts, cfg.scale_mcpn))
         self.output = bytearray()
+        self.truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_KEPT)
         self.core = TensionCore(self.storage, cell=cell, send=self.output.extend)
         self.now_ms = 0
         self._next_sample_ms = 0.0
@@ -69,6 +74,7 @@ class DeviceTwin:
             if self.now_ms >= self._next_sample_ms:
                 self._next_sample_ms += period_ms
                 self.core.sample(self.plant.read_counts(), self.now_ms)
+                self.truth.append((self.time, self.plant.tension))
             self.core.tick(self.now_ms)
 
     def take_output(self) -> bytes:
@@ -76,6 +82,12 @@ class DeviceTwin:
         data = bytes(self.output)
         self.output.clear()
         return data
+
+    def take_truth(self) -> list[tuple[float, float]]:
+        """Ground-truth samples ``(simulated time s, tension N)`` since the last call."""
+        samples = list(self.truth)
+        self.truth.clear()
+        return samples
 
 
 class PtyTwin:
@@ -98,6 +110,9 @@ class PtyTwin:
         self._master = -1
         self._slave = -1
         self.pty_path = ""
+        self._start_wall = time.monotonic()
+        self._start_epoch_ns = time.time_ns()
+        self._start_sim = twin.time
         self._open()
 
     @property
@@ -152,10 +167,28 @@ class PtyTwin:
             self.twin.advance(seconds)
             self._flush()
 
+    def take_truth(self) -> list[tuple[int, float]]:
+        """Ground-truth samples since the last call as ``(host time ns since the epoch, N)``.
+
+        Meaningful for the threaded twin (:meth:`start`): simulated time maps onto host time at
+        ``speed``. The samples are taken under the lock, so no sample is seen twice or lost
+        (beyond ``TRUTH_KEPT`` untaken ones).
+        """
+        with self._lock:
+            samples = self.twin.take_truth()
+        return [(self.host_time_ns(t), tension) for t, tension in samples]
+
+    def host_time_ns(self, sim_time: float) -> int:
+        """Host time (ns since the epoch) at which the threaded twin reaches ``sim_time`` s."""
+        return self._start_epoch_ns + round((sim_time - self._start_sim) / self.speed * 1e9)
+
     def _run(self) -> None:
-        start_wall, start_sim = time.monotonic(), self.twin.time
+        start_wall, start_sim = self._start_wall, self._start_sim
         while not self._stop.is_set():
-            select.select([self._master], [], [], 0.002)
+            try:
+                select.select([self._master], [], [], 0.002)
+            except (OSError, ValueError):  # reopen() swapped the fd under us: just go on
+                time.sleep(0.002)
             due = start_sim + (time.monotonic() - start_wall) * self.speed
             with self._lock:
                 self._exchange()
@@ -165,6 +198,8 @@ class PtyTwin:
     def start(self) -> Self:
         """Serve from a daemon thread at ``speed`` times real time."""
         self._stop.clear()
+        self._start_wall, self._start_epoch_ns = time.monotonic(), time.time_ns()
+        self._start_sim = self.twin.time
         self._thread = threading.Thread(target=self._run, name="tdcm-twin", daemon=True)
         self._thread.start()
         return self
