@@ -1,0 +1,40 @@
+"""ROS-free motion capture: Vicon Nexus CSV reading, labelling, occlusion, registration, sources.
+
+Never imports rclpy; ``tdcm_ros.nodes.mocap_node`` puts it on a runtime.
+"""
+
+from tdcm_ros.mocap.errors import CsvFormatError, LabelError, MocapError
+from tdcm_ros.mocap.labelling import (
+    ArcLengthLabeller,
+    LabelledFrame,
+    NameLabeller,
+    NameMap,
+    project_on_polyline,
+    straight_axis,
+)
+from tdcm_ros.mocap.nexus_csv import Trajectories, parse_nexus_csv, read_nexus_csv
+from tdcm_ros.mocap.occlusion import visible
+from tdcm_ros.mocap.register import estimate_from_recordings, given_registration
+from tdcm_ros.mocap.sources import CsvReplay, RawFrame, SimSource, SourceError
+
+__all__ = [
+    "ArcLengthLabeller",
+    "CsvFormatError",
+    "CsvReplay",
+    "LabelError",
+    "LabelledFrame",
+    "MocapError",
+    "NameLabeller",
+    "NameMap",
+    "RawFrame",
+    "SimSource",
+    "SourceError",
+    "Trajectories",
+    "estimate_from_recordings",
+    "given_registration",
+    "parse_nexus_csv",
+    "project_on_polyline",
+    "read_nexus_csv",
+    "straight_axis",
+    "visible",
+]
