@@ -1,0 +1,153 @@
+"""``device_twin``: the simulated tension device (firmware logic on a simulated bench) on a pty.
+
+Serves :class:`tdcm_ros.device.twin.PtyTwin` in real time (times ``speed``) behind the symlink
+``link`` (default ``<tmp>/tdcm_twin_<pid>``), which ``tension_driver`` opens as its ``port``.
+The plant is :class:`tdcm_ros.device.plant.PlantConfig` from the ``plant.<field>`` parameters;
+with ``scene`` set (a shipped scene name or a YAML path) their defaults come from
+``load_scene(scene).plant_config()`` and explicit ``plant.*`` values still override them.
+
+Publishes ``sim/tension_true`` (``geometry_msgs/msg/WrenchStamped``): the true tendon tension
+(N, ``wrench.force.z``, frame ``frame_id``) at every load-cell sample, stamped with the host time
+of the sample; and ``/diagnostics`` (port, simulated time, device mode, faults).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from dataclasses import fields
+from typing import Any
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.device.driver import fault_names
+from tdcm_ros.device.plant import PlantConfig
+from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from tdcm_ros.errors import InputError
+from tdcm_ros.nodes.shape_messages import header
+from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime.run_node import main_for
+
+PLANT_UNITS = {"stroke": "m", "lag": "s", "rate": "m/s", "stiffness": "N/m", "slack": "m",
+               "counts_per_newton": "counts/N", "tare_counts": "counts", "noise": "N",
+               "quantum": "counts", "sample_period": "s", "deadband": "m",
+               "bias": "N", "drift": "N/s"}
+
+
+def scene_plant(scene: str) -> PlantConfig:
+    """The plant of a scene (imported lazily: scenes are optional for this node)."""
+    try:
+        from tdcm_ros.scenes import load_scene
+    except ImportError as error:
+        raise InputError(f"scene = {scene!r} needs tdcm_ros.scenes, which cannot be imported: "
+                         f"{error}", parameter="scene", value=scene) from error
+    config = load_scene(scene).plant_config()
+    if not isinstance(config, PlantConfig):
+        raise InputError(f"scene = {scene!r} gave a {type(config).__name__}, not a PlantConfig",
+                         parameter="scene", value=scene)
+    return config
+
+
+def default_link() -> str:
+    """``<tmp>/tdcm_twin_<pid>``: unique per process."""
+    return os.path.join(tempfile.gettempdir(), f"tdcm_twin_{os.getpid()}")
+
+
+def check_link(path: str) -> None:
+    """Refuse to replace anything but a symlink (or nothing) at ``path``."""
+    if os.path.lexists(path) and not os.path.islink(path):
+        raise InputError(f"link = {path!r} exists and is not a symlink; allowed: a new path or "
+                         f"an old twin link", parameter="link", value=path,
+                         allowed="a path that is absent or a symlink")
+    if not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+        raise InputError(f"link = {path!r}: its directory does not exist", parameter="link",
+                         value=path, allowed="a path in an existing directory")
+
+
+class DeviceTwinNode(NodeLogic):
+    """Serves the device twin on a pty; see the module docstring."""
+
+    default_name = "device_twin"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        declare = port.declare_parameter
+        scene = str(declare("scene", "", read_only=True,
+                            description="scene name or YAML path giving the plant (optional)"))
+        base = scene_plant(scene) if scene.strip() else PlantConfig()
+        values: dict[str, Any] = {}
+        for field in fields(PlantConfig):
+            unit = PLANT_UNITS.get(field.name, "")
+            values[field.name] = declare(
+                f"plant.{field.name}", type(field.default)(getattr(base, field.name)),
+                read_only=True, description=f"PlantConfig.{field.name}" + (f" ({unit})" * bool(unit)))
+        try:
+            plant = PlantConfig(**values)
+        except InputError as error:
+            name = f"plant.{error.parameter}"
+            raise InputError(f"{name}: {error}", parameter=name, value=error.value,
+                             allowed=error.allowed) from error
+        link = str(declare("link", "", read_only=True,
+                           description="symlink to the pty (empty: <tmp>/tdcm_twin_<pid>)"))
+        link = link.strip() or default_link()
+        check_link(link)
+        speed = float(declare("speed", 1.0, range=(0.01, 100.0), read_only=True,
+                              description="simulated time / real time"))
+        self.frame_id = str(declare("frame_id", "tdcm_tendon", read_only=True,
+                                    description="frame of sim/tension_true"))
+        period = float(declare("publish_period_s", 0.01, range=(0.001, 1.0), read_only=True,
+                               description="how often the samples are published (s); every "
+                                           "load-cell sample is published"))
+        diag_period = float(declare("diagnostics_period_s", 1.0, range=(0.05, 60.0),
+                                    read_only=True, description="/diagnostics period (s)"))
+        self.truth = port.create_publisher("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
+                                           QoS(depth=100))
+        self.diagnostics = port.create_publisher("/diagnostics",
+                                                 "diagnostic_msgs/msg/DiagnosticArray", QoS(depth=10))
+        self.server = PtyTwin(DeviceTwin(plant), speed=speed, link=link).start()
+        self.samples = 0
+        port.create_timer(period, self.publish_truth)
+        port.create_timer(diag_period, self.report)
+        port.logger.info("device twin on %s -> %s (scene %r, speed %g)", self.server.port,
+                         self.server.pty_path, scene or "none", speed)
+
+    def publish_truth(self) -> None:
+        """Publish every ground-truth sample taken since the last call."""
+        for stamp_ns, tension in self.server.take_truth():
+            self.truth.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
+                "header": header(stamp_ns, self.frame_id),
+                "wrench": {"force": {"z": tension}}}))
+            self.samples += 1
+
+    def _state(self) -> dict[str, str]:
+        twin = self.server.twin
+        return {"port": self.server.port, "pty": self.server.pty_path,
+                "sim_time": f"{twin.time:.3f}", "mode": twin.core.mode.name.lower(),
+                "faults": fault_names(twin.core.faults),
+                "setpoint": f"{twin.core.setpoint_mn / 1000:.3f}",
+                "tension_true": f"{twin.plant.tension:.3f}", "samples": str(self.samples)}
+
+    def report(self) -> None:
+        """Publish the twin's state on ``/diagnostics`` (always OK: it is a simulation)."""
+        state = self._state()
+        status = {"level": 0, "name": f"{self.port.node_name}: device twin",
+                  "message": f"serving {state['port']}", "hardware_id": "tdcm_twin",
+                  "values": [{"key": k, "value": v} for k, v in state.items()]}
+        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
+            "header": header(self.port.now_ns(), ""), "status": [status]}))
+
+    def close(self) -> None:
+        """Stop the twin (the pty closes, the link is removed); logs the final device state."""
+        self.server.stop()
+        state = self._state()
+        self.port.logger.info("device twin stopped: mode %s, faults %s, true tension %s N",
+                              state["mode"], state["faults"] or "none", state["tension_true"])
+
+
+def main() -> int:
+    """``ros2 run tdcm_ros device_twin`` / ``device_twin`` console script."""
+    return main_for(DeviceTwinNode)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,319 @@
+"""``tension_driver``: the tension device on a serial port, as a node.
+
+Wraps :class:`tdcm_ros.device.driver.TensionDriver` (handshake, heartbeats, setpoint ramp and
+clamp, reconnect with backoff, stale detection). A timer (``step_period_s``) steps the driver and
+publishes every telemetry frame as ``tension`` (``geometry_msgs/msg/WrenchStamped``,
+``wrench.force.z`` = measured tension in N, frame ``frame_id``; stamp = host receive time, frames
+read together keep their device-clock spacing). ``device_state``
+(``diagnostic_msgs/msg/DiagnosticStatus``, every ``state_period_s``) carries link, mode, faults,
+setpoints and the schedule state (key ``schedule_done``); ``/diagnostics`` the same status plus
+counters every ``diagnostics_period_s``.
+
+Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
+warning, ramped at ``setpoint_rate``; cancels a running schedule), ``estop``
+(``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable),
+``clear_faults`` (``std_msgs/msg/Empty``: clear latched faults and re-enable if ``enabled``),
+``start_schedule`` (``std_msgs/msg/Empty``: (re)start the ``schedule.*`` staircase). On shutdown
+the node releases the tendon and closes the port.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.device import constants as c
+from tdcm_ros.device.driver import (
+    DriverConfig,
+    DriverStatus,
+    Level,
+    LinkState,
+    TensionDriver,
+    fault_names,
+)
+from tdcm_ros.device.errors import ProtocolVersionError
+from tdcm_ros.device.protocol import Telemetry
+from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.errors import InputError
+from tdcm_ros.nodes.shape_messages import header
+from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime.run_node import main_for
+
+#: DriverConfig fields as parameters: (range, description); all but port/baudrate change at runtime
+DRIVER_PARAMS: dict[str, tuple[tuple[float, float], str]] = {
+    "tension_max": ((0.001, c.SETPOINT_MAX_MN / 1000), "largest setpoint (N)"),
+    "setpoint_rate": ((0.1, 1000.0), "setpoint ramp rate (N/s)"),
+    "heartbeat_period": ((0.01, c.WATCHDOG_MS / 2000 - 0.001),
+                         "heartbeat period (s), below half the device watchdog"),
+    "handshake_timeout": ((0.1, 60.0), "time allowed for the banner (s)"),
+    "stale_timeout": ((0.02, 10.0), "telemetry age reported as stale (s)"),
+    "link_timeout": ((0.1, 60.0), "telemetry silence that drops the link (s)"),
+    "backoff_initial": ((0.01, 60.0), "first reconnect delay (s)"),
+    "backoff_max": ((0.01, 600.0), "largest reconnect delay (s)"),
+}
+SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
+
+
+class TensionDriverNode(NodeLogic):
+    """The tension device as a node; see the module docstring."""
+
+    default_name = "tension_driver"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        declare = port.declare_parameter
+        defaults = DriverConfig()
+        url = str(declare("port", defaults.port, read_only=True,
+                          description="device path, pty path or pyserial URL",
+                          validator=_non_empty("port")))
+        baudrate = int(declare("baudrate", defaults.baudrate, range=(1200, 4_000_000),
+                               read_only=True, description="serial line rate (baud)"))
+        for name, (limits, text) in DRIVER_PARAMS.items():
+            declare(name, float(getattr(defaults, name)), range=limits, description=text)
+        declare("frame_id", "tdcm_tendon", description="frame of `tension`")
+        declare("enabled", True, description="hold the setpoint (device mode T) when no fault")
+        declare("schedule.levels", list(StepSchedule().levels),
+                description="staircase levels (N), in order")
+        declare("schedule.hold_s", StepSchedule().hold, range=(0.01, 86_400.0),
+                description="hold time of each level (s)")
+        declare("schedule.trials", StepSchedule().trials, range=(1, 10_000),
+                description="repetitions of the staircase")
+        autostart = bool(declare("schedule.autostart", False, read_only=True,
+                                 description="run the schedule once the device is connected"))
+        step_period = float(declare("step_period_s", 0.005, range=(0.001, 0.02), read_only=True,
+                                    description="driver step period (s); telemetry is 50 Hz"))
+        state_period = float(declare("state_period_s", 0.1, range=(0.01, 10.0), read_only=True,
+                                     description="device_state period (s)"))
+        diag_period = float(declare("diagnostics_period_s", 0.5, range=(0.05, 60.0),
+                                    read_only=True, description="/diagnostics period (s)"))
+        config = DriverConfig(port=url, baudrate=baudrate, **self._driver_values({}))
+        self.schedule = self._schedule({})
+        port.add_on_set_parameters(self._on_set)
+
+        self.counts: Counter[str] = Counter()
+        self.last_warning = ""
+        self.clamped_since_report = False
+        self.schedule_state = "waiting" if autostart else "idle"
+        self.status: DriverStatus | None = None
+        self.driver = TensionDriver(config, clock=time.monotonic, warn=self._warn)
+        if bool(port.get_parameter("enabled")):
+            self.driver.enable()
+
+        self.tension = port.create_publisher("tension", "geometry_msgs/msg/WrenchStamped",
+                                             QoS(depth=100))
+        self.state = port.create_publisher("device_state", "diagnostic_msgs/msg/DiagnosticStatus",
+                                           QoS(depth=10))
+        self.diagnostics = port.create_publisher("/diagnostics",
+                                                 "diagnostic_msgs/msg/DiagnosticArray", QoS(depth=10))
+        port.create_subscription("tension_setpoint", "std_msgs/msg/Float64", self._on_setpoint,
+                                 QoS(depth=10))
+        port.create_subscription("estop", "std_msgs/msg/Empty", self._on_estop, QoS(depth=10))
+        port.create_subscription("clear_faults", "std_msgs/msg/Empty", self._on_clear,
+                                 QoS(depth=10))
+        port.create_subscription("start_schedule", "std_msgs/msg/Empty",
+                                 lambda _: self._start_schedule(), QoS(depth=10))
+        port.create_timer(step_period, self.step)
+        port.create_timer(state_period, self.publish_state)
+        port.create_timer(diag_period, self.report)
+        port.logger.info("driving the tension device on %s (tension_max %g N)", url,
+                         config.tension_max)
+
+    # --- parameters -------------------------------------------------------------------------
+    def _param(self, changes: Mapping[str, Any], name: str) -> Any:
+        return changes[name] if name in changes else self.port.get_parameter(name)
+
+    def _driver_values(self, changes: Mapping[str, Any]) -> dict[str, float]:
+        return {name: float(self._param(changes, name)) for name in DRIVER_PARAMS}
+
+    def _schedule(self, changes: Mapping[str, Any]) -> StepSchedule:
+        """The schedule from the parameters; raises ``InputError`` naming the parameter."""
+        try:
+            return StepSchedule(levels=tuple(float(v) for v in
+                                             self._param(changes, "schedule.levels")),
+                                hold=float(self._param(changes, "schedule.hold_s")),
+                                trials=int(self._param(changes, "schedule.trials")))
+        except InputError as error:
+            name = {"levels": "schedule.levels", "hold": "schedule.hold_s",
+                    "trials": "schedule.trials"}.get(str(error.parameter), "schedule")
+            raise InputError(f"{name}: {error}", parameter=name, value=error.value,
+                             allowed=error.allowed) from error
+
+    def _on_set(self, changes: Mapping[str, Any]) -> None:
+        """Validate runtime changes as a whole, then apply them (raising keeps the old values)."""
+        config = replace(self.driver.config, **self._driver_values(changes))
+        schedule = self._schedule(changes)
+        self.driver.config, self.schedule = config, schedule
+        status = self.status
+        if (status is not None and not self.driver.schedule_running
+                and status.target > self.driver.tension_max):
+            self._request(status.target)  # re-clamp a held setpoint to the lower maximum
+        if "enabled" in changes:
+            if changes["enabled"]:
+                self.driver.enable()
+            else:
+                self.driver.release()
+
+    # --- inputs -----------------------------------------------------------------------------
+    def _warn(self, text: str) -> None:
+        self.last_warning = text
+        self.port.logger.warning("%s", text)
+
+    def _request(self, newtons: float) -> None:
+        applied = self.driver.set_setpoint(newtons)
+        if applied != newtons:
+            self.counts["clamped_setpoints"] += 1
+            self.clamped_since_report = True
+
+    def _on_setpoint(self, message: Any) -> None:
+        newtons = float(message.data)
+        if not math.isfinite(newtons):
+            self.counts["rejected_setpoints"] += 1
+            self._warn(f"tension_setpoint = {newtons!r} N is not finite; ignored")
+            return
+        if self.schedule_state in ("waiting", "running"):
+            self.schedule_state = "cancelled"
+        self._request(newtons)
+
+    def _on_estop(self, _message: Any) -> None:
+        self.counts["estops"] += 1
+        self.driver.estop()
+        if self.schedule_state in ("waiting", "running"):
+            self.schedule_state = "cancelled"
+
+    def _on_clear(self, _message: Any) -> None:
+        self.driver.clear_faults()
+        if bool(self.port.get_parameter("enabled")):
+            self.driver.enable()
+        self.port.logger.info("faults cleared on request")
+
+    def _start_schedule(self) -> None:
+        if self.status is not None and self.status.link is LinkState.CONNECTED:
+            self._run_schedule()
+        else:
+            self.schedule_state = "waiting"
+
+    def _run_schedule(self) -> None:
+        for level in self.schedule.levels:
+            if level > self.driver.tension_max:
+                self.counts["clamped_setpoints"] += 1
+                self.clamped_since_report = True
+        self.driver.run_schedule(self.schedule)
+        self.schedule_state = "running"
+        self.port.logger.info("schedule started: %s N, %g s each, %d trial(s)",
+                              list(self.schedule.levels), self.schedule.hold,
+                              self.schedule.trials)
+
+    # --- the step ---------------------------------------------------------------------------
+    def step(self) -> None:
+        """Step the driver; publish every telemetry frame received."""
+        try:
+            result = self.driver.step()
+        except ProtocolVersionError as error:
+            self.counts["version_mismatches"] += 1
+            self.last_warning = str(error)
+            self.port.logger.error("%s", error)
+            return
+        self.status = result.status
+        if result.telemetry:
+            self._publish_tension(result.telemetry)
+        connected = result.status.link is LinkState.CONNECTED
+        if self.schedule_state == "waiting" and connected:
+            self._run_schedule()
+        elif self.schedule_state == "running" and not self.driver.schedule_running:
+            self.schedule_state = "done"
+            self.port.logger.info("schedule done")
+
+    def _publish_tension(self, frames: tuple[Telemetry, ...]) -> None:
+        now = self.port.now_ns()
+        newest = frames[-1].time
+        frame_id = str(self.port.get_parameter("frame_id"))
+        for frame in frames:
+            stamp = now - max(0, round((newest - frame.time) * 1e9))
+            self.tension.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
+                "header": header(stamp, frame_id),
+                "wrench": {"force": {"z": frame.tension}}}))
+        self.counts["telemetry_frames"] += len(frames)
+
+    # --- state and diagnostics ----------------------------------------------------------------
+    def _status_dict(self, name: str, extra: Mapping[str, str]) -> dict[str, Any]:
+        status = self.status
+        if status is None:
+            return {"level": int(Level.STALE), "name": name, "message": "not stepped yet",
+                    "hardware_id": str(self.port.get_parameter("port")), "values": []}
+        latest, banner = status.telemetry, status.banner
+        values = {
+            "link": status.link.value,
+            "mode": latest.mode.name.lower() if latest else "",
+            "faults": fault_names(latest.faults) if latest else "",
+            "tension": f"{latest.tension:.3f}" if latest else "",
+            "pulse_us": str(latest.pulse_us) if latest else "",
+            "raw_counts": str(latest.raw) if latest else "",
+            "device_time": f"{latest.time:.3f}" if latest else "",
+            "target": f"{status.target:.3f}",
+            "setpoint": f"{status.setpoint:.3f}",
+            "tension_max": f"{self.driver.tension_max:g}",
+            "enabled": str(status.enabled).lower(),
+            "schedule": self.schedule_state,
+            "schedule_done": str(self.schedule_state == "done").lower(),
+            "firmware": banner.firmware if banner else "",
+            "cell": banner.cell if banner else "",
+            **extra,
+        }
+        hardware = f"{self.port.get_parameter('port')}"
+        return {"level": int(status.level), "name": name, "message": status.message,
+                "hardware_id": hardware,
+                "values": [{"key": k, "value": v} for k, v in values.items()]}
+
+    def publish_state(self) -> None:
+        """Publish ``device_state``."""
+        self.state.publish(from_dict("diagnostic_msgs/msg/DiagnosticStatus",
+                                     self._status_dict(self.port.node_name, {})))
+
+    def report(self) -> None:
+        """Publish ``/diagnostics``: link, staleness, faults and counters (WARN after a clamp)."""
+        status = self.status
+        counters = {
+            "reconnects": status.reconnects if status else 0,
+            "rejected_lines": status.rejected_lines if status else 0,
+            "nacks": status.nacks if status else 0,
+            **{key: self.counts[key] for key in ("clamped_setpoints", "rejected_setpoints",
+                                                 "estops", "version_mismatches",
+                                                 "telemetry_frames")},
+        }
+        extra = {k: str(v) for k, v in counters.items()}
+        extra["last_warning"] = self.last_warning
+        entry = self._status_dict(f"{self.port.node_name}: tension device", extra)
+        if self.clamped_since_report and entry["level"] < Level.WARN:
+            entry["level"] = int(Level.WARN)
+            entry["message"] += f"; setpoint clamped to [0, {self.driver.tension_max:g}] N"
+        self.clamped_since_report = False
+        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
+            "header": header(self.port.now_ns(), ""), "status": [entry]}))
+
+    def close(self) -> None:
+        """Release the tendon and close the port."""
+        self.driver.close()
+        self.port.logger.info("tendon released, port closed")
+
+
+def _non_empty(name: str) -> Any:
+    def check(value: Any) -> None:
+        if not str(value).strip():
+            raise InputError(f"{name} = {value!r} is invalid; allowed: a non-empty path or URL",
+                             parameter=name, value=value, allowed="a non-empty path or URL")
+    return check
+
+
+def main() -> int:
+    """``ros2 run tdcm_ros tension_driver`` / ``tension_driver`` console script."""
+    return main_for(TensionDriverNode)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
