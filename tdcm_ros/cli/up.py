@@ -1,11 +1,22 @@
-"""``tdcm up``: start the node set on the embedded runtime, each node its own process."""
+"""``tdcm up``: start the node set on the embedded runtime, each node its own process.
+
+``--twin`` adds ``device_twin`` and ``tension_driver`` in front of the node set, the driver's
+``port`` wired to the twin's pty link (``<tmp>/tdcm_twin_<pid of tdcm up>``, unique per run), so
+tension -> model runs with no hardware. Ctrl-C stops the nodes in reverse order: the driver
+releases the tendon before the twin goes away.
+"""
 
 from __future__ import annotations
 
 import argparse
 import os
+import tempfile
+from typing import Any
 
+from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES
+
+TWIN_NODES = ("device_twin", "tension_driver")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -18,7 +29,35 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="runtime of every node (default zenoh)")
     parser.add_argument("--endpoint", default=None,
                         help="router endpoint (default TDCM_ZENOH_ENDPOINT or tcp/127.0.0.1:7447)")
+    parser.add_argument("--twin", action="store_true",
+                        help="also start device_twin and tension_driver wired to it (no hardware)")
+    parser.add_argument("--scene", help="scene of the device twin (name or YAML path; needs --twin)")
+    parser.add_argument("--schedule", action="store_true",
+                        help="tension_driver runs its schedule.* staircase once connected")
     parser.set_defaults(handler=run)
+
+
+def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[str, Any]],
+                                                      dict[str, str]]:
+    """Node names, per-node parameter overrides and ready paths for ``launch``."""
+    nodes = [n.strip() for n in args.nodes.split(",") if n.strip()]
+    overrides: dict[str, dict[str, Any]] = {}
+    ready: dict[str, str] = {}
+    if args.scene and not args.twin:
+        raise InputError(f"--scene = {args.scene!r} needs --twin", parameter="--scene",
+                         value=args.scene, allowed="with --twin")
+    if args.twin:
+        link = os.path.join(tempfile.gettempdir(), f"tdcm_twin_{pid}")
+        nodes = [*TWIN_NODES, *(n for n in nodes if n not in TWIN_NODES)]
+        overrides["device_twin"] = {"link": link, **({"scene": args.scene} if args.scene else {})}
+        overrides["tension_driver"] = {"port": link}
+        ready["device_twin"] = link
+    if args.schedule:
+        if "tension_driver" not in nodes:
+            raise InputError("--schedule needs tension_driver in the node set (or --twin)",
+                             parameter="--schedule", value=True, allowed="with tension_driver")
+        overrides.setdefault("tension_driver", {})["schedule.autostart"] = True
+    return nodes, overrides, ready
 
 
 def run(args: argparse.Namespace) -> int:
@@ -30,6 +69,6 @@ def run(args: argparse.Namespace) -> int:
     configure_logging()
     if args.endpoint:
         os.environ[ENDPOINT_ENV] = args.endpoint
-    nodes = [n.strip() for n in args.nodes.split(",") if n.strip()]
-    return launch(nodes, params_file=args.params, runtime=args.runtime,
-                  endpoint=endpoint())
+    nodes, overrides, ready = plan(args, os.getpid())
+    return launch(nodes, params_file=args.params, runtime=args.runtime, endpoint=endpoint(),
+                  overrides=overrides, ready_paths=ready)
