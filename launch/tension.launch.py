@@ -1,0 +1,39 @@
+"""ROS 2 launch: the tension driver on a real serial port, and the model node fed by it.
+
+``ros2 launch tdcm_ros tension.launch.py [port:=/dev/ttyACM0] [params_file:=...]
+[model_params_file:=...]``
+
+This opens the real device (an Arduino UNO running ``firmware/tdcm_tension``). Without hardware
+use ``tdcm up --twin`` (embedded runtime) or run the ``device_twin`` node and point ``port`` at
+its link.
+"""
+
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+from launch import LaunchDescription
+
+
+def generate_launch_description() -> LaunchDescription:
+    """tension_driver (``port`` overrides the file) and model_node."""
+    config = os.path.join(get_package_share_directory("tdcm_ros"), "config")
+    return LaunchDescription([
+        DeclareLaunchArgument("port", default_value="/dev/ttyACM0",
+                              description="serial device, pty path or pyserial URL"),
+        DeclareLaunchArgument("params_file",
+                              default_value=os.path.join(config, "tension_driver.yaml"),
+                              description="ROS 2 parameter YAML for tension_driver"),
+        DeclareLaunchArgument("model_params_file",
+                              default_value=os.path.join(config, "model_node.yaml"),
+                              description="ROS 2 parameter YAML for model_node"),
+        Node(package="tdcm_ros", executable="tension_driver", name="tension_driver",
+             parameters=[LaunchConfiguration("params_file"),
+                         {"port": LaunchConfiguration("port")}],
+             output="screen"),
+        Node(package="tdcm_ros", executable="model_node", name="model_node",
+             parameters=[LaunchConfiguration("model_params_file")], output="screen"),
+    ])
