@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from tdcm_ros.errors import TdcmError
+from tdcm_ros.errors import InputError
 
 
-class BagError(TdcmError):
-    """A message type, definition or payload could not be handled; the message names it."""
+class BagError(InputError):
+    """A bag, message type, definition or payload could not be handled; the message names it."""
