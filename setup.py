@@ -16,6 +16,7 @@ setup(
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/launch", glob("launch/*.launch.py")),
         (f"share/{PACKAGE}/config", glob("config/*.yaml")),
+        (f"share/{PACKAGE}/config/scenes", glob("config/scenes/*.yaml")),
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.msg"))
           for folder in sorted({str(Path(p).parent) for p in glob("msg_defs/*/msg/*.msg")})],
     ],
@@ -47,6 +48,7 @@ setup(
             "tdcm_node = tdcm_ros.runtime.run_node:main",
             "tdcm_talker = tdcm_ros.nodes.talker:main",
             "model_node = tdcm_ros.nodes.model_node:main",
+            "mocap_node = tdcm_ros.nodes.mocap_node:main",
             "tension_driver = tdcm_ros.nodes.tension_driver:main",
             "device_twin = tdcm_ros.nodes.device_twin:main",
         ],

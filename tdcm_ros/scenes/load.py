@@ -1,0 +1,45 @@
+"""Load a scene by shipped name or from a YAML file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from tdcm_ros.scenes.errors import InvalidSceneError
+from tdcm_ros.scenes.paths import SUFFIXES, shipped_scenes
+from tdcm_ros.scenes.scene import Scene, parse_scene
+
+#: names of the shipped scenes found at import time
+SCENE_NAMES: tuple[str, ...] = tuple(shipped_scenes())
+
+
+def scene_from_text(text: str, *, name: str = "scene", source: Path | None = None) -> Scene:
+    """Parse and validate a scene from YAML text; ``name`` is used when the file has none."""
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        where = source or name
+        raise InvalidSceneError(f"{where}: not valid YAML ({error})".replace("\n", " "),
+                                parameter="file", value=str(where), allowed="a YAML mapping"
+                                ) from error
+    return parse_scene(data, default_name=name, source=source)
+
+
+def load_scene(scene: str | Path) -> Scene:
+    """A shipped scene by name (see :data:`SCENE_NAMES`) or a scene file by path."""
+    shipped = shipped_scenes()
+    path = Path(scene)
+    if str(scene) in shipped:
+        path = shipped[str(scene)]
+    elif not (path.suffix in SUFFIXES or path.exists()):
+        allowed = ", ".join(shipped) + ", or a path to a .yaml file"
+        raise InvalidSceneError(f"unknown scene {str(scene)!r}; allowed: {allowed}",
+                                parameter="scene", value=str(scene), allowed=allowed)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise InvalidSceneError(f"scene file {str(path)!r} cannot be read: {error.strerror}",
+                                parameter="scene", value=str(path),
+                                allowed="a readable .yaml file") from error
+    return scene_from_text(text, name=path.stem, source=path)
