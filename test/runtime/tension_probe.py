@@ -1,0 +1,99 @@
+"""Test-side port for the tension nodes: publishes commands, collects what the nodes publish."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from tdcm_ros.bagio import from_dict
+
+REPO = Path(__file__).resolve().parents[2]
+DRIVER = "tdcm_ros.nodes.tension_driver:TensionDriverNode"
+TWIN = "tdcm_ros.nodes.device_twin:DeviceTwinNode"
+
+
+def stamp_ns(message: Any) -> int:
+    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
+
+
+def values(status: Any) -> dict[str, str]:
+    """``DiagnosticStatus.values`` as a dict."""
+    return {kv.key: kv.value for kv in status.values}
+
+
+def driver_params(path: Path, **changes: Any) -> str:
+    """``config/tension_driver.yaml`` with ``changes`` (dotted names) applied, written to ``path``."""
+    data = yaml.safe_load((REPO / "config" / "tension_driver.yaml").read_text())
+    params = data["tension_driver"]["ros__parameters"]
+    for name, value in changes.items():
+        *parents, leaf = name.split(".")
+        node = params
+        for key in parents:
+            node = node.setdefault(key, {})
+        node[leaf] = value
+    path.write_text(yaml.safe_dump(data))
+    return str(path)
+
+
+class Probe:
+    """Publishes setpoints/e-stops; records ``tension``, ``device_state``, ``/diagnostics``,
+    ``sim/tension_true`` and ``midline``."""
+
+    def __init__(self, ctx: Any) -> None:
+        self.ctx = ctx
+        port = ctx.create_port("probe")
+        self.tension: list[Any] = []
+        self.states: list[Any] = []
+        self.diagnostics: list[Any] = []
+        self.truth: list[Any] = []
+        self.midlines: list[Any] = []
+        port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", self.tension.append)
+        port.create_subscription("device_state", "diagnostic_msgs/msg/DiagnosticStatus",
+                                 self.states.append)
+        port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
+                                 self._on_diagnostics)
+        port.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
+                                 self.truth.append)
+        port.create_subscription("midline", "nav_msgs/msg/Path", self.midlines.append)
+        self._setpoint = port.create_publisher("tension_setpoint", "std_msgs/msg/Float64")
+        self._estop = port.create_publisher("estop", "std_msgs/msg/Empty")
+        self._clear = port.create_publisher("clear_faults", "std_msgs/msg/Empty")
+
+    def _on_diagnostics(self, array: Any) -> None:
+        self.diagnostics.extend(s for s in array.status if "tension device" in s.name)
+
+    def setpoint(self, newtons: float) -> None:
+        self._setpoint.publish(from_dict("std_msgs/msg/Float64", {"data": newtons}))
+
+    def estop(self) -> None:
+        self._estop.publish(from_dict("std_msgs/msg/Empty", {}))
+
+    def clear_faults(self) -> None:
+        self._clear.publish(from_dict("std_msgs/msg/Empty", {}))
+
+    def state(self) -> dict[str, str]:
+        """Values of the newest ``device_state`` (empty before the first)."""
+        return values(self.states[-1]) if self.states else {}
+
+    def until(self, predicate: Callable[[], bool], timeout: float, what: str,
+              action: Callable[[], None] | None = None) -> None:
+        """Spin until ``predicate``; ``action`` (e.g. a publish) runs every 0.3 s meanwhile."""
+        deadline = time.monotonic() + timeout
+        next_action = 0.0
+        while not predicate():
+            now = time.monotonic()
+            if now > deadline:
+                raise AssertionError(f"timed out after {timeout} s waiting for {what}; "
+                                     f"last state {self.state()}")
+            if action is not None and now >= next_action:
+                action()
+                next_action = now + 0.3
+            self.ctx.spin_for(0.05)
+
+    def connected(self, mode: str = "tension", timeout: float = 30.0) -> None:
+        self.until(lambda: self.state().get("link") == "connected"
+                   and self.state().get("mode") == mode, timeout, f"connected in mode {mode}")

@@ -1,0 +1,198 @@
+"""tension_driver in its own process, over a real pty to the device twin running in this process.
+
+The twin (firmware logic on a simulated bench) runs at real time in a thread, so the test can
+look inside the device (mode, faults, setpoint, true tension) while the node talks to it through
+the pty like it would to a UNO. Timeouts are generous; the assertions are about behaviour.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from runtime_helpers import stop
+from tension_probe import DRIVER, Probe, driver_params, stamp_ns, values
+
+from tdcm_ros.device import constants as c
+from tdcm_ros.device.plant import PlantConfig
+from tdcm_ros.device.protocol import Fault, Mode
+from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+
+Spawn = Callable[..., subprocess.Popen[bytes]]
+BAND = 0.25      #: N, settling band around the setpoint
+SETTLE = 3.0     #: s from the setpoint message to the last sample outside the band
+
+
+@pytest.fixture
+def twin(tmp_path: Path) -> Iterator[PtyTwin]:
+    server = PtyTwin(DeviceTwin(PlantConfig(seed=5)), link=str(tmp_path / "tdcm_port")).start()
+    yield server
+    server.stop()
+
+
+@pytest.fixture
+def probe(router: subprocess.Popen[bytes]) -> Iterator[Probe]:
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    ctx = ZenohContext()
+    yield Probe(ctx)
+    ctx.close()
+
+
+def start_driver(spawn: Spawn, tmp_path: Path, twin: PtyTwin, **params: Any
+                 ) -> subprocess.Popen[bytes]:
+    path = driver_params(tmp_path / "driver.yaml", port=twin.port, diagnostics_period_s=0.2,
+                         **params)
+    return spawn("tdcm_ros.runtime.run_node", DRIVER, "--name", "tension_driver",
+                 "--params", path)
+
+
+def stderr_of(process: subprocess.Popen[bytes]) -> str:
+    """SIGINT the node, wait, return what it logged."""
+    assert stop(process, 20.0) == 0
+    assert process.stderr is not None
+    return process.stderr.read().decode()
+
+
+def test_step_0_to_20_n_settles_within_the_band(spawn, probe, twin, tmp_path) -> None:
+    """Enters +-0.25 N of 20 N within 3 s of the setpoint message and stays there for 2 s."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    assert abs(float(probe.state()["tension"])) < 0.1
+    t0 = time.time_ns()
+    probe.until(lambda: probe.state().get("target") == "20.000", 10.0, "target 20 N",
+                action=lambda: probe.setpoint(20.0))
+    probe.until(lambda: probe.tension and stamp_ns(probe.tension[-1]) > t0 + 5.5e9, 30.0,
+                "5.5 s of telemetry after the step")
+    after = [(stamp_ns(m) - t0) / 1e9 for m in probe.tension if stamp_ns(m) > t0]
+    forces = [m.wrench.force.z for m in probe.tension if stamp_ns(m) > t0]
+    settle = max(t for t, f in zip(after, forces, strict=True) if abs(f - 20.0) > BAND)
+    print(f"\nnode 0->20 N step: settled into +-{BAND} N {settle:.2f} s after the setpoint "
+          f"message, peak {max(forces):.3f} N, {len(forces)} frames in {after[-1]:.1f} s")
+    assert settle <= SETTLE
+    assert after[-1] - settle >= 2.0
+    assert max(forces) < 20.0 + BAND
+    assert all(m.header.frame_id == "tdcm_tendon" for m in probe.tension)
+    assert twin.twin.plant.tension == pytest.approx(20.0, abs=BAND)
+    assert probe.states[-1].level == 0 and probe.state()["faults"] == ""
+
+
+def test_setpoint_above_the_maximum_is_clamped_with_a_warning(spawn, probe, twin,
+                                                              tmp_path) -> None:
+    node = start_driver(spawn, tmp_path, twin, tension_max=12.0)
+    probe.connected()
+    probe.until(lambda: probe.state().get("target") == "12.000", 10.0, "target clamped to 12 N",
+                action=lambda: probe.setpoint(35.0))
+    probe.until(lambda: any(d.level == 1 and int(values(d)["clamped_setpoints"]) >= 1
+                            for d in probe.diagnostics), 10.0, "a WARN on /diagnostics")
+    warned = next(d for d in probe.diagnostics if d.level == 1)
+    assert "clamped to 12 N" in values(warned)["last_warning"]
+    assert "clamped to [0, 12] N" in warned.message
+    probe.until(lambda: abs(twin.twin.plant.tension - 12.0) < BAND, 15.0, "12 N on the tendon")
+    assert twin.twin.core.setpoint_mn == 12000
+    log = stderr_of(node)
+    assert "setpoint = 35 N is out of range [0, 12] N; clamped to 12 N" in log
+
+
+def test_estop_releases_at_once_and_stays_released_until_cleared(spawn, probe, twin,
+                                                                 tmp_path) -> None:
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    probe.until(lambda: twin.twin.plant.tension > 7.5, 15.0, "8 N on the tendon",
+                action=lambda: probe.setpoint(8.0))
+    core = twin.twin.core
+    sent = time.monotonic()
+    probe.estop()
+    probe.until(lambda: core.mode is Mode.RELEASE, 10.0, "the device released")
+    print(f"\ne-stop: device released {time.monotonic() - sent:.3f} s after the message")
+    assert core.faults & Fault.ESTOP and core.pulse_us == c.PULSE_RELEASE_US
+    probe.until(lambda: twin.twin.plant.tension == 0.0, 5.0, "a slack tendon")
+    probe.until(lambda: "ESTOP" in probe.state().get("faults", ""), 5.0, "ESTOP in device_state")
+    assert probe.states[-1].level == 2 and probe.state()["target"] == "0.000"
+    time.sleep(0.5)
+    assert core.mode is Mode.RELEASE  # latched: no automatic recovery
+    probe.clear_faults()
+    probe.until(lambda: probe.state().get("faults") == "" and probe.state().get("mode")
+                == "tension", 10.0, "faults cleared, holding 0 N again")
+
+
+def test_closing_and_reopening_the_pty_triggers_a_reconnect(spawn, probe, twin,
+                                                            tmp_path) -> None:
+    node = start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    old = twin.pty_path
+    twin.reopen()
+    assert twin.pty_path != old or os.path.realpath(twin.port) == twin.pty_path
+    probe.until(lambda: any(values(d)["reconnects"] == "1" for d in probe.diagnostics), 20.0,
+                "reconnects = 1 on /diagnostics")
+    probe.connected()
+    count = len(probe.tension)
+    probe.until(lambda: len(probe.tension) > count + 10, 10.0, "telemetry after the reconnect")
+    assert "device link lost" in stderr_of(node)
+
+
+def test_device_releases_within_its_watchdog_when_heartbeats_stop(spawn, probe, twin,
+                                                                  tmp_path) -> None:
+    """The driver process is frozen (SIGSTOP: a hung host); the device releases by itself."""
+    node = start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    probe.until(lambda: twin.twin.plant.tension > 7.5, 15.0, "8 N on the tendon",
+                action=lambda: probe.setpoint(8.0))
+    core = twin.twin.core
+    released: list[tuple[int, int]] = []
+    tick = core.tick
+
+    def watch(now_ms: int) -> None:
+        tick(now_ms)
+        if not released and core.mode is Mode.RELEASE:
+            released.append((now_ms, core.last_rx_ms))
+
+    core.tick = watch  # type: ignore[method-assign]
+    os.kill(node.pid, signal.SIGSTOP)
+    try:
+        probe.until(lambda: bool(released), 10.0, "the watchdog release")
+        time.sleep(1.0)
+        assert twin.twin.plant.tension == 0.0
+    finally:
+        os.kill(node.pid, signal.SIGCONT)
+    at_ms, last_rx_ms = released[0]
+    delay = (at_ms - last_rx_ms) / 1000
+    print(f"\nwatchdog: released {delay:.3f} s (device time) after the host's last byte")
+    assert c.WATCHDOG_MS / 1000 <= delay <= (c.WATCHDOG_MS + c.CONTROL_PERIOD_MS) / 1000
+    assert core.faults & Fault.WATCHDOG
+    probe.until(lambda: "WATCHDOG" in probe.state().get("faults", ""), 15.0,
+                "WATCHDOG reported once the host is back")
+    assert core.mode is Mode.RELEASE
+
+
+def test_schedule_runs_the_staircase_and_reports_done(spawn, probe, twin, tmp_path) -> None:
+    start_driver(spawn, tmp_path, twin, **{"schedule.levels": [0.0, 4.0, 8.0],
+                                           "schedule.hold_s": 1.0, "schedule.trials": 2,
+                                           "schedule.autostart": True})
+    probe.until(lambda: probe.state().get("schedule_done") == "true", 40.0, "schedule_done")
+    targets = [float(values(s)["target"]) for s in probe.states
+               if values(s)["schedule"] == "running"]
+    steps = [t for i, t in enumerate(targets) if i == 0 or t != targets[i - 1]]
+    assert steps == [0.0, 4.0, 8.0, 0.0, 4.0, 8.0]
+    assert max(m.wrench.force.z for m in probe.tension) == pytest.approx(8.0, abs=0.3)
+    probe.until(lambda: probe.state().get("target") == "0.000", 5.0, "0 N after the schedule")
+
+
+@pytest.mark.parametrize(("name", "value", "message"), [
+    ("tension_max", 30.0, "tension_max = 30.0 is out of range"),
+    ("heartbeat_period", 0.3, "heartbeat_period = 0.3 is out of range"),
+    ("schedule.levels", [0.0, -4.0], "schedule.levels"),
+])
+def test_bad_parameters_stop_the_node_with_a_message(spawn, router, tmp_path, name, value,
+                                                     message) -> None:
+    path = driver_params(tmp_path / "bad.yaml", **{name: value})
+    node = spawn("tdcm_ros.runtime.run_node", DRIVER, "--params", path)
+    assert node.wait(30) == 2
+    assert node.stderr is not None
+    assert message in node.stderr.read().decode()
