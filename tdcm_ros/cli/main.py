@@ -22,6 +22,7 @@ SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.param",
     "tdcm_ros.cli.bench",
     "tdcm_ros.cli.figures",
+    "tdcm_ros.cli.scene",
 )
 
 

@@ -35,7 +35,7 @@ class ActuatorDynamics(ActuationEffect):
               low_open=True, high=10.0),
         Param("rate_m_per_s", "m/s", "speed limit of the actuator", 0.025, low=0.0, low_open=True,
               high=10.0),
-        Param("deadband_m", "m", "travel lost on each reversal (backlash)", 0.0, low=0.0,
+        Param("deadband_m", "m", "dead zone: the actuator stops this short of its command", 0.0, low=0.0,
               high=0.01),
     )
     fields: ClassVar[dict[str, str]] = {"lag_s": "lag", "rate_m_per_s": "rate", "deadband_m": "deadband"}
