@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -15,9 +16,11 @@ from tdcm_ros.model.errors import (
     TensionRangeError,
 )
 from tdcm_ros.model.grid import Grid
-from tdcm_ros.model.kinematics import PlanarShape
+from tdcm_ros.model.kinematics import PlanarShape, integrate
 
 Array = NDArray[np.float64]
+
+CLOSURE_BISECTIONS = 60
 
 
 def check_tension(tension: Any) -> float:
@@ -89,3 +92,28 @@ def check_closure(grid: Grid, shape: PlanarShape, tension: float) -> None:
             f"notch {worst + 1} closes at tension {tension:g} N (face gap {gaps[worst] * 1e3:.3f}"
             " mm): its faces touch, which the base model does not include",
             notch=worst + 1, gap_m=float(gaps[worst]))
+
+
+@lru_cache(maxsize=64)
+def closure_angle(grid: Grid) -> float:
+    """Bend angle (rad) across a notch at which its faces touch (:func:`notch_gaps` = 0) under
+    a moment uniform over the notch; ``inf`` if they do not touch below pi. All notches of a
+    design share it. For a uniform-curvature notch it is ``w_n / R_outer`` exactly."""
+    cells = np.flatnonzero(grid.notch_index == 0)
+    per_moment = float(np.sum(grid.C0[cells] + grid.C1[cells]))
+
+    def gap(angle: float) -> float:
+        moment = np.zeros(grid.n_cells)
+        moment[cells] = angle / per_moment
+        return float(notch_gaps(grid, integrate(grid, moment, moment))[0])
+
+    low, high = 0.0, math.pi * (1.0 - 1e-9)
+    if gap(high) > 0.0:
+        return math.inf
+    for _ in range(CLOSURE_BISECTIONS):
+        middle = 0.5 * (low + high)
+        if gap(middle) > 0.0:
+            low = middle
+        else:
+            high = middle
+    return low

@@ -60,6 +60,69 @@ def closed_form(grid: Grid, shape: PlanarShape, tension: Array) -> tuple[Array, 
     return m_a, m_b
 
 
+def closed_form_cells(grid: Grid, shape: PlanarShape, t_a: Array, t_b: Array
+                      ) -> tuple[Array, Array]:
+    """:func:`closed_form` with a tension that varies along ``s`` (one unbatched shape).
+
+    ``t_a``, ``t_b`` (N, shape (cells,)) are the tendon tensions at each cell's start and
+    end, one-sided like the moments. Equilibrium of the tendon piece beyond the cut still gives
+    ``m(s) = (p_c(s) - p(s)) x (-T(s) t_c(s))`` with ``T(s)`` the tension at the cut: friction
+    between tendon and channel is internal to the tendon + distal body. On a chord the
+    tendon runs free, so the caller passes the chord's one tension at both ends.
+    """
+    r_c = grid.design.R_c
+    m_a = r_c * t_a
+    m_b = r_c * t_b
+    cells = grid.chord_cells
+    if cells.size == 0:
+        return m_a, m_b
+    anchor, chord = _chords(grid, shape, cells)
+    m_a[cells] = -t_a[cells] * (np.conj(anchor - shape.p[cells]) * chord).imag
+    m_b[cells] = -t_b[cells] * (np.conj(anchor - shape.p[cells + 1]) * chord).imag
+    return m_a, m_b
+
+
+def tendon_wrap(grid: Grid, shape: PlanarShape) -> tuple[Array, Array]:
+    """Cumulative absolute turning (rad) of the tendon from the base, at every node.
+
+    Returns ``(before, after)``, shape (nodes,): the turning up to each node excluding and
+    including the kink there (eqs. 3-4: a chord meeting the offset curve). The tendon arrives
+    at the base along +z (the clamped base's tangent); the first kink, if any, is where it
+    enters its first chord. Inside a cell where the tendon follows the offset curve it turns
+    by the body's ``|theta_b - theta_a|``; along a chord it does not turn.
+    """
+    n = grid.n_cells
+    con = grid.constrained
+    start = shape.tangent[:-1].copy()
+    end = shape.tangent[1:].copy()
+    cells = grid.chord_cells
+    if cells.size:
+        _, chord = _chords(grid, shape, cells)
+        start[cells] = chord
+        end[cells] = chord
+    previous = np.concatenate([np.ones(1, dtype=complex), end[:-1]])
+    kink = np.abs(np.angle(np.conj(previous) * start))
+    within = np.where(con, np.abs(np.diff(shape.theta)), 0.0)
+    steps = np.empty(2 * n)
+    steps[0::2] = kink
+    steps[1::2] = within
+    total = np.cumsum(steps)
+    before = np.zeros(n + 1)
+    before[1:] = total[1::2]
+    after = before.copy()
+    after[:-1] = total[0::2]
+    return before, after
+
+
+def _chords(grid: Grid, shape: PlanarShape, cells: NDArray[np.int64]
+            ) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+    """Start point and unit direction (``z + i x``) of the tendon chord over each cell."""
+    p_c = shape.p + (1j * grid.design.R_c) * shape.tangent
+    anchor = p_c[grid.chord_start_node[cells]]
+    chord = p_c[grid.chord_end_node[cells]] - anchor
+    return anchor, chord / np.abs(chord)
+
+
 def literal(grid: Grid, shape: PlanarShape, tension: float, m_a: Array, m_b: Array
             ) -> tuple[Array, Array]:
     """Per-cell end moments (N m) as the paper's sum of eqs. 8-10, for one (unbatched) shape.
@@ -103,7 +166,7 @@ def literal(grid: Grid, shape: PlanarShape, tension: float, m_a: Array, m_b: Arr
         theta_q = th[cells, None] + phi
         sigma = grid.s_q[cells] - grid.s_nodes[cells, None]
         mean_k = ((th[cells + 1] - th[cells]) / grid.length[cells])[:, None]
-        along, across = _arc(mean_k, sigma)
+        along, across = arc_offsets(mean_k, sigma)
         ta = np.stack([np.sin(th[cells]), np.cos(th[cells])], axis=-1)[:, None, :]
         na = np.stack([np.cos(th[cells]), -np.sin(th[cells])], axis=-1)[:, None, :]
         p_q = (np.stack([x[cells], z[cells]], axis=-1)[:, None, :]
@@ -169,7 +232,7 @@ def literal(grid: Grid, shape: PlanarShape, tension: float, m_a: Array, m_b: Arr
     return moment(a_nodes, strict=True), moment(a_nodes + 1, strict=False)
 
 
-def _arc(curvature: Array, length: Array) -> tuple[Array, Array]:
+def arc_offsets(curvature: Array, length: Array) -> tuple[Array, Array]:
     """Along-tangent and toward-normal displacement (m) after ``length`` on a circular arc."""
     angle = curvature * length
     small = np.abs(angle) < 1e-8

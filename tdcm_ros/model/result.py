@@ -23,6 +23,11 @@ class SolveResult:
     Node arrays (one entry per cell boundary, base to tip): ``s`` (m), ``positions`` (n, 3) m,
     ``theta`` (rad, about +y), ``quaternions`` (n, 4) as ``(x, y, z, w)``. ``cell_moments``
     (cells, 2) holds each cell's end moments (N m), the fixed point of Algorithm 1.
+
+    Under a :class:`~tdcm_ros.model.loading.Loading`: ``loading`` is it; ``tendon_tension``
+    (N, per node, just past each node's kink) is set when the tension varies along ``s``;
+    ``contact_scale`` (per cell) is set with notch contact: the curvature follows
+    ``cell_moments * contact_scale`` (:attr:`bend_moments`).
     """
 
     design: Design
@@ -38,14 +43,34 @@ class SolveResult:
     strategy: str
     solve_time_s: float
     grid: Grid = field(repr=False)
+    loading: Any = None
+    contact_scale: Array | None = field(default=None, repr=False)
+    tendon_tension: Array | None = field(default=None, repr=False)
+
+    @property
+    def bend_moments(self) -> Array:
+        """Per-cell end moments (N m) that set the curvature: ``cell_moments``, scaled in
+        closed notches when notch contact is on."""
+        if self.contact_scale is None:
+            return self.cell_moments
+        return self.cell_moments * self.contact_scale[:, None]
+
+    @property
+    def closed_notches(self) -> tuple[int, ...]:
+        """1-based indices of the notches in contact (empty without notch contact)."""
+        if self.contact_scale is None:
+            return ()
+        closed = np.unique(self.grid.notch_index[self.contact_scale < 1.0])
+        return tuple(int(i) + 1 for i in closed)
 
     @property
     def curvature_profile(self) -> tuple[Array, Array]:
         """``(s, kappa)``: curvature (1/m) inside every cell and one-sidedly at its ends (m),
         so the jumps at ``l_i`` and ``r_i`` show."""
         grid = self.grid
-        m_a = self.cell_moments[:, 0:1]
-        m_b = self.cell_moments[:, 1:2]
+        moments = self.bend_moments
+        m_a = moments[:, 0:1]
+        m_b = moments[:, 1:2]
         m_q = m_a * (1.0 - grid.xi_q) + m_b * grid.xi_q
         s = np.concatenate([grid.s_nodes[:-1, None], grid.s_q, grid.s_nodes[1:, None]], axis=1)
         kappa = np.concatenate([m_a * grid.c_start[:, None], m_q * grid.c_q,
@@ -98,8 +123,9 @@ class SolveResult:
         grid = self.grid
         cells = np.clip(np.searchsorted(grid.s_nodes, query, side="right") - 1, 0,
                         grid.n_cells - 1)
-        m_a = self.cell_moments[cells, 0]
-        m_b = self.cell_moments[cells, 1]
+        moments = self.bend_moments
+        m_a = moments[cells, 0]
+        m_b = moments[cells, 1]
         a0_s, a1_s, a0_r, a1_r, w_r = grid.partial_integrals(cells, query)
         phi_r = m_a[:, None] * a0_r + m_b[:, None] * a1_r
         along = np.sum(w_r * np.cos(phi_r), axis=1)
@@ -127,4 +153,5 @@ class SolveResult:
             "residual_history_m": list(self.residual_history),
             "design": self.design.to_dict(),
             "settings": self.settings.to_dict(),
+            **({} if self.loading is None else {"loading": self.loading.describe()}),
         }

@@ -11,6 +11,12 @@ continuation (tension ramped in ``continuation_steps`` warm-started steps). Fail
 of them raises :class:`ConvergenceError`. Physical limits are checked explicitly: the
 tendon-offset singularity before iterating and again on the solution, notch closure on the
 solution.
+
+A :class:`~tdcm_ros.model.loading.Loading` adds a tension varying along ``s``, external loads
+and notch contact (see :mod:`tdcm_ros.model.loading`); the same strategies drive it, and
+continuation ramps its external loads with the tension. Under a loading the singularity is
+checked on the solution (its moments are not known beforehand), and closure raises unless
+notch contact is on.
 """
 
 from __future__ import annotations
@@ -34,15 +40,27 @@ from tdcm_ros.model.limits import (
     check_tendon_singularity,
     check_tension,
 )
+from tdcm_ros.model.loading import InvalidLoadingError, LoadedModel, Loading
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
-MomentMap = Callable[[PlanarShape, Array], Array]
+MomentMap = Callable[[PlanarShape, Array, float, float], Array]
+"""(shape, current moments, tension level (N), external load factor) -> new moments (N m)."""
 
 DEFAULT_SETTINGS = SolverSettings()
 SLOW_CONTRACTION = 0.3
 DIVERGENCE_GROWTH = 1e3
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """What the strategies iterate: the moment map and the map from moments to shape."""
+
+    grid: Grid
+    settings: SolverSettings
+    moments: MomentMap
+    shape_of: Callable[[Array], PlanarShape]
 
 
 @dataclass
@@ -57,25 +75,33 @@ class _Run:
 
 
 def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_SETTINGS,
-          warm_start: SolveResult | None = None, strict: bool = True) -> SolveResult:
-    """Shape of ``design`` under tendon tension ``tension`` (N).
+          warm_start: SolveResult | None = None, strict: bool = True,
+          loading: Loading | None = None) -> SolveResult:
+    """Shape of ``design`` under tendon tension ``tension`` (N), the tension at the base.
 
     ``warm_start`` reuses a previous result of the same design and settings as the initial
     iterate (scaled by the tension ratio). With ``strict=False`` a non-converged solve returns
-    its last finite iterate with ``converged=False`` instead of raising.
+    its last finite iterate with ``converged=False`` instead of raising. ``loading`` adds a
+    varying tension, external loads and notch contact; None (or ``Loading()``) is the paper's
+    model.
     """
     started = perf_counter()
     t_base = check_tension(tension)
     grid = build_grid(design, settings)
     n = grid.n_cells
-    check_tendon_singularity(grid, t_base)
-    moment_map = _moment_map(grid, settings)
-    x0 = _initial_guess(grid, settings, t_base, warm_start)
+    model = _loaded_model(grid, settings, t_base, loading)
+    if model is None:
+        check_tendon_singularity(grid, t_base)
+        problem = _Problem(grid, settings, _moment_map(grid, settings), partial(_shape, grid))
+    else:
+        problem = _Problem(grid, settings, model.moments,
+                           lambda x: _shape(grid, model.bend_moments(x)))
+    x0 = _initial_guess(grid, settings, t_base, warm_start, loaded=model is not None)
 
     runs: list[tuple[str, _Run]] = []
     budget = settings.max_iter
     for name, run_strategy in _strategies(settings):
-        run = run_strategy(grid, moment_map, t_base, x0, settings, budget)
+        run = run_strategy(problem, t_base, x0, budget)
         runs.append((name, run))
         budget -= len(run.history)
         if run.converged or budget <= 0:
@@ -84,11 +110,15 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     iterations = sum(len(r.history) for _, r in runs)
     history = tuple(v for _, r in runs for v in r.history)
     if final.converged:
-        if settings.loads == "literal":
+        if model is not None:
+            bend = model.bend_moments(final.x)
+            check_singularity(grid, bend[:n], bend[n:])
+        elif settings.loads == "literal":
             check_singularity(grid, final.x[:n], final.x[n:])
-        check_closure(grid, final.shape, t_base)
+        if model is None or not model.has_contact:
+            check_closure(grid, final.shape, t_base)
     result = _result(grid, settings, t_base, final, strategy, iterations, history,
-                     perf_counter() - started)
+                     perf_counter() - started, loading, model)
     if not final.converged and strict:
         reasons = "; ".join(f"{name}: {r.reason}" for name, r in runs)
         raise ConvergenceError(
@@ -98,32 +128,58 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     return result
 
 
+def _loaded_model(grid: Grid, settings: SolverSettings, tension: float,
+                  loading: Loading | None) -> LoadedModel | None:
+    """The loading's model on this grid, or None for the paper's model."""
+    if loading is None:
+        return None
+    if not isinstance(loading, Loading):
+        raise InvalidLoadingError(f"loading = {loading!r} is not a Loading; allowed: None or "
+                                  "Loading(...)", parameter="loading", value=loading,
+                                  allowed="None | Loading")
+    if loading.is_trivial:
+        return None
+    if settings.loads != "closed":
+        raise InvalidLoadingError(
+            f"loading is not supported with loads = {settings.loads!r}; allowed: loads=closed "
+            "(the literal sum of eqs. 8-10 assumes a constant tension and no external load)",
+            parameter="loading", value=loading.describe(), allowed="loads=closed")
+    return LoadedModel(grid, loading, tension)
+
+
+def _shape(grid: Grid, x: Array) -> PlanarShape:
+    """Shape integrated from the stacked cell end moments ``[m_a, m_b]``."""
+    n = grid.n_cells
+    return integrate(grid, x[:n], x[n:])
+
+
 def _moment_map(grid: Grid, settings: SolverSettings) -> MomentMap:
-    """The map from (shape, current moments) to new moments for the chosen load form."""
+    """The map from (shape, current moments, tension) to new moments for the chosen load form."""
     n = grid.n_cells
 
-    def closed(shape: PlanarShape, x: Array, tension: float) -> Array:
+    def closed(shape: PlanarShape, x: Array, tension: float, factor: float) -> Array:
         m_a, m_b = loads.closed_form(grid, shape, np.float64(tension))
         return np.concatenate([m_a, m_b])
 
-    def literal(shape: PlanarShape, x: Array, tension: float) -> Array:
+    def literal(shape: PlanarShape, x: Array, tension: float, factor: float) -> Array:
         m_a, m_b = loads.literal(grid, shape, tension, x[:n], x[n:])
         return np.concatenate([m_a, m_b])
 
-    return closed if settings.loads == "closed" else literal  # type: ignore[return-value]
+    return closed if settings.loads == "closed" else literal
 
 
 def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
-                   warm_start: SolveResult | None) -> Array:
-    """The tendon moment ``R_c T`` everywhere, or a compatible previous solution rescaled."""
+                   warm_start: SolveResult | None, *, loaded: bool) -> Array:
+    """The tendon moment ``R_c T`` everywhere, or a compatible previous solution rescaled
+    (by the tension ratio; under a loading, unscaled from a zero-tension result)."""
     if (warm_start is not None and warm_start.grid is grid and warm_start.settings == settings
-            and warm_start.tension_n > 0.0 and warm_start.converged):
-        scale = tension / warm_start.tension_n
+            and (warm_start.tension_n > 0.0 or loaded) and warm_start.converged):
+        scale = tension / warm_start.tension_n if warm_start.tension_n > 0.0 else 1.0
         return np.concatenate([warm_start.cell_moments[:, 0], warm_start.cell_moments[:, 1]]) * scale
     return np.full(2 * grid.n_cells, grid.design.R_c * tension)
 
 
-Strategy = Callable[[Grid, MomentMap, float, Array, SolverSettings, int], _Run]
+Strategy = Callable[[_Problem, float, Array, int], _Run]
 
 
 def _strategies(settings: SolverSettings) -> list[tuple[str, Strategy]]:
@@ -138,21 +194,21 @@ def _strategies(settings: SolverSettings) -> list[tuple[str, Strategy]]:
     return [(settings.acceleration, partial(_iterate, mode=mode))]
 
 
-def _continuation(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
-                  settings: SolverSettings, budget: int) -> _Run:
-    """Ramp the tension in equal steps, each warm-started from the previous solution."""
+def _continuation(problem: _Problem, tension: float, x0: Array, budget: int) -> _Run:
+    """Ramp the tension (and any external loads) in equal steps, each warm-started from the
+    previous solution."""
+    grid, settings = problem.grid, problem.settings
     steps = settings.continuation_steps
     x = np.full_like(x0, grid.design.R_c * tension / steps)
     history: list[float] = []
-    run = _Run(x, integrate(grid, x[: grid.n_cells], x[grid.n_cells:]), history, False,
-               "no steps")
+    run = _Run(x, problem.shape_of(x), history, False, "no steps")
     previous = tension / steps
     for k in range(1, steps + 1):
         level = tension * k / steps
-        x = x * (level / previous)
+        x = x * (level / previous if previous > 0.0 else k / (k - 1) if k > 1 else 1.0)
         previous = level
-        run = _iterate(grid, moment_map, level, x, settings, budget - len(history),
-                       mode="anderson")
+        run = _iterate(problem, level, x, budget - len(history), mode="anderson",
+                       factor=k / steps)
         history.extend(run.history)
         if not run.converged:
             return _Run(run.x, run.shape, history, False,
@@ -161,12 +217,14 @@ def _continuation(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
     return _Run(run.x, run.shape, history, True, "converged")
 
 
-def _iterate(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
-             settings: SolverSettings, budget: int, *, mode: str) -> _Run:
-    """Fixed-point iteration on the cell moments; ``mode`` picks the update rule."""
-    n = grid.n_cells
+def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode: str,
+             factor: float = 1.0) -> _Run:
+    """Fixed-point iteration on the cell moments; ``mode`` picks the update rule. ``factor``
+    scales the external loads (continuation)."""
+    grid, settings = problem.grid, problem.settings
+    moment_map, shape_of = problem.moments, problem.shape_of
     x = x0
-    shape = integrate(grid, x[:n], x[n:])
+    shape = shape_of(x)
     history: list[float] = []
     using = "picard" if mode == "auto" else mode
     d_x: list[Array] = []
@@ -174,7 +232,7 @@ def _iterate(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
     last: tuple[Array, Array] | None = None
     length = grid.design.length
     for _ in range(max(budget, 0)):
-        g = moment_map(shape, x, tension)
+        g = moment_map(shape, x, tension, factor)
         f = g - x
         if using == "anderson":
             x_new = _anderson_step(x, f, last, d_x, d_f, settings.anderson_depth)
@@ -183,7 +241,7 @@ def _iterate(grid: Grid, moment_map: MomentMap, tension: float, x0: Array,
             x_new = x + settings.relaxation * f
         else:
             x_new = g
-        new_shape = integrate(grid, x_new[:n], x_new[n:])
+        new_shape = shape_of(x_new)
         step = float(np.max(np.abs(new_shape.p - shape.p)))
         if not np.isfinite(step):
             return _Run(x, shape, history, False, "iterate became non-finite")
@@ -218,9 +276,16 @@ def _anderson_step(x: Array, f: Array, last: tuple[Array, Array] | None, d_x: li
 
 
 def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, strategy: str,
-            iterations: int, history: tuple[float, ...], elapsed: float) -> SolveResult:
+            iterations: int, history: tuple[float, ...], elapsed: float,
+            loading: Loading | None, model: LoadedModel | None) -> SolveResult:
     n = grid.n_cells
     shape = run.shape
+    contact_scale = tendon_tension = None
+    if model is not None:
+        if model.has_contact:
+            contact_scale = model.contact_scale(run.x)
+        if model.loading.tension_profile is not None:
+            tendon_tension = model.node_tensions(shape, tension)[1]
     positions = np.zeros((n + 1, 3))
     positions[:, 0] = shape.p.imag
     positions[:, 2] = shape.p.real
@@ -228,4 +293,5 @@ def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, str
         design=grid.design, settings=settings, tension_n=tension, s=grid.s_nodes,
         positions=positions, theta=shape.theta, cell_moments=run.x.reshape(2, n).T,
         iterations=iterations, residual_history=history, converged=run.converged,
-        strategy=strategy, solve_time_s=elapsed, grid=grid)
+        strategy=strategy, solve_time_s=elapsed, grid=grid, loading=loading,
+        contact_scale=contact_scale, tendon_tension=tendon_tension)
