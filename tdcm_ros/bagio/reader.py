@@ -14,55 +14,35 @@ UNIX epoch. Every failure is a :class:`~tdcm_ros.bagio.errors.BagError` naming t
 from __future__ import annotations
 
 import heapq
+import io
+import itertools
+import mmap
 import struct
+import zlib
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
+from operator import itemgetter
 from pathlib import Path
 from typing import IO, Any
 
+import lz4.frame
 import yaml
 import zstandard
+from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
 from mcap.reader import SeekingReader
-from mcap.records import Channel, Footer, Message, Schema
-from mcap.stream_reader import StreamReader
+from mcap.records import Channel, Schema
 from mcap.summary import Summary
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
 from tdcm_ros.bagio.errors import BagError
-from tdcm_ros.bagio.typestore import deserialize, typestore
+from tdcm_ros.bagio.typestore import typestore
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 SQLITE_MAGIC = b"SQLite format 3\x00"
 METADATA_FILE = "metadata.yaml"
 
 RawMessage = tuple[int, str, bytes]  # (log time ns, topic, CDR bytes)
-
-
-class _Truncated(Exception):
-    """The file ended inside a record."""
-
-
-# What a cut or damaged MCAP file raises inside ``mcap`` (lz4 raises RuntimeError).
-_READ_ERRORS = (McapError, _Truncated, struct.error, ValueError, KeyError, IndexError, EOFError,
-                OSError, RuntimeError, zstandard.ZstdError)
-
-
-class _ExactStream:
-    """A read-only view of a file whose ``read(n)`` returns n bytes or raises :class:`_Truncated`.
-
-    ``mcap``'s stream reader accepts short reads at the end of a file, which would turn a
-    half-written record into a partial message; this wrapper makes the cut explicit.
-    """
-
-    def __init__(self, stream: IO[bytes]) -> None:
-        self._stream = stream
-
-    def read(self, size: int = -1) -> bytes:
-        data = self._stream.read(size)
-        if size > 0 and len(data) != size:
-            raise _Truncated(f"{size - len(data)} bytes missing")
-        return data
 
 
 @dataclass(frozen=True)
@@ -85,8 +65,40 @@ def _describe(error: BaseException) -> str:
     return f"{type(error).__name__}: {text}" if text else type(error).__name__
 
 
+_RECORD = struct.Struct("<BQ")  # opcode, record length
+_MESSAGE = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
+_CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
+_OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 2, 3, 4, 5, 6, 15
+
+Unit = list[tuple[int, int, bytes]]  # (log time ns, channel id, data) of one chunk or record
+
+
+class _Damaged(Exception):
+    """A record of the data section is cut short or fails its check."""
+
+
+# What record parsers and decompressors raise on damaged bytes (lz4 raises RuntimeError).
+_DAMAGE = (_Damaged, McapError, struct.error, ValueError, KeyError, IndexError, EOFError,
+           RuntimeError, zstandard.ZstdError)
+
+
+def _decompress(compression: str, data: bytes, size: int) -> bytes:
+    if not compression:
+        return data
+    if compression == "zstd":
+        return zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
+    if compression == "lz4":
+        return bytes(lz4.frame.decompress(data))
+    raise _Damaged(f"unsupported chunk compression {compression!r}")
+
+
 class _McapSource:
-    """One MCAP file: indexed reading through its summary, else a linear scan to the cut."""
+    """One MCAP file, read by a linear pass over its data section (chunks checked by CRC).
+
+    With a summary (footer, statistics, chunk indexes) the file is complete: damage found
+    while reading is an error. Without one (writer killed), :meth:`_scan` finds at open where
+    the readable part ends; reading stops there and ``warnings`` says how much survived.
+    """
 
     def __init__(self, path: Path) -> None:
         self.path = path
@@ -97,31 +109,31 @@ class _McapSource:
         self._schemas: dict[int, Schema] = {}
         self._types: dict[int, str] = {}
         self._size = path.stat().st_size
-        self._indexed = False
-        self._sorted = True
+        self._last_end = -1
+        self.ordered = True  # units (chunks, loose messages) do not overlap in time
         with path.open("rb") as stream:
             if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
                 raise BagError(f"{path}: not an MCAP file (no MCAP magic at the start)")
             summary = self._summary(stream)
+        self.complete = summary is not None
         if summary is not None:
-            self._indexed = True
-            self._schemas, self._channels = dict(summary.schemas), dict(summary.channels)
+            self._schemas = dict(summary.schemas)
             counts = summary.statistics.channel_message_counts if summary.statistics else {}
-            for channel_id, channel in self._channels.items():
+            for channel in summary.channels.values():
                 self._declare(channel)
-                self.counts[channel.topic] += counts.get(channel_id, 0)
+                self.counts[channel.topic] += counts.get(channel.id, 0)
+            for index in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
+                self._note_range(index.message_start_time, index.message_end_time)
         else:
-            self._scan_all()
+            self._scan()
 
     def _summary(self, stream: IO[bytes]) -> Summary | None:
         """The summary when it indexes every message (chunk indexes and statistics), else None."""
-        if self._size < 2 * len(MCAP_MAGIC) + 29:
-            return None
         try:
             stream.seek(0)
             summary = SeekingReader(stream, validate_crcs=True,
                                     record_size_limit=self._size).get_summary()
-        except _READ_ERRORS:  # no footer, bad footer or summary: the linear scan decides
+        except (*_DAMAGE, OSError):  # no footer, bad footer or summary: the linear scan decides
             return None
         if summary is None or summary.statistics is None or (
                 summary.statistics.message_count and not summary.chunk_indexes):
@@ -129,6 +141,9 @@ class _McapSource:
         return summary
 
     def _declare(self, channel: Channel) -> None:
+        if channel.id in self._channels:
+            return
+        self._channels[channel.id] = channel
         schema = self._schemas.get(channel.schema_id)
         info = _TopicInfo(_canonical_type(schema.name) if schema else "",
                           schema.encoding if schema else "",
@@ -140,44 +155,88 @@ class _McapSource:
             self.warnings.append(f"{self.path}: topic {channel.topic} has several types "
                                  f"({known.msgtype}, {info.msgtype}); reading {known.msgtype}")
 
-    def _records(self, stream: IO[bytes]) -> Iterator[Any]:
-        reader = StreamReader(_ExactStream(stream), validate_crcs=True,  # type: ignore[arg-type]
-                              record_size_limit=self._size)
-        return iter(reader.records)
+    def _note_range(self, start: int, end: int) -> None:
+        self.ordered = self.ordered and start >= self._last_end
+        self._last_end = max(self._last_end, end)
 
-    def _scan_all(self) -> None:
-        """Learn topics and counts by reading every complete record; note where the file stops."""
+    def _records(self, block: bytes, wanted: set[int] | None) -> Unit:
+        """Messages of a block of records (a chunk's content or one top-level record)."""
+        out: Unit = []
+        pos, end = 0, len(block)
+        while pos < end:
+            op, length = _RECORD.unpack_from(block, pos)
+            body, after = pos + 9, pos + 9 + length
+            if after > end:
+                raise _Damaged(f"a record (opcode {op:#x}) runs {after - end} bytes past its chunk")
+            if op == _OP_MESSAGE:
+                channel, _, log_time, _ = _MESSAGE.unpack_from(block, body)
+                if channel in self._channels and (wanted is None or channel in wanted):
+                    out.append((log_time, channel, block[body + _MESSAGE.size:after]))
+            elif op == _OP_SCHEMA:
+                schema = Schema.read(ReadDataStream(io.BytesIO(block[body:after])))
+                self._schemas.setdefault(schema.id, schema)
+            elif op == _OP_CHANNEL:
+                self._declare(Channel.read(ReadDataStream(io.BytesIO(block[body:after]))))
+            pos = after
+        return out
+
+    def _chunk(self, body: bytes, wanted: set[int] | None) -> Unit:
+        _, _, size, crc, name_length = _CHUNK.unpack_from(body, 0)
+        pos = _CHUNK.size + name_length
+        compression = body[_CHUNK.size:pos].decode()
+        (stored,) = struct.unpack_from("<Q", body, pos)
+        if pos + 8 + stored != len(body):
+            raise _Damaged("chunk length fields disagree")
+        content = _decompress(compression, body[pos + 8:], size)
+        if len(content) != size or (crc and zlib.crc32(content) != crc):
+            raise _Damaged("chunk CRC or size mismatch")
+        unit = self._records(content, wanted)
+        unit.sort(key=itemgetter(0))
+        return unit
+
+    def _units(self, buf: bytes | mmap.mmap, wanted: set[int] | None) -> Iterator[Unit]:
+        """Messages chunk by chunk, each unit complete and checked, up to the data end."""
+        pos, end = len(MCAP_MAGIC), len(buf)
+        while pos < end:
+            if pos + 9 > end:
+                raise _Damaged(f"the file ends inside a record header at byte {pos}")
+            op, length = _RECORD.unpack_from(buf, pos)
+            body, after = pos + 9, pos + 9 + length
+            if after > end:
+                raise _Damaged(f"the record (opcode {op:#x}) at byte {pos} needs {length} "
+                               f"bytes; the file ends {end - body} bytes later")
+            if op == _OP_CHUNK:
+                yield self._chunk(buf[body:after], wanted)
+            elif op in (_OP_MESSAGE, _OP_SCHEMA, _OP_CHANNEL):
+                yield self._records(buf[pos:after], wanted)
+            elif op in (_OP_DATA_END, _OP_FOOTER):
+                return
+            pos = after
+        raise _Damaged("the file ends without a data end record")
+
+    def _scan(self) -> None:
+        """Learn topics and counts from every complete chunk; note where the readable part ends."""
         messages = 0
-        last_time = -1
-        ended = False
-        with self.path.open("rb") as stream:
+        with self.path.open("rb") as stream, mmap.mmap(stream.fileno(), 0,
+                                                          access=mmap.ACCESS_READ) as buf:
             try:
-                for record in self._records(stream):
-                    if isinstance(record, Schema):
-                        self._schemas[record.id] = record
-                    elif isinstance(record, Channel):
-                        if record.id not in self._channels:
-                            self._channels[record.id] = record
-                            self._declare(record)
-                    elif isinstance(record, Message) and record.channel_id in self._channels:
-                        messages += 1
-                        self.counts[self._channels[record.channel_id].topic] += 1
-                        self._sorted = self._sorted and record.log_time >= last_time
-                        last_time = record.log_time
-                    elif isinstance(record, Footer):
-                        ended = True
-            except _READ_ERRORS as error:  # a cut or damaged record ends the readable part
+                for unit in self._units(buf, None):
+                    for _, channel, _ in unit:
+                        self.counts[self._channels[channel].topic] += 1
+                    if unit:
+                        messages += len(unit)
+                        self._note_range(unit[0][0], unit[-1][0])
+            except _DAMAGE as error:
                 if not messages:
                     raise BagError(f"{self.path}: truncated or corrupt before the first complete "
                                    f"chunk ({_describe(error)}); no message can be "
                                    f"recovered") from error
                 self.warnings.append(
                     f"{self.path}: truncated after {messages} messages (last complete chunk); "
-                    f"the rest of the file ({self._size} bytes) is unreadable: "
-                    f"{_describe(error)}")
+                    f"the rest of the file is unreadable: {_describe(error)}")
                 return
-        if not ended:
-            self.warnings.append(f"{self.path}: no MCAP footer; read {messages} messages")
+        self.warnings.append(f"{self.path}: no MCAP summary/footer; all {messages} messages "
+                             f"of the data section were read")
 
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
         """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""
@@ -185,35 +244,24 @@ class _McapSource:
                   if ch.topic in topics and self._types[cid] == self.topics[ch.topic].msgtype}
         if not wanted:
             return
-        with self.path.open("rb") as stream:
-            if self._indexed:
-                yield from self._raw_indexed(stream, wanted)
-            elif self._sorted:
-                yield from self._raw_scanned(stream, wanted)
-            else:
-                yield from sorted(self._raw_scanned(stream, wanted), key=lambda m: m[0])
+        names = {cid: self._channels[cid].topic for cid in wanted}
+        with self.path.open("rb") as stream, mmap.mmap(stream.fileno(), 0,
+                                                          access=mmap.ACCESS_READ) as buf:
+            units = self._units(buf, wanted)
+            if not self.ordered:
+                units = iter([sorted(itertools.chain.from_iterable(self._until_cut(units)),
+                                     key=itemgetter(0))])
+            for unit in self._until_cut(units):
+                for stamp, channel, data in unit:
+                    yield stamp, names[channel], data
 
-    def _raw_indexed(self, stream: IO[bytes], wanted: set[int]) -> Iterator[RawMessage]:
-        topics = sorted({self._channels[c].topic for c in wanted})
-        reader = SeekingReader(stream, validate_crcs=True, record_size_limit=self._size)
+    def _until_cut(self, units: Iterator[Unit]) -> Iterator[Unit]:
+        """``units`` up to the damage; an error if the file claimed to be complete."""
         try:
-            for _, channel, message in reader.iter_messages(topics=topics, log_time_order=True):
-                if channel.id in wanted:
-                    yield message.log_time, channel.topic, message.data
-        except _READ_ERRORS as error:  # damaged chunk behind an intact summary
-            raise BagError(f"{self.path}: corrupt data section ({_describe(error)})") from error
-
-    def _raw_scanned(self, stream: IO[bytes], wanted: set[int]) -> Iterator[RawMessage]:
-        records = self._records(stream)
-        while True:
-            try:
-                record = next(records)
-            except StopIteration:
-                return
-            except _READ_ERRORS:  # the cut found by _scan_all; its messages were counted already
-                return
-            if isinstance(record, Message) and record.channel_id in wanted:
-                yield record.log_time, self._channels[record.channel_id].topic, record.data
+            yield from units
+        except _DAMAGE as error:
+            if self.complete:
+                raise BagError(f"{self.path}: corrupt data section ({_describe(error)})") from error
 
 
 class _RosbagsSource:
@@ -332,11 +380,13 @@ class BagReader:
 
     def messages(self, topics: Sequence[str] | None = None) -> Iterator[tuple[str, int, Any]]:
         """(topic, log time ns, rosbags message) of ``topics`` (default all), in log-time order."""
+        decode = typestore().deserialize_cdr
         for topic, stamp, data in self.raw_messages(topics):
             try:
-                message = deserialize(data, self.topics[topic])
-            except BagError as error:
-                raise BagError(f"{self.path}: message on {topic} at {stamp} ns: {error}") from error
+                message = decode(data, self.topics[topic])
+            except Exception as error:  # rosbags raises SerdeError, struct and index errors
+                raise BagError(f"{self.path}: cannot decode the message on {topic} at {stamp} "
+                               f"ns as {self.topics[topic]}: {_describe(error)}") from error
             yield topic, stamp, message
 
 
