@@ -112,6 +112,7 @@ class Phase:
     rate: float
     sent: int
     latencies_ms: np.ndarray
+    hop_ms: np.ndarray
     coalesced: int
     solved: int
     load: tuple[float, float]
@@ -139,6 +140,7 @@ class Bench:
                                 *extra)
         self.lock = threading.Lock()
         self.received: list[tuple[int, int]] = []   # (receive ns, stamp ns) of each midline
+        self.inputs: list[tuple[int, int]] = []     # the same for each `tension` (one hop)
         self.counters: dict[str, int] = {}
         self.diag_ns = 0
         from tdcm_ros.runtime import wire
@@ -146,8 +148,13 @@ class Bench:
 
         self.context = ZenohContext()
         port = self.context.create_port("bench_latency")
-        key = wire.topic_key(0, "midline", "nav_msgs/msg/Path", type_hash("nav_msgs/msg/Path"))
-        self.subscriber = self.context.session.declare_subscriber(key, self._on_midline)
+        self.subscribers = [
+            self.context.session.declare_subscriber(
+                wire.topic_key(0, topic, type_name, type_hash(type_name)),
+                lambda sample, into=into: self._on_stamped(sample, into))
+            for topic, type_name, into in (("midline", "nav_msgs/msg/Path", self.received),
+                                           ("tension", "geometry_msgs/msg/WrenchStamped",
+                                            self.inputs))]
         port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
                                  self._on_diagnostics)
         self._wait(lambda: self.diag_ns > 0, 30.0, "model_node's first /diagnostics",
@@ -180,11 +187,11 @@ class Bench:
     def node_exited(self) -> bool:
         return len(self.children) > 1 and self.children[1].poll() is not None
 
-    def _on_midline(self, sample: Any) -> None:
+    def _on_stamped(self, sample: Any, into: list[tuple[int, int]]) -> None:
         now = time.time_ns()
         sec, nanosec = _STAMP.unpack_from(sample.payload.to_bytes(), 4)
         with self.lock:
-            self.received.append((now, sec * 1_000_000_000 + nanosec))
+            into.append((now, sec * 1_000_000_000 + nanosec))
 
     def _on_diagnostics(self, message: Any) -> None:
         for status in message.status:
@@ -203,6 +210,7 @@ class Bench:
         before = self.fresh_counters(time.time_ns())
         with self.lock:
             self.received.clear()
+            self.inputs.clear()
         load0 = os.getloadavg()[0]
         cpu0 = cpu_s(self.node.pid)
         publisher = self._spawn(__file__, "--publish", str(rate), str(duration), output=True)
@@ -227,15 +235,17 @@ class Bench:
         with self.lock:
             samples = [(recv, stamp) for recv, stamp in self.received
                        if summary["first_ns"] <= stamp <= summary["last_ns"]]
+            hop = np.array([(recv - stamp) / 1e6 for recv, stamp in self.inputs])
         latencies = np.array([(recv - stamp) / 1e6 for recv, stamp in samples])
-        return Phase(rate, summary["sent"], latencies,
+        return Phase(rate, summary["sent"], latencies, hop,
                      after.get("coalesced", 0) - before.get("coalesced", 0),
                      after.get("solved", 0) - before.get("solved", 0),
                      (load0, os.getloadavg()[0]), cpu_s(self.node.pid) - cpu0,
                      summary["elapsed_s"], rss)
 
     def close(self) -> None:
-        self.subscriber.undeclare()
+        for subscriber in self.subscribers:
+            subscriber.undeclare()
         self.context.close()
         for child in reversed(self.children):
             if child.poll() is None:
@@ -267,13 +277,15 @@ def row(phase: Phase) -> str:
     delivered = len(lat)
     figures = (f"{np.percentile(lat, 50):7.2f} {np.percentile(lat, 99):7.2f} {lat.max():8.2f}"
                if delivered else f"{'-':>7} {'-':>7} {'-':>8}")
+    hop = (f"{np.percentile(phase.hop_ms, 50):5.2f} {np.percentile(phase.hop_ms, 99):5.2f}"
+           if len(phase.hop_ms) else f"{'-':>5} {'-':>5}")
     return (f"{phase.rate:7.0f} {figures} {delivered:7d}/{phase.sent:<7d} "
-            f"{phase.coalesced:9d} {phase.cpu_node / phase.elapsed_s * 100:6.0f}% "
+            f"{phase.coalesced:9d} {hop} {phase.cpu_node / phase.elapsed_s * 100:7.0f}% "
             f"{phase.load[0]:5.2f}->{phase.load[1]:.2f}")
 
 
 HEADER = (f"{'rate Hz':>7} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>8} {'delivered/sent':>15} "
-          f"{'coalesced':>9} {'node CPU':>7} load1")
+          f"{'coalesced':>9} {'hop p50':>5} {'p99':>5} {'node CPU':>8} load1")
 
 
 def soak_report(phase: Phase) -> None:

@@ -171,14 +171,13 @@ class ModelNode(NodeLogic):
         placement = self.port.get_parameter("markers.placement")
         radius = (self.design.R_outer + float(self.port.get_parameter("markers.radius"))
                   if placement == "surface" else 0.0)
-        messages = midline_messages(
-            result, stamp_ns=stamp_ns, frame_id=self.frame_id,
-            samples=int(self.port.get_parameter("output.samples")),
-            marker_s=np.asarray(self.port.get_parameter("markers.arc_lengths"), dtype=float),
-            marker_radius=radius,
-            marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))))
-        for topic, message in messages.items():
-            self.publishers[topic].publish(message)
+        for topic, message in midline_messages(
+                result, stamp_ns=stamp_ns, frame_id=self.frame_id,
+                samples=int(self.port.get_parameter("output.samples")),
+                marker_s=np.asarray(self.port.get_parameter("markers.arc_lengths"), dtype=float),
+                marker_radius=radius,
+                marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg")))):
+            self.publishers[topic].publish(message)  # midline first: sent before the rest is built
 
     def report(self) -> None:
         """Publish counters and the last problem on ``/diagnostics``."""

@@ -2,16 +2,21 @@
 
 All poses are in the frame given as ``frame_id`` (``tdcm_base`` by default, see README Frames),
 positions in m, orientations as quaternions of the body frame (z axis = midline tangent).
+Messages are built from the typestore classes directly (not through ``from_dict``), one
+``pose_at`` call per result: the model node does this for every input (see bench_latency.py).
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from dataclasses import replace
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import from_dict
+from tdcm_ros.bagio import from_dict, msg_class
 from tdcm_ros.model import SolveResult
 
 Array = NDArray[np.float64]
@@ -23,11 +28,29 @@ def header(stamp_ns: int, frame_id: str) -> dict[str, Any]:
             "frame_id": frame_id}
 
 
-def _poses(positions: Array, quats: Array) -> list[dict[str, Any]]:
-    return [{"position": {"x": float(p[0]), "y": float(p[1]), "z": float(p[2])},
-             "orientation": {"x": float(q[0]), "y": float(q[1]), "z": float(q[2]),
-                             "w": float(q[3])}}
-            for p, q in zip(positions, quats, strict=True)]
+def _header_msg(stamp_ns: int, frame_id: str) -> Any:
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    return msg_class("std_msgs/msg/Header")(
+        stamp=msg_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec),
+        frame_id=frame_id)
+
+
+def _poses(positions: Array, quats: Array) -> list[Any]:
+    """``geometry_msgs/Pose`` objects for positions (k, 3) m and quaternions (k, 4) xyzw."""
+    point = msg_class("geometry_msgs/msg/Point")
+    quaternion = msg_class("geometry_msgs/msg/Quaternion")
+    pose = msg_class("geometry_msgs/msg/Pose")
+    return [pose(position=point(x=p[0], y=p[1], z=p[2]),
+                 orientation=quaternion(x=q[0], y=q[1], z=q[2], w=q[3]))
+            for p, q in zip(positions.tolist(), quats.tolist(), strict=True)]
+
+
+def _offset(positions: Array, quats: Array, radius: float, side_rad: float) -> Array:
+    """Points ``radius`` (m) off midline poses at ``side_rad`` around the body z axis."""
+    theta = 2.0 * np.arctan2(quats[:, 1], quats[:, 3])
+    body_x = np.stack([np.cos(theta), np.zeros_like(theta), -np.sin(theta)], axis=1)
+    body_y = np.array([0.0, 1.0, 0.0])
+    return positions + radius * (np.cos(side_rad) * body_x + np.sin(side_rad) * body_y)
 
 
 def surface_points(result: SolveResult, s: Array, radius: float, side_rad: float
@@ -35,44 +58,50 @@ def surface_points(result: SolveResult, s: Array, radius: float, side_rad: float
     """Points at arc lengths ``s`` (m), ``radius`` (m) off the midline at angle ``side_rad``
     around the body z axis from the body x axis (0 = tendon side); with their orientations."""
     positions, quats = result.pose_at(s)
-    theta = 2.0 * np.arctan2(quats[:, 1], quats[:, 3])
-    body_x = np.stack([np.cos(theta), np.zeros_like(theta), -np.sin(theta)], axis=1)
-    body_y = np.array([0.0, 1.0, 0.0])
-    offset = radius * (np.cos(side_rad) * body_x + np.sin(side_rad) * body_y)
-    return positions + offset, quats
+    return _offset(positions, quats, radius, side_rad), quats
+
+
+@lru_cache(maxsize=16)
+def _marker_template(ns: str, marker_id: int, marker_type: int, scale: tuple[float, float, float],
+                     color: tuple[float, float, float, float]) -> Any:
+    return from_dict("visualization_msgs/msg/Marker", {
+        "ns": ns, "id": marker_id, "type": marker_type, "action": 0,
+        "pose": {"orientation": {"w": 1.0}}, "scale": dict(zip("xyz", scale, strict=True)),
+        "color": dict(zip("rgba", color, strict=True)), "frame_locked": True})
+
+
+def _marker(hdr: Any, ns: str, marker_id: int, marker_type: int,
+            scale: tuple[float, float, float], color: tuple[float, float, float, float],
+            points: list[Any]) -> Any:
+    """A ``visualization_msgs/Marker``: a cached template with this header and points."""
+    return replace(_marker_template(ns, marker_id, marker_type, scale, color), header=hdr,
+                   points=points)
 
 
 def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, samples: int,
                      marker_s: Array, marker_radius: float, marker_side_rad: float
-                     ) -> dict[str, Any]:
-    """Messages keyed by topic: ``midline``, ``midline_poses``, ``tip_pose``,
-    ``predicted_markers`` and ``body_markers``."""
-    hdr = header(stamp_ns, frame_id)
+                     ) -> Iterator[tuple[str, Any]]:
+    """``(topic, message)`` for ``midline``, ``midline_poses``, ``tip_pose``,
+    ``predicted_markers`` and ``body_markers``, in that order, each built when the previous one
+    has been taken (so ``midline`` can be sent before the rest exist). The messages share
+    sub-objects (header, poses): serialise them, do not modify them."""
     s = np.linspace(0.0, result.design.length, samples)
-    positions, quats = result.pose_at(s)
-    poses = _poses(positions, quats)
-    markers_xyz, markers_q = surface_points(result, marker_s, marker_radius, marker_side_rad)
+    positions, quats = result.pose_at(np.concatenate([s, np.asarray(marker_s, dtype=float)]))
+    hdr = _header_msg(stamp_ns, frame_id)
+    pose_stamped = msg_class("geometry_msgs/msg/PoseStamped")
+    pose_array = msg_class("geometry_msgs/msg/PoseArray")
+    poses = _poses(positions[:samples], quats[:samples])
+    yield "midline", msg_class("nav_msgs/msg/Path")(
+        header=hdr, poses=[pose_stamped(header=hdr, pose=pose) for pose in poses])
+    yield "midline_poses", pose_array(header=hdr, poses=poses)
     tip = _poses(result.tip_position[None, :], result.tip_quaternion[None, :])[0]
-    diameter = 2.0 * result.design.R_outer
-    body = {
-        "header": hdr, "ns": "tdcm_body", "id": 0, "type": 4, "action": 0,
-        "pose": {"orientation": {"w": 1.0}}, "scale": {"x": diameter},
-        "color": {"r": 0.85, "g": 0.85, "b": 0.9, "a": 0.8}, "frame_locked": True,
-        "points": [pose["position"] for pose in poses],
-    }
-    spheres = {
-        "header": hdr, "ns": "tdcm_predicted_markers", "id": 1, "type": 7, "action": 0,
-        "pose": {"orientation": {"w": 1.0}}, "scale": {"x": 0.002, "y": 0.002, "z": 0.002},
-        "color": {"r": 1.0, "g": 0.2, "b": 0.8, "a": 1.0}, "frame_locked": True,
-        "points": [p["position"] for p in _poses(markers_xyz, markers_q)],
-    }
-    return {
-        "midline": from_dict("nav_msgs/msg/Path", {
-            "header": hdr, "poses": [{"header": hdr, "pose": pose} for pose in poses]}),
-        "midline_poses": from_dict("geometry_msgs/msg/PoseArray", {"header": hdr, "poses": poses}),
-        "tip_pose": from_dict("geometry_msgs/msg/PoseStamped", {"header": hdr, "pose": tip}),
-        "predicted_markers": from_dict("geometry_msgs/msg/PoseArray", {
-            "header": hdr, "poses": _poses(markers_xyz, markers_q)}),
-        "body_markers": from_dict("visualization_msgs/msg/MarkerArray",
-                                  {"markers": [body, spheres]}),
-    }
+    yield "tip_pose", pose_stamped(header=hdr, pose=tip)
+    markers = _poses(_offset(positions[samples:], quats[samples:], marker_radius,
+                             marker_side_rad), quats[samples:])
+    yield "predicted_markers", pose_array(header=hdr, poses=markers)
+    body = _marker(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
+                   (0.85, 0.85, 0.9, 0.8), [p.position for p in poses])
+    spheres = _marker(hdr, "tdcm_predicted_markers", 1, 7, (0.002, 0.002, 0.002),
+                      (1.0, 0.2, 0.8, 1.0), [p.position for p in markers])
+    yield "body_markers", msg_class("visualization_msgs/msg/MarkerArray")(
+        markers=[body, spheres])
