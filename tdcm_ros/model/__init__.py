@@ -25,6 +25,13 @@ from tdcm_ros.model.errors import (
     TendonSingularityError,
     TensionRangeError,
 )
+from tdcm_ros.model.loading import (
+    Capstan,
+    InvalidLoadingError,
+    Loading,
+    NotchContact,
+    TensionProfile,
+)
 from tdcm_ros.model.profiles import CircularProfile, CustomProfile, RectangularProfile
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SolverSettings
@@ -34,20 +41,25 @@ __all__ = [
     "DEFAULT_SETTINGS",
     "FIELD_SPECS",
     "PRESETS",
+    "Capstan",
     "CircularProfile",
     "ConvergenceError",
     "CustomProfile",
     "Design",
     "FieldSpec",
     "InvalidDesignError",
+    "InvalidLoadingError",
     "InvalidSettingsError",
+    "Loading",
     "ModelError",
     "ModelLimitError",
     "NotchClosureError",
+    "NotchContact",
     "RectangularProfile",
     "SolveResult",
     "SolverSettings",
     "TendonSingularityError",
+    "TensionProfile",
     "TensionRangeError",
     "parse_field",
     "preset",

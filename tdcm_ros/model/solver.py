@@ -50,6 +50,7 @@ MomentMap = Callable[[PlanarShape, Array, float, float], Array]
 
 DEFAULT_SETTINGS = SolverSettings()
 SLOW_CONTRACTION = 0.3
+CONTINUATION_HALVINGS = 5
 DIVERGENCE_GROWTH = 1e3
 
 
@@ -100,8 +101,8 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
 
     runs: list[tuple[str, _Run]] = []
     budget = settings.max_iter
-    for name, run_strategy in _strategies(settings):
-        run = run_strategy(problem, t_base, x0, budget)
+    for name, run_strategy, share in _strategies(settings, loaded=model is not None):
+        run = run_strategy(problem, t_base, x0, min(budget, share))
         runs.append((name, run))
         budget -= len(run.history)
         if run.converged or budget <= 0:
@@ -182,21 +183,36 @@ def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
 Strategy = Callable[[_Problem, float, Array, int], _Run]
 
 
-def _strategies(settings: SolverSettings) -> list[tuple[str, Strategy]]:
-    """Strategies to try in order for ``settings.acceleration``."""
+def _strategies(settings: SolverSettings, *, loaded: bool) -> list[tuple[str, Strategy, int]]:
+    """Strategies to try in order for ``settings.acceleration``, each with its iteration cap.
+
+    Under a loading the moment depends on the shape everywhere, so plain iteration gains
+    nothing over Anderson, which starts at once; Anderson and relaxation get a quarter of
+    ``max_iter`` each, leaving the rest to continuation (whose steps adapt: a failing step is
+    halved).
+    """
+    budget = settings.max_iter
     if settings.acceleration == "auto":
-        out: list[tuple[str, Strategy]] = [("picard+anderson", partial(_iterate, mode="auto")),
-                                           ("relaxation", partial(_iterate, mode="relaxation"))]
+        if loaded:
+            out: list[tuple[str, Strategy, int]] = [
+                ("anderson", partial(_iterate, mode="anderson"), max(budget // 4, 1)),
+                ("relaxation", partial(_iterate, mode="relaxation"), max(budget // 4, 1))]
+        else:
+            out = [("picard+anderson", partial(_iterate, mode="auto"), budget),
+                   ("relaxation", partial(_iterate, mode="relaxation"), budget)]
         if settings.continuation_steps > 0:
-            out.append(("continuation", _continuation))
+            out.append(("continuation", partial(_continuation, adaptive=loaded), budget))
         return out
     mode = "picard" if settings.acceleration == "none" else settings.acceleration
-    return [(settings.acceleration, partial(_iterate, mode=mode))]
+    return [(settings.acceleration, partial(_iterate, mode=mode), budget)]
 
 
-def _continuation(problem: _Problem, tension: float, x0: Array, budget: int) -> _Run:
+def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
+                  adaptive: bool = False) -> _Run:
     """Ramp the tension (and any external loads) in equal steps, each warm-started from the
-    previous solution."""
+    previous solution; ``adaptive`` halves a failing step (see :func:`_adaptive_continuation`)."""
+    if adaptive:
+        return _adaptive_continuation(problem, tension, x0, budget)
     grid, settings = problem.grid, problem.settings
     steps = settings.continuation_steps
     x = np.full_like(x0, grid.design.R_c * tension / steps)
@@ -214,6 +230,36 @@ def _continuation(problem: _Problem, tension: float, x0: Array, budget: int) -> 
             return _Run(run.x, run.shape, history, False,
                         f"step {k}/{steps} at {level:g} N: {run.reason}")
         x = run.x
+    return _Run(run.x, run.shape, history, True, "converged")
+
+
+def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget: int) -> _Run:
+    """Continuation on the load factor ``lam`` in [0, 1] (tension and external loads together):
+    steps start at ``1/continuation_steps``; a step that fails is retried from the last solution
+    at half the size (down to ``2**-CONTINUATION_HALVINGS`` of it) and a step that succeeds
+    lets the next one double back. Each step is predicted by scaling the last solution."""
+    largest = 1.0 / problem.settings.continuation_steps
+    smallest = largest / 2**CONTINUATION_HALVINGS
+    step = largest
+    lam = 0.0
+    x = np.zeros_like(x0)
+    history: list[float] = []
+    run = _Run(x, problem.shape_of(x), history, False, "no steps")
+    while lam < 1.0:
+        target = 1.0 if lam + step >= 1.0 - 1e-12 else lam + step
+        guess = x * (target / lam) if lam > 0.0 else np.full_like(
+            x0, problem.grid.design.R_c * tension * target)
+        run = _iterate(problem, tension * target, guess, budget - len(history),
+                       mode="anderson", factor=target)
+        history.extend(run.history)
+        if run.converged:
+            lam, x = target, run.x
+            step = min(2.0 * step, largest)
+            continue
+        if step <= smallest or len(history) >= budget:
+            return _Run(run.x, run.shape, history, False,
+                        f"load factor {target:.4g} (step {step:.3g}): {run.reason}")
+        step *= 0.5
     return _Run(run.x, run.shape, history, True, "converged")
 
 

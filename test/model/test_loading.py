@@ -1,0 +1,368 @@
+"""Loading: varying tension, external loads and notch contact inside Algorithm 1."""
+
+from itertools import pairwise
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from scipy.integrate import quad
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.model import (
+    PRESETS,
+    NotchClosureError,
+    SolverSettings,
+    preset,
+    solve,
+)
+from tdcm_ros.model.grid import build_grid
+from tdcm_ros.model.limits import closure_angle
+from tdcm_ros.model.loading import (
+    Capstan,
+    InvalidLoadingError,
+    Loading,
+    NotchContact,
+)
+from tdcm_ros.model.section import notched_area, notched_moment, tube_area
+
+RHO_G = 1010.0 * 9.81  # N/m^3, Nylon 12 under 1 g
+TIGHT = SolverSettings(tol=1e-14, max_iter=400)
+FINE = SolverSettings(cells_per_notch=32, cells_per_tube=32, quad_order=8, tol=1e-14,
+                      max_iter=400)
+HYPO = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def constant(s, wrap, tension):
+    return np.full_like(s, tension)
+
+
+def compliance_function(design):
+    """``1/(E I(s))`` written directly in ``s`` (eqs. 12-13), independent of the grid."""
+    left, right = design.notch_bounds()
+
+    def compliance(s: float) -> float:
+        for lo, hi in zip(left, right, strict=True):
+            if lo < s < hi:
+                half = design.w_n / 2
+                h1 = (design.w_n + design.w_d) / 2 - np.sqrt(max(half**2 - (s - lo - half) ** 2, 0))
+                return 1.0 / (design.E * float(notched_moment(h1, design.R_outer, design.r_inner)))
+        return 1.0 / (design.E * design.tube_second_moment)
+
+    breaks = sorted({0.0, design.length, *left, *right})
+    return compliance, list(pairwise(breaks))
+
+
+def linear_tip_x(design, weight) -> float:
+    """Small-deflection tip x (m): ``int_0^L (L - s) m(s) / (E I(s)) ds`` for a moment ``m(s)``."""
+    compliance, pieces = compliance_function(design)
+    length = design.length
+    return sum(quad(lambda s: (length - s) * weight(s) * compliance(s), a, b, limit=200,
+                    epsrel=1e-12)[0] for a, b in pieces)
+
+
+# --- section area ----------------------------------------------------------------------------
+
+@HYPO
+@given(h1=st.floats(1e-5, 5e-3), r_inner=st.floats(0.0, 3e-3))
+def test_notched_area_matches_quadrature(h1, r_inner):
+    r_outer = 3.92e-3
+    outer = quad(lambda y: 2 * np.sqrt(max(r_outer**2 - y**2, 0)), -min(h1, r_outer),
+                 min(h1, r_outer), epsabs=1e-14)[0]
+    h2 = min(h1, r_inner)
+    inner = quad(lambda y: 2 * np.sqrt(max(r_inner**2 - y**2, 0)), -h2, h2, epsabs=1e-14)[0]
+    assert float(notched_area(h1, r_outer, r_inner)) == pytest.approx(outer - inner, rel=1e-9,
+                                                                      abs=1e-15)
+
+
+def test_area_of_uncut_notch_is_the_tube():
+    assert float(notched_area(5e-3, 3.92e-3, 1.55e-3)) == pytest.approx(
+        tube_area(3.92e-3, 1.55e-3), rel=1e-14)
+
+
+# --- identity with the base model ------------------------------------------------------------
+
+@HYPO
+@given(name=st.sampled_from(list(PRESETS)), tension=st.floats(0.0, 20.0),
+       routing=st.sampled_from(["paper", "free"]))
+def test_empty_loading_is_the_base_model(name, tension, routing):
+    cfg = SolverSettings(routing=routing)
+    base = solve(preset(name), tension, settings=cfg)
+    same = solve(preset(name), tension, settings=cfg, loading=Loading())
+    assert np.array_equal(base.positions, same.positions)
+    assert np.array_equal(base.cell_moments, same.cell_moments)
+
+
+@HYPO
+@given(name=st.sampled_from(list(PRESETS)), tension=st.floats(0.0, 20.0),
+       routing=st.sampled_from(["paper", "free"]), cells=st.sampled_from([1, 4, 9]))
+def test_constant_profile_is_the_base_model(name, tension, routing, cells):
+    cfg = SolverSettings(routing=routing, cells_per_notch=cells, cells_per_tube=cells)
+    base = solve(preset(name), tension, settings=cfg)
+    varying = solve(preset(name), tension, settings=cfg, loading=Loading(tension_profile=constant))
+    assert np.max(np.abs(varying.positions - base.positions)) <= 1e-12
+    assert np.array_equal(varying.tendon_tension, np.full(base.s.shape, tension))
+
+
+# --- varying tension -------------------------------------------------------------------------
+
+@pytest.mark.parametrize("routing", ["paper", "free"])
+def test_tension_lost_along_s_deflects_less(routing):
+    design = preset("paper-experiment")
+    cfg = SolverSettings(routing=routing)
+    base = solve(design, 20.0, settings=cfg)
+    friction = solve(design, 20.0, settings=cfg, loading=Loading(tension_profile=Capstan(0.2)))
+    linear = solve(design, 20.0, settings=cfg, loading=Loading(
+        tension_profile=lambda s, w, t: t * (1.0 - 0.5 * s / s[-1])))
+    unloading = solve(design, 20.0, settings=cfg,
+                      loading=Loading(tension_profile=Capstan(0.2, unloading=True)))
+    assert friction.tip_position[0] < base.tip_position[0] < unloading.tip_position[0]
+    assert linear.tip_position[0] < friction.tip_position[0]
+    # The capstan loss follows the tendon's turning: exp(-mu * wrap) at the tip.
+    assert np.all(np.diff(friction.tendon_tension) <= 0.0)
+    assert friction.tendon_tension[-1] < 20.0 * np.exp(-0.2 * 0.9 * friction.tip_angle_rad)
+
+
+def test_chord_tension_is_constant_along_the_chord():
+    design = preset("paper-experiment")
+    cfg = SolverSettings(cells_per_tube=4)
+    seen = []
+
+    def recording(s, wrap, tension):
+        seen.append(wrap.copy())
+        return tension * (1.0 - 0.5 * s / s[-1])
+
+    result = solve(design, 20.0, settings=cfg, loading=Loading(tension_profile=recording))
+    grid = result.grid
+    # Cells of one chord (a tube segment under paper routing) share one tension: the moment
+    # there is T times the distance to the chord line, linear in s along a straight chord.
+    chord = grid.chord_cells[grid.chord_start_node[grid.chord_cells] == grid.chord_start_node[
+        grid.chord_cells[1]]]
+    assert chord.size == 4
+    assert np.ptp(result.cell_moments[chord, 0] / np.maximum(
+        result.cell_moments[chord, 0], 1e-30)) == 0.0
+    assert all(np.all(np.diff(w) >= 0.0) for w in seen)
+
+
+# --- tip force -------------------------------------------------------------------------------
+
+def uniform_tube():
+    """A design whose notches remove nothing (h1 >= R_outer): a plain tube of stiffness E I0."""
+    return preset("paper-experiment").with_overrides(w_d=2 * 3.92e-3)
+
+
+@pytest.mark.parametrize("tension", [0.0, 5.0])
+def test_tip_force_on_uniform_tube_is_the_cantilever(tension):
+    design = uniform_tube()
+    force = 1e-3
+    length, stiffness = design.length, design.E * design.tube_second_moment
+    expected = force * length**3 / (3 * stiffness) + design.R_c * tension * length**2 / (
+        2 * stiffness)
+    result = solve(design, tension, settings=TIGHT, loading=Loading(tip_force=(force, 0.0)))
+    # Geometric nonlinearity at this load is below 1e-6 relative.
+    assert result.tip_position[0] == pytest.approx(expected, rel=1e-5)
+
+
+def test_tip_force_on_notched_design_matches_linear_solution():
+    design = preset("paper-experiment")
+    force = 1e-3
+    expected = force * linear_tip_x(design, lambda s: design.length - s)
+    result = solve(design, 0.0, settings=FINE, loading=Loading(tip_force=(force, 0.0)))
+    assert result.tip_position[0] == pytest.approx(expected, rel=1e-4)
+
+
+@HYPO
+@given(tension=st.floats(0.0, 20.0), angle=st.floats(0.0, 2 * np.pi))
+def test_small_tip_force_response_is_linear(tension, angle):
+    design = preset("paper-experiment")
+    base = solve(design, tension, settings=TIGHT).tip_position
+    force = 2e-3 * np.array([np.sin(angle), np.cos(angle)])
+    one = solve(design, tension, settings=TIGHT, loading=Loading(tip_force=tuple(force)))
+    two = solve(design, tension, settings=TIGHT, loading=Loading(tip_force=tuple(2 * force)))
+    d1 = one.tip_position - base
+    d2 = two.tip_position - base
+    # Second-order terms at 2 mN are below 1e-3 of the first-order change.
+    assert np.linalg.norm(d2 - 2 * d1) <= 1e-3 * np.linalg.norm(d2) + 1e-12
+
+
+def test_tip_moment_bends_toward_x_like_the_tendon():
+    design = uniform_tube()
+    moment = 2e-4
+    result = solve(design, 0.0, settings=TIGHT, loading=Loading(tip_moment=moment))
+    stiffness = design.E * design.tube_second_moment
+    assert result.tip_position[0] == pytest.approx(moment * design.length**2 / (2 * stiffness),
+                                                   rel=1e-5)
+    tendon = solve(design, moment / design.R_c, settings=TIGHT)
+    assert result.tip_position[0] == pytest.approx(tendon.tip_position[0], rel=1e-5)
+
+
+# --- body force ------------------------------------------------------------------------------
+
+def test_body_force_on_uniform_tube_is_the_distributed_cantilever():
+    design = uniform_tube()
+    q = RHO_G * tube_area(design.R_outer, design.r_inner)
+    expected = -q * design.length**4 / (8 * design.E * design.tube_second_moment)
+    result = solve(design, 0.0, settings=FINE, loading=Loading(body_force_density=(-RHO_G, 0.0)))
+    assert result.tip_position[0] == pytest.approx(expected, rel=1e-4)
+
+
+@HYPO
+@given(angle=st.floats(-np.pi, np.pi), tension=st.floats(0.0, 20.0),
+       scale=st.floats(1.0, 1000.0))
+def test_gravity_sags_toward_its_direction(angle, tension, scale):
+    design = preset("paper-experiment")
+    gravity = scale * RHO_G * np.array([np.sin(angle), np.cos(angle)])
+    base = solve(design, tension)
+    sagged = solve(design, tension, loading=Loading(body_force_density=tuple(gravity)))
+    move = sagged.tip_position[[0, 2]] - base.tip_position[[0, 2]]
+    # The tip moves toward the gravity direction (or not at all when gravity is along the body).
+    assert move @ gravity >= -1e-12 * np.linalg.norm(gravity)
+
+
+def test_gravity_along_minus_x_reduces_the_deflection():
+    design = preset("paper-experiment")
+    base = solve(design, 8.0)
+    sagged = solve(design, 8.0, loading=Loading(body_force_density=(-100 * RHO_G, 0.0)))
+    assert sagged.tip_position[0] < base.tip_position[0]
+    alone = solve(design, 0.0, loading=Loading(body_force_density=(-100 * RHO_G, 0.0)))
+    assert alone.tip_position[0] < 0.0
+
+
+def test_body_force_on_notched_design_matches_linear_solution():
+    design = preset("paper-experiment")
+    area = compliance_area(design)
+    left, right = design.notch_bounds()
+    breaks = sorted({design.length, *left, *right})
+
+    def moment(s: float) -> float:
+        edges = [s, *(b for b in breaks if b > s)]
+        return sum(quad(lambda xi: (xi - s) * area(xi), a, b, epsrel=1e-12)[0]
+                   for a, b in pairwise(edges))
+
+    expected = RHO_G * linear_tip_x(design, moment)
+    result = solve(design, 0.0, settings=FINE, loading=Loading(body_force_density=(RHO_G, 0.0)))
+    assert result.tip_position[0] == pytest.approx(expected, rel=1e-4)
+
+
+def compliance_area(design):
+    left, right = design.notch_bounds()
+
+    def area(s: float) -> float:
+        for lo, hi in zip(left, right, strict=True):
+            if lo < s < hi:
+                half = design.w_n / 2
+                h1 = (design.w_n + design.w_d) / 2 - np.sqrt(max(half**2 - (s - lo - half) ** 2, 0))
+                return float(notched_area(h1, design.R_outer, design.r_inner))
+        return tube_area(design.R_outer, design.r_inner)
+
+    return area
+
+
+# --- notch contact ---------------------------------------------------------------------------
+
+def closing_design():
+    return preset("paper-experiment").with_overrides(profile="rectangular", E=0.3e9)
+
+
+@pytest.mark.parametrize("routing", ["paper", "free"])
+def test_contact_stiffens_a_closing_notch(routing):
+    design = closing_design()
+    cfg = SolverSettings(routing=routing)
+    with pytest.raises(NotchClosureError):
+        solve(design, 40.0, settings=cfg)
+    result = solve(design, 40.0, settings=cfg, loading=Loading(notch_contact=NotchContact()))
+    grid = result.grid
+    angles = result.theta[grid.notch_right_node] - result.theta[grid.notch_left_node]
+    closure = closure_angle(grid)
+    assert result.converged and result.closed_notches
+    assert np.all(angles >= 0.0)
+    # Past closure each notch bends only as much as the tube's stiffness allows: a few % over.
+    assert np.max(angles) <= 1.05 * closure
+    assert np.max(angles) > closure
+    # Below closure, contact changes nothing.
+    below = solve(design, 20.0, settings=cfg)
+    same = solve(design, 20.0, settings=cfg, loading=Loading(notch_contact=NotchContact()))
+    assert not same.closed_notches
+    assert np.max(np.abs(same.positions - below.positions)) <= 1e-12
+
+
+def test_closure_angle_of_a_uniform_notch():
+    design = closing_design()
+    grid = build_grid(design, SolverSettings())
+    assert closure_angle(grid) == pytest.approx(design.w_n / design.R_outer, rel=1e-9)
+
+
+@pytest.mark.parametrize("stiffness", [1.0, 0.2])
+def test_contact_with_a_tip_force_closes_base_notches_first(stiffness):
+    # The tip force's moment grows toward the base: the base notch closes first. Without
+    # contact the same load raises NotchClosureError; with it, the kinked constitutive law
+    # still converges.
+    design = closing_design()
+    cfg = SolverSettings(routing="free")
+    with pytest.raises(NotchClosureError):
+        solve(design, 0.0, settings=cfg, loading=Loading(tip_force=(10.0, 0.0)))
+    loading = Loading(tip_force=(10.0, 0.0), notch_contact=NotchContact(stiffness))
+    result = solve(design, 0.0, settings=cfg, loading=loading)
+    closed = result.closed_notches
+    assert closed and closed == tuple(range(1, len(closed) + 1))
+    assert len(closed) < design.N
+    grid = result.grid
+    angles = result.theta[grid.notch_right_node] - result.theta[grid.notch_left_node]
+    assert np.all(np.diff(angles) < 0.0)
+    assert closure_angle(grid) < angles[0] <= 1.05 * closure_angle(grid)
+
+
+# --- bad input -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize(("field", "value"), [
+    ("tip_force", (float("nan"), 0.0)),
+    ("tip_force", (1.0,)),
+    ("tip_force", "ab"),
+    ("tip_moment", float("inf")),
+    ("body_force_density", (0.0, float("-inf"))),
+    ("tension_profile", 3.0),
+    ("notch_contact", 1.0),
+])
+def test_bad_loading_fields_name_the_parameter(field, value):
+    with pytest.raises(InvalidLoadingError) as info:
+        Loading(**{field: value})
+    assert info.value.parameter == field
+    assert field in str(info.value)
+
+
+@pytest.mark.parametrize("factor", [0.0, -1.0, float("nan"), 1e9])
+def test_bad_contact_stiffness(factor):
+    with pytest.raises(InvalidLoadingError, match="stiffness_factor"):
+        NotchContact(factor)
+
+
+@pytest.mark.parametrize("profile", [
+    lambda s, w, t: t - 30.0 * s / s[-1],
+    lambda s, w, t: np.full_like(s, np.nan),
+    lambda s, w, t: np.ones(3),
+    lambda s, w, t: 1 / 0,
+])
+def test_bad_profile_output_is_rejected(profile):
+    with pytest.raises(InvalidLoadingError) as info:
+        solve(preset("paper-experiment"), 20.0, loading=Loading(tension_profile=profile))
+    assert info.value.parameter == "tension_profile"
+    assert isinstance(info.value, InputError)
+
+
+def test_literal_loads_reject_a_loading():
+    with pytest.raises(InvalidLoadingError, match="loads=closed"):
+        solve(preset("paper-experiment"), 5.0, settings=SolverSettings(loads="literal"),
+              loading=Loading(tip_force=(0.1, 0.0)))
+
+
+# --- convergence -----------------------------------------------------------------------------
+
+def test_warm_start_under_a_loading():
+    design = preset("paper-experiment")
+    loading = Loading(tension_profile=Capstan(0.2), tip_force=(0.3, 0.0),
+                      body_force_density=(-RHO_G, 0.0))
+    cold = solve(design, 12.0, loading=loading)
+    first = solve(design, 10.0, loading=loading)
+    warm = solve(design, 12.0, loading=loading, warm_start=first)
+    assert np.max(np.abs(warm.positions - cold.positions)) <= 1e-9
+    assert warm.iterations <= cold.iterations
