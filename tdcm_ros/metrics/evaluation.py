@@ -1,0 +1,226 @@
+"""Evaluation: measured steps against the model re-run at each step's mean tension.
+
+Per step: the measured markers in ``tdcm_base``, the model's markers at the same surface points
+(:func:`tdcm_ros.nodes.shape_messages.surface_points`), both tip deflections and the shape error;
+then Table I (:mod:`tdcm_ros.metrics.table`). A step is *flagged* (left out of every metric,
+kept in the per-step table with a note) when its tip marker was never visible or the model has
+no solution at its tension.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.errors import TdcmError
+from tdcm_ros.metrics.geometry import deflection, measured_midline, station_distance
+from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
+from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.registration import (
+    Registration,
+    RegistrationError,
+    estimate_registration,
+)
+from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.table import TableMetrics, table_metrics
+from tdcm_ros.model import Design, SolveResult, solve
+from tdcm_ros.nodes.shape_messages import surface_points
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class Prediction:
+    """The model at one tension: markers (k, 3) and midline at the stations (m, 3), m."""
+
+    result: SolveResult
+    markers: Array
+    midline: Array
+
+
+def predict(design: Design, tension_n: float, options: EvaluateOptions,
+            warm_start: SolveResult | None = None) -> Prediction:
+    """Solve ``design`` at ``tension_n`` (N) and take the marker points and midline stations."""
+    result = solve(design, tension_n, settings=options.solver, warm_start=warm_start)
+    layout = options.layout
+    markers, _ = surface_points(result, layout.s, layout.radius(design.R_outer), layout.side_rad)
+    return Prediction(result, markers, result.pose_at(stations(options))[0])
+
+
+def stations(options: EvaluateOptions) -> Array:
+    """Arc-length stations (m) of the shape error: base to the tip marker."""
+    return np.linspace(0.0, options.layout.arc_lengths[-1], options.stations)
+
+
+@dataclass(frozen=True, eq=False)
+class StepRecord:
+    """One step of the evaluation (SI units, frame ``tdcm_base``); ``trial`` counts from 1."""
+
+    trial: int
+    tension_n: float
+    start_s: float
+    end_s: float
+    frames: int
+    measured_markers: Array
+    predicted_markers: Array | None
+    measured_deflection_m: float | None
+    predicted_deflection_m: float | None
+    shape_error_m: float | None
+    measured_midline: Array | None
+    predicted_midline: Array | None
+    missing: tuple[str, ...]
+    note: str
+
+    @property
+    def usable(self) -> bool:
+        """Both tip deflections exist: the step counts in the metrics."""
+        return self.measured_deflection_m is not None and self.predicted_deflection_m is not None
+
+    def to_json(self) -> dict[str, Any]:
+        """``trial``, ``tension`` (N), ``measured``/``predicted`` tip deflection (m), extras."""
+        return {"trial": self.trial, "tension": self.tension_n,
+                "measured": self.measured_deflection_m, "predicted": self.predicted_deflection_m,
+                "shape_error_m": self.shape_error_m, "start_s": self.start_s,
+                "end_s": self.end_s, "frames": self.frames, "missing_markers": list(self.missing),
+                "note": self.note}
+
+
+@dataclass(frozen=True, eq=False)
+class Evaluation:
+    """Per-step records, Table I, the registration used per source and any warnings."""
+
+    records: tuple[StepRecord, ...]
+    metrics: TableMetrics
+    registrations: tuple[Registration, ...]
+    options: EvaluateOptions
+    warnings: tuple[str, ...] = ()
+    sources: tuple[str, ...] = ("arrays",)
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``--json`` document: the issue's keys first, then extras."""
+        m = self.metrics
+        return {"mape_pct": m.mape_pct, "rmse_m": m.rmse_m, "mae_m": m.mae_m,
+                "shape_error_m": m.shape_error_m, "deflection_mean_m": m.deflection_mean_m,
+                "n_trials": m.n_trials, "n_steps": m.n_steps,
+                "steps": [r.to_json() for r in self.records],
+                "details": {**m.to_dict(), "sources": [
+                    {"source": name, "registration": registration_json(reg)}
+                    for name, reg in zip(self.sources, self.registrations, strict=True)],
+                            "design": self.options.design.to_dict(),
+                            "deflection_axis": self.options.deflection_axis,
+                            "warnings": list(self.warnings)}}
+
+
+def registration_json(reg: Registration) -> dict[str, Any]:
+    """The registration as JSON: method, translation (m), quaternion (x, y, z, w), residual."""
+    return {"method": reg.method, "translation_m": list(reg.translation),
+            "quaternion_xyzw": list(reg.quaternion), "residual_m": reg.residual_m}
+
+
+def choose_registration(steps: Sequence[MeasuredStep], options: EvaluateOptions,
+                        given: Registration | None) -> Registration:
+    """``given`` if any, else estimated from the lowest step (at most ``steps.zero_n``) and the
+    highest step with every marker visible."""
+    if given is not None:
+        return given
+    complete = [m for m in steps if not m.missing]
+    zero = [m for m in complete if m.tension_n <= options.steps.zero_n]
+    if not zero:
+        raise RegistrationError(
+            "no registration given (no /tf_static mocap -> tdcm_base) and no zero-tension step "
+            f"(<= steps.zero_n = {options.steps.zero_n:g} N) with every marker visible to "
+            "estimate it", parameter="registration", value=None,
+            allowed="a mocap -> tdcm_base transform or a zero-tension hold")
+    rest = min(zero, key=lambda m: m.tension_n)
+    bent = max(complete, key=lambda m: m.tension_n)
+    layout = options.layout
+    return estimate_registration(rest.markers, layout.s,
+                                 radius=layout.radius(options.design.R_outer),
+                                 side_rad=layout.side_rad, bent_markers=bent.markers)
+
+
+def model_tension(tension_n: float, options: EvaluateOptions) -> float:
+    """The tension (N) the model runs at: a mean within ``steps.tolerance_n`` below zero is
+    load-cell noise around zero and becomes 0."""
+    return 0.0 if -options.steps.tolerance_n <= tension_n < 0.0 else tension_n
+
+
+def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
+                options: EvaluateOptions) -> tuple[list[StepRecord], list[str]]:
+    """Per-step records against the model of ``options.design``; warnings for flagged steps."""
+    design = options.design
+    offset = options.layout.rest_offset(design.R_outer)
+    radius = options.layout.radius(design.R_outer)
+    at = stations(options)
+    records: list[StepRecord] = []
+    warnings: list[str] = []
+    warm: SolveResult | None = None
+    for measured in steps:
+        base = registration.to_base(measured.markers)
+        note, pred = "", None
+        try:
+            pred = predict(design, model_tension(measured.tension_n, options), options, warm)
+            warm = pred.result
+        except TdcmError as error:
+            note = f"model: {error}"
+        midline = measured_midline(base, options.layout, radius, at)
+        tip_seen = not np.isnan(base[-1, 0])
+        if not tip_seen:
+            note = note or f"tip marker {options.layout.labels[-1]} not visible"
+        if note:
+            warnings.append(f"trial {measured.step.trial + 1} step at "
+                            f"{measured.tension_n:.3f} N left out: {note}")
+        records.append(StepRecord(
+            trial=measured.step.trial + 1, tension_n=measured.tension_n,
+            start_s=measured.step.start_s, end_s=measured.step.end_s, frames=measured.frames,
+            measured_markers=base, predicted_markers=None if pred is None else pred.markers,
+            measured_deflection_m=float(deflection(base[-1], offset, options.deflection_axis))
+            if tip_seen else None,
+            predicted_deflection_m=None if pred is None else float(
+                deflection(pred.markers[-1], offset, options.deflection_axis)),
+            shape_error_m=None if pred is None or midline is None else station_distance(
+                midline, pred.midline),
+            measured_midline=midline, predicted_midline=None if pred is None else pred.midline,
+            missing=measured.missing, note=note))
+    return records, warnings
+
+
+def metrics_of(records: Sequence[StepRecord], options: EvaluateOptions) -> TableMetrics:
+    """Table I of the records."""
+    def col(values: list[float | None]) -> Array:
+        return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+    return table_metrics(
+        [r.trial for r in records], [r.tension_n for r in records],
+        col([r.measured_deflection_m if r.usable else None for r in records]),
+        col([r.predicted_deflection_m if r.usable else None for r in records]),
+        col([r.shape_error_m for r in records]), mape_threshold_m=options.mape_threshold_m)
+
+
+def evaluate_series(tension: TensionSeries, markers: MarkerSeries,
+                    options: EvaluateOptions | None = None,
+                    registration: Registration | None = None) -> Evaluation:
+    """Evaluate one recording given as arrays. ``registration`` maps the markers' frame to
+    ``tdcm_base``; ``None`` estimates it from the data (see :func:`choose_registration`)."""
+    opts = options or EvaluateOptions()
+    steps = measure_steps(tension, markers, opts)
+    reg = choose_registration(steps, opts, registration)
+    records, warnings = score_steps(steps, reg, opts)
+    return Evaluation(tuple(records), metrics_of(records, opts), (reg,), opts, tuple(warnings))
+
+
+def combine(parts: Sequence[Evaluation], sources: Sequence[str]) -> Evaluation:
+    """One evaluation of several recordings (same options): trials numbered on across them."""
+    records: list[StepRecord] = []
+    offset = 0
+    for part in parts:
+        records.extend(replace(r, trial=r.trial + offset) for r in part.records)
+        offset = max((r.trial for r in records), default=offset)
+    opts = parts[0].options
+    return Evaluation(tuple(records), metrics_of(records, opts),
+                      tuple(r for p in parts for r in p.registrations), opts,
+                      tuple(w for p in parts for w in p.warnings), tuple(sources))

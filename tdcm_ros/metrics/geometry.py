@@ -1,0 +1,128 @@
+"""Marker geometry in ``tdcm_base``: the marker layout, tip deflection and the measured midline.
+
+Contract conventions: markers sit on the body surface at arc lengths ``arc_lengths`` (m),
+``radius = R_outer + ball_radius`` off the midline, at ``side_rad`` around the body z axis from
+the body x axis (0 = tendon side; the default 180 deg is opposite the tendon). The body bends in
+the x-z plane, so the body y axis stays +y.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import CubicSpline
+
+from tdcm_ros.errors import out_of_range
+
+Array = NDArray[np.float64]
+DEFLECTION_AXES = ("marker", "body")
+_OFFSET_PASSES = 4
+
+
+@dataclass(frozen=True)
+class MarkerLayout:
+    """Where the markers sit: ``labels`` (last = tip marker), ``arc_lengths`` (m, increasing),
+    ``ball_radius`` (m) and ``side_deg`` (deg from the tendon side)."""
+
+    labels: tuple[str, ...] = ("m1", "m2", "m3")
+    arc_lengths: tuple[float, ...] = (0.015, 0.033, 0.053)
+    ball_radius: float = 0.001
+    side_deg: float = 180.0
+
+    def __post_init__(self) -> None:
+        s = np.asarray(self.arc_lengths, dtype=float)
+        if len(self.labels) != s.size or s.size == 0 or len(set(self.labels)) != s.size:
+            raise out_of_range("markers.labels", list(self.labels),
+                               f"{s.size} distinct labels, one per arc length")
+        if not np.all(np.isfinite(s)) or s[0] <= 0.0 or np.any(np.diff(s) <= 0.0):
+            raise out_of_range("markers.arc_lengths", list(self.arc_lengths),
+                               "increasing values > 0", unit="m")
+        if not (math.isfinite(self.ball_radius) and self.ball_radius >= 0.0):
+            raise out_of_range("markers.ball_radius", self.ball_radius, "[0, inf)", unit="m")
+        if not (math.isfinite(self.side_deg) and -360.0 <= self.side_deg <= 360.0):
+            raise out_of_range("markers.side_deg", self.side_deg, "[-360, 360] deg")
+        object.__setattr__(self, "labels", tuple(self.labels))
+        object.__setattr__(self, "arc_lengths", tuple(float(v) for v in s))
+
+    @property
+    def side_rad(self) -> float:
+        """Marker side around the body z axis (rad)."""
+        return math.radians(self.side_deg)
+
+    @property
+    def s(self) -> Array:
+        """Arc lengths (k,) m."""
+        return np.asarray(self.arc_lengths)
+
+    def radius(self, r_outer: float) -> float:
+        """Distance of the marker centres from the midline (m) for a body of radius ``r_outer``."""
+        return r_outer + self.ball_radius
+
+    def rest_offset(self, r_outer: float) -> Array:
+        """Offset (3,) m of every marker from the midline at zero tension (straight body)."""
+        r = self.radius(r_outer)
+        return np.array([r * math.cos(self.side_rad), r * math.sin(self.side_rad), 0.0])
+
+    def check_within(self, length: float) -> None:
+        """Every marker must lie on a body of ``length`` (m)."""
+        if self.arc_lengths[-1] > length + 1e-12:
+            raise out_of_range("markers.arc_lengths", list(self.arc_lengths),
+                               f"values in (0, L = {length:g}] m")
+
+
+def deflection(points_base: ArrayLike, rest_offset: Sequence[float], axis: str = "marker"
+               ) -> Array:
+    """Deflection (m) of marker points (..., 3) in ``tdcm_base``.
+
+    ``axis="marker"``: distance from the line parallel to +z through the marker's rest position
+    (``rest_offset``), so it is 0 at zero tension. ``axis="body"``: distance from the body axis
+    (+z) itself, which is the marker radius at zero tension.
+    """
+    if axis not in DEFLECTION_AXES:
+        raise out_of_range("deflection_axis", axis, " | ".join(DEFLECTION_AXES))
+    p = np.asarray(points_base, dtype=float)
+    ox, oy = (float(rest_offset[0]), float(rest_offset[1])) if axis == "marker" else (0.0, 0.0)
+    return np.hypot(p[..., 0] - ox, p[..., 1] - oy)
+
+
+def _body_offsets(tangents: Array, radius: float, side_rad: float) -> Array:
+    """Marker offsets (k, 3) for midline tangents (k, 3): body x = y x t, body y = +y (planar)."""
+    t = tangents / np.linalg.norm(tangents, axis=1, keepdims=True)
+    body_x = np.cross(np.array([0.0, 1.0, 0.0]), t)
+    body_x /= np.linalg.norm(body_x, axis=1, keepdims=True)
+    body_y = np.cross(t, body_x)
+    return radius * (math.cos(side_rad) * body_x + math.sin(side_rad) * body_y)
+
+
+def measured_midline(markers_base: ArrayLike, layout: MarkerLayout, radius: float,
+                     stations: Array) -> Array | None:
+    """Midline points (m, 3) at arc lengths ``stations`` (m) from markers (k, 3) in ``tdcm_base``.
+
+    A cubic spline in arc length through the base point (clamped along +z, the fixed base) and
+    the markers' midline points; each marker is moved back by its offset from the midline, with
+    the body frame taken from the spline's tangent there (repeated until it settles). ``None``
+    when the tip marker or every other marker is missing (NaN).
+    """
+    p = np.asarray(markers_base, dtype=float)
+    seen = ~np.isnan(p[:, 0])
+    if not seen[-1] or seen.sum() < 2:
+        return None
+    s = np.concatenate([[0.0], layout.s[seen]])
+    tangents = np.tile([0.0, 0.0, 1.0], (int(seen.sum()), 1))
+    spline = None
+    for _ in range(_OFFSET_PASSES):
+        mid = p[seen] - _body_offsets(tangents, radius, layout.side_rad)
+        spline = CubicSpline(s, np.vstack([np.zeros(3), mid]),
+                             bc_type=((1, np.array([0.0, 0.0, 1.0])), "not-a-knot"))
+        tangents = spline(s[1:], 1)
+    assert spline is not None
+    return np.asarray(spline(stations))
+
+
+def station_distance(a: Array, b: Array) -> float:
+    """Mean Euclidean distance (m) between two midlines sampled at the same stations."""
+    return float(np.mean(np.linalg.norm(np.asarray(a) - np.asarray(b), axis=1)))

@@ -1,0 +1,72 @@
+"""Measured side of the evaluation: marker frames assigned to tension steps, averaged per step.
+
+Each marker frame takes the tension sample nearest its stamp within ``align_tolerance_s``; the
+frame belongs to the step holding that sample. Per step, each marker's position is the mean over
+the frames where it was visible; a marker never visible in a step leaves a NaN row and flags
+the step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.metrics.align import nearest_within
+from tdcm_ros.metrics.errors import NoStepsError
+from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.steps import Step, detect_steps
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredStep:
+    """A step with its mean tension (N) and mean marker positions (k, 3) m in the markers' frame
+    (NaN rows: never visible in the step); ``frames`` marker frames fell in the step."""
+
+    step: Step
+    tension_n: float
+    markers: Array
+    frames: int
+    labels: tuple[str, ...]
+
+    @property
+    def missing(self) -> tuple[str, ...]:
+        """Labels of the markers never visible during the step."""
+        return tuple(lb for lb, row in zip(self.labels, self.markers, strict=True)
+                     if np.isnan(row[0]))
+
+
+def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: EvaluateOptions
+                  ) -> list[MeasuredStep]:
+    """Detect the steps and average the markers over each (frame of ``markers``)."""
+    markers.require_visible()
+    steps = detect_steps(tension.stamps_s, tension.tension_n, options.steps)
+    if not steps:
+        cfg = options.steps
+        raise NoStepsError(
+            f"no tension hold within {cfg.tolerance_n:g} N for {cfg.min_hold_s:g} s in "
+            f"{len(tension.stamps_s)} samples over {np.ptp(tension.stamps_s):.3g} s; adjust "
+            "steps.tolerance_n / steps.min_hold_s", parameter="steps.min_hold_s",
+            value=cfg.min_hold_s, allowed="a hold at least this long in the data")
+    step_of_sample = np.full(tension.stamps_s.size, -1, dtype=np.int64)
+    for k, step in enumerate(steps):
+        step_of_sample[step.start:step.stop] = k
+    nearest = nearest_within(markers.stamps_s, tension.stamps_s, options.align_tolerance_s)
+    frame_step = np.where(nearest >= 0, step_of_sample[np.maximum(nearest, 0)], -1)
+    visible = markers.visible()
+    filled = np.where(visible[:, :, None], markers.positions, 0.0)
+    n = len(steps)
+    counts = np.zeros((n, len(markers.labels)))
+    sums = np.zeros((n, len(markers.labels), 3))
+    frames = np.bincount(frame_step[frame_step >= 0], minlength=n)
+    used = frame_step >= 0
+    np.add.at(counts, frame_step[used], visible[used])
+    np.add.at(sums, frame_step[used], filled[used])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        means = np.where(counts[:, :, None] > 0, sums / counts[:, :, None], np.nan)
+    return [MeasuredStep(step, step.mean_n, means[k], int(frames[k]), markers.labels)
+            for k, step in enumerate(steps)]

@@ -1,0 +1,86 @@
+"""Time series the metrics work on: tension samples and labelled marker frames (SI units)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from tdcm_ros.metrics.errors import MarkersNotVisibleError, MetricsError
+
+Array = NDArray[np.float64]
+
+
+def _sorted_stamps(name: str, stamps: ArrayLike) -> tuple[Array, NDArray[np.int64]]:
+    t = np.asarray(stamps, dtype=float)
+    if t.ndim != 1 or t.size == 0 or not np.all(np.isfinite(t)):
+        raise MetricsError(f"{name} = array of shape {t.shape}; allowed: a non-empty 1-D array "
+                           "of finite stamps (s)", parameter=name, value=t.shape,
+                           allowed="non-empty 1-D finite (s)")
+    order = np.argsort(t, kind="stable")
+    return t[order], order
+
+
+@dataclass(frozen=True, eq=False)
+class TensionSeries:
+    """Measured tendon tension: ``stamps_s`` (n,) s ascending, ``tension_n`` (n,) N, finite."""
+
+    stamps_s: Array
+    tension_n: Array
+
+    @classmethod
+    def of(cls, stamps_s: ArrayLike, tension_n: ArrayLike) -> TensionSeries:
+        """Validate, drop non-finite tensions and sort by stamp."""
+        t, order = _sorted_stamps("tension stamps", stamps_s)
+        x = np.asarray(tension_n, dtype=float)
+        if x.shape != (len(order),):
+            raise MetricsError(f"tension samples of shape {x.shape}; allowed: ({len(order)},), "
+                               "one per stamp", parameter="tension", value=x.shape,
+                               allowed=f"({len(order)},)")
+        x = x[order]
+        keep = np.isfinite(x)
+        if not keep.any():
+            raise MetricsError("no finite tension sample; allowed: finite values (N)",
+                               parameter="tension", value="all non-finite", allowed="finite (N)")
+        return cls(t[keep], x[keep])
+
+
+@dataclass(frozen=True, eq=False)
+class MarkerSeries:
+    """Labelled marker frames: ``stamps_s`` (n,) ascending, ``positions`` (n, k, 3) m in the frame
+    ``frame_id``, NaN rows where a marker was not visible; ``labels`` (k,)."""
+
+    stamps_s: Array
+    labels: tuple[str, ...]
+    positions: Array
+    frame_id: str = "mocap"
+
+    @classmethod
+    def of(cls, stamps_s: ArrayLike, labels: Sequence[str], positions: ArrayLike, *,
+           frame_id: str = "mocap") -> MarkerSeries:
+        """Validate and sort by stamp; a position row with any non-finite value becomes NaN."""
+        t, order = _sorted_stamps("marker stamps", stamps_s)
+        p = np.array(positions, dtype=float)
+        if p.shape != (len(order), len(labels), 3):
+            raise MetricsError(f"marker positions of shape {p.shape}; allowed: "
+                               f"({len(order)}, {len(labels)}, 3)", parameter="markers",
+                               value=p.shape, allowed=f"({len(order)}, {len(labels)}, 3)")
+        p = p[order]
+        p[~np.all(np.isfinite(p), axis=2)] = np.nan
+        return cls(t, tuple(labels), p, frame_id)
+
+    def visible(self) -> NDArray[np.bool_]:
+        """(n, k) True where the marker was seen."""
+        return ~np.isnan(self.positions[:, :, 0])
+
+    def require_visible(self) -> None:
+        """Raise :class:`MarkersNotVisibleError` naming the markers never seen."""
+        never = [label for label, seen in zip(self.labels, self.visible().any(axis=0),
+                                              strict=True) if not seen]
+        if never:
+            raise MarkersNotVisibleError(
+                f"markers {', '.join(never)} never come into view in {len(self.stamps_s)} "
+                "frames; allowed: each marker visible in at least one frame",
+                parameter="markers", value=never, allowed="visible in >= 1 frame")

@@ -1,0 +1,161 @@
+"""Step detection: holds at one tension level, grouped into trials (staircases).
+
+A *step* is a contiguous run of tension samples that stay within ``tolerance_n`` of the run's
+median for at least ``min_hold_s``, once the transients are excluded:
+
+1. samples are *steady* where the tension (despiked by a ``despike_samples`` median filter)
+   spans at most ``2 tolerance_n`` over a centred window of ``settle_s``: ramps and ringing
+   between levels are cut out;
+2. in each steady run, the longest contiguous stretch within ``tolerance_n`` of its median is
+   taken (the median is re-taken on the stretch until it settles); the rest of the run is
+   searched again, so a slow ramp through several levels can yield several steps;
+3. the first ``settle_s`` of the stretch is dropped (settling after the change); what is left
+   is a step if it lasts at least ``min_hold_s``.
+
+A *trial* is one staircase: a new trial starts at the first step at or below ``zero_n``
+(or the first step after the tension dipped to ``zero_n``) once the current trial has risen
+above ``zero_n``. Steps at zero after the last rise stay with the last trial.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.ndimage import maximum_filter1d, median_filter, minimum_filter1d
+
+from tdcm_ros.errors import out_of_range
+
+Array = NDArray[np.float64]
+_MEDIAN_PASSES = 4
+
+
+@dataclass(frozen=True)
+class StepSettings:
+    """Parameters of step detection (SI units), validated on construction."""
+
+    tolerance_n: float = 0.3
+    """Half-width of the band around the hold's median (N)."""
+    min_hold_s: float = 1.0
+    """Shortest hold, after the transient is dropped (s)."""
+    settle_s: float = 0.25
+    """Steadiness window and the settling time dropped at the start of a hold (s)."""
+    zero_n: float = 0.5
+    """Tension at or below which the tendon counts as released (N): trial boundaries."""
+    despike_samples: int = 5
+    """Median filter length (samples) applied before the steadiness test (1 = off)."""
+
+    def __post_init__(self) -> None:
+        for name, low in (("tolerance_n", 0.0), ("min_hold_s", 0.0), ("settle_s", 0.0)):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > low):
+                raise out_of_range(f"steps.{name}", value, "(0, inf)")
+        if not (isinstance(self.zero_n, (int, float)) and np.isfinite(self.zero_n)
+                and self.zero_n >= 0.0):
+            raise out_of_range("steps.zero_n", self.zero_n, "[0, inf) N")
+        if isinstance(self.despike_samples, bool) or not isinstance(self.despike_samples, int) \
+                or not 1 <= self.despike_samples <= 1001:
+            raise out_of_range("steps.despike_samples", self.despike_samples,
+                               "integer in [1, 1001]")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One hold: samples ``[start, stop)`` of the tension series, stamps in s, tensions in N."""
+
+    trial: int
+    start: int
+    stop: int
+    start_s: float
+    end_s: float
+    median_n: float
+    mean_n: float
+
+    @property
+    def duration_s(self) -> float:
+        """Length of the hold (s)."""
+        return self.end_s - self.start_s
+
+
+def _true_runs(mask: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """(m, 2) ``[start, stop)`` of the runs of True in ``mask``."""
+    padded = np.concatenate([[False], mask, [False]]).astype(np.int8)
+    edges = np.flatnonzero(np.diff(padded))
+    return edges.reshape(-1, 2)
+
+
+def _odd(n: int) -> int:
+    return max(1, n | 1)
+
+
+def _steady(t: Array, x: Array, cfg: StepSettings) -> NDArray[np.bool_]:
+    dt = float(np.median(np.diff(t))) if t.size > 1 else cfg.settle_s
+    window = _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
+    smooth = median_filter(x, size=cfg.despike_samples, mode="nearest") \
+        if cfg.despike_samples > 1 else x
+    span = maximum_filter1d(smooth, window, mode="nearest") - \
+        minimum_filter1d(smooth, window, mode="nearest")
+    return span <= 2.0 * cfg.tolerance_n
+
+
+def _longest_band(x: Array, tol: float) -> tuple[int, int]:
+    """``[a, b)`` of the longest stretch within ``tol`` of its own median (iterated)."""
+    a, b = 0, x.size
+    for _ in range(_MEDIAN_PASSES):
+        runs = _true_runs(np.abs(x - np.median(x[a:b])) <= tol)
+        if runs.size == 0:
+            return 0, 0
+        longest = runs[np.argmax(runs[:, 1] - runs[:, 0])]
+        if (longest[0], longest[1]) == (a, b):
+            break
+        a, b = int(longest[0]), int(longest[1])
+    return a, b
+
+
+def _holds(t: Array, x: Array, lo: int, hi: int, cfg: StepSettings) -> list[tuple[int, int]]:
+    """Hold index ranges inside the steady run ``[lo, hi)``."""
+    found: list[tuple[int, int]] = []
+    pending = [(lo, hi)]
+    while pending:
+        a, b = pending.pop()
+        if b - a < 2 or t[b - 1] - t[a] < cfg.min_hold_s:
+            continue
+        ra, rb = _longest_band(x[a:b], cfg.tolerance_n)
+        if rb <= ra:
+            continue
+        start, stop = a + ra, a + rb
+        trimmed = int(np.searchsorted(t, t[start] + cfg.settle_s, side="left"))
+        if trimmed < stop and t[stop - 1] - t[trimmed] >= cfg.min_hold_s:
+            found.append((trimmed, stop))
+        pending.extend([(a, start), (stop, b)])
+    return found
+
+
+def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | None = None
+                 ) -> list[Step]:
+    """Steps of a tension series (stamps ascending, s; tensions N), in time order, with trials."""
+    cfg = settings or StepSettings()
+    t = np.asarray(stamps_s, dtype=float)
+    x = np.asarray(tension_n, dtype=float)
+    if t.size < 2:
+        return []
+    ranges: list[tuple[int, int]] = []
+    for lo, hi in _true_runs(_steady(t, x, cfg)):
+        ranges.extend(_holds(t, x, int(lo), int(hi), cfg))
+    ranges.sort()
+    steps: list[Step] = []
+    trial, risen, previous_stop = 0, False, 0
+    for start, stop in ranges:
+        median = float(np.median(x[start:stop]))
+        released = median <= cfg.zero_n or (
+            start > previous_stop and float(x[previous_stop:start].min()) <= cfg.zero_n)
+        if risen and released:
+            trial, risen = trial + 1, False
+        risen = risen or median > cfg.zero_n
+        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median,
+                          float(np.mean(x[start:stop]))))
+        previous_stop = stop
+    if trial > 0 and not risen:  # zero holds after the last rise end the last staircase
+        steps = [replace(s, trial=trial - 1) if s.trial == trial else s for s in steps]
+    return steps
