@@ -40,6 +40,10 @@ def given_registration(translation: Sequence[float], *, quaternion: Sequence[flo
     if (quaternion is None) == (rpy is None):
         raise RegistrationError("give exactly one of quaternion or rpy", parameter="registration",
                                 value=None, allowed="quaternion or rpy")
+    if quaternion is not None and (len(quaternion) != 4 or not np.all(np.isfinite(quaternion))
+                                   or np.linalg.norm(quaternion) < 1e-9):
+        raise out_of_range("registration.quaternion", list(quaternion),
+                           "4 finite numbers (x, y, z, w), not all zero", error=RegistrationError)
     if rpy is not None:
         angles = np.asarray(rpy, dtype=float)
         if angles.shape != (3,) or not np.all(np.isfinite(angles)):

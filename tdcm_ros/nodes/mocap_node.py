@@ -1,0 +1,365 @@
+"""``mocap_node``: labelled motion-capture markers from a Nexus CSV, a live Vicon driver or a scene.
+
+Publishes ``markers`` (``mocap4r2_msgs/msg/Markers``, the MOCAP4ROS2 Vicon driver's type) and
+``markers_poses`` (``geometry_msgs/msg/PoseArray``, same order, identity orientations), both in
+``frame_id`` (``mocap``), positions in m; marker_name = label (``m1``...), marker_index = the
+label's index. Occluded markers (NaN or exactly zero) and unlabelled ones are left out and
+counted. The static transform ``mocap`` -> ``tdcm_base`` goes to ``/tf_static``
+(``tf2_msgs/msg/TFMessage``, transient local) once at start. ``/diagnostics`` carries the
+counters and the source state.
+
+``source`` (read-only):
+
+- ``csv``: replay ``csv.path`` (Vicon Nexus export, Trajectories section) at ``csv.rate_scale``
+  times real time, ``csv.start_delay_s`` after start, optionally looping; stamps = replay time,
+  frame_number = the CSV's Frame;
+- ``relabel``: subscribe ``relabel.input_topic`` (a live driver's Markers; positions times
+  ``relabel.input_scale`` give m), relabel and republish with the input's stamp and frame number;
+- ``sim``: a scene's world (``sim.scene``): on a timer at the scene's mocap rate, markers for
+  the latest ``sim/tension_true`` (0 N until one arrives), published ``world.delay_s("markers")``
+  after their stamp; the registration comes from the scene (``world.mocap_to_base``).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections import Counter
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
+from tdcm_ros.metrics.registration import Registration
+from tdcm_ros.mocap import (
+    ArcLengthLabeller,
+    CsvReplay,
+    LabelledFrame,
+    NameLabeller,
+    NameMap,
+    RawFrame,
+    SimSource,
+    estimate_from_recordings,
+    given_registration,
+    read_nexus_csv,
+    straight_axis,
+)
+from tdcm_ros.mocap.labelling import Labeller
+from tdcm_ros.nodes.shape_messages import header
+from tdcm_ros.runtime.names import resolve_topic
+from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime.run_node import main_for
+
+SOURCES = ("csv", "relabel", "sim")
+LABELLING_MODES = ("name", "arc_length")
+AXES = ("straight", "predicted")
+REGISTRATION_MODES = ("quaternion", "rpy", "estimate")
+MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
+USE_BOTH = 2   # mocap4r2_msgs/Marker.id_type: name and index are both meaningful
+
+
+def _one_of(name: str, allowed: tuple[str, ...]) -> Callable[[Any], None]:
+    def check(value: Any) -> None:
+        if value not in allowed:
+            raise InputError(f"{name} = {value!r} is invalid; allowed: {', '.join(allowed)}",
+                             parameter=name, value=value, allowed=", ".join(allowed))
+    return check
+
+
+def _length(name: str, size: int) -> Callable[[Any], None]:
+    def check(value: Any) -> None:
+        if len(value) != size:
+            raise InputError(f"{name} = {value!r} needs {size} values", parameter=name,
+                             value=value, allowed=f"{size} numbers")
+    return check
+
+
+def _stamp_ns(message: Any) -> int:
+    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
+
+
+class MocapNode(NodeLogic):
+    """Labels, registers and publishes motion-capture markers; see the module docstring."""
+
+    default_name = "mocap_node"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        self._declare()
+        get = port.get_parameter
+        self.source_name = str(get("source"))
+        self.frame_id = str(get("frame_id"))
+        self.base_frame_id = str(get("base_frame_id"))
+        self.counts: Counter[str] = Counter()
+        self.state = "starting"
+        self.last_problem = ""
+        self.labels = tuple(str(v) for v in get("labelling.labels"))
+        self.name_map = NameMap.parse([str(v) for v in get("labelling.map")],
+                                      self.labels)
+        qos = QoS(depth=10)
+        self.markers_pub = port.create_publisher("markers", MARKERS_TYPE, qos)
+        self.poses_pub = port.create_publisher("markers_poses", "geometry_msgs/msg/PoseArray", qos)
+        self.tf_pub = port.create_publisher("/tf_static", "tf2_msgs/msg/TFMessage",
+                                            QoS(depth=1, durability="transient_local"))
+        self.diagnostics = port.create_publisher("/diagnostics",
+                                                 "diagnostic_msgs/msg/DiagnosticArray", qos)
+        start = {"csv": self._start_csv, "relabel": self._start_relabel, "sim": self._start_sim}
+        self.registration = start[self.source_name]()
+        self.labeller = self._labeller()
+        self._publish_tf()
+        port.create_timer(float(get("diagnostics_period_s")), self.report)
+
+    def _declare(self) -> None:
+        declare = self.port.declare_parameter
+        declare("source", "csv", read_only=True, description="csv, relabel or sim",
+                validator=_one_of("source", SOURCES))
+        declare("frame_id", "mocap", read_only=True, description="frame of the markers (Vicon world)")
+        declare("base_frame_id", "tdcm_base", read_only=True,
+                description="child frame of the published registration")
+        declare("csv.path", "", read_only=True, description="Vicon Nexus CSV export (source csv)")
+        declare("csv.rate_scale", 1.0, range=(0.01, 100.0), read_only=True,
+                description="replay speed, times real time")
+        declare("csv.loop", False, read_only=True, description="replay again from the start")
+        declare("csv.start_delay_s", 1.0, range=(0.0, 3600.0), read_only=True,
+                description="wait before the first frame (s), lets subscribers connect")
+        declare("relabel.input_topic", "/markers", read_only=True,
+                description="Markers topic of the live Vicon driver (source relabel)")
+        declare("relabel.input_scale", 1.0, range=(1e-6, 1e3), read_only=True,
+                description="m per input position unit (0.001 if the driver sends mm)")
+        declare("sim.scene", "ideal", read_only=True, description="scene name or YAML path (sim)")
+        declare("labelling.mode", "name", read_only=True, description="name or arc_length",
+                validator=_one_of("labelling.mode", LABELLING_MODES))
+        declare("labelling.labels", ["m1", "m2", "m3"], read_only=True,
+                description="published labels, base to tip")
+        declare("labelling.map", ["m1=m1", "m2=m2", "m3=m3"], read_only=True,
+                description="'Vicon name=label' entries; name: Subject:Marker or Marker")
+        declare("labelling.arc_lengths", [0.015, 0.033, 0.053], range=(0.0, 2.0), read_only=True,
+                description="arc length of each label (m)")
+        declare("labelling.axis", "straight", read_only=True,
+                description="arc_length axis: straight or predicted (latest axis topic)",
+                validator=_one_of("labelling.axis", AXES))
+        declare("labelling.axis_topic", "midline_poses", read_only=True,
+                description="PoseArray midline in base_frame_id (axis predicted)")
+        declare("labelling.body_length", 0.053, range=(1e-3, 2.0), read_only=True,
+                description="length of the straight axis (m)")
+        declare("labelling.max_distance", 0.03, range=(1e-4, 1.0), read_only=True,
+                description="largest marker distance from the label's axis point (m)")
+        declare("registration.mode", "quaternion", read_only=True,
+                description="quaternion, rpy or estimate (ignored by source sim)",
+                validator=_one_of("registration.mode", REGISTRATION_MODES))
+        declare("registration.translation", [0.0, 0.0, 0.0], range=(-1e3, 1e3), read_only=True,
+                description="tdcm_base origin in mocap (m)",
+                validator=_length("registration.translation", 3))
+        declare("registration.quaternion", [0.0, 0.0, 0.0, 1.0], range=(-1.0, 1.0),
+                read_only=True, description="tdcm_base orientation in mocap (x, y, z, w)",
+                validator=_length("registration.quaternion", 4))
+        declare("registration.rpy", [0.0, 0.0, 0.0], range=(-2 * math.pi, 2 * math.pi),
+                read_only=True, description="roll, pitch, yaw (rad, fixed axes)",
+                validator=_length("registration.rpy", 3))
+        declare("registration.zero_csv", "", read_only=True,
+                description="zero-tension Nexus CSV (mode estimate)")
+        declare("registration.bent_csv", "", read_only=True,
+                description="bent-body Nexus CSV fixing the roll (mode estimate)")
+        declare("registration.x_hint", [0.0, 0.0, 0.0], range=(-1e3, 1e3), read_only=True,
+                description="mocap direction of +x if no bent_csv (mode estimate; 0 = unset)",
+                validator=_length("registration.x_hint", 3))
+        declare("markers.radius", 0.00492, range=(0.0, 0.1), read_only=True,
+                description="marker centre distance from the midline (m)")
+        declare("markers.side_deg", 180.0, range=(-360.0, 360.0), read_only=True,
+                description="marker side around the body z axis from the tendon side (deg)")
+        declare("diagnostics_period_s", 1.0, range=(0.05, 60.0), read_only=True,
+                description="diagnostics period (s)")
+
+    # -- registration and labelling ---------------------------------------------------------
+
+    def _given_registration(self) -> Registration:
+        get = self.port.get_parameter
+        mode = str(get("registration.mode"))
+        translation = [float(v) for v in get("registration.translation")]
+        if mode == "quaternion":
+            return given_registration(translation, quaternion=[
+                float(v) for v in get("registration.quaternion")])
+        if mode == "rpy":
+            return given_registration(translation, rpy=[
+                float(v) for v in get("registration.rpy")])
+        zero_csv = str(get("registration.zero_csv"))
+        if not zero_csv:
+            raise InputError("registration.mode = 'estimate' needs registration.zero_csv",
+                             parameter="registration.zero_csv", value="",
+                             allowed="a zero-tension Nexus CSV recording")
+        hint = [float(v) for v in get("registration.x_hint")]
+        return estimate_from_recordings(
+            zero_csv, self.name_map, [float(v) for v in get("labelling.arc_lengths")],
+            radius=float(get("markers.radius")),
+            side_rad=math.radians(float(get("markers.side_deg"))),
+            bent_csv=str(get("registration.bent_csv")) or None,
+            x_hint=hint if any(hint) else None)
+
+    def _labeller(self) -> Labeller:
+        get = self.port.get_parameter
+        if get("labelling.mode") == "name":
+            return NameLabeller(self.name_map)
+        labeller = ArcLengthLabeller(
+            self.labels, [float(v) for v in get("labelling.arc_lengths")],
+            self.registration, straight_axis(float(get("labelling.body_length"))),
+            float(get("labelling.max_distance")))
+        if get("labelling.axis") == "predicted":
+            self.port.create_subscription(str(get("labelling.axis_topic")),
+                                          "geometry_msgs/msg/PoseArray", self._on_axis,
+                                          QoS(depth=1))
+        return labeller
+
+    def _on_axis(self, message: Any) -> None:
+        if message.header.frame_id != self.base_frame_id or len(message.poses) < 2:
+            self.counts["axis_rejected"] += 1
+            self.last_problem = (f"axis message in frame {message.header.frame_id!r} with "
+                                 f"{len(message.poses)} poses; need {self.base_frame_id!r}, >= 2")
+            return
+        points = np.array([[p.position.x, p.position.y, p.position.z] for p in message.poses])
+        if isinstance(self.labeller, ArcLengthLabeller) and np.all(np.isfinite(points)):
+            self.labeller.set_axis(points)
+            self.counts["axis_updates"] += 1
+
+    # -- sources ----------------------------------------------------------------------------
+
+    def _start_csv(self) -> Registration:
+        get = self.port.get_parameter
+        path = str(get("csv.path"))
+        if not path:
+            raise InputError("source 'csv' needs csv.path", parameter="csv.path", value="",
+                             allowed="a Vicon Nexus CSV export")
+        trajectories = read_nexus_csv(path)
+        if get("labelling.mode") == "name":
+            self.name_map.require(trajectories.names, path)
+        scale = float(get("csv.rate_scale"))
+        start = self.port.now_ns() + round(float(get("csv.start_delay_s")) * 1e9)
+        self.replay = CsvReplay(trajectories, rate_scale=scale, loop=bool(get("csv.loop")),
+                                start_ns=start)
+        self.state = "waiting to start replay"
+        period = min(max(1.0 / (trajectories.rate_hz * scale), 1e-3), 0.05)
+        self.port.create_timer(period, self._replay_tick)
+        return self._given_registration()
+
+    def _replay_tick(self) -> None:
+        if self.replay.finished:
+            return
+        for frame in self.replay.due(self.port.now_ns()):
+            self.state = "replaying"
+            self._publish(frame)
+        if self.replay.finished:
+            self.state = f"finished replay of {len(self.replay.trajectories.frames)} frames"
+
+    def _start_relabel(self) -> Registration:
+        get = self.port.get_parameter
+        topic = str(get("relabel.input_topic"))
+        ns, name = self.port.namespace, self.port.node_name
+        if resolve_topic(topic, ns, name) == resolve_topic("markers", ns, name):
+            raise InputError(
+                f"relabel.input_topic = {topic!r} is this node's own output "
+                f"{resolve_topic('markers', ns, name)!r}; allowed: another topic, or run the node "
+                "in a namespace", parameter="relabel.input_topic", value=topic,
+                allowed="a topic other than the output")
+        self.input_scale = float(get("relabel.input_scale"))
+        self.port.create_subscription(topic, MARKERS_TYPE, self._on_markers, QoS(depth=100))
+        self.state = f"waiting for {resolve_topic(topic, ns, name)}"
+        return self._given_registration()
+
+    def _on_markers(self, message: Any) -> None:
+        self.counts["frames_received"] += 1
+        self.state = "relabelling"
+        positions = np.array([[m.translation.x, m.translation.y, m.translation.z]
+                              for m in message.markers], dtype=float).reshape(-1, 3)
+        names = tuple(str(m.marker_name) for m in message.markers)
+        self._publish(RawFrame(_stamp_ns(message) or self.port.now_ns(),
+                               int(message.frame_number), names, positions * self.input_scale))
+
+    def _start_sim(self) -> Registration:
+        from tdcm_ros.scenes import load_scene
+
+        scene = load_scene(str(self.port.get_parameter("sim.scene")))
+        world = scene.world()
+        self.sim = SimSource(world, delay_s=float(world.delay_s("markers")))
+        self.true_tension: float | None = None
+        self.port.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
+                                      self._on_true_tension, QoS(depth=10))
+        self.port.create_timer(1.0 / float(scene.mocap_rate_hz), self._sim_tick)
+        if self.sim.delay_ns:
+            self.port.create_timer(min(0.002, self.sim.delay_ns * 1e-9), self._sim_drain)
+        self.state = f"simulating scene {scene.name!r}; no sim/tension_true yet (0 N)"
+        translation, quaternion = world.mocap_to_base
+        return Registration(tuple(np.asarray(translation, dtype=float)),
+                            tuple(np.asarray(quaternion, dtype=float)), method="scene")
+
+    def _on_true_tension(self, message: Any) -> None:
+        tension = float(message.wrench.force.z)
+        if not math.isfinite(tension):
+            self.counts["dropped_non_finite_tension"] += 1
+            return
+        if self.true_tension is None:
+            self.state = "simulating"
+        self.true_tension = tension
+
+    def _sim_tick(self) -> None:
+        try:
+            self.sim.sample(self.port.now_ns(), self.true_tension or 0.0)
+        except InputError as error:
+            self.counts["source_errors"] += 1
+            self.last_problem = str(error)
+        self._sim_drain()
+
+    def _sim_drain(self) -> None:
+        for frame in self.sim.due(self.port.now_ns()):
+            self._publish(frame)
+
+    # -- output -----------------------------------------------------------------------------
+
+    def _publish(self, raw: RawFrame) -> None:
+        frame: LabelledFrame = self.labeller(raw.names, raw.positions)
+        self.counts["frames_published"] += 1
+        self.counts["markers_published"] += len(frame.labels)
+        self.counts["markers_occluded"] += frame.occluded
+        self.counts["markers_unlabelled"] += frame.unlabelled
+        hdr = header(raw.stamp_ns, self.frame_id)
+        points = [{"x": float(p[0]), "y": float(p[1]), "z": float(p[2])} for p in frame.positions]
+        self.markers_pub.publish(from_dict(MARKERS_TYPE, {
+            "header": hdr, "frame_number": raw.frame_number % 2**32,
+            "markers": [{"id_type": USE_BOTH, "marker_index": self.labels.index(label),
+                         "marker_name": label, "translation": point}
+                        for label, point in zip(frame.labels, points, strict=True)]}))
+        self.poses_pub.publish(from_dict("geometry_msgs/msg/PoseArray", {
+            "header": hdr, "poses": [{"position": point, "orientation": {"w": 1.0}}
+                                     for point in points]}))
+
+    def _publish_tf(self) -> None:
+        t, q = self.registration.translation, self.registration.quaternion
+        self.tf_pub.publish(from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
+            "header": header(self.port.now_ns(), self.frame_id),
+            "child_frame_id": self.base_frame_id,
+            "transform": {"translation": {"x": t[0], "y": t[1], "z": t[2]},
+                          "rotation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}}}]}))
+
+    def report(self) -> None:
+        """Publish counters, the source state and the registration on ``/diagnostics``."""
+        waiting = self.state.startswith("waiting") or "no sim/tension_true" in self.state
+        problems = self.counts["source_errors"] + self.counts["axis_rejected"]
+        level = 1 if (problems or (waiting and self.source_name != "csv")) else 0
+        values = {**{k: str(v) for k, v in sorted(self.counts.items())},
+                  "source": self.source_name, "state": self.state,
+                  "registration": self.registration.method,
+                  "registration_residual_m": f"{self.registration.residual_m:.6g}"}
+        status = {"level": level, "name": f"{self.port.node_name}: {self.source_name} source",
+                  "message": self.last_problem or self.state, "hardware_id": "tdcm_mocap",
+                  "values": [{"key": k, "value": v} for k, v in values.items()]}
+        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
+            "header": header(self.port.now_ns(), ""), "status": [status]}))
+
+
+def main() -> int:
+    """``ros2 run tdcm_ros mocap_node`` / ``mocap_node`` console script."""
+    return main_for(MocapNode)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,184 @@
+"""mocap_node logic in-process on an in-memory port: sim source with a test double of a scene,
+arc-length labelling on the predicted axis, CSV replay timing and configuration errors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from mocap_helpers import DATA
+from mocap_memory_port import MemoryPort
+
+import tdcm_ros.scenes
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
+from tdcm_ros.mocap import read_nexus_csv
+from tdcm_ros.nodes.mocap_node import MocapNode
+
+LABELS = ("m1", "m2", "m3")
+ARCS = (0.015, 0.033, 0.053)
+SAMPLE = str(DATA / "nexus_trial.csv")
+RELABEL = {"source": "relabel", "relabel.input_topic": "/vicon/markers"}
+
+
+def xyz(message) -> np.ndarray:
+    return np.array([[m.translation.x, m.translation.y, m.translation.z]
+                     for m in message.markers]).reshape(-1, 3)
+
+
+def stamp(message) -> int:
+    return message.header.stamp.sec * 10**9 + message.header.stamp.nanosec
+
+
+def counters(port: MemoryPort) -> dict[str, str]:
+    status = port.messages("/diagnostics")[-1].status[0]
+    return {v.key: v.value for v in status.values}
+
+
+class DoubleFrame:
+    def __init__(self, labels, positions):
+        self.labels, self.positions = labels, positions
+
+
+class DoubleWorld:
+    """MarkerFrame contract double: markers at x = tension * 1 mm/N; tip hidden above 8 N."""
+
+    mocap_to_base = (np.array([0.5, -0.25, 1.0]), np.array([0.0, 0.0, 0.0, 1.0]))
+
+    def __init__(self):
+        self.calls: list[tuple[float, float]] = []
+
+    def markers(self, stamp_s, true_tension):
+        self.calls.append((stamp_s, true_tension))
+        p = np.array([[1e-3 * true_tension, 0.0, s] for s in ARCS])
+        if true_tension > 8.0:
+            p[2] = np.nan
+        return DoubleFrame(LABELS, p)
+
+    def delay_s(self, topic):
+        return 0.05 if topic == "markers" else 0.0
+
+
+class DoubleScene:
+    name = "double"
+    mocap_rate_hz = 50.0
+
+    def __init__(self):
+        self.the_world = DoubleWorld()
+
+    def world(self):
+        return self.the_world
+
+
+def wrench(tension: float):
+    return from_dict("geometry_msgs/msg/WrenchStamped", {"wrench": {"force": {"z": tension}}})
+
+
+def test_sim_source_samples_the_scene_world_at_its_rate_with_its_delay(monkeypatch):
+    scene = DoubleScene()
+    monkeypatch.setattr(tdcm_ros.scenes, "load_scene", lambda name: scene)
+    port = MemoryPort({"source": "sim", "sim.scene": "double"})
+    node = MocapNode(port)
+    (tf,) = port.messages("/tf_static")
+    t = tf.transforms[0].transform.translation
+    assert [t.x, t.y, t.z] == [0.5, -0.25, 1.0] and tf.transforms[0].child_frame_id == "tdcm_base"
+    assert port.publishers["/tf_static"].qos.durability == "transient_local"
+    port.advance(0.1)                                  # 5 samples at 50 Hz, before any tension
+    assert all(tension == 0.0 for _, tension in scene.the_world.calls)
+    port.deliver("sim/tension_true", wrench(5.0))
+    port.advance(0.2)
+    port.deliver("sim/tension_true", wrench(12.0))
+    port.advance(0.2)
+    calls = scene.the_world.calls
+    assert len(calls) == 25 and np.allclose(np.diff([s for s, _ in calls]), 0.02, atol=1e-6)
+    published = port.published["markers"]
+    assert len(published) == 22                   # samples of the last 50 ms are still delayed
+    for (sent_ns, message), (stamp_s, tension) in zip(published, calls, strict=False):
+        assert abs(stamp(message) - stamp_s * 1e9) < 1e3      # float s since the epoch
+        assert sent_ns - stamp(message) == pytest.approx(50e6, abs=2e6)
+        expected = 3 if tension <= 8.0 else 2
+        assert [m.marker_name for m in message.markers] == list(LABELS[:expected])
+        assert np.allclose(xyz(message)[:, 0], 1e-3 * tension)
+    port.advance(1.0)
+    node.report()
+    values = counters(port)
+    assert values["state"] == "simulating" and values["registration"] == "scene"
+    hidden = sum(3 - len(m.markers) for m in port.messages("markers"))
+    assert hidden > 0 and int(values["markers_occluded"]) == hidden
+
+
+def test_arc_length_labelling_follows_the_predicted_axis():
+    # Registration: tdcm_base is rotated 90 deg about mocap x and offset.
+    rpy = [math.pi / 2, 0.0, 0.0]
+    port = MemoryPort({"source": "relabel", "relabel.input_topic": "/vicon/markers",
+                       "labelling.mode": "arc_length", "labelling.axis": "predicted",
+                       "labelling.max_distance": 0.005, "registration.mode": "rpy",
+                       "registration.rpy": rpy, "registration.translation": [1.0, 2.0, 3.0]})
+    node = MocapNode(port)
+    assert "midline_poses" in port.subscriptions
+    # A body bent into a quarter circle of radius 0.04 m toward +x; markers on the midline.
+    s = np.linspace(0, 0.053, 40)
+    midline = np.column_stack([0.04 * (1 - np.cos(s / 0.04)), np.zeros_like(s),
+                               0.04 * np.sin(s / 0.04)])
+    port.deliver("midline_poses", from_dict("geometry_msgs/msg/PoseArray", {
+        "header": {"frame_id": "tdcm_base"},
+        "poses": [{"position": {"x": p[0], "y": p[1], "z": p[2]}} for p in midline]}))
+    on_axis = np.column_stack([0.04 * (1 - np.cos(np.array(ARCS) / 0.04)), np.zeros(3),
+                               0.04 * np.sin(np.array(ARCS) / 0.04)])
+    in_mocap = node.registration.to_mocap(on_axis)
+    order = [2, 0, 1]
+    port.deliver("/vicon/markers", from_dict("mocap4r2_msgs/msg/Markers", {
+        "header": {"stamp": {"sec": 5}}, "frame_number": 9,
+        "markers": [{"marker_name": "", "translation": {"x": p[0], "y": p[1], "z": p[2]}}
+                    for p in in_mocap[order]]}))
+    (message,) = port.messages("markers")
+    assert [m.marker_name for m in message.markers] == list(LABELS)
+    assert np.allclose(xyz(message), in_mocap, atol=1e-12)
+    assert message.frame_number == 9 and stamp(message) == 5 * 10**9
+    # On the straight axis the tip (16 mm off) would exceed the 5 mm gate; the predicted axis
+    # was used. An axis in another frame is rejected and counted.
+    port.deliver("midline_poses", from_dict("geometry_msgs/msg/PoseArray", {
+        "header": {"frame_id": "mocap"}, "poses": [{}, {}]}))
+    port.advance(1.0)
+    assert counters(port)["axis_rejected"] == "1" and counters(port)["axis_updates"] == "1"
+
+
+def test_csv_replay_through_the_node_publishes_every_row_once():
+    port = MemoryPort({"source": "csv", "csv.path": SAMPLE, "csv.rate_scale": 2.0,
+                       "csv.start_delay_s": 0.5,
+                       "labelling.map": ["TDCM:M1=m1", "TDCM:M2=m2", "TDCM:M3=m3"]})
+    MocapNode(port)
+    start = port.clock_ns
+    port.advance(0.49)
+    assert not port.messages("markers")
+    port.advance(1.0)
+    messages = port.messages("markers")
+    traj = read_nexus_csv(SAMPLE)
+    assert [m.frame_number for m in messages] == traj.frames.tolist()
+    assert [stamp(m) - start for m in messages] == [500_000_000 + i * 5_000_000
+                                                    for i in range(30)]
+    port.advance(1.0)
+    values = counters(port)
+    assert values["frames_published"] == "30" and values["state"].startswith("finished")
+    assert values["markers_occluded"] == "4"                 # 3 tip gaps and one m1 gap
+    assert values["markers_unlabelled"] == "30"              # *17 on every row
+
+
+@pytest.mark.parametrize(("values", "parameter"), [
+    ({"source": "csv"}, "csv.path"),
+    ({"source": "bag"}, "source"),
+    ({"source": "csv", "csv.path": SAMPLE, "labelling.map": ["M1=m1", "M2=m2"]}, "labelling.map"),
+    ({"source": "relabel"}, "relabel.input_topic"),     # /markers is the output at the root
+    ({**RELABEL, "registration.quaternion": [0.0, 0.0, 1.0]}, "registration.quaternion"),
+    ({**RELABEL, "registration.quaternion": [0.0, 0.0, 0.0, 0.0]}, "registration.quaternion"),
+    ({**RELABEL, "registration.mode": "estimate"}, "registration.zero_csv"),
+    ({**RELABEL, "labelling.mode": "arc_length", "labelling.arc_lengths": [0.01, 0.02]},
+     "labelling.arc_lengths"),
+    ({**RELABEL, "labelling.max_distance": 5.0}, "labelling.max_distance"),
+    ({**RELABEL, "relabel.input_scale": 0.0}, "relabel.input_scale"),
+])
+def test_bad_configuration_is_a_typed_error_naming_the_parameter(values, parameter):
+    with pytest.raises(InputError) as caught:
+        MocapNode(MemoryPort(values))
+    assert caught.value.parameter == parameter
