@@ -182,3 +182,42 @@ def test_bad_configuration_is_a_typed_error_naming_the_parameter(values, paramet
     with pytest.raises(InputError) as caught:
         MocapNode(MemoryPort(values))
     assert caught.value.parameter == parameter
+
+
+def test_sim_source_with_the_real_ideal_scene_publishes_the_model_markers():
+    from tdcm_ros.metrics.registration import Registration
+    from tdcm_ros.model import solve
+    from tdcm_ros.nodes.shape_messages import surface_points
+    from tdcm_ros.scenes import load_scene
+
+    scene = load_scene("ideal")
+    port = MemoryPort({"source": "sim", "sim.scene": "ideal"})
+    MocapNode(port)
+    port.deliver("sim/tension_true", wrench(15.0))
+    port.advance(0.1)
+    messages = port.messages("markers")
+    assert len(messages) == round(0.1 * scene.mocap_rate_hz)
+    tf = port.messages("/tf_static")[0].transforms[0].transform
+    registration = Registration((tf.translation.x, tf.translation.y, tf.translation.z),
+                                (tf.rotation.x, tf.rotation.y, tf.rotation.z, tf.rotation.w))
+    expected, _ = surface_points(solve(scene.true_design, 15.0), np.array(ARCS),
+                                 scene.marker_radius, scene.marker_side_rad)
+    for message in messages:
+        assert [m.marker_name for m in message.markers] == list(LABELS)
+        assert np.allclose(registration.to_base(xyz(message)), expected, rtol=0, atol=1e-12)
+
+
+def test_shipped_config_file_starts_the_node():
+    from pathlib import Path
+
+    from tdcm_ros.runtime.params import node_parameters
+
+    config = Path(__file__).resolve().parents[2] / "config" / "mocap_node.yaml"
+    values = node_parameters(str(config), "/mocap_node")
+    port = MemoryPort(values)
+    MocapNode(port)
+    port.advance(0.05)
+    assert port.messages("markers") and port.messages("/tf_static")
+    relabel = MemoryPort({**values, "source": "relabel"})
+    MocapNode(relabel)
+    assert "/vicon/markers" in relabel.subscriptions
