@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -28,3 +29,17 @@ def nexus_text(names: Sequence[str], positions_m: np.ndarray, *, rate: float = 1
         cells = [number(v * 1000.0) for v in np.asarray(positions_m[row]).ravel()]
         lines.append(d.join([str(frame), "0", *cells]))
     return before + "\n".join(lines) + "\n" + after
+
+
+def straight_and_bent(truth: Any, arcs: Sequence[float] = (0.015, 0.033, 0.053),
+                      radius: float = 0.00492) -> tuple[np.ndarray, np.ndarray]:
+    """Markers (mocap, m) of a straight body and one bent toward +x in a plane (hand geometry:
+    the body bends on a circle of radius 0.1 m in the x-z plane; markers on the -x surface)."""
+    s = np.array(arcs)
+    straight = np.column_stack([np.full(len(s), -radius), np.zeros(len(s)), s])
+    rho = 0.1
+    phi = s / rho
+    mid = np.column_stack([rho * (1 - np.cos(phi)), np.zeros(len(s)), rho * np.sin(phi)])
+    body_x = np.column_stack([np.cos(phi), np.zeros(len(s)), -np.sin(phi)])
+    bent = mid - radius * body_x
+    return truth.to_mocap(straight), truth.to_mocap(bent)

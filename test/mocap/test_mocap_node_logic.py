@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from mocap_helpers import DATA
+from mocap_helpers import DATA, nexus_text, straight_and_bent
 from mocap_memory_port import MemoryPort
 
 import tdcm_ros.scenes
@@ -163,6 +163,31 @@ def test_csv_replay_through_the_node_publishes_every_row_once():
     assert values["frames_published"] == "30" and values["state"].startswith("finished")
     assert values["markers_occluded"] == "4"                 # 3 tip gaps and one m1 gap
     assert values["markers_unlabelled"] == "30"              # *17 on every row
+
+
+def test_registration_estimated_from_recordings_is_published_on_tf_static(tmp_path):
+    from scipy.spatial.transform import Rotation
+
+    from tdcm_ros.metrics.registration import Registration
+
+    truth = Registration((0.4, 0.1, 1.2),
+                         tuple(Rotation.from_euler("xyz", [0.2, 2.8, -1.0]).as_quat()))
+    zero, bent = straight_and_bent(truth)
+    names = ["TDCM:M1", "TDCM:M2", "TDCM:M3"]
+    (tmp_path / "zero.csv").write_text(nexus_text(names, np.repeat(zero[None], 3, axis=0)))
+    (tmp_path / "bent.csv").write_text(nexus_text(names, np.stack([zero, bent])))
+    port = MemoryPort({**RELABEL, "labelling.map": ["M1=m1", "M2=m2", "M3=m3"],
+                       "registration.mode": "estimate",
+                       "registration.zero_csv": str(tmp_path / "zero.csv"),
+                       "registration.bent_csv": str(tmp_path / "bent.csv")})
+    node = MocapNode(port)
+    transform = port.messages("/tf_static")[0].transforms[0].transform
+    t, q = transform.translation, transform.rotation
+    assert np.allclose([t.x, t.y, t.z], truth.translation, atol=1e-9)
+    got = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
+    assert np.allclose(got, truth.rotation, atol=1e-9)
+    node.report()
+    assert counters(port)["registration"] == "estimated"
 
 
 @pytest.mark.parametrize(("values", "parameter"), [

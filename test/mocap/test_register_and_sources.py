@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from mocap_helpers import DATA, nexus_text
+from mocap_helpers import DATA, nexus_text, straight_and_bent
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.metrics.registration import Registration, RegistrationError
@@ -40,19 +40,6 @@ def test_given_registration_from_quaternion_or_rpy():
                 {"rpy": [0, 0, 0], "quaternion": [0, 0, 0, 1]}):
         with pytest.raises(RegistrationError):
             given_registration([0, 0, 0], **bad)
-
-
-def straight_and_bent(truth: Registration) -> tuple[np.ndarray, np.ndarray]:
-    """Markers (mocap, m) of a straight body and one bent toward +x in a plane (hand geometry:
-    the body bends on a circle of radius 0.1 m in the x-z plane; markers on the -x surface)."""
-    s = np.array(ARCS)
-    straight = np.column_stack([np.full(3, -RADIUS), np.zeros(3), s])
-    rho = 0.1
-    phi = s / rho
-    mid = np.column_stack([rho * (1 - np.cos(phi)), np.zeros(3), rho * np.sin(phi)])
-    body_x = np.column_stack([np.cos(phi), np.zeros(3), -np.sin(phi)])
-    bent = mid - RADIUS * body_x
-    return truth.to_mocap(straight), truth.to_mocap(bent)
 
 
 def test_registration_estimated_from_zero_and_bent_recordings(tmp_path):
