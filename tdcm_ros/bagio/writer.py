@@ -129,6 +129,7 @@ class BagWriter:
         self._writer.start(profile="ros2", library="tdcm_ros")
         self._schemas: dict[str, int] = {}
         self._topics: dict[str, _Topic] = {}
+        self.flush_period_s = flush_period_s
         self._flush_period_ns = int(flush_period_s * 1e9)
         self._pending = 0
         self._written_at_flush = self._file.written

@@ -19,6 +19,7 @@ SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.solve",
     "tdcm_ros.cli.up",
     "tdcm_ros.cli.topic",
+    "tdcm_ros.cli.record",
     "tdcm_ros.cli.param",
     "tdcm_ros.cli.bench",
     "tdcm_ros.cli.figures",

@@ -1,0 +1,102 @@
+"""``tdcm record BAG [TOPIC...]``: record the embedded (zenoh) graph into a rosbag2 MCAP bag.
+
+Also ``tdcm bag info BAG``: topics, types, counts and warnings of a bag (folder or ``.mcap``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import signal
+import sys
+from types import FrameType
+
+from tdcm_ros.errors import InputError
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``record``."""
+    parser = subparsers.add_parser(
+        "record", help="record topics into a rosbag2 MCAP bag (zenoh)",
+        description="Record topics (all when none are named, including ones that appear later) "
+                    "until Ctrl-C/SIGTERM, --duration or --max-messages; the bag is then closed.")
+    parser.add_argument("bag", help="bag folder to create (must not exist)")
+    parser.add_argument("topics", nargs="*", help="topics to record (default: all)")
+    parser.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
+    parser.add_argument("--max-messages", type=int, default=0, help="stop after N messages")
+    parser.add_argument("--flush-period", type=float, default=0.1,
+                        help="longest time (s) a received message waits before it is written "
+                             "to the file (bounds the loss on SIGKILL)")
+    parser.set_defaults(handler=run_record)
+
+    bag = subparsers.add_parser("bag", help="inspect bags")
+    verbs = bag.add_subparsers(dest="verb", required=True, metavar="VERB")
+    info = verbs.add_parser("info", help="topics, types, message counts, warnings")
+    info.add_argument("bag", help="rosbag2 folder or .mcap file")
+    info.set_defaults(handler=run_info)
+
+
+def run_info(args: argparse.Namespace) -> int:
+    """Print what ``open_bag`` finds in a bag."""
+    from tdcm_ros.bagio.reader import open_bag
+
+    reader = open_bag(args.bag)
+    print(f"bag: {reader.path}\nmessages: {reader.message_count}\ntopics:")
+    for topic in sorted(reader.topics):
+        print(f"  {topic} [{reader.topics[topic]}]: {reader.counts[topic]}")
+    for warning in reader.warnings:
+        print(f"warning: {warning}")
+    return 0
+
+
+def _check(args: argparse.Namespace) -> None:
+    if not args.duration >= 0:
+        raise InputError(f"--duration = {args.duration} s is out of range; allowed: >= 0",
+                         parameter="duration", value=args.duration, allowed=">= 0 s")
+    if args.max_messages < 0:
+        raise InputError(f"--max-messages = {args.max_messages} is out of range; allowed: >= 0",
+                         parameter="max_messages", value=args.max_messages, allowed=">= 0")
+
+
+def run_record(args: argparse.Namespace) -> int:
+    """Record until a signal or a limit; print a per-topic summary."""
+    _check(args)
+    stop_requested: list[int] = []
+
+    def on_signal(signum: int, _: FrameType | None) -> None:
+        stop_requested.append(signum)
+        if recorder is not None:
+            recorder.request_stop()
+
+    recorder = None
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, on_signal)
+
+    from tdcm_ros.bagio.writer import BagWriter
+    from tdcm_ros.recording import Recorder
+
+    writer = BagWriter(args.bag, flush_period_s=args.flush_period)
+    try:
+        recorder = Recorder(writer, args.topics, max_messages=args.max_messages,
+                            on_topic=lambda t, m: print(f"subscribed {t} [{m}]", flush=True))
+    except BaseException:
+        writer.close()
+        shutil.rmtree(writer.path, ignore_errors=True)
+        raise
+    print(f"recording to {writer.path} ({', '.join(args.topics) or 'all topics'}); "
+          f"Ctrl-C to stop", flush=True)
+    try:
+        if not stop_requested:
+            recorder.run(args.duration)
+    finally:
+        recorder.close()
+    counts = writer.counts
+    for topic in sorted(counts):
+        print(f"{topic} [{writer.topics[topic]}]: {counts[topic]} messages")
+    print(f"{sum(counts.values())} messages in {len(counts)} topics written to {writer.path}",
+          flush=True)
+    if recorder.missing:
+        print(f"tdcm record: never published: {', '.join(recorder.missing)}", file=sys.stderr)
+    if not sum(counts.values()):
+        print("tdcm record: no message was recorded; the bag is empty", file=sys.stderr)
+    return 0

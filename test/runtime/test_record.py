@@ -1,0 +1,172 @@
+"""``tdcm record`` over the embedded runtime: stopped by SIGINT/SIGTERM, killed, bad input."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from runtime_helpers import wait_for
+
+from tdcm_ros.bagio import from_dict, serialize
+from tdcm_ros.bagio.reader import open_bag
+from tdcm_ros.bagio.writer import BagWriter
+from tdcm_ros.cli.main import main
+
+REPO = Path(__file__).resolve().parents[2]
+RATE_HZ = 200.0
+
+# Publishes /count (std_msgs/Float64, data = 1, 2, ...) at RATE_HZ and one transient-local
+# /tf_static; appends "<n> <publish time ns>" per message to the log file argv[1].
+PUBLISHER = f"""
+import sys, time
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.runtime.port import QoS
+from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+context = ZenohContext()
+port = context.create_port("counter")
+count = port.create_publisher("/count", "std_msgs/msg/Float64")
+tf = port.create_publisher("/tf_static", "tf2_msgs/msg/TFMessage",
+                           QoS(depth=1, durability="transient_local"))
+tf.publish(from_dict("tf2_msgs/msg/TFMessage",
+                     {{"transforms": [{{"child_frame_id": "tdcm_base"}}]}}))
+with open(sys.argv[1], "w") as log:
+    n = 0
+    while True:
+        n += 1
+        stamp = time.time_ns()
+        count.publish(from_dict("std_msgs/msg/Float64", {{"data": float(n)}}))
+        log.write(f"{{n}} {{stamp}}\\n")
+        log.flush()
+        time.sleep({1.0 / RATE_HZ})
+"""
+
+
+class Lines:
+    """Lines of a child's stdout, collected by a thread (never blocks the test)."""
+
+    def __init__(self, process: subprocess.Popen[bytes]) -> None:
+        self.lines: list[str] = []
+        assert process.stdout is not None
+        stream = process.stdout
+        self._thread = threading.Thread(
+            target=lambda: self.lines.extend(line.decode() for line in stream), daemon=True)
+        self._thread.start()
+
+    def has(self, text: str) -> bool:
+        return any(text in line for line in self.lines)
+
+
+def _published(log: Path) -> list[tuple[int, int]]:
+    rows = [line.split() for line in log.read_text().splitlines()]
+    return [(int(r[0]), int(r[1])) for r in rows if len(r) == 2]
+
+
+def _start_publisher(zenoh_env: dict[str, str], log: Path) -> subprocess.Popen[bytes]:
+    return subprocess.Popen([sys.executable, "-c", PUBLISHER, str(log)], env=zenoh_env, cwd=REPO,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+def _record_until(spawn: Callable[..., subprocess.Popen[bytes]], zenoh_env: dict[str, str],
+                  tmp_path: Path, stop: signal.Signals) -> tuple[Path, list[tuple[int, int]], int,
+                                                            subprocess.Popen[bytes], Lines]:
+    """Record a running publisher, send ``stop`` after ~200 messages; returns what happened."""
+    log, bag = tmp_path / "published.txt", tmp_path / "bag"
+    publisher = _start_publisher(zenoh_env, log)
+    try:
+        wait_for(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
+        recorder = spawn("tdcm_ros.cli.main", "record", str(bag))
+        out = Lines(recorder)
+        wait_for(lambda: out.has("subscribed /count"), 20.0, "the recorder to subscribe")
+        first = len(_published(log))
+        wait_for(lambda: len(_published(log)) > first + 200, 20.0, "200 more messages")
+        signalled_ns = time.time_ns()
+        recorder.send_signal(stop)
+        recorder.wait(20.0)
+    finally:
+        publisher.kill()
+        publisher.wait()
+    return bag, _published(log), signalled_ns, recorder, out
+
+
+def _counts(bag: Path) -> tuple[list[int], int]:
+    reader = open_bag(bag)
+    values = [int(m.data) for _, _, m in reader.messages(["/count"])]
+    return values, reader.counts.get("/tf_static", 0)
+
+
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM])
+def test_signal_closes_a_bag_with_every_message_before_it(
+        router: subprocess.Popen[bytes], spawn: Callable[..., subprocess.Popen[bytes]],
+        zenoh_env: dict[str, str], tmp_path: Path, stop: signal.Signals) -> None:
+    bag, published, signalled_ns, recorder, out = _record_until(spawn, zenoh_env, tmp_path, stop)
+    assert recorder.returncode == 0, recorder.stderr.read() if recorder.stderr else ""
+    assert (bag / "metadata.yaml").is_file()
+    values, tf_count = _counts(bag)
+    assert tf_count == 1  # transient-local, published before the recorder started
+    assert values == list(range(values[0], values[-1] + 1))  # no gap
+    # everything published 0.2 s (loopback delivery allowance) before the signal is in the bag
+    before = max(n for n, stamp in published if stamp < signalled_ns - 200_000_000)
+    assert values[-1] >= before
+    wait_for(lambda: out.has("messages in"), 5.0, "the summary")
+    assert any(line.startswith(f"/count [std_msgs/msg/Float64]: {len(values)} messages")
+               for line in out.lines)
+
+
+def test_sigkill_leaves_a_bag_readable_to_the_last_chunk(
+        router: subprocess.Popen[bytes], spawn: Callable[..., subprocess.Popen[bytes]],
+        zenoh_env: dict[str, str], tmp_path: Path) -> None:
+    bag, published, killed_ns, recorder, _ = _record_until(spawn, zenoh_env, tmp_path,
+                                                           signal.SIGKILL)
+    assert recorder.returncode == -signal.SIGKILL
+    assert not (bag / "metadata.yaml").exists()
+    reader = open_bag(bag)
+    assert any("no metadata.yaml" in w for w in reader.warnings)
+    values, _ = _counts(bag)
+    assert values == list(range(values[0], values[-1] + 1))
+    # the loss is bounded by the flush period (0.1 s) plus delivery; 1 s is a generous bound
+    before = max(n for n, stamp in published if stamp < killed_ns - 1_000_000_000)
+    assert values[-1] >= before
+    lost = max(n for n, stamp in published if stamp < killed_ns) - values[-1]
+    print(f"SIGKILL at {RATE_HZ:.0f} Hz lost the last {lost} messages")
+
+
+def _one_line_error(capsys: pytest.CaptureFixture[str], args: list[str], text: str) -> None:
+    """``tdcm ARGS`` exits 2 with one line on stderr naming ``text`` (no traceback)."""
+    assert main(args) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and text in lines[0], lines
+
+
+def test_record_refuses_an_existing_bag(tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "bag").mkdir()
+    _one_line_error(capsys, ["record", str(tmp_path / "bag")], "refusing to overwrite")
+    _one_line_error(capsys, ["record", str(tmp_path / "new"), "--duration", "-1"], "--duration")
+    assert not (tmp_path / "new").exists()
+
+
+def test_bag_info_bad_inputs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _one_line_error(capsys, ["bag", "info", str(tmp_path / "absent")], "no such bag")
+    (tmp_path / "corrupt.mcap").write_bytes(b"\x89MCAP0\r\n" + bytes(range(256)) * 4)
+    _one_line_error(capsys, ["bag", "info", str(tmp_path / "corrupt.mcap")],
+                    "no message can be recovered")
+    (tmp_path / "notes.txt").write_text("not a bag")
+    _one_line_error(capsys, ["bag", "info", str(tmp_path / "notes.txt")], "not a bag")
+    with BagWriter(tmp_path / "empty") as writer:
+        writer.add_topic("/tension", "geometry_msgs/msg/WrenchStamped")
+    _one_line_error(capsys, ["bag", "info", str(tmp_path / "empty")], "empty bag")
+
+
+def test_bag_info_lists_topics(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    with BagWriter(tmp_path / "bag") as writer:
+        writer.add_topic("/x", "std_msgs/msg/Float64")
+        writer.write("/x", 1, serialize(from_dict("std_msgs/msg/Float64", {"data": 1.0})))
+    assert main(["bag", "info", str(tmp_path / "bag")]) == 0
+    assert "  /x [std_msgs/msg/Float64]: 1" in capsys.readouterr().out.splitlines()
