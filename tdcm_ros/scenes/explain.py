@@ -8,7 +8,7 @@ schedule's top tension:
   distance between the true tips (tdcm_base).
 - actuation: the device twin holds the top setpoint for one hold time; cost = extra wall time
   per 1 ms twin step; tip change = distance between the world's tips at the true tensions the
-  twin reached (mean over the hold's last second).
+  twin reached (mean over the last second of the hold, or its last half if shorter).
 - sensing: ``samples`` motion-capture frames at the mocap rate; cost = the effect's own time
   per call (per frame; once per world for ``registration_error``); tip change = RMS distance between the tip marker as the estimator sees it
   (mapped to tdcm_base through the published transform), over frames where both see it.
@@ -91,7 +91,7 @@ def _sweep(scene: Scene, repeats: int) -> tuple[Array, float]:
 
 
 def _twin_hold(scene: Scene, setpoint: float, repeats: int) -> tuple[float, float]:
-    """Mean true tension (N) over the last second of a hold at ``setpoint`` N, and the wall
+    """Mean true tension (N) at the end of a hold at ``setpoint`` N (see module docstring), the wall
     time per 1 ms twin step (s, fastest of ``repeats`` holds)."""
     hold = scene.schedule.hold
     steps = max(1, round(hold / HEARTBEAT_S))
@@ -105,7 +105,7 @@ def _twin_hold(scene: Scene, setpoint: float, repeats: int) -> tuple[float, floa
             twin.advance(HEARTBEAT_S)
             twin.receive(encode(Heartbeat()))
         best = min(best, (perf_counter() - started) / (steps * HEARTBEAT_S * 1000))
-        truth = [t for stamp, t in twin.take_truth() if stamp >= twin.time - 1.0]
+        truth = [t for stamp, t in twin.take_truth() if stamp >= twin.time - min(1.0, hold / 2)]
         tension = float(np.mean(truth))
     return tension, best
 

@@ -34,6 +34,7 @@ if TYPE_CHECKING:
 
 Array = NDArray[np.float64]
 CACHE_SIZE = 512
+WARM_RATIO = (1e-3, 1e3)  #: tension ratios over which the previous shape is a useful start
 
 
 @dataclass(frozen=True)
@@ -89,7 +90,7 @@ class World:
             return cached
         started = perf_counter()
         try:
-            result = solve(self.scene.true_design, tension, warm_start=self._last,
+            result = solve(self.scene.true_design, tension, warm_start=self._warm_start(tension),
                            loading=self.loading)
         finally:
             self.solves += 1
@@ -102,6 +103,15 @@ class World:
             if len(self._cache) > CACHE_SIZE:
                 self._cache.popitem(last=False)
         return result
+
+    def _warm_start(self, tension: float) -> SolveResult | None:
+        """The previous shape, unless the tension ratio makes its rescaling meaningless (the
+        solver scales a warm start by ``tension / previous``; from ~0 N that overflows)."""
+        last = self._last
+        if last is None or not WARM_RATIO[0] <= tension / max(last.tension_n, 1e-300) \
+                <= WARM_RATIO[1]:
+            return None
+        return last
 
     def _lookup(self, tension: float) -> SolveResult | None:
         if self._stateful:  # history matters: only the same tension again is the same state
