@@ -124,13 +124,21 @@ def test_estop_releases_at_once_and_stays_released_until_cleared(spawn, probe, t
 
 def test_closing_and_reopening_the_pty_triggers_a_reconnect(spawn, probe, twin,
                                                             tmp_path) -> None:
-    node = start_driver(spawn, tmp_path, twin)
+    """A pulled cable: the link drops, the device's watchdog releases the tendon during the
+    outage (backoff 1 s > watchdog 0.5 s), the driver reconnects, reports the latched fault and
+    holds again once the fault is cleared."""
+    node = start_driver(spawn, tmp_path, twin, backoff_initial=1.0)
     probe.connected()
     old = twin.pty_path
     twin.reopen()
-    assert twin.pty_path != old or os.path.realpath(twin.port) == twin.pty_path
+    assert twin.pty_path != old and os.path.realpath(twin.port) == twin.pty_path
     probe.until(lambda: any(values(d)["reconnects"] == "1" for d in probe.diagnostics), 20.0,
                 "reconnects = 1 on /diagnostics")
+    probe.until(lambda: probe.state().get("link") == "connected"
+                and "WATCHDOG" in probe.state().get("faults", ""), 20.0,
+                "connected again, with the watchdog release of the outage reported")
+    assert twin.twin.core.mode is Mode.RELEASE
+    probe.clear_faults()
     probe.connected()
     count = len(probe.tension)
     probe.until(lambda: len(probe.tension) > count + 10, 10.0, "telemetry after the reconnect")
@@ -185,14 +193,26 @@ def test_schedule_runs_the_staircase_and_reports_done(spawn, probe, twin, tmp_pa
 
 
 @pytest.mark.parametrize(("name", "value", "message"), [
-    ("tension_max", 30.0, "tension_max = 30.0 is out of range"),
+    ("tension_max", 30.0, "tension_max = 30.0 is out of range; allowed: [0.001, 22.0]"),
     ("heartbeat_period", 0.3, "heartbeat_period = 0.3 is out of range"),
-    ("schedule.levels", [0.0, -4.0], "schedule.levels"),
+    ("backoff_max", 0.1, "backoff_max = 0.1 s is out of range; allowed: >= backoff_initial"),
+    ("schedule.levels", [0.0, -4.0], "schedule.levels: levels = -4.0 N is out of range"),
+    ("schedule.trials", 0, "schedule.trials = 0 is out of range"),
+    ("port", " ", "port = ' ' is invalid"),
 ])
-def test_bad_parameters_stop_the_node_with_a_message(spawn, router, tmp_path, name, value,
-                                                     message) -> None:
-    path = driver_params(tmp_path / "bad.yaml", **{name: value})
-    node = spawn("tdcm_ros.runtime.run_node", DRIVER, "--params", path)
+def test_bad_parameters_are_refused_naming_the_parameter(probe, name, value, message) -> None:
+    from tdcm_ros.errors import InputError
+    from tdcm_ros.nodes.tension_driver import TensionDriverNode
+
+    port = probe.ctx.create_port("bad_driver", overrides={name: value})
+    with pytest.raises(InputError) as caught:
+        TensionDriverNode(port)
+    assert message in str(caught.value)
+
+
+def test_a_bad_parameter_file_exits_with_status_2(spawn, router, tmp_path) -> None:
+    node = spawn("tdcm_ros.runtime.run_node", DRIVER, "--params",
+                 driver_params(tmp_path / "bad.yaml", tension_max=30.0))
     assert node.wait(30) == 2
     assert node.stderr is not None
-    assert message in node.stderr.read().decode()
+    assert "tension_max = 30.0 is out of range" in node.stderr.read().decode()
