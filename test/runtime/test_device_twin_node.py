@@ -1,0 +1,124 @@
+"""device_twin in its own process (driven by the driver core here), and the whole chain
+``tdcm up --twin``: device_twin -> tension_driver -> model_node, with no hardware."""
+
+from __future__ import annotations
+
+import os
+import statistics
+import subprocess
+import tempfile
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from runtime_helpers import stop, wait_for
+from tension_probe import TWIN, Probe, stamp_ns
+
+from tdcm_ros.device.driver import DriverConfig, LinkState, TensionDriver
+from tdcm_ros.errors import InputError
+from tdcm_ros.model import preset, solve
+
+
+@pytest.fixture
+def probe(router: subprocess.Popen[bytes]) -> Iterator[Probe]:
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    ctx = ZenohContext()
+    yield Probe(ctx)
+    ctx.close()
+
+
+def test_twin_node_serves_its_plant_and_publishes_the_true_tension(spawn, probe,
+                                                                   tmp_path) -> None:
+    """With a +1 N load-cell bias the device holds 8 N measured, so the tendon carries 7 N."""
+    link = tmp_path / "twin_link"
+    params = tmp_path / "twin.yaml"
+    params.write_text(yaml.safe_dump({"device_twin": {"ros__parameters": {
+        "link": str(link), "plant": {"bias": 1.0, "noise": 0.0}}}}))
+    node = spawn("tdcm_ros.runtime.run_node", TWIN, "--params", str(params))
+    wait_for(lambda: link.is_symlink(), 30.0, "the twin's link")
+    driver = TensionDriver(DriverConfig(port=str(link)), clock=time.monotonic)
+    measured: list[float] = []
+    try:
+        driver.enable()
+        driver.set_setpoint(8.0)
+        deadline = time.monotonic() + 30.0
+        while not (measured and abs(measured[-1] - 8.0) < 0.02 and probe.truth
+                   and abs(probe.truth[-1].wrench.force.z - 7.0) < 0.05):
+            assert time.monotonic() < deadline, f"no 8 N / 7 N: {measured[-1:]}, {probe.truth[-1:]}"
+            result = driver.step()
+            measured.extend(frame.tension for frame in result.telemetry)
+            probe.ctx.spin_for(0.005)
+        assert result.status.link is LinkState.CONNECTED and result.status.banner is not None
+        assert result.status.banner.cell == "TWIN"
+    finally:
+        driver.close()
+    stamps = [stamp_ns(m) for m in probe.truth]
+    gaps = np.diff(stamps) / 1e9
+    assert np.all(gaps >= 0) and 0.010 <= statistics.median(gaps) <= 0.015  # 12.5 ms samples
+    assert all(m.header.frame_id == "tdcm_tendon" for m in probe.truth)
+    assert stop(node, 20.0) == 0
+    assert not link.exists() and not link.is_symlink()
+    assert node.stderr is not None and "device twin stopped" in node.stderr.read().decode()
+
+
+@pytest.mark.parametrize(("name", "value", "message"), [
+    ("plant.stiffness", -1.0, "plant.stiffness: stiffness = -1.0 is out of range"),
+    ("plant.deadband", 0.5, "plant.deadband: deadband = 0.5 m is out of range; allowed: < stroke"),
+    ("speed", 0.0, "speed = 0.0 is out of range"),
+])
+def test_bad_parameters_are_refused_naming_the_parameter(probe, name, value, message) -> None:
+    from tdcm_ros.nodes.device_twin import DeviceTwinNode
+
+    port = probe.ctx.create_port("bad_twin", overrides={name: value})
+    with pytest.raises(InputError) as caught:
+        DeviceTwinNode(port)
+    assert message in str(caught.value)
+
+
+def test_the_link_never_replaces_a_regular_file(probe, tmp_path) -> None:
+    from tdcm_ros.nodes.device_twin import DeviceTwinNode
+
+    precious = tmp_path / "notes.txt"
+    precious.write_text("keep me")
+    port = probe.ctx.create_port("careful_twin", overrides={"link": str(precious)})
+    with pytest.raises(InputError, match="exists and is not a symlink"):
+        DeviceTwinNode(port)
+    assert precious.read_text() == "keep me"
+
+
+def test_tdcm_up_twin_runs_tension_to_midline_with_no_hardware(spawn, probe,
+                                                               zenoh_env) -> None:
+    """A setpoint published on the runtime comes back as a `midline` for the measured tension;
+    Ctrl-C stops everything, the driver releasing the tendon before the twin stops."""
+    up = spawn("tdcm_ros.cli.main", "up", "--twin", "--endpoint",
+               zenoh_env["TDCM_ZENOH_ENDPOINT"])
+    link = Path(tempfile.gettempdir()) / f"tdcm_twin_{up.pid}"
+
+    def settled_midline() -> bool:
+        stamps = {stamp_ns(m): m.wrench.force.z for m in probe.tension
+                  if abs(m.wrench.force.z - 8.0) < 0.25}
+        return any(stamp_ns(path) in stamps for path in probe.midlines)
+
+    probe.until(settled_midline, 60.0, "a midline for a tension near 8 N",
+                action=lambda: probe.setpoint(8.0))
+    assert link.is_symlink()
+    tensions = {stamp_ns(m): m.wrench.force.z for m in probe.tension}
+    path = next(p for p in reversed(probe.midlines) if stamp_ns(p) in tensions
+                and abs(tensions[stamp_ns(p)] - 8.0) < 0.25)
+    expected = solve(preset("paper-experiment"), tensions[stamp_ns(path)]).tip_position
+    tip = path.poses[-1].pose.position
+    assert np.allclose([tip.x, tip.y, tip.z], expected, atol=1e-9)
+    assert path.header.frame_id == "tdcm_base"
+    assert probe.truth and abs(probe.truth[-1].wrench.force.z - 8.0) < 0.3
+
+    assert stop(up, 30.0) == 0
+    assert up.stderr is not None
+    log = up.stderr.read().decode()
+    assert "[/tension_driver]: tendon released, port closed" in log
+    assert "device twin stopped: mode release" in log
+    assert log.index("tendon released") < log.index("device twin stopped")
+    assert not os.path.lexists(link)
