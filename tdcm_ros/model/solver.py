@@ -7,10 +7,11 @@ the vector of cell end moments.
 
 Convergence strategy (``acceleration="auto"``): plain iteration while it contracts fast;
 Anderson mixing once it slows; if that fails, damped relaxation; if that fails, load
-continuation (tension ramped in ``continuation_steps`` warm-started steps). Failure after all
-of them raises :class:`ConvergenceError`. Physical limits are checked explicitly: the
-tendon-offset singularity before iterating and again on the solution, notch closure on the
-solution.
+continuation (tension ramped in ``continuation_steps`` warm-started steps). Under a
+loading: Anderson (a quarter of ``max_iter``), then adaptive continuation, then relaxation.
+Failure after all of them raises :class:`ConvergenceError`. Physical limits are checked
+explicitly: the tendon-offset singularity before iterating and again on the solution, notch
+closure on the solution.
 
 A :class:`~tdcm_ros.model.loading.Loading` adds a tension varying along ``s``, external loads
 and notch contact (see :mod:`tdcm_ros.model.loading`); the same strategies drive it, and
@@ -21,6 +22,7 @@ notch contact is on.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -93,10 +95,7 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     model = _loaded_model(grid, settings, t_base, loading)
     if model is None:
         check_tendon_singularity(grid, t_base)
-        problem = _Problem(grid, settings, _moment_map(grid, settings), partial(_shape, grid))
-    else:
-        problem = _Problem(grid, settings, model.moments,
-                           lambda x: _shape(grid, model.bend_moments(x)))
+    problem = _problem(grid, settings, model)
     x0 = _initial_guess(grid, settings, t_base, warm_start, loaded=model is not None)
 
     runs: list[tuple[str, _Run]] = []
@@ -148,6 +147,14 @@ def _loaded_model(grid: Grid, settings: SolverSettings, tension: float,
     return LoadedModel(grid, loading, tension)
 
 
+def _problem(grid: Grid, settings: SolverSettings, model: LoadedModel | None) -> _Problem:
+    """The fixed-point problem of the paper's model (``model`` None) or of a loading."""
+    if model is None:
+        return _Problem(grid, settings, _moment_map(grid, settings), partial(_shape, grid))
+    return _Problem(grid, settings, model.moments,
+                    lambda x: _shape(grid, model.bend_moments(x)))
+
+
 def _shape(grid: Grid, x: Array) -> PlanarShape:
     """Shape integrated from the stacked cell end moments ``[m_a, m_b]``."""
     n = grid.n_cells
@@ -187,24 +194,24 @@ def _strategies(settings: SolverSettings, *, loaded: bool) -> list[tuple[str, St
     """Strategies to try in order for ``settings.acceleration``, each with its iteration cap.
 
     Under a loading the moment depends on the shape everywhere, so plain iteration gains
-    nothing over Anderson, which starts at once; Anderson and relaxation get a quarter of
-    ``max_iter`` each, leaving the rest to continuation (whose steps adapt: a failing step is
-    halved).
+    nothing over Anderson, which starts at once with a quarter of ``max_iter``; continuation
+    (adaptive steps) comes next and relaxation last, which on a scan of hard loadings rescued
+    more solves than the base order (relaxation before continuation).
     """
     budget = settings.max_iter
-    if settings.acceleration == "auto":
-        if loaded:
-            out: list[tuple[str, Strategy, int]] = [
-                ("anderson", partial(_iterate, mode="anderson"), max(budget // 4, 1)),
-                ("relaxation", partial(_iterate, mode="relaxation"), max(budget // 4, 1))]
-        else:
-            out = [("picard+anderson", partial(_iterate, mode="auto"), budget),
-                   ("relaxation", partial(_iterate, mode="relaxation"), budget)]
-        if settings.continuation_steps > 0:
-            out.append(("continuation", partial(_continuation, adaptive=loaded), budget))
-        return out
-    mode = "picard" if settings.acceleration == "none" else settings.acceleration
-    return [(settings.acceleration, partial(_iterate, mode=mode), budget)]
+    if settings.acceleration != "auto":
+        mode = "picard" if settings.acceleration == "none" else settings.acceleration
+        return [(settings.acceleration, partial(_iterate, mode=mode), budget)]
+    relaxation: tuple[str, Strategy, int] = (
+        "relaxation", partial(_iterate, mode="relaxation"), budget)
+    continuation: list[tuple[str, Strategy, int]] = []
+    if settings.continuation_steps > 0:
+        continuation.append(("continuation", partial(_continuation, adaptive=loaded), budget))
+    if loaded:
+        return [("anderson", partial(_iterate, mode="anderson"), max(budget // 4, 1)),
+                *continuation, relaxation]
+    return [("picard+anderson", partial(_iterate, mode="auto"), budget), relaxation,
+            *continuation]
 
 
 def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
@@ -237,7 +244,9 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
     """Continuation on the load factor ``lam`` in [0, 1] (tension and external loads together):
     steps start at ``1/continuation_steps``; a step that fails is retried from the last solution
     at half the size (down to ``2**-CONTINUATION_HALVINGS`` of it) and a step that succeeds
-    lets the next one double back. Each step is predicted by scaling the last solution."""
+    lets the next one double back. Each step is predicted by scaling the last solution and
+    solved to the loose tolerance ``sqrt(tol * L)`` (it only seeds the next one); the last
+    step to ``tol``."""
     largest = 1.0 / problem.settings.continuation_steps
     smallest = largest / 2**CONTINUATION_HALVINGS
     step = largest
@@ -245,12 +254,14 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
     x = np.zeros_like(x0)
     history: list[float] = []
     run = _Run(x, problem.shape_of(x), history, False, "no steps")
+    tol = problem.settings.tol
+    loose = max(tol, math.sqrt(tol * problem.grid.design.length))
     while lam < 1.0:
         target = 1.0 if lam + step >= 1.0 - 1e-12 else lam + step
         guess = x * (target / lam) if lam > 0.0 else np.full_like(
             x0, problem.grid.design.R_c * tension * target)
         run = _iterate(problem, tension * target, guess, budget - len(history),
-                       mode="anderson", factor=target)
+                       mode="anderson", factor=target, tol=tol if target == 1.0 else loose)
         history.extend(run.history)
         if run.converged:
             lam, x = target, run.x
@@ -264,10 +275,11 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
 
 
 def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode: str,
-             factor: float = 1.0) -> _Run:
+             factor: float = 1.0, tol: float | None = None) -> _Run:
     """Fixed-point iteration on the cell moments; ``mode`` picks the update rule. ``factor``
-    scales the external loads (continuation)."""
+    scales the external loads (continuation); ``tol`` (m) defaults to ``settings.tol``."""
     grid, settings = problem.grid, problem.settings
+    tol = settings.tol if tol is None else tol
     moment_map, shape_of = problem.moments, problem.shape_of
     x = x0
     shape = shape_of(x)
@@ -293,7 +305,7 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
             return _Run(x, shape, history, False, "iterate became non-finite")
         history.append(step)
         x, shape = x_new, new_shape
-        if step <= settings.tol:
+        if step <= tol:
             return _Run(x, shape, history, True, "converged")
         if step > 2.0 * length or (len(history) > 5 and step > DIVERGENCE_GROWTH * min(history)):
             return _Run(x, shape, history, False, f"diverging (step {step:.3g} m)")

@@ -11,6 +11,8 @@ from scipy.integrate import quad
 from tdcm_ros.errors import InputError
 from tdcm_ros.model import (
     PRESETS,
+    ConvergenceError,
+    ModelLimitError,
     NotchClosureError,
     SolverSettings,
     preset,
@@ -21,10 +23,12 @@ from tdcm_ros.model.limits import closure_angle
 from tdcm_ros.model.loading import (
     Capstan,
     InvalidLoadingError,
+    LoadedModel,
     Loading,
     NotchContact,
 )
 from tdcm_ros.model.section import notched_area, notched_moment, tube_area
+from tdcm_ros.model.solver import _continuation, _problem
 
 RHO_G = 1010.0 * 9.81  # N/m^3, Nylon 12 under 1 g
 TIGHT = SolverSettings(tol=1e-14, max_iter=400)
@@ -366,3 +370,64 @@ def test_warm_start_under_a_loading():
     warm = solve(design, 12.0, loading=loading, warm_start=first)
     assert np.max(np.abs(warm.positions - cold.positions)) <= 1e-9
     assert warm.iterations <= cold.iterations
+
+
+MIXED = Loading(tension_profile=Capstan(0.3), tip_force=(0.5, -0.5), tip_moment=-1e-3,
+                body_force_density=(-50 * RHO_G, 0.0))
+
+
+@pytest.mark.parametrize("acceleration", ["anderson", "relaxation", "none"])
+def test_every_strategy_reaches_the_same_loaded_solution(acceleration):
+    design = preset("paper-experiment")
+    reference = solve(design, 12.0, loading=MIXED)
+    assert reference.strategy == "anderson"
+    other = solve(design, 12.0, settings=SolverSettings(acceleration=acceleration, max_iter=2000),
+                  loading=MIXED)
+    assert np.max(np.abs(other.positions - reference.positions)) <= 1e-9
+
+
+@pytest.mark.parametrize("contact", [None, NotchContact()])
+def test_continuation_ramps_the_external_loads_with_the_tension(contact):
+    design = closing_design()
+    loading = Loading(tension_profile=Capstan(0.3), tip_force=(4.0, 0.0),
+                      body_force_density=(0.0, -50 * RHO_G), notch_contact=contact)
+    cfg = SolverSettings(routing="free")
+    reference = solve(design, 5.0, settings=cfg, loading=loading)
+    grid = reference.grid
+    seen: list[float] = []
+    model = LoadedModel(grid, loading, 5.0)
+    moments = model.moments
+
+    def spy(shape, x, level, factor):
+        seen.append(factor)
+        # Loads and tension ramp together: the tension level is the same fraction of 5 N.
+        assert level == pytest.approx(5.0 * factor, rel=1e-12)
+        return moments(shape, x, level, factor)
+
+    model.moments = spy  # type: ignore[method-assign]
+    run = _continuation(_problem(grid, cfg, model), 5.0, np.zeros(2 * grid.n_cells), 400,
+                        adaptive=True)
+    assert run.converged
+    assert min(seen) < 0.2 and max(seen) == 1.0
+    shape = run.shape
+    assert np.max(np.abs(shape.p.imag - reference.positions[:, 0])) <= 1e-9
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(tension=st.floats(0.0, 60.0), fx=st.floats(-40.0, 40.0), fz=st.floats(-40.0, 40.0),
+       gx=st.floats(-1e6, 1e6), mu=st.floats(0.0, 1.0), contact=st.booleans(),
+       routing=st.sampled_from(["paper", "free"]))
+def test_any_loading_converges_or_raises_a_typed_error(tension, fx, fz, gx, mu, contact, routing):
+    design = preset("paper-experiment").with_overrides(E=0.5e9)
+    loading = Loading(tension_profile=Capstan(mu), tip_force=(fx, fz),
+                      body_force_density=(gx, 0.0),
+                      notch_contact=NotchContact() if contact else None)
+    try:
+        result = solve(design, tension, settings=SolverSettings(routing=routing), loading=loading)
+    except ConvergenceError as error:
+        assert error.result is None or np.all(np.isfinite(error.result.positions))
+        return
+    except ModelLimitError:
+        return
+    assert result.converged
+    assert np.all(np.isfinite(result.positions)) and np.all(np.isfinite(result.cell_moments))
