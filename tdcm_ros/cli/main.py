@@ -23,6 +23,7 @@ SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.param",
     "tdcm_ros.cli.bench",
     "tdcm_ros.cli.figures",
+    "tdcm_ros.cli.evaluate",
     "tdcm_ros.cli.scene",
 )
 

@@ -1,0 +1,75 @@
+"""Write a simulated :class:`~tdcm_ros.metrics.synthetic.Recording` as a rosbag2 MCAP bag with the
+contract topics: ``/tension`` (WrenchStamped, force.z), ``/markers`` (mocap4r2_msgs/Markers in
+``mocap``, occluded markers omitted) and, optionally, ``/tf_static`` (``mocap`` -> ``tdcm_base``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tdcm_ros.bagio import msg_class, serialize
+from tdcm_ros.bagio.writer import BagWriter, OfferedQos
+from tdcm_ros.metrics.synthetic import Recording
+
+EPOCH_NS = 1_700_000_000 * 1_000_000_000
+"""Stamp (ns) of ``t = 0`` of a recording."""
+
+
+def _header(stamp_ns: int, frame_id: str) -> object:
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    return msg_class("std_msgs/msg/Header")(
+        stamp=msg_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec),
+        frame_id=frame_id)
+
+
+def write_recording(recording: Recording, path: str | Path, *, tf_static: bool = True,
+                    tension_topic: str = "tension", markers_topic: str = "markers") -> Path:
+    """Write ``recording`` to the new bag folder ``path``; returns ``path``."""
+    vector = msg_class("geometry_msgs/msg/Vector3")
+    wrench, stamped = msg_class("geometry_msgs/msg/Wrench"), msg_class(
+        "geometry_msgs/msg/WrenchStamped")
+    marker, markers = msg_class("mocap4r2_msgs/msg/Marker"), msg_class("mocap4r2_msgs/msg/Markers")
+    point = msg_class("geometry_msgs/msg/Point")
+    zero = vector(x=0.0, y=0.0, z=0.0)
+    with BagWriter(path) as bag:
+        bag.add_topic(tension_topic, "geometry_msgs/msg/WrenchStamped")
+        bag.add_topic(markers_topic, "mocap4r2_msgs/msg/Markers")
+        messages: list[tuple[int, str, bytes]] = []
+        if tf_static:
+            bag.add_topic("/tf_static", "tf2_msgs/msg/TFMessage",
+                          OfferedQos(depth=1, durability="transient_local"))
+            messages.append((EPOCH_NS, "/tf_static", serialize(_tf(recording))))
+        tension = recording.tension
+        for t, value in zip(tension.stamps_s.tolist(), tension.tension_n.tolist(), strict=True):
+            ns = EPOCH_NS + round(t * 1e9)
+            msg = stamped(header=_header(ns, "tdcm_tendon"),
+                          wrench=wrench(force=vector(x=0.0, y=0.0, z=value), torque=zero))
+            messages.append((ns, tension_topic, serialize(msg)))
+        frames = recording.markers
+        labels = frames.labels
+        for n, (t, rows) in enumerate(zip(frames.stamps_s.tolist(), frames.positions,
+                                          strict=True)):
+            ns = EPOCH_NS + round(t * 1e9)
+            items = [marker(id_type=0, marker_index=i, marker_name=labels[i],
+                            translation=point(x=row[0], y=row[1], z=row[2]))
+                     for i, row in enumerate(rows.tolist()) if not np.isnan(row[0])]
+            msg = markers(header=_header(ns, frames.frame_id), frame_number=n, markers=items)
+            messages.append((ns, markers_topic, serialize(msg)))
+        messages.sort(key=lambda m: m[0])
+        for ns, topic, data in messages:
+            bag.write(topic, ns, data)
+    return Path(path)
+
+
+def _tf(recording: Recording) -> object:
+    reg = recording.registration
+    tx, ty, tz = reg.translation
+    qx, qy, qz, qw = reg.quaternion
+    transform = msg_class("geometry_msgs/msg/TransformStamped")(
+        header=_header(EPOCH_NS, "mocap"), child_frame_id="tdcm_base",
+        transform=msg_class("geometry_msgs/msg/Transform")(
+            translation=msg_class("geometry_msgs/msg/Vector3")(x=tx, y=ty, z=tz),
+            rotation=msg_class("geometry_msgs/msg/Quaternion")(x=qx, y=qy, z=qz, w=qw)))
+    return msg_class("tf2_msgs/msg/TFMessage")(transforms=[transform])
