@@ -122,3 +122,45 @@ def test_tdcm_up_twin_runs_tension_to_midline_with_no_hardware(spawn, probe,
     assert "device twin stopped: mode release" in log
     assert log.index("tendon released") < log.index("device twin stopped")
     assert not os.path.lexists(link)
+
+
+def up_args(*argv: str):
+    import argparse
+
+    from tdcm_ros.cli.up import register
+
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers())
+    return parser.parse_args(["up", *argv])
+
+
+def test_up_plan_wires_the_driver_to_a_per_run_twin_link() -> None:
+    from tdcm_ros.cli.up import plan
+
+    nodes, overrides, ready = plan(up_args("--twin", "--schedule", "--nodes",
+                                           "model_node,tension_driver"), 4242)
+    assert nodes == ["device_twin", "tension_driver", "model_node"]
+    link = overrides["device_twin"]["link"]
+    assert link.endswith("tdcm_twin_4242") and overrides["tension_driver"]["port"] == link
+    assert overrides["tension_driver"]["schedule.autostart"] is True
+    assert ready == {"device_twin": link}
+    assert plan(up_args(), 1) == (["model_node"], {}, {})
+    with pytest.raises(InputError, match="--scene .* needs --twin"):
+        plan(up_args("--scene", "paper_experiment"), 1)
+    with pytest.raises(InputError, match="--schedule needs tension_driver"):
+        plan(up_args("--schedule"), 1)
+
+
+def test_merged_parameter_file_keeps_the_users_values_under_the_overrides(tmp_path) -> None:
+    from tdcm_ros.runtime.launcher import merged_params
+    from tdcm_ros.runtime.params import node_parameters
+
+    user = tmp_path / "user.yaml"
+    user.write_text(yaml.safe_dump({
+        "/**": {"ros__parameters": {"frame_id": "from_wildcard"}},
+        "tension_driver": {"ros__parameters": {"tension_max": 12.0, "port": "/dev/ttyUSB0",
+                                               "schedule": {"hold_s": 2.0}}}}))
+    written = merged_params(tmp_path, "tension_driver", str(user), {"port": "/tmp/x"})
+    assert node_parameters(written, "/tension_driver") == {
+        "frame_id": "from_wildcard", "tension_max": 12.0, "port": "/tmp/x",
+        "schedule.hold_s": 2.0}

@@ -96,6 +96,18 @@ def test_setpoint_above_the_maximum_is_clamped_with_a_warning(spawn, probe, twin
     assert "clamped to [0, 12] N" in warned.message
     probe.until(lambda: abs(twin.twin.plant.tension - 12.0) < BAND, 15.0, "12 N on the tendon")
     assert twin.twin.core.setpoint_mn == 12000
+
+    from tdcm_ros.runtime.zenoh_runtime import call_parameters
+
+    def set_param(name: str, value: Any) -> dict[str, Any]:
+        return call_parameters(probe.ctx.session, 0, "/tension_driver", "set",
+                               {"name": name, "value": value})
+
+    assert set_param("tension_max", 10.0)["successful"]  # a lower maximum re-clamps the target
+    probe.until(lambda: probe.state().get("target") == "10.000", 10.0, "target re-clamped")
+    refused = set_param("tension_max", 25.0)
+    assert not refused["successful"] and "tension_max" in refused["reason"]
+    assert not set_param("port", "/dev/null")["successful"]  # read-only
     log = stderr_of(node)
     assert "setpoint = 35 N is out of range [0, 12] N; clamped to 12 N" in log
 
