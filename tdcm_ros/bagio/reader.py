@@ -136,7 +136,8 @@ class _McapSource:
         except (*_DAMAGE, OSError):  # no footer, bad footer or summary: the linear scan decides
             return None
         if summary is None or summary.statistics is None or (
-                summary.statistics.message_count and not summary.chunk_indexes):
+                summary.statistics.message_count and not summary.chunk_indexes) or any(
+                c not in summary.channels for c in summary.statistics.channel_message_counts):
             return None
         return summary
 
@@ -235,8 +236,8 @@ class _McapSource:
                     f"{self.path}: truncated after {messages} messages (last complete chunk); "
                     f"the rest of the file is unreadable: {_describe(error)}")
                 return
-        self.warnings.append(f"{self.path}: no MCAP summary/footer; all {messages} messages "
-                             f"of the data section were read")
+        self.warnings.append(f"{self.path}: no usable MCAP summary; all {messages} messages of "
+                             f"the data section were read")
 
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
         """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""

@@ -12,6 +12,8 @@ import yaml
 from mcap.reader import SeekingReader
 from mcap.writer import Writer
 from rosbags.rosbag2 import Reader as RosbagsReader
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as RosbagsWriter
 
 from tdcm_ros.bagio import BagError, from_dict, serialize, to_dict, type_hash, typestore
 from tdcm_ros.bagio.reader import open_bag, require_topic
@@ -145,6 +147,21 @@ def test_uncompressed_unchunked_mcap_without_summary(tmp_path: Path) -> None:
         writer.finish()
     reader = open_bag(path)
     assert [m.data for _, _, m in reader.messages()] == [0.0, 1.0, 2.0, 3.0, 4.0]
+
+
+def test_sqlite3_rosbag2_folder(tmp_path: Path) -> None:
+    """A sqlite3 (db3) bag written by rosbags is read with its topics in log-time order."""
+    expected = _expected()
+    with RosbagsWriter(tmp_path / "db", version=9,
+                       storage_plugin=StoragePlugin.SQLITE3) as writer:
+        connections = {}
+        for topic, stamp, msgtype, message in expected:
+            if topic not in connections:
+                connections[topic] = writer.add_connection(topic, msgtype, typestore=typestore())
+            writer.write(connections[topic], stamp, serialize(message, msgtype))
+    reader = open_bag(tmp_path / "db")
+    assert reader.topics["/markers"] == "mocap4r2_msgs/msg/Markers"
+    assert _as_plain(list(reader.messages())) == [(t, s, to_dict(m)) for t, s, _, m in expected]
 
 
 def _reading_cdr(sec: int, nanosec: int, value: float, text: str, ident: int) -> bytes:

@@ -9,8 +9,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import SeekingReader
+from mcap.writer import Writer
 
-from tdcm_ros.bagio import BagError, from_dict, serialize, to_dict
+from tdcm_ros.bagio import BagError, from_dict, serialize, to_dict, typestore
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.bagio.writer import BagWriter
 
@@ -33,7 +34,7 @@ def _messages() -> list[tuple[str, int, str, object]]:
 
 @pytest.fixture(scope="module")
 def bag_bytes() -> dict[str, tuple[bytes, list[tuple[str, int, object]]]]:
-    """Bytes of one bag per compression (small chunks), with the expected messages."""
+    """Bytes of one bag per compression (small chunks) and an unchunked one, with the messages."""
     expected = _messages()
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -45,12 +46,30 @@ def bag_bytes() -> dict[str, tuple[bytes, list[tuple[str, int, object]]]]:
                     writer.write(topic, stamp, serialize(message, msgtype))
             out[compression] = ((path / f"{compression}_0.mcap").read_bytes(),
                                 [(t, s, to_dict(m)) for t, s, _, m in expected])
+        out["unchunked"] = (_unchunked(Path(tmp) / "unchunked.mcap", expected),
+                            out["none"][1])
     return out
+
+
+def _unchunked(path: Path, expected: list[tuple[str, int, str, object]]) -> bytes:
+    """An MCAP of loose message records (no chunks, no summary repeats of channels)."""
+    with path.open("wb") as stream:
+        writer = Writer(stream, use_chunking=False, repeat_channels=False, repeat_schemas=False)
+        writer.start(profile="ros2", library="test")
+        channels: dict[str, int] = {}
+        for topic, stamp, msgtype, message in expected:
+            if topic not in channels:
+                definition = typestore().generate_msgdef(msgtype, ros_version=2)[0]
+                schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
+                channels[topic] = writer.register_channel(topic, "cdr", schema)
+            writer.add_message(channels[topic], stamp, serialize(message, msgtype), stamp)
+        writer.finish()
+    return path.read_bytes()
 
 
 @settings(max_examples=120, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(compression=st.sampled_from(["zstd", "lz4", "none"]), fraction=st.floats(0.0, 1.0))
+@given(compression=st.sampled_from(["zstd", "lz4", "none", "unchunked"]), fraction=st.floats(0.0, 1.0))
 def test_cut_file_gives_an_intact_prefix_or_bag_error(
         bag_bytes: dict[str, tuple[bytes, list[tuple[str, int, object]]]], tmp_path: Path,
         compression: str, fraction: float) -> None:
@@ -67,7 +86,7 @@ def test_cut_file_gives_an_intact_prefix_or_bag_error(
     assert reader.message_count == len(got)
     if cut < len(data):
         assert len(got) < len(expected) or reader.warnings
-        assert any("truncated" in w or "footer" in w for w in reader.warnings)
+        assert any("truncated" in w or "summary" in w for w in reader.warnings)
 
 
 def test_every_complete_chunk_survives(
