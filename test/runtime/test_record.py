@@ -170,3 +170,36 @@ def test_bag_info_lists_topics(tmp_path: Path, capsys: pytest.CaptureFixture[str
         writer.write("/x", 1, serialize(from_dict("std_msgs/msg/Float64", {"data": 1.0})))
     assert main(["bag", "info", str(tmp_path / "bag")]) == 0
     assert "  /x [std_msgs/msg/Float64]: 1" in capsys.readouterr().out.splitlines()
+
+
+def test_recorder_in_process_stops_at_max_messages(router: subprocess.Popen[bytes],
+                                                   tmp_path: Path) -> None:
+    """The Recorder class: named topic (short name), max_messages, a topic that never appears."""
+    from tdcm_ros.recording import Recorder
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    context = ZenohContext()
+    publisher = context.create_port("counter").create_publisher("/count", "std_msgs/msg/Float64")
+    stop = threading.Event()
+
+    def publish() -> None:
+        n = 0
+        while not stop.is_set():
+            n += 1
+            publisher.publish(from_dict("std_msgs/msg/Float64", {"data": float(n)}))
+            time.sleep(0.005)
+
+    thread = threading.Thread(target=publish, daemon=True)
+    thread.start()
+    try:
+        recorder = Recorder(BagWriter(tmp_path / "bag"), ["count", "/absent"], max_messages=20)
+        recorder.run(duration_s=30.0)
+        assert recorder.stopping and recorder.total == 20
+        recorder.close()
+    finally:
+        stop.set()
+        thread.join()
+        context.close()
+    assert recorder.missing == ["/absent"]
+    values = [m.data for _, _, m in open_bag(tmp_path / "bag").messages()]
+    assert len(values) == 20 and values == [values[0] + i for i in range(20)]
