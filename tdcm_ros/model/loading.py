@@ -21,7 +21,7 @@ the moment of the external loads on the body beyond each cut, in frame ``tdcm_ba
 - **Tip force and moment** act at the tip midline ``p(L)``.
 - **Body force density** ``f`` (N/m^3, e.g. ``rho g``) acts on the section area ``A(s)``
   (:func:`tdcm_ros.model.section.notched_area`) at the cells' Gauss points, placed on each
-  cell's mean-curvature arc. Inside a cell the moment is linear between its end values, as for
+  cell's mean-curvature arc (to 4th order in the cell's bend angle). Inside a cell the moment is linear between its end values, as for
   the tendon (the quadratic part of a distributed load is a discretisation error that
   shrinks with the cell length).
 - **Notch contact** (:class:`NotchContact`): once a notch's bend angle passes its closure angle
@@ -172,12 +172,12 @@ def _pair(name: str, value: Any, unit: str) -> tuple[float, float]:
 
 @dataclass(frozen=True, eq=False)
 class _BodyCells:
-    """Per-grid constants of the body force: ``A ds`` weights at the Gauss points (m^2 m),
-    their sum per cell and the points' distance from the cell start (m)."""
+    """Per-grid constants of the body force: per cell, the moments ``S_j = sum w A sigma^j``
+    (m^(3+j)) of the ``A ds`` weights at the Gauss points about the cell start (``S_0`` is the
+    cell's volume), and ``1 / length`` (1/m)."""
 
-    weights: Array
-    mass: Array
-    sigma: Array
+    moments: Array
+    inverse_length: Array
 
 
 @lru_cache(maxsize=64)
@@ -189,8 +189,9 @@ def _body_cells(grid: Grid) -> _BodyCells:
     area = np.where(grid.is_notch[:, None], notched_area(h1, d.R_outer, d.r_inner),
                     tube_area(d.R_outer, d.r_inner))
     weights = grid.w_q * area
-    return _BodyCells(weights=weights, mass=np.sum(weights, axis=1),
-                      sigma=grid.s_q - grid.s_nodes[:-1, None])
+    sigma = grid.s_q - grid.s_nodes[:-1, None]
+    moments = np.stack([np.sum(weights * sigma**j, axis=1) for j in range(5)])
+    return _BodyCells(moments=moments, inverse_length=1.0 / grid.length)
 
 
 @dataclass(frozen=True, eq=False)
@@ -309,13 +310,19 @@ class LoadedModel:
             out += factor * (np.conj(p[-1] - p) * tip).imag
         cells = self._body_cells
         if cells is not None:
-            mean_k = np.diff(shape.theta) / self.grid.length
-            along, across = loads.arc_offsets(mean_k[:, None], cells.sigma)
-            local = np.sum(cells.weights * (along + 1j * across), axis=1)
-            first = cells.mass * p[:-1] + shape.tangent[:-1] * local
-            beyond_first = np.append(np.cumsum(first[::-1])[::-1], 0.0)
-            beyond_mass = np.append(np.cumsum(cells.mass[::-1])[::-1], 0.0)
-            out += factor * (np.conj(beyond_first - beyond_mass * p) * body).imag
+            # Each cell's first moment of A ds about its start, its points placed on the
+            # cell's mean-curvature arc: along = sin(k s)/k, across = (1 - cos(k s))/k,
+            # to 4th order in the cell's bend angle k s.
+            s0, s1, s2, s3, s4 = cells.moments
+            k = np.diff(shape.theta) * cells.inverse_length
+            k2 = k * k
+            local = (s1 - k2 * s3 / 6.0) + 1j * k * (0.5 * s2 - k2 * s4 / 24.0)
+            first = s0 * p[:-1] + shape.tangent[:-1] * local
+            beyond_first = np.zeros_like(p)
+            beyond_first[:-1] = np.cumsum(first[::-1])[::-1]
+            beyond_volume = np.zeros(p.shape)
+            beyond_volume[:-1] = np.cumsum(s0[::-1])[::-1]
+            out += factor * (np.conj(beyond_first - beyond_volume * p) * body).imag
         return out
 
 

@@ -1,0 +1,78 @@
+"""Loading benchmark (issue 7): cost per solve of each loading kind and its iterations.
+
+Run: ``python bench/bench_loading.py [--repeats 500]``. Solves ``paper-experiment`` at 20 N with
+default settings under: no loading, a capstan tension profile, a tip force, gravity (body
+force) and notch contact, then all together; prints the median and p90 time per solve, the
+iterations, the strategy and the tip's move against no loading. A last row solves a softer
+rectangular-notch design where contact is active (its notches close at 40 N).
+Single-threaded: BLAS threads are pinned to one before NumPy loads.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np
+
+from tdcm_ros.model import Capstan, Loading, NotchContact, preset, solve
+
+GRAVITY = (-1010.0 * 9.81, 0.0)  # N/m^3: Nylon 12 with gravity along -x (base frame)
+KINDS: dict[str, Loading | None] = {
+    "none": None,
+    "tension profile": Loading(tension_profile=Capstan(0.1)),
+    "tip force": Loading(tip_force=(0.2, 0.0)),
+    "body force": Loading(body_force_density=GRAVITY),
+    "contact": Loading(notch_contact=NotchContact()),
+    "all": Loading(tension_profile=Capstan(0.1), tip_force=(0.2, 0.0),
+                   body_force_density=GRAVITY, notch_contact=NotchContact()),
+}
+
+
+def time_solves(design, tension: float, loading: Loading | None, repeats: int) -> np.ndarray:
+    """Wall time (s) of ``repeats`` solves (warm grid and closure-angle caches)."""
+    solve(design, tension, loading=loading)
+    times = np.empty(repeats)
+    for k in range(repeats):
+        start = time.perf_counter()
+        solve(design, tension, loading=loading)
+        times[k] = time.perf_counter() - start
+    return times
+
+
+def row(label: str, design, tension: float, loading: Loading | None, repeats: int,
+        base_tip: np.ndarray) -> None:
+    result = solve(design, tension, loading=loading)
+    times = time_solves(design, tension, loading, repeats)
+    move = np.linalg.norm(result.tip_position - base_tip) * 1e6
+    print(f"  {label:24s} {np.median(times) * 1e6:8.1f} {np.percentile(times, 90) * 1e6:8.1f}"
+          f" {result.iterations:5d}  {result.strategy:13s} {move:10.2f}"
+          f"  {len(result.closed_notches)}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=500)
+    args = parser.parse_args()
+    design = preset("paper-experiment")
+    base_tip = solve(design, 20.0).tip_position
+    print("paper-experiment, T = 20 N, default settings")
+    print(f"  {'loading':24s} {'median':>8s} {'p90':>8s} {'iter':>5s}  {'strategy':13s} "
+          f"{'tip move':>10s}  closed")
+    print(f"  {'':24s} {'us':>8s} {'us':>8s} {'':5s}  {'':13s} {'um':>10s}")
+    for name, loading in KINDS.items():
+        row(name, design, 20.0, loading, args.repeats, base_tip)
+    soft = design.with_overrides(profile="rectangular", E=0.3e9)
+    soft_tip = solve(soft, 20.0).tip_position
+    print("rectangular notches, E = 0.3 GPa (closure at ~34 N without contact)")
+    row("none, 20 N", soft, 20.0, None, args.repeats, soft_tip)
+    row("contact, 40 N (closed)", soft, 40.0, Loading(notch_contact=NotchContact()),
+        args.repeats, soft_tip)
+
+
+if __name__ == "__main__":
+    main()
