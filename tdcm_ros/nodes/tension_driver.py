@@ -219,7 +219,9 @@ class TensionDriverNode(NodeLogic):
             self.last_warning = str(error)
             self.port.logger.error("%s", error)
             return
-        self.status = result.status
+        previous, self.status = self.status, result.status
+        if previous is None or previous.link is not result.status.link:
+            self._log_link(result.status)
         if result.telemetry:
             self._publish_tension(result.telemetry)
         connected = result.status.link is LinkState.CONNECTED
@@ -228,6 +230,14 @@ class TensionDriverNode(NodeLogic):
         elif self.schedule_state == "running" and not self.driver.schedule_running:
             self.schedule_state = "done"
             self.port.logger.info("schedule done")
+
+    def _log_link(self, status: DriverStatus) -> None:
+        if status.link is LinkState.CONNECTED and status.banner is not None:
+            self.port.logger.info("link connected: firmware %s, load cell %s, watchdog %g s",
+                                  status.banner.firmware, status.banner.cell,
+                                  status.banner.watchdog)
+        elif status.link is LinkState.DISCONNECTED:
+            self.port.logger.warning("link down: %s", status.message)
 
     def _publish_tension(self, frames: tuple[Telemetry, ...]) -> None:
         now = self.port.now_ns()
