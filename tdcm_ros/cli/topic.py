@@ -58,18 +58,52 @@ def _context() -> Any:
     return ZenohContext()
 
 
-def run_list(args: argparse.Namespace) -> int:
-    """Print topic names (``-t``: with types) known from liveliness tokens."""
-    from tdcm_ros.runtime.zenoh_runtime import graph_tokens
+def graph_topics(timeout: float) -> dict[str, set[str]]:
+    """Topic -> message types of the publishers and subscriptions seen within ``timeout`` s.
+
+    A liveliness subscriber with history collects the tokens (present ones and those that show
+    up while waiting); a one-shot liveliness query right after the session opens can come back
+    empty.
+    """
+    import zenoh
+
+    from tdcm_ros.runtime import wire
+    from tdcm_ros.runtime.errors import RuntimePortError
 
     context = _context()
+    alive: set[str] = set()
+
+    def seen(sample: zenoh.Sample) -> None:
+        key = str(sample.key_expr)
+        if sample.kind == zenoh.SampleKind.DELETE:
+            alive.discard(key)
+        else:
+            alive.add(key)
+
     try:
-        topics: dict[str, set[str]] = {}
-        for token in graph_tokens(context.session, context.domain_id, args.timeout):
-            if token.kind in ("MP", "MS"):
-                topics.setdefault(token.topic, set()).add(token.type_name)
+        subscriber = context.session.liveliness().declare_subscriber(
+            f"{wire.ADMIN_SPACE}/{context.domain_id}/**", seen, history=True)
+        time.sleep(timeout)
+        subscriber.undeclare()
     finally:
         context.close()
+    topics: dict[str, set[str]] = {}
+    for key in sorted(alive):
+        try:
+            token = wire.parse_token(key)
+        except (RuntimePortError, ValueError):
+            continue
+        if token.kind in (wire.PUBLISHER, wire.SUBSCRIPTION):
+            topics.setdefault(token.topic, set()).add(token.type_name)
+    return topics
+
+
+def run_list(args: argparse.Namespace) -> int:
+    """Print topic names (``-t``: with types) known from liveliness tokens."""
+    if not args.timeout > 0:
+        raise InputError(f"--timeout = {args.timeout} s must be > 0", parameter="timeout",
+                         value=args.timeout, allowed="> 0 s")
+    topics = graph_topics(args.timeout)
     for topic in sorted(topics):
         print(f"{topic} [{', '.join(sorted(topics[topic]))}]" if args.show_types else topic)
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import subprocess
+import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -48,3 +49,54 @@ def test_echo_prints_exactly_the_requested_number_of_a_burst(port, spawn: Spawn,
     # Keep-last history may skip samples of the burst, never repeat or reorder them.
     indices = [int(doc["data"].removeprefix("burst ")) for doc in docs]
     assert indices == sorted(set(indices))
+
+
+def test_list_shows_publishers_and_subscriptions_with_types(port, spawn: Spawn):
+    port.create_publisher("chatter", "std_msgs/msg/String")
+    port.create_subscription("/ns/wrench", "geometry_msgs/msg/WrenchStamped", lambda _: None)
+    listing = spawn("tdcm_ros.cli.main", "topic", "list", "-t", "--timeout", "1.5")
+    out, err = listing.communicate(timeout=30)
+    assert listing.returncode == 0, err.decode()
+    lines = out.decode().splitlines()
+    assert "/chatter [std_msgs/msg/String]" in lines
+    assert "/ns/wrench [geometry_msgs/msg/WrenchStamped]" in lines
+    assert lines == sorted(lines)
+
+
+def test_rate_stats_of_known_arrivals():
+    from tdcm_ros.cli.topic import rate_stats
+
+    rate, low, high, std = rate_stats([10.0, 10.1, 10.3, 10.4])
+    assert rate == pytest.approx(3 / 0.4)
+    assert (low, high) == (pytest.approx(0.1), pytest.approx(0.2))
+    assert std == pytest.approx((2 * 0.1**2 / 9) ** 0.5)   # periods 0.1, 0.2, 0.1
+
+
+def test_hz_reports_the_rate_of_a_live_publisher(port, spawn: Spawn):
+    """50 Hz published; the reported rate only has to be in a wide band (loaded CI boxes)."""
+    publisher = port.create_publisher("chatter", "std_msgs/msg/String")
+    hz = spawn("tdcm_ros.cli.main", "topic", "hz", "chatter", "--duration", "3")
+    wait_for(publisher.matched, 15.0, "topic hz to subscribe")
+    message = from_dict("std_msgs/msg/String", {"data": "tick"})
+    start = time.monotonic()
+    k = 0
+    while hz.poll() is None and k < 1000:
+        publisher.publish(message)
+        k += 1
+        time.sleep(max(0.0, start + k / 50.0 - time.monotonic()))
+    out, err = hz.communicate(timeout=20)
+    assert hz.returncode == 0, err.decode()
+    rates = [float(line.split()[-1]) for line in out.decode().splitlines()
+             if line.startswith("average rate:")]
+    assert rates, out.decode()
+    assert 25.0 < rates[-1] < 100.0
+
+
+@pytest.mark.parametrize("argv", [["topic", "list", "--timeout", "0"],
+                                  ["topic", "pub", "tension", "std_msgs/msg/Float64", "--rate", "0"]])
+def test_bad_options_are_one_line_errors(argv, capsys):
+    from tdcm_ros.cli.main import main
+
+    assert main(argv) != 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and argv[-2] in err
