@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any, Protocol
 
@@ -146,7 +146,9 @@ class Loading:
     @property
     def is_trivial(self) -> bool:
         """True when nothing differs from the paper's base model."""
-        return all(getattr(self, f.name) == f.default for f in fields(self))
+        return (self.tension_profile is None and self.notch_contact is None
+                and self.tip_force == (0.0, 0.0) and self.tip_moment == 0.0
+                and self.body_force_density == (0.0, 0.0))
 
     def describe(self) -> dict[str, Any]:
         """A JSON-ready description (the profile by its repr)."""

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -12,6 +12,9 @@ from tdcm_ros.model.design import Design
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import quaternions_y
 from tdcm_ros.model.settings import SolverSettings
+
+if TYPE_CHECKING:
+    from tdcm_ros.model.loading import Loading
 
 Array = NDArray[np.float64]
 
@@ -43,7 +46,7 @@ class SolveResult:
     strategy: str
     solve_time_s: float
     grid: Grid = field(repr=False)
-    loading: Any = None
+    loading: Loading | None = None
     contact_scale: Array | None = field(default=None, repr=False)
     tendon_tension: Array | None = field(default=None, repr=False)
 

@@ -15,6 +15,7 @@ from tdcm_ros.model import (
     ModelLimitError,
     NotchClosureError,
     SolverSettings,
+    TendonSingularityError,
     preset,
     solve,
 )
@@ -431,3 +432,14 @@ def test_any_loading_converges_or_raises_a_typed_error(tension, fx, fz, gx, mu, 
         return
     assert result.converged
     assert np.all(np.isfinite(result.positions)) and np.all(np.isfinite(result.cell_moments))
+
+
+def test_singularity_is_checked_on_the_loaded_solution():
+    design = preset("paper-experiment").with_overrides(E=0.2e9)
+    with pytest.raises(TendonSingularityError):
+        solve(design, 40.0)
+    with pytest.raises(TendonSingularityError):
+        solve(design, 40.0, loading=Loading(tension_profile=constant))
+    # A tip moment opposing the tendon lowers the notch moments below the singular level.
+    relieved = solve(design, 40.0, loading=Loading(tip_moment=-0.6 * design.R_c * 40.0))
+    assert relieved.converged
