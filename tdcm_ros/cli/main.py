@@ -24,6 +24,7 @@ SUBCOMMAND_MODULES: tuple[str, ...] = (
     "tdcm_ros.cli.bench",
     "tdcm_ros.cli.figures",
     "tdcm_ros.cli.evaluate",
+    "tdcm_ros.cli.calibrate",
     "tdcm_ros.cli.scene",
 )
 

@@ -6,6 +6,8 @@
     from tdcm_ros.metrics.options import options_from_sets
     ev = evaluate_paths(["run.mcap"], options_from_sets(["E=0.7e9"]))
     ev.metrics.rmse_m, ev.to_json()
+    cal = calibrate_paths(["run.mcap"], ["E"])
+    cal.parameters[0].value, cal.parameters[0].ci_low, cal.after.metrics
 """
 
 from __future__ import annotations
@@ -16,7 +18,14 @@ from pathlib import Path
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.bagdata import BagSource, load_bag
-from tdcm_ros.metrics.evaluation import Evaluation, combine, evaluate_series
+from tdcm_ros.metrics.calibration import Calibration, calibrate_steps
+from tdcm_ros.metrics.evaluation import (
+    Evaluation,
+    choose_registration,
+    combine,
+    evaluate_steps,
+)
+from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.registration import Registration
 
@@ -40,14 +49,31 @@ def load_paths(paths: Sequence[str | Path], options: EvaluateOptions,
                      markers_topic=names.markers) for p in paths]
 
 
+def prepare(sources: Sequence[BagSource], options: EvaluateOptions,
+            registration: Registration | None = None
+            ) -> list[tuple[list[MeasuredStep], Registration]]:
+    """Measured steps of each bag with the registration it uses: ``registration``, else the
+    bag's ``/tf_static``, else an estimate from its zero-tension and largest-tension steps."""
+    prepared = []
+    for source in sources:
+        steps = measure_steps(source.tension, source.markers, options)
+        prepared.append((steps, choose_registration(
+            steps, options, registration or source.registration)))
+    return prepared
+
+
 def evaluate_sources(sources: Sequence[BagSource], options: EvaluateOptions,
                      registration: Registration | None = None) -> Evaluation:
-    """Evaluate loaded bags; each uses ``registration``, else its ``/tf_static``, else an
-    estimate from its own zero-tension and largest-tension steps."""
+    """Evaluate loaded bags (see :func:`prepare` for the registration)."""
+    return _evaluate(sources, prepare(sources, options, registration), options)
+
+
+def _evaluate(sources: Sequence[BagSource],
+              prepared: Sequence[tuple[list[MeasuredStep], Registration]],
+              options: EvaluateOptions) -> Evaluation:
     parts = []
-    for source in sources:
-        part = evaluate_series(source.tension, source.markers, options,
-                               registration or source.registration)
+    for source, (steps, reg) in zip(sources, prepared, strict=True):
+        part = evaluate_steps(steps, reg, options)
         parts.append(Evaluation(part.records, part.metrics, part.registrations, options,
                                 (*(f"{source.path}: {w}" for w in source.warnings),
                                  *(f"{source.path}: {w}" for w in part.warnings))))
@@ -61,3 +87,20 @@ def evaluate_paths(paths: Sequence[str | Path], options: EvaluateOptions | None 
     ``options.design``; see :class:`~tdcm_ros.metrics.evaluation.Evaluation`."""
     opts = options or EvaluateOptions()
     return evaluate_sources(load_paths(paths, opts, topics), opts, registration)
+
+
+def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
+                    options: EvaluateOptions | None = None, *, topics: Topics | None = None,
+                    registration: Registration | None = None,
+                    confidence: float = 0.95) -> Calibration:
+    """Fit the design fields ``fit`` (start: ``options.design``) to the bags' marker positions
+    by least squares; see :mod:`tdcm_ros.metrics.calibration`."""
+    opts = options or EvaluateOptions()
+    sources = load_paths(paths, opts, topics)
+    prepared = prepare(sources, opts, registration)
+    design, params, corr, condition, rms, count, warnings = calibrate_steps(
+        prepared, fit, opts, confidence=confidence)
+    before = _evaluate(sources, prepared, opts)
+    after = _evaluate(sources, prepared, opts.with_design(design))
+    return Calibration(tuple(params), confidence, corr, condition, rms, count, not warnings,
+                       before, after, tuple(warnings))

@@ -208,9 +208,15 @@ def evaluate_series(tension: TensionSeries, markers: MarkerSeries,
     ``tdcm_base``; ``None`` estimates it from the data (see :func:`choose_registration`)."""
     opts = options or EvaluateOptions()
     steps = measure_steps(tension, markers, opts)
-    reg = choose_registration(steps, opts, registration)
-    records, warnings = score_steps(steps, reg, opts)
-    return Evaluation(tuple(records), metrics_of(records, opts), (reg,), opts, tuple(warnings))
+    return evaluate_steps(steps, choose_registration(steps, opts, registration), opts)
+
+
+def evaluate_steps(steps: Sequence[MeasuredStep], registration: Registration,
+                   options: EvaluateOptions) -> Evaluation:
+    """Evaluate measured steps (markers in the registration's parent frame)."""
+    records, warnings = score_steps(steps, registration, options)
+    return Evaluation(tuple(records), metrics_of(records, options), (registration,), options,
+                      tuple(warnings))
 
 
 def combine(parts: Sequence[Evaluation], sources: Sequence[str]) -> Evaluation:

@@ -1,0 +1,235 @@
+"""Least-squares calibration of design parameters (e.g. Young's modulus) from measured steps.
+
+Residuals: for every step and every marker visible in it, the model's marker point at the
+step's mean tension minus the measured mean position, all three coordinates, in ``tdcm_base``
+(m). ``scipy.optimize.least_squares`` (trust region, bounds from the design field ranges) fits
+the parameters relative to their start values.
+
+Uncertainty: ``cov = s^2 (J^T J)^-1`` at the optimum with ``s^2 = |r|^2 / (m - n)``; the interval
+is ``value +- t_{(1+confidence)/2, m-n} sqrt(cov_ii)``. It assumes independent residuals of
+equal variance and a model that can match the data (systematic misfit widens ``s`` but not
+the bias). A parameter is reported *not identifiable* when ``J^T J`` is near-singular
+(condition number above ``MAX_CONDITION``), when its interval is wider than
+``MAX_RELATIVE_HALF_WIDTH`` of its value, or when two fitted parameters correlate beyond
+``MAX_CORRELATION``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+from scipy.stats import t as student_t
+
+from tdcm_ros.errors import InputError, TdcmError, out_of_range
+from tdcm_ros.metrics.evaluation import Evaluation, model_tension
+from tdcm_ros.metrics.measure import MeasuredStep
+from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.registration import Registration
+from tdcm_ros.model import FIELD_SPECS, Design, SolveResult, solve
+from tdcm_ros.nodes.shape_messages import surface_points
+
+Array = NDArray[np.float64]
+MAX_CONDITION = 1e10
+MAX_RELATIVE_HALF_WIDTH = 0.5
+MAX_CORRELATION = 0.99
+SINGULAR_CONDITION = 1e14
+"""Above this condition number ``J^T J`` is treated as singular: infinite standard errors."""
+FAILED_RESIDUAL_M = 1.0
+"""Residual (m) given to every coordinate when the model has no solution at a trial point."""
+
+
+class CalibrationError(InputError):
+    """The calibration cannot run on these data or parameters."""
+
+
+@dataclass(frozen=True)
+class FittedParameter:
+    """One fitted design field: start and fitted value, standard error and interval (SI)."""
+
+    name: str
+    unit: str
+    initial: float
+    value: float
+    std: float
+    ci_low: float
+    ci_high: float
+
+    def to_json(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        def num(v: float) -> float | None:
+            return v if np.isfinite(v) else None
+
+        return {"value": self.value, "unit": self.unit, "initial": self.initial,
+                "std": num(self.std), "ci_low": num(self.ci_low), "ci_high": num(self.ci_high)}
+
+
+@dataclass(frozen=True, eq=False)
+class Calibration:
+    """Fitted parameters, the fit's statistics and the evaluations before and after."""
+
+    parameters: tuple[FittedParameter, ...]
+    confidence: float
+    correlation: Array
+    condition: float
+    residual_rms_m: float
+    n_residuals: int
+    identifiable: bool
+    before: Evaluation
+    after: Evaluation
+    warnings: tuple[str, ...]
+
+    @property
+    def design(self) -> Design:
+        """The design with the fitted values."""
+        return self.after.options.design
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``tdcm calibrate --json`` document."""
+        def table(ev: Evaluation) -> dict[str, Any]:
+            doc = ev.to_json()
+            return {k: doc[k] for k in ("mape_pct", "rmse_m", "mae_m", "shape_error_m",
+                                        "deflection_mean_m", "n_trials", "n_steps")}
+
+        return {"parameters": {p.name: p.to_json() for p in self.parameters},
+                "confidence": self.confidence, "identifiable": self.identifiable,
+                "correlation": [[None if not np.isfinite(c) else float(c) for c in row]
+                                for row in self.correlation],
+                "condition_number": self.condition if np.isfinite(self.condition) else None,
+                "residual_rms_m": self.residual_rms_m, "n_residuals": self.n_residuals,
+                "before": table(self.before), "after": table(self.after),
+                "warnings": list(self.warnings)}
+
+
+def parse_fit(text: str) -> tuple[str, ...]:
+    """``E`` or ``E,w_d``: names of real-valued design fields, without repeats."""
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    allowed = [n for n, spec in FIELD_SPECS.items() if not spec.integer]
+    for name in names:
+        if name not in allowed:
+            raise CalibrationError(f"--fit {name!r} is not a real-valued design field; allowed: "
+                                   f"{', '.join(allowed)}", parameter="--fit", value=name,
+                                   allowed=", ".join(allowed))
+    if not names or len(set(names)) != len(names):
+        raise CalibrationError(f"--fit {text!r}: give distinct names, e.g. E or E,w_d",
+                               parameter="--fit", value=text, allowed="NAME[,NAME...]")
+    return names
+
+
+@dataclass(frozen=True, eq=False)
+class _Data:
+    """Measured marker points in ``tdcm_base`` (steps, k, 3) with their step tensions (N)."""
+
+    tensions: Array
+    markers: Array
+
+    @classmethod
+    def of(cls, prepared: Sequence[tuple[Sequence[MeasuredStep], Registration]],
+           options: EvaluateOptions) -> _Data:
+        tensions, markers = [], []
+        for steps, reg in prepared:
+            for step in steps:
+                tensions.append(model_tension(step.tension_n, options))
+                markers.append(reg.to_base(step.markers))
+        order = np.argsort(tensions, kind="stable")  # warm starts follow increasing tension
+        return cls(np.asarray(tensions)[order], np.asarray(markers)[order])
+
+
+def _model_markers(design: Design, data: _Data, options: EvaluateOptions) -> Array:
+    layout = options.layout
+    radius = layout.radius(design.R_outer)
+    out = np.empty_like(data.markers)
+    warm: SolveResult | None = None
+    for i, tension in enumerate(data.tensions):
+        warm = solve(design, float(tension), settings=options.solver, warm_start=warm)
+        out[i] = surface_points(warm, layout.s, radius, layout.side_rad)[0]
+    return out
+
+
+def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registration]],
+                    names: Sequence[str], options: EvaluateOptions, *,
+                    confidence: float = 0.95) -> tuple[Design, list[FittedParameter], Array,
+                                                       float, float, int, list[str]]:
+    """Fit ``names`` on measured steps with their registrations; see the module docstring.
+
+    Returns the fitted design, the parameters, their correlation matrix, the condition number
+    of ``J^T J``, the residual RMS (m), the residual count and the identifiability warnings.
+    """
+    if not (np.isfinite(confidence) and 0.0 < confidence < 1.0):
+        raise out_of_range("confidence", confidence, "(0, 1)")
+    data = _Data.of(prepared, options)
+    seen = ~np.isnan(data.markers)
+    n = len(names)
+    m = int(seen.sum())
+    if m <= n:
+        raise CalibrationError(f"{m} marker coordinates for {n} parameters; allowed: more "
+                               "residuals than parameters", parameter="--fit", value=list(names))
+    start = options.design
+    x0 = np.array([float(getattr(start, name)) for name in names])
+    specs = [FIELD_SPECS[name] for name in names]
+    low = np.array([max(s.low, 0.0) / v + 1e-6 for s, v in zip(specs, x0, strict=True)])
+    high = np.array([s.high / v for s, v in zip(specs, x0, strict=True)])
+
+    def design_at(scaled: Array) -> Design:
+        return start.with_overrides(**{nm: float(v) for nm, v in zip(names, scaled * x0,
+                                                                      strict=True)})
+
+    def residuals(scaled: Array) -> Array:
+        try:
+            predicted = _model_markers(design_at(scaled), data, options)
+        except TdcmError:
+            return np.full(m, FAILED_RESIDUAL_M)
+        return (predicted - data.markers)[seen]
+
+    first = residuals(np.ones(n))
+    if np.all(first == FAILED_RESIDUAL_M):
+        _model_markers(design_at(np.ones(n)), data, options)  # raises the model's own error
+    fit = least_squares(residuals, np.ones(n), bounds=(low, high), x_scale="jac",
+                        diff_step=1e-4, xtol=1e-10, ftol=1e-12)
+    dof = m - n
+    s2 = float(fit.fun @ fit.fun) / dof
+    jtj = np.asarray(fit.jac).T @ np.asarray(fit.jac)  # relative units: parameter / start
+    eig = np.linalg.eigvalsh(jtj)
+    condition = float(eig[-1] / eig[0]) if eig[0] > 0 else float("inf")
+    if condition < SINGULAR_CONDITION:
+        cov = s2 * np.linalg.inv(jtj) * np.outer(x0, x0)
+        std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        corr = np.clip(cov / np.outer(std, std), -1.0, 1.0) if np.all(std > 0) else np.eye(n)
+    else:  # numerically singular: no finite interval
+        std = np.full(n, np.inf)
+        corr = np.full((n, n), np.nan)
+        np.fill_diagonal(corr, 1.0)
+    half = float(student_t.ppf(0.5 + confidence / 2.0, dof)) * std
+    values = fit.x * x0
+    params = [FittedParameter(nm, spec.unit, float(v0), float(v), float(sd), float(v - h),
+                              float(v + h))
+              for nm, spec, v0, v, sd, h in zip(names, specs, x0, values, std, half, strict=True)]
+    warnings = _identifiability(params, corr, condition)
+    if fit.status <= 0:
+        warnings.append(f"least squares stopped without converging: {fit.message}")
+    rms = float(np.sqrt(np.mean(fit.fun**2)))
+    return design_at(fit.x), params, corr, condition, rms, m, warnings
+
+
+def _identifiability(params: Sequence[FittedParameter], corr: Array, condition: float
+                     ) -> list[str]:
+    warnings = []
+    if not condition < MAX_CONDITION:
+        warnings.append(f"not identifiable: J^T J is near-singular (condition number "
+                        f"{condition:.3g} > {MAX_CONDITION:.0e}); the data do not fix "
+                        f"{', '.join(p.name for p in params)} together")
+    for p in params:
+        if not (p.ci_high - p.value < MAX_RELATIVE_HALF_WIDTH * abs(p.value)):
+            warnings.append(f"not identifiable: {p.name} = {p.value:.4g} {p.unit} +- "
+                            f"{p.ci_high - p.value:.3g} {p.unit} (interval half-width above "
+                            f"{MAX_RELATIVE_HALF_WIDTH:.0%} of the value)")
+    for i in range(len(params)):
+        for j in range(i + 1, len(params)):
+            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > MAX_CORRELATION:
+                warnings.append(f"not identifiable: {params[i].name} and {params[j].name} are "
+                                f"correlated ({corr[i, j]:+.4f}); fit one and fix the other")
+    return warnings
