@@ -23,7 +23,8 @@ import threading
 import time
 import tty
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import fields
 from typing import Self
 
@@ -159,6 +160,16 @@ class PtyTwin:
         except OSError as error:
             if error.errno != errno.EIO:
                 raise
+
+    @contextmanager
+    def frozen(self) -> Iterator[None]:
+        """Inside this block the device neither runs nor talks (a hung board, a stalled UART).
+
+        The threaded twin then catches up the simulated time it missed in one go, with the
+        host's bytes of the pause delivered at its start.
+        """
+        with self._lock:
+            yield
 
     def pump(self, seconds: float) -> None:
         """Lock-step use: take the host's bytes, run ``seconds`` of simulated time, send output."""

@@ -157,6 +157,19 @@ def test_closing_and_reopening_the_pty_triggers_a_reconnect(spawn, probe, twin,
     assert "device link lost" in stderr_of(node)
 
 
+def test_a_silent_device_is_reported_stale_then_fresh_again(spawn, probe, twin,
+                                                            tmp_path) -> None:
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    with twin.frozen():  # no telemetry for longer than stale_timeout, shorter than link_timeout
+        probe.until(lambda: probe.states[-1].level == 3, 10.0, "STALE in device_state")
+        assert "no telemetry for" in probe.states[-1].message
+        probe.until(lambda: any(d.level == 3 for d in probe.diagnostics), 10.0,
+                    "STALE on /diagnostics")
+    probe.until(lambda: probe.states[-1].level != 3 and probe.state()["link"] == "connected",
+                20.0, "fresh telemetry again")
+
+
 def test_device_releases_within_its_watchdog_when_heartbeats_stop(spawn, probe, twin,
                                                                   tmp_path) -> None:
     """The driver process is frozen (SIGSTOP: a hung host); the device releases by itself."""
