@@ -3,14 +3,16 @@
 A *step* is a contiguous run of tension samples that stay within ``tolerance_n`` of the run's
 median for at least ``min_hold_s``, once the transients are excluded:
 
-1. samples are *steady* where the tension (despiked by a ``despike_samples`` median filter)
-   spans at most ``2 tolerance_n`` over a centred window of ``settle_s``: ramps and ringing
-   between levels are cut out;
-2. in each steady run, the longest contiguous stretch within ``tolerance_n`` of its median is
+1. the tension is despiked by a ``despike_samples`` median filter (single-sample glitches of
+   the load cell); samples are *steady* where it spans at most ``2 tolerance_n`` over a centred
+   window of ``settle_s``: ramps and ringing between levels are cut out;
+2. in each steady run, the longest contiguous stretch (of the despiked tension) within
+   ``tolerance_n`` of its median is
    taken (the median is re-taken on the stretch until it settles); the rest of the run is
    searched again, so a slow ramp through several levels can yield several steps;
 3. the first ``settle_s`` of the stretch is dropped (settling after the change); what is left
-   is a step if it lasts at least ``min_hold_s``.
+   is a step if it lasts at least ``min_hold_s``. Its median and mean are of the measured
+   samples, the mean over those within ``tolerance_n`` of the median (glitches left out).
 
 A *trial* is one staircase: a new trial starts at the first step at or below ``zero_n``
 (or the first step after the tension dipped to ``zero_n``) once the current trial has risen
@@ -89,11 +91,9 @@ def _odd(n: int) -> int:
     return max(1, n | 1)
 
 
-def _steady(t: Array, x: Array, cfg: StepSettings) -> NDArray[np.bool_]:
+def _steady(t: Array, smooth: Array, cfg: StepSettings) -> NDArray[np.bool_]:
     dt = float(np.median(np.diff(t))) if t.size > 1 else cfg.settle_s
     window = _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
-    smooth = median_filter(x, size=cfg.despike_samples, mode="nearest") \
-        if cfg.despike_samples > 1 else x
     span = maximum_filter1d(smooth, window, mode="nearest") - \
         minimum_filter1d(smooth, window, mode="nearest")
     return span <= 2.0 * cfg.tolerance_n
@@ -140,9 +140,11 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
     x = np.asarray(tension_n, dtype=float)
     if t.size < 2:
         return []
+    smooth = median_filter(x, size=cfg.despike_samples, mode="nearest") \
+        if cfg.despike_samples > 1 else x
     ranges: list[tuple[int, int]] = []
-    for lo, hi in _true_runs(_steady(t, x, cfg)):
-        ranges.extend(_holds(t, x, int(lo), int(hi), cfg))
+    for lo, hi in _true_runs(_steady(t, smooth, cfg)):
+        ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
     ranges.sort()
     steps: list[Step] = []
     trial, risen, previous_stop = 0, False, 0
@@ -153,8 +155,9 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
         if risen and released:
             trial, risen = trial + 1, False
         risen = risen or median > cfg.zero_n
-        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median,
-                          float(np.mean(x[start:stop]))))
+        held = x[start:stop]
+        mean = float(np.mean(held[np.abs(held - median) <= cfg.tolerance_n]))
+        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median, mean))
         previous_stop = stop
     if trial > 0 and not risen:  # zero holds after the last rise end the last staircase
         steps = [replace(s, trial=trial - 1) if s.trial == trial else s for s in steps]

@@ -1,0 +1,67 @@
+"""Step detection on synthetic staircases with noise, transients and spikes (hypothesis)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.metrics.steps import StepSettings, detect_steps
+from tdcm_ros.metrics.synthetic import staircase
+
+
+@settings(max_examples=25, deadline=None)
+@given(levels=st.lists(st.floats(1.0, 25.0), min_size=1, max_size=5).map(
+           lambda v: [0.0, *sorted({round(x) for x in v})]),
+       trials=st.integers(1, 3), hold_s=st.floats(2.3, 4.0), lag_s=st.floats(0.0, 0.15),
+       noise=st.floats(0.0, 0.08), seed=st.integers(0, 2**16))
+def test_staircases_give_their_levels_and_trials(levels: list[float], trials: int,
+                                                 hold_s: float, lag_s: float, noise: float,
+                                                 seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    t, true = staircase(levels, hold_s=hold_s, trials=trials, rate_hz=500.0, lag_s=lag_s)
+    x = true + rng.normal(0.0, noise, t.size)
+    spikes = rng.choice(t.size, size=5, replace=False)
+    x[spikes] += 3.0  # single-sample glitches of the load cell
+    steps = detect_steps(t, x)
+    expected = [lv for _ in range(trials) for lv in levels] + [levels[0]]
+    assert [round(s.median_n) for s in steps] == [round(v) for v in expected]
+    assert [s.trial for s in steps] == [k for k in range(trials) for _ in levels] + [trials - 1]
+    for s in steps:
+        assert s.duration_s >= 1.0
+        assert abs(s.mean_n - round(s.median_n)) < 0.05 + 3 * noise
+        # transients excluded: the lag has settled to within the tolerance inside every step
+        held = true[s.start:s.stop]
+        assert np.all(np.abs(held - round(s.median_n)) <= 0.3)
+
+
+def test_holds_too_short_are_not_steps() -> None:
+    t, x = staircase([0.0, 4.0, 8.0], hold_s=0.9, trials=1, rate_hz=1000.0, lag_s=0.0)
+    assert detect_steps(t, x) == []
+    # steady from 0.125 s after each change (half the window) plus 0.25 s settling dropped
+    # up to 0.125 s before the next: 0.4 s of each 0.9 s hold is a step
+    steps = detect_steps(t, x, StepSettings(min_hold_s=0.35))
+    assert [round(s.median_n) for s in steps] == [0, 4, 8, 0]
+    assert all(0.35 <= s.duration_s <= 0.9 for s in steps)
+
+
+def test_a_slow_ramp_is_not_a_hold() -> None:
+    t = np.linspace(0.0, 10.0, 5001)
+    assert detect_steps(t, 2.0 * t) == []  # 2 N/s: 0.6 N band crossed in 0.3 s
+
+
+def test_release_without_a_zero_hold_starts_a_trial() -> None:
+    t = np.arange(0.0, 12.0, 0.002)
+    x = np.select([t < 3, t < 3.2, t < 6, t < 9], [4.0, 0.0, 8.0, 4.0], 8.0)
+    steps = detect_steps(t, x)
+    assert [round(s.median_n) for s in steps] == [4, 8, 4, 8]
+    assert [s.trial for s in steps] == [0, 1, 1, 1]
+
+
+def test_settings_are_validated() -> None:
+    for bad in ({"tolerance_n": 0.0}, {"min_hold_s": -1.0}, {"zero_n": float("nan")},
+                {"despike_samples": 0}, {"settle_s": float("inf")}):
+        with pytest.raises(InputError, match="steps."):
+            StepSettings(**bad)
