@@ -27,6 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
 from time import perf_counter
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -56,14 +57,20 @@ CONTINUATION_HALVINGS = 5
 DIVERGENCE_GROWTH = 1e3
 
 
-@dataclass(frozen=True)
-class _Problem:
-    """What the strategies iterate: the moment map and the map from moments to shape."""
+class _Problem(NamedTuple):
+    """What the strategies iterate: the moment map, and the map from the iterate to the moments
+    that bend the body (None: the iterate itself)."""
 
     grid: Grid
     settings: SolverSettings
     moments: MomentMap
-    shape_of: Callable[[Array], PlanarShape]
+    bend: Callable[[Array], Array] | None
+
+    def shape_of(self, x: Array) -> PlanarShape:
+        """Shape integrated from the stacked cell end moments ``x = [m_a, m_b]``."""
+        y = x if self.bend is None else self.bend(x)
+        n = self.grid.n_cells
+        return integrate(self.grid, y[:n], y[n:])
 
 
 @dataclass
@@ -150,15 +157,9 @@ def _loaded_model(grid: Grid, settings: SolverSettings, tension: float,
 def _problem(grid: Grid, settings: SolverSettings, model: LoadedModel | None) -> _Problem:
     """The fixed-point problem of the paper's model (``model`` None) or of a loading."""
     if model is None:
-        return _Problem(grid, settings, _moment_map(grid, settings), partial(_shape, grid))
+        return _Problem(grid, settings, _moment_map(grid, settings), None)
     return _Problem(grid, settings, model.moments,
-                    lambda x: _shape(grid, model.bend_moments(x)))
-
-
-def _shape(grid: Grid, x: Array) -> PlanarShape:
-    """Shape integrated from the stacked cell end moments ``[m_a, m_b]``."""
-    n = grid.n_cells
-    return integrate(grid, x[:n], x[n:])
+                    model.bend_moments if model.has_contact else None)
 
 
 def _moment_map(grid: Grid, settings: SolverSettings) -> MomentMap:
@@ -278,11 +279,11 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
              factor: float = 1.0, tol: float | None = None) -> _Run:
     """Fixed-point iteration on the cell moments; ``mode`` picks the update rule. ``factor``
     scales the external loads (continuation); ``tol`` (m) defaults to ``settings.tol``."""
-    grid, settings = problem.grid, problem.settings
+    grid, settings, moment_map, bend = problem
     tol = settings.tol if tol is None else tol
-    moment_map, shape_of = problem.moments, problem.shape_of
+    n = grid.n_cells
     x = x0
-    shape = shape_of(x)
+    shape = problem.shape_of(x)
     history: list[float] = []
     using = "picard" if mode == "auto" else mode
     d_x: list[Array] = []
@@ -299,7 +300,8 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
             x_new = x + settings.relaxation * f
         else:
             x_new = g
-        new_shape = shape_of(x_new)
+        y = x_new if bend is None else bend(x_new)
+        new_shape = integrate(grid, y[:n], y[n:])
         step = float(np.max(np.abs(new_shape.p - shape.p)))
         if not np.isfinite(step):
             return _Run(x, shape, history, False, "iterate became non-finite")
