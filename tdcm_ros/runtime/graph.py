@@ -1,0 +1,176 @@
+"""A node graph as child processes: a zenoh router if none is reachable, nodes, helper processes.
+
+Each node runs ``python -m tdcm_ros.runtime.run_node <module:Class>``. Per-node parameter
+overrides are merged over the parameter file into a per-node file in a temporary directory.
+A node given a ``ready_path`` must create it before :meth:`NodeGraph.start_node` returns (e.g. the
+twin's pty link before the driver opens it); a symlink left there at exit is removed. Stopping
+goes in reverse start order, router last: SIGINT, then SIGKILL after ``grace`` seconds. Children
+run in their own sessions and, on Linux, get SIGTERM if the parent dies (``PR_SET_PDEATHSIG``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import logging
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any
+
+import yaml
+
+from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.names import fully_qualified_node_name
+from tdcm_ros.runtime.params import ROS_PARAMETERS, node_parameters
+from tdcm_ros.runtime.registry import node_target
+
+log = logging.getLogger("tdcm.graph")
+_PR_SET_PDEATHSIG = 1
+#: Exit statuses of a child that stopped because it was asked to.
+CLEAN_EXITS = (0, -signal.SIGINT, 130)
+
+
+def _die_with_parent() -> None:
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+
+
+@dataclass
+class Child:
+    """A started process and the name shown in logs."""
+
+    name: str
+    process: subprocess.Popen[bytes]
+
+    @property
+    def running(self) -> bool:
+        """True until the process exits."""
+        return self.process.poll() is None
+
+
+def merged_params(folder: Path, name: str, params_file: str | None,
+                  overrides: Mapping[str, Any]) -> str:
+    """Write node ``name``'s parameters from ``params_file`` with ``overrides`` on top; the path."""
+    fqn = fully_qualified_node_name("/", name)
+    values = {**node_parameters(params_file, fqn), **overrides}
+    path = folder / f"{name}.yaml"
+    path.write_text(yaml.safe_dump({fqn: {ROS_PARAMETERS: values}}), encoding="utf-8")
+    return str(path)
+
+
+class NodeGraph:
+    """Start nodes and processes in order; :meth:`close` stops them all.
+
+    ``log_dir``, when set, receives each child's stdout and stderr as ``<name>.log``; otherwise
+    children share the terminal. ``stop_event`` aborts waits for ready paths.
+    """
+
+    def __init__(self, *, endpoint: str, runtime: str = "zenoh", params_file: str | None = None,
+                 grace: float = 5.0, log_dir: Path | None = None,
+                 stop_event: threading.Event | None = None) -> None:
+        self.endpoint = endpoint
+        self.runtime = runtime
+        self.params_file = params_file
+        self.grace = grace
+        self.log_dir = log_dir
+        self.stop_event = stop_event or threading.Event()
+        self.children: list[Child] = []
+        self.router: Child | None = None
+        self._ready_paths: list[str] = []
+        self._logs: list[IO[bytes]] = []
+        self._folder = tempfile.TemporaryDirectory(prefix="tdcm_graph_")
+
+    def start(self, name: str, argv: Sequence[str]) -> Child:
+        """Start ``argv`` as child ``name``."""
+        log.info("starting %s: %s", name, " ".join(argv))
+        output: IO[bytes] | None = None
+        if self.log_dir is not None:
+            output = open(self.log_dir / f"{name}.log", "wb")  # noqa: SIM115 - closed in close()
+            self._logs.append(output)
+        process = subprocess.Popen(
+            list(argv), start_new_session=True,
+            preexec_fn=_die_with_parent,  # noqa: PLW1509 - it only calls prctl
+            stdout=output, stderr=output)
+        child = Child(name, process)
+        self.children.append(child)
+        return child
+
+    def ensure_router(self, timeout: float = 10.0) -> None:
+        """Start a router on ``endpoint`` unless one already answers there (zenoh runtime only)."""
+        from tdcm_ros.runtime.router import is_listening
+
+        if self.runtime != "zenoh" or is_listening(self.endpoint):
+            return
+        self.router = self.start("router", [sys.executable, "-m", "tdcm_ros.runtime.router",
+                                            "--listen", self.endpoint])
+        self.children.remove(self.router)
+        deadline = time.monotonic() + timeout
+        while not is_listening(self.endpoint):
+            if not self.router.running or time.monotonic() > deadline:
+                raise RuntimePortError(f"zenoh router did not come up on {self.endpoint}")
+            time.sleep(0.05)
+
+    def start_node(self, name: str, *, overrides: Mapping[str, Any] | None = None,
+                   ready_path: str | None = None, ready_timeout: float = 30.0) -> Child:
+        """Start registered node ``name``; with ``ready_path``, wait until the node creates it."""
+        argv = [sys.executable, "-m", "tdcm_ros.runtime.run_node", node_target(name), "--name",
+                name, "--runtime", self.runtime]
+        params = (merged_params(Path(self._folder.name), name, self.params_file, overrides)
+                  if overrides else self.params_file)
+        if params:
+            argv += ["--params", params]
+        child = self.start(name, argv)
+        if ready_path is not None:
+            self._ready_paths.append(ready_path)
+            self._wait_ready(child, ready_path, ready_timeout)
+        return child
+
+    def _wait_ready(self, child: Child, path: str, timeout: float) -> None:
+        deadline = time.monotonic() + timeout
+        while not os.path.lexists(path):
+            if not child.running:
+                raise RuntimePortError(f"{child.name} exited ({child.process.returncode}) before "
+                                       f"creating {path}")
+            if time.monotonic() > deadline:
+                raise RuntimePortError(f"{child.name} did not create {path} within {timeout:g} s")
+            if self.stop_event.wait(0.05):
+                return
+
+    def stop(self, child: Child) -> int:
+        """Stop one child: SIGINT, then SIGKILL after ``grace`` s; its exit status."""
+        if child.running:
+            child.process.send_signal(signal.SIGINT)
+            try:
+                child.process.wait(self.grace)
+            except subprocess.TimeoutExpired:
+                log.warning("%s ignored SIGINT for %.1f s; killing it", child.name, self.grace)
+                child.process.kill()
+                child.process.wait()
+        log.info("%s exited with %s", child.name, child.process.returncode)
+        return int(child.process.returncode)
+
+    def failed(self) -> list[Child]:
+        """Children that exited with a status other than a clean stop."""
+        return [c for c in self.children
+                if not c.running and c.process.returncode not in CLEAN_EXITS]
+
+    def close(self) -> None:
+        """Stop every child newest first, then the router; remove leftovers."""
+        for child in reversed(self.children):
+            self.stop(child)
+        if self.router is not None:
+            self.stop(self.router)
+        for path in self._ready_paths:
+            if os.path.islink(path):
+                os.unlink(path)
+        for handle in self._logs:
+            handle.close()
+        self._logs.clear()
+        self._folder.cleanup()
