@@ -48,6 +48,7 @@ setup(
             "tdcm_node = tdcm_ros.runtime.run_node:main",
             "tdcm_talker = tdcm_ros.nodes.talker:main",
             "model_node = tdcm_ros.nodes.model_node:main",
+            "metrics_node = tdcm_ros.nodes.metrics_node:main",
             "mocap_node = tdcm_ros.nodes.mocap_node:main",
             "tension_driver = tdcm_ros.nodes.tension_driver:main",
             "device_twin = tdcm_ros.nodes.device_twin:main",

@@ -8,6 +8,7 @@ the step.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,6 +53,12 @@ def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: Evalua
             f"{len(tension.stamps_s)} samples over {np.ptp(tension.stamps_s):.3g} s; adjust "
             "steps.tolerance_n / steps.min_hold_s", parameter="steps.min_hold_s",
             value=cfg.min_hold_s, allowed="a hold at least this long in the data")
+    return average_markers(tension, markers, steps, options)
+
+
+def average_markers(tension: TensionSeries, markers: MarkerSeries, steps: Sequence[Step],
+                    options: EvaluateOptions) -> list[MeasuredStep]:
+    """Mean marker positions per step (steps index ``tension``'s samples)."""
     step_of_sample = np.full(tension.stamps_s.size, -1, dtype=np.int64)
     for k, step in enumerate(steps):
         step_of_sample[step.start:step.stop] = k

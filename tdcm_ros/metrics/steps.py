@@ -21,7 +21,8 @@ above ``zero_n``. Steps at zero after the last rise stay with the last trial.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -146,19 +147,31 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
     for lo, hi in _true_runs(_steady(t, smooth, cfg)):
         ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
     ranges.sort()
-    steps: list[Step] = []
-    trial, risen, previous_stop = 0, False, 0
-    for start, stop in ranges:
-        median = float(np.median(x[start:stop]))
-        released = median <= cfg.zero_n or (
-            start > previous_stop and float(x[previous_stop:start].min()) <= cfg.zero_n)
-        if risen and released:
-            trial, risen = trial + 1, False
-        risen = risen or median > cfg.zero_n
+    medians = [float(np.median(x[a:b])) for a, b in ranges]
+    previous_stops = [0, *(b for _, b in ranges)][:len(ranges)]
+    dips = [float(x[prev:a].min()) if a > prev else np.inf
+            for (a, _), prev in zip(ranges, previous_stops, strict=True)]
+    steps = []
+    for (start, stop), median, trial in zip(ranges, medians,
+                                            assign_trials(medians, dips, cfg.zero_n), strict=True):
         held = x[start:stop]
         mean = float(np.mean(held[np.abs(held - median) <= cfg.tolerance_n]))
         steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median, mean))
-        previous_stop = stop
-    if trial > 0 and not risen:  # zero holds after the last rise end the last staircase
-        steps = [replace(s, trial=trial - 1) if s.trial == trial else s for s in steps]
     return steps
+
+
+def assign_trials(medians: Sequence[float], dips: Sequence[float], zero_n: float,
+                  *, final: bool = True) -> list[int]:
+    """Trial (0-based) of each step from its median tension and the lowest tension between it
+    and the previous step (``dips``, N). With ``final``, zero holds after the last rise stay
+    with the last staircase; otherwise (a live stream) they wait as the next trial's start."""
+    trials: list[int] = []
+    trial, risen = 0, False
+    for median, dip in zip(medians, dips, strict=True):
+        if risen and (median <= zero_n or dip <= zero_n):
+            trial, risen = trial + 1, False
+        risen = risen or median > zero_n
+        trials.append(trial)
+    if final and trial > 0 and not risen:
+        trials = [k - 1 if k == trial else k for k in trials]
+    return trials

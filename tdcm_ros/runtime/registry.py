@@ -7,6 +7,7 @@ from tdcm_ros.errors import InputError
 NODES: dict[str, str] = {
     "talker": "tdcm_ros.nodes.talker:Talker",
     "model_node": "tdcm_ros.nodes.model_node:ModelNode",
+    "metrics_node": "tdcm_ros.nodes.metrics_node:MetricsNode",
     "mocap_node": "tdcm_ros.nodes.mocap_node:MocapNode",
     "tension_driver": "tdcm_ros.nodes.tension_driver:TensionDriverNode",
     "device_twin": "tdcm_ros.nodes.device_twin:DeviceTwinNode",

@@ -1,0 +1,156 @@
+"""Streaming form of the evaluation for the live node: samples in, finished steps and running
+Table I out, with the same definitions as the offline evaluation.
+
+Tension samples and marker frames are buffered; :meth:`RunningEvaluation.update` runs step
+detection on the buffer. A step is *finished* once the buffer reaches ``settle_s`` past its end
+(the tension left the band); finished steps are averaged, scored against the model and dropped
+from the buffer. Trials are assigned over all finished steps; a zero hold after a rise waits as
+the start of the next trial (a live stream cannot know it was the last). The buffer keeps at most
+``max_buffer_s`` of data (older samples are dropped when no step finishes, e.g. a long ramp).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from tdcm_ros.errors import TdcmError, out_of_range
+from tdcm_ros.metrics.evaluation import (
+    StepRecord,
+    choose_registration,
+    metrics_of,
+    score_steps,
+)
+from tdcm_ros.metrics.lookup import MarkerTable
+from tdcm_ros.metrics.measure import MeasuredStep, average_markers
+from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.registration import Registration
+from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.steps import assign_trials, detect_steps
+from tdcm_ros.metrics.table import TableMetrics
+
+Array = NDArray[np.float64]
+
+
+class RunningEvaluation:
+    """Running Table I of a live stream; registration given, or (``estimate``) estimated from
+    the finished steps once a zero-tension and a bent step exist."""
+
+    def __init__(self, options: EvaluateOptions, registration: Registration | None = None, *,
+                 max_buffer_s: float = 120.0, estimate: bool = True) -> None:
+        if not (np.isfinite(max_buffer_s) and max_buffer_s > 0.0):
+            raise out_of_range("max_buffer_s", max_buffer_s, "(0, inf) s")
+        self.options = options
+        self.registration = registration
+        self.max_buffer_s = float(max_buffer_s)
+        self.estimate = estimate
+        self.table = MarkerTable(options.design, options.layout, settings=options.solver)
+        self._t: list[float] = []
+        self._x: list[float] = []
+        self._frame_t: list[float] = []
+        self._frames: list[Array] = []
+        self.measured: list[MeasuredStep] = []
+        self._dips: list[float] = []
+        self._low_since_step = np.inf
+        self.records: list[StepRecord] = []
+        self.metrics: TableMetrics | None = None
+        self.used_registration: Registration | None = registration
+        self.problem = ""
+
+    def set_registration(self, registration: Registration) -> None:
+        """Use ``registration`` from now on (finished steps are re-scored)."""
+        self.registration = self.used_registration = registration
+        self._rescore()
+
+    def add_tension(self, stamp_s: float, tension_n: float) -> None:
+        """One tension sample (s, N); out-of-order samples are ignored."""
+        if self._t and stamp_s <= self._t[-1]:
+            return
+        self._t.append(float(stamp_s))
+        self._x.append(float(tension_n))
+
+    def add_markers(self, stamp_s: float, positions: ArrayLike) -> None:
+        """One marker frame (s; (k, 3) m in the markers' frame, NaN rows not visible)."""
+        self._frame_t.append(float(stamp_s))
+        self._frames.append(np.asarray(positions, dtype=float))
+
+    def tension_at(self, stamp_s: float) -> float | None:
+        """The buffered tension nearest ``stamp_s`` within the alignment tolerance (N)."""
+        if not self._t:
+            return None
+        t = np.asarray(self._t)
+        i = int(np.argmin(np.abs(t - stamp_s)))
+        return self._x[i] if abs(t[i] - stamp_s) <= self.options.align_tolerance_s else None
+
+    def sample_errors(self, stamp_s: float, positions: ArrayLike) -> Array | None:
+        """Measured minus predicted marker points (k, 3) m in ``tdcm_base`` for one frame, the
+        model at the aligned tension (:class:`MarkerTable`); ``None`` without a registration
+        (given or estimated yet) or an aligned tension."""
+        tension = self.tension_at(stamp_s)
+        if tension is None or self.used_registration is None:
+            return None
+        measured = self.used_registration.to_base(np.asarray(positions, dtype=float))
+        return measured - self.table.markers(max(tension, 0.0))
+
+    def update(self) -> list[StepRecord]:
+        """Finish the steps that ended; returns their records (Table I updated)."""
+        if len(self._t) < 2:
+            return []
+        t, x = np.asarray(self._t), np.asarray(self._x)
+        cfg = self.options.steps
+        done = [s for s in detect_steps(t, x, cfg) if s.end_s < t[-1] - cfg.settle_s]
+        if not done:
+            self._trim(t[-1] - self.max_buffer_s)
+            return []
+        tension = TensionSeries(t, x)
+        if self._frames:
+            markers = MarkerSeries.of(self._frame_t, self.options.layout.labels,
+                                      np.asarray(self._frames))
+            new = average_markers(tension, markers, done, self.options)
+        else:
+            empty = np.full((len(self.options.layout.labels), 3), np.nan)
+            new = [MeasuredStep(s, s.mean_n, empty, 0, self.options.layout.labels) for s in done]
+        previous_stop = 0
+        for step in done:
+            between = x[previous_stop:step.start]
+            self._dips.append(min(self._low_since_step,
+                                  float(between.min()) if between.size else np.inf))
+            self._low_since_step = np.inf
+            previous_stop = step.stop
+        tail = x[done[-1].stop:]
+        self._low_since_step = float(tail.min()) if tail.size else np.inf
+        self.measured.extend(new)
+        self._trim(done[-1].end_s, keep_low=True)
+        before = len(self.records)
+        self._rescore()
+        return self.records[before:]
+
+    def _trim(self, until_s: float, keep_low: bool = False) -> None:
+        keep = int(np.searchsorted(np.asarray(self._t), until_s, side="right"))
+        if not keep_low and keep:
+            self._low_since_step = min(self._low_since_step, float(np.min(self._x[:keep])))
+        del self._t[:keep], self._x[:keep]
+        first = int(np.searchsorted(np.asarray(self._frame_t),
+                                    until_s - self.options.align_tolerance_s, side="right"))
+        del self._frame_t[:first], self._frames[:first]
+
+    def _rescore(self) -> None:
+        if not self.measured:
+            return
+        if self.registration is None and not self.estimate:
+            self.problem = "waiting for a registration (estimation off)"
+            return
+        try:
+            reg = self.registration or choose_registration(self.measured, self.options, None)
+        except TdcmError as error:
+            self.problem = f"waiting for a registration: {error}"
+            return
+        records, warnings = score_steps(self.measured, reg, self.options)
+        trials = assign_trials([m.tension_n for m in self.measured], self._dips,
+                               self.options.steps.zero_n, final=False)
+        self.records = [replace(r, trial=k + 1) for r, k in zip(records, trials, strict=True)]
+        self.metrics = metrics_of(self.records, self.options)
+        self.used_registration = reg
+        self.problem = warnings[-1] if warnings else ""

@@ -1,0 +1,189 @@
+"""metrics_node logic on an in-memory port, and the streaming form against the offline one."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
+from tdcm_ros.metrics.evaluation import evaluate_series
+from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.streaming import RunningEvaluation
+from tdcm_ros.metrics.synthetic import Recording, simulate
+from tdcm_ros.model import preset
+from tdcm_ros.nodes.metrics_node import MetricsNode
+from tdcm_ros.runtime.parameters import ParamSpec
+
+DESIGN = preset("paper-experiment").with_overrides(E=0.7e9)
+
+
+class Port:
+    """A NodePort in memory: parameters checked like the runtimes, messages kept per topic."""
+
+    node_name = "metrics_node"
+    namespace = "/"
+
+    def __init__(self, overrides: dict[str, Any] | None = None) -> None:
+        self.overrides = {"design.E": DESIGN.E, **(overrides or {})}
+        self.params: dict[str, Any] = {}
+        self.published: dict[str, list[Any]] = {}
+        self.subs: dict[str, Callable[[Any], None]] = {}
+        self.timers: list[Callable[[], None]] = []
+        self.clock_ns = 0
+
+    def declare_parameter(self, name: str, default: Any, **kw: Any) -> Any:
+        spec = ParamSpec(name, default, kw.get("description", ""), kw.get("range"),
+                         kw.get("validator"), kw.get("read_only", False))
+        self.params[name] = spec.coerce(self.overrides.get(name, default))
+        return self.params[name]
+
+    def get_parameter(self, name: str) -> Any:
+        return self.params[name]
+
+    def add_on_set_parameters(self, callback: Any) -> None:
+        pass
+
+    def create_publisher(self, topic: str, type_name: str, qos: Any = None) -> Any:
+        sink = self.published.setdefault(topic, [])
+
+        class Pub:
+            def publish(self, message: Any) -> None:
+                sink.append(message)
+
+        return Pub()
+
+    def create_subscription(self, topic: str, type_name: str, callback: Any,
+                            qos: Any = None) -> None:
+        self.subs[topic] = callback
+
+    def create_timer(self, period: float, callback: Callable[[], None]) -> None:
+        self.timers.append(callback)
+
+    def now_ns(self) -> int:
+        return self.clock_ns
+
+
+def _hdr(stamp_s: float, frame: str) -> dict[str, Any]:
+    ns = round(stamp_s * 1e9)
+    return {"stamp": {"sec": ns // 10**9, "nanosec": ns % 10**9}, "frame_id": frame}
+
+
+def feed(port: Port, node: MetricsNode, rec: Recording, every_s: float = 0.5) -> None:
+    """Deliver the recording in stamp order, running the update timer every ``every_s``."""
+    tension, markers = rec.tension, rec.markers
+    labels = markers.labels
+    fi, next_update = 0, every_s
+    for t, x in zip(tension.stamps_s, tension.tension_n, strict=True):
+        port.clock_ns = round(t * 1e9)
+        port.subs["tension"](from_dict("geometry_msgs/msg/WrenchStamped", {
+            "header": _hdr(t, "tdcm_tendon"), "wrench": {"force": {"z": float(x)}}}))
+        while fi < markers.stamps_s.size and markers.stamps_s[fi] <= t:
+            rows = markers.positions[fi]
+            port.subs["markers"](from_dict("mocap4r2_msgs/msg/Markers", {
+                "header": _hdr(markers.stamps_s[fi], "mocap"), "frame_number": fi,
+                "markers": [{"marker_name": labels[i], "marker_index": i,
+                             "translation": {"x": r[0], "y": r[1], "z": r[2]}}
+                            for i, r in enumerate(rows.tolist()) if not np.isnan(r[0])]}))
+            fi += 1
+        if t >= next_update:
+            node.update()
+            next_update += every_s
+
+
+@pytest.fixture(scope="module")
+def recording() -> Recording:
+    return simulate(DESIGN, levels=(0.0, 6.0, 12.0), hold_s=2.5, trials=2, tension_hz=200.0,
+                    mocap_hz=50.0, occlusion=0.1, seed=5)
+
+
+def test_streaming_matches_the_offline_evaluation(recording: Recording) -> None:
+    opts = EvaluateOptions(design=DESIGN)
+    offline = evaluate_series(recording.tension, recording.markers, opts)
+    running = RunningEvaluation(opts)
+    frames = iter(range(recording.markers.stamps_s.size))
+    fi = next(frames)
+    for t, x in zip(recording.tension.stamps_s, recording.tension.tension_n, strict=True):
+        running.add_tension(t, x)
+        while fi is not None and recording.markers.stamps_s[fi] <= t:
+            running.add_markers(recording.markers.stamps_s[fi], recording.markers.positions[fi])
+            fi = next(frames, None)
+        if round(t * 200) % 100 == 0:
+            running.update()
+    running.update()
+    # the stream ends inside the final zero hold, which never finishes
+    assert len(running.records) == len(offline.records) - 1
+    for live, off in zip(running.records, offline.records, strict=False):
+        assert (live.trial, live.tension_n) == (off.trial, off.tension_n)
+        assert live.measured_deflection_m == pytest.approx(off.measured_deflection_m, abs=1e-12)
+
+
+def test_node_publishes_errors_and_the_running_table(recording: Recording) -> None:
+    port = Port()
+    node = MetricsNode(port)
+    port.subs["/tf_static"](from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
+        "header": _hdr(0.0, "mocap"), "child_frame_id": "tdcm_base",
+        "transform": {"translation": dict(zip("xyz", recording.registration.translation,
+                                              strict=True)),
+                      "rotation": dict(zip("xyzw", recording.registration.quaternion,
+                                           strict=True))}}]}))
+    feed(port, node, recording)
+    errors = port.published["metrics/marker_errors"]
+    assert len(errors) > 0.9 * recording.markers.stamps_s.size
+    sizes = [np.linalg.norm([m.translation.x, m.translation.y, m.translation.z])
+             for msg in errors for m in msg.markers]
+    # true model + 0.05 mm marker noise; the tension lags the command by 0.1 s, so frames in
+    # the ramps see up to one step of model error: the median stays at the noise level
+    assert np.median(sizes) < 3e-4
+    assert errors[0].header.frame_id == "tdcm_base"
+    assert len(port.published["metrics/tip_error"]) > 0
+    table = json.loads(port.published["metrics/table"][-1].data)
+    assert table["n_steps"] == 6 and table["n_trials"] == 2
+    assert table["rmse_m"] < 2e-5
+    assert port.published["metrics/rmse_m"][-1].data == pytest.approx(table["rmse_m"])
+    node.report()
+    status = port.published["/diagnostics"][-1].status[0]
+    assert status.level == 0 and status.message == "ok"
+    values = {kv.key: kv.value for kv in status.values}
+    assert values["registration"] == "tf_static"
+
+
+def test_node_estimates_the_registration_without_tf(recording: Recording) -> None:
+    port = Port({"registration.source": "estimate"})
+    node = MetricsNode(port)
+    assert "/tf_static" not in port.subs
+    feed(port, node, recording)
+    table = json.loads(port.published["metrics/table"][-1].data)
+    assert table["details"]["sources"][0]["registration"]["method"] == "estimated"
+    assert table["rmse_m"] < 5e-5
+
+
+def test_stale_inputs_and_no_registration_warn() -> None:
+    port = Port({"registration.source": "tf_static", "stale_s": 0.5})
+    node = MetricsNode(port)
+    port.clock_ns = 10**10
+    node.report()
+    status = port.published["/diagnostics"][-1].status[0]
+    assert status.level == 1
+    assert "no tension for more than 0.5 s" in status.message
+    assert "no markers" in status.message and "no registration" in status.message
+
+
+@pytest.mark.parametrize(("name", "value", "match"), [
+    ("steps.tolerance_n", -1.0, "steps.tolerance_n"),
+    ("align.tolerance_s", 20.0, "align.tolerance_s"),
+    ("registration.source", "guess", "registration.source"),
+    ("markers.arc_lengths", [0.01, 0.2, 0.5], "markers.arc_lengths"),
+    ("deflection_axis", "tip", "deflection_axis"),
+    ("registration.rotation", [0.0, 0.0, 0.0, 0.0], "quaternion"),
+])
+def test_bad_parameters_are_rejected(name: str, value: Any, match: str) -> None:
+    overrides = {name: value}
+    if name == "registration.rotation":
+        overrides["registration.source"] = "parameter"
+    with pytest.raises(InputError, match=match):
+        MetricsNode(Port(overrides))
