@@ -8,7 +8,8 @@ the vector of cell end moments.
 Convergence strategy (``acceleration="auto"``): plain iteration while it contracts fast;
 Anderson mixing once it slows; if that fails, damped relaxation; if that fails, load
 continuation (tension ramped in ``continuation_steps`` warm-started steps). Under a
-loading: Anderson (a quarter of ``max_iter``), then adaptive continuation, then relaxation.
+loading: plain iteration, handing over to Anderson restarted from the initial iterate if it
+slows (a quarter of ``max_iter``), then adaptive continuation, then relaxation.
 Failure after all of them raises :class:`ConvergenceError`. Physical limits are checked
 explicitly: the tendon-offset singularity before iterating and again on the solution, notch
 closure on the solution.
@@ -194,10 +195,10 @@ Strategy = Callable[[_Problem, float, Array, int], _Run]
 def _strategies(settings: SolverSettings, *, loaded: bool) -> list[tuple[str, Strategy, int]]:
     """Strategies to try in order for ``settings.acceleration``, each with its iteration cap.
 
-    Under a loading the moment depends on the shape everywhere, so plain iteration gains
-    nothing over Anderson, which starts at once with a quarter of ``max_iter``; continuation
-    (adaptive steps) comes next and relaxation last, which on a scan of hard loadings rescued
-    more solves than the base order (relaxation before continuation).
+    Under a loading the moment depends on the shape everywhere: plain iteration (cheapest for
+    small loads) hands over to Anderson restarted from the initial iterate as soon as it slows,
+    within a quarter of ``max_iter``; continuation (adaptive steps) comes next and relaxation
+    last, which on a scan of hard loadings rescued more solves than the base order.
     """
     budget = settings.max_iter
     if settings.acceleration != "auto":
@@ -209,7 +210,8 @@ def _strategies(settings: SolverSettings, *, loaded: bool) -> list[tuple[str, St
     if settings.continuation_steps > 0:
         continuation.append(("continuation", partial(_continuation, adaptive=loaded), budget))
     if loaded:
-        return [("anderson", partial(_iterate, mode="anderson"), max(budget // 4, 1)),
+        return [("picard+anderson", partial(_iterate, mode="auto", restart=True),
+                 max(budget // 4, 1)),
                 *continuation, relaxation]
     return [("picard+anderson", partial(_iterate, mode="auto"), budget), relaxation,
             *continuation]
@@ -276,14 +278,16 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
 
 
 def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode: str,
-             factor: float = 1.0, tol: float | None = None) -> _Run:
+             factor: float = 1.0, tol: float | None = None, restart: bool = False) -> _Run:
     """Fixed-point iteration on the cell moments; ``mode`` picks the update rule. ``factor``
-    scales the external loads (continuation); ``tol`` (m) defaults to ``settings.tol``."""
+    scales the external loads (continuation); ``tol`` (m) defaults to ``settings.tol``. With
+    ``restart``, plain iteration that slows down (mode ``auto``) hands over to Anderson from
+    ``x0`` rather than from wherever it has wandered."""
     grid, settings, moment_map, bend = problem
     tol = settings.tol if tol is None else tol
     n = grid.n_cells
     x = x0
-    shape = problem.shape_of(x)
+    shape = start = problem.shape_of(x)
     history: list[float] = []
     using = "picard" if mode == "auto" else mode
     d_x: list[Array] = []
@@ -314,6 +318,8 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
         if mode == "auto" and using == "picard" and len(history) >= 2 and \
                 step > SLOW_CONTRACTION * history[-2]:
             using = "anderson"
+            if restart:
+                x, shape = x0, start
     return _Run(x, shape, history, False,
                 f"budget exhausted, last step {history[-1]:.3g} m" if history else "no budget")
 
