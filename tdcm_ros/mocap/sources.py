@@ -8,6 +8,7 @@ them. The live-driver source needs no state and lives in the node.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -98,14 +99,20 @@ class MarkerWorld(Protocol):
         """Markers of the simulated bench at ``stamp_s`` (s) under ``true_tension`` (N)."""
 
 
-class SimSource:
-    """Samples a scene world's markers and hands each out ``delay_s`` after its stamp."""
+def no_delay() -> float:
+    """A zero latency (s)."""
+    return 0.0
 
-    def __init__(self, world: MarkerWorld, *, delay_s: float = 0.0) -> None:
-        if not (np.isfinite(delay_s) and delay_s >= 0.0):
-            raise out_of_range("delay_s", delay_s, "[0, inf)", unit="s", error=SourceError)
+
+class SimSource:
+    """Samples a scene world's markers and hands each out ``delay()`` s after its stamp.
+
+    ``delay`` is drawn once per frame, so a latency with jitter varies from frame to frame.
+    """
+
+    def __init__(self, world: MarkerWorld, *, delay: Callable[[], float] = no_delay) -> None:
         self.world = world
-        self.delay_ns = round(delay_s * 1e9)
+        self.delay = delay
         self.frame_number = 0
         self._queue: deque[tuple[int, RawFrame]] = deque()
 
@@ -118,8 +125,11 @@ class SimSource:
             raise SourceError(f"scene marker frame has positions of shape {positions.shape} for "
                               f"{len(labels)} labels", parameter="sim.scene", value=positions.shape,
                               allowed=f"({len(labels)}, 3)")
+        delay_s = float(self.delay())
+        if not (np.isfinite(delay_s) and delay_s >= 0.0):
+            raise out_of_range("delay_s", delay_s, "[0, inf)", unit="s", error=SourceError)
         self.frame_number += 1
-        self._queue.append((now_ns + self.delay_ns,
+        self._queue.append((now_ns + round(delay_s * 1e9),
                             RawFrame(now_ns, self.frame_number, labels, positions)))
 
     def due(self, now_ns: int) -> list[RawFrame]:

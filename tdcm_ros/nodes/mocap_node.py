@@ -17,7 +17,7 @@ counters and the source state.
   ``relabel.input_scale`` give m), relabel and republish with the input's stamp and frame number;
 - ``sim``: a scene's world (``sim.scene``): on a timer at the scene's mocap rate, markers for
   the latest ``sim/tension_true`` (0 N until one arrives), published ``world.delay_s("markers")``
-  after their stamp; the registration comes from the scene (``world.mocap_to_base``).
+  (drawn per frame) after their stamp; the registration comes from the scene (``world.mocap_to_base``).
 """
 
 from __future__ import annotations
@@ -280,13 +280,12 @@ class MocapNode(NodeLogic):
 
         scene = load_scene(str(self.port.get_parameter("sim.scene")))
         world = scene.world()
-        self.sim = SimSource(world, delay_s=float(world.delay_s("markers")))
+        self.sim = SimSource(world, delay=lambda: world.delay_s("markers"))
         self.true_tension: float | None = None
         self.port.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
                                       self._on_true_tension, QoS(depth=10))
         self.port.create_timer(1.0 / float(scene.mocap_rate_hz), self._sim_tick)
-        if self.sim.delay_ns:
-            self.port.create_timer(min(0.002, self.sim.delay_ns * 1e-9), self._sim_drain)
+        self.port.create_timer(0.002, self._sim_drain)  # frames become due between ticks
         self.state = f"simulating scene {scene.name!r}; no sim/tension_true yet (0 N)"
         translation, quaternion = world.mocap_to_base
         return Registration(tuple(np.asarray(translation, dtype=float)),

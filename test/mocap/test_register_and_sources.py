@@ -114,7 +114,8 @@ class FakeWorld:
 
 def test_sim_source_samples_the_world_and_delays_frames():
     world = FakeWorld()
-    source = SimSource(world, delay_s=0.25)
+    delays = iter([0.25, 0.5])
+    source = SimSource(world, delay=lambda: next(delays))
     source.sample(2_000_000_000, 5.0)
     source.sample(3_000_000_000, 7.0)
     assert world.calls == [(2.0, 5.0), (3.0, 7.0)]
@@ -122,10 +123,11 @@ def test_sim_source_samples_the_world_and_delays_frames():
     (first,) = source.due(2_250_000_000)
     assert first.stamp_ns == 2_000_000_000 and first.frame_number == 1
     assert first.names == LABELS and np.allclose(first.positions[:, 0], 5e-3)
-    (second,) = source.due(4_000_000_000)
+    assert source.due(3_400_000_000) == []
+    (second,) = source.due(3_500_000_000)
     assert second.frame_number == 2 and np.isnan(second.positions[2]).all()
-    with pytest.raises(SourceError):
-        SimSource(world, delay_s=-1.0)
+    with pytest.raises(SourceError, match="delay_s"):
+        SimSource(world, delay=lambda: -1.0).sample(0, 0.0)
 
     class Broken(FakeWorld):
         def markers(self, stamp_s, true_tension):
