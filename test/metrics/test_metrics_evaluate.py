@@ -131,3 +131,20 @@ def test_markers_never_in_view(tmp_path: Path, capsys: pytest.CaptureFixture[str
     path = write_recording(rec, tmp_path / "hidden")
     err = _error(capsys, str(path))
     assert "m3 never come into view" in err
+
+
+def test_a_bag_cut_mid_write_is_evaluated_up_to_its_last_chunk(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = write_recording(small_recording(trials=3), tmp_path / "whole")
+    mcap = next(path.glob("*.mcap"))
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(mcap.read_bytes()[: int(mcap.stat().st_size * 0.8)])
+    code, doc = run_json(capsys, str(cut), "--set", f"E={TRUE_E}")
+    assert code == 0
+    assert 0 < doc["n_steps"] < 10  # the tail of the third trial is lost with the cut
+    assert any("truncated" in w or "footer" in w for w in doc["details"]["warnings"])
+
+
+def test_json_errors_are_json(bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, doc = run_json(capsys, str(bag), "--markers-topic", "nope")
+    assert code == 2 and doc["error"]["kind"] == "input" and "nope" in doc["error"]["message"]
