@@ -70,6 +70,11 @@ class TensionProfile(Protocol):
     ``s``: node arc lengths (m, shape (n+1,)); ``wrap_angle``: cumulative absolute turning of
     the tendon from the base (rad, (n+1,)); ``tension_base``: tension at the base (N). Returns
     the tension at each node (N, (n+1,)), finite and >= 0.
+
+    The solver calls it inside the fixed point, twice per iteration: first with the wrap angle
+    just before each node's kink, then just after (a chord takes the value after its proximal
+    kink). A successful solve's last call is the "after" call on the converged shape, so a
+    stateful profile (e.g. stick-slip friction) can keep the result of its last call.
     """
 
     def __call__(self, s: Array, wrap_angle: Array, tension_base: float) -> Array: ...
