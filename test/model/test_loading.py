@@ -20,6 +20,7 @@ from tdcm_ros.model import (
     solve,
 )
 from tdcm_ros.model.grid import build_grid
+from tdcm_ros.model.kinematics import integrate
 from tdcm_ros.model.limits import closure_angle
 from tdcm_ros.model.loading import (
     Capstan,
@@ -128,24 +129,35 @@ def test_tension_lost_along_s_deflects_less(routing):
     assert friction.tendon_tension[-1] < 20.0 * np.exp(-0.2 * 0.9 * friction.tip_angle_rad)
 
 
-def test_chord_tension_is_constant_along_the_chord():
+@pytest.mark.parametrize("routing", ["paper", "free"])
+def test_chord_tension_is_constant_along_the_chord(routing):
     design = preset("paper-experiment")
-    cfg = SolverSettings(cells_per_tube=4)
+    cfg = SolverSettings(routing=routing, cells_per_tube=4, cells_per_notch=4)
     seen = []
+
+    def falling(s, wrap, tension):
+        return tension * (1.0 - 0.5 * s / s[-1])
 
     def recording(s, wrap, tension):
         seen.append(wrap.copy())
-        return tension * (1.0 - 0.5 * s / s[-1])
+        return falling(s, wrap, tension)
 
-    result = solve(design, 20.0, settings=cfg, loading=Loading(tension_profile=recording))
+    loading = Loading(tension_profile=recording)
+    result = solve(design, 20.0, settings=cfg, loading=loading)
     grid = result.grid
-    # Cells of one chord (a tube segment under paper routing) share one tension: the moment
-    # there is T times the distance to the chord line, linear in s along a straight chord.
-    chord = grid.chord_cells[grid.chord_start_node[grid.chord_cells] == grid.chord_start_node[
-        grid.chord_cells[1]]]
-    assert chord.size == 4
-    assert np.ptp(result.cell_moments[chord, 0] / np.maximum(
-        result.cell_moments[chord, 0], 1e-30)) == 0.0
+    model = LoadedModel(grid, loading, 20.0)
+    shape = integrate(grid, result.cell_moments[:, 0], result.cell_moments[:, 1])
+    t_a, t_b = model.cell_tensions(shape, 20.0)
+    chords = grid.chord_cells
+    start = grid.chord_start_node[chords]
+    # Every cell of a chord carries the tension just past the chord's proximal node...
+    assert np.array_equal(t_a[chords], t_b[chords])
+    assert np.array_equal(t_a[chords], falling(grid.s_nodes, None, 20.0)[start])
+    # ...while on the offset curve the tension follows the profile node by node.
+    on_curve = grid.constrained_cells
+    assert np.array_equal(t_b[on_curve], falling(grid.s_nodes, None, 20.0)[on_curve + 1])
+    assert np.all(np.diff(t_a) <= 0.0)
+    # The wrap angle never decreases along the tendon.
     assert all(np.all(np.diff(w) >= 0.0) for w in seen)
 
 
