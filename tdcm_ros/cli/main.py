@@ -16,6 +16,7 @@ from tdcm_ros import __version__
 from tdcm_ros.errors import TdcmError
 
 SUBCOMMAND_MODULES: tuple[str, ...] = (
+    "tdcm_ros.cli.demo",
     "tdcm_ros.cli.solve",
     "tdcm_ros.cli.up",
     "tdcm_ros.cli.topic",

@@ -1,0 +1,80 @@
+"""What the demo starts, in which order, with which parameters, all derived from one scene."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.errors import InputError
+from tdcm_ros.model.design import FIELD_SPECS
+from tdcm_ros.scenes import Scene
+
+#: Nodes in start order: consumers first, so nothing published at the start is missed; the
+#: device twin before the driver (the driver opens the twin's pty link).
+NODE_ORDER: tuple[str, ...] = ("model_node", "mocap_node", "metrics_node", "device_twin",
+                               "tension_driver")
+#: Topics the recorder writes: what evaluation needs, plus the live outputs worth replaying.
+RECORDED_TOPICS: tuple[str, ...] = (
+    "tension", "sim/tension_true", "markers", "/tf_static", "tip_pose", "predicted_markers",
+    "midline", "device_state", "/diagnostics")
+
+
+@dataclass(frozen=True)
+class DemoPlan:
+    """One demo run: the scene, its (possibly shortened) schedule and where outputs go."""
+
+    scene: Scene
+    scene_ref: str          #: shipped name or YAML path, as the nodes load it
+    schedule: StepSchedule
+    out: Path
+
+    @property
+    def bag(self) -> Path:
+        """The rosbag2 folder the recorder writes."""
+        return self.out / "bag"
+
+    @property
+    def link(self) -> str:
+        """The device twin's pty link, unique per run."""
+        return os.path.join(tempfile.gettempdir(), f"tdcm_demo_twin_{os.getpid()}")
+
+    def node_overrides(self) -> dict[str, dict[str, Any]]:
+        """Per-node parameters (ROS names), on top of each node's defaults."""
+        scene = self.scene
+        design = {f"design.{name}": float(getattr(scene.design, name)) for name in FIELD_SPECS}
+        design["design.N"] = int(scene.design.N)
+        markers = {"markers.arc_lengths": [float(s) for s in scene.marker_arc_lengths],
+                   "markers.side_deg": float(scene.marker_side_deg)}
+        top = max(self.schedule.levels)
+        return {
+            "model_node": {**design, **markers, "markers.radius": scene.marker_ball_radius},
+            "mocap_node": {"source": "sim", "sim.scene": self.scene_ref,
+                           "labelling.labels": list(scene.marker_labels),
+                           "labelling.arc_lengths": [float(s) for s in scene.marker_arc_lengths]},
+            "metrics_node": {**design, **markers, "markers.radius": scene.marker_ball_radius,
+                             "markers.labels": list(scene.marker_labels)},
+            "device_twin": {"scene": self.scene_ref, "link": self.link},
+            "tension_driver": {"port": self.link, "tension_max": top,
+                               "schedule.levels": [float(v) for v in self.schedule.levels],
+                               "schedule.hold_s": float(self.schedule.hold),
+                               "schedule.trials": int(self.schedule.trials),
+                               "schedule.autostart": True},
+        }
+
+
+def make_plan(scene: Scene, scene_ref: str, out: Path, *, trials: int | None = None,
+              hold_s: float | None = None) -> DemoPlan:
+    """The plan for ``scene``, with the schedule's trials and hold time optionally shortened."""
+    schedule = scene.schedule
+    if trials is not None or hold_s is not None:
+        schedule = replace(schedule, trials=schedule.trials if trials is None else trials,
+                           hold=schedule.hold if hold_s is None else hold_s)
+    if max(schedule.levels) <= 0:
+        raise InputError(f"schedule levels {schedule.levels!r} never tension the tendon; "
+                         "allowed: at least one level > 0 N", parameter="schedule.levels",
+                         value=list(schedule.levels), allowed="a level > 0 N")
+    return DemoPlan(scene, scene_ref, schedule, out)

@@ -1,0 +1,43 @@
+"""After the run: evaluate the demo's bag, write plots and JSON, calibrate E, show the metrics after."""
+
+from __future__ import annotations
+
+import json
+
+from tdcm_ros.demo.plan import DemoPlan
+from tdcm_ros.metrics.geometry import MarkerLayout
+from tdcm_ros.metrics.options import EvaluateOptions
+
+
+def scene_options(plan: DemoPlan) -> EvaluateOptions:
+    """Evaluation options matching the scene: the estimator's design and the marker layout."""
+    scene = plan.scene
+    return EvaluateOptions(design=scene.design, layout=MarkerLayout(
+        labels=tuple(scene.marker_labels), arc_lengths=tuple(scene.marker_arc_lengths),
+        ball_radius=scene.marker_ball_radius, side_deg=scene.marker_side_deg))
+
+
+def report(plan: DemoPlan, *, calibrate: bool) -> None:
+    """Print Table I and the per-step table, write ``plots/`` and ``metrics.json``; calibrate."""
+    from tdcm_ros.cli.evaluate import format_report
+    from tdcm_ros.metrics.api import evaluate_paths
+    from tdcm_ros.metrics.plots import write_plots
+
+    options = scene_options(plan)
+    evaluation = evaluate_paths([plan.bag], options)
+    print(f"\n== evaluation of {plan.bag} (estimator: scene {plan.scene.name!r} nominal design) ==")
+    print(format_report(evaluation))
+    for path in write_plots(evaluation, plan.out / "plots"):
+        print(f"plot written to {path}")
+    results = {"scene": plan.scene.name, "before_calibration": evaluation.to_json()}
+    if calibrate:
+        from tdcm_ros.cli.calibrate import format_report as format_calibration
+        from tdcm_ros.metrics.api import calibrate_paths
+
+        fit = calibrate_paths([plan.bag], ("E",), options)
+        print(f"\n== calibration of E on {plan.bag} (start: the scene's nominal E) ==")
+        print(format_calibration(fit))
+        results["calibration"] = fit.to_json()
+    path = plan.out / "metrics.json"
+    path.write_text(json.dumps(results, indent=2), encoding="utf-8")
+    print(f"metrics written to {path}")

@@ -1,0 +1,154 @@
+"""Run a demo plan: the live graph on the embedded runtime, the bag, then evaluation and calibration.
+
+The demo process joins the graph itself (a zenoh port named ``_tdcm_demo``) to print progress
+and to see the driver report ``schedule_done`` on ``device_state``. Ctrl-C stops the graph
+cleanly (the bag is closed and keeps everything received) and skips the evaluation.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from types import FrameType
+from typing import Any
+
+from tdcm_ros.demo.plan import NODE_ORDER, RECORDED_TOPICS, DemoPlan
+from tdcm_ros.errors import TdcmError
+from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.graph import NodeGraph
+
+log = logging.getLogger("tdcm.demo")
+#: Extra time (s) over the schedule before the demo gives up waiting for ``schedule_done``.
+START_MARGIN_S = 60.0
+#: Time (s) after ``schedule_done`` before the recorder is stopped, so the last samples land.
+SETTLE_S = 0.5
+
+
+class DemoInterrupted(TdcmError):
+    """The user stopped the demo (Ctrl-C or SIGTERM) before the schedule finished."""
+
+    exit_code = 130
+
+
+@dataclass
+class Progress:
+    """Latest values seen on the graph (updated by subscription callbacks)."""
+
+    tension: float | None = None
+    tip_x: float | None = None
+    setpoint: str = ""
+    schedule: str = ""
+    schedule_done: bool = False
+    counts: dict[str, int] = field(default_factory=dict)
+
+    def count(self, topic: str) -> None:
+        """Count one message on ``topic``."""
+        self.counts[topic] = self.counts.get(topic, 0) + 1
+
+    def line(self, elapsed: float) -> str:
+        """One progress line."""
+        tension = "-" if self.tension is None else f"{self.tension:6.2f} N"
+        tip = "-" if self.tip_x is None else f"{self.tip_x * 1e3:6.2f} mm"
+        return (f"  t = {elapsed:5.1f} s  schedule {self.schedule or '-':9s} setpoint "
+                f"{self.setpoint or '-':>7s} N  tension {tension}  predicted tip x {tip}  "
+                f"markers {self.counts.get('markers', 0)}")
+
+
+def _watch(port: Any, progress: Progress) -> None:
+    """Subscribe the topics the progress line shows."""
+    from tdcm_ros.runtime.port import QoS
+
+    def on_tension(message: Any) -> None:
+        progress.tension = float(message.wrench.force.z)
+        progress.count("tension")
+
+    def on_tip(message: Any) -> None:
+        progress.tip_x = float(message.pose.position.x)
+        progress.count("tip_pose")
+
+    def on_state(message: Any) -> None:
+        values = {kv.key: kv.value for kv in message.values}
+        progress.setpoint = values.get("setpoint", progress.setpoint)
+        progress.schedule = values.get("schedule", progress.schedule)
+        progress.schedule_done = progress.schedule_done or values.get("schedule_done") == "true"
+
+    def on_markers(message: Any) -> None:
+        progress.count("markers")
+
+    qos = QoS(depth=10)
+    port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", on_tension, qos)
+    port.create_subscription("tip_pose", "geometry_msgs/msg/PoseStamped", on_tip, qos)
+    port.create_subscription("device_state", "diagnostic_msgs/msg/DiagnosticStatus", on_state,
+                             qos)
+    port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", on_markers, qos)
+
+
+def _graph_alive(graph: NodeGraph) -> None:
+    exited = [c for c in graph.children if not c.running]
+    if exited:
+        names = ", ".join(f"{c.name} (exit {c.process.returncode})" for c in exited)
+        logs = f"; see {graph.log_dir}/<name>.log" if graph.log_dir else ""
+        raise RuntimePortError(f"demo process exited early: {names}{logs}")
+
+
+def record_live(plan: DemoPlan, *, endpoint: str, say: Callable[[str], None] = print,
+                progress_period: float = 2.0) -> Progress:
+    """Run the graph until the driver's schedule is done; the bag is closed on return."""
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    stop = threading.Event()
+
+    def on_signal(signum: int, frame: FrameType | None) -> None:
+        stop.set()
+
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    logs = plan.out / "logs"
+    logs.mkdir(parents=True, exist_ok=True)
+    progress = Progress()
+    graph = NodeGraph(endpoint=endpoint, log_dir=logs, stop_event=stop)
+    context: ZenohContext | None = None
+    try:
+        graph.ensure_router()
+        recorder = graph.start("recorder", [sys.executable, "-m", "tdcm_ros.cli.main", "record",
+                                            str(plan.bag), *RECORDED_TOPICS])
+        context = ZenohContext()
+        _watch(context.create_port("_tdcm_demo"), progress)
+        overrides = plan.node_overrides()
+        for name in NODE_ORDER:
+            if stop.is_set():
+                break
+            graph.start_node(name, overrides=overrides[name],
+                             ready_path=plan.link if name == "device_twin" else None)
+        say(f"graph up: router, recorder, {', '.join(NODE_ORDER)} (logs in {logs})")
+        started = time.monotonic()
+        deadline = started + plan.schedule.duration + START_MARGIN_S
+        next_line = started
+        while not progress.schedule_done:
+            if stop.is_set():
+                raise DemoInterrupted("demo interrupted; the bag so far is closed and readable")
+            _graph_alive(graph)
+            if time.monotonic() > deadline:
+                raise RuntimePortError(
+                    f"the schedule did not finish within {plan.schedule.duration:g} s + "
+                    f"{START_MARGIN_S:g} s (last state {progress.schedule or 'none'}); see {logs}")
+            context.spin_for(0.1)
+            if time.monotonic() >= next_line:
+                say(progress.line(time.monotonic() - started))
+                next_line += progress_period
+        context.spin_for(SETTLE_S)
+        status = graph.stop(recorder)
+        if status not in (0, 130, -signal.SIGINT):
+            raise RuntimePortError(f"the recorder exited with {status}; see {logs}/recorder.log")
+        say(f"schedule done after {time.monotonic() - started:.1f} s; bag closed: {plan.bag}")
+        return progress
+    finally:
+        if context is not None:
+            context.close()
+        graph.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
