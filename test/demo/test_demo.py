@@ -1,0 +1,104 @@
+"""``tdcm demo`` end to end on a shortened schedule, and its input checks."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from tdcm_ros.bagio.reader import open_bag
+from tdcm_ros.cli.main import main
+from tdcm_ros.demo.plan import NODE_ORDER, make_plan
+from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.registry import NODES
+from tdcm_ros.scenes import load_scene
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _run_demo(out: Path, *args: str) -> subprocess.CompletedProcess[str]:
+    pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    env.pop("TDCM_ZENOH_ENDPOINT", None)
+    return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "demo", "--out", str(out),
+                           "--trials", "1", "--hold", "2.5", *args],
+                          env=env, cwd=REPO, capture_output=True, text=True, timeout=240,
+                          check=False)
+
+
+def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: Path) -> None:
+    done = _run_demo(tmp_path / "ideal", "--scene", "ideal", "--no-calibrate")
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    reader = open_bag(tmp_path / "ideal" / "bag")
+    for topic in ("/tension", "/markers", "/tf_static", "/tip_pose", "/sim/tension_true"):
+        assert reader.counts[topic] > 0, topic
+    assert not reader.warnings
+    metrics = json.loads((tmp_path / "ideal" / "metrics.json").read_text())["before_calibration"]
+    assert metrics["n_trials"] == 1
+    assert metrics["n_steps"] == 6
+    levels = sorted(round(step["tension"]) for step in metrics["steps"])
+    assert levels == [0, 4, 8, 12, 16, 20]
+    # The world is the estimator's model: what is left is the load-cell reading versus the true
+    # tension inside a hold and the 3-marker spline; both are far below a Vicon's noise.
+    assert metrics["rmse_m"] < 2e-5
+    assert metrics["mae_m"] < 2e-5
+    assert metrics["mape_pct"] < 0.5
+    assert metrics["shape_error_m"] < 1e-4
+    assert (tmp_path / "ideal" / "plots" / "shapes.png").stat().st_size > 0
+
+
+def test_paper_scene_demo_calibrates_into_the_papers_range(tmp_path: Path) -> None:
+    done = _run_demo(tmp_path / "paper", "--scene", "paper_experiment")
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    results = json.loads((tmp_path / "paper" / "metrics.json").read_text())
+    before = results["before_calibration"]
+    calibration = results["calibration"]
+    after = calibration["after"]
+    # Datasheet E (1.85 GPa) against a 0.70 GPa world: the tip is predicted far too stiff.
+    assert before["mape_pct"] > 40.0
+    # After fitting E: the paper's Table I range (MAPE 2.51 %, RMSE 0.54 mm, shape 0.85 mm),
+    # with margin for a single shortened trial.
+    assert after["mape_pct"] < 8.0
+    assert after["rmse_m"] < 1e-3
+    assert after["shape_error_m"] < 1.5e-3
+    fitted = calibration["parameters"]["E"]
+    assert fitted["ci_low"] <= fitted["value"] <= fitted["ci_high"]
+    assert 0.6e9 < fitted["value"] < 0.9e9
+    assert "Table I" in done.stdout
+
+
+def test_demo_refuses_an_output_folder_that_holds_a_bag(tmp_path: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "bag").mkdir()
+    assert main(["demo", "--out", str(tmp_path), "--scene", "ideal"]) == 2
+    assert "already holds a bag" in capsys.readouterr().err
+
+
+def test_demo_rejects_an_unknown_scene(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo", "--out", str(tmp_path), "--scene", "no_such_scene"]) == 2
+    assert "no_such_scene" in capsys.readouterr().err
+    assert not (tmp_path / "bag").exists()
+
+
+def test_demo_rejects_a_schedule_that_never_tensions(tmp_path: Path) -> None:
+    scene = load_scene("ideal")
+    plan = make_plan(scene, "ideal", tmp_path, trials=2, hold_s=1.0)
+    assert plan.schedule.trials == 2 and plan.schedule.hold == 1.0
+    idle = replace(scene, schedule=StepSchedule(levels=(0.0,), hold=1.0, trials=1))
+    with pytest.raises(InputError, match="schedule.levels"):
+        make_plan(idle, "ideal", tmp_path)
+
+
+def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
+    plan = make_plan(load_scene("paper_experiment"), "paper_experiment", tmp_path)
+    overrides = plan.node_overrides()
+    assert set(overrides) == set(NODE_ORDER) <= set(NODES)
+    assert overrides["tension_driver"]["port"] == overrides["device_twin"]["link"]
+    assert overrides["model_node"]["design.E"] == pytest.approx(1.85e9)
