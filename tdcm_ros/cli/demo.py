@@ -15,6 +15,7 @@ import socket
 import time
 from pathlib import Path
 
+from tdcm_ros.demo.plan import RECORDED_TOPICS, make_plan
 from tdcm_ros.errors import InputError
 
 
@@ -24,12 +25,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--scene", default="paper_experiment",
                         help="shipped scene name or scene YAML path (default paper_experiment)")
     parser.add_argument("--out", default=None,
-                        help="output folder (default tdcm_demo/<scene>-<time>); must not hold a bag")
+                        help="output folder: logs, plots, metrics.json (default tdcm_demo/<scene>-<time>)")
     parser.add_argument("--trials", type=int, default=None,
                         help="override the scene's number of trials")
     parser.add_argument("--hold", type=float, default=None,
                         help="override the scene's hold time per level (s)")
     parser.add_argument("--no-calibrate", action="store_true", help="skip the calibration of E")
+    parser.add_argument("--bag", default=None,
+                        help="where the recorder writes the bag (default OUT/bag; must not exist)")
+    parser.add_argument("--record", default=",".join(RECORDED_TOPICS),
+                        help="comma-separated topics to record (default: %(default)s)")
     parser.add_argument("--endpoint", default=None,
                         help="zenoh router endpoint (default: a private router on a free port)")
     parser.set_defaults(handler=run)
@@ -42,19 +47,19 @@ def _free_endpoint() -> str:
 
 
 def _out_dir(requested: str | None, scene_name: str) -> Path:
-    out = Path(requested) if requested else Path("tdcm_demo") / (
+    return Path(requested) if requested else Path("tdcm_demo") / (
         f"{scene_name}-{time.strftime('%Y%m%d-%H%M%S')}")
-    if (out / "bag").exists():
-        raise InputError(f"--out {str(out)!r} already holds a bag; allowed: a new or empty folder "
-                         "(recorded data is never overwritten)", parameter="--out",
-                         value=str(out), allowed="a folder without bag/")
-    out.mkdir(parents=True, exist_ok=True)
-    return out
+
+
+def _check_new(bag: Path, option: str) -> None:
+    if bag.exists():
+        raise InputError(f"{option} {str(bag)!r} already exists; allowed: a path that does not "
+                         "exist yet (recorded data is never overwritten)", parameter=option,
+                         value=str(bag), allowed="a new path")
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the demo; returns the exit status."""
-    from tdcm_ros.demo.plan import make_plan
     from tdcm_ros.demo.report import report
     from tdcm_ros.demo.run import record_live
     from tdcm_ros.runtime.run_node import configure_logging
@@ -64,8 +69,12 @@ def run(args: argparse.Namespace) -> int:
     configure_logging("WARNING")
     started = time.monotonic()
     scene = load_scene(args.scene)
-    plan = make_plan(scene, args.scene, _out_dir(args.out, scene.name), trials=args.trials,
-                     hold_s=args.hold)
+    out = _out_dir(args.out, scene.name)
+    topics = tuple(t.strip() for t in args.record.split(",") if t.strip())
+    plan = make_plan(scene, args.scene, out, trials=args.trials, hold_s=args.hold,
+                     bag=Path(args.bag) if args.bag else None, recorded_topics=topics)
+    _check_new(plan.bag, "--bag" if args.bag else "--out")
+    out.mkdir(parents=True, exist_ok=True)
     endpoint = args.endpoint or _free_endpoint()
     os.environ[ENDPOINT_ENV] = endpoint
     levels = ", ".join(f"{v:g}" for v in plan.schedule.levels)

@@ -21,6 +21,8 @@ NODE_ORDER: tuple[str, ...] = ("model_node", "mocap_node", "metrics_node", "devi
 RECORDED_TOPICS: tuple[str, ...] = (
     "tension", "sim/tension_true", "markers", "/tf_static", "tip_pose", "predicted_markers",
     "midline", "device_state", "/diagnostics")
+#: Topics the evaluation after the run reads.
+EVALUATED_TOPICS: tuple[str, ...] = ("tension", "markers", "/tf_static")
 
 
 @dataclass(frozen=True)
@@ -31,11 +33,8 @@ class DemoPlan:
     scene_ref: str          #: shipped name or YAML path, as the nodes load it
     schedule: StepSchedule
     out: Path
-
-    @property
-    def bag(self) -> Path:
-        """The rosbag2 folder the recorder writes."""
-        return self.out / "bag"
+    bag: Path                            #: the rosbag2 folder the recorder writes
+    recorded_topics: tuple[str, ...] = RECORDED_TOPICS
 
     @property
     def link(self) -> str:
@@ -67,8 +66,10 @@ class DemoPlan:
 
 
 def make_plan(scene: Scene, scene_ref: str, out: Path, *, trials: int | None = None,
-              hold_s: float | None = None) -> DemoPlan:
-    """The plan for ``scene``, with the schedule's trials and hold time optionally shortened."""
+              hold_s: float | None = None, bag: Path | None = None,
+              recorded_topics: tuple[str, ...] = RECORDED_TOPICS) -> DemoPlan:
+    """The plan for ``scene``: outputs in ``out`` (the bag in ``bag``, default ``out/bag``), the
+    schedule's trials and hold time optionally shortened, ``recorded_topics`` in the bag."""
     schedule = scene.schedule
     if trials is not None or hold_s is not None:
         schedule = replace(schedule, trials=schedule.trials if trials is None else trials,
@@ -77,4 +78,10 @@ def make_plan(scene: Scene, scene_ref: str, out: Path, *, trials: int | None = N
         raise InputError(f"schedule levels {schedule.levels!r} never tension the tendon; "
                          "allowed: at least one level > 0 N", parameter="schedule.levels",
                          value=list(schedule.levels), allowed="a level > 0 N")
-    return DemoPlan(scene, scene_ref, schedule, out)
+    missing = [t for t in EVALUATED_TOPICS if t not in recorded_topics]
+    if missing:
+        raise InputError(f"recorded topics {list(recorded_topics)} lack {missing}, which the "
+                         f"evaluation reads; allowed: any list including {list(EVALUATED_TOPICS)}",
+                         parameter="--record", value=list(recorded_topics),
+                         allowed=f"includes {', '.join(EVALUATED_TOPICS)}")
+    return DemoPlan(scene, scene_ref, schedule, out, bag or out / "bag", recorded_topics)

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from types import FrameType
 from typing import Any
 
-from tdcm_ros.demo.plan import NODE_ORDER, RECORDED_TOPICS, DemoPlan
+from tdcm_ros.demo.plan import NODE_ORDER, DemoPlan
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.graph import NodeGraph
@@ -115,7 +115,7 @@ def record_live(plan: DemoPlan, *, endpoint: str, say: Callable[[str], None] = p
     try:
         graph.ensure_router()
         recorder = graph.start("recorder", [sys.executable, "-m", "tdcm_ros.cli.main", "record",
-                                            str(plan.bag), *RECORDED_TOPICS])
+                                            str(plan.bag), *plan.recorded_topics])
         context = ZenohContext()
         _watch(context.create_port("_tdcm_demo"), progress)
         overrides = plan.node_overrides()

@@ -27,7 +27,7 @@ def _run_demo(out: Path, *args: str) -> subprocess.CompletedProcess[str]:
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(
         [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])])}
     env.pop("TDCM_ZENOH_ENDPOINT", None)
-    return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "demo", "--out", str(out),
+    return subprocess.run([sys.executable, "-m", "tdcm_ros", "demo", "--out", str(out),
                            "--trials", "1", "--hold", "2.5", *args],
                           env=env, cwd=REPO, capture_output=True, text=True, timeout=240,
                           check=False)
@@ -74,11 +74,19 @@ def test_paper_scene_demo_calibrates_into_the_papers_range(tmp_path: Path) -> No
     assert "Table I" in done.stdout
 
 
-def test_demo_refuses_an_output_folder_that_holds_a_bag(tmp_path: Path,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_demo_never_overwrites_a_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / "bag").mkdir()
+    (tmp_path / "bag" / "keep.mcap").write_bytes(b"recorded")
     assert main(["demo", "--out", str(tmp_path), "--scene", "ideal"]) == 2
-    assert "already holds a bag" in capsys.readouterr().err
+    assert "already exists" in capsys.readouterr().err
+    assert main(["demo", "--out", str(tmp_path / "x"), "--bag", str(tmp_path / "bag")]) == 2
+    assert (tmp_path / "bag" / "keep.mcap").read_bytes() == b"recorded"
+
+
+def test_demo_refuses_to_record_without_the_evaluated_topics(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo", "--out", str(tmp_path), "--record", "tension,markers"]) == 2
+    assert "/tf_static" in capsys.readouterr().err
 
 
 def test_demo_rejects_an_unknown_scene(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
