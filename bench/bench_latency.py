@@ -297,6 +297,9 @@ def soak_report(phase: Phase) -> None:
     print(f"model_node RSS: start {kib[0] / 1024:.1f} MiB, end {kib[-1] / 1024:.1f} MiB, "
           f"max {kib.max() / 1024:.1f} MiB, slope {slope:+.2f} KiB/s over the run "
           f"({late:+.2f} KiB/s over the second half), {len(kib)} samples")
+    every = max(1, len(kib) // 12)
+    series = " ".join(f"{k / 1024:.1f}" for k in kib[::every])
+    print(f"RSS (MiB) every ~{every} s: {series}")
     print(f"coalesced inputs (from /diagnostics): {phase.coalesced} of {phase.sent} sent; "
           f"solved {phase.solved}")
 
