@@ -8,8 +8,6 @@ each holds ``<pkg>/msg/<Name>.msg``.
 
 from __future__ import annotations
 
-import os
-import sys
 from functools import cache
 from pathlib import Path
 from typing import Any
@@ -18,6 +16,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.resources import resource_dirs
 
 STORE = Stores.ROS2_JAZZY
 MSG_DEFS_ENV = "TDCM_MSG_DEFS"
@@ -25,26 +24,7 @@ MSG_DEFS_ENV = "TDCM_MSG_DEFS"
 
 def msg_defs_dirs() -> list[Path]:
     """Existing ``msg_defs`` directories, in search order."""
-    candidates = [Path(p) for p in os.environ.get(MSG_DEFS_ENV, "").split(os.pathsep) if p]
-    candidates.append(Path(__file__).resolve().parents[2] / "msg_defs")
-    candidates.append(Path(sys.prefix) / "share" / "tdcm_ros" / "msg_defs")
-    candidates.extend(_ament_share())
-    return [p for p in candidates if p.is_dir()]
-
-
-def _ament_share() -> list[Path]:
-    """``<share>/tdcm_ros/msg_defs`` of a colcon install, where ament_index is available."""
-    try:
-        from ament_index_python.packages import (
-            PackageNotFoundError,
-            get_package_share_directory,
-        )
-    except ImportError:
-        return []
-    try:
-        return [Path(get_package_share_directory("tdcm_ros")) / "msg_defs"]
-    except PackageNotFoundError:
-        return []
+    return resource_dirs("msg_defs", MSG_DEFS_ENV)
 
 
 def _msg_files() -> dict[str, Path]:
