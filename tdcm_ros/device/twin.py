@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import math
 import os
 import select
 import signal
@@ -23,7 +24,7 @@ import threading
 import time
 import tty
 from collections import deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import fields
 from typing import Self
@@ -96,13 +97,18 @@ class PtyTwin:
 
     With ``link`` the port is a symlink to the current pty, kept pointing at the new one by
     :meth:`reopen` (a cable pulled and plugged back). Bytes the twin sends while nobody reads
-    are dropped once the pty buffer is full, as a UART would.
+    are dropped once the pty buffer is full, as a UART would. With ``line_delay``, each line the
+    device sends reaches the pty ``line_delay()`` s (drawn per line) later, in order.
     """
 
-    def __init__(self, twin: DeviceTwin, *, speed: float = 1.0, link: str | None = None) -> None:
+    def __init__(self, twin: DeviceTwin, *, speed: float = 1.0, link: str | None = None,
+                 line_delay: Callable[[], float] | None = None) -> None:
         if not speed > 0:
             raise out_of_range("speed", speed, "> 0", error=DeviceInputError)
         self.twin = twin
+        self.line_delay = line_delay
+        self._delayed: deque[tuple[float, bytes]] = deque()
+        self._partial = b""
         self.speed = speed
         self.link = link
         self._lock = threading.Lock()
@@ -151,8 +157,30 @@ class PtyTwin:
         if data:
             self.twin.receive(data)
 
+    def _delay_lines(self, out: bytes) -> bytes:
+        """Queue each complete line ``line_delay()`` s (host time) after now, in order (a serial
+        line cannot reorder); return the bytes now due."""
+        assert self.line_delay is not None
+        now = time.monotonic()
+        *lines, self._partial = (self._partial + out).split(b"\n")
+        for line in lines:
+            delay = float(self.line_delay())
+            if not (math.isfinite(delay) and delay >= 0.0):
+                raise out_of_range("line_delay", delay, "[0, inf)", unit="s",
+                                   error=DeviceInputError)
+            due = now + delay
+            if self._delayed:
+                due = max(due, self._delayed[-1][0])
+            self._delayed.append((due, line + b"\n"))
+        ready = bytearray()
+        while self._delayed and self._delayed[0][0] <= now:
+            ready += self._delayed.popleft()[1]
+        return bytes(ready)
+
     def _flush(self) -> None:
         out = self.twin.take_output()
+        if self.line_delay is not None:
+            out = self._delay_lines(out)
         try:
             os.write(self._master, out)
         except BlockingIOError:

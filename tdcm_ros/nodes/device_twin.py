@@ -4,7 +4,8 @@ Serves :class:`tdcm_ros.device.twin.PtyTwin` in real time (times ``speed``) behi
 ``link`` (default ``<tmp>/tdcm_twin_<pid>``), which ``tension_driver`` opens as its ``port``.
 The plant is :class:`tdcm_ros.device.plant.PlantConfig` from the ``plant.<field>`` parameters;
 with ``scene`` set (a shipped scene name or a YAML path) their defaults come from
-``load_scene(scene).plant_config()`` and explicit ``plant.*`` values still override them.
+``load_scene(scene).plant_config()`` and explicit ``plant.*`` values still override them, and the
+scene's ``latency`` effect delays every line the device sends by its ``tension`` delay.
 
 Publishes ``sim/tension_true`` (``geometry_msgs/msg/WrenchStamped``): the true tendon tension
 (N, ``wrench.force.z``, frame ``frame_id``) at every load-cell sample, stamped with the host time
@@ -16,6 +17,7 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+from collections.abc import Callable
 from dataclasses import fields
 from typing import Any
 
@@ -34,18 +36,21 @@ PLANT_UNITS = {"stroke": "m", "lag": "s", "rate": "m/s", "stiffness": "N/m", "sl
                "bias": "N", "drift": "N/s"}
 
 
-def scene_plant(scene: str) -> PlantConfig:
-    """The plant of a scene (imported lazily: scenes are optional for this node)."""
+def scene_bench(scene: str) -> tuple[PlantConfig, Callable[[], float]]:
+    """A scene's plant and its serial-line latency (s per line, the ``latency`` effect's
+    ``tension`` delay; 0 without it). Imported lazily: scenes are optional for this node."""
     try:
         from tdcm_ros.scenes import load_scene
     except ImportError as error:
         raise InputError(f"scene = {scene!r} needs tdcm_ros.scenes, which cannot be imported: "
                          f"{error}", parameter="scene", value=scene) from error
-    config = load_scene(scene).plant_config()
+    loaded = load_scene(scene)
+    config = loaded.plant_config()
     if not isinstance(config, PlantConfig):
         raise InputError(f"scene = {scene!r} gave a {type(config).__name__}, not a PlantConfig",
                          parameter="scene", value=scene)
-    return config
+    world = loaded.world()
+    return config, lambda: world.delay_s("tension")
 
 
 def default_link() -> str:
@@ -74,7 +79,7 @@ class DeviceTwinNode(NodeLogic):
         declare = port.declare_parameter
         scene = str(declare("scene", "", read_only=True,
                             description="scene name or YAML path giving the plant (optional)"))
-        base = scene_plant(scene) if scene.strip() else PlantConfig()
+        base, line_delay = scene_bench(scene) if scene.strip() else (PlantConfig(), None)
         values: dict[str, Any] = {}
         for field in fields(PlantConfig):
             unit = PLANT_UNITS.get(field.name, "")
@@ -104,7 +109,8 @@ class DeviceTwinNode(NodeLogic):
                                            QoS(depth=100))
         self.diagnostics = port.create_publisher("/diagnostics",
                                                  "diagnostic_msgs/msg/DiagnosticArray", QoS(depth=10))
-        self.server = PtyTwin(DeviceTwin(plant), speed=speed, link=link).start()
+        self.server = PtyTwin(DeviceTwin(plant), speed=speed, link=link,
+                              line_delay=line_delay).start()
         self.samples = 0
         port.create_timer(period, self.publish_truth)
         port.create_timer(diag_period, self.report)

@@ -77,3 +77,40 @@ def test_loop_url_transport_round_trip() -> None:
 def test_missing_port_is_a_port_error(tmp_path: Path) -> None:
     with pytest.raises(PortError, match="cannot open"):
         open_transport(str(tmp_path / "nothing"))
+
+
+def test_line_delay_holds_the_devices_lines_back_in_order() -> None:
+    """With ``line_delay`` what the device sends reaches the host only after the delay, whole
+    lines in order; a negative delay is a typed error."""
+    import time
+
+    from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+
+    server = PtyTwin(DeviceTwin(), line_delay=lambda: 0.3)
+    host = os.open(server.port, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+
+    def read() -> bytes:
+        try:
+            return os.read(host, 65536)
+        except BlockingIOError:
+            return b""
+
+    try:
+        server.pump(0.1)                          # banner and telemetry, all held back
+        assert read() == b""
+        time.sleep(0.35)
+        server.pump(0.0)
+        lines = read().split(b"\n")
+        assert len(lines) > 2 and lines[-1] == b""
+        decoder = LineDecoder()
+        frames = [m for line in lines[:-1] for m in decoder.feed(line + b"\n")]
+        assert isinstance(frames[0], Banner)
+        times = [f.time for f in frames if isinstance(f, Telemetry)]
+        assert times == sorted(times) and times
+        server.line_delay = lambda: -1.0
+        server.twin.receive(encode(Info()))
+        with pytest.raises(InputError, match="line_delay"):
+            server.pump(0.05)
+    finally:
+        os.close(host)
+        server.stop()
