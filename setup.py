@@ -22,7 +22,7 @@ setup(
     ],
     package_data={PACKAGE: ["py.typed"]},
     include_package_data=True,
-    python_requires=">=3.10",
+    python_requires=">=3.11",
     install_requires=[
         "numpy>=1.24",
         "scipy>=1.10",
