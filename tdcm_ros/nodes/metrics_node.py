@@ -44,20 +44,13 @@ from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.model import FIELD_SPECS, preset
 from tdcm_ros.model.design import PRESETS
 from tdcm_ros.nodes.shape_messages import header
+from tdcm_ros.runtime.parameters import one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
 
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
 TABLE_TOPICS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m")
 BASE_FRAME = "tdcm_base"
-
-
-def _one_of(name: str, allowed: tuple[str, ...]) -> Any:
-    def check(value: Any) -> None:
-        if value not in allowed:
-            raise InputError(f"{name} = {value!r} is invalid; allowed: {', '.join(allowed)}",
-                             parameter=name, value=value, allowed=", ".join(allowed))
-    return check
 
 
 def _stamp_s(message: Any) -> float:
@@ -75,7 +68,7 @@ class MetricsNode(NodeLogic):
         declare = port.declare_parameter
         self.source = str(declare("registration.source", "auto", read_only=True,
                                   description="auto, tf_static, parameter or estimate",
-                                  validator=_one_of("registration.source",
+                                  validator=one_of("registration.source",
                                                     REGISTRATION_SOURCES)))
         translation = declare("registration.translation", [0.0, 0.0, 0.0], read_only=True,
                               description="tdcm_base origin in mocap (m), source=parameter")
@@ -123,7 +116,7 @@ class MetricsNode(NodeLogic):
         declare = self.port.declare_parameter
         name = str(declare("design.preset", "paper-experiment", read_only=True,
                            description="design preset the fields start from",
-                           validator=_one_of("design.preset", tuple(PRESETS))))
+                           validator=one_of("design.preset", tuple(PRESETS))))
         base = preset(name)
         fields = {f: declare(f"design.{f}", getattr(base, f), read_only=True,
                              range=(spec.low, spec.high),
@@ -155,7 +148,7 @@ class MetricsNode(NodeLogic):
                                  description="arc-length stations of the shape error")),
             deflection_axis=str(declare("deflection_axis", "marker", read_only=True,
                                         description="marker or body",
-                                        validator=_one_of("deflection_axis", DEFLECTION_AXES))))
+                                        validator=one_of("deflection_axis", DEFLECTION_AXES))))
 
     def _on_tension(self, message: Any) -> None:
         value = float(message.wrench.force.z)

@@ -49,6 +49,7 @@ from tdcm_ros.mocap import (
 from tdcm_ros.mocap.labelling import Labeller
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.names import resolve_topic
+from tdcm_ros.runtime.parameters import one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
 
@@ -58,14 +59,6 @@ AXES = ("straight", "predicted")
 REGISTRATION_MODES = ("quaternion", "rpy", "estimate")
 MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
 USE_BOTH = 2   # mocap4r2_msgs/Marker.id_type: name and index are both meaningful
-
-
-def _one_of(name: str, allowed: tuple[str, ...]) -> Callable[[Any], None]:
-    def check(value: Any) -> None:
-        if value not in allowed:
-            raise InputError(f"{name} = {value!r} is invalid; allowed: {', '.join(allowed)}",
-                             parameter=name, value=value, allowed=", ".join(allowed))
-    return check
 
 
 def _length(name: str, size: int) -> Callable[[Any], None]:
@@ -114,7 +107,7 @@ class MocapNode(NodeLogic):
     def _declare(self) -> None:
         declare = self.port.declare_parameter
         declare("source", "csv", read_only=True, description="csv, relabel or sim",
-                validator=_one_of("source", SOURCES))
+                validator=one_of("source", SOURCES))
         declare("frame_id", "mocap", read_only=True, description="frame of the markers (Vicon world)")
         declare("base_frame_id", "tdcm_base", read_only=True,
                 description="child frame of the published registration")
@@ -130,7 +123,7 @@ class MocapNode(NodeLogic):
                 description="m per input position unit (0.001 if the driver sends mm)")
         declare("sim.scene", "ideal", read_only=True, description="scene name or YAML path (sim)")
         declare("labelling.mode", "name", read_only=True, description="name or arc_length",
-                validator=_one_of("labelling.mode", LABELLING_MODES))
+                validator=one_of("labelling.mode", LABELLING_MODES))
         declare("labelling.labels", ["m1", "m2", "m3"], read_only=True,
                 description="published labels, base to tip")
         declare("labelling.map", ["m1=m1", "m2=m2", "m3=m3"], read_only=True,
@@ -139,7 +132,7 @@ class MocapNode(NodeLogic):
                 description="arc length of each label (m)")
         declare("labelling.axis", "straight", read_only=True,
                 description="arc_length axis: straight or predicted (latest axis topic)",
-                validator=_one_of("labelling.axis", AXES))
+                validator=one_of("labelling.axis", AXES))
         declare("labelling.axis_topic", "midline_poses", read_only=True,
                 description="PoseArray midline in base_frame_id (axis predicted)")
         declare("labelling.body_length", 0.053, range=(1e-3, 2.0), read_only=True,
@@ -148,7 +141,7 @@ class MocapNode(NodeLogic):
                 description="largest marker distance from the label's axis point (m)")
         declare("registration.mode", "quaternion", read_only=True,
                 description="quaternion, rpy or estimate (ignored by source sim)",
-                validator=_one_of("registration.mode", REGISTRATION_MODES))
+                validator=one_of("registration.mode", REGISTRATION_MODES))
         declare("registration.translation", [0.0, 0.0, 0.0], range=(-1e3, 1e3), read_only=True,
                 description="tdcm_base origin in mocap (m)",
                 validator=_length("registration.translation", 3))

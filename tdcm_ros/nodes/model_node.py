@@ -28,20 +28,13 @@ from tdcm_ros.errors import InputError, PhysicsError
 from tdcm_ros.model import FIELD_SPECS, SolveResult, SolverSettings, preset, solve
 from tdcm_ros.model.design import PRESETS, Design
 from tdcm_ros.nodes.shape_messages import header, midline_messages
+from tdcm_ros.runtime.parameters import one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
 SOLVER_FIELDS = {"routing": "paper", "loads": "closed", "cells_per_notch": 4,
                  "cells_per_tube": 1, "quad_order": 4, "tol": 1e-10, "max_iter": 200}
-
-
-def _one_of(name: str, allowed: tuple[str, ...]) -> Any:
-    def check(value: Any) -> None:
-        if value not in allowed:
-            raise InputError(f"{name} = {value!r} is invalid; allowed: {', '.join(allowed)}",
-                             parameter=name, value=value, allowed=", ".join(allowed))
-    return check
 
 
 class ModelNode(NodeLogic):
@@ -54,12 +47,12 @@ class ModelNode(NodeLogic):
         declare = port.declare_parameter
         self.tension_type = str(declare(
             "input.tension_type", TENSION_TYPES[0], read_only=True,
-            description="message type on `tension`", validator=_one_of("input.tension_type",
+            description="message type on `tension`", validator=one_of("input.tension_type",
                                                                       TENSION_TYPES)))
         self.frame_id = str(declare("frame_id", "tdcm_base", description="frame of all outputs"))
         base_name = str(declare("design.preset", "paper-experiment", read_only=True,
                                 description="design preset the fields start from",
-                                validator=_one_of("design.preset", tuple(PRESETS))))
+                                validator=one_of("design.preset", tuple(PRESETS))))
         base = preset(base_name)
         for name, spec in FIELD_SPECS.items():
             declare(f"design.{name}", getattr(base, name), range=(spec.low, spec.high),
@@ -70,7 +63,7 @@ class ModelNode(NodeLogic):
         declare("markers.arc_lengths", [0.015, 0.033, 0.053],
                 description="arc lengths (m) of the predicted markers")
         declare("markers.placement", "surface", description="surface or midline",
-                validator=_one_of("markers.placement", ("surface", "midline")))
+                validator=one_of("markers.placement", ("surface", "midline")))
         declare("markers.radius", 0.001, range=(0.0, 0.05), description="marker ball radius (m)")
         declare("markers.side_deg", 180.0, range=(-360.0, 360.0),
                 description="marker side around the body z axis from the tendon side (deg)")
