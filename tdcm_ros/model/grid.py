@@ -17,7 +17,7 @@ Grids depend only on the design and the discretisation settings and are cached.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 import numpy as np
@@ -30,8 +30,12 @@ from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+#: ``(cells, A0_s, A1_s, A0_r, A1_r, w_r)`` of :meth:`Grid.query`.
+Query = tuple[IntArray, Array, Array, Array, Array, Array]
 
 PEAK_SAMPLES = 17
+#: Distinct query station sets a grid keeps (see :meth:`Grid.query`).
+QUERY_CACHE_SIZE = 8
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,6 +70,7 @@ class Grid:
     peak_s: Array
     notch_left_node: IntArray
     notch_right_node: IntArray
+    _queries: dict[bytes, Query] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def constrained_cells(self) -> IntArray:
@@ -121,6 +126,21 @@ class Grid:
             return u_lin
         ratio = np.clip(1.0 - 2.0 * sigma / self.design.w_n, -1.0, 1.0)
         return np.where(self.is_notch[cells], np.arccos(ratio) / np.pi, u_lin)
+
+    def query(self, s: Array) -> Query:
+        """Cells of arc lengths ``s`` (m) and their :meth:`partial_integrals`, kept for the last
+        ``QUERY_CACHE_SIZE`` distinct ``s`` (a node asks for the same stations at every input).
+        The arrays are shared: callers must not modify them."""
+        key = s.tobytes()
+        found = self._queries.get(key)
+        if found is None:
+            cells = np.clip(np.searchsorted(self.s_nodes, s, side="right") - 1, 0,
+                            self.n_cells - 1)
+            found = (cells, *self.partial_integrals(cells, s))
+            if len(self._queries) >= QUERY_CACHE_SIZE:
+                del self._queries[next(iter(self._queries))]
+            self._queries[key] = found
+        return found
 
     def partial_integrals(self, cells: IntArray, s: Array
                           ) -> tuple[Array, Array, Array, Array, Array]:

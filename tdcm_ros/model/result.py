@@ -123,13 +123,10 @@ class SolveResult:
         length = self.design.length
         if not np.all(np.isfinite(query)) or np.any(query < 0.0) or np.any(query > length):
             raise out_of_range("s", query.tolist(), f"[0, {length:g}] m")
-        grid = self.grid
-        cells = np.clip(np.searchsorted(grid.s_nodes, query, side="right") - 1, 0,
-                        grid.n_cells - 1)
+        cells, a0_s, a1_s, a0_r, a1_r, w_r = self.grid.query(query)
         moments = self.bend_moments
         m_a = moments[cells, 0]
         m_b = moments[cells, 1]
-        a0_s, a1_s, a0_r, a1_r, w_r = grid.partial_integrals(cells, query)
         phi_r = m_a[:, None] * a0_r + m_b[:, None] * a1_r
         along = np.sum(w_r * np.cos(phi_r), axis=1)
         across = np.sum(w_r * np.sin(phi_r), axis=1)

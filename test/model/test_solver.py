@@ -159,3 +159,23 @@ def test_warm_start_reaches_the_same_shape():
     warm = solve(design, 21.0, warm_start=cold)
     again = solve(design, 21.0)
     assert np.allclose(warm.positions, again.positions, atol=1e-9)
+
+
+def test_pose_at_reuses_a_grids_query_stations_without_changing_the_answer():
+    """Repeated stations hit the grid's cache; the poses equal a fresh grid's to the bit."""
+    from tdcm_ros.model.grid import QUERY_CACHE_SIZE
+
+    design = preset("paper-experiment")
+    first = solve(design, 12.0)
+    stations = np.linspace(0.0, design.length, 54)
+    before = first.pose_at(stations)
+    second = solve(design, 20.0)                  # same cached grid, other moments
+    assert second.grid is first.grid
+    cached = second.pose_at(stations)
+    first.grid._queries.clear()
+    fresh = second.pose_at(stations)
+    assert np.array_equal(cached[0], fresh[0]) and np.array_equal(cached[1], fresh[1])
+    assert not np.allclose(before[0], cached[0])
+    for k in range(QUERY_CACHE_SIZE + 3):         # bounded: old station sets are dropped
+        second.pose_at(stations[: k + 2])
+    assert len(second.grid._queries) == QUERY_CACHE_SIZE
