@@ -24,17 +24,20 @@ def report(plan: DemoPlan, *, calibrate: bool) -> None:
     from tdcm_ros.metrics.plots import write_plots
 
     options = scene_options(plan)
-    evaluation = evaluate_paths([plan.bag], options)
+    fit = None
+    if calibrate:
+        from tdcm_ros.metrics.api import calibrate_paths
+
+        fit = calibrate_paths([plan.bag], ("E",), options)  # its `before` is the evaluation
+    evaluation = fit.before if fit is not None else evaluate_paths([plan.bag], options)
     print(f"\n== evaluation of {plan.bag} (estimator: scene {plan.scene.name!r} nominal design) ==")
     print(format_report(evaluation))
     for path in write_plots(evaluation, plan.out / "plots"):
         print(f"plot written to {path}")
     results = {"scene": plan.scene.name, "before_calibration": evaluation.to_json()}
-    if calibrate:
+    if fit is not None:
         from tdcm_ros.cli.calibrate import format_report as format_calibration
-        from tdcm_ros.metrics.api import calibrate_paths
 
-        fit = calibrate_paths([plan.bag], ("E",), options)
         print(f"\n== calibration of E on {plan.bag} (start: the scene's nominal E) ==")
         print(format_calibration(fit))
         results["calibration"] = fit.to_json()

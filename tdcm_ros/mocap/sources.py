@@ -69,6 +69,11 @@ class CsvReplay:
     def _due_ns(self) -> int:
         return self.start_ns + self.passes * self._pass_ns + int(self._offsets_ns[self.next_row])
 
+    @property
+    def pending(self) -> bool:
+        """True while sampled frames wait for their delay."""
+        return bool(self._queue)
+
     def due(self, now_ns: int) -> list[RawFrame]:
         """Rows due at ``now_ns``, in order (at most :data:`MAX_BURST`)."""
         frames: list[RawFrame] = []
@@ -131,6 +136,11 @@ class SimSource:
         self.frame_number += 1
         self._queue.append((now_ns + round(delay_s * 1e9),
                             RawFrame(now_ns, self.frame_number, labels, positions)))
+
+    @property
+    def pending(self) -> bool:
+        """True while sampled frames wait for their delay."""
+        return bool(self._queue)
 
     def due(self, now_ns: int) -> list[RawFrame]:
         """Queued frames whose delay has passed, oldest first."""

@@ -278,7 +278,7 @@ class MocapNode(NodeLogic):
         self.port.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
                                       self._on_true_tension, QoS(depth=10))
         self.port.create_timer(1.0 / float(scene.mocap_rate_hz), self._sim_tick)
-        self.port.create_timer(0.002, self._sim_drain)  # frames become due between ticks
+        self.drain_timer: Any = None
         self.state = f"simulating scene {scene.name!r}; no sim/tension_true yet (0 N)"
         translation, quaternion = world.mocap_to_base
         return Registration(tuple(np.asarray(translation, dtype=float)),
@@ -300,6 +300,8 @@ class MocapNode(NodeLogic):
             self.counts["source_errors"] += 1
             self.last_problem = str(error)
         self._sim_drain()
+        if self.sim.pending and self.drain_timer is None:  # delayed frames fall due between ticks
+            self.drain_timer = self.port.create_timer(0.002, self._sim_drain)
 
     def _sim_drain(self) -> None:
         for frame in self.sim.due(self.port.now_ns()):
