@@ -25,13 +25,10 @@ def resource_dirs(relative: str, env_var: str) -> list[Path]:
 
 def _ament_share(relative: str) -> list[Path]:
     try:
-        from ament_index_python.packages import (
-            PackageNotFoundError,
-            get_package_share_directory,
-        )
+        from ament_index_python.packages import get_package_share_directory
     except ImportError:
         return []
     try:
         return [Path(get_package_share_directory(PACKAGE)) / relative]
-    except PackageNotFoundError:
+    except (LookupError, OSError):  # not installed with colcon, or AMENT_PREFIX_PATH unset
         return []

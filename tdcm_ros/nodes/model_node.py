@@ -49,7 +49,7 @@ class ModelNode(NodeLogic):
             "input.tension_type", TENSION_TYPES[0], read_only=True,
             description="message type on `tension`", validator=one_of("input.tension_type",
                                                                       TENSION_TYPES)))
-        self.frame_id = str(declare("frame_id", "tdcm_base", description="frame of all outputs"))
+        declare("frame_id", "tdcm_base", description="frame of all outputs")
         base_name = str(declare("design.preset", "paper-experiment", read_only=True,
                                 description="design preset the fields start from",
                                 validator=one_of("design.preset", tuple(PRESETS))))
@@ -165,7 +165,7 @@ class ModelNode(NodeLogic):
         radius = (self.design.R_outer + float(self.port.get_parameter("markers.radius"))
                   if placement == "surface" else 0.0)
         for topic, message in midline_messages(
-                result, stamp_ns=stamp_ns, frame_id=self.frame_id,
+                result, stamp_ns=stamp_ns, frame_id=str(self.port.get_parameter("frame_id")),
                 samples=int(self.port.get_parameter("output.samples")),
                 marker_s=np.asarray(self.port.get_parameter("markers.arc_lengths"), dtype=float),
                 marker_radius=radius,

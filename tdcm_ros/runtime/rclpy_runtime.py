@@ -1,20 +1,31 @@
-"""The rclpy adapter: node logic as a real ROS 2 node, with no per-type code.
+"""The rclpy runtime: node logic as real ROS 2 nodes, with no per-type code.
 
-Message classes come from ``rosidl_runtime_py.utilities.get_message``; subscriptions are raw
-(CDR) and decoded with rosbags; publishing hands rclpy the CDR bytes. Parameters are declared
-with ``ParameterDescriptor`` ranges from the same :class:`ParamSpec`, and an on-set callback runs
-the same checks as the zenoh runtime. rclpy is imported only inside functions, so this module
-imports where ROS is absent.
+A message class is ``importlib.import_module("<pkg>.msg").<Name>`` (what
+``rosidl_runtime_py.utilities.get_message`` does, without needing that package). Subscriptions
+are raw (CDR) and decoded with rosbags; publishing hands rclpy the CDR bytes. Parameters are
+declared on the rclpy node with typed ``ParameterDescriptor`` ranges from the same
+:class:`ParamSpec`, so ``ros2 param`` (the six rcl_interfaces services rclpy serves) lists, gets and
+sets them; an on-set callback runs the same checks as the zenoh runtime.
+
+One :class:`RclpyContext` per process: its own ``rclpy`` context (domain from ``ROS_DOMAIN_ID``,
+discovery range from ``ROS_AUTOMATIC_DISCOVERY_RANGE``), one single-threaded executor for every
+node it creates, and no rclpy signal handlers: the caller stops it with :meth:`request_stop`, so
+nodes close (and log) while the context is still up. rclpy is imported only inside this module's
+functions and classes, so the module imports where ROS is absent.
 """
 
 from __future__ import annotations
 
-import sys
-from collections.abc import Callable, Sequence
+import importlib
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize
 from tdcm_ros.errors import InputError
+from tdcm_ros.runtime import wire
+from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.parameters import (
     ParameterStore,
     ParamSpec,
@@ -22,7 +33,23 @@ from tdcm_ros.runtime.parameters import (
     SetCallback,
     Validator,
 )
-from tdcm_ros.runtime.port import DEFAULT_QOS, NodeLogic, QoS
+from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
+from tdcm_ros.runtime.wire import RawSample
+
+#: Seconds a parameter client waits for a node's parameter services.
+PARAM_TIMEOUT_S = 5.0
+_NO_GID = bytes(wire.GID_SIZE)
+
+
+def message_class(type_name: str) -> Any:
+    """The rclpy message class of ``pkg/msg/Name``; ``RuntimePortError`` if it is not installed."""
+    package, _, name = normalize_type_name(type_name).partition("/msg/")
+    try:
+        return getattr(importlib.import_module(f"{package}.msg"), name)
+    except (ImportError, AttributeError) as error:
+        raise RuntimePortError(
+            f"message type {type_name} is not importable for rclpy ({error}); build and source "
+            f"its interface package (see README, 'On a ROS 2 machine')") from error
 
 
 def _plain(value: Any) -> Any:
@@ -62,11 +89,13 @@ def qos_profile(qos: QoS) -> Any:
 
 
 def descriptor(spec: ParamSpec) -> Any:
-    """``ParameterDescriptor`` with the spec's description, read-only flag and range."""
+    """``ParameterDescriptor`` with the spec's type, description, read-only flag and range."""
     from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+    from rclpy.parameter import Parameter
 
     desc = ParameterDescriptor(name=spec.name, description=spec.description,
-                               read_only=spec.read_only)
+                               read_only=spec.read_only,
+                               type=Parameter.Type.from_parameter_value(spec.default).value)
     if spec.range is not None and spec.kind in ("float", "list[float]"):
         desc.floating_point_range = [FloatingPointRange(
             from_value=float(spec.range[0]), to_value=float(spec.range[1]), step=0.0)]
@@ -80,10 +109,8 @@ class _Publisher:
     """Publishes CDR bytes through an rclpy publisher."""
 
     def __init__(self, node: Any, topic: str, type_name: str, qos: QoS) -> None:
-        from rosidl_runtime_py.utilities import get_message
-
         self.type_name = normalize_type_name(type_name)
-        self._publisher = node.create_publisher(get_message(self.type_name), topic,
+        self._publisher = node.create_publisher(message_class(self.type_name), topic,
                                                 qos_profile(qos))
         self.topic = self._publisher.topic_name
 
@@ -97,23 +124,43 @@ class _Publisher:
 
 
 class RclpyNodePort:
-    """:class:`tdcm_ros.runtime.port.NodePort` on an ``rclpy.node.Node``."""
+    """:class:`tdcm_ros.runtime.port.NodePort` on an ``rclpy.node.Node``.
 
-    def __init__(self, node: Any) -> None:
+    ``overrides`` are the node's values from the parameter file, read by the same reader as the
+    zenoh runtime, so an ``int`` in YAML widens to a ``float`` parameter instead of failing
+    rclpy's static typing. Overrides given on the command line (``-p name:=value``) reach the
+    parameter through rclpy itself.
+    """
+
+    def __init__(self, node: Any, overrides: Mapping[str, Any] | None = None) -> None:
         self.node = node
         self.node_name = node.get_name()
         self.namespace = node.get_namespace()
         self.logger = _Logger(node.get_logger())
+        self._overrides = dict(overrides or {})
         self._params = ParameterStore()
+        node.add_pre_set_parameters_callback(self._widen)
         node.add_on_set_parameters_callback(self._on_set)
 
     def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
                           read_only: bool = False) -> ParamValue:
-        """Declare on the rclpy node (which applies YAML overrides), then check the value."""
+        """Declare on the rclpy node with the checked override or default; returns the value."""
+        from rclpy.exceptions import (
+            InvalidParameterTypeException,
+            InvalidParameterValueException,
+        )
+
         spec = ParamSpec(name, default, description, range, validator, read_only)
-        value = self.node.declare_parameter(name, default, descriptor(spec)).value
+        spec.coerce(default)
+        from_file = name in self._overrides
+        initial = spec.coerce(self._overrides[name]) if from_file else default
+        try:
+            value = self.node.declare_parameter(name, initial, descriptor(spec),
+                                                ignore_override=from_file).value
+        except (InvalidParameterTypeException, InvalidParameterValueException) as error:
+            raise InputError(f"{name}: {error}", parameter=name, allowed=spec.kind) from error
         return self._params.declare(spec, _plain(value))
 
     def get_parameter(self, name: str) -> ParamValue:
@@ -124,6 +171,22 @@ class RclpyNodePort:
         """Add a node-level check of runtime changes."""
         self._params.add_on_set(callback)
 
+    def _widen(self, parameters: list[Any]) -> list[Any]:
+        """Pre-set hook: an integer for a float parameter becomes that float, as on zenoh."""
+        from rclpy.parameter import Parameter
+
+        specs = self._params.specs
+        widened = []
+        for parameter in parameters:
+            spec = specs.get(parameter.name)
+            if spec is not None and spec.kind in ("float", "list[float]") and (
+                    parameter.type_ in (Parameter.Type.INTEGER, Parameter.Type.INTEGER_ARRAY)):
+                value = parameter.value
+                parameter = Parameter(parameter.name, value=(
+                    float(value) if spec.kind == "float" else [float(v) for v in value]))
+            widened.append(parameter)
+        return widened
+
     def _on_set(self, parameters: list[Any]) -> Any:
         from rcl_interfaces.msg import SetParametersResult
 
@@ -133,6 +196,7 @@ class RclpyNodePort:
         try:
             accepted = self._params.validate(changes)
         except InputError as error:
+            self.logger.warning("parameter change rejected: %s", error)
             return SetParametersResult(successful=False, reason=str(error))
         self._params.commit(accepted)
         return SetParametersResult(successful=True)
@@ -144,20 +208,32 @@ class RclpyNodePort:
     def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
                             qos: QoS = DEFAULT_QOS) -> None:
         """Raw subscription; the CDR bytes are decoded with rosbags before ``callback``."""
-        from rosidl_runtime_py.utilities import get_message
-
         name = normalize_type_name(type_name)
 
-        def decode(data: bytes) -> None:
+        def decode(sample: RawSample) -> None:
             try:
-                message = deserialize(data, name)
+                message = deserialize(sample.data, name)
             except BagError as error:
-                self.logger.warning("dropped message on %s: %s", topic, error)
+                self.logger.warning("dropped message on %s: %s", sample.topic, error)
                 return
             callback(message)
 
-        self.node.create_subscription(get_message(name), topic, decode, qos_profile(qos),
-                                      raw=True)
+        self.create_raw_subscription(topic, name, decode, qos)
+
+    def create_raw_subscription(self, topic: str, type_name: str,
+                                callback: Callable[[RawSample], None],
+                                qos: QoS = DEFAULT_QOS) -> None:
+        """Subscribe to CDR samples with the sender's timestamp and sequence number."""
+        name = normalize_type_name(type_name)
+        holder: list[Any] = []
+
+        def on_message(data: bytes, info: Mapping[str, Any]) -> None:
+            attachment = wire.Attachment(int(info.get("publication_sequence_number", 0)),
+                                         int(info.get("source_timestamp", 0)), _NO_GID)
+            callback(RawSample(holder[0].topic_name, name, bytes(data), attachment))
+
+        holder.append(self.node.create_subscription(message_class(name), topic, on_message,
+                                                    qos_profile(qos), raw=True))
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> Any:
         """rclpy timer of ``period`` s."""
@@ -171,26 +247,70 @@ class RclpyNodePort:
         return int(self.node.get_clock().now().nanoseconds)
 
 
-def run_rclpy(node_class: type[NodeLogic], *, name: str, namespace: str = "/",
-              params_file: str | None = None, ros_args: Sequence[str] = ()) -> int:
-    """Run ``node_class`` as an rclpy node until shutdown (Ctrl-C); returns the exit status."""
-    import rclpy
-    from rclpy.executors import ExternalShutdownException
+class RclpyContext:
+    """An rclpy context with one executor for the nodes it creates; see the module docstring.
 
-    args = list(ros_args) or ["--ros-args"]
-    if params_file:
-        args += ["--params-file", params_file]
-    rclpy.init(args=[sys.argv[0], *args])
-    node = rclpy.create_node(name, namespace=namespace)
-    logic: NodeLogic | None = None
-    try:
-        logic = node_class(RclpyNodePort(node))
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if logic is not None:
-            logic.close()
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return 0
+    ``args`` are rclpy command-line arguments (``--ros-args ...``), applied to every node.
+    """
+
+    def __init__(self, args: Sequence[str] = ()) -> None:
+        import rclpy
+        from rclpy.context import Context
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.signals import SignalHandlerOptions
+
+        self.context = Context()
+        rclpy.init(args=["tdcm", *args], context=self.context,
+                   signal_handler_options=SignalHandlerOptions.NO)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.domain_id = int(self.context.get_domain_id())
+        self._stop = threading.Event()
+        self._nodes: list[Any] = []
+
+    def create_port(self, name: str, namespace: str = "/",
+                    overrides: Mapping[str, Any] | None = None) -> RclpyNodePort:
+        """A node port on a new rclpy node ``namespace/name``."""
+        node = self.create_node(name, namespace)
+        return RclpyNodePort(node, overrides)
+
+    def create_node(self, name: str, namespace: str = "/") -> Any:
+        """A plain ``rclpy.node.Node`` spun by this context's executor."""
+        from rclpy.node import Node
+
+        node = Node(name, namespace=namespace, context=self.context)
+        self._nodes.append(node)
+        self.executor.add_node(node)
+        return node
+
+    def spin(self) -> None:
+        """Run callbacks until :meth:`request_stop` (or rclpy shuts down)."""
+        while not self._stop.is_set() and self.context.ok():
+            self.executor.spin_once(timeout_sec=0.1)
+
+    def spin_for(self, seconds: float) -> None:
+        """Run callbacks for ``seconds`` s."""
+        end = time.monotonic() + seconds
+        while ((left := end - time.monotonic()) > 0 and not self._stop.is_set()
+               and self.context.ok()):
+            self.executor.spin_once(timeout_sec=min(left, 0.05))
+
+    def spin_until_future(self, future: Any, timeout: float) -> Any:
+        """Spin until ``future`` is done; its result, or ``RuntimePortError`` after ``timeout``."""
+        end = time.monotonic() + timeout
+        while not future.done():
+            if time.monotonic() > end or not self.context.ok():
+                raise RuntimePortError(f"no answer within {timeout:g} s")
+            self.executor.spin_once(timeout_sec=0.05)
+        return future.result()
+
+    def request_stop(self) -> None:
+        """Make :meth:`spin` return (safe from signal handlers and other threads)."""
+        self._stop.set()
+
+    def close(self) -> None:
+        """Destroy every node, then shut the context down."""
+        self.executor.shutdown()
+        for node in self._nodes:
+            node.destroy_node()
+        self._nodes.clear()
+        self.context.try_shutdown()

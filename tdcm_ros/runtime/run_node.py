@@ -16,6 +16,7 @@ import signal
 import sys
 from collections.abc import Sequence
 from types import FrameType
+from typing import Any
 
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.runtime.names import fully_qualified_node_name
@@ -56,23 +57,41 @@ def configure_logging(level: str = "INFO") -> None:
                         format="[%(levelname)s] [%(created).6f] [%(name)s]: %(message)s")
 
 
-def run_zenoh(node_class: type[NodeLogic], *, name: str, namespace: str = "/",
-              params_file: str | None = None) -> int:
-    """Run ``node_class`` on the zenoh runtime until SIGINT/SIGTERM; returns the exit status."""
+def open_context(runtime: str, ros_args: Sequence[str] = ()) -> Any:
+    """A new context of ``runtime`` (``zenoh`` or ``rclpy``; ``ros_args`` go to rclpy)."""
+    if runtime == "rclpy":
+        from tdcm_ros.runtime.rclpy_runtime import RclpyContext
+
+        return RclpyContext(ros_args)
     from tdcm_ros.runtime.zenoh_runtime import ZenohContext
 
-    overrides = node_parameters(params_file, fully_qualified_node_name(namespace, name))
-    context = ZenohContext()
+    return ZenohContext()
+
+
+def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file: str | None = None,
+             name: str | None = None, namespace: str = "/",
+             ros_args: Sequence[str] = ()) -> int:
+    """Run ``node_class`` on ``runtime`` (``auto``, ``zenoh`` or ``rclpy``) until SIGINT/SIGTERM.
+
+    The node's ``close`` runs before its context shuts down, so what it logs or sends on the way
+    out (the driver's release) still reaches the graph.
+    """
+    node_name = name or node_class.default_name
+    chosen = resolve_runtime(runtime)
+    overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
+    if chosen == "rclpy":
+        ros_args = [*(ros_args or ["--ros-args"]),
+                    *(["--params-file", params_file] if params_file else [])]
+    context = open_context(chosen, ros_args)
 
     def stop(signum: int, frame: FrameType | None) -> None:
         context.request_stop()
 
     previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        port = context.create_port(name, namespace, overrides)
+        port = context.create_port(node_name, namespace, overrides)
         node = node_class(port)
-        port.logger.info("running on zenoh (domain %d, session %s)", context.domain_id,
-                         context.zid)
+        port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
         try:
             context.spin()
         finally:
@@ -82,20 +101,6 @@ def run_zenoh(node_class: type[NodeLogic], *, name: str, namespace: str = "/",
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return 0
-
-
-def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file: str | None = None,
-             name: str | None = None, namespace: str = "/",
-             ros_args: Sequence[str] = ()) -> int:
-    """Run ``node_class`` on ``runtime`` (``auto``, ``zenoh`` or ``rclpy``) until shut down."""
-    node_name = name or node_class.default_name
-    chosen = resolve_runtime(runtime)
-    if chosen == "rclpy":
-        from tdcm_ros.runtime.rclpy_runtime import run_rclpy
-
-        return run_rclpy(node_class, name=node_name, namespace=namespace,
-                         params_file=params_file, ros_args=ros_args)
-    return run_zenoh(node_class, name=node_name, namespace=namespace, params_file=params_file)
 
 
 def build_parser(prog: str = "tdcm_node", *, with_target: bool = True) -> argparse.ArgumentParser:

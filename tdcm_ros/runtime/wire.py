@@ -160,6 +160,16 @@ class Attachment:
     gid: bytes
 
 
+@dataclass(frozen=True)
+class RawSample:
+    """A received sample: fully qualified topic, type, CDR payload and decoded attachment."""
+
+    topic: str
+    type_name: str
+    data: bytes
+    attachment: Attachment | None
+
+
 def decode_attachment(data: bytes) -> Attachment:
     """Decode an rmw_zenoh attachment; raises ``RuntimePortError`` on another layout."""
     if len(data) != _ATTACHMENT.size or data[16] != GID_SIZE:

@@ -53,6 +53,7 @@ from tdcm_ros.runtime.parameters import (
     Validator,
 )
 from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
+from tdcm_ros.runtime.wire import RawSample
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
 CONFIG_ENV = "TDCM_ZENOH_CONFIG"
@@ -228,16 +229,6 @@ class _Publisher:
     def close(self) -> None:
         self._token.undeclare()
         self._pub.undeclare()
-
-
-@dataclass(frozen=True)
-class RawSample:
-    """A received sample: fully qualified topic, type, CDR payload and decoded attachment."""
-
-    topic: str
-    type_name: str
-    data: bytes
-    attachment: wire.Attachment | None
 
 
 class _Subscription:

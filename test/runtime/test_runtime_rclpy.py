@@ -18,7 +18,7 @@ NO_RCLPY = "rclpy is not importable (no ROS 2 Jazzy sourced); the adapter test r
 def test_adapter_imports_without_ros() -> None:
     import tdcm_ros.runtime.rclpy_runtime as adapter
 
-    assert callable(adapter.run_rclpy)
+    assert callable(adapter.RclpyContext)
     if not HAVE_RCLPY:
         assert "rclpy" not in sys.modules
         print(f"SKIP rclpy end-to-end: {NO_RCLPY}")
