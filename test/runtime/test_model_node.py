@@ -1,29 +1,19 @@
-"""model_node in its own process over the embedded runtime (zenoh router on a private port)."""
+"""model_node in its own process, on the embedded runtime and on rclpy (see conftest.py)."""
 
 from __future__ import annotations
 
 import subprocess
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-import pytest
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.model import preset, solve
 
 MODEL = "tdcm_ros.nodes.model_node:ModelNode"
 Spawn = Callable[..., subprocess.Popen[bytes]]
-
-
-@pytest.fixture
-def context(router: subprocess.Popen[bytes]) -> Iterator[Any]:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
-
-    ctx = ZenohContext()
-    yield ctx
-    ctx.close()
 
 
 def wrench(tension: float, stamp_ns: int | None = None) -> Any:
@@ -76,10 +66,9 @@ def tip(path: Any) -> np.ndarray:
     return np.array([p.x, p.y, p.z])
 
 
-def test_midline_equals_library_solve_and_parameters_change_at_runtime(context, spawn):
-    from tdcm_ros.runtime.zenoh_runtime import call_parameters
-
-    spawn("tdcm_ros.runtime.run_node", MODEL, "--runtime", "zenoh")
+def test_midline_equals_library_solve_and_parameters_change_at_runtime(runtime, context, spawn,
+                                                                     params):
+    spawn("tdcm_ros.runtime.run_node", MODEL)
     probe = Probe(context)
     path = probe.midline_for(20.0)
     expected = solve(preset("paper-experiment"), 20.0)
@@ -89,19 +78,27 @@ def test_midline_equals_library_solve_and_parameters_change_at_runtime(context, 
     got = np.array([[p.pose.position.x, p.pose.position.y, p.pose.position.z] for p in path.poses])
     assert np.allclose(got, positions, atol=1e-12)
 
-    call_parameters(context.session, 0, "/model_node", "set", {"name": "design.E", "value": 1.2e9})
+    node = params("/model_node")
+    assert {"design.E", "frame_id", "solver.tol", "input.tension_max"} <= set(node.names())
+    assert node.set("design.E", 1.2e9) == {"successful": True, "reason": ""}
+    assert node.get("design.E") == 1.2e9
     softer = solve(preset("paper-experiment").with_overrides(E=1.2e9), 20.0)
     assert np.allclose(tip(probe.midline_for(20.0)), softer.tip_position, atol=1e-12)
+    assert node.set("frame_id", "robot_base")["successful"]
+    assert probe.midline_for(20.0).header.frame_id == "robot_base"
 
     for name, value in (("design.E", -5.0), ("design.r_inner", 0.01)):
-        answer = call_parameters(context.session, 0, "/model_node", "set",
-                                 {"name": name, "value": value})
-        assert not answer["successful"] and name.split(".")[1] in answer["reason"]
+        answer = node.set(name, value)
+        assert not answer["successful"] and name.split(".")[1] in answer["reason"], answer
+    assert node.get("design.E") == 1.2e9
+    refused = node.set("design.preset", "ideal")
+    assert not refused["successful"] and "read-only" in refused["reason"]
+    assert node.get("design.preset") == "paper-experiment"
     assert np.allclose(tip(probe.midline_for(20.0)), softer.tip_position, atol=1e-12)
 
 
-def test_bad_messages_are_counted_and_the_node_keeps_running(context, spawn):
-    node = spawn("tdcm_ros.runtime.run_node", MODEL, "--runtime", "zenoh")
+def test_bad_messages_are_counted_and_the_node_keeps_running(runtime, context, spawn):
+    node = spawn("tdcm_ros.runtime.run_node", MODEL)
     probe = Probe(context)
     probe.midline_for(4.0)
     for bad in (float("nan"), -3.0, 1e9):
@@ -116,19 +113,26 @@ def test_bad_messages_are_counted_and_the_node_keeps_running(context, spawn):
     probe.midline_for(12.0)
 
 
-def test_node_survives_its_peer_restarting(context, spawn):
-    spawn("tdcm_ros.runtime.run_node", MODEL, "--runtime", "zenoh")
+def test_node_survives_its_peer_restarting(runtime, context, graph_env):
+    import sys
+    from pathlib import Path
+
+    spawn_node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", MODEL],
+                                  env=graph_env)
     probe = Probe(context)
-    values = "{wrench: {force: {z: 16.0}}}"
-    for _ in range(2):
-        publisher = spawn("tdcm_ros.cli.main", "topic", "pub", "tension",
-                          "geometry_msgs/msg/WrenchStamped", values, "--rate", "20")
-        probe.paths.clear()
-        deadline = time.monotonic() + 20
-        while time.monotonic() < deadline and not probe.paths:
-            context.spin_for(0.1)
-        assert probe.paths, "no midline from the restarted publisher"
-        expected = solve(preset("paper-experiment"), 16.0).tip_position
-        assert np.allclose(tip(probe.paths[-1]), expected, atol=1e-12)
-        publisher.kill()
-        publisher.wait()
+    peer = Path(__file__).with_name("peer_publisher.py")
+    try:
+        for _ in range(2):
+            publisher = subprocess.Popen([sys.executable, str(peer), "16.0"], env=graph_env)
+            probe.paths.clear()
+            deadline = time.monotonic() + 20
+            while time.monotonic() < deadline and not probe.paths:
+                context.spin_for(0.1)
+            publisher.kill()
+            publisher.wait()
+            assert probe.paths, "no midline from the restarted publisher"
+            expected = solve(preset("paper-experiment"), 16.0).tip_position
+            assert np.allclose(tip(probe.paths[-1]), expected, atol=1e-12)
+    finally:
+        spawn_node.kill()
+        spawn_node.wait()
