@@ -1,4 +1,5 @@
-"""mocap_node in its own process over the embedded runtime: CSV replay and live relabelling.
+"""mocap_node in its own process, on the embedded runtime and on rclpy (see conftest.py): CSV
+replay, live relabelling and bad configuration.
 
 The node's logic in detail (sim source, arc-length labelling, every configuration error) is
 tested in-process in test/mocap/test_mocap_node_logic.py.
@@ -8,7 +9,7 @@ from __future__ import annotations
 
 import subprocess
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -25,15 +26,6 @@ SAMPLE = Path(__file__).resolve().parents[1] / "mocap" / "data" / "nexus_trial.c
 Spawn = Callable[..., subprocess.Popen[bytes]]
 
 
-@pytest.fixture
-def context(router: subprocess.Popen[bytes]) -> Iterator[Any]:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
-
-    ctx = ZenohContext()
-    yield ctx
-    ctx.close()
-
-
 def params_file(tmp_path: Path, node: str, values: dict[str, Any]) -> str:
     path = tmp_path / "mocap.yaml"
     path.write_text(yaml.safe_dump({node: {"ros__parameters": values}}))
@@ -41,7 +33,7 @@ def params_file(tmp_path: Path, node: str, values: dict[str, Any]) -> str:
 
 
 class Probe:
-    """Collects mocap_node's outputs (under ``prefix``) and the static transform."""
+    """Collects mocap_node's outputs (under ``prefix``) and, once joined, the static transform."""
 
     def __init__(self, ctx: Any, prefix: str = "") -> None:
         from tdcm_ros.runtime.port import QoS
@@ -57,10 +49,16 @@ class Probe:
                                  self.markers.append, QoS(depth=1000))
         port.create_subscription(f"{prefix}/markers_poses", "geometry_msgs/msg/PoseArray",
                                  self.poses.append, QoS(depth=1000))
-        port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self.tf.append,
-                                 QoS(depth=1, durability="transient_local"))
         port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
                                  self.diagnostics.append)
+
+    def join_tf_static(self) -> None:
+        """Subscribe to ``/tf_static`` from a new node, after the mocap node has sent it."""
+        from tdcm_ros.runtime.port import QoS
+
+        self.ctx.create_port("late_joiner").create_subscription(
+            "/tf_static", "tf2_msgs/msg/TFMessage", self.tf.append,
+            QoS(depth=1, durability="transient_local"))
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
         deadline = time.monotonic() + timeout
@@ -85,7 +83,7 @@ def stamp_ns(message: Any) -> int:
     return message.header.stamp.sec * 10**9 + message.header.stamp.nanosec
 
 
-def test_csv_replay_publishes_the_csv_positions_in_metres(context, spawn, tmp_path):
+def test_csv_replay_publishes_the_csv_positions_in_metres(runtime, context, spawn, tmp_path):
     quaternion = [0.0, 0.0, 0.6, 0.8]
     params = params_file(tmp_path, "mocap_node", {
         "source": "csv", "csv": {"path": str(SAMPLE), "rate_scale": 4.0, "loop": True,
@@ -93,7 +91,7 @@ def test_csv_replay_publishes_the_csv_positions_in_metres(context, spawn, tmp_pa
         "labelling": {"map": ["TDCM:M1=m1", "TDCM:M2=m2", "TDCM:M3=m3"]},
         "registration": {"translation": [0.25, -0.12, 0.81], "quaternion": quaternion},
         "diagnostics_period_s": 0.2})
-    node = spawn("tdcm_ros.runtime.run_node", MOCAP, "--runtime", "zenoh", "--params", params)
+    node = spawn("tdcm_ros.runtime.run_node", MOCAP, "--params", params)
     probe = Probe(context)
     # Two passes of 30 frames reach the probe (the first may be partly missed while connecting).
     probe.spin_until(lambda: len({(m.frame_number, stamp_ns(m)) for m in probe.markers}) >= 40,
@@ -122,7 +120,8 @@ def test_csv_replay_publishes_the_csv_positions_in_metres(context, spawn, tmp_pa
              if b.frame_number == a.frame_number + 1]
     assert pairs and all(stamp_ns(b) - stamp_ns(a) == 2_500_000 for a, b in pairs)
 
-    # /tf_static is transient local: the probe got it although it subscribed after it was sent.
+    # /tf_static is transient local: a node joining after it was sent (at start) still gets it.
+    probe.join_tf_static()
     probe.spin_until(lambda: bool(probe.tf), 10.0, "/tf_static")
     (transform,) = probe.tf[-1].transforms
     assert transform.header.frame_id == "mocap" and transform.child_frame_id == "tdcm_base"
@@ -145,13 +144,14 @@ def driver_markers(stamp: int, frame: int, entries: list[tuple[str, list[float]]
                     for i, (name, p) in enumerate(entries)]})
 
 
-def test_relabel_republishes_relabelled_markers_from_a_live_driver(context, spawn, tmp_path):
+def test_relabel_republishes_relabelled_markers_from_a_live_driver(runtime, context, spawn,
+                                                                  tmp_path):
     params = params_file(tmp_path, "/tdcm/mocap_node", {
         "source": "relabel", "relabel": {"input_scale": 0.001},
         "labelling": {"map": ["Robot:Base=m1", "Mid=m2", "Tip=m3"]},
         "registration": {"mode": "rpy", "rpy": [3.14159, 0.0, 0.0]},
         "diagnostics_period_s": 0.2})
-    spawn("tdcm_ros.runtime.run_node", MOCAP, "--runtime", "zenoh", "--namespace", "/tdcm",
+    spawn("tdcm_ros.runtime.run_node", MOCAP, "--namespace", "/tdcm",
           "--params", params)
     probe = Probe(context, prefix="/tdcm")
     driver = probe.port.create_publisher("/markers", "mocap4r2_msgs/msg/Markers")
@@ -175,6 +175,7 @@ def test_relabel_republishes_relabelled_markers_from_a_live_driver(context, spaw
     probe.spin_until(lambda: probe.counter("state") == "relabelling"
                      and int(probe.counter("markers_occluded") or 0) >= 1
                      and int(probe.counter("markers_unlabelled") or 0) >= 1, 10.0, "diagnostics")
+    probe.join_tf_static()
     probe.spin_until(lambda: bool(probe.tf), 10.0, "/tf_static")
     rotation = probe.tf[-1].transforms[0].transform.rotation
     assert np.allclose([rotation.x, rotation.y, rotation.z, rotation.w],
@@ -185,9 +186,9 @@ def test_relabel_republishes_relabelled_markers_from_a_live_driver(context, spaw
     ({"source": "csv", "csv": {"path": "/nonexistent/trial.csv"}}, "cannot read file"),
     ({"source": "relabel", "relabel": {"input_topic": "markers"}}, "own output"),
 ])
-def test_bad_configuration_exits_with_one_line(router, spawn, tmp_path, values, phrase):
+def test_bad_configuration_exits_with_one_line(runtime, spawn, tmp_path, values, phrase):
     params = params_file(tmp_path, "mocap_node", values)
-    node = spawn("tdcm_ros.runtime.run_node", MOCAP, "--runtime", "zenoh", "--params", params)
+    node = spawn("tdcm_ros.runtime.run_node", MOCAP, "--params", params)
     wait_for(lambda: node.poll() is not None, 20.0, "the node to exit")
     stderr = node.stderr.read().decode()
     assert node.returncode == 2 and phrase in stderr and "Traceback" not in stderr
