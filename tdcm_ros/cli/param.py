@@ -1,48 +1,67 @@
-"""``tdcm param get|set|list NODE ...``: parameters of nodes on the embedded runtime."""
+"""``tdcm param get|set|list NODE ...``: parameters of running nodes, on either runtime.
+
+On zenoh it uses the embedded runtime's parameter queryables; on rclpy the node's
+rcl_interfaces parameter services (what ``ros2 param`` uses). ``--runtime`` defaults to
+``TDCM_RUNTIME`` if set, else zenoh.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 from typing import Any
 
 import yaml
 
 from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``param`` with its verbs."""
-    parser = subparsers.add_parser("param", help="get, set or list node parameters (zenoh)")
+    parser = subparsers.add_parser("param", help="get, set or list node parameters")
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--runtime", choices=RUNTIMES,
+                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
+                        help=f"runtime of the node (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
+                             f"if importable)")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
-    get = verbs.add_parser("get", help="print a parameter value")
+    get = verbs.add_parser("get", parents=[common], help="print a parameter value")
     get.add_argument("node")
     get.add_argument("name")
     get.set_defaults(handler=run_get)
-    put = verbs.add_parser("set", help="change a parameter (validated by the node)")
+    put = verbs.add_parser("set", parents=[common], help="change a parameter (validated by the node)")
     put.add_argument("node")
     put.add_argument("name")
     put.add_argument("value", help="YAML value, e.g. 0.25, true, [15, 33, 53]")
     put.set_defaults(handler=run_set)
-    listing = verbs.add_parser("list", help="list parameters with values")
+    listing = verbs.add_parser("list", parents=[common], help="list parameters with values")
     listing.add_argument("node")
     listing.set_defaults(handler=run_list)
 
 
-def _call(node: str, op: str, request: dict[str, Any]) -> dict[str, Any]:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext, call_parameters
+def _call(args: argparse.Namespace, op: str, request: dict[str, Any]) -> dict[str, Any]:
+    from tdcm_ros.runtime.run_node import open_context, resolve_runtime
 
-    context = ZenohContext()
+    runtime = resolve_runtime(args.runtime)
+    context = open_context(runtime)
+    node = "/" + args.node.strip("/")
     try:
-        return call_parameters(context.session, context.domain_id, "/" + node.strip("/"), op,
-                               request)
+        if runtime == "rclpy":
+            from tdcm_ros.runtime.rclpy_runtime import call_parameters as call_rclpy
+
+            return call_rclpy(context, node, op, request)
+        from tdcm_ros.runtime.zenoh_runtime import call_parameters
+
+        return call_parameters(context.session, context.domain_id, node, op, request)
     finally:
         context.close()
 
 
 def run_get(args: argparse.Namespace) -> int:
     """Print the value."""
-    print(json.dumps(_call(args.node, "get", {"name": args.name})["value"]))
+    print(json.dumps(_call(args, "get", {"name": args.name})["value"]))
     return 0
 
 
@@ -53,7 +72,7 @@ def run_set(args: argparse.Namespace) -> int:
     except yaml.YAMLError as error:
         raise InputError(f"value is not valid YAML: {error}", parameter=args.name,
                          value=args.value) from error
-    answer = _call(args.node, "set", {"name": args.name, "value": value})
+    answer = _call(args, "set", {"name": args.name, "value": value})
     if not answer["successful"]:
         raise InputError(f"rejected: {answer['reason']}", parameter=args.name, value=value)
     print("Set parameter successful")
@@ -62,7 +81,7 @@ def run_set(args: argparse.Namespace) -> int:
 
 def run_list(args: argparse.Namespace) -> int:
     """Print ``name: value  # description`` lines."""
-    for name, info in sorted(_call(args.node, "list", {})["parameters"].items()):
+    for name, info in sorted(_call(args, "list", {})["parameters"].items()):
         note = f"  # {info['description']}" if info["description"] else ""
         print(f"  {name}: {json.dumps(info['value'])}{note}")
     return 0

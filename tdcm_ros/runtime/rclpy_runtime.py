@@ -314,3 +314,69 @@ class RclpyContext:
             node.destroy_node()
         self._nodes.clear()
         self.context.try_shutdown()
+
+
+def call_parameters(context: RclpyContext, node_fqn: str, op: str, request: dict[str, Any],
+                    timeout: float = PARAM_TIMEOUT_S) -> dict[str, Any]:
+    """A parameter request through the node's rcl_interfaces services (what ``ros2 param`` uses).
+
+    Answers in the zenoh client's shapes: ``get`` ``{"value"}``, ``set`` ``{"successful",
+    "reason"}``, ``list`` ``{"parameters": {name: {"value", "description", "range",
+    "read_only"}}}``. ``RuntimePortError`` if the node's services do not appear within ``timeout``.
+    """
+    from rclpy.parameter_client import AsyncParameterClient
+
+    client = AsyncParameterClient(context.create_node(f"_tdcm_param_{id(context):x}"), node_fqn)
+    end = time.monotonic() + timeout
+    while not client.services_are_ready():
+        if time.monotonic() > end:
+            raise RuntimePortError(f"node {node_fqn} has no parameter services after {timeout:g} "
+                                   f"s; is it running on ROS domain {context.domain_id}?")
+        context.spin_for(0.1)
+    if op == "get":
+        return {"value": _get(context, client, node_fqn, str(request.get("name")), timeout)}
+    if op == "set":
+        return _set(context, client, str(request.get("name")), request.get("value"), timeout)
+    if op == "list":
+        return {"parameters": _list(context, client, timeout)}
+    raise InputError(f"unknown parameter operation {op!r}; allowed: get, set, list",
+                     parameter="op", value=op, allowed="get, set, list")
+
+
+def _get(context: RclpyContext, client: Any, node_fqn: str, name: str, timeout: float) -> Any:
+    from rcl_interfaces.msg import ParameterType
+    from rclpy.parameter import parameter_value_to_python
+
+    value = context.spin_until_future(client.get_parameters([name]), timeout).values[0]
+    if value.type == ParameterType.PARAMETER_NOT_SET:
+        raise InputError(f"{node_fqn}: parameter {name!r} is not declared", parameter=name)
+    return _plain(parameter_value_to_python(value))
+
+
+def _set(context: RclpyContext, client: Any, name: str, value: Any,
+         timeout: float) -> dict[str, Any]:
+    from rclpy.parameter import Parameter
+
+    try:
+        parameter = Parameter(name, value=value)
+    except TypeError as error:
+        raise InputError(f"{name} = {value!r} is not a ROS parameter value: {error}",
+                         parameter=name, value=value) from error
+    result = context.spin_until_future(client.set_parameters([parameter]), timeout).results[0]
+    return {"successful": bool(result.successful), "reason": str(result.reason)}
+
+
+def _list(context: RclpyContext, client: Any, timeout: float) -> dict[str, dict[str, Any]]:
+    from rclpy.parameter import parameter_value_to_python
+
+    names = list(context.spin_until_future(client.list_parameters(), timeout).result.names)
+    values = context.spin_until_future(client.get_parameters(names), timeout).values
+    descriptors = context.spin_until_future(client.describe_parameters(names),
+                                            timeout).descriptors
+    listing = {}
+    for name, value, desc in zip(names, values, descriptors, strict=True):
+        ranges = [*desc.floating_point_range, *desc.integer_range]
+        listing[name] = {"value": _plain(parameter_value_to_python(value)),
+                         "description": desc.description, "read_only": bool(desc.read_only),
+                         "range": [ranges[0].from_value, ranges[0].to_value] if ranges else None}
+    return listing

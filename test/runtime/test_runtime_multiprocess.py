@@ -1,11 +1,13 @@
-"""Nodes in separate processes over a zenoh router on a private loopback port."""
+"""Nodes in separate processes: the talker, ``tdcm up`` and ``tdcm param`` on both runtimes;
+wire-level checks (attachments, liveliness tokens, transient-local cache) on zenoh only."""
 
 from __future__ import annotations
 
 import signal
 import subprocess
+import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -17,15 +19,6 @@ from tdcm_ros.runtime.port import QoS
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 TALKER = "tdcm_ros.nodes.talker:Talker"
-
-
-@pytest.fixture
-def context(router: subprocess.Popen[bytes]) -> Iterator[Any]:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
-
-    ctx = ZenohContext()
-    yield ctx
-    ctx.close()
 
 
 def spin_until(ctx: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
@@ -65,30 +58,48 @@ def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
                                        "_tdcm_topic")], 10.0, "the publisher's liveliness token")
 
 
-def test_parameter_change_at_runtime(context: Any, spawn: Spawn, tmp_path: Path) -> None:
-    from tdcm_ros.runtime.zenoh_runtime import call_parameters
-
-    params = tmp_path / "params.yaml"
-    params.write_text("talker:\n  ros__parameters:\n    period: 0.05\n    prefix: p1\n")
+def test_parameter_change_at_runtime(runtime: str, context: Any, spawn: Spawn, params: Any,
+                                     tmp_path: Path) -> None:
+    path = tmp_path / "params.yaml"
+    path.write_text("talker:\n  ros__parameters:\n    period: 0.05\n    prefix: p1\n")
     texts: list[str] = []
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data), QoS(depth=50))
-    spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(params))
+    spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(path))
     spin_until(context, lambda: any(t.startswith("p1 ") for t in texts), 15.0, "p1 messages")
 
-    answer = call_parameters(context.session, 0, "/talker", "set", {"name": "prefix",
-                                                                    "value": "p2"})
-    assert answer == {"successful": True, "reason": ""}
+    talker = params("/talker")
+    assert {"period", "prefix"} <= set(talker.names())
+    assert talker.set("prefix", "p2") == {"successful": True, "reason": ""}
     spin_until(context, lambda: texts[-1].startswith("p2 "), 5.0, "p2 messages")
-
-    bad = call_parameters(context.session, 0, "/talker", "set", {"name": "period",
-                                                                 "value": -1.0})
-    assert not bad["successful"] and "out of range" in bad["reason"]
-    assert call_parameters(context.session, 0, "/talker", "get", {"name": "period"}) == {
-        "value": 0.05}
+    bad = talker.set("period", -1.0)
+    assert not bad["successful"] and "out of range" in bad["reason"] and "period" in bad["reason"]
+    assert talker.get("period") == 0.05
 
 
-def test_subscriber_survives_publisher_restart(context: Any, spawn: Spawn) -> None:
+def tdcm_param(env: dict[str, str], *argv: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "param", *argv],
+                          env=env, capture_output=True, text=True, timeout=60, check=False)
+
+
+def test_tdcm_param_lists_gets_and_sets(runtime: str, graph_env: dict[str, str],
+                                        spawn: Spawn) -> None:
+    spawn("tdcm_ros.runtime.run_node", TALKER)
+    deadline = time.monotonic() + 30
+    while (listing := tdcm_param(graph_env, "list", "talker")).returncode != 0:
+        assert time.monotonic() < deadline, listing.stderr
+    assert "  period: 0.5  # " in listing.stdout and "  prefix: " in listing.stdout
+    assert tdcm_param(graph_env, "set", "/talker", "period", "0.2").stdout.strip() == (
+        "Set parameter successful")
+    assert tdcm_param(graph_env, "get", "talker", "period").stdout.strip() == "0.2"
+    bad = tdcm_param(graph_env, "set", "talker", "period", "-1")
+    assert bad.returncode == 2 and "period" in bad.stderr and "out of range" in bad.stderr
+    assert tdcm_param(graph_env, "get", "talker", "period").stdout.strip() == "0.2"
+    missing = tdcm_param(graph_env, "get", "nobody", "period", "--runtime", runtime)
+    assert missing.returncode != 0 and "nobody" in missing.stderr
+
+
+def test_subscriber_survives_publisher_restart(runtime: str, context: Any, spawn: Spawn) -> None:
     texts: list[str] = []
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
@@ -116,7 +127,23 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
-def test_tdcm_up_sigint_stops_every_child(zenoh_env: dict[str, str], spawn: Spawn) -> None:
+def test_tdcm_up_sigint_stops_every_child(runtime: str, context: Any, spawn: Spawn) -> None:
+    launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--runtime", runtime)
+    # The talker alone: on zenoh the fixture's router already listens on the endpoint.
+    wait_for(lambda: len(_children(launcher.pid)) == 1, 15.0, "the talker process")
+    children = _children(launcher.pid)
+    texts: list[str] = []
+    context.create_port("listener").create_subscription(
+        "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
+    spin_until(context, lambda: any(t.startswith("hello") for t in texts), 20.0, "the talker")
+    launcher.send_signal(signal.SIGINT)
+    assert launcher.wait(15) == 0
+    assert not [pid for pid in children if _alive(pid)]
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+def test_tdcm_up_starts_a_router_when_none_listens(zenoh_env: dict[str, str],
+                                                   spawn: Spawn) -> None:
     launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker")
     wait_for(lambda: len(_children(launcher.pid)) == 2, 15.0, "router and talker processes")
     children = _children(launcher.pid)
