@@ -33,6 +33,7 @@ from tdcm_ros.runtime.parameters import (
     SetCallback,
     Validator,
 )
+from tdcm_ros.runtime.params import node_parameters
 from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
 from tdcm_ros.runtime.wire import RawSample
 
@@ -250,7 +251,9 @@ class RclpyNodePort:
 class RclpyContext:
     """An rclpy context with one executor for the nodes it creates; see the module docstring.
 
-    ``args`` are rclpy command-line arguments (``--ros-args ...``), applied to every node.
+    ``args`` are rclpy command-line arguments (``--ros-args ...``), applied to every node; the
+    ``--params-file`` files among them also give each port its overrides, looked up by the node's
+    final (remapped) name, as ``ros2 launch`` passes them.
     """
 
     def __init__(self, args: Sequence[str] = ()) -> None:
@@ -264,13 +267,20 @@ class RclpyContext:
                    signal_handler_options=SignalHandlerOptions.NO)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.domain_id = int(self.context.get_domain_id())
+        self.params_files = [args[i + 1] for i in range(len(args) - 1)
+                             if args[i] == "--params-file"]
         self._stop = threading.Event()
         self._nodes: list[Any] = []
 
     def create_port(self, name: str, namespace: str = "/",
                     overrides: Mapping[str, Any] | None = None) -> RclpyNodePort:
-        """A node port on a new rclpy node ``namespace/name``."""
+        """A node port on a new rclpy node ``namespace/name``; ``overrides`` default to the
+        node's values in the ``--params-file`` files (later files win)."""
         node = self.create_node(name, namespace)
+        if overrides is None:
+            fqn = node.get_fully_qualified_name()
+            overrides = {k: v for path in self.params_files
+                         for k, v in node_parameters(path, fqn).items()}
         return RclpyNodePort(node, overrides)
 
     def create_node(self, name: str, namespace: str = "/") -> Any:

@@ -78,10 +78,12 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     """
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
-    overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
+    overrides: dict[str, Any] | None = None  # rclpy: from every --params-file, by final name
     if chosen == "rclpy":
         ros_args = [*(ros_args or ["--ros-args"]),
                     *(["--params-file", params_file] if params_file else [])]
+    else:
+        overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
     context = open_context(chosen, ros_args)
 
     def stop(signum: int, frame: FrameType | None) -> None:

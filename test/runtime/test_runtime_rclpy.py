@@ -91,3 +91,24 @@ def test_a_bad_override_is_an_input_error_naming_the_parameter(rclpy_context: An
     port = rclpy_context.create_port("talker", overrides={"period": -2.0})
     with pytest.raises(InputError, match="period"):
         Talker(port)
+
+
+@pytest.mark.rclpy
+def test_params_files_in_ros_args_apply_by_the_remapped_name(monkeypatch, tmp_path) -> None:
+    """As ``ros2 launch`` starts a node: ``--ros-args -r __node:=... --params-file F``."""
+    require_rclpy()
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(private_domain_id()))
+    from tdcm_ros.runtime.rclpy_runtime import RclpyContext
+
+    path = tmp_path / "launch.yaml"
+    path.write_text("/lab/chatty:\n  ros__parameters:\n    period: 3\n    prefix: launched\n"
+                    "talker:\n  ros__parameters:\n    prefix: wrong_name\n")
+    context = RclpyContext(["--ros-args", "-r", "__node:=chatty", "-r", "__ns:=/lab",
+                            "--params-file", str(path)])
+    try:
+        port = context.create_port("talker")
+        Talker(port)
+        assert port.node.get_fully_qualified_name() == "/lab/chatty"
+        assert port.get_parameter("period") == 3.0 and port.get_parameter("prefix") == "launched"
+    finally:
+        context.close()
