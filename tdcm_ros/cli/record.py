@@ -1,4 +1,6 @@
-"""``tdcm record BAG [TOPIC...]``: record the embedded (zenoh) graph into a rosbag2 MCAP bag.
+"""``tdcm record BAG [TOPIC...]``: record a live graph (zenoh or rclpy) into a rosbag2 MCAP bag.
+
+``--runtime`` defaults to ``TDCM_RUNTIME`` if set, else zenoh.
 
 Also ``tdcm bag info BAG``: topics, types, counts and warnings of a bag (folder or ``.mcap``).
 """
@@ -6,18 +8,20 @@ Also ``tdcm bag info BAG``: topics, types, counts and warnings of a bag (folder 
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
 import signal
 import sys
 from types import FrameType
 
 from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``record``."""
     parser = subparsers.add_parser(
-        "record", help="record topics into a rosbag2 MCAP bag (zenoh)",
+        "record", help="record topics into a rosbag2 MCAP bag (zenoh or rclpy)",
         description="Record topics (all when none are named, including ones that appear later) "
                     "until Ctrl-C/SIGTERM, --duration or --max-messages; the bag is then closed.")
     parser.add_argument("bag", help="bag folder to create (must not exist)")
@@ -27,6 +31,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--flush-period", type=float, default=0.1,
                         help="longest time (s) a received message waits before it is written "
                              "to the file (bounds the loss on SIGKILL)")
+    parser.add_argument("--runtime", choices=RUNTIMES,
+                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
+                        help=f"graph to record (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
+                             f"if importable)")
     parser.set_defaults(handler=run_record)
 
     bag = subparsers.add_parser("bag", help="inspect bags")
@@ -75,15 +83,16 @@ def run_record(args: argparse.Namespace) -> int:
     from tdcm_ros.bagio.writer import BagWriter
     from tdcm_ros.recording import Recorder
 
+    runtime = resolve_runtime(args.runtime)
     writer = BagWriter(args.bag, flush_period_s=args.flush_period)
     try:
-        recorder = Recorder(writer, args.topics, max_messages=args.max_messages,
+        recorder = Recorder(writer, args.topics, runtime=runtime, max_messages=args.max_messages,
                             on_topic=lambda t, m: print(f"subscribed {t} [{m}]", flush=True))
     except BaseException:
         writer.close()
         shutil.rmtree(writer.path, ignore_errors=True)
         raise
-    print(f"recording to {writer.path} ({', '.join(args.topics) or 'all topics'}); "
+    print(f"recording to {writer.path} from the {runtime} graph ({', '.join(args.topics) or 'all topics'}); "
           f"Ctrl-C to stop", flush=True)
     try:
         if not stop_requested:

@@ -1,4 +1,4 @@
-"""Recording the embedded (zenoh) graph into rosbag2 MCAP bags (``tdcm record``)."""
+"""Recording a live graph (embedded zenoh or rclpy) into rosbag2 MCAP bags (``tdcm record``)."""
 
 from tdcm_ros.recording.recorder import Recorder
 

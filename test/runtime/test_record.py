@@ -1,7 +1,9 @@
-"""``tdcm record`` over the embedded runtime: stopped by SIGINT/SIGTERM, killed, bad input."""
+"""``tdcm record`` on both runtimes (see conftest.py): stopped by SIGINT/SIGTERM, killed, bad input."""
 
 from __future__ import annotations
 
+import itertools
+import os
 import signal
 import subprocess
 import sys
@@ -9,43 +11,50 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
+from mcap.reader import make_reader
 from runtime_helpers import wait_for
 
 from tdcm_ros.bagio import from_dict, serialize
 from tdcm_ros.bagio.reader import open_bag
+from tdcm_ros.bagio.typestore import typestore
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
 
 REPO = Path(__file__).resolve().parents[2]
 RATE_HZ = 200.0
 
-# Publishes /count (std_msgs/Float64, data = 1, 2, ...) at RATE_HZ and one transient-local
-# /tf_static; appends "<n> <publish time ns>" per message to the log file argv[1].
+# On the runtime of TDCM_RUNTIME: publishes /count (std_msgs/Float64, data = 1, 2, ...) at
+# RATE_HZ, one transient-local /latched (std_msgs/String) and, with argv[2], one /kv
+# (diagnostic_msgs/KeyValue); appends "<n> <publish time ns>" per message to the file argv[1].
 PUBLISHER = f"""
-import sys, time
+import os, sys, time
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.port import QoS
-from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+from tdcm_ros.runtime.run_node import open_context
 
-context = ZenohContext()
+context = open_context(os.environ["TDCM_RUNTIME"])
 port = context.create_port("counter")
 count = port.create_publisher("/count", "std_msgs/msg/Float64")
-tf = port.create_publisher("/tf_static", "tf2_msgs/msg/TFMessage",
-                           QoS(depth=1, durability="transient_local"))
-tf.publish(from_dict("tf2_msgs/msg/TFMessage",
-                     {{"transforms": [{{"child_frame_id": "tdcm_base"}}]}}))
+latched = port.create_publisher("/latched", "std_msgs/msg/String",
+                                QoS(depth=1, durability="transient_local"))
+latched.publish(from_dict("std_msgs/msg/String", {{"data": "tdcm_base"}}))
+kv = port.create_publisher("/kv", "diagnostic_msgs/msg/KeyValue") if sys.argv[2:] else None
 with open(sys.argv[1], "w") as log:
     n = 0
     while True:
         n += 1
         stamp = time.time_ns()
         count.publish(from_dict("std_msgs/msg/Float64", {{"data": float(n)}}))
+        if kv is not None:
+            kv.publish(from_dict("diagnostic_msgs/msg/KeyValue", {{"key": "n"}}))
         log.write(f"{{n}} {{stamp}}\\n")
         log.flush()
         time.sleep({1.0 / RATE_HZ})
 """
+Spawn = Callable[..., subprocess.Popen[bytes]]
 
 
 class Lines:
@@ -68,22 +77,22 @@ def _published(log: Path) -> list[tuple[int, int]]:
     return [(int(r[0]), int(r[1])) for r in rows if len(r) == 2]
 
 
-def _start_publisher(zenoh_env: dict[str, str], log: Path) -> subprocess.Popen[bytes]:
-    return subprocess.Popen([sys.executable, "-c", PUBLISHER, str(log)], env=zenoh_env, cwd=REPO,
+def _start_publisher(env: dict[str, str], log: Path, *extra: str) -> subprocess.Popen[bytes]:
+    return subprocess.Popen([sys.executable, "-c", PUBLISHER, str(log), *extra], env=env, cwd=REPO,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
-def _record_until(spawn: Callable[..., subprocess.Popen[bytes]], zenoh_env: dict[str, str],
-                  tmp_path: Path, stop: signal.Signals) -> tuple[Path, list[tuple[int, int]], int,
-                                                            subprocess.Popen[bytes], Lines]:
+def _record_until(spawn: Spawn, env: dict[str, str], tmp_path: Path, stop: signal.Signals
+                  ) -> tuple[Path, list[tuple[int, int]], int, subprocess.Popen[bytes], Lines]:
     """Record a running publisher, send ``stop`` after ~200 messages; returns what happened."""
     log, bag = tmp_path / "published.txt", tmp_path / "bag"
-    publisher = _start_publisher(zenoh_env, log)
+    publisher = _start_publisher(env, log)
     try:
         wait_for(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
         recorder = spawn("tdcm_ros.cli.main", "record", str(bag))
         out = Lines(recorder)
-        wait_for(lambda: out.has("subscribed /count"), 20.0, "the recorder to subscribe")
+        wait_for(lambda: out.has("subscribed /count") and out.has("subscribed /latched"), 20.0,
+                 "the recorder to subscribe")
         first = len(_published(log))
         wait_for(lambda: len(_published(log)) > first + 200, 20.0, "200 more messages")
         signalled_ns = time.time_ns()
@@ -98,18 +107,18 @@ def _record_until(spawn: Callable[..., subprocess.Popen[bytes]], zenoh_env: dict
 def _counts(bag: Path) -> tuple[list[int], int]:
     reader = open_bag(bag)
     values = [int(m.data) for _, _, m in reader.messages(["/count"])]
-    return values, reader.counts.get("/tf_static", 0)
+    return values, reader.counts.get("/latched", 0)
 
 
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM])
 def test_signal_closes_a_bag_with_every_message_before_it(
-        router: subprocess.Popen[bytes], spawn: Callable[..., subprocess.Popen[bytes]],
-        zenoh_env: dict[str, str], tmp_path: Path, stop: signal.Signals) -> None:
-    bag, published, signalled_ns, recorder, out = _record_until(spawn, zenoh_env, tmp_path, stop)
+        runtime: str, spawn: Spawn, graph_env: dict[str, str], tmp_path: Path,
+        stop: signal.Signals) -> None:
+    bag, published, signalled_ns, recorder, out = _record_until(spawn, graph_env, tmp_path, stop)
     assert recorder.returncode == 0, recorder.stderr.read() if recorder.stderr else ""
     assert (bag / "metadata.yaml").is_file()
-    values, tf_count = _counts(bag)
-    assert tf_count == 1  # transient-local, published before the recorder started
+    values, latched_count = _counts(bag)
+    assert latched_count == 1  # transient-local, published before the recorder started
     assert values == list(range(values[0], values[-1] + 1))  # no gap
     # everything published 0.2 s (loopback delivery allowance) before the signal is in the bag
     before = max(n for n, stamp in published if stamp < signalled_ns - 200_000_000)
@@ -117,12 +126,27 @@ def test_signal_closes_a_bag_with_every_message_before_it(
     wait_for(lambda: out.has("messages in"), 5.0, "the summary")
     assert any(line.startswith(f"/count [std_msgs/msg/Float64]: {len(values)} messages")
                for line in out.lines)
+    reader = open_bag(bag)
+    assert {"/count": "std_msgs/msg/Float64", "/latched": "std_msgs/msg/String"}.items() <= \
+        reader.topics.items()
+    # the sender's clock and sequence number reach the bag on both runtimes
+    stamps = dict(published)
+    rows: list[tuple[int, int, Any]] = []
+    with open(next(bag.glob("*.mcap")), "rb") as stream:
+        decode = typestore().deserialize_cdr
+        for _, _, record in make_reader(stream).iter_messages(topics=["/count"]):
+            n = int(decode(record.data, "std_msgs/msg/Float64").data)
+            rows.append((stamps[n], n, record))
+    assert len(rows) == len(values)
+    assert all(abs(record.publish_time - sent) < 100_000_000 and record.log_time >= sent
+               for sent, _, record in rows)
+    assert all(b.sequence - a.sequence == m - n > 0
+               for (_, n, a), (_, m, b) in itertools.pairwise(rows))
 
 
 def test_sigkill_leaves_a_bag_readable_to_the_last_chunk(
-        router: subprocess.Popen[bytes], spawn: Callable[..., subprocess.Popen[bytes]],
-        zenoh_env: dict[str, str], tmp_path: Path) -> None:
-    bag, published, killed_ns, recorder, _ = _record_until(spawn, zenoh_env, tmp_path,
+        runtime: str, spawn: Spawn, graph_env: dict[str, str], tmp_path: Path) -> None:
+    bag, published, killed_ns, recorder, _ = _record_until(spawn, graph_env, tmp_path,
                                                            signal.SIGKILL)
     assert recorder.returncode == -signal.SIGKILL
     assert not (bag / "metadata.yaml").exists()
@@ -134,7 +158,42 @@ def test_sigkill_leaves_a_bag_readable_to_the_last_chunk(
     before = max(n for n, stamp in published if stamp < killed_ns - 1_000_000_000)
     assert values[-1] >= before
     lost = max(n for n, stamp in published if stamp < killed_ns) - values[-1]
-    print(f"SIGKILL at {RATE_HZ:.0f} Hz lost the last {lost} messages")
+    print(f"SIGKILL at {RATE_HZ:.0f} Hz on {runtime} lost the last {lost} messages")
+
+
+# rclpy only: on zenoh the recorder needs no per-type code, so every type it can name is recorded.
+@pytest.mark.parametrize("runtime", [pytest.param("rclpy", marks=pytest.mark.rclpy)],
+                         indirect=True)
+def test_a_type_without_an_rclpy_class_is_reported_and_skipped(
+        runtime: str, graph_env: dict[str, str], tmp_path: Path) -> None:
+    shadow = tmp_path / "shadow" / "diagnostic_msgs"   # the package, without its msg classes
+    (shadow / "msg").mkdir(parents=True)
+    (shadow / "__init__.py").write_text("")
+    (shadow / "msg" / "__init__.py").write_text("")
+    log, bag = tmp_path / "published.txt", tmp_path / "bag"
+    publisher = _start_publisher(graph_env, log, "kv")
+    env = {**graph_env, "PYTHONPATH": os.pathsep.join([str(shadow.parent),
+                                                       graph_env["PYTHONPATH"]])}
+    recorder = subprocess.Popen([sys.executable, "-m", "tdcm_ros.cli.main", "record", str(bag),
+                                 "count", "kv"], env=env, cwd=REPO,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        out = Lines(recorder)
+        wait_for(lambda: out.has("subscribed /count"), 20.0, "the recorder to subscribe")
+        wait_for(lambda: len(_published(log)) > 100, 20.0, "100 messages")
+        recorder.send_signal(signal.SIGINT)
+        recorder.wait(20.0)
+    finally:
+        for child in (publisher, recorder):
+            if child.poll() is None:
+                child.kill()
+            child.wait()
+    assert recorder.returncode == 0
+    assert recorder.stderr is not None
+    err = recorder.stderr.read().decode()
+    assert "not recording /kv [diagnostic_msgs/msg/KeyValue]" in err and "importable" in err, err
+    assert open_bag(bag).topics == {"/count": "std_msgs/msg/Float64"}
+    assert "never published: /kv" in err
 
 
 def _one_line_error(capsys: pytest.CaptureFixture[str], args: list[str], text: str) -> None:
@@ -172,13 +231,12 @@ def test_bag_info_lists_topics(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert "  /x [std_msgs/msg/Float64]: 1" in capsys.readouterr().out.splitlines()
 
 
-def test_recorder_in_process_stops_at_max_messages(router: subprocess.Popen[bytes],
-                                                   tmp_path: Path) -> None:
+def test_recorder_in_process_stops_at_max_messages(runtime: str, tmp_path: Path) -> None:
     """The Recorder class: named topic (short name), max_messages, a topic that never appears."""
     from tdcm_ros.recording import Recorder
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+    from tdcm_ros.runtime.run_node import open_context
 
-    context = ZenohContext()
+    context = open_context(runtime)
     publisher = context.create_port("counter").create_publisher("/count", "std_msgs/msg/Float64")
     stop = threading.Event()
 
@@ -192,7 +250,8 @@ def test_recorder_in_process_stops_at_max_messages(router: subprocess.Popen[byte
     thread = threading.Thread(target=publish, daemon=True)
     thread.start()
     try:
-        recorder = Recorder(BagWriter(tmp_path / "bag"), ["count", "/absent"], max_messages=20)
+        recorder = Recorder(BagWriter(tmp_path / "bag"), ["count", "/absent"], runtime=runtime,
+                            max_messages=20)
         recorder.run(duration_s=30.0)
         assert recorder.stopping and recorder.total == 20
         recorder.close()
@@ -203,3 +262,12 @@ def test_recorder_in_process_stops_at_max_messages(router: subprocess.Popen[byte
     assert recorder.missing == ["/absent"]
     values = [m.data for _, _, m in open_bag(tmp_path / "bag").messages()]
     assert len(values) == 20 and values == [values[0] + i for i in range(20)]
+
+
+def test_recorder_refuses_an_unknown_runtime(tmp_path: Path) -> None:
+    from tdcm_ros.errors import InputError
+    from tdcm_ros.recording import Recorder
+
+    with BagWriter(tmp_path / "bag") as writer, pytest.raises(
+            InputError, match="runtime = 'dds'.*allowed: zenoh, rclpy"):
+        Recorder(writer, runtime="dds")
