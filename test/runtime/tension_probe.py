@@ -20,6 +20,12 @@ def stamp_ns(message: Any) -> int:
     return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
 
 
+def level(status: Any) -> int:
+    """``DiagnosticStatus.level`` as an int (rosidl's Python type for ``byte`` is ``bytes``)."""
+    raw = status.level
+    return int.from_bytes(raw, "little") if isinstance(raw, bytes) else int(raw)
+
+
 def values(status: Any) -> dict[str, str]:
     """``DiagnosticStatus.values`` as a dict."""
     return {kv.key: kv.value for kv in status.values}

@@ -2,7 +2,9 @@
 
 The twin (firmware logic on a simulated bench) runs at real time in a thread, so the test can
 look inside the device (mode, faults, setpoint, true tension) while the node talks to it through
-the pty like it would to a UNO. Timeouts are generous; the assertions are about behaviour.
+the pty like it would to a UNO. Every node test runs on the embedded runtime and on rclpy (the
+``runtime`` fixture, conftest.py); the probe is the test's peer on that runtime. Timeouts are
+generous; the assertions are about behaviour.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from typing import Any
 
 import pytest
 from runtime_helpers import stop
-from tension_probe import DRIVER, Probe, driver_params, stamp_ns, values
+from tension_probe import DRIVER, Probe, driver_params, level, stamp_ns, values
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.plant import PlantConfig
@@ -37,12 +39,9 @@ def twin(tmp_path: Path) -> Iterator[PtyTwin]:
 
 
 @pytest.fixture
-def probe(router: subprocess.Popen[bytes]) -> Iterator[Probe]:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
-
-    ctx = ZenohContext()
-    yield Probe(ctx)
-    ctx.close()
+def probe(context: Any) -> Probe:
+    """The test's peer on the test's runtime (zenoh for tests without ``runtime``)."""
+    return Probe(context)
 
 
 def start_driver(spawn: Spawn, tmp_path: Path, twin: PtyTwin, **params: Any
@@ -53,16 +52,26 @@ def start_driver(spawn: Spawn, tmp_path: Path, twin: PtyTwin, **params: Any
                  "--params", path)
 
 
-def stderr_of(process: subprocess.Popen[bytes]) -> str:
-    """SIGINT the node, wait, return what it logged."""
+def stop_driver(process: subprocess.Popen[bytes], twin: PtyTwin) -> str:
+    """SIGINT the node and wait; checks it released the tendon on the way out (on the device
+    and in its log, which on rclpy must still be written before the context shuts down);
+    returns what it logged."""
     assert stop(process, 20.0) == 0
     assert process.stderr is not None
-    return process.stderr.read().decode()
+    log = process.stderr.read().decode()
+    assert "tension_driver]: tendon released, port closed" in log
+    deadline = time.monotonic() + 5.0
+    while twin.twin.core.mode is not Mode.RELEASE:
+        assert time.monotonic() < deadline, f"device still in {twin.twin.core.mode} after close"
+        time.sleep(0.02)
+    return log
 
 
-def test_step_0_to_20_n_settles_within_the_band(spawn, probe, twin, tmp_path) -> None:
-    """Enters +-0.25 N of 20 N within 3 s of the setpoint message and stays there for 2 s."""
-    start_driver(spawn, tmp_path, twin)
+def test_step_0_to_20_n_settles_within_the_band(runtime, spawn, probe, twin,
+                                               tmp_path) -> None:
+    """Enters +-0.25 N of 20 N within 3 s of the setpoint message and stays there for 2 s;
+    stopping the node releases the held tendon."""
+    node = start_driver(spawn, tmp_path, twin)
     probe.connected()
     assert abs(float(probe.state()["tension"])) < 0.1
     t0 = time.time_ns()
@@ -80,39 +89,40 @@ def test_step_0_to_20_n_settles_within_the_band(spawn, probe, twin, tmp_path) ->
     assert max(forces) < 20.0 + BAND
     assert all(m.header.frame_id == "tdcm_tendon" for m in probe.tension)
     assert twin.twin.plant.tension == pytest.approx(20.0, abs=BAND)
-    assert probe.states[-1].level == 0 and probe.state()["faults"] == ""
+    assert level(probe.states[-1]) == 0 and probe.state()["faults"] == ""
+    stop_driver(node, twin)
 
 
-def test_setpoint_above_the_maximum_is_clamped_with_a_warning(spawn, probe, twin,
-                                                              tmp_path) -> None:
+def test_setpoint_above_the_maximum_is_clamped_with_a_warning(runtime, spawn, probe, twin,
+                                                              tmp_path, params) -> None:
     node = start_driver(spawn, tmp_path, twin, tension_max=12.0)
     probe.connected()
     probe.until(lambda: probe.state().get("target") == "12.000", 10.0, "target clamped to 12 N",
                 action=lambda: probe.setpoint(35.0))
-    probe.until(lambda: any(d.level == 1 and int(values(d)["clamped_setpoints"]) >= 1
+    probe.until(lambda: any(level(d) == 1 and int(values(d)["clamped_setpoints"]) >= 1
                             for d in probe.diagnostics), 10.0, "a WARN on /diagnostics")
-    warned = next(d for d in probe.diagnostics if d.level == 1)
+    warned = next(d for d in probe.diagnostics if level(d) == 1)
     assert "clamped to 12 N" in values(warned)["last_warning"]
     assert "clamped to [0, 12] N" in warned.message
     probe.until(lambda: abs(twin.twin.plant.tension - 12.0) < BAND, 15.0, "12 N on the tendon")
     assert twin.twin.core.setpoint_mn == 12000
 
-    from tdcm_ros.runtime.zenoh_runtime import call_parameters
-
-    def set_param(name: str, value: Any) -> dict[str, Any]:
-        return call_parameters(probe.ctx.session, 0, "/tension_driver", "set",
-                               {"name": name, "value": value})
-
-    assert set_param("tension_max", 10.0)["successful"]  # a lower maximum re-clamps the target
+    driver = params("/tension_driver")
+    assert driver.set("tension_max", 10.0)["successful"]  # a lower maximum re-clamps the target
+    assert driver.get("tension_max") == 10.0
     probe.until(lambda: probe.state().get("target") == "10.000", 10.0, "target re-clamped")
-    refused = set_param("tension_max", 25.0)
-    assert not refused["successful"] and "tension_max" in refused["reason"]
-    assert not set_param("port", "/dev/null")["successful"]  # read-only
-    log = stderr_of(node)
+    refused = driver.set("tension_max", 25.0)
+    assert not refused["successful"] and "tension_max" in refused["reason"], refused
+    refused = driver.set("backoff_max", 0.02)  # below backoff_initial: the node's own check
+    assert not refused["successful"] and "backoff_initial" in refused["reason"], refused
+    refused = driver.set("port", "/dev/null")
+    assert not refused["successful"] and "read-only" in refused["reason"], refused
+    assert driver.get("tension_max") == 10.0 and driver.get("port") == twin.port
+    log = stop_driver(node, twin)
     assert "setpoint = 35 N is out of range [0, 12] N; clamped to 12 N" in log
 
 
-def test_estop_releases_at_once_and_stays_released_until_cleared(spawn, probe, twin,
+def test_estop_releases_at_once_and_stays_released_until_cleared(runtime, spawn, probe, twin,
                                                                  tmp_path) -> None:
     start_driver(spawn, tmp_path, twin)
     probe.connected()
@@ -126,7 +136,7 @@ def test_estop_releases_at_once_and_stays_released_until_cleared(spawn, probe, t
     assert core.faults & Fault.ESTOP and core.pulse_us == c.PULSE_RELEASE_US
     probe.until(lambda: twin.twin.plant.tension == 0.0, 5.0, "a slack tendon")
     probe.until(lambda: "ESTOP" in probe.state().get("faults", ""), 5.0, "ESTOP in device_state")
-    assert probe.states[-1].level == 2 and probe.state()["target"] == "0.000"
+    assert level(probe.states[-1]) == 2 and probe.state()["target"] == "0.000"
     time.sleep(0.5)
     assert core.mode is Mode.RELEASE  # latched: no automatic recovery
     probe.clear_faults()
@@ -134,7 +144,7 @@ def test_estop_releases_at_once_and_stays_released_until_cleared(spawn, probe, t
                 == "tension", 10.0, "faults cleared, holding 0 N again")
 
 
-def test_closing_and_reopening_the_pty_triggers_a_reconnect(spawn, probe, twin,
+def test_closing_and_reopening_the_pty_triggers_a_reconnect(runtime, spawn, probe, twin,
                                                             tmp_path) -> None:
     """A pulled cable: the link drops, the device's watchdog releases the tendon during the
     outage (backoff 1 s > watchdog 0.5 s), the driver reconnects, reports the latched fault and
@@ -154,23 +164,23 @@ def test_closing_and_reopening_the_pty_triggers_a_reconnect(spawn, probe, twin,
     probe.connected()
     count = len(probe.tension)
     probe.until(lambda: len(probe.tension) > count + 10, 10.0, "telemetry after the reconnect")
-    assert "device link lost" in stderr_of(node)
+    assert "device link lost" in stop_driver(node, twin)
 
 
-def test_a_silent_device_is_reported_stale_then_fresh_again(spawn, probe, twin,
+def test_a_silent_device_is_reported_stale_then_fresh_again(runtime, spawn, probe, twin,
                                                             tmp_path) -> None:
     start_driver(spawn, tmp_path, twin)
     probe.connected()
     with twin.frozen():  # no telemetry for longer than stale_timeout, shorter than link_timeout
-        probe.until(lambda: probe.states[-1].level == 3, 10.0, "STALE in device_state")
+        probe.until(lambda: level(probe.states[-1]) == 3, 10.0, "STALE in device_state")
         assert "no telemetry for" in probe.states[-1].message
-        probe.until(lambda: any(d.level == 3 for d in probe.diagnostics), 10.0,
+        probe.until(lambda: any(level(d) == 3 for d in probe.diagnostics), 10.0,
                     "STALE on /diagnostics")
-    probe.until(lambda: probe.states[-1].level != 3 and probe.state()["link"] == "connected",
+    probe.until(lambda: level(probe.states[-1]) != 3 and probe.state()["link"] == "connected",
                 20.0, "fresh telemetry again")
 
 
-def test_device_releases_within_its_watchdog_when_heartbeats_stop(spawn, probe, twin,
+def test_device_releases_within_its_watchdog_when_heartbeats_stop(runtime, spawn, probe, twin,
                                                                   tmp_path) -> None:
     """The driver process is frozen (SIGSTOP: a hung host); the device releases by itself."""
     node = start_driver(spawn, tmp_path, twin)
@@ -204,7 +214,8 @@ def test_device_releases_within_its_watchdog_when_heartbeats_stop(spawn, probe, 
     assert core.mode is Mode.RELEASE
 
 
-def test_schedule_runs_the_staircase_and_reports_done(spawn, probe, twin, tmp_path) -> None:
+def test_schedule_runs_the_staircase_and_reports_done(runtime, spawn, probe, twin,
+                                                     tmp_path) -> None:
     start_driver(spawn, tmp_path, twin, **{"schedule.levels": [0.0, 4.0, 8.0],
                                            "schedule.hold_s": 1.0, "schedule.trials": 2,
                                            "schedule.autostart": True})
@@ -226,6 +237,8 @@ def test_schedule_runs_the_staircase_and_reports_done(spawn, probe, twin, tmp_pa
     ("port", " ", "port = ' ' is invalid"),
 ])
 def test_bad_parameters_are_refused_naming_the_parameter(probe, name, value, message) -> None:
+    """Node logic, not the runtime: ports built in-process on a ZenohContext, so zenoh only
+    (the rclpy path of a bad file is the exit-status test below)."""
     from tdcm_ros.errors import InputError
     from tdcm_ros.nodes.tension_driver import TensionDriverNode
 
@@ -235,7 +248,7 @@ def test_bad_parameters_are_refused_naming_the_parameter(probe, name, value, mes
     assert message in str(caught.value)
 
 
-def test_a_bad_parameter_file_exits_with_status_2(spawn, router, tmp_path) -> None:
+def test_a_bad_parameter_file_exits_with_status_2(runtime, spawn, tmp_path) -> None:
     node = spawn("tdcm_ros.runtime.run_node", DRIVER, "--params",
                  driver_params(tmp_path / "bad.yaml", tension_max=30.0))
     assert node.wait(30) == 2
