@@ -1,4 +1,6 @@
-"""``tdcm up``: start the node set on the embedded runtime, each node its own process.
+"""``tdcm up``: start the node set, each node its own process, on the embedded zenoh runtime
+(with a router unless one answers on the endpoint) or on rclpy (``--runtime rclpy``: no router,
+no zenoh import; nodes discover each other on ``ROS_DOMAIN_ID``).
 
 ``--twin`` adds ``device_twin`` and ``tension_driver`` in front of the node set, the driver's
 ``port`` wired to the twin's pty link (``<tmp>/tdcm_twin_<pid of tdcm up>``, unique per run), so
@@ -28,7 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--runtime", default="zenoh", choices=("zenoh", "rclpy"),
                         help="runtime of every node (default zenoh)")
     parser.add_argument("--endpoint", default=None,
-                        help="router endpoint (default TDCM_ZENOH_ENDPOINT or tcp/127.0.0.1:7447)")
+                        help="zenoh router endpoint (default TDCM_ZENOH_ENDPOINT or "
+                             "tcp/127.0.0.1:7447; zenoh runtime only)")
     parser.add_argument("--twin", action="store_true",
                         help="also start device_twin and tension_driver wired to it (no hardware)")
     parser.add_argument("--scene", help="scene of the device twin (name or YAML path; needs --twin)")
@@ -43,6 +46,9 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
     nodes = [n.strip() for n in args.nodes.split(",") if n.strip()]
     overrides: dict[str, dict[str, Any]] = {}
     ready: dict[str, str] = {}
+    if args.endpoint and args.runtime != "zenoh":
+        raise InputError(f"--endpoint = {args.endpoint!r} needs --runtime zenoh",
+                         parameter="--endpoint", value=args.endpoint, allowed="with --runtime zenoh")
     if args.scene and not args.twin:
         raise InputError(f"--scene = {args.scene!r} needs --twin", parameter="--scene",
                          value=args.scene, allowed="with --twin")
@@ -60,15 +66,23 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
     return nodes, overrides, ready
 
 
+def router_endpoint(args: argparse.Namespace) -> str | None:
+    """The zenoh router endpoint (``--endpoint``, also exported to the nodes); ``None`` on rclpy."""
+    if args.runtime != "zenoh":
+        return None
+    from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV, endpoint
+
+    if args.endpoint:
+        os.environ[ENDPOINT_ENV] = args.endpoint
+    return endpoint()
+
+
 def run(args: argparse.Namespace) -> int:
     """Launch and wait; returns the exit status."""
     from tdcm_ros.runtime.launcher import launch
     from tdcm_ros.runtime.run_node import configure_logging
-    from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV, endpoint
 
     configure_logging()
-    if args.endpoint:
-        os.environ[ENDPOINT_ENV] = args.endpoint
     nodes, overrides, ready = plan(args, os.getpid())
-    return launch(nodes, params_file=args.params, runtime=args.runtime, endpoint=endpoint(),
-                  overrides=overrides, ready_paths=ready)
+    return launch(nodes, params_file=args.params, runtime=args.runtime,
+                  endpoint=router_endpoint(args), overrides=overrides, ready_paths=ready)

@@ -1,4 +1,5 @@
-"""A node graph as child processes: a zenoh router if none is reachable, nodes, helper processes.
+"""A node graph as child processes: nodes, helper processes and, on the zenoh runtime, a router
+if none is reachable (rclpy nodes discover each other; nothing here imports zenoh for them).
 
 Each node runs ``python -m tdcm_ros.runtime.run_node <module:Class>``. Per-node parameter
 overrides are merged over the parameter file into a per-node file in a temporary directory.
@@ -69,11 +70,12 @@ class NodeGraph:
     """Start nodes and processes in order; :meth:`close` stops them all.
 
     ``log_dir``, when set, receives each child's stdout and stderr as ``<name>.log``; otherwise
-    children share the terminal. ``stop_event`` aborts waits for ready paths.
+    children share the terminal. ``stop_event`` aborts waits for ready paths. ``endpoint`` is the
+    zenoh router's (``None`` on rclpy).
     """
 
-    def __init__(self, *, endpoint: str, runtime: str = "zenoh", params_file: str | None = None,
-                 grace: float = 5.0, log_dir: Path | None = None,
+    def __init__(self, *, endpoint: str | None = None, runtime: str = "zenoh",
+                 params_file: str | None = None, grace: float = 5.0, log_dir: Path | None = None,
                  stop_event: threading.Event | None = None) -> None:
         self.endpoint = endpoint
         self.runtime = runtime
@@ -103,18 +105,24 @@ class NodeGraph:
         return child
 
     def ensure_router(self, timeout: float = 10.0) -> None:
-        """Start a router on ``endpoint`` unless one already answers there (zenoh runtime only)."""
+        """Start a router on ``endpoint`` unless one already answers there (zenoh runtime only;
+        ``timeout`` in s)."""
+        if self.runtime != "zenoh":
+            return
         from tdcm_ros.runtime.router import is_listening
 
-        if self.runtime != "zenoh" or is_listening(self.endpoint):
+        endpoint = self.endpoint
+        if endpoint is None:
+            raise RuntimePortError("the zenoh runtime needs a router endpoint")
+        if is_listening(endpoint):
             return
         self.router = self.start("router", [sys.executable, "-m", "tdcm_ros.runtime.router",
-                                            "--listen", self.endpoint])
+                                            "--listen", endpoint])
         self.children.remove(self.router)
         deadline = time.monotonic() + timeout
-        while not is_listening(self.endpoint):
+        while not is_listening(endpoint):
             if not self.router.running or time.monotonic() > deadline:
-                raise RuntimePortError(f"zenoh router did not come up on {self.endpoint}")
+                raise RuntimePortError(f"zenoh router did not come up on {endpoint}")
             time.sleep(0.05)
 
     def start_node(self, name: str, *, overrides: Mapping[str, Any] | None = None,

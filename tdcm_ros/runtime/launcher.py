@@ -1,8 +1,9 @@
 """``launch``: run a node set (see :class:`~tdcm_ros.runtime.graph.NodeGraph`) until a signal.
 
-Nodes start in the order given, after a zenoh router if none is reachable. Per-node parameter
-``overrides`` are merged over the parameter file; a node listed in ``ready_paths`` must create
-that path before the next node starts (e.g. the twin's pty link before the driver opens it).
+Nodes start in the order given, on the zenoh runtime after a router if none is reachable.
+Per-node parameter ``overrides`` are merged over the parameter file; a node listed in
+``ready_paths`` must create that path before the next node starts (e.g. the twin's pty link
+before the driver opens it).
 SIGINT/SIGTERM to the launcher stops nodes in reverse order, router last.
 """
 
@@ -24,13 +25,15 @@ log = logging.getLogger("tdcm.up")
 
 
 def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str = "zenoh",
-           endpoint: str, grace: float = 5.0,
+           endpoint: str | None = None, grace: float = 5.0,
            overrides: Mapping[str, Mapping[str, Any]] | None = None,
            ready_paths: Mapping[str, str] | None = None, ready_timeout: float = 30.0) -> int:
     """Run ``nodes`` (registry names) until SIGINT/SIGTERM or until every node has exited.
 
-    ``overrides``: node name -> parameter values over ``params_file``; ``ready_paths``: node
-    name -> path it creates when ready (waited for, ``ready_timeout`` s, before the next node).
+    ``endpoint``: the zenoh router's (``None`` on rclpy); ``grace``: s from SIGINT to SIGKILL of
+    a node; ``overrides``: node name -> parameter values over ``params_file``; ``ready_paths``:
+    node name -> path it creates when ready (waited for, ``ready_timeout`` s, before the next
+    node).
     """
     for name in nodes:
         node_target(name)  # unknown names fail before anything starts

@@ -1,15 +1,15 @@
 """device_twin in its own process (driven by the driver core here), and the whole chain
-``tdcm up --twin``: device_twin -> tension_driver -> model_node, with no hardware."""
+``tdcm up --twin``: device_twin -> tension_driver -> model_node, with no hardware. The process
+tests run on the embedded runtime and on rclpy (the ``runtime`` fixture, conftest.py)."""
 
 from __future__ import annotations
 
 import os
 import statistics
-import subprocess
 import tempfile
 import time
-from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -23,15 +23,12 @@ from tdcm_ros.model import preset, solve
 
 
 @pytest.fixture
-def probe(router: subprocess.Popen[bytes]) -> Iterator[Probe]:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
-
-    ctx = ZenohContext()
-    yield Probe(ctx)
-    ctx.close()
+def probe(context: Any) -> Probe:
+    """The test's peer on the test's runtime (zenoh for tests without ``runtime``)."""
+    return Probe(context)
 
 
-def test_twin_node_serves_its_plant_and_publishes_the_true_tension(spawn, probe,
+def test_twin_node_serves_its_plant_and_publishes_the_true_tension(runtime, spawn, probe,
                                                                    tmp_path) -> None:
     """With a +1 N load-cell bias the device holds 8 N measured, so the tendon carries 7 N."""
     link = tmp_path / "twin_link"
@@ -71,6 +68,7 @@ def test_twin_node_serves_its_plant_and_publishes_the_true_tension(spawn, probe,
     ("speed", 0.0, "speed = 0.0 is out of range"),
 ])
 def test_bad_parameters_are_refused_naming_the_parameter(probe, name, value, message) -> None:
+    """Node logic, not the runtime: ports built in-process on a ZenohContext, so zenoh only."""
     from tdcm_ros.nodes.device_twin import DeviceTwinNode
 
     port = probe.ctx.create_port("bad_twin", overrides={name: value})
@@ -80,6 +78,7 @@ def test_bad_parameters_are_refused_naming_the_parameter(probe, name, value, mes
 
 
 def test_the_link_never_replaces_a_regular_file(probe, tmp_path) -> None:
+    """Node logic on an in-process ZenohContext port (zenoh only, like the test above)."""
     from tdcm_ros.nodes.device_twin import DeviceTwinNode
 
     precious = tmp_path / "notes.txt"
@@ -90,12 +89,16 @@ def test_the_link_never_replaces_a_regular_file(probe, tmp_path) -> None:
     assert precious.read_text() == "keep me"
 
 
-def test_tdcm_up_twin_runs_tension_to_midline_with_no_hardware(spawn, probe,
-                                                               zenoh_env) -> None:
+def test_tdcm_up_twin_runs_tension_to_midline_with_no_hardware(runtime, spawn, probe, graph_env,
+                                                               tmp_path) -> None:
     """A setpoint published on the runtime comes back as a `midline` for the measured tension;
-    Ctrl-C stops everything, the driver releasing the tendon before the twin stops."""
-    up = spawn("tdcm_ros.cli.main", "up", "--twin", "--endpoint",
-               zenoh_env["TDCM_ZENOH_ENDPOINT"])
+    Ctrl-C stops everything, the driver releasing the tendon before the twin stops. On zenoh
+    the launcher finds the test's router (TDCM_ZENOH_ENDPOINT); on rclpy it starts none and
+    runs where eclipse-zenoh cannot be imported (a ROS machine need not have it)."""
+    if runtime == "rclpy":
+        (tmp_path / "zenoh.py").write_text("raise ImportError('no eclipse-zenoh here')\n")
+        graph_env["PYTHONPATH"] = os.pathsep.join([str(tmp_path), graph_env["PYTHONPATH"]])
+    up = spawn("tdcm_ros.cli.main", "up", "--twin", "--runtime", runtime)
     link = Path(tempfile.gettempdir()) / f"tdcm_twin_{up.pid}"
 
     def settled_midline() -> bool:
@@ -118,7 +121,8 @@ def test_tdcm_up_twin_runs_tension_to_midline_with_no_hardware(spawn, probe,
     assert stop(up, 30.0) == 0
     assert up.stderr is not None
     log = up.stderr.read().decode()
-    assert "[/tension_driver]: tendon released, port closed" in log
+    assert "tension_driver]: tendon released, port closed" in log  # logger /x (zenoh), x (rclpy)
+    assert "starting router" not in log
     assert "device twin stopped: mode release" in log
     assert log.index("tendon released") < log.index("device twin stopped")
     assert not os.path.lexists(link)
@@ -149,6 +153,8 @@ def test_up_plan_wires_the_driver_to_a_per_run_twin_link() -> None:
         plan(up_args("--scene", "paper_experiment"), 1)
     with pytest.raises(InputError, match="--schedule needs tension_driver"):
         plan(up_args("--schedule"), 1)
+    with pytest.raises(InputError, match="--endpoint = 'tcp/127.0.0.1:1' needs --runtime zenoh"):
+        plan(up_args("--runtime", "rclpy", "--endpoint", "tcp/127.0.0.1:1"), 1)
 
 
 def test_merged_parameter_file_keeps_the_users_values_under_the_overrides(tmp_path) -> None:
