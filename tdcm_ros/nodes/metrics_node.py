@@ -74,8 +74,8 @@ class MetricsNode(NodeLogic):
                               description="tdcm_base origin in mocap (m), source=parameter")
         rotation = declare("registration.rotation", [0.0, 0.0, 0.0, 1.0], read_only=True,
                            description="tdcm_base orientation in mocap (x, y, z, w)")
-        self.stale_s = float(declare("stale_s", 1.0, range=(0.01, 3600.0),
-                                     description="inputs older than this are stale (s)"))
+        declare("stale_s", 1.0, range=(0.01, 3600.0),
+                description="inputs older than this are stale (s); changeable at run time")
         update_s = float(declare("update_period_s", 0.5, range=(0.01, 60.0), read_only=True,
                                  description="period of step detection (s)"))
         diag_s = float(declare("diagnostics_period_s", 1.0, range=(0.05, 60.0), read_only=True,
@@ -226,9 +226,10 @@ class MetricsNode(NodeLogic):
     def report(self) -> None:
         """``/diagnostics``: staleness, registration and counters."""
         now = self.port.now_ns()
-        problems = [f"no {name} for more than {self.stale_s:g} s"
+        stale_s = float(self.port.get_parameter("stale_s"))
+        problems = [f"no {name} for more than {stale_s:g} s"
                     for name in ("tension", "markers")
-                    if now - self.last_ns.get(name, -(1 << 62)) > self.stale_s * 1e9]
+                    if now - self.last_ns.get(name, -(1 << 62)) > stale_s * 1e9]
         reg = self.running.used_registration
         if reg is None:
             problems.append("no registration yet (waiting for /tf_static or a zero-tension and "
