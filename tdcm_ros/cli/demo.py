@@ -1,8 +1,9 @@
-"""``tdcm demo``: the paper's experiment end to end on the embedded runtime, with no hardware.
+"""``tdcm demo``: the paper's experiment end to end, with no hardware, on zenoh or rclpy.
 
 A scene's simulated bench (device twin on a pty, simulated Vicon markers) runs with the real
 tension driver, model node, mocap node, metrics node and recorder, each its own process, on a
-private zenoh router. After the schedule (default: the scene's, the paper's 3 trials of
+private zenoh router (``--runtime zenoh``, the default unless ``TDCM_RUNTIME`` says otherwise) or
+as rclpy nodes in the environment's ROS domain (``--runtime rclpy``). After the schedule (default: the scene's, the paper's 3 trials of
 0 -> 20 N in 4 N steps) the bag is evaluated (Table I metrics, per-step table, plots) and the
 model's E is calibrated on it, with the metrics after calibration.
 """
@@ -17,6 +18,7 @@ from pathlib import Path
 
 from tdcm_ros.demo.plan import RECORDED_TOPICS, make_plan
 from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -37,6 +39,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="comma-separated topics to record (default: %(default)s)")
     parser.add_argument("--endpoint", default=None,
                         help="zenoh router endpoint (default: a private router on a free port)")
+    parser.add_argument("--runtime", choices=RUNTIMES,
+                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
+                        help=f"runtime of the graph (default: {RUNTIME_ENV}, else zenoh; auto: "
+                             f"rclpy if importable); rclpy uses ROS_DOMAIN_ID and "
+                             f"ROS_AUTOMATIC_DISCOVERY_RANGE from the environment")
     parser.set_defaults(handler=run)
 
 
@@ -62,11 +69,12 @@ def run(args: argparse.Namespace) -> int:
     """Run the demo; returns the exit status."""
     from tdcm_ros.demo.report import report
     from tdcm_ros.demo.run import record_live
-    from tdcm_ros.runtime.run_node import configure_logging
+    from tdcm_ros.runtime.run_node import configure_logging, resolve_runtime
     from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV
     from tdcm_ros.scenes import load_scene
 
     configure_logging("WARNING")
+    runtime = resolve_runtime(args.runtime)
     started = time.monotonic()
     scene = load_scene(args.scene)
     out = _out_dir(args.out, scene.name)
@@ -82,8 +90,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"  schedule: {plan.schedule.trials} trial(s) of [{levels}] N, {plan.schedule.hold:g} s "
           f"per level ({plan.schedule.duration:g} s); effects: "
           f"{', '.join(scene.effect_names()) or 'none'}")
-    print(f"  output: {plan.out}   router: {endpoint}")
-    record_live(plan, endpoint=endpoint)
+    graph = (f"router {endpoint}" if runtime == "zenoh" else
+             f"rclpy, ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}")
+    print(f"  output: {plan.out}   runtime: {graph}")
+    record_live(plan, endpoint=endpoint, runtime=runtime)
     report(plan, calibrate=not args.no_calibrate)
     print(f"tdcm demo: done in {time.monotonic() - started:.1f} s; outputs in {plan.out}")
     return 0

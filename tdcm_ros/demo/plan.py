@@ -61,7 +61,7 @@ class DemoPlan:
                                "schedule.levels": [float(v) for v in self.schedule.levels],
                                "schedule.hold_s": float(self.schedule.hold),
                                "schedule.trials": int(self.schedule.trials),
-                               "schedule.autostart": True},
+                               "schedule.autostart": False},  # the demo starts it
         }
 
 

@@ -1,8 +1,12 @@
-"""Run a demo plan: the live graph on the embedded runtime, the bag, then evaluation and calibration.
+"""Run a demo plan: the live graph (embedded zenoh or rclpy), the bag, then evaluation and calibration.
 
-The demo process joins the graph itself (a zenoh port named ``_tdcm_demo``) to print progress
-and to see the driver report ``schedule_done`` on ``device_state``. Ctrl-C stops the graph
-cleanly (the bag is closed and keeps everything received) and skips the evaluation.
+The demo process joins the graph itself (a node named ``_tdcm_demo`` on the same runtime) to print
+progress, to start the driver's schedule (``start_schedule``) once the bag holds every evaluated
+topic (so the first level is recorded whatever the runtime's discovery time), and to see the
+driver report ``schedule_done`` on ``device_state``. Children inherit the
+environment (``ROS_DOMAIN_ID``, ``ROS_AUTOMATIC_DISCOVERY_RANGE``, the zenoh endpoint). Ctrl-C
+stops the graph cleanly (the bag is closed and keeps everything received) and skips the
+evaluation.
 """
 
 from __future__ import annotations
@@ -14,19 +18,29 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from tdcm_ros.demo.plan import NODE_ORDER, DemoPlan
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.demo.plan import EVALUATED_TOPICS, NODE_ORDER, DemoPlan
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.graph import NodeGraph
+from tdcm_ros.runtime.names import resolve_topic
 
 log = logging.getLogger("tdcm.demo")
 #: Extra time (s) over the schedule before the demo gives up waiting for ``schedule_done``.
 START_MARGIN_S = 60.0
 #: Time (s) after ``schedule_done`` before the recorder is stopped, so the last samples land.
 SETTLE_S = 0.5
+#: Longest wait (s) for the bag to hold every evaluated topic before the schedule starts.
+READY_TIMEOUT_S = 60.0
+#: Time (s) between ``start_schedule`` messages while the driver still reports no schedule.
+START_RETRY_S = 1.0
+#: Schedule states (``device_state`` key ``schedule``) before a start request was taken.
+_NOT_STARTED = ("", "idle")
 
 
 class DemoInterrupted(TdcmError):
@@ -96,10 +110,39 @@ def _graph_alive(graph: NodeGraph) -> None:
         raise RuntimePortError(f"demo process exited early: {names}{logs}")
 
 
-def record_live(plan: DemoPlan, *, endpoint: str, say: Callable[[str], None] = print,
-                progress_period: float = 2.0) -> Progress:
-    """Run the graph until the driver's schedule is done; the bag is closed on return."""
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+def bag_holds(bag: Path, topics: tuple[str, ...]) -> bool:
+    """True once the bag being written at ``bag`` holds a message on each of ``topics``."""
+    from tdcm_ros.bagio.reader import open_bag
+
+    try:
+        counts = open_bag(bag).counts
+    except BagError:  # not created yet, or no chunk flushed yet
+        return False
+    return all(counts.get(resolve_topic(topic), 0) > 0 for topic in topics)
+
+
+class _Loop:
+    """One 0.1 s turn of the demo's waits: spin, then fail on Ctrl-C, a dead child or a deadline."""
+
+    def __init__(self, graph: NodeGraph, context: Any, stop: threading.Event) -> None:
+        self.graph, self.context, self.stop = graph, context, stop
+
+    def turn(self, deadline: float, late: Callable[[], str]) -> None:
+        """Spin 0.1 s; ``late()`` is the error message once ``deadline`` (monotonic s) passed."""
+        if self.stop.is_set():
+            raise DemoInterrupted("demo interrupted; the bag so far is closed and readable")
+        _graph_alive(self.graph)
+        if time.monotonic() > deadline:
+            raise RuntimePortError(late())
+        self.context.spin_for(0.1)
+
+
+def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
+                say: Callable[[str], None] = print, progress_period: float = 2.0) -> Progress:
+    """Run the graph on ``runtime`` (``zenoh``: with a router on ``endpoint`` unless one answers
+    there; ``rclpy``) until the driver's schedule is done; the bag is closed on return.
+    ``progress_period`` is the time between progress lines (s)."""
+    from tdcm_ros.runtime.run_node import open_context
 
     stop = threading.Event()
 
@@ -110,33 +153,42 @@ def record_live(plan: DemoPlan, *, endpoint: str, say: Callable[[str], None] = p
     logs = plan.out / "logs"
     logs.mkdir(parents=True, exist_ok=True)
     progress = Progress()
-    graph = NodeGraph(endpoint=endpoint, log_dir=logs, stop_event=stop)
-    context: ZenohContext | None = None
+    graph = NodeGraph(endpoint=endpoint, runtime=runtime, log_dir=logs, stop_event=stop)
+    context: Any = None
     try:
         graph.ensure_router()
         recorder = graph.start("recorder", [sys.executable, "-m", "tdcm_ros.cli.main", "record",
-                                            str(plan.bag), *plan.recorded_topics])
-        context = ZenohContext()
-        _watch(context.create_port("_tdcm_demo"), progress)
+                                            "--runtime", runtime, str(plan.bag),
+                                            *plan.recorded_topics])
+        context = open_context(runtime)
+        port = context.create_port("_tdcm_demo")
+        _watch(port, progress)
+        start = port.create_publisher("start_schedule", "std_msgs/msg/Empty")
         overrides = plan.node_overrides()
         for name in NODE_ORDER:
             if stop.is_set():
                 break
             graph.start_node(name, overrides=overrides[name],
                              ready_path=plan.link if name == "device_twin" else None)
-        say(f"graph up: router, recorder, {', '.join(NODE_ORDER)} (logs in {logs})")
+        say(f"graph up on {runtime}: {'router, ' if graph.router else ''}recorder, "
+            f"{', '.join(NODE_ORDER)} (logs in {logs})")
+        loop = _Loop(graph, context, stop)
+        ready_by = time.monotonic() + READY_TIMEOUT_S
+        while not bag_holds(plan.bag, EVALUATED_TOPICS):
+            loop.turn(ready_by, lambda: f"the recorder wrote no {', '.join(EVALUATED_TOPICS)} "
+                                        f"within {READY_TIMEOUT_S:g} s; see {logs}")
         started = time.monotonic()
+        say(f"the bag holds {', '.join(EVALUATED_TOPICS)}; starting the schedule")
         deadline = started + plan.schedule.duration + START_MARGIN_S
-        next_line = started
+        next_line = next_start = started
         while not progress.schedule_done:
-            if stop.is_set():
-                raise DemoInterrupted("demo interrupted; the bag so far is closed and readable")
-            _graph_alive(graph)
-            if time.monotonic() > deadline:
-                raise RuntimePortError(
-                    f"the schedule did not finish within {plan.schedule.duration:g} s + "
-                    f"{START_MARGIN_S:g} s (last state {progress.schedule or 'none'}); see {logs}")
-            context.spin_for(0.1)
+            now = time.monotonic()
+            if progress.schedule in _NOT_STARTED and now >= next_start:
+                start.publish(from_dict("std_msgs/msg/Empty", {}))
+                next_start = now + START_RETRY_S
+            loop.turn(deadline, lambda: f"the schedule did not finish within "
+                                        f"{plan.schedule.duration:g} s + {START_MARGIN_S:g} s "
+                                        f"(last state {progress.schedule or 'none'}); see {logs}")
             if time.monotonic() >= next_line:
                 say(progress.line(time.monotonic() - started))
                 next_line += progress_period

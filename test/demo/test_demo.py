@@ -1,7 +1,9 @@
-"""``tdcm demo`` end to end on a shortened schedule, and its input checks."""
+"""``tdcm demo`` end to end on a shortened schedule (on zenoh, and on rclpy: marked ``rclpy``),
+and its input checks."""
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import subprocess
@@ -13,32 +15,69 @@ import pytest
 
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.cli.main import main
-from tdcm_ros.demo.plan import NODE_ORDER, make_plan
+from tdcm_ros.demo.plan import NODE_ORDER, RECORDED_TOPICS, make_plan
 from tdcm_ros.device.schedule import StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.registry import NODES
 from tdcm_ros.scenes import load_scene
 
 REPO = Path(__file__).resolve().parents[2]
+RUNTIMES = ["zenoh", pytest.param("rclpy", marks=pytest.mark.rclpy)]
+#: Python packages the demo needs on rclpy: rclpy and the message packages not in the Jazzy
+#: wheels (.ci/ros.sh builds them).
+RCLPY_NEEDS = ("rclpy", "tf2_msgs.msg", "mocap4r2_msgs.msg")
+#: What every demo bag holds, whatever the runtime.
+BAG_TYPES = {
+    "/tension": "geometry_msgs/msg/WrenchStamped", "/sim/tension_true":
+    "geometry_msgs/msg/WrenchStamped", "/markers": "mocap4r2_msgs/msg/Markers",
+    "/tf_static": "tf2_msgs/msg/TFMessage", "/tip_pose": "geometry_msgs/msg/PoseStamped",
+    "/predicted_markers": "geometry_msgs/msg/PoseArray", "/midline": "nav_msgs/msg/Path",
+    "/device_state": "diagnostic_msgs/msg/DiagnosticStatus",
+    "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray"}
 
 
-def _run_demo(out: Path, *args: str) -> subprocess.CompletedProcess[str]:
-    pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+def _runtime_env(runtime: str) -> dict[str, str]:
+    """Environment of a demo on ``runtime``: rclpy in a private domain on this host only.
+
+    Without rclpy or its message packages the rclpy half is skipped, unless
+    ``TDCM_REQUIRE_RCLPY=1`` (CI's ROS step), where that fails (as test/runtime/conftest.py)."""
+    if runtime == "zenoh":
+        pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
+        return {"TDCM_RUNTIME": "zenoh"}
+    for module in RCLPY_NEEDS:
+        try:
+            importlib.import_module(module)
+        except ImportError as error:
+            if os.environ.get("TDCM_REQUIRE_RCLPY") == "1":
+                pytest.fail(f"TDCM_REQUIRE_RCLPY=1 but {module} is not importable: {error}")
+            pytest.skip(f"{module} is not importable; run .ci/ros.sh for the rclpy half")
+    return {"TDCM_RUNTIME": "rclpy", "ROS_DOMAIN_ID": str(100 + os.getpid() % 100),
+            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+
+
+def _run_demo(out: Path, *args: str, runtime: str = "zenoh") -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, **_runtime_env(runtime), "PYTHONPATH": os.pathsep.join(
         [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])])}
     env.pop("TDCM_ZENOH_ENDPOINT", None)
     return subprocess.run([sys.executable, "-m", "tdcm_ros", "demo", "--out", str(out),
-                           "--trials", "1", "--hold", "2.5", *args],
+                           "--trials", "1", "--hold", "2.5", "--runtime", runtime, *args],
                           env=env, cwd=REPO, capture_output=True, text=True, timeout=240,
                           check=False)
 
 
-def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: Path) -> None:
-    done = _run_demo(tmp_path / "ideal", "--scene", "ideal", "--no-calibrate")
+@pytest.mark.parametrize("runtime", RUNTIMES)
+def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: Path,
+                                                                     runtime: str) -> None:
+    done = _run_demo(tmp_path / "ideal", "--scene", "ideal", "--no-calibrate", runtime=runtime)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
-    reader = open_bag(tmp_path / "ideal" / "bag")
-    for topic in ("/tension", "/markers", "/tf_static", "/tip_pose", "/sim/tension_true"):
+    assert f"graph up on {runtime}" in done.stdout
+    bag = tmp_path / "ideal" / "bag"
+    assert sorted(p.name for p in bag.iterdir()) == ["bag_0.mcap", "metadata.yaml"]
+    reader = open_bag(bag)
+    assert reader.topics == BAG_TYPES and len(BAG_TYPES) == len(RECORDED_TOPICS)
+    for topic in BAG_TYPES:
         assert reader.counts[topic] > 0, topic
+    assert reader.counts["/tf_static"] == 1
     assert not reader.warnings
     metrics = json.loads((tmp_path / "ideal" / "metrics.json").read_text())["before_calibration"]
     assert metrics["n_trials"] == 1
