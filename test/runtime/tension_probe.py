@@ -100,6 +100,10 @@ class Probe:
                 next_action = now + 0.3
             self.ctx.spin_for(0.05)
 
-    def connected(self, mode: str = "tension", timeout: float = 30.0) -> None:
+    def connected(self, mode: str = "tension", timeout: float = 30.0,
+                  action: Callable[[], None] | None = None) -> None:
+        """Until the driver reports the link up with the device in ``mode`` (``action`` as in
+        :meth:`until`)."""
         self.until(lambda: self.state().get("link") == "connected"
-                   and self.state().get("mode") == mode, timeout, f"connected in mode {mode}")
+                   and self.state().get("mode") == mode, timeout, f"connected in mode {mode}",
+                   action)
