@@ -114,14 +114,16 @@ class Peer:
 
     def stream(self, rec: Recording) -> None:
         """Send the recording in stamp order, in bursts of ``CHUNK_S``: each burst's tension
-        first, then (after a short spin) its frames, so a frame's tension is already there."""
+        first, then, once the node's diagnostics count it received, the burst's frames, so a
+        frame's tension is always there (as live, where mocap lags the load cell)."""
         t_ns, f_ns = stamps_ns(rec.tension.stamps_s), stamps_ns(rec.markers.stamps_s)
         ti = fi = 0
         for end in np.arange(CHUNK_S, rec.tension.stamps_s[-1] + CHUNK_S, CHUNK_S):
             while ti < len(t_ns) and rec.tension.stamps_s[ti] < end:
                 self.send_tension(t_ns[ti], float(rec.tension.tension_n[ti]))
                 ti += 1
-            self.ctx.spin_for(0.05)
+            self.spin_until(lambda sent=ti: self.diagnostic("tension") == str(sent), 10.0,
+                            f"the node to count {ti} tension samples")
             while fi < len(f_ns) and rec.markers.stamps_s[fi] < end:
                 self.send_frame(f_ns[fi], fi, rec.markers.labels, rec.markers.positions[fi])
                 fi += 1
@@ -167,7 +169,7 @@ def test_errors_and_running_table_equal_the_library(runtime, context, spawn, tmp
     peer.ctx.spin_for(0.2)
     # /tf_static went out before the node existed: it reaches the node as a late joiner.
     spawn("tdcm_ros.runtime.run_node", METRICS, "--params", params_file(tmp_path, {
-        "update_period_s": 0.1, "diagnostics_period_s": 0.2}))
+        "update_period_s": 0.1, "diagnostics_period_s": 0.05}))
     peer.spin_until(lambda: peer.diagnostic("registration") == "tf_static", 20.0,
                     "the registration from /tf_static")
     peer.stream(recording)
@@ -180,7 +182,9 @@ def test_errors_and_running_table_equal_the_library(runtime, context, spawn, tmp
                              recording.tension.tension_n.tolist(), strict=True))
     frames = dict(zip(stamps_ns(recording.markers.stamps_s), recording.markers.positions,
                       strict=True))
-    peer.spin_until(lambda: len(peer.errors) >= 0.9 * len(frames), 10.0, "per-frame errors")
+    tip_seen = int(np.count_nonzero(~np.isnan(recording.markers.positions[:, -1, 0])))
+    peer.spin_until(lambda: len(peer.errors) == len(frames) and len(peer.tips) == tip_seen, 10.0,
+                    "an error message per frame and a tip error per frame with the tip")
     for message in peer.errors:
         ns = int(message.header.stamp.sec) * 10**9 + int(message.header.stamp.nanosec)
         expected = reg.to_base(frames[ns]) - table.markers(max(tension_by_ns[ns], 0.0))
@@ -188,12 +192,11 @@ def test_errors_and_running_table_equal_the_library(runtime, context, spawn, tmp
         assert message.header.frame_id == "tdcm_base"
         assert [m.marker_name for m in message.markers] == [options.layout.labels[i]
                                                            for i in visible]
-        got = np.array([vector(m.translation) for m in message.markers]).reshape(-1, 3)
-        assert np.allclose(got, expected[visible], rtol=0, atol=1e-12)
+        errors = np.array([vector(m.translation) for m in message.markers]).reshape(-1, 3)
+        assert np.allclose(errors, expected[visible], rtol=0, atol=1e-12)
     # tip_error: the m3 error of each frame where the tip marker is visible, and only those.
     with_tip = {stamp_s(m): vector(m.markers[-1].translation) for m in peer.errors
                 if m.markers and m.markers[-1].marker_name == "m3"}
-    peer.spin_until(lambda: len(peer.tips) >= len(with_tip), 10.0, "tip errors")
     assert {stamp_s(m): vector(m.vector) for m in peer.tips} == with_tip
 
     # Table I: the library's offline evaluation of the same samples; the final zero hold never
