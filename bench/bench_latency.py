@@ -1,23 +1,37 @@
 """Tension -> ``midline`` end-to-end latency of ``model_node`` across processes (issue 4).
 
-Run: ``python bench/bench_latency.py [--rates 100 500 1000] [--duration 10]`` or
-``python bench/bench_latency.py --soak [--soak-duration 60] [--soak-rate 1000]``.
+Run: ``python bench/bench_latency.py [--runtime zenoh|rclpy|both] [--rates 100 500 1000]
+[--duration 10]`` or ``python bench/bench_latency.py --soak [--soak-duration 60] [--soak-rate 1000]``.
+``--runtime`` defaults to ``both`` when rclpy is importable, else ``zenoh``; with ``both`` the
+runtimes are interleaved per rate (zenoh 100, rclpy 100, zenoh 500, ...) in the same run, and a
+table of rclpy/zenoh ratios of p50 and p99 per rate follows.
 
-Starts a private zenoh router (``tdcm_ros.runtime.router``), ``model_node`` and, per rate, a
-tension publisher, each its own process, as ``tdcm up`` does. The publisher sends
-``geometry_msgs/WrenchStamped`` on ``tension`` with the send time (``time.time_ns``) in the
-header stamp; model_node stamps its outputs with the input's stamp, so this process measures
-latency = receive time of a ``midline`` (taken first thing in the zenoh callback) minus its
-stamp. Per rate it prints p50, p99 and max latency (ms), delivered/sent (inputs that produced a
-midline; the rest were coalesced by the keep-latest node or lost) and the coalesced inputs the
-node reports on ``/diagnostics``, with the 1-min load average (the figures are only as good as
-an idle machine). ``--soak`` also samples model_node's RSS (``VmRSS``) once a second and prints
-start, end and max RSS and the least-squares slope.
+Per phase (one runtime, one rate) it starts a fresh stack, each its own process, as ``tdcm up``
+does: on zenoh a private router (``tdcm_ros.runtime.router``) and ``model_node --runtime zenoh``;
+on rclpy ``model_node --runtime rclpy`` and nothing else (DDS discovery; the caller's
+``ROS_DOMAIN_ID`` and ``ROS_AUTOMATIC_DISCOVERY_RANGE`` apply). Only one stack runs at a time. A
+tension publisher process on the same runtime sends ``geometry_msgs/WrenchStamped`` on ``tension``
+(CDR bytes serialised once; the send time, ``time.time_ns``, is written into the header stamp
+right before each publish). model_node stamps its outputs with the input's stamp, so this process
+measures latency = receive time of a ``midline`` minus its stamp. The receive time is taken first
+thing in the callback: on zenoh a session subscriber's callback (zenoh's thread), on rclpy a raw
+subscription's callback (``RclpyNodePort.create_raw_subscription``, run by this process's
+executor, so it includes this process's executor delay); the stamp is parsed from the CDR bytes.
+Per phase it prints p50, p99 and max latency (ms), delivered/sent (inputs that produced a
+midline; the rest were coalesced by the keep-latest node or lost), the coalesced inputs the node
+reports on ``/diagnostics``, ``lost`` (sent minus every input the node's ``/diagnostics``
+counters account for: solved, coalesced, dropped, model errors; so inputs that never reached its
+callback, e.g. beyond its subscription's depth of 100), the one-hop transport latency (``hop``:
+publisher -> this process's listener on ``tension``, the same measurement without the node),
+model_node's CPU (all its threads, so above 100 % is possible) and the 1-min load average (the
+figures are only as good as an idle machine). ``--soak`` also samples model_node's RSS
+(``VmRSS``) once a second and prints start, end and max RSS and the least-squares slope, per runtime.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import socket
@@ -27,19 +41,23 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from tdcm_ros.bagio import from_dict, type_hash
+from tdcm_ros.bagio import from_dict, serialize, type_hash
 
 MODEL = "tdcm_ros.nodes.model_node:ModelNode"
 TENSION_N = 12.0
+TENSION_TYPE = "geometry_msgs/msg/WrenchStamped"
+RUNTIMES = ("zenoh", "rclpy")
 _STAMP = struct.Struct("<iI")  # header.stamp (sec, nanosec) right after the 4-byte CDR header
+_CDR_LE = b"\x00\x01"          # little-endian plain CDR encapsulation
 
 
 def free_port() -> int:
@@ -63,25 +81,43 @@ def cpu_s(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def rclpy_available() -> bool:
+    return importlib.util.find_spec("rclpy") is not None
+
+
+def open_context(runtime: str) -> Any:
+    from tdcm_ros.runtime.run_node import open_context as open_runtime
+
+    return open_runtime(runtime)
+
+
 # -- publisher process ------------------------------------------------------------------------
 
-def publish(rate: float, duration: float, wait: float) -> None:
-    """Publish ``tension`` at ``rate`` Hz for ``duration`` s; print a JSON summary on stdout."""
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+def _ready(runtime: str, port: Any, publisher: Any) -> bool:
+    """The publisher reaches model_node: zenoh key matched; on rclpy both subscribers discovered
+    (model_node and this bench's one-hop listener)."""
+    if runtime == "rclpy":
+        return bool(port.node.count_subscribers(publisher.topic) >= 2)
+    return bool(publisher.matched())
 
-    context = ZenohContext()
+
+def publish(runtime: str, rate: float, duration: float, wait: float) -> None:
+    """Publish ``tension`` at ``rate`` Hz for ``duration`` s; print a JSON summary on stdout."""
+    context = open_context(runtime)
     try:
-        publisher = context.create_port("bench_tension").create_publisher(
-            "tension", "geometry_msgs/msg/WrenchStamped")
+        port = context.create_port("bench_tension")
+        publisher = port.create_publisher("tension", TENSION_TYPE)
         deadline = time.monotonic() + wait
-        while not publisher.matched():
+        while not _ready(runtime, port, publisher):
             if time.monotonic() > deadline:
                 raise SystemExit("bench publisher: no subscriber on `tension`")
             time.sleep(0.01)
         time.sleep(0.3)  # let the route settle
-        message = from_dict("geometry_msgs/msg/WrenchStamped", {
+        message = from_dict(TENSION_TYPE, {
             "header": {"frame_id": "tdcm_tendon"}, "wrench": {"force": {"z": TENSION_N}}})
-        stamp = message.header.stamp
+        data = bytearray(serialize(message, TENSION_TYPE))
+        if data[:2] != _CDR_LE:
+            raise SystemExit("bench publisher: expected little-endian CDR")
         period_ns = int(1e9 / rate)
         count = round(rate * duration)
         start = time.monotonic_ns()
@@ -91,8 +127,8 @@ def publish(rate: float, duration: float, wait: float) -> None:
             while (left := due - time.monotonic_ns()) > 0:
                 time.sleep(left / 1e9)
             now = time.time_ns()
-            stamp.sec, stamp.nanosec = divmod(now, 1_000_000_000)
-            publisher.publish(message)
+            _STAMP.pack_into(data, 4, *divmod(now, 1_000_000_000))
+            publisher.publish_cdr(bytes(data))
             first_ns = first_ns or now
             last_ns = now
         elapsed = (time.monotonic_ns() - start) / 1e9
@@ -109,52 +145,66 @@ def publish(rate: float, duration: float, wait: float) -> None:
 class Phase:
     """Figures of one publishing run."""
 
+    runtime: str
     rate: float
     sent: int
     latencies_ms: np.ndarray
     hop_ms: np.ndarray
     coalesced: int
     solved: int
+    lost: int
     load: tuple[float, float]
     cpu_node: float
     elapsed_s: float
     rss_kib: list[tuple[float, int]] = field(default_factory=list)
 
+    def percentile(self, q: float) -> float:
+        return float(np.percentile(self.latencies_ms, q)) if len(self.latencies_ms) else np.nan
+
 
 class Bench:
-    """Router + model_node children and the receiving side in this process."""
+    """model_node (and on zenoh a router) as children; the measuring side in this process."""
 
-    def __init__(self, params: Path | None) -> None:
-        self.port = free_port()
-        self.env = {**os.environ, "TDCM_ZENOH_ENDPOINT": f"tcp/127.0.0.1:{self.port}",
-                    "TDCM_RUNTIME": "zenoh", "ROS_DOMAIN_ID": "0"}
+    def __init__(self, runtime: str, params: Path | None) -> None:
+        from tdcm_ros.runtime.port import QoS
+
+        self.runtime = runtime
+        self.env = {**os.environ, "TDCM_RUNTIME": runtime}
         self.env.pop("TDCM_ZENOH_CONFIG", None)
-        os.environ.update({k: self.env[k] for k in ("TDCM_ZENOH_ENDPOINT", "ROS_DOMAIN_ID")})
-        os.environ.pop("TDCM_ZENOH_CONFIG", None)
         self.children: list[subprocess.Popen[bytes]] = []
-        self.router = self._spawn("-m", "tdcm_ros.runtime.router", "--listen",
-                                  self.env["TDCM_ZENOH_ENDPOINT"])
-        self._wait(lambda: self._listening(), 15.0, "the router")
+        self.node: subprocess.Popen[bytes] | None = None
+        if runtime == "zenoh":
+            self.port = free_port()
+            self.env["TDCM_ZENOH_ENDPOINT"] = f"tcp/127.0.0.1:{self.port}"
+            os.environ["TDCM_ZENOH_ENDPOINT"] = self.env["TDCM_ZENOH_ENDPOINT"]
+            os.environ.pop("TDCM_ZENOH_CONFIG", None)
+            self._spawn("-m", "tdcm_ros.runtime.router", "--listen",
+                        self.env["TDCM_ZENOH_ENDPOINT"])
+            self._wait(lambda: self._listening(), 15.0, "the router")
         extra = ["--params", str(params)] if params else []
-        self.node = self._spawn("-m", "tdcm_ros.runtime.run_node", MODEL, "--runtime", "zenoh",
+        self.node = self._spawn("-m", "tdcm_ros.runtime.run_node", MODEL, "--runtime", runtime,
                                 *extra)
         self.lock = threading.Lock()
         self.received: list[tuple[int, int]] = []   # (receive ns, stamp ns) of each midline
         self.inputs: list[tuple[int, int]] = []     # the same for each `tension` (one hop)
         self.counters: dict[str, int] = {}
         self.diag_ns = 0
-        from tdcm_ros.runtime import wire
-        from tdcm_ros.runtime.zenoh_runtime import ZenohContext
-
-        self.context = ZenohContext()
+        self.context = open_context(runtime)
         port = self.context.create_port("bench_latency")
-        self.subscribers = [
-            self.context.session.declare_subscriber(
-                wire.topic_key(0, topic, type_name, type_hash(type_name)),
-                lambda sample, into=into: self._on_stamped(sample, into))
-            for topic, type_name, into in (("midline", "nav_msgs/msg/Path", self.received),
-                                           ("tension", "geometry_msgs/msg/WrenchStamped",
-                                            self.inputs))]
+        self.subscribers: list[Any] = []
+        for topic, type_name, into in (("midline", "nav_msgs/msg/Path", self.received),
+                                       ("tension", TENSION_TYPE, self.inputs)):
+            if runtime == "zenoh":  # straight on the session: zenoh's thread, no executor
+                from tdcm_ros.runtime import wire
+
+                self.subscribers.append(self.context.session.declare_subscriber(
+                    wire.topic_key(self.context.domain_id, topic, type_name,
+                                   type_hash(type_name)),
+                    self._stamped(into, lambda sample: sample.payload.to_bytes())))
+            else:  # raw CDR, deep enough that this listener never drops
+                port.create_raw_subscription(topic, type_name,
+                                             self._stamped(into, lambda sample: sample.data),
+                                             QoS(depth=2000))
         port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
                                  self._on_diagnostics)
         self._wait(lambda: self.diag_ns > 0, 30.0, "model_node's first /diagnostics",
@@ -178,20 +228,25 @@ class Bench:
         deadline = time.monotonic() + timeout
         while not predicate():
             if time.monotonic() > deadline or self.node_exited():
-                raise SystemExit(f"bench: timed out after {timeout} s waiting for {what}")
+                raise SystemExit(f"bench ({self.runtime}): timed out after {timeout} s waiting "
+                                 f"for {what}")
             if spin:
                 self.context.spin_for(0.05)
             else:
                 time.sleep(0.05)
 
     def node_exited(self) -> bool:
-        return len(self.children) > 1 and self.children[1].poll() is not None
+        return self.node is not None and self.node.poll() is not None
 
-    def _on_stamped(self, sample: Any, into: list[tuple[int, int]]) -> None:
-        now = time.time_ns()
-        sec, nanosec = _STAMP.unpack_from(sample.payload.to_bytes(), 4)
-        with self.lock:
-            into.append((now, sec * 1_000_000_000 + nanosec))
+    def _stamped(self, into: list[tuple[int, int]],
+                 payload: Callable[[Any], bytes]) -> Callable[[Any], None]:
+        """Callback recording (receive time, header stamp); the time is taken first."""
+        def on_sample(sample: Any) -> None:
+            now = time.time_ns()
+            sec, nanosec = _STAMP.unpack_from(payload(sample), 4)
+            with self.lock:
+                into.append((now, sec * 1_000_000_000 + nanosec))
+        return on_sample
 
     def _on_diagnostics(self, message: Any) -> None:
         for status in message.status:
@@ -207,13 +262,15 @@ class Bench:
 
     def run(self, rate: float, duration: float, sample_rss: bool = False) -> Phase:
         """Publish at ``rate`` Hz for ``duration`` s from a child process; collect figures."""
+        assert self.node is not None
         before = self.fresh_counters(time.time_ns())
         with self.lock:
             self.received.clear()
             self.inputs.clear()
         load0 = os.getloadavg()[0]
         cpu0 = cpu_s(self.node.pid)
-        publisher = self._spawn(__file__, "--publish", str(rate), str(duration), output=True)
+        publisher = self._spawn(__file__, "--publish", str(rate), str(duration),
+                                "--runtime", self.runtime, output=True)
         rss: list[tuple[float, int]] = []
         t0 = time.monotonic()
         next_rss = t0
@@ -223,10 +280,10 @@ class Bench:
                 next_rss += 1.0
             self.context.spin_for(0.05)
             if self.node_exited():
-                raise SystemExit("bench: model_node exited")
+                raise SystemExit(f"bench: model_node ({self.runtime}) exited")
         out = publisher.stdout.read() if publisher.stdout else b""
         if publisher.returncode != 0:
-            raise SystemExit(f"bench: publisher failed ({publisher.returncode})")
+            raise SystemExit(f"bench: publisher ({self.runtime}) failed ({publisher.returncode})")
         summary = json.loads(out.decode().strip().splitlines()[-1])
         if sample_rss:
             rss.append((time.monotonic() - t0, rss_kib(self.node.pid)))
@@ -237,9 +294,12 @@ class Bench:
                        if summary["first_ns"] <= stamp <= summary["last_ns"]]
             hop = np.array([(recv - stamp) / 1e6 for recv, stamp in self.inputs])
         latencies = np.array([(recv - stamp) / 1e6 for recv, stamp in samples])
-        return Phase(rate, summary["sent"], latencies, hop,
-                     after.get("coalesced", 0) - before.get("coalesced", 0),
-                     after.get("solved", 0) - before.get("solved", 0),
+        delta = {key: value - before.get(key, 0) for key, value in after.items()}
+        accounted = sum(value for key, value in delta.items()
+                        if key in ("solved", "coalesced") or key.startswith(("dropped_", "model_")))
+        return Phase(self.runtime, rate, summary["sent"], latencies, hop,
+                     delta.get("coalesced", 0), delta.get("solved", 0),
+                     summary["sent"] - accounted,
                      (load0, os.getloadavg()[0]), cpu_s(self.node.pid) - cpu0,
                      summary["elapsed_s"], rss)
 
@@ -258,34 +318,63 @@ class Bench:
 
 
 @contextmanager
-def bench(period: float | None) -> Iterator[Bench]:
+def bench(runtime: str, period: float | None) -> Iterator[Bench]:
     """A running :class:`Bench`, with ``process_period_s`` overridden when given."""
     with tempfile.TemporaryDirectory() as tmp:
         params = None
         if period is not None:
             params = Path(tmp) / "model_node.yaml"
             params.write_text(f"model_node:\n  ros__parameters:\n    process_period_s: {period}\n")
-        runner = Bench(params)
+        runner = Bench(runtime, params)
         try:
             yield runner
         finally:
             runner.close()
 
 
+def measure(runtime: str, rate: float, duration: float, warmup: float, period: float | None,
+            sample_rss: bool = False) -> Phase:
+    """One phase on a fresh stack: warm up at 100 Hz (not reported), then ``rate`` Hz."""
+    with bench(runtime, period) as runner:
+        if warmup > 0:
+            runner.run(100.0, warmup)
+        return runner.run(rate, duration, sample_rss)
+
+
 def row(phase: Phase) -> str:
     lat = phase.latencies_ms
     delivered = len(lat)
-    figures = (f"{np.percentile(lat, 50):7.2f} {np.percentile(lat, 99):7.2f} {lat.max():8.2f}"
+    figures = (f"{phase.percentile(50):7.2f} {phase.percentile(99):7.2f} {lat.max():8.2f}"
                if delivered else f"{'-':>7} {'-':>7} {'-':>8}")
     hop = (f"{np.percentile(phase.hop_ms, 50):5.2f} {np.percentile(phase.hop_ms, 99):5.2f}"
            if len(phase.hop_ms) else f"{'-':>5} {'-':>5}")
-    return (f"{phase.rate:7.0f} {figures} {delivered:7d}/{phase.sent:<7d} "
-            f"{phase.coalesced:9d} {hop} {phase.cpu_node / phase.elapsed_s * 100:7.0f}% "
+    return (f"{phase.runtime:>7} {phase.rate:7.0f} {figures} {delivered:7d}/{phase.sent:<7d} "
+            f"{phase.coalesced:9d} {phase.lost:5d} {hop} "
+            f"{phase.cpu_node / phase.elapsed_s * 100:7.0f}% "
             f"{phase.load[0]:5.2f}->{phase.load[1]:.2f}")
 
 
-HEADER = (f"{'rate Hz':>7} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>8} {'delivered/sent':>15} "
-          f"{'coalesced':>9} {'hop p50':>5} {'p99':>5} {'node CPU':>8} load1")
+HEADER = (f"{'runtime':>7} {'rate Hz':>7} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>8} "
+          f"{'delivered/sent':>15} {'coalesced':>9} {'lost':>5} {'hop p50':>5} {'p99':>5} "
+          f"{'node CPU':>8} load1")
+
+
+def ratio_table(phases: list[Phase]) -> None:
+    """rclpy/zenoh ratios of p50 and p99 (and of the one-hop p99) per rate."""
+    by_key = {(p.runtime, p.rate): p for p in phases}
+    print("\nrclpy/zenoh ratio (same run, interleaved per rate)")
+    print(f"{'rate Hz':>7} {'p50 zenoh':>9} {'p50 rclpy':>9} {'ratio':>6} "
+          f"{'p99 zenoh':>9} {'p99 rclpy':>9} {'ratio':>6} {'hop p99 ratio':>13}")
+    for rate in dict.fromkeys(p.rate for p in phases):
+        zenoh, rclpy = by_key.get(("zenoh", rate)), by_key.get(("rclpy", rate))
+        if zenoh is None or rclpy is None:
+            continue
+        z50, r50, z99, r99 = (zenoh.percentile(50), rclpy.percentile(50), zenoh.percentile(99),
+                              rclpy.percentile(99))
+        hop = (np.percentile(rclpy.hop_ms, 99) / np.percentile(zenoh.hop_ms, 99)
+               if len(rclpy.hop_ms) and len(zenoh.hop_ms) else np.nan)
+        print(f"{rate:7.0f} {z50:9.2f} {r50:9.2f} {r50 / z50:6.2f} "
+              f"{z99:9.2f} {r99:9.2f} {r99 / z99:6.2f} {hop:13.2f}", flush=True)
 
 
 def soak_report(phase: Phase) -> None:
@@ -294,23 +383,47 @@ def soak_report(phase: Phase) -> None:
     slope = np.polyfit(times, kib, 1)[0] if len(times) > 1 else 0.0
     half = times >= times[-1] / 2
     late = np.polyfit(times[half], kib[half], 1)[0] if half.sum() > 1 else 0.0
-    print(f"model_node RSS: start {kib[0] / 1024:.1f} MiB, end {kib[-1] / 1024:.1f} MiB, "
-          f"max {kib.max() / 1024:.1f} MiB, slope {slope:+.2f} KiB/s over the run "
-          f"({late:+.2f} KiB/s over the second half), {len(kib)} samples")
+    print(f"model_node ({phase.runtime}) RSS: start {kib[0] / 1024:.1f} MiB, end "
+          f"{kib[-1] / 1024:.1f} MiB, max {kib.max() / 1024:.1f} MiB, slope {slope:+.2f} KiB/s "
+          f"over the run ({late:+.2f} KiB/s over the second half), {len(kib)} samples")
     every = max(1, len(kib) // 12)
     series = " ".join(f"{k / 1024:.1f}" for k in kib[::every])
     print(f"RSS (MiB) every ~{every} s: {series}")
     print(f"coalesced inputs (from /diagnostics): {phase.coalesced} of {phase.sent} sent; "
-          f"solved {phase.solved}")
+          f"solved {phase.solved}; lost {phase.lost}")
+
+
+def fmt_load() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def describe(runtimes: list[str], period: float | None) -> str:
+    """Header line: date, CPUs, load average, runtimes (and the rclpy RMW and domain)."""
+    parts = [datetime.now().astimezone().isoformat(timespec="seconds"),
+             f"{os.cpu_count()} CPUs, load average {fmt_load()}",
+             f"runtimes {', '.join(runtimes)}"]
+    if "rclpy" in runtimes:
+        from rclpy.utilities import get_rmw_implementation_identifier
+
+        parts.append(f"rclpy on {get_rmw_implementation_identifier()}, ROS_DOMAIN_ID "
+                     f"{os.environ.get('ROS_DOMAIN_ID', '(unset: 0)')}, "
+                     f"ROS_AUTOMATIC_DISCOVERY_RANGE "
+                     f"{os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', '(unset)')}")
+    parts.append(f"tension {TENSION_N} N, paper-experiment, default model_node parameters"
+                 + (f", process_period_s {period}" if period else ""))
+    return "; ".join(parts)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runtime", choices=[*RUNTIMES, "both"], default=None,
+                        help="runtime(s) to measure (default: both when rclpy is importable, "
+                             "else zenoh)")
     parser.add_argument("--rates", type=float, nargs="+", default=[100.0, 500.0, 1000.0],
                         help="input rates (Hz)")
     parser.add_argument("--duration", type=float, default=10.0, help="seconds per rate")
     parser.add_argument("--warmup", type=float, default=2.0,
-                        help="seconds at 100 Hz before measuring (not reported)")
+                        help="seconds at 100 Hz before each phase (not reported)")
     parser.add_argument("--soak", action="store_true", help="memory soak instead of the rates")
     parser.add_argument("--soak-rate", type=float, default=1000.0, help="soak input rate (Hz)")
     parser.add_argument("--soak-duration", type=float, default=60.0, help="soak length (s)")
@@ -320,26 +433,33 @@ def main() -> None:
                         help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.publish:
-        publish(*args.publish, wait=20.0)
+        publish(args.runtime or "zenoh", *args.publish, wait=20.0)
         return
+    choice = args.runtime or ("both" if rclpy_available() else "zenoh")
+    runtimes = list(RUNTIMES) if choice == "both" else [choice]
+    if "rclpy" in runtimes and not rclpy_available():
+        parser.error("--runtime rclpy/both needs rclpy (source ROS 2 or use its Python)")
     if min([*args.rates, args.soak_rate]) <= 0 or min(args.duration, args.soak_duration) <= 0:
         parser.error("rates and durations must be > 0")
-    print(f"{os.cpu_count()} CPUs, load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}; "
-          f"tension {TENSION_N} N, paper-experiment, default model_node parameters"
-          + (f", process_period_s {args.period}" if args.period else ""), flush=True)
-    with bench(args.period) as runner:
-        if args.warmup > 0:
-            runner.run(100.0, args.warmup)
-        if args.soak:
-            phase = runner.run(args.soak_rate, args.soak_duration, sample_rss=True)
-            print(f"soak: {args.soak_rate:g} Hz for {args.soak_duration:g} s")
+    print(describe(runtimes, args.period), flush=True)
+    if args.soak:
+        for runtime in runtimes:
+            phase = measure(runtime, args.soak_rate, args.soak_duration, args.warmup,
+                            args.period, sample_rss=True)
+            print(f"soak ({runtime}): {args.soak_rate:g} Hz for {args.soak_duration:g} s")
             print(HEADER)
             print(row(phase))
             soak_report(phase)
-            return
-        print(HEADER)
-        for rate in args.rates:
-            print(row(runner.run(rate, args.duration)), flush=True)
+        return
+    print(HEADER, flush=True)
+    phases = []
+    for rate in args.rates:
+        for runtime in runtimes:
+            phases.append(measure(runtime, rate, args.duration, args.warmup, args.period))
+            print(row(phases[-1]), flush=True)
+    if len(runtimes) > 1:
+        ratio_table(phases)
+    print(f"load average at the end {fmt_load()}")
 
 
 if __name__ == "__main__":
