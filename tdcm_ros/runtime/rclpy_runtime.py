@@ -22,6 +22,8 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
+import yaml
+
 from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import wire
@@ -51,6 +53,11 @@ def message_class(type_name: str) -> Any:
         raise RuntimePortError(
             f"message type {type_name} is not importable for rclpy ({error}); build and source "
             f"its interface package (see README, 'On a ROS 2 machine')") from error
+
+
+def _flag_values(args: Sequence[str], flags: tuple[str, ...]) -> list[str]:
+    """The value after each occurrence of one of ``flags`` in ``args``."""
+    return [args[i + 1] for i in range(len(args) - 1) if args[i] in flags]
 
 
 def _plain(value: Any) -> Any:
@@ -224,14 +231,29 @@ class RclpyNodePort:
     def create_raw_subscription(self, topic: str, type_name: str,
                                 callback: Callable[[RawSample], None],
                                 qos: QoS = DEFAULT_QOS) -> None:
-        """Subscribe to CDR samples with the sender's timestamp and sequence number."""
+        """Subscribe to CDR samples with the sender's timestamp and sequence number.
+
+        rclpy's executor takes one message per subscription per wake-up; at 1 kHz that alone
+        let model_node's queue fill (100 ms behind). So each wake-up also drains what is
+        already queued, up to ``qos.depth`` messages, in order, through the same callback.
+        """
         name = normalize_type_name(type_name)
         holder: list[Any] = []
 
-        def on_message(data: bytes, info: Mapping[str, Any]) -> None:
+        def deliver(data: bytes, info: Mapping[str, Any]) -> None:
             attachment = wire.Attachment(int(info.get("publication_sequence_number", 0)),
                                          int(info.get("source_timestamp", 0)), _NO_GID)
             callback(RawSample(holder[0].topic_name, name, bytes(data), attachment))
+
+        def on_message(data: bytes, info: Mapping[str, Any]) -> None:
+            deliver(data, info)
+            subscription = holder[0]
+            for _ in range(qos.depth):
+                with subscription.handle:
+                    taken = subscription.handle.take_message(subscription.msg_type, True)
+                if taken is None:
+                    return
+                deliver(*taken)
 
         holder.append(self.node.create_subscription(message_class(name), topic, on_message,
                                                     qos_profile(qos), raw=True))
@@ -251,37 +273,52 @@ class RclpyNodePort:
 class RclpyContext:
     """An rclpy context with one executor for the nodes it creates; see the module docstring.
 
-    ``args`` are rclpy command-line arguments (``--ros-args ...``), applied to every node; the
-    ``--params-file`` files among them also give each port its overrides, looked up by the node's
-    final (remapped) name, as ``ros2 launch`` passes them.
+    ``args`` are rclpy command-line arguments (``--ros-args ...``), applied to every node.
+    Each port's overrides are read by the package's own reader (so an ``int`` widens to a
+    ``float`` parameter and mixed ``[0.1, 0, 0.5]`` lists load, which rcl's parser refuses), looked
+    up by the node's final (remapped) name, later sources winning: ``params_files`` (never handed
+    to rcl), then the ``--params-file`` files in ``args`` (as ``ros2 launch`` passes them), then
+    ``-p [node:]name:=value`` in ``args``.
     """
 
-    def __init__(self, args: Sequence[str] = ()) -> None:
+    def __init__(self, args: Sequence[str] = (), params_files: Sequence[str] = ()) -> None:
         import rclpy
         from rclpy.context import Context
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.signals import SignalHandlerOptions
 
         self.context = Context()
-        rclpy.init(args=["tdcm", *args], context=self.context,
-                   signal_handler_options=SignalHandlerOptions.NO)
+        try:
+            rclpy.init(args=["tdcm", *args], context=self.context,
+                       signal_handler_options=SignalHandlerOptions.NO)
+        except rclpy.exceptions.RCLError as error:
+            raise InputError(f"ROS arguments {' '.join(args)!r} are refused by rcl: {error}",
+                             parameter="--ros-args", value=" ".join(args)) from error
         self.executor = SingleThreadedExecutor(context=self.context)
         self.domain_id = int(self.context.get_domain_id())
-        self.params_files = [args[i + 1] for i in range(len(args) - 1)
-                             if args[i] == "--params-file"]
+        self.params_files = [*params_files, *_flag_values(args, ("--params-file",))]
+        self.cli_params = _flag_values(args, ("-p", "--param"))
         self._stop = threading.Event()
         self._nodes: list[Any] = []
 
     def create_port(self, name: str, namespace: str = "/",
                     overrides: Mapping[str, Any] | None = None) -> RclpyNodePort:
         """A node port on a new rclpy node ``namespace/name``; ``overrides`` default to the
-        node's values in the ``--params-file`` files (later files win)."""
+        node's values from the parameter files and ``-p`` arguments (see the class docstring)."""
         node = self.create_node(name, namespace)
         if overrides is None:
-            fqn = node.get_fully_qualified_name()
-            overrides = {k: v for path in self.params_files
-                         for k, v in node_parameters(path, fqn).items()}
+            overrides = self.file_overrides(node.get_fully_qualified_name(), node.get_name())
         return RclpyNodePort(node, overrides)
+
+    def file_overrides(self, fqn: str, name: str) -> dict[str, Any]:
+        """Values for node ``fqn`` from the parameter files, then the ``-p`` arguments."""
+        values = {k: v for path in self.params_files for k, v in node_parameters(path, fqn).items()}
+        for item in self.cli_params:
+            target, _, text = item.partition(":=")
+            node, _, parameter = target.rpartition(":")
+            if node in ("", name, fqn):
+                values[parameter] = yaml.safe_load(text)
+        return values
 
     def create_node(self, name: str, namespace: str = "/") -> Any:
         """A plain ``rclpy.node.Node`` spun by this context's executor."""

@@ -57,12 +57,14 @@ def configure_logging(level: str = "INFO") -> None:
                         format="[%(levelname)s] [%(created).6f] [%(name)s]: %(message)s")
 
 
-def open_context(runtime: str, ros_args: Sequence[str] = ()) -> Any:
-    """A new context of ``runtime`` (``zenoh`` or ``rclpy``; ``ros_args`` go to rclpy)."""
+def open_context(runtime: str, ros_args: Sequence[str] = (),
+                 params_files: Sequence[str] = ()) -> Any:
+    """A new context of ``runtime`` (``zenoh`` or ``rclpy``; ``ros_args`` and the parameter
+    files whose values its nodes take are for rclpy)."""
     if runtime == "rclpy":
         from tdcm_ros.runtime.rclpy_runtime import RclpyContext
 
-        return RclpyContext(ros_args)
+        return RclpyContext(ros_args, params_files)
     from tdcm_ros.runtime.zenoh_runtime import ZenohContext
 
     return ZenohContext()
@@ -78,13 +80,10 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     """
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
-    overrides: dict[str, Any] | None = None  # rclpy: from every --params-file, by final name
-    if chosen == "rclpy":
-        ros_args = [*(ros_args or ["--ros-args"]),
-                    *(["--params-file", params_file] if params_file else [])]
-    else:
+    overrides: dict[str, Any] | None = None  # rclpy: by the node's final name, in create_port
+    if chosen == "zenoh":
         overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
-    context = open_context(chosen, ros_args)
+    context = open_context(chosen, ros_args, [params_file] if params_file else [])
 
     def stop(signum: int, frame: FrameType | None) -> None:
         context.request_stop()

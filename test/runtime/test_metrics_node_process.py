@@ -254,12 +254,7 @@ def test_stale_inputs_warn_and_stale_s_changes_at_runtime(runtime, context, spaw
     assert node.get("design.E") == preset("paper-experiment").E
 
 
-def test_a_float_list_with_integer_entries_is_read(runtime, context, spawn, params, tmp_path,
-                                                    request):
-    if runtime == "rclpy":
-        request.applymarker(pytest.mark.xfail(strict=True, reason=(
-            "run_node hands the params file to rcl (--params-file), whose parser refuses "
-            "sequences of mixed int and float")))
+def test_a_float_list_with_integer_entries_is_read(runtime, context, spawn, params, tmp_path):
     peer = Peer(context)
     node = spawn("tdcm_ros.runtime.run_node", METRICS, "--params", params_file(tmp_path, {
         "registration": {"source": "parameter", "translation": [0.1, 0, 0.5]},
