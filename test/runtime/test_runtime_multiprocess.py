@@ -99,16 +99,18 @@ def test_tdcm_param_lists_gets_and_sets(runtime: str, graph_env: dict[str, str],
     assert missing.returncode != 0 and "nobody" in missing.stderr
 
 
-def test_subscriber_survives_publisher_restart(runtime: str, context: Any, spawn: Spawn) -> None:
+def test_subscriber_survives_publisher_restart(runtime: str, context: Any, spawn: Spawn,
+                                               tmp_path: Path) -> None:
     texts: list[str] = []
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
     first = spawn("tdcm_ros.runtime.run_node", TALKER)
-    spin_until(context, lambda: len(texts) >= 1, 15.0, "the first talker")
+    spin_until(context, lambda: len(texts) >= 1, 30.0, "the first talker")
     assert stop(first) == 0
-    texts.clear()
-    spawn("tdcm_ros.runtime.run_node", TALKER)
-    spin_until(context, lambda: "hello 1" in texts or "hello 2" in texts, 15.0,
+    second = tmp_path / "second.yaml"
+    second.write_text("talker:\n  ros__parameters:\n    prefix: second\n")
+    spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(second))
+    spin_until(context, lambda: any(t.startswith("second ") for t in texts), 30.0,
                "the restarted talker")
 
 
