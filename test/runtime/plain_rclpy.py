@@ -1,7 +1,8 @@
 """Test-side peers on rclpy: plain rclpy nodes, as a user's own node would be.
 
 They subscribe and publish the rosidl-generated message classes (so every message crosses
-rosidl's own typesupport, not rosbags), and reach node parameters through
+rosidl's own typesupport, not rosbags; the class lookup and QoS mapping are the package's small
+helpers, which hold no transport logic), and reach node parameters through
 ``rclpy.parameter_client.AsyncParameterClient`` (what ``ros2 param`` uses). The port shape
 (``create_subscription``/``create_publisher``/``spin_for``) matches the zenoh context, so one
 probe class serves both runtimes.
@@ -9,28 +10,14 @@ probe class serves both runtimes.
 
 from __future__ import annotations
 
-import importlib
 import time
 from collections.abc import Callable
 from typing import Any
 
 from tdcm_ros.bagio import serialize
 from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
-
-
-def native_class(type_name: str) -> Any:
-    package, _, name = type_name.partition("/msg/")
-    return getattr(importlib.import_module(f"{package}.msg"), name)
-
-
-def profile(qos: QoS) -> Any:
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-
-    return QoSProfile(depth=qos.depth, reliability=(
-        ReliabilityPolicy.RELIABLE if qos.reliability == "reliable"
-        else ReliabilityPolicy.BEST_EFFORT), durability=(
-        DurabilityPolicy.VOLATILE if qos.durability == "volatile"
-        else DurabilityPolicy.TRANSIENT_LOCAL))
+from tdcm_ros.runtime.rclpy_runtime import message_class as native_class
+from tdcm_ros.runtime.rclpy_runtime import qos_profile as profile
 
 
 class NativePublisher:
