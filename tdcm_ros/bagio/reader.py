@@ -5,7 +5,10 @@ writer was killed: its ``.mcap`` files are read) or one ``.mcap`` file. Message 
 the Jazzy typestore plus ``msg_defs/``; a type the store does not know is registered from the
 definition the bag embeds (MCAP schema encoding ``ros2msg`` or ``ros2idl``, as ``ros2 bag record``
 writes). An MCAP file without a usable summary (writer killed: no footer, a half-written last
-chunk) is read up to its last complete record, and the loss is reported in ``warnings``.
+chunk) is read up to its last complete record, and the loss is reported in ``warnings``. A
+chunk that fails its CRC, size or record checks (a flipped byte) is skipped: every file is
+checked when it is opened, so ``warnings`` (what ``tdcm bag info`` prints) names each skipped
+chunk before any message is read, and reading leaves the same chunks out.
 
 Topic arguments may omit the leading ``/`` (``tension`` = ``/tension``). Times are ns since the
 UNIX epoch. Every failure is a :class:`~tdcm_ros.bagio.errors.BagError` naming the file.
@@ -31,7 +34,7 @@ import zstandard
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
 from mcap.reader import SeekingReader
-from mcap.records import Channel, Schema
+from mcap.records import Channel, ChunkIndex, Schema
 from mcap.summary import Summary
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
@@ -68,7 +71,10 @@ def _describe(error: BaseException) -> str:
 _RECORD = struct.Struct("<BQ")  # opcode, record length
 _MESSAGE = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
-_OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_DATA_END = 2, 3, 4, 5, 6, 15
+_INDEX = struct.Struct("<HI")  # message index: channel id, byte length of its (time, offset) pairs
+_FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offset start, crc
+_OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_INDEX, _OP_DATA_END = \
+    2, 3, 4, 5, 6, 7, 15
 
 Unit = list[tuple[int, int, bytes]]  # (log time ns, channel id, data) of one chunk or record
 
@@ -110,6 +116,8 @@ class _McapSource:
         self._types: dict[int, str] = {}
         self._size = path.stat().st_size
         self._last_end = -1
+        self._chunks: list[ChunkIndex] = []
+        self._skipped: set[int] = set()  # byte offsets of the chunks left out as damaged
         self.ordered = True  # units (chunks, loose messages) do not overlap in time
         with path.open("rb") as stream:
             if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
@@ -122,8 +130,10 @@ class _McapSource:
             for channel in summary.channels.values():
                 self._declare(channel)
                 self.counts[channel.topic] += counts.get(channel.id, 0)
-            for index in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
+            self._chunks = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
+            for index in self._chunks:
                 self._note_range(index.message_start_time, index.message_end_time)
+            self._check_chunks()
         else:
             self._scan()
 
@@ -135,11 +145,20 @@ class _McapSource:
                                     record_size_limit=self._size).get_summary()
         except (*_DAMAGE, OSError):  # no footer, bad footer or summary: the linear scan decides
             return None
-        if summary is None or summary.statistics is None or (
+        if summary is None or summary.statistics is None or not self._summary_crc_ok(stream) or (
                 summary.statistics.message_count and not summary.chunk_indexes) or any(
                 c not in summary.channels for c in summary.statistics.channel_message_counts):
             return None
         return summary
+
+    def _summary_crc_ok(self, stream: IO[bytes]) -> bool:
+        """The footer's summary CRC matches the summary section (or the writer left it 0)."""
+        stream.seek(self._size - len(MCAP_MAGIC) - _FOOTER.size)
+        _, _, start, _, crc = _FOOTER.unpack(stream.read(_FOOTER.size))
+        if not crc:
+            return True
+        stream.seek(start)
+        return zlib.crc32(stream.read(self._size - len(MCAP_MAGIC) - 4 - start)) == crc
 
     def _declare(self, channel: Channel) -> None:
         if channel.id in self._channels:
@@ -181,7 +200,9 @@ class _McapSource:
             pos = after
         return out
 
-    def _chunk(self, body: bytes, wanted: set[int] | None) -> Unit:
+    @staticmethod
+    def _content(body: bytes) -> tuple[bytes, bool]:
+        """A chunk body's records, decompressed and checked; and whether a CRC checked them."""
         _, _, size, crc, name_length = _CHUNK.unpack_from(body, 0)
         pos = _CHUNK.size + name_length
         compression = body[_CHUNK.size:pos].decode()
@@ -191,12 +212,85 @@ class _McapSource:
         content = _decompress(compression, body[pos + 8:], size)
         if len(content) != size or (crc and zlib.crc32(content) != crc):
             raise _Damaged("chunk CRC or size mismatch")
-        unit = self._records(content, wanted)
+        return content, bool(crc)
+
+    def _chunk(self, body: bytes, wanted: set[int] | None) -> Unit:
+        unit = self._records(self._content(body)[0], wanted)
         unit.sort(key=itemgetter(0))
         return unit
 
+    @staticmethod
+    def _chunk_body(buf: bytes | mmap.mmap, index: ChunkIndex) -> bytes:
+        """The body of the chunk record the summary indexes at ``index.chunk_start_offset``."""
+        pos, end = index.chunk_start_offset, index.chunk_start_offset + index.chunk_length
+        if pos < 0 or end > len(buf) or end < pos + 9:
+            raise _Damaged(f"the indexed chunk at byte {pos} lies outside the file")
+        op, length = _RECORD.unpack_from(buf, pos)
+        if op != _OP_CHUNK or pos + 9 + length != end:
+            raise _Damaged(f"no chunk record of {index.chunk_length} bytes at byte {pos}")
+        return buf[pos + 9:end]
+
+    def _check_chunks(self) -> None:
+        """Check every indexed chunk (size, CRC; records too where no CRC was written) and
+        skip the damaged ones, before any message is read."""
+        with self.path.open("rb") as stream, mmap.mmap(stream.fileno(), 0,
+                                                          access=mmap.ACCESS_READ) as buf:
+            for index in self._chunks:
+                try:
+                    content, crc_checked = self._content(self._chunk_body(buf, index))
+                    if not crc_checked:
+                        self._records(content, set())
+                except _DAMAGE as error:
+                    self._skip(index.chunk_start_offset, error, self._indexed_counts(buf, index))
+
+    def _indexed_counts(self, buf: bytes | mmap.mmap, index: ChunkIndex) -> dict[str, int] | None:
+        """Messages per topic of a chunk from its message index records; None if unreadable."""
+        lost: dict[str, int] = {}
+        try:
+            for channel, offset in index.message_index_offsets.items():
+                op, _ = _RECORD.unpack_from(buf, offset)
+                found, size = _INDEX.unpack_from(buf, offset + _RECORD.size)
+                if op != _OP_INDEX or found != channel or channel not in self._channels:
+                    return None
+                topic = self._channels[channel].topic
+                lost[topic] = lost.get(topic, 0) + size // 16  # (u64 time, u64 offset) pairs
+        except struct.error:
+            return None
+        return lost
+
+    def _skip(self, offset: int, error: BaseException, lost: dict[str, int] | None) -> None:
+        """Leave the chunk at byte ``offset`` out and say so; ``lost`` (messages per topic, if
+        known) comes off the topic counts."""
+        self._skipped.add(offset)
+        if lost is None:
+            what = "its messages (how many is unknown) are" if self.complete else \
+                "its messages are"
+        else:
+            for topic, n in lost.items():
+                self.counts[topic] = max(0, self.counts[topic] - n)
+            what = f"{sum(lost.values())} messages " + \
+                f"({', '.join(f'{t} {n}' for t, n in sorted(lost.items()))}) are"
+        self.warnings.append(f"{self.path}: corrupt chunk at byte {offset} skipped "
+                             f"({_describe(error)}); {what} left out, the rest is read")
+
+    def _checked_chunk(self, pos: int, body: bytes, wanted: set[int] | None) -> Unit:
+        """A chunk found by the linear pass; damaged ones are skipped (see :meth:`_skip`)."""
+        if pos in self._skipped:
+            return []
+        try:
+            return self._chunk(body, wanted)
+        except _DAMAGE as error:
+            self._skip(pos, error, None)
+            return []
+
     def _units(self, buf: bytes | mmap.mmap, wanted: set[int] | None) -> Iterator[Unit]:
-        """Messages chunk by chunk, each unit complete and checked, up to the data end."""
+        """Messages chunk by chunk, each unit complete and checked, up to the data end: the
+        summary's chunks (checked at open) if the file is complete, else a linear pass."""
+        if self.complete:
+            for index in self._chunks:
+                if index.chunk_start_offset not in self._skipped:
+                    yield self._chunk(self._chunk_body(buf, index), wanted)
+            return
         pos, end = len(MCAP_MAGIC), len(buf)
         while pos < end:
             if pos + 9 > end:
@@ -207,7 +301,7 @@ class _McapSource:
                 raise _Damaged(f"the record (opcode {op:#x}) at byte {pos} needs {length} "
                                f"bytes; the file ends {end - body} bytes later")
             if op == _OP_CHUNK:
-                yield self._chunk(buf[body:after], wanted)
+                yield self._checked_chunk(pos, buf[body:after], wanted)
             elif op in (_OP_MESSAGE, _OP_SCHEMA, _OP_CHANNEL):
                 yield self._records(buf[pos:after], wanted)
             elif op in (_OP_DATA_END, _OP_FOOTER):
@@ -262,7 +356,8 @@ class _McapSource:
             yield from units
         except _DAMAGE as error:
             if self.complete:
-                raise BagError(f"{self.path}: corrupt data section ({_describe(error)})") from error
+                raise BagError(f"{self.path}: corrupt data section, changed since it was opened "
+                               f"({_describe(error)})") from error
 
 
 class _RosbagsSource:

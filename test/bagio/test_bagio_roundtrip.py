@@ -280,15 +280,24 @@ def test_require_topic_errors(tmp_path: Path) -> None:
         require_topic(reader, "tension_setpoint", ["geometry_msgs/msg/WrenchStamped"])
 
 
-def test_corrupt_chunk_is_a_bag_error(tmp_path: Path) -> None:
-    _write(tmp_path / "trial", compression="none", chunk_size=2048)
+@pytest.mark.parametrize("compression", ["none", "zstd"])
+def test_a_corrupt_chunk_is_skipped_with_a_warning_given_at_open(
+        tmp_path: Path, compression: str) -> None:
+    expected = _write(tmp_path / "trial", compression=compression, chunk_size=2048)
     source = tmp_path / "trial" / "trial_0.mcap"
     with source.open("rb") as stream:
         chunk = SeekingReader(stream).get_summary().chunk_indexes[1]  # type: ignore[union-attr]
     data = bytearray(source.read_bytes())
-    inside = chunk.chunk_start_offset + 100  # in the records of the second chunk
-    data[inside:inside + 16] = bytes(16)
+    inside = chunk.chunk_start_offset + chunk.chunk_length - 40  # in the chunk's (compressed) data
+    data[inside] ^= 0x10
     bad = tmp_path / "bad.mcap"
     bad.write_bytes(bytes(data))
-    with pytest.raises(BagError, match="bad.mcap"):
-        list(open_bag(bad).messages())
+    reader = open_bag(bad)
+    (warning,) = [w for w in reader.warnings if "corrupt chunk" in w]
+    assert f"at byte {chunk.chunk_start_offset} skipped" in warning and "bad.mcap" in warning
+    lost = [e for e in expected
+            if chunk.message_start_time <= e[1] <= chunk.message_end_time]
+    assert f"{len(lost)} messages" in warning
+    kept = [(t, s, to_dict(m)) for t, s, _, m in expected if (t, s, _, m) not in lost]
+    assert _as_plain(list(reader.messages())) == kept
+    assert reader.message_count == len(kept)
