@@ -78,6 +78,9 @@ def format_report(ev: Evaluation) -> str:
               f"  Shape error     {_mm(m.shape_error_m)} mm",
               (f"  Deflection mean {_mm(m.deflection_mean_m, 2)} mm "
               f"(model {_mm(m.predicted_deflection_mean_m, 2)} mm)")]
+    if any(ev.occluded.values()):
+        lines.append("occluded marker positions left out (NaN or exactly 0): " + ", ".join(
+            f"{label} {count}" for label, count in ev.occluded.items()))
     lines += [f"warning: {w}" for w in ev.warnings]
     return "\n".join(lines)
 

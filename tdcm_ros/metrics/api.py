@@ -76,7 +76,8 @@ def _evaluate(sources: Sequence[BagSource],
         part = evaluate_steps(steps, reg, options)
         parts.append(Evaluation(part.records, part.metrics, part.registrations, options,
                                 (*(f"{source.path}: {w}" for w in source.warnings),
-                                 *(f"{source.path}: {w}" for w in part.warnings))))
+                                 *(f"{source.path}: {w}" for w in part.warnings)),
+                                occluded=source.occluded))
     return combine(parts, [str(s.path) for s in sources])
 
 

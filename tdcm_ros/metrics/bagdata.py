@@ -2,18 +2,25 @@
 
 - tension: ``geometry_msgs/msg/WrenchStamped`` (``wrench.force.z``, N);
 - markers: ``mocap4r2_msgs/msg/Markers`` (positions in the message's frame, matched to the
-  layout's labels by ``marker_name``; unknown names are ignored and counted in a warning);
+  layout's labels by ``marker_name``; unknown names are ignored and counted in a warning). A
+  position that is NaN or exactly ``(0, 0, 0)`` is an occluded marker, as mocap_node treats it
+  (:func:`tdcm_ros.mocap.occlusion.visible`): missing, counted, never a measurement;
 - registration: the ``/tf_static`` transform whose child is ``tdcm_base`` and whose parent is the
   markers' frame, if the bag has one.
 
 Stamps are the header stamps (s since the epoch); a topic whose header stamps are all zero uses
-the bag's log times instead (said in a warning).
+the bag's log times instead (said in a warning). Messages are left out, counted in a warning:
+
+- duplicates: the same topic, stamp and payload bytes as an earlier message;
+- implausible stamps: at or before 0 s, at or beyond 2^31 - 1 s (the int32 ``sec`` maximum), or more
+  than :data:`FAR_S` from the median stamp of the topic's other messages. A topic with no
+  plausible stamp at all is an error naming it, the count and a stamp.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -23,30 +30,86 @@ from tdcm_ros.metrics.cdr import markers_frame, wrench_force_z
 from tdcm_ros.metrics.errors import MetricsError
 from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.mocap.occlusion import visible
 
 TENSION_TYPE = "geometry_msgs/msg/WrenchStamped"
 MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 BASE_FRAME = "tdcm_base"
+MAX_STAMP_S = 2.0**31 - 1.0
+"""Stamps (s since the epoch) at or beyond this are implausible: the int32 ``sec`` maximum."""
+FAR_S = 86_400.0
+"""Stamps farther than this (s) from the median stamp of their topic are implausible."""
 
 
 @dataclass(frozen=True, eq=False)
 class BagSource:
-    """One bag's inputs: series, the registration it carries (or None) and reading warnings."""
+    """One bag's inputs: series, the registration it carries (or None), reading warnings and
+    the occluded marker positions (NaN or exactly zero) left out, per label."""
 
     path: Path
     tension: TensionSeries
     markers: MarkerSeries
     registration: Registration | None
     warnings: tuple[str, ...]
+    occluded: dict[str, int] = field(default_factory=dict)
 
 
-def _stamps(header_ns: np.ndarray, log_ns: np.ndarray, topic: str, warnings: list[str]
-            ) -> np.ndarray:
+def _stamps_ns(header_ns: np.ndarray, log_ns: np.ndarray, topic: str, warnings: list[str]
+               ) -> np.ndarray:
+    """The stamps (ns since the epoch) of a topic: its header stamps, or its log times when
+    the header stamps are all zero."""
     if np.all(header_ns == 0):
         warnings.append(f"{topic}: header stamps are all zero; using the bag's log times")
-        return log_ns * 1e-9
-    return header_ns * 1e-9
+        return log_ns
+    return header_ns
+
+
+def _unique(stamps_ns: np.ndarray, payloads: Sequence[bytes], topic: str, warnings: list[str]
+            ) -> np.ndarray:
+    """Mask of the messages kept: each is dropped that repeats an earlier one's stamp (ns) and
+    payload bytes."""
+    keep = np.ones(len(payloads), dtype=bool)
+    order = np.argsort(stamps_ns, kind="stable")
+    equal = np.flatnonzero(np.diff(stamps_ns[order]) == 0)  # positions equal to the next
+    seen: set[tuple[int, bytes]] = set()
+    for n in order[np.union1d(equal, equal + 1)].tolist():  # only stamps shared, in order
+        key = (int(stamps_ns[n]), payloads[n])
+        keep[n] = key not in seen
+        seen.add(key)
+    if dropped := int((~keep).sum()):
+        warnings.append(f"{topic}: {dropped} duplicated messages (same stamp and payload as an "
+                        "earlier one) left out")
+    return keep
+
+
+def _plausible(stamps_ns: np.ndarray, path: Path, topic: str, warnings: list[str]
+               ) -> np.ndarray:
+    """Mask of the messages whose stamps are plausible (see the module docstring)."""
+    t = stamps_ns * 1e-9
+    keep = (t > 0.0) & (np.abs(t) < MAX_STAMP_S)
+    if keep.any():
+        keep &= np.abs(t - np.median(t[keep])) <= FAR_S
+    allowed = f"(0, 2^31 - 1) s since the epoch, within {FAR_S:g} s of the topic's median stamp"
+    bad = t[~keep]
+    if keep.any() and bad.size:
+        warnings.append(f"{topic}: {bad.size} messages with implausible stamps left out (e.g. "
+                        f"{bad[0]:.9g} s; allowed: {allowed} {np.median(t[keep]):.9g} s)")
+    elif not keep.any():
+        raise MetricsError(f"{path}: {topic}: all {bad.size} stamps are implausible (e.g. "
+                           f"{bad[0]:.9g} s); allowed: {allowed}", parameter=f"{topic} stamps",
+                           value=float(bad[0]), allowed=allowed)
+    return keep
+
+
+def _usable(header_ns: np.ndarray, log_ns: np.ndarray, payloads: Sequence[bytes], path: Path,
+            topic: str, warnings: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Stamps (s since the epoch) of a topic and the mask of its messages kept: neither
+    duplicated nor implausibly stamped."""
+    stamps_ns = _stamps_ns(header_ns, log_ns, topic, warnings)
+    keep = _unique(stamps_ns, payloads, topic, warnings)
+    keep[keep] = _plausible(stamps_ns[keep], path, topic, warnings)
+    return stamps_ns * 1e-9, keep
 
 
 def _payloads(reader: BagReader, name: str) -> tuple[np.ndarray, list[bytes]]:
@@ -62,16 +125,33 @@ def _tension(reader: BagReader, topic: str, warnings: list[str]) -> TensionSerie
     name = require_topic(reader, topic, [TENSION_TYPE])
     log, data = _payloads(reader, name)
     header_ns, force_z = wrench_force_z(data)
-    return TensionSeries.of(_stamps(header_ns, log, name, warnings), force_z)
+    stamps, keep = _usable(header_ns, log, data, reader.path, name, warnings)
+    return TensionSeries.of(stamps[keep], force_z[keep])
+
+
+def _occlude(rows: np.ndarray, reported: np.ndarray, labels: Sequence[str], topic: str,
+             warnings: list[str]) -> dict[str, int]:
+    """Set the occluded positions of ``rows`` (n, k, 3) m, those reported (``reported``
+    (n, k)) as NaN or exactly (0, 0, 0), to NaN; their count per label."""
+    hidden = reported & ~visible(rows.reshape(-1, 3)).reshape(reported.shape)
+    rows[hidden] = np.nan
+    counts = {label: int(c) for label, c in zip(labels, hidden.sum(axis=0), strict=True)}
+    if any(counts.values()):
+        warnings.append(f"{topic}: {sum(counts.values())} occluded marker positions (NaN or "
+                        "exactly (0, 0, 0), as mocap_node drops them) left out: "
+                        f"{', '.join(f'{k} {v}' for k, v in counts.items())}")
+    return counts
 
 
 def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: list[str]
-             ) -> MarkerSeries:
+             ) -> tuple[MarkerSeries, dict[str, int]]:
+    """Marker frames of ``topic`` and the occluded positions per label."""
     name = require_topic(reader, topic, [MARKERS_TYPE])
     index = {label: i for i, label in enumerate(labels)}
     log, payloads = _payloads(reader, name)
     header = np.zeros(len(payloads), dtype=np.int64)
     rows = np.full((len(payloads), len(labels), 3), np.nan)
+    reported = np.zeros(rows.shape[:2], dtype=bool)
     frames: set[str] = set()
     unknown: set[str] = set()
     for n, data in enumerate(payloads):
@@ -82,7 +162,7 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
             if i is None:
                 unknown.add(marker_name or "(unnamed)")
             else:
-                rows[n, i] = p
+                rows[n, i], reported[n, i] = p, True
     if unknown:
         warnings.append(f"{name}: ignored markers not in the layout ({', '.join(labels)}): "
                         f"{', '.join(sorted(unknown))}")
@@ -91,7 +171,10 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
                            "allowed: one frame", parameter="markers_topic", value=sorted(frames),
                            allowed="one frame_id")
     frame = frames.pop() if frames else "mocap"
-    return MarkerSeries.of(_stamps(header, log, name, warnings), labels, rows, frame_id=frame)
+    stamps, keep = _usable(header, log, payloads, reader.path, name, warnings)
+    rows = rows[keep]
+    occluded = _occlude(rows, reported[keep], labels, name, warnings)
+    return MarkerSeries.of(stamps[keep], labels, rows, frame_id=frame), occluded
 
 
 def _registration(reader: BagReader, parent: str, warnings: list[str]) -> Registration | None:
@@ -118,6 +201,6 @@ def load_bag(path: str | Path, *, labels: Sequence[str], tension_topic: str = "t
     reader = open_bag(path)
     warnings = list(reader.warnings)
     tension = _tension(reader, tension_topic, warnings)
-    markers = _markers(reader, markers_topic, labels, warnings)
+    markers, occluded = _markers(reader, markers_topic, labels, warnings)
     registration = _registration(reader, markers.frame_id, warnings)
-    return BagSource(Path(path), tension, markers, registration, tuple(warnings))
+    return BagSource(Path(path), tension, markers, registration, tuple(warnings), occluded)

@@ -10,7 +10,7 @@ no solution at its tension.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -91,7 +91,8 @@ class StepRecord:
 
 @dataclass(frozen=True, eq=False)
 class Evaluation:
-    """Per-step records, Table I, the registration used per source and any warnings."""
+    """Per-step records, Table I, the registration used per source, any warnings and the
+    occluded marker positions (NaN or exactly zero, left out) per label."""
 
     records: tuple[StepRecord, ...]
     metrics: TableMetrics
@@ -99,6 +100,7 @@ class Evaluation:
     options: EvaluateOptions
     warnings: tuple[str, ...] = ()
     sources: tuple[str, ...] = ("arrays",)
+    occluded: dict[str, int] = field(default_factory=dict)
 
     def to_json(self) -> dict[str, Any]:
         """The ``--json`` document: the issue's keys first, then extras."""
@@ -112,6 +114,7 @@ class Evaluation:
                     for name, reg in zip(self.sources, self.registrations, strict=True)],
                             "design": self.options.design.to_dict(),
                             "deflection_axis": self.options.deflection_axis,
+                            "occluded_markers": dict(self.occluded),
                             "warnings": list(self.warnings)}}
 
 
@@ -227,6 +230,10 @@ def combine(parts: Sequence[Evaluation], sources: Sequence[str]) -> Evaluation:
         records.extend(replace(r, trial=r.trial + offset) for r in part.records)
         offset = max((r.trial for r in records), default=offset)
     opts = parts[0].options
+    occluded: dict[str, int] = {}
+    for part in parts:
+        for label, count in part.occluded.items():
+            occluded[label] = occluded.get(label, 0) + count
     return Evaluation(tuple(records), metrics_of(records, opts),
                       tuple(r for p in parts for r in p.registrations), opts,
-                      tuple(w for p in parts for w in p.warnings), tuple(sources))
+                      tuple(w for p in parts for w in p.warnings), tuple(sources), occluded)
