@@ -1,0 +1,140 @@
+"""Bounded YAML loading for every configuration input of the package (ROS-free).
+
+:func:`load_yaml` reads YAML text as ``yaml.safe_load`` does, with four bounds that make
+hostile input fail fast with a typed error naming the source, the line and the limit:
+
+- anchors and aliases are rejected (not capped): scenes, ROS parameter files, bag metadata
+  and CLI values never need them, and without them nothing can expand ("billion laughs");
+- nesting deeper than :data:`MAX_DEPTH_LEVELS` collections is rejected while composing,
+  before Python's recursion limit is near;
+- text longer than :data:`MAX_INPUT_BYTES` (UTF-8) is rejected before parsing;
+- a mapping with the same key twice is an error (YAML 1.1 ``<<`` merge keys excepted).
+
+Every failure, including plain syntax errors and scalars Python cannot build (e.g. the date
+``2020-13-01``), is raised as ``error`` (default :class:`YamlInputError`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import yaml
+from yaml.nodes import MappingNode, Node, ScalarNode
+
+from tdcm_ros.errors import InputError
+
+#: deepest nesting of sequences and mappings (the top-level collection is level 1)
+MAX_DEPTH_LEVELS = 64
+#: largest accepted text, UTF-8 encoded
+MAX_INPUT_BYTES = 1024 * 1024
+
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
+class YamlInputError(InputError, yaml.YAMLError):
+    """YAML text that is malformed or exceeds a bound; also a ``yaml.YAMLError`` so callers
+    that fall back on unreadable YAML (bag metadata) keep doing so."""
+
+
+class _LimitError(yaml.MarkedYAMLError):
+    """A bound was exceeded at ``problem_mark``; ``allowed`` states the bound."""
+
+    def __init__(self, problem: str, mark: yaml.Mark, allowed: str) -> None:
+        super().__init__(problem=problem, problem_mark=mark)
+        self.allowed = allowed
+
+
+class _BoundedLoader(yaml.SafeLoader):
+    """``SafeLoader`` without anchors or aliases, with a nesting bound and unique keys."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text)
+        self._depth = 0
+
+    def compose_node(self, parent: Node | None, index: Any) -> Node:
+        """Reject anchors and aliases; count nesting depth around collections."""
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent) or event.anchor is not None:
+            raise _LimitError("anchors and aliases (&, *) are not accepted",
+                              event.start_mark, "YAML without anchors or aliases")
+        if isinstance(event, yaml.ScalarEvent):
+            return super().compose_node(parent, index)
+        self._depth += 1
+        if self._depth > MAX_DEPTH_LEVELS:
+            raise _LimitError(f"nesting deeper than {MAX_DEPTH_LEVELS} levels",
+                              event.start_mark, f"at most {MAX_DEPTH_LEVELS} nested levels")
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_object(self, node: Node, deep: bool = False) -> Any:
+        """The node's value; a scalar Python cannot build (a 13th month, an integer of more
+        than 4300 digits) is a constructor error at the node's line."""
+        try:
+            return super().construct_object(node, deep=deep)
+        except (ValueError, OverflowError) as problem:
+            raise yaml.constructor.ConstructorError(
+                None, None, str(problem), node.start_mark) from problem
+
+    def construct_mapping(self, node: MappingNode, deep: bool = False) -> dict[Any, Any]:
+        """The mapping, after checking that no scalar key occurs twice."""
+        first_line: dict[Any, int] = {}
+        for key_node, _ in node.value:
+            if not isinstance(key_node, ScalarNode) or key_node.tag == _MERGE_TAG:
+                continue
+            key = self.construct_object(key_node)
+            line = key_node.start_mark.line + 1
+            if key in first_line:
+                raise _LimitError(f"duplicate key {key!r} (first at line {first_line[key]})",
+                                  key_node.start_mark, "each key once per mapping")
+            first_line[key] = line
+        return super().construct_mapping(node, deep=deep)
+
+
+def _oversize(text: str, source: str) -> str | None:
+    """Why ``text`` is over :data:`MAX_INPUT_BYTES`, naming the line the limit falls on."""
+    data = text.encode("utf-8", "surrogatepass")
+    if len(data) <= MAX_INPUT_BYTES:
+        return None
+    line = data.count(b"\n", 0, MAX_INPUT_BYTES) + 1
+    return (f"{source}: {len(data)} bytes of YAML, over the limit of {MAX_INPUT_BYTES} bytes "
+            f"at line {line}")
+
+
+def load_yaml(text: str, source: str, *, parameter: str | None = None,
+              error: type[InputError] = YamlInputError) -> Any:
+    """The value of one YAML document ``text`` read from ``source`` (a file or parameter
+    name, shown in messages); ``error(message, parameter=parameter or source, value=source,
+    allowed=...)`` on any problem (see the module docstring)."""
+    name = parameter or source
+    if too_big := _oversize(text, source):
+        raise error(too_big, parameter=name, value=source,
+                    allowed=f"at most {MAX_INPUT_BYTES} bytes")
+    try:
+        return _load(text)
+    except _LimitError as problem:
+        raise error(_describe(source, problem), parameter=name, value=source,
+                    allowed=problem.allowed) from problem
+    except yaml.YAMLError as problem:
+        raise error(_describe(source, problem, "not valid YAML: "), parameter=name,
+                    value=source, allowed="valid YAML") from problem
+
+
+def _load(text: str) -> Any:
+    """The single document of ``text`` (raises ``yaml.YAMLError``, including bounds)."""
+    loader = _BoundedLoader(text)
+    try:
+        return loader.get_single_data()
+    finally:
+        loader.dispose()
+
+
+def _describe(source: str, problem: yaml.YAMLError, prefix: str = "") -> str:
+    """One line: ``source: line N: {prefix}what is wrong``."""
+    mark = getattr(problem, "problem_mark", None) or getattr(problem, "context_mark", None)
+    where = f"{source}: line {mark.line + 1}" if mark is not None else source
+    what = getattr(problem, "problem", None) or str(problem)
+    context = getattr(problem, "context", None)
+    detail = f"{context} {what}" if context else what
+    return f"{where}: {prefix}{detail}".replace("\n", " ")

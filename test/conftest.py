@@ -1,0 +1,56 @@
+"""Fixtures shared by every test directory: hostile YAML texts and a printing stopwatch."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager
+
+import pytest
+
+NESTED_LEVELS = 5000
+HUGE_BYTES = 10_000_000
+
+
+def billion_laughs(levels: int = 9) -> str:
+    """The classic alias bomb: ``levels`` lists of nine aliases to the previous level."""
+    lines = ["l0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+    for level in range(1, levels):
+        aliases = ", ".join([f"*l{level - 1}"] * 9)
+        lines.append(f"l{level}: &l{level} [{aliases}]")
+    return "\n".join(lines) + "\n"
+
+
+#: name -> (hostile YAML text, a phrase the error must contain)
+HOSTILE_YAML: dict[str, tuple[str, str]] = {
+    "billion_laughs": (billion_laughs(), "anchors and aliases"),
+    "flow_nesting": ("[" * NESTED_LEVELS + "]" * NESTED_LEVELS, "deeper than 64 levels"),
+    "flow_mapping_nesting": ("{a: " * NESTED_LEVELS + "1" + "}" * NESTED_LEVELS,
+                             "deeper than 64 levels"),
+    "block_nesting": ("- " * NESTED_LEVELS + "x\n", "deeper than 64 levels"),
+    "huge_input": ("k: " + "x" * HUGE_BYTES + "\n", "bytes of YAML, over the limit of"),
+    "duplicate_top_level_key": ("seed: 1\nname: a\nseed: 2\n", "line 3: duplicate key 'seed'"),
+    "duplicate_nested_key": ("schedule:\n  trials: 1\n  trials: 2\n",
+                             "line 3: duplicate key 'trials'"),
+}
+
+
+@pytest.fixture(params=sorted(HOSTILE_YAML))
+def hostile_yaml(request: pytest.FixtureRequest) -> tuple[str, str, str]:
+    """``(name, text, phrase)`` for each hostile YAML text."""
+    return (request.param, *HOSTILE_YAML[request.param])
+
+
+@contextmanager
+def _stopwatch(label: str) -> Iterator[None]:
+    start = time.perf_counter()
+    try:
+        yield
+    finally:
+        print(f"{label}: {1e3 * (time.perf_counter() - start):.1f} ms")
+
+
+@pytest.fixture
+def stopwatch() -> Callable[[str], AbstractContextManager[None]]:
+    """``with stopwatch(label):`` prints the block's wall time (never asserted on)."""
+    return _stopwatch

@@ -1,0 +1,79 @@
+"""The bounded YAML loader: hostile texts fail fast with a typed error naming the problem."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+
+import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.yamlio import MAX_DEPTH_LEVELS, MAX_INPUT_BYTES, YamlInputError, load_yaml
+
+Stopwatch = Callable[[str], AbstractContextManager[None]]
+
+
+def test_hostile_yaml_is_a_typed_error_naming_source_and_limit(
+        hostile_yaml: tuple[str, str, str], stopwatch: Stopwatch) -> None:
+    name, text, phrase = hostile_yaml
+    with stopwatch(f"load_yaml {name} ({len(text)} chars)"), \
+            pytest.raises(YamlInputError, match=phrase) as caught:
+        load_yaml(text, "cfg.yaml", parameter="params_file")
+    message = str(caught.value)
+    assert message.startswith("cfg.yaml: ") and "\n" not in message
+    assert caught.value.parameter == "params_file" and caught.value.value == "cfg.yaml"
+    assert caught.value.allowed
+
+
+def test_limits_name_the_line() -> None:
+    deep = "a:\n" + "".join("  " * i + "- \n" for i in range(1, MAX_DEPTH_LEVELS + 2))
+    with pytest.raises(YamlInputError, match=f"cfg: line {MAX_DEPTH_LEVELS + 1}: nesting"):
+        load_yaml(deep, "cfg")
+    with pytest.raises(YamlInputError, match="cfg: line 2: anchors and aliases"):
+        load_yaml("a: 1\nb: &x 2\n", "cfg")
+    with pytest.raises(YamlInputError, match="at line 3$"):
+        load_yaml("a\nb\n" + "c" * MAX_INPUT_BYTES, "cfg")
+
+
+def test_bounds_are_inclusive_and_plain_yaml_loads_as_safe_load() -> None:
+    nested = "[" * MAX_DEPTH_LEVELS + "]" * MAX_DEPTH_LEVELS
+    assert load_yaml(nested, "cfg") == yaml.safe_load(nested)
+    text = "a: [1, {b: 2.5e+0}]\nc: ~\n<<: {d: x}\nt: 2020-01-02\n"
+    assert load_yaml(text, "cfg") == yaml.safe_load(text)
+    assert load_yaml("", "cfg") is None
+
+
+def test_bad_scalars_and_syntax_are_typed_errors() -> None:
+    for text, phrase in (("d: 2020-13-01", "line 1: .*month"), ("n: " + "9" * 5000, "digits"),
+                         ("a: [1, 2\n", "not valid YAML"), ("a: !!python/name:os.system x",
+                                                             "constructor"),
+                         ("a: 1\n---\nb: 2\n", "single document")):
+        with pytest.raises(YamlInputError, match=phrase):
+            load_yaml(text, "cfg")
+
+
+def test_error_class_is_chosen_by_the_caller_and_is_a_yaml_error() -> None:
+    class SceneLikeError(InputError):
+        pass
+
+    with pytest.raises(SceneLikeError, match="duplicate key"):
+        load_yaml("a: 1\na: 2\n", "scene.yaml", error=SceneLikeError)
+    assert issubclass(YamlInputError, yaml.YAMLError) and issubclass(YamlInputError, InputError)
+
+
+_TOKENS = st.sampled_from(["[", "]", "{", "}", ",", ": ", "- ", "\n", "  ", "a", "1", "&x ",
+                           "*x", "? ", "!!str ", "'", '"', "#", "---\n", "<<: ", "2020-13-01"])
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.one_of(st.text(max_size=200), st.lists(_TOKENS, max_size=80).map("".join),
+                 st.tuples(st.sampled_from(["[", "{a: ", "- ", "a:\n  "]),
+                           st.integers(0, 3000)).map(lambda pair: pair[0] * pair[1])))
+def test_any_text_gives_a_value_or_a_typed_error(text: str) -> None:
+    try:
+        load_yaml(text, "cfg")
+    except YamlInputError as error:
+        assert str(error).startswith("cfg")
