@@ -12,18 +12,18 @@ NESTED_LEVELS = 5000
 HUGE_BYTES = 10_000_000
 
 
-def billion_laughs(levels: int = 9) -> str:
-    """The classic alias bomb: ``levels`` lists of nine aliases to the previous level."""
-    lines = ["l0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol]"]
+def alias_bomb(levels: int = 9) -> str:
+    """The "billion laughs" as one flow sequence: ``levels`` anchored lists, each of nine
+    aliases to the previous one (9**levels strings once expanded)."""
+    items = ["&l0 [" + ", ".join(["lol"] * 9) + "]"]
     for level in range(1, levels):
-        aliases = ", ".join([f"*l{level - 1}"] * 9)
-        lines.append(f"l{level}: &l{level} [{aliases}]")
-    return "\n".join(lines) + "\n"
+        items.append(f"&l{level} [" + ", ".join([f"*l{level - 1}"] * 9) + "]")
+    return "[" + ", ".join(items) + "]"
 
 
 #: name -> (hostile YAML text, a phrase the error must contain)
 HOSTILE_YAML: dict[str, tuple[str, str]] = {
-    "billion_laughs": (billion_laughs(), "anchors and aliases"),
+    "billion_laughs": (f"laughs: {alias_bomb()}\n", "anchors and aliases"),
     "flow_nesting": ("[" * NESTED_LEVELS + "]" * NESTED_LEVELS, "deeper than 64 levels"),
     "flow_mapping_nesting": ("{a: " * NESTED_LEVELS + "1" + "}" * NESTED_LEVELS,
                              "deeper than 64 levels"),
@@ -39,6 +39,12 @@ HOSTILE_YAML: dict[str, tuple[str, str]] = {
 def hostile_yaml(request: pytest.FixtureRequest) -> tuple[str, str, str]:
     """``(name, text, phrase)`` for each hostile YAML text."""
     return (request.param, *HOSTILE_YAML[request.param])
+
+
+@pytest.fixture
+def alias_bomb_value() -> str:
+    """A 9-level alias bomb to put under any key."""
+    return alias_bomb()
 
 
 @contextmanager

@@ -4,25 +4,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import yaml
-
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.paths import SUFFIXES, shipped_scenes
 from tdcm_ros.scenes.scene import Scene, parse_scene
+from tdcm_ros.yamlio import load_yaml
 
 #: names of the shipped scenes found at import time
 SCENE_NAMES: tuple[str, ...] = tuple(shipped_scenes())
 
 
 def scene_from_text(text: str, *, name: str = "scene", source: Path | None = None) -> Scene:
-    """Parse and validate a scene from YAML text; ``name`` is used when the file has none."""
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        where = source or name
-        raise InvalidSceneError(f"{where}: not valid YAML ({error})".replace("\n", " "),
-                                parameter="file", value=str(where), allowed="a YAML mapping"
-                                ) from error
+    """Parse and validate a scene from YAML text (bounded: see :mod:`tdcm_ros.yamlio`);
+    ``name`` is used when the file has none."""
+    data = load_yaml(text, str(source or name), parameter="file", error=InvalidSceneError)
     return parse_scene(data, default_name=name, source=source)
 
 
@@ -38,8 +32,9 @@ def load_scene(scene: str | Path) -> Scene:
                                 parameter="scene", value=str(scene), allowed=allowed)
     try:
         text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise InvalidSceneError(f"scene file {str(path)!r} cannot be read: {error.strerror}",
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or error
+        raise InvalidSceneError(f"scene file {str(path)!r} cannot be read: {reason}",
                                 parameter="scene", value=str(path),
                                 allowed="a readable .yaml file") from error
     return scene_from_text(text, name=path.stem, source=path)
