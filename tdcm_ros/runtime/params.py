@@ -12,9 +12,8 @@ import re
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from tdcm_ros.errors import InputError
+from tdcm_ros.yamlio import load_yaml
 
 ROS_PARAMETERS = "ros__parameters"
 
@@ -54,13 +53,15 @@ def _pattern(key: str) -> re.Pattern[str]:
 
 
 def read_param_file(path: str | Path) -> list[tuple[str, dict[str, Any]]]:
-    """``(node key, {parameter: value})`` entries of a parameter file, in file order."""
+    """``(node key, {parameter: value})`` entries of a parameter file, in file order; the
+    YAML is bounded (:mod:`tdcm_ros.yamlio`), any problem an :class:`InputError`."""
     where = Path(path)
     try:
-        tree = yaml.safe_load(where.read_text(encoding="utf-8")) or {}
-    except (OSError, yaml.YAMLError) as error:
+        text = where.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
         raise InputError(f"cannot read parameter file {where}: {error}",
                          parameter="params_file", value=str(where)) from error
+    tree = load_yaml(text, str(where), parameter="params_file") or {}
     if not isinstance(tree, dict):
         raise InputError(f"{where}: top level must map node names to {ROS_PARAMETERS}",
                          parameter="params_file", value=str(where))

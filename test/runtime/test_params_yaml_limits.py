@@ -1,0 +1,61 @@
+"""Parameter files and YAML parameter values are read through the bounded YAML loader."""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.params import read_param_file
+
+Stopwatch = Callable[[str], AbstractContextManager[None]]
+
+
+def test_hostile_parameter_file_is_an_input_error_naming_file_and_limit(
+        tmp_path: Path, hostile_yaml: tuple[str, str, str], stopwatch: Stopwatch) -> None:
+    name, text, phrase = hostile_yaml
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    with stopwatch(f"read_param_file {name}"), pytest.raises(InputError, match=phrase) as caught:
+        read_param_file(path)
+    assert str(caught.value).startswith(f"{path}: ") and caught.value.parameter == "params_file"
+
+
+def test_duplicate_parameter_names_the_line(tmp_path: Path) -> None:
+    path = tmp_path / "params.yaml"
+    path.write_text("talker:\n  ros__parameters:\n    rate: 1.0\n    rate: 2.0\n")
+    with pytest.raises(InputError, match="line 4: duplicate key 'rate'"):
+        read_param_file(path)
+
+
+def test_non_utf8_parameter_file_is_an_input_error(tmp_path: Path) -> None:
+    path = tmp_path / "params.yaml"
+    path.write_bytes(b"talker:\n  ros__parameters:\n    name: \xff\n")
+    with pytest.raises(InputError, match="cannot read parameter file"):
+        read_param_file(path)
+
+
+_PARAM_TOKENS = st.sampled_from(["/**:\n", "talker:\n", "  ros__parameters:\n", "    rate: ",
+                                 "    ", "  ", "- ", "[", "]", "{", "}", ", ", "&a ", "*a", "1.0",
+                                 "x", "~", "2020-13-01", "\n", "a: ", "? "])
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.one_of(st.binary(max_size=200).map(lambda b: b.decode("latin-1")),
+                 st.lists(_PARAM_TOKENS, max_size=60).map("".join),
+                 st.tuples(st.sampled_from(["[", "{a: ", "- "]), st.integers(0, 3000))
+                 .map(lambda pair: "talker:\n  ros__parameters:\n    x: " + pair[0] * pair[1])))
+def test_parameter_file_reader_returns_entries_or_an_input_error(text: str) -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "params.yaml"
+        path.write_text(text, encoding="utf-8")
+        try:
+            assert isinstance(read_param_file(path), list)
+        except InputError:
+            pass
