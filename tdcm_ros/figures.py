@@ -8,6 +8,9 @@
   (bending strain above the allowable, notch closure, tendon-offset singularity).
 
 Surfaces show feasible points only; infeasible ones are left out, never extrapolated.
+
+Also the checks of every plot output option (``--plot FILE``, ``--plots DIR``, ``--out DIR``):
+:func:`plot_file` and :func:`output_folder`. Nothing creates a parent folder it was not asked for.
 """
 
 from __future__ import annotations
@@ -29,9 +32,50 @@ from tdcm_ros.model.design_space import (
 )
 
 MM = 1e-3
+PLOT_FORMATS = ("png", "pdf", "svg")
+"""File extensions a plot may have: formats matplotlib writes with its default backends."""
 T_BASE = 20.0
 STATUS_COLOURS = {"ok": "#4c9a5b", "strain": "#e5b53c", "closure": "#c8553d",
                   "singularity": "#5b3c88", "non_convergence": "#555555", "invalid": "#bbbbbb"}
+
+
+class PlotPathError(InputError):
+    """A plot output path has an extension matplotlib cannot write or a missing parent."""
+
+
+def _parent(option: str, path: Path) -> Path:
+    """``path`` if its parent folder exists, else a :class:`PlotPathError` naming the parent."""
+    parent = path.parent
+    if not parent.is_dir():
+        raise PlotPathError(f"{option} = {str(path)!r}: the folder {str(parent)!r} does not "
+                            "exist; allowed: a path in an existing folder (it is not created)",
+                            parameter=option, value=str(path), allowed="an existing parent folder")
+    return path
+
+
+def plot_file(option: str, path: str | Path) -> Path:
+    """Check the plot file ``path`` given as ``option``: an extension of :data:`PLOT_FORMATS`
+    and an existing parent folder."""
+    out = Path(path)
+    extension = out.suffix.lower().lstrip(".")
+    if extension not in PLOT_FORMATS:
+        allowed = ", ".join(f".{e}" for e in PLOT_FORMATS)
+        raise PlotPathError(f"{option} = {str(out)!r} has extension {out.suffix or '(none)'!r};"
+                            f" allowed: {allowed}", parameter=option, value=str(out),
+                            allowed=allowed)
+    return _parent(option, out)
+
+
+def output_folder(option: str, path: str | Path) -> Path:
+    """Create the output folder ``path`` given as ``option`` if needed; its parent must exist."""
+    out = _parent(option, Path(path))
+    try:
+        out.mkdir(exist_ok=True)
+    except OSError as error:
+        raise PlotPathError(f"{option} = {str(out)!r}: cannot create the folder ({error})",
+                            parameter=option, value=str(out), allowed="a writable folder"
+                            ) from error
+    return out
 
 
 @dataclass(frozen=True)
@@ -77,8 +121,7 @@ def write_figures(out_dir: str | Path, *, points: int = 41, dpi: int = 130) -> l
         raise InputError(f"points = {points!r} is out of range; allowed: integer in [3, 400]",
                          parameter="points", value=points, allowed="integer in [3, 400]")
     plt = _pyplot()
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder("--out", out_dir)
     tensions = np.linspace(0.0, T_BASE, points)
     paths = [_paper_figure(plt, spec, tensions, points, out / f"{spec.name}.png", dpi)
              for spec in FIGURES]

@@ -19,7 +19,8 @@ def register(subparsers: Any) -> None:
                     "Algorithm 1's settings and the baselines, on every preset and hard "
                     "designs at 4-20 N (SI units).")
     accuracy.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    accuracy.add_argument("--plot", metavar="FILE.png", help="write the Pareto plot to a PNG")
+    accuracy.add_argument("--plot", metavar="FILE", help="write the Pareto plot to a .png, .pdf "
+                          "or .svg file in an existing folder")
     accuracy.add_argument("--quick", action="store_true",
                           help="a small subset (3 designs, 2 tensions, fewer knobs) for tests")
     accuracy.set_defaults(handler=run_accuracy)
@@ -27,8 +28,11 @@ def register(subparsers: Any) -> None:
 
 def run_accuracy(args: argparse.Namespace) -> int:
     """Run the accuracy bench; the table (or JSON) on stdout, progress on stderr."""
+    from tdcm_ros.figures import plot_file
     from tdcm_ros.model.accuracy import format_table, plot_pareto, run_bench
 
+    if args.plot:
+        plot_file("--plot", args.plot)  # before the bench: a bad path fails at once
     def progress(label: str) -> None:
         print(f"  running {label}", file=sys.stderr, flush=True)
 

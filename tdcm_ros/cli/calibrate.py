@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from typing import Any
 
 from tdcm_ros.cli.evaluate import add_input_arguments, fail
-from tdcm_ros.errors import TdcmError
+from tdcm_ros.errors import PhysicsError, TdcmError
 from tdcm_ros.metrics.api import Topics, calibrate_paths
 from tdcm_ros.metrics.calibration import Calibration, parse_fit
 from tdcm_ros.metrics.options import options_from_sets
+
+UNUSABLE_FIT_EXIT = PhysicsError.exit_code
+"""Exit status when the fit did not converge or a parameter is not identifiable (numerics)."""
 
 
 def register(subparsers: Any) -> None:
@@ -34,9 +38,11 @@ def _metric(value: float | None, scale: float, unit: str) -> str:
 
 
 def format_report(cal: Calibration) -> str:
-    """Fitted values with intervals, residuals, Table I before/after and warnings."""
+    """Warnings (not identifiable, not converged) first, then fitted values with intervals,
+    residuals, Table I before/after and the evaluation's warnings."""
     steps = cal.before.metrics.n_steps + cal.before.metrics.n_flagged
-    lines = [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
+    lines = [f"warning: {w}" for w in cal.warnings]
+    lines += [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
              f"residual RMS {cal.residual_rms_m * 1e3:.4f} mm")]
     level = f"{cal.confidence:.0%}"
     for p in cal.parameters:
@@ -51,7 +57,7 @@ def format_report(cal: Calibration) -> str:
     lines += ["", f"{'Table I':<16} {'before':>12} {'after':>12}"]
     lines += [f"{name:<16} {_metric(x, k, u):>12} {_metric(y, k, u):>12}"
               for name, x, y, k, u in rows]
-    lines += [f"warning: {w}" for w in cal.warnings]
+    lines += [f"warning: {w}" for w in cal.after.warnings]
     return "\n".join(lines)
 
 
@@ -65,4 +71,8 @@ def run(args: argparse.Namespace) -> int:
     except TdcmError as error:
         return fail("calibrate", error, args.json)
     print(json.dumps(cal.to_json()) if args.json else format_report(cal))
+    if cal.warnings:
+        print(f"tdcm calibrate: the fit is not usable: {'; '.join(cal.warnings)}",
+              file=sys.stderr)
+        return UNUSABLE_FIT_EXIT
     return 0

@@ -41,7 +41,8 @@ def register(subparsers: Any) -> None:
                     "error, deflection mean).")
     add_input_arguments(parser)
     parser.add_argument("--plots", metavar="DIR",
-                        help="write shapes.png and error_vs_tension.png (needs matplotlib)")
+                        help="write shapes.png and error_vs_tension.png into DIR (created if "
+                             "missing; its parent must exist; needs matplotlib)")
     parser.set_defaults(handler=run)
 
 

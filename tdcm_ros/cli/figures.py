@@ -13,7 +13,8 @@ def register(subparsers: Any) -> None:
         "figures", help="reproduce the paper's Figs. 2-3 and a feasibility map as PNG",
         description="Write fig2.png, fig3.png and feasibility.png (needs matplotlib: "
                     "pip install 'tdcm_ros[plot]').")
-    parser.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    parser.add_argument("--out", required=True, metavar="DIR",
+                        help="output directory (created if missing; its parent must exist)")
     parser.add_argument("--points", type=int, default=41,
                         help="grid points per sweep axis (default: 41)")
     parser.add_argument("--dpi", type=int, default=130, help="PNG resolution (default: 130)")

@@ -17,6 +17,9 @@ from types import FrameType
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
 
+EMPTY_BAG_EXIT = 1
+"""Exit status of a recording that wrote no message (the empty bag is kept)."""
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``record``."""
@@ -108,4 +111,5 @@ def run_record(args: argparse.Namespace) -> int:
         print(f"tdcm record: never published: {', '.join(recorder.missing)}", file=sys.stderr)
     if not sum(counts.values()):
         print("tdcm record: no message was recorded; the bag is empty", file=sys.stderr)
+        return EMPTY_BAG_EXIT
     return 0

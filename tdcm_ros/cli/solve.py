@@ -8,6 +8,7 @@ import sys
 from typing import Any
 
 from tdcm_ros.errors import InputError, TdcmError
+from tdcm_ros.figures import plot_file
 from tdcm_ros.model import PRESETS, SolverSettings, parse_field, preset, solve
 from tdcm_ros.model.profiles import PROFILE_NAMES
 from tdcm_ros.model.settings import ROUTINGS
@@ -28,7 +29,8 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--loads", choices=("closed", "literal"), default="closed",
                         help="tendon load form")
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    parser.add_argument("--plot", metavar="FILE.png", help="draw midline and curvature to a PNG")
+    parser.add_argument("--plot", metavar="FILE", help="draw midline and curvature to a .png, "
+                        ".pdf or .svg file in an existing folder")
     parser.set_defaults(handler=run)
 
 
@@ -51,6 +53,8 @@ def run(args: argparse.Namespace) -> int:
             overrides["profile"] = args.profile
         design = preset(args.design).with_overrides(**overrides)
         settings = SolverSettings(routing=args.routing, loads=args.loads)
+        if args.plot:
+            plot_file("--plot", args.plot)
         result = solve(design, args.tension, settings=settings)
     except TdcmError as error:
         if args.json:

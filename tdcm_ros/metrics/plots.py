@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from tdcm_ros.errors import InputError
+from tdcm_ros.figures import output_folder
 from tdcm_ros.metrics.evaluation import Evaluation
 
 
@@ -26,14 +27,10 @@ def _pyplot(target: Path) -> Any:
 
 def write_plots(evaluation: Evaluation, directory: str | Path) -> list[Path]:
     """Write ``shapes.png`` (measured and predicted midlines and markers, x-z plane of
-    ``tdcm_base``, one panel per trial) and ``error_vs_tension.png`` into ``directory``."""
-    out = Path(directory)
-    plt = _pyplot(out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as error:
-        raise InputError(f"--plots {out}: cannot create the folder ({error})", parameter="plots",
-                         value=str(out), allowed="a writable folder") from error
+    ``tdcm_base``, one panel per trial) and ``error_vs_tension.png`` into ``directory`` (created
+    if missing; its parent must exist)."""
+    plt = _pyplot(Path(directory))
+    out = output_folder("--plots", directory)
     records = evaluation.records
     trials = sorted({r.trial for r in records})
     fig, axes = plt.subplots(1, len(trials), figsize=(4 * len(trials), 5), squeeze=False,

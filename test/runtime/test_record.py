@@ -271,3 +271,14 @@ def test_recorder_refuses_an_unknown_runtime(tmp_path: Path) -> None:
     with BagWriter(tmp_path / "bag") as writer, pytest.raises(
             InputError, match="runtime = 'dds'.*allowed: zenoh, rclpy"):
         Recorder(writer, runtime="dds")
+        Recorder(writer, runtime="dds")
+
+
+def test_a_recording_that_wrote_nothing_exits_non_zero(runtime: str, spawn: Spawn,
+                                                       tmp_path: Path) -> None:
+    recorder = spawn("tdcm_ros.cli.main", "record", str(tmp_path / "bag"), "/never_published",
+                     "--duration", "1")
+    recorder.wait(30.0)
+    err = recorder.stderr.read().decode() if recorder.stderr else ""
+    assert recorder.returncode == 1, err
+    assert "no message was recorded; the bag is empty" in err
