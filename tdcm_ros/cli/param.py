@@ -12,10 +12,9 @@ import json
 import os
 from typing import Any
 
-import yaml
-
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
+from tdcm_ros.yamlio import load_yaml
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -67,11 +66,7 @@ def run_get(args: argparse.Namespace) -> int:
 
 def run_set(args: argparse.Namespace) -> int:
     """Set the value; a rejection is an input error carrying the node's reason."""
-    try:
-        value = yaml.safe_load(args.value)
-    except yaml.YAMLError as error:
-        raise InputError(f"value is not valid YAML: {error}", parameter=args.name,
-                         value=args.value) from error
+    value = load_yaml(args.value, args.name)
     answer = _call(args, "set", {"name": args.name, "value": value})
     if not answer["successful"]:
         raise InputError(f"rejected: {answer['reason']}", parameter=args.name, value=value)

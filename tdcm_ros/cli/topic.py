@@ -13,6 +13,7 @@ from typing import Any
 import yaml
 
 from tdcm_ros.errors import InputError
+from tdcm_ros.yamlio import load_yaml
 
 TOOL_NODE = "_tdcm_topic"
 
@@ -150,11 +151,7 @@ def run_pub(args: argparse.Namespace) -> int:
     if not args.rate > 0:
         raise InputError(f"--rate = {args.rate} Hz must be > 0", parameter="rate",
                          value=args.rate, allowed="> 0 Hz")
-    try:
-        values = yaml.safe_load(args.values)
-    except yaml.YAMLError as error:
-        raise InputError(f"values are not valid YAML: {error}", parameter="values",
-                         value=args.values) from error
+    values = load_yaml(args.values, "values")
     message = from_dict(args.type, values if values is not None else {})
     times = 1 if args.once else args.times
     context = _context()
