@@ -16,12 +16,23 @@ from collections.abc import Mapping, Sequence
 from types import FrameType
 from typing import Any
 
-from tdcm_ros.runtime.graph import NodeGraph, merged_params
+from tdcm_ros.runtime.graph import CLEAN_EXITS, NodeGraph, merged_params
 from tdcm_ros.runtime.registry import node_target
 
 __all__ = ["launch", "merged_params"]
 
 log = logging.getLogger("tdcm.up")
+
+
+def report_exits(graph: NodeGraph, reported: set[str]) -> None:
+    """Log each node that exited on its own since the last call (once per node)."""
+    for child in graph.children:
+        if not child.running and child.name not in reported:
+            reported.add(child.name)
+            status = child.process.returncode
+            level = logging.WARNING if status in CLEAN_EXITS else logging.ERROR
+            log.log(level, "node %s exited with status %s while the graph runs; the other "
+                    "nodes go on", child.name, status)
 
 
 def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str = "zenoh",
@@ -53,7 +64,9 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
                 break
             graph.start_node(name, overrides=overrides.get(name),
                              ready_path=ready_paths.get(name), ready_timeout=ready_timeout)
+        reported: set[str] = set()
         while not stop.wait(0.2):
+            report_exits(graph, reported)
             if all(not c.running for c in graph.children):
                 log.warning("every node has exited")
                 break
@@ -61,4 +74,4 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
         graph.close()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    return 1 if graph.failed() and not stop.is_set() else 0
+    return 1 if graph.failed() else 0

@@ -156,7 +156,14 @@ class ParameterStore:
                 raise InputError(f"parameter {name!r} is read-only", parameter=name)
             coerced[name] = spec.coerce(value)
         for callback in self._callbacks:
-            callback(coerced)
+            try:
+                callback(coerced)
+            except InputError:
+                raise
+            except Exception as error:  # a failing node check rejects the change
+                raise InputError(f"change of {', '.join(coerced)} rejected: the node's check "
+                                 f"failed with {type(error).__name__}: {error}",
+                                 parameter=", ".join(coerced)) from error
         return coerced
 
     def set(self, changes: Mapping[str, Any]) -> SetResult:

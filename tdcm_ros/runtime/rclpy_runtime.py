@@ -28,6 +28,7 @@ from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import wire
 from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.guard import CallbackGuard
 from tdcm_ros.runtime.parameters import (
     ParameterStore,
     ParamSpec,
@@ -147,6 +148,8 @@ class RclpyNodePort:
         self.logger = _Logger(node.get_logger())
         self._overrides = dict(overrides or {})
         self._params = ParameterStore()
+        self.guard = CallbackGuard(node.get_fully_qualified_name(), self.logger,
+                                   self.create_publisher, self.now_ns)
         node.add_pre_set_parameters_callback(self._widen)
         node.add_on_set_parameters_callback(self._on_set)
 
@@ -239,6 +242,8 @@ class RclpyNodePort:
         """
         name = normalize_type_name(type_name)
         holder: list[Any] = []
+        callback = self.guard.wrap(f"subscription {self.node.resolve_topic_name(topic)}",
+                                   callback)
 
         def deliver(data: bytes, info: Mapping[str, Any]) -> None:
             attachment = wire.Attachment(int(info.get("publication_sequence_number", 0)),
@@ -263,7 +268,8 @@ class RclpyNodePort:
         if not period > 0:
             raise InputError(f"timer period = {period!r} s must be > 0", parameter="period",
                              value=period, allowed="> 0 s")
-        return self.node.create_timer(period, callback)
+        return self.node.create_timer(period, self.guard.wrap(
+            f"timer {getattr(callback, '__qualname__', period)}", callback))
 
     def now_ns(self) -> int:
         """The node clock (ROS time if ``use_sim_time``), ns."""

@@ -25,6 +25,9 @@ from tdcm_ros.runtime.port import NodeLogic
 
 RUNTIMES = ("auto", "zenoh", "rclpy")
 RUNTIME_ENV = "TDCM_RUNTIME"
+#: Exit status of a node whose loop died of an unexpected error (callbacks are isolated, see
+#: :mod:`tdcm_ros.runtime.guard`; this is what is left), so ``tdcm up`` and launch see it.
+LOOP_DIED = 70
 
 
 def resolve_runtime(choice: str = "auto") -> str:
@@ -95,6 +98,10 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
         port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
         try:
             context.spin()
+        except Exception as error:  # noqa: BLE001 - the loop died: close, then exit non-zero
+            port.logger.error("the node's loop died (%s: %s); closing it and exiting with %d",
+                              type(error).__name__, error, LOOP_DIED)
+            return LOOP_DIED
         finally:
             node.close()
     finally:

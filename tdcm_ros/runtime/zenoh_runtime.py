@@ -37,9 +37,10 @@ from tdcm_ros.bagio import (
     serialize,
     type_hash,
 )
-from tdcm_ros.errors import InputError, TdcmError
+from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import wire
 from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.guard import CallbackGuard
 from tdcm_ros.runtime.names import (
     fully_qualified_node_name,
     normalize_namespace,
@@ -148,7 +149,7 @@ class _Executor:
         def run() -> None:
             try:
                 future.set_result(task())
-            except TdcmError as error:  # handed to the waiting thread, which re-raises it
+            except Exception as error:  # noqa: BLE001 - handed to the waiting thread, which re-raises it
                 future.set_exception(error)
 
         self.post(run)
@@ -297,6 +298,7 @@ class ZenohNodePort:
         self.identity = wire.NodeIdentity(context.domain_id, context.zid, node_id,
                                           self.namespace, name)
         self._entities: list[_Publisher | _Subscription] = []
+        self.guard = CallbackGuard(self.fqn, self.logger, self.create_publisher, self.now_ns)
         self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
         self._queryable = context.session.declare_queryable(
             param_key(context.domain_id, self.fqn, "*"), self._on_param_query)
@@ -318,7 +320,11 @@ class ZenohNodePort:
         """Add a check run on each runtime change; raising ``InputError`` rejects it."""
         self._params.add_on_set(callback)
 
-    def _param_request(self, op: str, request: dict[str, Any]) -> dict[str, Any]:
+    def _param_request(self, op: str, request: Any) -> dict[str, Any]:
+        if not isinstance(request, dict) or not isinstance(request.get("name", ""), str):
+            raise InputError(f"parameter request {request!r} is invalid; allowed: a JSON object "
+                             f"with a string 'name'", parameter="request", value=request,
+                             allowed="JSON object")
         if op == "list":
             specs = self._params.specs
             return {"parameters": {n: {"value": v, "description": specs[n].description,
@@ -340,11 +346,25 @@ class ZenohNodePort:
         op = str(query.key_expr).rsplit("/", 1)[-1]
         try:
             request = json.loads(query.payload.to_bytes() or b"{}") if query.payload else {}
-            reply = self._context.executor.call(lambda: self._param_request(op, request),
+            reply = self._context.executor.call(lambda: self._param_answer(op, request),
                                                 PARAM_TIMEOUT_S)
-        except (InputError, RuntimePortError, ValueError) as error:
+        except (RuntimePortError, ValueError) as error:
             reply = {"error": str(error)}
         query.reply(query.key_expr, json.dumps(reply))
+
+    def _param_answer(self, op: str, request: Any) -> dict[str, Any]:
+        """The reply to a parameter request, errors included (executor thread).
+
+        No exception leaves: one raised across threads would keep the zenoh query alive in a
+        reference cycle, and its reply would wait for the query's timeout.
+        """
+        try:
+            return self._param_request(op, request)
+        except InputError as error:
+            return {"error": str(error)}
+        except Exception as error:  # noqa: BLE001 - a hostile query must not end the node
+            self.guard.failed(f"parameter query {op}", error)
+            return {"error": f"{type(error).__name__}: {error}"}
 
     # endpoints
     def create_publisher(self, topic: str, type_name: str, qos: QoS = DEFAULT_QOS) -> _Publisher:
@@ -376,14 +396,16 @@ class ZenohNodePort:
         resolved = resolve_topic(topic, self.namespace, self.node_name)
         name = normalize_type_name(type_name) if type_name else ""
         self._entities.append(_Subscription(self._context, self.identity, resolved, name,
-                                            callback, qos, any_type=type_name is None))
+                                            self.guard.wrap(f"subscription {resolved}", callback),
+                                            qos, any_type=type_name is None))
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> _Timer:
         """Call ``callback`` every ``period`` s on the executor thread."""
         if not period > 0:
             raise InputError(f"timer period = {period!r} s must be > 0", parameter="period",
                              value=period, allowed="> 0 s")
-        return self._context.executor.add_timer(period, callback)
+        return self._context.executor.add_timer(period, self.guard.wrap(
+            f"timer {getattr(callback, '__qualname__', period)}", callback))
 
     def now_ns(self) -> int:
         """System time, ns since the UNIX epoch."""

@@ -1,0 +1,206 @@
+"""Callbacks cannot kill a node: failing callbacks, failing parameter checks and hostile parameter
+queries are isolated on both runtimes; a loop that dies anyway exits non-zero; ``tdcm up`` says so."""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from runtime_helpers import stop, wait_for
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.runtime.guard import CallbackGuard
+from tdcm_ros.runtime.port import NodeLogic, QoS
+from tdcm_ros.runtime.run_node import LOOP_DIED, run_node
+
+HERE = Path(__file__).resolve().parent
+FRAGILE = "fragile_node:FragileNode"
+
+
+class Sink:
+    """A publisher stand-in that keeps what it is given."""
+
+    def __init__(self) -> None:
+        self.messages: list[Any] = []
+
+    def publish(self, message: Any) -> None:
+        self.messages.append(message)
+
+
+def test_the_guard_logs_counts_and_reports_and_lets_interrupts_through(caplog) -> None:
+    sink = Sink()
+    made: list[tuple[str, str]] = []
+
+    def factory(topic: str, type_name: str) -> Sink:
+        made.append((topic, type_name))
+        return sink
+
+    guard = CallbackGuard("/n", logging.getLogger("guard_test"), factory, lambda: 5 * 10**9 + 7)
+
+    def broken(value: int) -> int:
+        return 10 // value
+
+    wrapped = guard.wrap("subscription /x", broken)
+    assert wrapped(2) == 5 and not made
+    with caplog.at_level(logging.ERROR, logger="guard_test"):
+        assert wrapped(0) is None
+        assert wrapped(0) is None  # within the report period: counted and logged, not re-sent
+    assert guard.failures == {"subscription /x": 2}
+    assert "ZeroDivisionError" in caplog.text and "Traceback" in caplog.text
+    assert made == [("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray")]
+    status = sink.messages[0].status[0]
+    assert len(sink.messages) == 1 and status.level == 2 and status.name == "/n: callbacks"
+    assert "ZeroDivisionError" in status.message
+    assert [(v.key, v.value) for v in status.values] == [("subscription /x", "1")]
+    assert sink.messages[0].header.stamp.sec == 5
+
+    def interrupted() -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        guard.wrap("timer", interrupted)()
+
+
+class _DyingContext:
+    """A context whose loop fails with an error no callback guard saw."""
+
+    domain_id = 0
+
+    def __init__(self) -> None:
+        self.closed = False
+
+    def create_port(self, name: str, namespace: str, overrides: Any) -> Any:
+        return type("Port", (), {"logger": logging.getLogger("dying"), "node_name": name})()
+
+    def spin(self) -> None:
+        raise RuntimeError("executor internals broke")
+
+    def close(self) -> None:
+        self.closed = True
+
+
+class _Closing(NodeLogic):
+    closed = False
+
+    def close(self) -> None:
+        _Closing.closed = True
+
+
+def test_a_loop_that_dies_anyway_closes_the_node_and_exits_non_zero(monkeypatch) -> None:
+    context = _DyingContext()
+    monkeypatch.setattr("tdcm_ros.runtime.run_node.open_context", lambda *a, **k: context)
+    assert run_node(_Closing, runtime="zenoh") == LOOP_DIED != 0
+    assert _Closing.closed and context.closed
+
+
+@pytest.fixture
+def fragile(runtime: str, graph_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
+    env = {**graph_env, "PYTHONPATH": os.pathsep.join([str(HERE), graph_env["PYTHONPATH"]])}
+    node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", FRAGILE],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    yield node
+    if node.poll() is None:
+        node.kill()
+    node.wait()
+
+
+def _until(context: Any, predicate: Callable[[], bool], timeout: float, what: str,
+           action: Callable[[], None]) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        assert time.monotonic() < deadline, f"timed out after {timeout} s waiting for {what}"
+        action()
+        context.spin_for(0.2)
+
+
+def test_a_failing_callback_is_reported_and_the_node_goes_on(runtime, context, params,
+                                                              fragile) -> None:
+    port = context.create_port("poker")
+    poke = port.create_publisher("poke", "std_msgs/msg/String")
+    echoes: list[str] = []
+    reports: list[Any] = []
+    port.create_subscription("echo", "std_msgs/msg/String", lambda m: echoes.append(m.data))
+    port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
+                             lambda a: reports.extend(s for s in a.status
+                                                      if s.name == "/fragile: callbacks"),
+                             QoS(depth=100))
+
+    def say(text: str) -> Callable[[], None]:
+        return lambda: poke.publish(from_dict("std_msgs/msg/String", {"data": text}))
+
+    _until(context, lambda: "first" in echoes, 30.0, "the node's first echo", say("first"))
+    _until(context, lambda: bool(reports), 20.0, "the failure on /diagnostics", say("boom"))
+    assert "RuntimeError: boom" in reports[0].message and "subscription /poke" in reports[0].message
+    _until(context, lambda: "after" in echoes, 20.0, "an echo after the failure", say("after"))
+
+    node = params("/fragile")
+    crashed = node.set("mode", "crash")
+    assert not crashed["successful"] and "KeyError" in crashed["reason"], crashed
+    assert node.get("mode") == "ok"
+    assert node.set("mode", "calm") == {"successful": True, "reason": ""}
+    _until(context, lambda: "still" in echoes, 20.0, "an echo after the parameter crash",
+           say("still"))
+    assert fragile.poll() is None
+
+
+def test_hostile_parameter_queries_get_errors_and_the_node_goes_on(context, zenoh_env) -> None:
+    """The embedded runtime's own parameter queryables (rclpy serves rcl_interfaces instead)."""
+    env = {**zenoh_env, "PYTHONPATH": os.pathsep.join([str(HERE), zenoh_env["PYTHONPATH"]])}
+    node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", FRAGILE],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        from tdcm_ros.runtime.zenoh_runtime import call_parameters, param_key
+
+        wait_for(lambda: _answers(context), 30.0, "the node's parameter queryable")
+        for body in ("null", "[]", "7", '"x"', '{"name": 5}', "{not json", '{"name": null}'):
+            for op in ("get", "set", "list"):
+                reply = next(r.ok.payload.to_bytes() for r in context.session.get(
+                    param_key(0, "/fragile", op), payload=body, timeout=5.0) if r.ok)
+                assert "error" in json.loads(reply), (op, body)
+        assert node.poll() is None
+        assert call_parameters(context.session, 0, "/fragile", "get", {"name": "mode"}) == {
+            "value": "ok"}
+    finally:
+        node.kill()
+        node.wait()
+
+
+def _answers(context: Any) -> bool:
+    from tdcm_ros.errors import TdcmError
+    from tdcm_ros.runtime.zenoh_runtime import call_parameters
+
+    try:
+        call_parameters(context.session, 0, "/fragile", "list", {}, timeout=1.0)
+    except TdcmError:
+        return False
+    return True
+
+
+def _children(pid: int) -> list[int]:
+    found: list[int] = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        found += [int(p) for p in (task / "children").read_text().split()]
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+def test_tdcm_up_reports_a_dead_node_and_exits_non_zero(runtime, spawn) -> None:
+    launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--runtime", runtime)
+    wait_for(lambda: len(_children(launcher.pid)) == 1, 20.0, "the talker process")
+    time.sleep(1.0)
+    os.kill(_children(launcher.pid)[0], signal.SIGKILL)
+    status = launcher.wait(30)  # every node has exited: tdcm up ends by itself
+    assert launcher.stderr is not None
+    log = launcher.stderr.read().decode()
+    assert "node talker exited with status -9 while the graph runs" in log, log
+    assert status == 1
+    assert stop(launcher) == 1
