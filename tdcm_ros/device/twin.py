@@ -35,6 +35,7 @@ from tdcm_ros.device.plant import Plant, PlantConfig
 from tdcm_ros.errors import out_of_range
 
 TRUTH_KEPT = 4096  #: ground-truth samples kept until taken (older ones are dropped)
+RX_BUFFER = 64     #: bytes the UNO's serial receive buffer holds while its loop does not read
 
 
 class DeviceTwin:
@@ -43,41 +44,81 @@ class DeviceTwin:
     The EEPROM starts with a calibration matching the plant's load cell unless ``storage``
     (an ``EEPROM_RECORD_SIZE`` byte buffer) is given. At every load-cell sample ``truth`` gets
     ``(simulated time s, true tendon tension N)`` (the newest ``TRUTH_KEPT`` are kept).
+
+    Failures: :meth:`reboot` (a reset: fresh firmware state, boot banner, EEPROM kept) and
+    :attr:`hung` (the firmware's loop stalls while time and the bench go on; see :meth:`advance`);
+    the host bytes of a stall beyond the first ``rx_buffer`` are lost.
     """
 
     def __init__(self, plant: PlantConfig | None = None, *, cell: str = "TWIN",
-                 storage: bytearray | None = None) -> None:
+                 storage: bytearray | None = None, rx_buffer: int = RX_BUFFER) -> None:
         self.plant = Plant(plant or PlantConfig())
         cfg = self.plant.config
         self.storage = storage if storage is not None else bytearray(
             pack_calibration(cfg.tare_counts, cfg.scale_mcpn))
         self.output = bytearray()
         self.truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_KEPT)
+        self.cell = cell
         self.core = TensionCore(self.storage, cell=cell, send=self.output.extend)
         self.now_ms = 0
         self._next_sample_ms = 0.0
+        self.hung = False
+        self.rx_buffer = rx_buffer
+        self._held = bytearray()
+        self._stalled = False
+        self._boot_ms = 0
         self.core.boot(self.now_ms)
+
+    def reboot(self) -> None:
+        """Reset the device now (as a UNO does when its port is opened): fresh firmware state --
+        released, no latched fault but CAL if the EEPROM is invalid, clock from 0 ms -- and a boot
+        banner. The EEPROM, the bench and the simulated time go on."""
+        self.core = TensionCore(self.storage, cell=self.cell, send=self.output.extend)
+        self.core.boot(0)
+        self._boot_ms = self.now_ms
 
     @property
     def time(self) -> float:
         """Simulated time, in s."""
         return self.now_ms / 1000
 
+    @property
+    def device_ms(self) -> int:
+        """The firmware's clock (ms since its last boot)."""
+        return self.now_ms - self._boot_ms
+
     def receive(self, data: bytes) -> None:
-        """Bytes from the host arrive now."""
-        self.core.receive(data, self.now_ms)
+        """Bytes from the host arrive now; while :attr:`hung` the first ``rx_buffer`` of them
+        wait in the receive buffer and the rest are lost."""
+        if self.hung:
+            self._held += data[:max(0, self.rx_buffer - len(self._held))]
+            return
+        if self._held:
+            data, self._held = bytes(self._held) + data, bytearray()
+        self.core.receive(data, self.device_ms)
 
     def advance(self, seconds: float) -> None:
-        """Run the bench and the firmware for ``seconds`` of simulated time (1 ms steps)."""
+        """Run the bench and the firmware for ``seconds`` of simulated time (1 ms steps).
+
+        While :attr:`hung` the firmware neither samples, ticks nor sends: the actuator holds its
+        last pulse. Once it is cleared, the buffered host bytes are read first."""
+        if not self.hung and self._held:
+            self.receive(b"")
         period_ms = self.plant.config.sample_period * 1000
         for _ in range(round(seconds * 1000)):
             self.now_ms += 1
             self.plant.step(self.core.pulse_us, 0.001)
-            if self.now_ms >= self._next_sample_ms:
+            due = self.now_ms >= self._next_sample_ms
+            if due:
                 self._next_sample_ms += period_ms
-                self.core.sample(self.plant.read_counts(), self.now_ms)
                 self.truth.append((self.time, self.plant.tension))
-            self.core.tick(self.now_ms)
+            if self.hung:
+                self._stalled = True
+                continue
+            if due or self._stalled:  # a resumed loop reads the load cell first
+                self._stalled = False
+                self.core.sample(self.plant.read_counts(), self.device_ms)
+            self.core.tick(self.device_ms)
 
     def take_output(self) -> bytes:
         """Bytes sent since the last call."""
@@ -143,11 +184,14 @@ class PtyTwin:
                 os.close(fd)
         self._master = self._slave = -1
 
-    def reopen(self) -> None:
-        """Close the pty (the host's reads fail) and open a new one behind the same link."""
+    def reopen(self, *, reboot: bool = False) -> None:
+        """Close the pty (the host's reads fail) and open a new one behind the same link; with
+        ``reboot`` the device also resets (a UNO resets when its port is opened)."""
         with self._lock:
             self._close_fds()
             self._open()
+            if reboot:
+                self.twin.reboot()
 
     def _exchange(self) -> None:
         try:
@@ -191,13 +235,27 @@ class PtyTwin:
 
     @contextmanager
     def frozen(self) -> Iterator[None]:
-        """Inside this block the device neither runs nor talks (a hung board, a stalled UART).
+        """Inside this block the device and its bench pause (a stalled simulation; for a
+        stalled firmware loop on a running bench see :meth:`hung`).
 
         The threaded twin then catches up the simulated time it missed in one go, with the
         host's bytes of the pause delivered at its start.
         """
         with self._lock:
             yield
+
+    @contextmanager
+    def hung(self) -> Iterator[None]:
+        """Inside this block the firmware's loop is stalled (:attr:`DeviceTwin.hung`): time and
+        the bench go on, the actuator holds its pulse, nothing is sent, the host's first
+        ``rx_buffer`` bytes wait to be read when the loop resumes at the end of the block."""
+        with self._lock:
+            self.twin.hung = True
+        try:
+            yield
+        finally:
+            with self._lock:
+                self.twin.hung = False
 
     def pump(self, seconds: float) -> None:
         """Lock-step use: take the host's bytes, run ``seconds`` of simulated time, send output."""
