@@ -14,6 +14,15 @@ without faults. Port failures, a missing banner or ``link_timeout`` s without te
 the port and retry after an exponential backoff (``backoff_initial`` doubling to
 ``backoff_max``). Device faults (watchdog, over-tension, e-stop, sensor) are never cleared
 automatically: call :meth:`TensionDriver.clear_faults`.
+
+Arming: the driver starts armed. It disarms -- target and setpoint 0 N, schedule cancelled, mode
+R sent, setpoints and schedules refused -- on an e-stop and on every event after which the device's
+state is unknown: the link lost while connected (port error, ``link_timeout``, a version
+mismatch), a device reboot (a banner nobody asked for, or the device clock running backwards)
+and a freeze (no telemetry for the device's own watchdog time while the host kept stepping).
+Disarmed, it commands mode R whatever the device reports. Only :meth:`TensionDriver.clear_faults`
+(the operator's arm command, accepted while connected) arms it again, at a target of 0 N: a new
+setpoint is needed before any tension.
 """
 
 from __future__ import annotations
@@ -57,6 +66,8 @@ _LOG = logging.getLogger(__name__)
 INFO_RETRY = 0.5        #: s between banner requests during the handshake
 SETPOINT_PERIOD = 0.02  #: s, shortest interval between two setpoint commands
 MODE_RETRY = 0.2        #: s between two mode requests
+REJECT_LOG_PERIOD = 1.0  #: s, shortest interval between two warnings about rejected lines
+CLOCK_WRAP = 2**32 / 1000  #: s, the device clock (u32 ms) wraps after this
 
 
 class LinkState(enum.Enum):
@@ -118,11 +129,14 @@ class DriverStatus:
     target: float                 #: N, requested setpoint after clamping
     setpoint: float               #: N, setpoint last sent (ramped toward ``target``)
     enabled: bool                 #: the driver wants the device in mode T
+    armed: bool                   #: False: held released until clear_faults (see the module)
+    disarm_reason: str            #: why it was disarmed last ("" while never disarmed)
     telemetry: Telemetry | None   #: latest frame
     banner: Banner | None
     reconnects: int               #: links lost since start
     rejected_lines: int           #: malformed lines from the device
     nacks: int                    #: commands the device refused
+    disarms: int                  #: times the driver disarmed since start
 
 
 @dataclass(frozen=True)
@@ -166,6 +180,13 @@ class TensionDriver:
         self._banner: Banner | None = None
         self._latest: Telemetry | None = None
         self._enabled = False
+        self._armed = True
+        self._disarm_reason = ""
+        self._disarms = 0
+        self._info_pending = 0      # banner requests not yet answered
+        self._silent = False        # the host saw the device silent for its watchdog time
+        self._rejects_unlogged = 0  # rejected lines since the last warning about them
+        self._next_reject_log = clock()
         self._target = 0.0
         self._setpoint = 0.0
         self._sent_setpoint: float | None = None
@@ -194,17 +215,37 @@ class TensionDriver:
         return clamped
 
     def set_setpoint(self, newtons: float) -> float:
-        """Request a tension (N); cancels a running schedule. Returns the clamped value."""
+        """Request a tension (N); cancels a running schedule. Returns the target now held, in N:
+        the clamped value, or 0 N while disarmed (the request is refused with a warning)."""
         self._schedule = None
-        self._target = self._clamp(newtons, "setpoint")
+        clamped = self._clamp(newtons, "setpoint")
+        if self._refused_while_disarmed(f"setpoint = {newtons:g} N"):
+            return self._target
+        self._target = clamped
         return self._target
 
-    def run_schedule(self, schedule: StepSchedule) -> None:
-        """Follow ``schedule`` from now on (levels above the maximum are clamped, with a warning)."""
+    def run_schedule(self, schedule: StepSchedule) -> bool:
+        """Follow ``schedule`` from now on (levels above the maximum are clamped, with a warning).
+        Returns False (with a warning) while disarmed: nothing runs."""
+        if self._refused_while_disarmed("the schedule"):
+            return False
         for level in sorted(set(schedule.levels)):
             self._clamp(level, "schedule level")
         self._schedule = schedule
         self._schedule_start = self._clock()
+        return True
+
+    def _refused_while_disarmed(self, what: str) -> bool:
+        if self._armed:
+            return False
+        self._warn(f"{what} refused: disarmed ({self._disarm_reason}); the tendon stays released "
+                   f"until clear_faults, then needs a new setpoint")
+        return True
+
+    @property
+    def armed(self) -> bool:
+        """False while the driver holds the device released until :meth:`clear_faults`."""
+        return self._armed
 
     @property
     def schedule_running(self) -> bool:
@@ -221,17 +262,41 @@ class TensionDriver:
         self._send_now(SetMode(Mode.RELEASE))
 
     def estop(self) -> None:
-        """Release at once: send ``E`` (latching the device's ESTOP fault), zero the setpoint,
-        stop any schedule and disable. Without a link the device's watchdog releases it."""
+        """Release at once: send ``E`` (latching the device's ESTOP fault), then disarm and
+        disable. Without a link the device's watchdog releases it."""
         self._enabled = False
+        self._send_now(EStop())
+        self._disarm("e-stop", send_release=False)  # E has released it
+
+    def clear_faults(self) -> bool:
+        """The operator's arm command: clear the device's latched faults (the device refuses
+        while over the trip) and arm the driver at its current target (0 N after a disarm).
+        Refused with a warning, returning False, while the link is not connected."""
+        if self._link is not LinkState.CONNECTED:
+            self._warn(f"clear_faults refused: link {self._link.value}")
+            return False
+        self._send_now(ClearFaults())
+        if not self._armed:
+            self._armed = True
+            self._warn(f"armed by clear_faults (was disarmed: {self._disarm_reason}); target "
+                       f"{self._target:g} N")
+        return True
+
+    def _disarm(self, reason: str, *, send_release: bool = True) -> None:
+        """Hold the device released until :meth:`clear_faults`: target and setpoint 0 N,
+        schedule cancelled, mode R sent at once if ``send_release`` (best effort; repeated while
+        the device reports mode T)."""
+        self._armed, self._disarm_reason = False, reason
+        self._disarms += 1
         self._schedule = None
         self._target = self._setpoint = 0.0
-        self._send_now(EStop())
-        self._warn("e-stop: tendon released")
-
-    def clear_faults(self) -> None:
-        """Clear the device's latched faults (the device refuses while over the trip)."""
-        self._send_now(ClearFaults())
+        self._sent_setpoint = None
+        self._warn(f"disarmed: {reason}; tendon held released until clear_faults")
+        if send_release and self._transport is not None:
+            try:
+                self._send(SetMode(Mode.RELEASE))
+            except PortError:
+                pass  # the next read or write drops the link
 
     def close(self) -> None:
         """Release the tendon (best effort) and close the port."""
@@ -262,7 +327,12 @@ class TensionDriver:
         self._decoder = LineDecoder(accept=DEVICE_TYPES, on_reject=self._on_reject)
         self._link, self._since = LinkState.HANDSHAKING, now
         self._last_info = now
+        self._send_info()
+
+    def _send_info(self) -> None:
+        """Ask for the banner; the answer is not taken for a reboot."""
         self._send(Info())
+        self._info_pending += 1
 
     def _retry_later(self, now: float, reason: str) -> None:
         self._link_error = reason
@@ -270,20 +340,31 @@ class TensionDriver:
         self._backoff = min(self._backoff * 2, self.config.backoff_max)
 
     def _drop(self, reason: str, *, reconnect: bool = True) -> None:
+        was_connected, self._link = self._link is LinkState.CONNECTED, LinkState.DISCONNECTED
+        if was_connected and reconnect:
+            self._reconnects += 1
+            self._warn(f"device link lost: {reason}")
+        if was_connected:
+            self._disarm(f"link lost: {reason}")
         if self._transport is not None:
             self._transport.close()
             self._transport = None
-        if self._link is LinkState.CONNECTED and reconnect:
-            self._reconnects += 1
-            self._warn(f"device link lost: {reason}")
-        self._link = LinkState.DISCONNECTED
         self._sent_setpoint = None
+        self._silent = False
         self._retry_later(self._clock(), reason)
 
     def _on_reject(self, error: FrameError) -> None:
+        """Count a rejected device line; warn about it at most every ``REJECT_LOG_PERIOD`` s."""
         self._rejected += 1
         if error.reason is Reject.VER:
             self._version_error = error
+        self._rejects_unlogged += 1
+        now = self._clock()
+        if now >= self._next_reject_log:
+            self._next_reject_log = now + REJECT_LOG_PERIOD
+            self._warn(f"rejected {self._rejects_unlogged} line(s) from the device "
+                       f"({self._rejected} in all); last: {error}")
+            self._rejects_unlogged = 0
 
     def _send(self, command: Command) -> None:
         if self._transport is None:
@@ -316,8 +397,11 @@ class TensionDriver:
                 self._drop(f"no banner within {self.config.handshake_timeout:g} s")
             elif now - self._last_info >= INFO_RETRY:
                 self._last_info = now
-                self._send(Info())
+                self._send_info()
             return
+        if self._latest is not None and self._banner is not None \
+                and now - self._last_rx >= self._banner.watchdog:
+            self._silent = True  # seen while stepping: the device, not this host, stalled
         if now - self._last_rx >= self.config.link_timeout:
             self._drop(f"no telemetry for {now - self._last_rx:.2f} s")
             return
@@ -326,17 +410,40 @@ class TensionDriver:
     def _handle(self, message: object, now: float, received: list[Telemetry]) -> None:
         if isinstance(message, Telemetry):
             received.append(message)
-            self._latest, self._last_rx = message, now
+            self._on_telemetry(message, now)
         elif isinstance(message, Banner):
-            if self._link is LinkState.CONNECTED:
-                self._warn("device sent a new banner: it rebooted")
-            self._banner, self._link = message, LinkState.CONNECTED
-            self._last_rx = self._last_ramp = now
-            self._backoff = self.config.backoff_initial
-            self._sent_setpoint = None
+            self._on_banner(message, now)
         elif isinstance(message, Nack):
             self._nacks += 1
             self._warn(f"device refused command {message.command}: {message.reason.value}")
+
+    def _on_telemetry(self, frame: Telemetry, now: float) -> None:
+        """Take a frame; a device clock running backwards is a reboot, a frame after the host saw
+        the device silent for its watchdog time ends a freeze: either disarms."""
+        previous, silence, silent = self._latest, now - self._last_rx, self._silent
+        self._latest, self._last_rx, self._silent = frame, now, False
+        if previous is not None and frame.time < previous.time \
+                and previous.time - frame.time < CLOCK_WRAP / 2:
+            self._warn(f"device rebooted: its clock went back from {previous.time:.3f} s to "
+                       f"{frame.time:.3f} s")
+            if self._armed:
+                self._disarm("device rebooted")
+        elif silent and self._armed:
+            self._disarm(f"device silent for {silence:.2f} s (frozen?)")
+
+    def _on_banner(self, banner: Banner, now: float) -> None:
+        """Complete the handshake; a banner nobody asked for while connected is a reboot."""
+        solicited = self._info_pending > 0
+        self._info_pending = max(0, self._info_pending - 1)
+        if self._link is LinkState.CONNECTED and not solicited:
+            self._warn("device rebooted: it sent a boot banner")
+            self._latest = None  # the old frames' clock is not the new boot's
+            if self._armed:
+                self._disarm("device rebooted")
+        self._banner, self._link = banner, LinkState.CONNECTED
+        self._last_rx = self._last_ramp = now
+        self._backoff = self.config.backoff_initial
+        self._sent_setpoint = None
 
     def _keep_alive(self, now: float) -> None:
         if now - self._last_heartbeat >= self.config.heartbeat_period:
@@ -356,10 +463,11 @@ class TensionDriver:
         latest = self._latest
         if latest is None or now - self._last_mode < MODE_RETRY:
             return
-        if self._enabled and latest.mode is Mode.RELEASE and not latest.faults:
+        holding = self._enabled and self._armed
+        if holding and latest.mode is Mode.RELEASE and not latest.faults:
             self._last_mode = now
             self._send(SetMode(Mode.TENSION))
-        elif not self._enabled and latest.mode is Mode.TENSION:
+        elif not holding and latest.mode is Mode.TENSION:
             self._last_mode = now
             self._send(SetMode(Mode.RELEASE))
 
@@ -375,6 +483,9 @@ class TensionDriver:
             level, text = Level.STALE, f"no telemetry for {now - self._last_rx:.2f} s"
         elif latest is not None and latest.faults:
             level, text = Level.ERROR, f"device fault {fault_names(latest.faults)}; tendon released"
+        elif not self._armed:
+            level, text = Level.WARN, (f"disarmed ({self._disarm_reason}): tendon held released; "
+                                       f"publish clear_faults to arm, then a new setpoint")
         elif latest is not None:
             mode = "tensioning" if latest.mode is Mode.TENSION else "released"
             level, text = Level.OK, (f"{mode}: tension {latest.tension:.3f} N, setpoint "
@@ -382,6 +493,8 @@ class TensionDriver:
         else:
             level, text = Level.WARN, "connected, no telemetry yet"
         return DriverStatus(link=self._link, level=level, message=text, target=self._target,
-                            setpoint=self._setpoint, enabled=self._enabled, telemetry=latest,
+                            setpoint=self._setpoint, enabled=self._enabled, armed=self._armed,
+                            disarm_reason=self._disarm_reason, telemetry=latest,
                             banner=self._banner, reconnects=self._reconnects,
-                            rejected_lines=self._rejected, nacks=self._nacks)
+                            rejected_lines=self._rejected, nacks=self._nacks,
+                            disarms=self._disarms)

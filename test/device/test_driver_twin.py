@@ -26,8 +26,8 @@ DT = 0.005  # s of simulated time per exchange
 class Bench:
     """Twin behind a pty (exposed as a symlink) plus a driver reading its simulated clock."""
 
-    def __init__(self, tmp_path: Path, **config: float) -> None:
-        self.twin = DeviceTwin()
+    def __init__(self, tmp_path: Path, *, rx_buffer: int = 64, **config: float) -> None:
+        self.twin = DeviceTwin(rx_buffer=rx_buffer)
         self.pty = PtyTwin(self.twin, link=str(tmp_path / "tdcm_port"))
         self.warnings: list[str] = []
         self.driver = TensionDriver(DriverConfig(port=self.pty.port, **config),
@@ -45,11 +45,48 @@ class Bench:
                 self.telemetry.extend(self.last.telemetry)
 
     def run_until_connected(self) -> None:
-        for _ in range(400):
+        for _ in range(1000):  # 5 s
             self.run(DT)
             if self.last is not None and self.last.status.link is LinkState.CONNECTED:
                 return
         raise AssertionError(f"no handshake: {self.last}")
+
+    def hold(self, newtons: float) -> None:
+        """Connect, enable and hold ``newtons`` on the tendon."""
+        self.run_until_connected()
+        self.driver.enable()
+        self.driver.set_setpoint(newtons)
+        self.run(3.0)
+        assert self.twin.core.mode is Mode.TENSION
+        assert self.twin.plant.tension == pytest.approx(newtons, abs=0.3)
+
+    def assert_released_until_cleared(self, seconds: float, reason: str) -> None:
+        """Once connected, the device is released within 0.5 s, then for ``seconds`` stays
+        released with a slack tendon while the driver reports itself disarmed for ``reason``; a
+        setpoint is refused; ``clear_faults`` arms it at 0 N (mode T, tendon still slack) and only
+        a new setpoint tensions it again."""
+        self.run_until_connected()
+        self.run(0.5)
+        end = self.twin.time + seconds
+        while self.twin.time < end:
+            self.run(0.1)
+            assert self.twin.core.mode is Mode.RELEASE, f"re-tensioned at {self.twin.time:.2f} s"
+            assert self.twin.plant.tension == 0.0
+        status = self.driver.step().status
+        assert not status.armed and reason in status.disarm_reason, status
+        assert status.target == 0.0 and status.level is Level.WARN or status.level is Level.ERROR
+        assert self.driver.set_setpoint(10.0) == 0.0
+        assert any("refused: disarmed" in w for w in self.warnings)
+        self.run(1.0)
+        assert self.twin.core.setpoint_mn == 0 and self.twin.core.mode is Mode.RELEASE
+        assert self.driver.clear_faults()
+        self.run(1.5)
+        assert self.twin.core.mode is Mode.TENSION and self.twin.core.setpoint_mn == 0
+        assert self.twin.plant.tension < 0.3  # armed at 0 N, not at the old 10 N
+        assert self.driver.step().status.armed
+        self.driver.set_setpoint(4.0)
+        self.run(3.0)
+        assert self.twin.plant.tension == pytest.approx(4.0, abs=0.3)
 
 
 @pytest.fixture
@@ -163,3 +200,56 @@ def test_schedule_runs_the_staircase(bench: Bench) -> None:
     assert [t for i, t in enumerate(targets) if i == 0 or t != targets[i - 1]] \
         == [0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 0.0, 4.0, 8.0, 12.0, 16.0, 20.0, 0.0]
     assert not bench.driver.schedule_running
+
+
+@pytest.mark.parametrize(("reboot", "outage"), [(False, 0.05), (True, 3.0)],
+                         ids=["unplug_replug", "reboot_on_open"])
+def test_a_reconnect_never_re_tensions(tmp_path: Path, reboot: bool, outage: float) -> None:
+    """Holding 10 N, the link drops and the device comes back on the same port: within the
+    device watchdog still tensioning (unplug_replug), or after 3 s freshly booted with no latched
+    fault (reboot_on_open, as a UNO does when its port is opened). Either way the driver holds
+    it released until clear_faults, then at 0 N until a new setpoint."""
+    bench = Bench(tmp_path, backoff_initial=outage)
+    try:
+        bench.hold(10.0)
+        bench.run(2.0)  # device clock past the outage: the reboot shows as the clock running back
+        bench.pty.reopen(reboot=reboot)
+        bench.run(0.05)
+        assert bench.last is not None and bench.last.status.link is LinkState.DISCONNECTED
+        bench.assert_released_until_cleared(2.0, "link lost")
+        assert any("device rebooted" in w for w in bench.warnings) is reboot
+    finally:
+        bench.driver.close()
+        bench.pty.stop()
+
+
+def test_a_reboot_on_an_open_port_is_seen_and_never_re_tensions(bench: Bench) -> None:
+    """A reset with the port still open (brown-out): the boot banner disarms the driver."""
+    bench.hold(10.0)
+    bench.twin.reboot()
+    bench.run(0.05)
+    assert any("device rebooted: it sent a boot banner" in w for w in bench.warnings)
+    bench.assert_released_until_cleared(2.0, "device rebooted")
+    assert bench.driver.step().status.reconnects == 0
+
+
+@pytest.mark.parametrize(("seconds", "rx_buffer", "reason"),
+                         [(1.0, 64, "device silent for 1."), (4.0, 4096, "link lost")],
+                         ids=["shorter_than_link_timeout", "longer_with_queued_requests"])
+def test_a_freeze_is_not_a_reboot_and_never_re_tensions(tmp_path: Path, seconds: float,
+                                                        rx_buffer: int, reason: str) -> None:
+    """The device's loop hangs holding 10 N, then resumes with the host's buffered bytes (no
+    watchdog trip): the driver releases it, reports a freeze (not a reboot, even when the late
+    answers to its banner requests arrive together) and waits for clear_faults."""
+    bench = Bench(tmp_path, rx_buffer=rx_buffer)
+    try:
+        bench.hold(10.0)
+        with bench.pty.hung():
+            bench.run(seconds)
+        bench.run(0.5)
+        assert not bench.twin.core.faults  # the device itself saw nothing wrong
+        bench.assert_released_until_cleared(2.0, reason)
+        assert not any("reboot" in w for w in bench.warnings), bench.warnings
+    finally:
+        bench.driver.close()
+        bench.pty.stop()

@@ -5,6 +5,8 @@ from __future__ import annotations
 import itertools
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tdcm_ros.device.driver import DriverConfig, Level, LinkState, TensionDriver
 from tdcm_ros.device.errors import DeviceError, PortError, ProtocolVersionError
@@ -56,10 +58,12 @@ class FakePort:
         return [decode(line) for line in bytes(self.written).splitlines()]
 
 
-def make(replies: bytes = b"", **config: float) -> tuple[TensionDriver, FakePort, Clock]:
+def make(replies: bytes = b"", warnings: list[str] | None = None,
+         **config: float) -> tuple[TensionDriver, FakePort, Clock]:
     port, clock = FakePort(replies), Clock()
     driver = TensionDriver(DriverConfig(port="fake", **config), clock=clock,
-                           open_port=lambda url: port, warn=lambda text: None)
+                           open_port=lambda url: port,
+                           warn=(lambda text: None) if warnings is None else warnings.append)
     return driver, port, clock
 
 
@@ -164,3 +168,35 @@ def test_schedule_levels() -> None:
         StepSchedule(trials=0)
     with pytest.raises(InputError, match="levels = -1"):
         StepSchedule(levels=(0.0, -1.0))
+
+
+def test_rejected_device_lines_are_counted_and_warned_about_once_a_second() -> None:
+    telemetry = encode(Telemetry(1.0, 8000, 0.0, 1000, Mode.RELEASE, Fault(0)))
+    warnings: list[str] = []
+    driver, port, clock = make(encode(BANNER) + telemetry, warnings)
+    driver.step()
+    for _ in range(30):
+        port.incoming.extend(b"$1,T,garbage*00\n" + telemetry)
+        clock.now += 0.1
+        status = driver.step().status
+    assert status.rejected_lines == 30 and status.link is LinkState.CONNECTED
+    rejected = [w for w in warnings if "line(s) from the device" in w]
+    assert 3 <= len(rejected) <= 4, rejected  # 3 s of garbage, at most one warning per second
+    assert "rejected 1 line(s) from the device (1 in all)" in rejected[0] and "CKSUM" in rejected[0]
+    assert sum(int(w.split()[1]) for w in rejected) <= 30
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.binary(max_size=120), max_size=10))
+def test_no_device_bytes_make_the_driver_raise(chunks: list[bytes]) -> None:
+    """Whatever the device sends, a step returns a result or raises the typed version error."""
+    driver, port, clock = make(encode(BANNER))
+    driver.step()
+    for chunk in chunks:
+        port.incoming.extend(chunk)
+        clock.now += 0.05
+        try:
+            result = driver.step()
+        except ProtocolVersionError:
+            continue
+        assert result.status.rejected_lines >= 0
