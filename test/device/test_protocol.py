@@ -160,3 +160,66 @@ def test_random_bytes_never_crash_and_are_counted(data: bytes) -> None:
     assert decoder.frames == len(decoded)
     if b"$" in data and b"\n" in data[data.index(b"$"):]:
         assert decoded or sum(decoder.rejects.values()) >= 1
+
+
+# --- hostile input: decode returns a frame or raises FrameError, nothing else, quickly ---------
+
+DECODED = (SetSetpoint, SetMode, Heartbeat, Tare, Calibrate, EStop, ClearFaults, Info, Banner,
+           Telemetry, Ack, Nack)
+hostile_field = st.one_of(
+    st.sampled_from(["", "-", "-0", "0", "00", "-0.000", "4.000", "22.001", "999999.999",
+                     "4294967295", "4294967296", "-2147483649", "99999999999999999999",
+                     "1e3", "nan", "inf", "0x1F", "FF", "ff", "R", "T", "X", "?", "TDCM",
+                     "NOISE", "VER", "\u00e9", " ", "a" * 13]),
+    st.text(alphabet=st.characters(min_codepoint=0x20, max_codepoint=0x7E), max_size=12),
+    st.text(max_size=6),  # any unicode: not even ASCII
+)
+hostile_body = st.builds(
+    lambda version, letter, fields: ",".join([version, letter, *fields]),
+    st.sampled_from(["1", "1", "1", "2", "0", "01", "-1", "999", "1000", ""]),
+    st.sampled_from(sorted("BTANSMHZKECIX?b") + ["", "TT"]),
+    st.lists(hostile_field, max_size=9))
+
+
+def hostile_frame(body: str) -> bytes:
+    """``$body*HH`` with the right checksum, so the line reaches the field checks."""
+    raw = body.encode("utf-8", "surrogatepass")
+    return b"$" + raw + b"*" + f"{checksum(raw):02X}".encode()
+
+
+def decodes_or_rejects(line: bytes, accept: frozenset[str]) -> None:
+    try:
+        message = decode(line, accept=accept)
+    except FrameError as error:
+        assert isinstance(error.reason, Reject)
+        assert error.reason.value in str(error)
+        return
+    assert isinstance(message, DECODED)
+    assert encode(message) == line + b"\n"  # only canonical lines are accepted
+
+
+@settings(max_examples=2000, deadline=200)
+@given(hostile_body, st.sampled_from([frozenset("BTAN"), frozenset("SMHZKECI")]))
+def test_hostile_frames_with_a_valid_checksum_decode_or_raise_frame_error(
+        body: str, accept: frozenset[str]) -> None:
+    decodes_or_rejects(hostile_frame(body), accept)
+
+
+@settings(max_examples=1000, deadline=200)
+@given(st.one_of(st.binary(max_size=200), st.binary(min_size=1000, max_size=20000),
+                 st.builds(lambda head, tail: b"$" + head + b"*" + tail,
+                           st.binary(max_size=90), st.binary(max_size=3))))
+def test_random_lines_decode_or_raise_frame_error(line: bytes) -> None:
+    decodes_or_rejects(line, frozenset("BTANSMHZKECI"))
+
+
+@settings(max_examples=300, deadline=500)
+@given(st.lists(st.one_of(st.binary(max_size=100), hostile_body.map(hostile_frame),
+                          st.just(b"\n"), st.just(b"$")), max_size=40))
+def test_the_framer_survives_any_stream_and_accounts_for_every_line(chunks: list[bytes]) -> None:
+    """Fed in any pieces, the framer returns only decoded messages, counts each one once, and
+    never raises (a rejected line goes to ``rejects``, not up the stack)."""
+    decoder = LineDecoder(accept=frozenset("BTAN"))
+    out = [message for chunk in chunks for message in decoder.feed(chunk)]
+    assert all(isinstance(m, DECODED) for m in out)
+    assert decoder.frames == len(out)
