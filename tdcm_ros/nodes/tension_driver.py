@@ -12,9 +12,17 @@ counters every ``diagnostics_period_s``.
 Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
 warning, ramped at ``setpoint_rate``; cancels a running schedule), ``estop``
 (``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable),
-``clear_faults`` (``std_msgs/msg/Empty``: clear latched faults and re-enable if ``enabled``),
-``start_schedule`` (``std_msgs/msg/Empty``: (re)start the ``schedule.*`` staircase). On shutdown
-the node releases the tendon and closes the port.
+``clear_faults`` (``std_msgs/msg/Empty``: clear latched faults, arm, and re-enable if
+``enabled``), ``start_schedule`` (``std_msgs/msg/Empty``: (re)start the ``schedule.*``
+staircase). On shutdown the node releases the tendon and closes the port.
+
+After a link loss, a device reboot or freeze, and an e-stop the driver is disarmed (see
+:mod:`tdcm_ros.device.driver`): the device is held released at a target of 0 N, setpoints and
+schedules are refused, until ``clear_faults``; after it a new setpoint is needed. ``device_state``
+and ``/diagnostics`` report ``armed`` and ``disarm_reason``.
+
+The force limits :data:`SAFETY_LIMITS` are read-only at run time unless the node is started with
+``safety.limits_writable: true`` (itself read-only).
 """
 
 from __future__ import annotations
@@ -58,6 +66,9 @@ DRIVER_PARAMS: dict[str, tuple[tuple[float, float], str]] = {
     "backoff_max": ((0.01, 600.0), "largest reconnect delay (s)"),
 }
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
+#: parameters that bound the force on the tendon: fixed at run time unless safety.limits_writable
+SAFETY_LIMITS = ("tension_max", "setpoint_rate")
+LIMITS_WRITABLE = "safety.limits_writable"
 
 
 class TensionDriverNode(NodeLogic):
@@ -74,8 +85,13 @@ class TensionDriverNode(NodeLogic):
                           validator=_non_empty("port")))
         baudrate = int(declare("baudrate", defaults.baudrate, range=(1200, 4_000_000),
                                read_only=True, description="serial line rate (baud)"))
+        self.limits_writable = bool(declare(
+            LIMITS_WRITABLE, False, read_only=True,
+            description=f"allow run-time changes of the safety limits {', '.join(SAFETY_LIMITS)}"))
         for name, (limits, text) in DRIVER_PARAMS.items():
-            declare(name, float(getattr(defaults, name)), range=limits, description=text)
+            locked = name in SAFETY_LIMITS and not self.limits_writable
+            declare(name, float(getattr(defaults, name)), range=limits,
+                    description=text + (f"; read-only unless {LIMITS_WRITABLE}" if locked else ""))
         declare("frame_id", "tdcm_tendon", description="frame of `tension`")
         declare("enabled", True, description="hold the setpoint (device mode T) when no fault")
         declare("schedule.levels", list(StepSchedule().levels),
@@ -146,6 +162,7 @@ class TensionDriverNode(NodeLogic):
 
     def _on_set(self, changes: Mapping[str, Any]) -> None:
         """Validate runtime changes as a whole, then apply them (raising keeps the old values)."""
+        self._check_limits_writable(changes)
         config = replace(self.driver.config, **self._driver_values(changes))
         schedule = self._schedule(changes)
         self.driver.config, self.schedule = config, schedule
@@ -159,6 +176,20 @@ class TensionDriverNode(NodeLogic):
             else:
                 self.driver.release()
 
+    def _check_limits_writable(self, changes: Mapping[str, Any]) -> None:
+        """Refuse a run-time change of a safety limit unless the node was started with
+        ``safety.limits_writable: true``; raises ``InputError`` naming the parameter."""
+        if self.limits_writable:
+            return
+        for name in SAFETY_LIMITS:
+            if name in changes:
+                current = self.port.get_parameter(name)
+                raise InputError(
+                    f"{name} = {changes[name]!r} refused: {name} is a safety limit, read-only at "
+                    f"run time (it stays {current!r}); to allow run-time changes start the node "
+                    f"with {LIMITS_WRITABLE}: true", parameter=name, value=changes[name],
+                    allowed=f"{current!r} (read-only unless {LIMITS_WRITABLE}: true)")
+
     # --- inputs -----------------------------------------------------------------------------
     def _warn(self, text: str) -> None:
         self.last_warning = text
@@ -166,7 +197,7 @@ class TensionDriverNode(NodeLogic):
 
     def _request(self, newtons: float) -> None:
         applied = self.driver.set_setpoint(newtons)
-        if applied != newtons:
+        if applied != newtons and self.driver.armed:
             self.counts["clamped_setpoints"] += 1
             self.clamped_since_report = True
 
@@ -178,6 +209,8 @@ class TensionDriverNode(NodeLogic):
             return
         if self.schedule_state in ("waiting", "running"):
             self.schedule_state = "cancelled"
+        if not self.driver.armed:
+            self.counts["rejected_setpoints"] += 1
         self._request(newtons)
 
     def _on_estop(self, _message: Any) -> None:
@@ -187,10 +220,13 @@ class TensionDriverNode(NodeLogic):
             self.schedule_state = "cancelled"
 
     def _on_clear(self, _message: Any) -> None:
-        self.driver.clear_faults()
+        """The operator's arm command: clear faults, arm, re-enable if ``enabled``."""
+        if not self.driver.clear_faults():
+            return
         if bool(self.port.get_parameter("enabled")):
             self.driver.enable()
-        self.port.logger.info("faults cleared on request")
+        self.port.logger.info("faults cleared and armed on request (target %g N)",
+                              self.status.target if self.status else 0.0)
 
     def _start_schedule(self) -> None:
         if self.status is not None and self.status.link is LinkState.CONNECTED:
@@ -203,7 +239,9 @@ class TensionDriverNode(NodeLogic):
             if level > self.driver.tension_max:
                 self.counts["clamped_setpoints"] += 1
                 self.clamped_since_report = True
-        self.driver.run_schedule(self.schedule)
+        if not self.driver.run_schedule(self.schedule):
+            self.schedule_state = "cancelled"
+            return
         self.schedule_state = "running"
         self.port.logger.info("schedule started: %s N, %g s each, %d trial(s)",
                               list(self.schedule.levels), self.schedule.hold,
@@ -222,6 +260,9 @@ class TensionDriverNode(NodeLogic):
         previous, self.status = self.status, result.status
         if previous is None or previous.link is not result.status.link:
             self._log_link(result.status)
+        if previous is not None and previous.armed and not result.status.armed \
+                and self.schedule_state in ("waiting", "running"):
+            self.schedule_state = "cancelled"
         if result.telemetry:
             self._publish_tension(result.telemetry)
         connected = result.status.link is LinkState.CONNECTED
@@ -269,6 +310,8 @@ class TensionDriverNode(NodeLogic):
             "setpoint": f"{status.setpoint:.3f}",
             "tension_max": f"{self.driver.tension_max:g}",
             "enabled": str(status.enabled).lower(),
+            "armed": str(status.armed).lower(),
+            "disarm_reason": status.disarm_reason,
             "schedule": self.schedule_state,
             "schedule_done": str(self.schedule_state == "done").lower(),
             "firmware": banner.firmware if banner else "",
@@ -292,6 +335,7 @@ class TensionDriverNode(NodeLogic):
             "reconnects": status.reconnects if status else 0,
             "rejected_lines": status.rejected_lines if status else 0,
             "nacks": status.nacks if status else 0,
+            "disarms": status.disarms if status else 0,
             **{key: self.counts[key] for key in ("clamped_setpoints", "rejected_setpoints",
                                                  "estops", "version_mismatches",
                                                  "telemetry_frames")},

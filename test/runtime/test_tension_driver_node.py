@@ -111,7 +111,10 @@ def test_step_0_to_20_n_settles_within_the_band(runtime, spawn, probe, twin,
 
 def test_setpoint_above_the_maximum_is_clamped_with_a_warning(runtime, spawn, probe, twin,
                                                               tmp_path, params) -> None:
-    node = start_driver(spawn, tmp_path, twin, tension_max=12.0)
+    """With the opt-in to writable safety limits, a lower ``tension_max`` re-clamps the target
+    and out-of-range values are still refused."""
+    node = start_driver(spawn, tmp_path, twin, tension_max=12.0,
+                        **{"safety.limits_writable": True})
     probe.connected()
     probe.until(lambda: probe.state().get("target") == "12.000", 10.0, "target clamped to 12 N",
                 action=lambda: probe.setpoint(35.0))
@@ -136,6 +139,84 @@ def test_setpoint_above_the_maximum_is_clamped_with_a_warning(runtime, spawn, pr
     assert driver.get("tension_max") == 10.0 and driver.get("port") == twin.port
     log = stop_driver(node, twin)
     assert "setpoint = 35 N is out of range [0, 12] N; clamped to 12 N" in log
+
+
+def test_safety_limits_are_read_only_at_run_time_by_default(runtime, spawn, probe, twin,
+                                                            tmp_path, params) -> None:
+    """Without ``safety.limits_writable`` (itself read-only) no peer can raise the force limits;
+    the refusal names the parameter and the opt-in. Link parameters stay writable."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    driver = params("/tension_driver")
+    for name, value in (("tension_max", 22.0), ("setpoint_rate", 1000.0)):
+        refused = driver.set(name, value)
+        assert not refused["successful"], refused
+        assert f"{name} = {value}" in refused["reason"], refused
+        assert "safety.limits_writable: true" in refused["reason"], refused
+    assert driver.get("tension_max") == 20.0 and driver.get("setpoint_rate") == 40.0
+    refused = driver.set("safety.limits_writable", True)
+    assert not refused["successful"] and "read-only" in refused["reason"], refused
+    assert driver.set("heartbeat_period", 0.05)["successful"]
+    probe.until(lambda: probe.state().get("target") == "20.000", 10.0, "target clamped to 20 N",
+                action=lambda: probe.setpoint(22.0))
+
+
+def released_until_armed(probe: Probe, twin: PtyTwin, reason: str) -> None:
+    """The driver reports itself disarmed for ``reason``; the device stays released with a slack
+    tendon and a setpoint is refused; ``clear_faults`` arms it at 0 N (mode T, tendon still
+    slack for 1 s) and only a new setpoint tensions it again."""
+    core, plant = twin.twin.core, twin.twin.plant
+    probe.until(lambda: probe.state().get("armed") == "false"
+                and reason in probe.state().get("disarm_reason", "")
+                and probe.state().get("link") == "connected", 20.0, f"disarmed ({reason})")
+    probe.until(lambda: core.mode is Mode.RELEASE and plant.tension == 0.0, 5.0, "released")
+    probe.setpoint(10.0)  # refused while disarmed
+    probe.until(lambda: any(int(values(d)["rejected_setpoints"]) >= 1 for d in probe.diagnostics),
+                10.0, "the setpoint refused")
+    end = time.monotonic() + 1.5
+    while time.monotonic() < end:
+        assert core.mode is Mode.RELEASE and plant.tension == 0.0, "re-tensioned while disarmed"
+        probe.ctx.spin_for(0.05)
+    state = probe.state()
+    assert state["target"] == "0.000" and state["armed"] == "false" and level(probe.states[-1]) \
+        in (1, 2), state
+    probe.until(lambda: probe.state().get("armed") == "true" and probe.state().get("mode")
+                == "tension", 10.0, "armed by clear_faults", action=probe.clear_faults)
+    end = time.monotonic() + 1.0
+    while time.monotonic() < end:
+        assert core.setpoint_mn == 0 and plant.tension < 0.3, "armed at the old setpoint"
+        probe.ctx.spin_for(0.05)
+    probe.until(lambda: abs(plant.tension - 4.0) < BAND, 15.0, "4 N after a new setpoint",
+                action=lambda: probe.setpoint(4.0))
+
+
+def test_a_device_rebooted_on_reopen_stays_released_until_armed(runtime, spawn, probe, twin,
+                                                                tmp_path) -> None:
+    """Holding 10 N, the port closes and the device comes back freshly booted, with no latched
+    fault (a UNO resets when its port is opened): the driver never re-tensions it by itself."""
+    node = start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    probe.until(lambda: abs(twin.twin.plant.tension - 10.0) < BAND, 15.0, "10 N on the tendon",
+                action=lambda: probe.setpoint(10.0))
+    twin.reopen(reboot=True)
+    released_until_armed(probe, twin, "link lost")
+    log = stop_driver(node, twin)
+    assert "device rebooted" in log and "disarmed: link lost" in log
+
+
+def test_a_frozen_device_stays_released_until_armed_and_is_not_a_reboot(runtime, spawn, probe,
+                                                                        twin, tmp_path) -> None:
+    """The device's loop hangs for 1 s holding 8 N, then resumes with the host's heartbeats
+    buffered (so its own watchdog does not trip): the driver releases it and says it froze."""
+    node = start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    probe.until(lambda: abs(twin.twin.plant.tension - 8.0) < BAND, 15.0, "8 N on the tendon",
+                action=lambda: probe.setpoint(8.0))
+    with twin.hung():
+        probe.ctx.spin_for(1.0)
+    released_until_armed(probe, twin, "frozen")
+    log = stop_driver(node, twin)
+    assert "disarmed: device silent for" in log and "reboot" not in log
 
 
 def test_estop_releases_at_once_and_stays_released_until_cleared(runtime, spawn, probe, twin,
