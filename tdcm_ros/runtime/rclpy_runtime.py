@@ -22,8 +22,6 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-import yaml
-
 from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import wire
@@ -39,6 +37,7 @@ from tdcm_ros.runtime.parameters import (
 from tdcm_ros.runtime.params import node_parameters
 from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
 from tdcm_ros.runtime.wire import RawSample
+from tdcm_ros.yamlio import load_yaml
 
 #: Seconds a parameter client waits for a node's parameter services.
 PARAM_TIMEOUT_S = 5.0
@@ -323,7 +322,7 @@ class RclpyContext:
             target, _, text = item.partition(":=")
             node, _, parameter = target.rpartition(":")
             if node in ("", name, fqn):
-                values[parameter] = yaml.safe_load(text)
+                values[parameter] = load_yaml(text, f"-p {target}")
         return values
 
     def create_node(self, name: str, namespace: str = "/") -> Any:
