@@ -40,6 +40,7 @@ from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
 from tdcm_ros.bagio.errors import BagError
 from tdcm_ros.bagio.typestore import typestore
+from tdcm_ros.yamlio import load_yaml
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -503,7 +504,7 @@ def _folder_files(path: Path, warnings: list[str]) -> tuple[str, list[Path]]:
     meta = path / METADATA_FILE
     if meta.is_file():
         try:
-            info = yaml.safe_load(meta.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+            info = load_yaml(meta.read_text(encoding="utf-8"), str(meta))["rosbag2_bagfile_information"]
             storage = str(info.get("storage_identifier") or "mcap")
             names = [str(n) for n in info.get("relative_file_paths") or []]
             if str(info.get("compression_mode") or "").upper() == "FILE":
