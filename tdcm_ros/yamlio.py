@@ -29,6 +29,8 @@ MAX_DEPTH_LEVELS = 64
 MAX_INPUT_BYTES = 1024 * 1024
 
 _MERGE_TAG = "tag:yaml.org,2002:merge"
+#: what ``SafeConstructor`` raises for tagged scalars it cannot build
+_SCALAR_FAILURES = (ValueError, ArithmeticError, LookupError, AttributeError)
 
 
 class YamlInputError(InputError, yaml.YAMLError):
@@ -70,12 +72,14 @@ class _BoundedLoader(yaml.SafeLoader):
 
     def construct_object(self, node: Node, deep: bool = False) -> Any:
         """The node's value; a scalar Python cannot build (a 13th month, an integer of more
-        than 4300 digits) is a constructor error at the node's line."""
+        than 4300 digits, an empty ``!!float``, ``!!bool x``) is a constructor error at the
+        node's line (``SafeConstructor`` raises these as plain Python errors)."""
         try:
             return super().construct_object(node, deep=deep)
-        except (ValueError, OverflowError) as problem:
+        except _SCALAR_FAILURES as problem:
             raise yaml.constructor.ConstructorError(
-                None, None, str(problem), node.start_mark) from problem
+                None, None, f"cannot build {node.tag} ({type(problem).__name__}: {problem})",
+                node.start_mark) from problem
 
     def construct_mapping(self, node: MappingNode, deep: bool = False) -> dict[Any, Any]:
         """The mapping, after checking that no scalar key occurs twice."""

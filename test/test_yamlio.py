@@ -50,7 +50,10 @@ def test_bad_scalars_and_syntax_are_typed_errors() -> None:
     for text, phrase in (("d: 2020-13-01", "line 1: .*month"), ("n: " + "9" * 5000, "digits"),
                          ("a: [1, 2\n", "not valid YAML"), ("a: !!python/name:os.system x",
                                                              "constructor"),
-                         ("a: 1\n---\nb: 2\n", "single document")):
+                         ("a: 1\n---\nb: 2\n", "single document"),
+                         ("a: !!float ", "line 1: .*build tag:yaml.org,2002:float"),
+                         ("a: !!bool x", "line 1: .*bool .KeyError: 'x'"),
+                         ("a: !!timestamp x", "line 1: .*AttributeError")):
         with pytest.raises(YamlInputError, match=phrase):
             load_yaml(text, "cfg")
 
