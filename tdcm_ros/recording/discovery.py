@@ -6,6 +6,9 @@ ignores repeats. zenoh: rmw_zenoh liveliness tokens (offered depth included). rc
 graph, polled every :data:`POLL_PERIOD_S` s (DDS discovery does not carry the history depth, so
 the offered depth is the writer's default, :class:`OfferedQos` ``depth``).
 
+``any_type`` tells whether the runtime can subscribe to a topic without naming its type (zenoh:
+``<domain>/<topic>/*/*``); the recorder then subscribes to each named topic at the start.
+
 zenoh and rclpy are imported inside the strategies only.
 """
 
@@ -31,6 +34,9 @@ OnOffer = Callable[[str, str, OfferedQos], None]
 class Discovery(Protocol):
     """Publisher discovery of one runtime."""
 
+    #: True when a topic can be subscribed before its type is known.
+    any_type: bool
+
     def close(self) -> None:
         """Stop discovering (no ``on_offer`` call after this returns)."""
 
@@ -51,6 +57,8 @@ def offered_qos(chunk: str) -> OfferedQos:
 
 class ZenohDiscovery:
     """Publishers from rmw_zenoh liveliness tokens (with history: the ones already there)."""
+
+    any_type = True
 
     def __init__(self, context: Any, port: Any, wanted: Collection[str],
                  on_offer: OnOffer) -> None:
@@ -97,6 +105,8 @@ def rclpy_offered_qos(profiles: list[Any]) -> OfferedQos:
 
 class RclpyGraphDiscovery:
     """Publishers from the rclpy node's graph, polled every :data:`POLL_PERIOD_S` s."""
+
+    any_type = False
 
     def __init__(self, context: Any, port: Any, wanted: Collection[str],
                  on_offer: OnOffer) -> None:

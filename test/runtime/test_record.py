@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 from mcap.reader import make_reader
 from runtime_helpers import wait_for
 
@@ -160,6 +161,79 @@ def test_sigkill_leaves_a_bag_readable_to_the_last_chunk(
     lost = max(n for n, stamp in published if stamp < killed_ns) - values[-1]
     print(f"SIGKILL at {RATE_HZ:.0f} Hz on {runtime} lost the last {lost} messages")
 
+
+TICKS = 3000  # messages of the 1 kHz ticker (3 s)
+
+# On the runtime of TDCM_RUNTIME: publishes /tick (std_msgs/UInt32, data = 0, 1, ...) TICKS
+# times at 1 kHz, lets the tail be delivered for 1 s, closes and exits.
+TICKER = f"""
+import os, time
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.runtime.run_node import open_context
+
+context = open_context(os.environ["TDCM_RUNTIME"])
+ticks = context.create_port("ticker").create_publisher("/tick", "std_msgs/msg/UInt32")
+due = time.monotonic()
+for n in range({TICKS}):
+    ticks.publish(from_dict("std_msgs/msg/UInt32", {{"data": n}}))
+    due += 0.001
+    time.sleep(max(0.0, due - time.monotonic()))
+context.spin_for(1.0)
+context.close()
+"""
+
+
+def test_a_named_topic_is_recorded_from_its_first_message_to_its_last(
+        runtime: str, spawn: Spawn, graph_env: dict[str, str], tmp_path: Path) -> None:
+    """A 1 kHz publisher that starts after the recorder: zenoh loses 0 at the head (the topic is
+    subscribed before any publisher exists); both lose 0 at the tail (it stops before SIGINT)."""
+    bag = tmp_path / "bag"
+    recorder = spawn("tdcm_ros.cli.main", "record", str(bag), "tick")
+    out = Lines(recorder)
+    wait_for(lambda: out.has("recording to"), 20.0, "the recorder to start")
+    ticker = subprocess.run([sys.executable, "-c", TICKER], check=False, env=graph_env,
+                            cwd=REPO, capture_output=True, timeout=120.0)
+    assert ticker.returncode == 0, ticker.stderr.decode()
+    recorder.send_signal(signal.SIGINT)
+    recorder.wait(20.0)
+    assert recorder.returncode == 0, recorder.stderr.read() if recorder.stderr else ""
+    values = [int(m.data) for _, _, m in open_bag(bag).messages(["/tick"])]
+    print(f"1 kHz ticker on {runtime}: lost {values[0] if values else TICKS} at the head, "
+          f"{TICKS - 1 - values[-1] if values else TICKS} at the tail of {TICKS}")
+    assert values == list(range(values[0], TICKS))  # contiguous, nothing lost at the tail
+    if runtime == "zenoh":
+        assert values[0] == 0
+
+
+def test_named_topics_keep_the_offered_qos_and_the_latched_message(
+        runtime: str, spawn: Spawn, graph_env: dict[str, str], tmp_path: Path) -> None:
+    """Named topics of a publisher running before the recorder: the transient-local message
+    published before the start is recorded, and the bag carries the offered QoS."""
+    log, bag = tmp_path / "published.txt", tmp_path / "bag"
+    publisher = _start_publisher(graph_env, log)
+    try:
+        wait_for(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
+        recorder = spawn("tdcm_ros.cli.main", "record", str(bag), "count", "latched")
+        out = Lines(recorder)
+        wait_for(lambda: out.has("subscribed /count") and out.has("subscribed /latched"), 20.0,
+                 "the recorder to subscribe")
+        first = len(_published(log))
+        wait_for(lambda: len(_published(log)) > first + 50, 20.0, "50 more messages")
+        recorder.send_signal(signal.SIGINT)
+        recorder.wait(20.0)
+    finally:
+        publisher.kill()
+        publisher.wait()
+    assert recorder.returncode == 0
+    values, latched_count = _counts(bag)
+    assert latched_count == 1 and values == list(range(values[0], values[-1] + 1))
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    qos = {t["topic_metadata"]["name"]: t["topic_metadata"]["offered_qos_profiles"][0]
+           for t in meta["topics_with_message_count"]}
+    assert qos["/latched"]["durability"] == "transient_local"
+    assert qos["/count"]["durability"] == "volatile"
+    if runtime == "zenoh":  # DDS discovery does not carry the depth (see README)
+        assert qos["/latched"]["depth"] == 1
 
 # rclpy only: on zenoh the recorder needs no per-type code, so every type it can name is recorded.
 @pytest.mark.parametrize("runtime", [pytest.param("rclpy", marks=pytest.mark.rclpy)],
