@@ -9,7 +9,14 @@ from typing import Any
 
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.figures import plot_file
-from tdcm_ros.model import PRESETS, SolverSettings, parse_field, preset, solve
+from tdcm_ros.model import (
+    PRESETS,
+    SolverSettings,
+    TensionRangeError,
+    parse_field,
+    preset,
+    solve,
+)
 from tdcm_ros.model.profiles import PROFILE_NAMES
 from tdcm_ros.model.settings import ROUTINGS
 
@@ -45,6 +52,16 @@ def _overrides(pairs: list[str]) -> dict[str, Any]:
     return values
 
 
+def _tension(text: str) -> float:
+    """``--tension`` text as a number (N); the solver checks its range."""
+    try:
+        return float(text)
+    except ValueError:
+        raise TensionRangeError(f"--tension = {text!r} is not a number; allowed: a finite "
+                                "number in [0, inf) N", parameter="--tension", value=text,
+                                allowed="[0, inf) N") from None
+
+
 def run(args: argparse.Namespace) -> int:
     """Solve and report; typed errors become exit status 2 (input) or 3 (physics)."""
     try:
@@ -55,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
         settings = SolverSettings(routing=args.routing, loads=args.loads)
         if args.plot:
             plot_file("--plot", args.plot)
-        result = solve(design, args.tension, settings=settings)
+        result = solve(design, _tension(args.tension), settings=settings)
     except TdcmError as error:
         if args.json:
             print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))

@@ -22,6 +22,9 @@ from tdcm_ros.model.profiles import CircularProfile, NotchProfile, profile_from_
 from tdcm_ros.model.section import tube_moment
 
 MM = 1e-3
+#: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
+#: or at least this, so no cell is negligible against the arc lengths it sits between.
+MIN_SEGMENT_M = 1e-6
 
 
 @dataclass(frozen=True)
@@ -66,7 +69,7 @@ FIELD_SPECS: dict[str, FieldSpec] = {
     for spec in (
         FieldSpec("w_base", "m", "length of the proximal tube segment", 0.0, 1.0, True),
         FieldSpec("w_tip", "m", "length of the distal tube segment", 0.0, 1.0, True),
-        FieldSpec("w_n", "m", "notch width along the body", 0.0, 1.0, False),
+        FieldSpec("w_n", "m", "notch width along the body", MIN_SEGMENT_M, 1.0, True),
         FieldSpec("w_t", "m", "tube length between adjacent notches", 0.0, 1.0, True),
         FieldSpec("w_d", "m", "backbone width (minimum, at the notch centre)", 0.0, 1.0, False),
         FieldSpec("N", "", "number of notches", 1, 1000, True, integer=True),
@@ -97,9 +100,7 @@ class Design:
     def __post_init__(self) -> None:
         for spec in FIELD_SPECS.values():
             spec.check(getattr(self, spec.name))
-        if self.r_inner >= self.R_outer:
-            raise out_of_range("r_inner", self.r_inner, f"[0, R_outer = {self.R_outer:g}) m",
-                               error=InvalidDesignError)
+        self._check_cross_fields()
         if not hasattr(self.profile, "h1"):
             raise InvalidDesignError(
                 f"profile = {self.profile!r} is not a notch profile; allowed: circular, "
@@ -109,6 +110,22 @@ class Design:
         for name, spec in FIELD_SPECS.items():
             if not spec.integer:
                 object.__setattr__(self, name, float(getattr(self, name)))
+
+    def _check_cross_fields(self) -> None:
+        """Ranges that depend on other fields: radii inside ``R_outer`` (m), the backbone
+        narrower than the tube, and tube segments absent or at least ``MIN_SEGMENT_M`` long."""
+        diameter = 2.0 * self.R_outer
+        below = (("r_inner", self.R_outer, f"[0, R_outer = {self.R_outer:g}) m"),
+                 ("R_c", self.R_outer, f"(0, R_outer = {self.R_outer:g}) m"),
+                 ("w_d", diameter, f"(0, 2 R_outer = {diameter:g}) m"))
+        for name, limit, allowed in below:
+            if getattr(self, name) >= limit:
+                raise out_of_range(name, getattr(self, name), allowed, error=InvalidDesignError)
+        for name in ("w_base", "w_t", "w_tip"):
+            value = getattr(self, name)
+            if 0.0 < value < MIN_SEGMENT_M:
+                raise out_of_range(name, value, f"0 (no segment) or [{MIN_SEGMENT_M:g}, 1] m",
+                                   error=InvalidDesignError)
 
     @property
     def length(self) -> float:

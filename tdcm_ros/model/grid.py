@@ -215,6 +215,24 @@ def _check_custom_profile(design: Design) -> None:
             parameter="h1(s)", value=np.ravel(bad)[:3].tolist(), allowed="(0, inf) m")
 
 
+def _check_rigidity(design: Design) -> None:
+    """Raise :class:`InvalidDesignError` unless the flexural rigidity ``E I`` (N m^2) is at least
+    the smallest normal double at ``PEAK_SAMPLES`` stations of a notch and in the tubes, so the
+    compliance ``1/(E I)`` is finite (a backbone or wall thinner than floating point resolves)."""
+    u = np.linspace(0.0, 1.0, PEAK_SAMPLES)
+    h1 = design.profile.h1(u, design.w_n, design.w_d)
+    rigidity = design.E * np.append(notched_moment(h1, design.R_outer, design.r_inner),
+                                    design.tube_second_moment)
+    floor = float(np.finfo(float).tiny)
+    if not np.all(rigidity >= floor):
+        least = float(np.min(rigidity))
+        raise InvalidDesignError(
+            f"E*I = {least:.3g} N m^2 (E = {design.E:g} Pa, w_d = {design.w_d:g} m, R_outer = "
+            f"{design.R_outer:g} m, r_inner = {design.r_inner:g} m) is out of range; allowed: "
+            f"[{floor:.3g}, inf) N m^2, so that 1/(E I) is finite",
+            parameter="E*I", value=least, allowed=f"[{floor:.3g}, inf) N m^2")
+
+
 def build_grid(design: Design, settings: SolverSettings) -> Grid:
     """The (cached) grid for ``design`` under ``settings``' routing and discretisation."""
     return _build_grid(design, settings.routing, settings.cells_per_notch,
@@ -225,6 +243,7 @@ def build_grid(design: Design, settings: SolverSettings) -> Grid:
 def _build_grid(design: Design, routing: str, cells_per_notch: int, cells_per_tube: int,
                 quad_order: int) -> Grid:
     _check_custom_profile(design)
+    _check_rigidity(design)
     segments = _segments(design)
     is_notch_l: list[bool] = []
     notch_l: list[int] = []

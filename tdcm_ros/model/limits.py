@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from functools import lru_cache
 from typing import Any
 
@@ -24,12 +25,16 @@ CLOSURE_BISECTIONS = 60
 
 
 def check_tension(tension: Any) -> float:
-    """Return ``tension`` (N) as a float, or raise :class:`TensionRangeError`."""
-    try:
-        value = float(tension)
-    except (TypeError, ValueError) as exc:
-        raise TensionRangeError(f"tension = {tension!r} is not a number; allowed: [0, inf) N",
-                                parameter="tension", value=tension, allowed="[0, inf) N") from exc
+    """Return ``tension`` (N) as a float, or raise :class:`TensionRangeError`.
+
+    A tension is a real number (``int``, ``float``, ``fractions.Fraction`` or a NumPy integer or
+    floating scalar), finite and ``>= 0``; ``bool``, strings and arrays are refused.
+    """
+    if isinstance(tension, (bool, np.bool_)) or not isinstance(tension, numbers.Real):
+        raise TensionRangeError(
+            f"tension = {tension!r} is not a real number; allowed: a finite number in [0, inf) N",
+            parameter="tension", value=tension, allowed="[0, inf) N")
+    value = float(tension)
     if not math.isfinite(value) or value < 0.0:
         raise out_of_range("tension", value, "[0, inf) N (finite)", unit="N",
                            error=TensionRangeError)

@@ -95,9 +95,22 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     its last finite iterate with ``converged=False`` instead of raising. ``loading`` adds a
     varying tension, external loads and notch contact; None (or ``Loading()``) is the paper's
     model.
+
+    Floating-point overflow at hostile inputs is handled, not printed: a non-finite iterate ends
+    its strategy, the limits compare an overflowed ``R_c kappa`` correctly, and no non-finite
+    value reaches LAPACK; so NumPy's overflow and invalid-value warnings are off inside.
     """
     started = perf_counter()
     t_base = check_tension(tension)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        return _solve(design, t_base, settings, warm_start, strict, loading, started)
+
+
+def _solve(design: Design, t_base: float, settings: SolverSettings,
+           warm_start: SolveResult | None, strict: bool, loading: Loading | None,
+           started: float) -> SolveResult:
+    """:func:`solve` for a checked base tension ``t_base`` (N); ``started`` is its start time
+    (s, ``perf_counter``)."""
     grid = build_grid(design, settings)
     n = grid.n_cells
     model = _loaded_model(grid, settings, t_base, loading)
@@ -114,9 +127,14 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
         budget -= len(run.history)
         if run.converged or budget <= 0:
             break
-    strategy, final = runs[-1]
     iterations = sum(len(r.history) for _, r in runs)
     history = tuple(v for _, r in runs for v in r.history)
+    reasons = "; ".join(f"{name}: {r.reason}" for name, r in runs)
+    last = _last_finite(runs)
+    if last is None:
+        raise ConvergenceError(
+            f"Algorithm 1 found no finite iterate at tension {t_base:g} N ({reasons})")
+    strategy, final = last
     if final.converged:
         if model is not None:
             bend = model.bend_moments(final.x)
@@ -128,12 +146,19 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     result = _result(grid, settings, t_base, final, strategy, iterations, history,
                      perf_counter() - started, loading, model)
     if not final.converged and strict:
-        reasons = "; ".join(f"{name}: {r.reason}" for name, r in runs)
         raise ConvergenceError(
             f"Algorithm 1 did not converge to tol = {settings.tol:g} m at tension {t_base:g} N "
-            f"within max_iter = {settings.max_iter} ({reasons})",
-            result=result if np.all(np.isfinite(result.positions)) else None)
+            f"within max_iter = {settings.max_iter} ({reasons})", result=result)
     return result
+
+
+def _last_finite(runs: list[tuple[str, _Run]]) -> tuple[str, _Run] | None:
+    """The last strategy run whose iterate (N m) and shape (m, rad) are all finite, if any."""
+    for name, run in reversed(runs):
+        if (np.all(np.isfinite(run.x)) and np.all(np.isfinite(run.shape.p))
+                and np.all(np.isfinite(run.shape.theta))):
+            return name, run
+    return None
 
 
 def _loaded_model(grid: Grid, settings: SolverSettings, tension: float,
@@ -299,6 +324,9 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
         f = g - x
         if using == "anderson":
             x_new = _anderson_step(x, f, last, d_x, d_f, settings.anderson_depth)
+            if x_new is None:
+                return _Run(x, shape, history, False,
+                            "Anderson least squares failed (non-finite residual or no SVD)")
             last = (x, f)
         elif using == "relaxation":
             x_new = x + settings.relaxation * f
@@ -325,8 +353,11 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
 
 
 def _anderson_step(x: Array, f: Array, last: tuple[Array, Array] | None, d_x: list[Array],
-                   d_f: list[Array], depth: int) -> Array:
-    """One Anderson (type II) update with memory ``depth``; plain iteration without history."""
+                   d_f: list[Array], depth: int) -> Array | None:
+    """One Anderson (type II) update of the cell moments ``x`` (N m) from the residual ``f``
+    (N m) with memory ``depth``; plain iteration without history. None when the least-squares
+    problem cannot be solved: a non-finite residual (LAPACK would reject it) or an SVD that
+    does not converge."""
     if last is not None:
         d_x.append(x - last[0])
         d_f.append(f - last[1])
@@ -335,9 +366,14 @@ def _anderson_step(x: Array, f: Array, last: tuple[Array, Array] | None, d_x: li
             d_f.pop(0)
     if not d_x:
         return x + f
+    if not (np.all(np.isfinite(f)) and np.all(np.isfinite(d_f[-1]))):
+        return None  # older columns were checked when they were added
     big_x = np.stack(d_x, axis=1)
     big_f = np.stack(d_f, axis=1)
-    gamma, *_ = np.linalg.lstsq(big_f, f, rcond=None)
+    try:
+        gamma, *_ = np.linalg.lstsq(big_f, f, rcond=None)
+    except np.linalg.LinAlgError:
+        return None
     return x + f - (big_x + big_f) @ gamma
 
 

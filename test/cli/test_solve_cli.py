@@ -64,3 +64,32 @@ def test_console_script_and_plot(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "tip" in proc.stdout and png.stat().st_size > 10_000
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+ISSUE_13 = ["--tension", "20", "--loads", "literal", "--profile", "rectangular",
+            *[arg for pair in ("w_base=0", "w_tip=0.00554", "w_n=0.0088", "w_t=0", "w_d=1e-9",
+                               "N=33", "R_outer=0.5", "r_inner=0.0005", "R_c=0.0005", "E=1000")
+              for arg in ("--set", pair)]]
+
+
+def test_issue_13_fuzz_case_exits_with_one_line_and_no_lapack_noise():
+    """It ended in a LinAlgError traceback, exit 1, with LAPACK's DLASCL complaint and NumPy
+    overflow warnings on stderr."""
+    proc = subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "solve", *ISSUE_13],
+                          capture_output=True, text=True, timeout=120, check=False)
+    assert proc.returncode in (2, 3), proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("tdcm solve:"), proc.stderr
+    assert "DLASCL" not in proc.stderr and "Warning" not in proc.stderr
+
+
+@pytest.mark.parametrize(("args", "kind"), [
+    (["--tension", "20", "--set", "R_c=0.004"], "invalid_design"),
+    (["--tension", "20", "--set", "w_d=0.008"], "invalid_design"),
+    (["--tension", "20", "--set", "w_t=1e-30"], "invalid_design"),
+])
+def test_cross_field_limits_exit_2(capsys, args, kind):
+    code = main(["solve", *args, "--json"])
+    out = capsys.readouterr()
+    assert code == 2 and json.loads(out.out)["error"]["kind"] == kind
+    assert len(out.err.strip().splitlines()) == 1

@@ -66,3 +66,27 @@ def test_to_dict_is_si_and_complete():
     data = preset("paper-experiment").to_dict()
     assert set(FIELD_SPECS) <= set(data)
     assert data["profile"] == "circular" and data["L"] == pytest.approx(0.053)
+
+
+@pytest.mark.parametrize(("field", "value", "allowed"), [
+    ("R_c", 3.92e-3, "(0, R_outer = 0.00392) m"),
+    ("R_c", 5e-3, "(0, R_outer = 0.00392) m"),
+    ("w_d", 2 * 3.92e-3, "(0, 2 R_outer = 0.00784) m"),
+    ("w_d", 0.01, "(0, 2 R_outer = 0.00784) m"),
+    ("w_t", 1e-30, "0 (no segment) or [1e-06, 1] m"),
+    ("w_base", 1e-9, "0 (no segment) or [1e-06, 1] m"),
+    ("w_tip", 5e-7, "0 (no segment) or [1e-06, 1] m"),
+    ("w_n", 1e-30, "[1e-06, 1] m"),
+])
+def test_cross_field_limits_name_the_field_value_and_range(field, value, allowed):
+    """Issue 13: the tendon inside the tube, the backbone narrower than it, no negligible cell."""
+    with pytest.raises(InvalidDesignError) as info:
+        preset("paper-experiment").with_overrides(**{field: value})
+    error = info.value
+    assert (error.parameter, error.value, error.allowed) == (field, value, allowed)
+    assert field in str(error) and allowed in str(error)
+
+
+def test_segments_at_their_floor_or_absent_are_valid():
+    design = preset("paper-experiment").with_overrides(w_base=0.0, w_t=1e-6, w_tip=0.0, w_n=1e-6)
+    assert design.length == pytest.approx(8e-6 + 7e-6)

@@ -228,7 +228,10 @@ def test_closed_form_with_friction_equals_the_sum_of_channel_forces(routing):
 
 def uniform_tube():
     """A design whose notches remove nothing (h1 >= R_outer): a plain tube of stiffness E I0."""
-    return preset("paper-experiment").with_overrides(w_d=2 * 3.92e-3)
+    from tdcm_ros.model import CustomProfile
+
+    return preset("paper-experiment").with_overrides(
+        profile=CustomProfile(lambda s: 0 * s + 3.92e-3))
 
 
 @pytest.mark.parametrize("tension", [0.0, 5.0])

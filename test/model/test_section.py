@@ -60,3 +60,17 @@ def test_stiffness_jumps_at_notch_edges_and_is_smooth_inside():
     # The softest point is the notch centre, with h1 = w_d / 2.
     i_min = float(notched_moment(design.w_d / 2, design.R_outer, design.r_inner))
     assert grid.peak_c.max() == pytest.approx(1.0 / (design.E * i_min), rel=1e-12)
+
+
+@pytest.mark.parametrize("ratio", [1e-12, 1e-6, 1e-3, 0.049, 0.051, 0.3])
+def test_second_moment_of_a_thin_backbone_keeps_full_precision(ratio):
+    """Issue 13: the closed form cancels for h << R (a 1 nm backbone in a 0.5 m tube gave a
+    zero or negative I); the series keeps the relative error at rounding level."""
+    radius = 0.5
+    h = ratio * radius
+    exact, _ = quad(lambda y: y * y * np.sqrt(radius * radius - y * y), 0.0, h,
+                    epsabs=0.0, epsrel=1e-13)
+    got = notched_moment(h, radius, 0.0) / 4.0
+    assert got == pytest.approx(exact, rel=1e-13)
+    hollow = notched_moment(h, radius, 0.5 * radius)
+    assert hollow > 0.0

@@ -9,6 +9,7 @@ from scipy.integrate import quad
 from tdcm_ros.model import (
     PRESETS,
     ConvergenceError,
+    ModelError,
     NotchClosureError,
     SolverSettings,
     TendonSingularityError,
@@ -143,7 +144,7 @@ def test_singularity_and_closure_are_typed():
 
 
 def test_non_convergence_is_typed_and_keeps_a_finite_iterate():
-    design = preset("paper-experiment").with_overrides(w_d=0.01, E=1e7)
+    design = preset("paper-experiment").with_overrides(w_d=7.8e-3, E=1e7)
     tight = SolverSettings(max_iter=2, tol=1e-14, acceleration="none")
     with pytest.raises(ConvergenceError) as info:
         solve(design, 20.0, settings=tight)
@@ -154,7 +155,7 @@ def test_non_convergence_is_typed_and_keeps_a_finite_iterate():
 
 
 def test_warm_start_reaches_the_same_shape():
-    design = preset("paper-experiment").with_overrides(w_d=0.01, E=1e7)
+    design = preset("paper-experiment").with_overrides(w_d=7.8e-3, E=1e7)
     cold = solve(design, 20.0)
     warm = solve(design, 21.0, warm_start=cold)
     again = solve(design, 21.0)
@@ -179,3 +180,73 @@ def test_pose_at_reuses_a_grids_query_stations_without_changing_the_answer():
     for k in range(QUERY_CACHE_SIZE + 3):         # bounded: old station sets are dropped
         second.pose_at(stations[: k + 2])
     assert len(second.grid._queries) == QUERY_CACHE_SIZE
+
+
+ISSUE_13_DESIGN = {"w_base": 0.0, "w_tip": 0.00554, "w_n": 0.0088, "w_t": 0.0, "w_d": 1e-9,
+                   "N": 33, "R_outer": 0.5, "r_inner": 0.0005, "R_c": 0.0005, "E": 1000.0,
+                   "profile": "rectangular"}
+
+
+@pytest.mark.parametrize("loads", ["literal", "closed"])
+def test_issue_13_fuzz_case_raises_a_typed_error_without_lapack_noise(loads, capfd):
+    """It raised numpy.linalg.LinAlgError with LAPACK's DLASCL complaint on stderr: the thin
+    backbone's I cancelled to ~0 and NaN moments reached lstsq."""
+    design = preset("paper-experiment").with_overrides(**ISSUE_13_DESIGN)
+    with pytest.raises(ModelError):
+        solve(design, 20.0, settings=SolverSettings(loads=loads))
+    assert capfd.readouterr().err == ""
+
+
+def test_anderson_with_a_non_finite_residual_never_calls_lapack(capfd):
+    from tdcm_ros.model.solver import _anderson_step
+
+    x = np.zeros(4)
+    d_x: list[np.ndarray] = []
+    d_f: list[np.ndarray] = []
+    assert _anderson_step(x, np.ones(4), None, d_x, d_f, 5) is not None
+    assert _anderson_step(x + 1.0, np.full(4, np.nan), (x, np.ones(4)), d_x, d_f, 5) is None
+    assert capfd.readouterr().err == ""
+
+
+def test_a_failing_least_squares_is_a_typed_convergence_error(monkeypatch):
+    """A LinAlgError inside Anderson ends that strategy with a reason naming it; with
+    ``strict=False`` the last finite iterate comes back, not converged."""
+    def broken(*args, **kwargs):
+        raise np.linalg.LinAlgError("SVD did not converge in Linear Least Squares")
+
+    monkeypatch.setattr(np.linalg, "lstsq", broken)
+    design = preset("paper-experiment").with_overrides(w_d=0.25e-3)
+    anderson = SolverSettings(routing="free", acceleration="anderson")
+    with pytest.raises(ConvergenceError, match="Anderson least squares failed"):
+        solve(design, 0.5, settings=anderson)
+    loose = solve(design, 0.5, settings=anderson, strict=False)
+    assert not loose.converged and np.all(np.isfinite(loose.positions))
+
+
+def test_strict_false_never_returns_nan(monkeypatch):
+    """Without any finite iterate there is nothing to return: a typed error, not NaN."""
+    from tdcm_ros.model import solver
+    from tdcm_ros.model.kinematics import integrate
+
+    def poisoned(grid, m_a, m_b):
+        shape = integrate(grid, m_a, m_b)
+        return type(shape)(p=shape.p * np.nan, theta=shape.theta * np.nan,
+                           tangent=shape.tangent)
+
+    monkeypatch.setattr(solver, "integrate", poisoned)
+    with pytest.raises(ConvergenceError, match="no finite iterate") as info:
+        solve(preset("paper-experiment"), 20.0, strict=False)
+    assert info.value.result is None
+
+
+@pytest.mark.parametrize("tension", ["20", True, False, None, [20.0], np.array([20.0]),
+                                     np.bool_(True), 1 + 0j])
+def test_tension_must_be_a_real_number(tension):
+    with pytest.raises(TensionRangeError, match="tension") as info:
+        solve(preset("paper-experiment"), tension)
+    assert info.value.parameter == "tension" and info.value.allowed == "[0, inf) N"
+
+
+@pytest.mark.parametrize("tension", [20, 20.0, np.float32(20.0), np.float64(20.0), np.int64(20)])
+def test_numpy_and_python_numbers_are_tensions(tension):
+    assert solve(preset("paper-experiment"), tension).tension_n == 20.0
