@@ -129,11 +129,10 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
             break
     iterations = sum(len(r.history) for _, r in runs)
     history = tuple(v for _, r in runs for v in r.history)
-    reasons = "; ".join(f"{name}: {r.reason}" for name, r in runs)
     last = _last_finite(runs)
     if last is None:
         raise ConvergenceError(
-            f"Algorithm 1 found no finite iterate at tension {t_base:g} N ({reasons})")
+            f"Algorithm 1 found no finite iterate at tension {t_base:g} N ({_reasons(runs)})")
     strategy, final = last
     if final.converged:
         if model is not None:
@@ -148,15 +147,21 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
     if not final.converged and strict:
         raise ConvergenceError(
             f"Algorithm 1 did not converge to tol = {settings.tol:g} m at tension {t_base:g} N "
-            f"within max_iter = {settings.max_iter} ({reasons})", result=result)
+            f"within max_iter = {settings.max_iter} ({_reasons(runs)})", result=result)
     return result
 
 
+def _reasons(runs: list[tuple[str, _Run]]) -> str:
+    """Why each strategy run stopped, for an error message."""
+    return "; ".join(f"{name}: {r.reason}" for name, r in runs)
+
+
 def _last_finite(runs: list[tuple[str, _Run]]) -> tuple[str, _Run] | None:
-    """The last strategy run whose iterate (N m) and shape (m, rad) are all finite, if any."""
+    """The last strategy run whose iterate (N m) and shape (m, rad) are all finite, if any.
+    A converged run is: its last step, a finite distance between finite shapes, ends it."""
     for name, run in reversed(runs):
-        if (np.all(np.isfinite(run.x)) and np.all(np.isfinite(run.shape.p))
-                and np.all(np.isfinite(run.shape.theta))):
+        if run.converged or (np.all(np.isfinite(run.x)) and np.all(np.isfinite(run.shape.p))
+                             and np.all(np.isfinite(run.shape.theta))):
             return name, run
     return None
 
