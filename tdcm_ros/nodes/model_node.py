@@ -10,7 +10,8 @@ with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (na
 Keep-latest: the subscription only stores the newest valid tension; a timer solves it, warm
 started from the previous shape, so a burst never builds a queue (skipped inputs are counted
 as coalesced). Bad inputs (non-finite, negative, above ``input.tension_max``, older than
-``input.max_age_s``) and model limits are dropped, counted and reported on ``/diagnostics``.
+``input.max_age_s``, stamped more than ``input.max_future_s`` ahead, or a WrenchStamped with a
+zero stamp) and model limits are dropped, counted and reported on ``/diagnostics``.
 """
 
 from __future__ import annotations
@@ -70,6 +71,8 @@ class ModelNode(NodeLogic):
         declare("input.tension_max", 200.0, range=(0.0, 1e6), description="largest valid tension (N)")
         declare("input.max_age_s", 0.5, range=(0.0, 3600.0),
                 description="inputs older than this are stale (s); 0 disables")
+        declare("input.max_future_s", 0.5, range=(0.0, 3600.0),
+                description="inputs stamped further ahead of the clock are dropped (s)")
         period = float(declare("process_period_s", 0.001, range=(1e-4, 1.0), read_only=True,
                                description="solver timer period (s)"))
         diag_period = float(declare("diagnostics_period_s", 1.0, range=(0.05, 60.0),
@@ -91,6 +94,7 @@ class ModelNode(NodeLogic):
         self.pending: tuple[float, int] | None = None
         self.previous: SolveResult | None = None
         self.counts: Counter[str] = Counter()
+        self.problems_reported = 0
         self.last_problem = ""
         port.create_timer(period, self.process)
         port.create_timer(diag_period, self.report)
@@ -118,12 +122,15 @@ class ModelNode(NodeLogic):
         self.previous = None
 
     def _on_tension(self, message: Any) -> None:
+        """Store a valid tension (N) with its stamp (ns); an unstamped ``Float64`` takes the
+        node's clock."""
+        stamp_ns: int | None
         if self.tension_type == TENSION_TYPES[0]:
             tension = float(message.wrench.force.z)
             stamp_ns = int(message.header.stamp.sec) * 1_000_000_000 + int(
                 message.header.stamp.nanosec)
         else:
-            tension, stamp_ns = float(message.data), 0
+            tension, stamp_ns = float(message.data), None
         now = self.port.now_ns()
         reason = self._reject_reason(tension, stamp_ns, now)
         if reason:
@@ -132,17 +139,26 @@ class ModelNode(NodeLogic):
             return
         if self.pending is not None:
             self.counts["coalesced"] += 1
-        self.pending = (tension, stamp_ns or now)
+        self.pending = (tension, now if stamp_ns is None else stamp_ns)
 
-    def _reject_reason(self, tension: float, stamp_ns: int, now_ns: int) -> str:
+    def _reject_reason(self, tension: float, stamp_ns: int | None, now_ns: int) -> str:
+        """Why a tension (N) stamped ``stamp_ns`` (ns; None: a type without a header) is
+        dropped at ``now_ns``, or ``""``. A zero header stamp was never set: its age is
+        unknown, so it is dropped as ``unstamped``."""
         if not math.isfinite(tension):
             return "non_finite"
         if tension < 0.0:
             return "negative"
         if tension > float(self.port.get_parameter("input.tension_max")):
             return "above_max"
+        if stamp_ns is None:
+            return ""
+        if stamp_ns == 0:
+            return "unstamped"
+        if stamp_ns - now_ns > float(self.port.get_parameter("input.max_future_s")) * 1e9:
+            return "future"
         max_age = float(self.port.get_parameter("input.max_age_s"))
-        if stamp_ns and max_age > 0.0 and now_ns - stamp_ns > max_age * 1e9:
+        if max_age > 0.0 and now_ns - stamp_ns > max_age * 1e9:
             return "stale"
         return ""
 
@@ -173,12 +189,15 @@ class ModelNode(NodeLogic):
             self.publishers[topic].publish(message)  # midline first: sent before the rest is built
 
     def report(self) -> None:
-        """Publish counters and the last problem on ``/diagnostics``."""
-        dropped = sum(v for k, v in self.counts.items() if k.startswith(("dropped", "model")))
-        level = 0 if not dropped else 1  # DiagnosticStatus OK, WARN
+        """Publish the cumulative counters on ``/diagnostics``; the level is WARN, with the last
+        problem as message, only if an input was dropped or failed since the previous report."""
+        problems = sum(v for k, v in self.counts.items() if k.startswith(("dropped", "model")))
+        recent = problems > self.problems_reported
+        self.problems_reported = problems
         status = {
-            "level": level, "name": f"{self.port.node_name}: tension input",
-            "message": self.last_problem or "ok", "hardware_id": "tdcm_model",
+            "level": 1 if recent else 0,  # DiagnosticStatus WARN, OK
+            "name": f"{self.port.node_name}: tension input",
+            "message": self.last_problem if recent else "ok", "hardware_id": "tdcm_model",
             "values": [{"key": k, "value": str(v)} for k, v in sorted(self.counts.items())],
         }
         self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {

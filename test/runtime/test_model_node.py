@@ -61,6 +61,12 @@ class Probe:
         return 0
 
 
+def level(array: Any) -> int:
+    """DiagnosticStatus level of the first status (rclpy gives a ``byte`` as ``bytes``)."""
+    value = array.status[0].level
+    return value[0] if isinstance(value, bytes) else int(value)
+
+
 def tip(path: Any) -> np.ndarray:
     p = path.poses[-1].pose.position
     return np.array([p.x, p.y, p.z])
@@ -110,6 +116,38 @@ def test_bad_messages_are_counted_and_the_node_keeps_running(runtime, context, s
         context.spin_for(0.2)
     assert {k: probe.counter(k) for k in keys} == dict.fromkeys(keys, 1)
     assert node.poll() is None
+    probe.midline_for(12.0)
+
+
+def test_future_and_zero_stamps_are_dropped_and_diagnostics_recover(runtime, context, spawn):
+    """Issue 13: a stamp 3 years ahead passed the age check and a zero stamp skipped it, both
+    were solved; and one drop left /diagnostics at WARN for good."""
+    spawn("tdcm_ros.runtime.run_node", MODEL)
+    probe = Probe(context)
+    probe.midline_for(4.0)
+    context.spin_for(0.5)
+    probe.paths.clear()
+    probe.diagnostics.clear()
+    probe.tension.publish(wrench(30.0, time.time_ns() + 3 * 365 * 86400 * 10**9))
+    probe.tension.publish(wrench(31.0, 0))
+    keys = ("dropped_future", "dropped_unstamped")
+    deadline = time.monotonic() + 15
+    while time.monotonic() < deadline and not all(probe.counter(k) >= 1 for k in keys):
+        context.spin_for(0.2)
+    assert {k: probe.counter(k) for k in keys} == dict.fromkeys(keys, 1)
+    assert not probe.paths, "a tension with a future or zero stamp was solved"
+    warned = [a.status[0] for a in probe.diagnostics if level(a) == 1]
+    assert warned and "dropped" in warned[0].message
+
+    def recovered() -> bool:
+        return (bool(probe.diagnostics) and level(probe.diagnostics[-1]) == 0
+                and probe.counter("dropped_future") == 1)
+
+    deadline = time.monotonic() + 15
+    while time.monotonic() < deadline and not recovered():
+        context.spin_for(0.2)
+    assert recovered(), [(level(a), a.status[0].message) for a in probe.diagnostics]
+    assert probe.diagnostics[-1].status[0].message == "ok"
     probe.midline_for(12.0)
 
 
