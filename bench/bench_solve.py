@@ -27,7 +27,7 @@ HARD = {
     "narrow-notch": preset("paper-experiment").with_overrides(w_n=2e-5),
     "N60-past-360deg": preset("paper-experiment").with_overrides(N=60, w_n=1e-3, w_t=0.2e-3,
                                                                  w_d=0.6e-3, E=0.5e9),
-    "soft-tube": preset("paper-experiment").with_overrides(w_d=0.01, E=1e7),
+    "soft-tube": preset("paper-experiment").with_overrides(w_d=7.8e-3, E=1e7),
 }
 HARD_TENSION = {"stiffness-ratio-1000": 0.5, "narrow-notch": 20.0, "N60-past-360deg": 4.0,
                 "soft-tube": 20.0}
