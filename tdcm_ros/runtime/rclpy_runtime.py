@@ -182,18 +182,19 @@ class RclpyNodePort:
         self._params.add_on_set(callback)
 
     def _widen(self, parameters: list[Any]) -> list[Any]:
-        """Pre-set hook: an integer for a float parameter becomes that float, as on zenoh."""
+        """Pre-set hook: an integer (array) for a float (list) parameter becomes floats, as on
+        zenoh; every other value goes on unchanged to rclpy's and the node's checks."""
         from rclpy.parameter import Parameter
 
         specs = self._params.specs
         widened = []
         for parameter in parameters:
             spec = specs.get(parameter.name)
-            if spec is not None and spec.kind in ("float", "list[float]") and (
-                    parameter.type_ in (Parameter.Type.INTEGER, Parameter.Type.INTEGER_ARRAY)):
-                value = parameter.value
-                parameter = Parameter(parameter.name, value=(
-                    float(value) if spec.kind == "float" else [float(v) for v in value]))
+            kind = spec.kind if spec is not None else ""
+            if kind == "float" and parameter.type_ == Parameter.Type.INTEGER:
+                parameter = Parameter(parameter.name, value=float(parameter.value))
+            elif kind == "list[float]" and parameter.type_ == Parameter.Type.INTEGER_ARRAY:
+                parameter = Parameter(parameter.name, value=[float(v) for v in parameter.value])
             widened.append(parameter)
         return widened
 
