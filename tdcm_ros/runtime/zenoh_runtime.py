@@ -78,30 +78,14 @@ def endpoint() -> str:
 
 
 def session_config(*, mode: str = "peer", router_endpoint: str | None = None) -> zenoh.Config:
-    """Zenoh config: the ``TDCM_ZENOH_CONFIG`` file, else loopback defaults like rmw_zenoh's.
-
-    ``peer``: connect to the router, listen on an ephemeral loopback port. ``router``: listen on
-    the endpoint. Multicast scouting is off; gossip scouting (zenoh's default) finds peers;
-    timestamping is on (as in rmw_zenoh's configs; transient-local publishers need it).
+    """Zenoh config of a ``peer`` or ``router`` session: loopback defaults like rmw_zenoh's, or
+    the ``TDCM_ZENOH_CONFIG`` file (a router: ``TDCM_ZENOH_ROUTER_CONFIG`` first) with ``mode``
+    and the endpoints of the role on top; see :func:`tdcm_ros.runtime.zenoh_config.build`.
     """
-    path = os.environ.get(CONFIG_ENV)
-    if path:
-        try:
-            return zenoh.Config.from_file(path)
-        except zenoh.ZError as error:
-            raise RuntimePortError(f"cannot load zenoh config {path}: {error}") from error
-    target = router_endpoint or endpoint()
-    config = zenoh.Config()
-    config.insert_json5("mode", json.dumps(mode))
-    config.insert_json5("scouting/multicast/enabled", "false")
-    config.insert_json5("timestamping/enabled",
-                        json.dumps({"router": True, "peer": True, "client": True}))
-    if mode == "router":
-        config.insert_json5("listen/endpoints", json.dumps([target]))
-    else:
-        config.insert_json5("connect/endpoints", json.dumps([target]))
-        config.insert_json5("listen/endpoints", json.dumps(["tcp/127.0.0.1:0"]))
-    return config
+    from tdcm_ros.runtime import zenoh_config
+
+    return zenoh_config.build(mode=mode, endpoint=router_endpoint or endpoint(),
+                              path=os.environ.get(CONFIG_ENV))
 
 
 def open_session(*, mode: str = "peer", router_endpoint: str | None = None) -> zenoh.Session:
