@@ -6,6 +6,12 @@ no zenoh import; nodes discover each other on ``ROS_DOMAIN_ID``).
 ``port`` wired to the twin's pty link (``<tmp>/tdcm_twin_<pid of tdcm up>``, unique per run), so
 tension -> model runs with no hardware. Ctrl-C stops the nodes in reverse order: the driver
 releases the tendon before the twin goes away.
+
+``--zenoh-config FILE`` (exported as ``TDCM_ZENOH_CONFIG``) is the zenoh config of every node and
+``--router-config FILE`` (``TDCM_ZENOH_ROUTER_CONFIG``) the router's, e.g. ``config/zenoh/``'s
+peer and router files (TLS, user/password, access control); the role's mode and endpoints are
+set on top of each. Both load before anything starts; nodes listening beyond loopback without
+authentication log a warning (the router warns for itself).
 """
 
 from __future__ import annotations
@@ -32,6 +38,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--endpoint", default=None,
                         help="zenoh router endpoint (default TDCM_ZENOH_ENDPOINT or "
                              "tcp/127.0.0.1:7447; zenoh runtime only)")
+    parser.add_argument("--zenoh-config", default=None,
+                        help="zenoh JSON5 config of every node (and of the router without "
+                             "--router-config), e.g. config/zenoh/peer.json5; zenoh runtime only")
+    parser.add_argument("--router-config", default=None,
+                        help="zenoh JSON5 config of the router tdcm up starts, e.g. "
+                             "config/zenoh/router.json5; zenoh runtime only")
     parser.add_argument("--twin", action="store_true",
                         help="also start device_twin and tension_driver wired to it (no hardware)")
     parser.add_argument("--scene", help="scene of the device twin (name or YAML path; needs --twin)")
@@ -46,9 +58,12 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
     nodes = [n.strip() for n in args.nodes.split(",") if n.strip()]
     overrides: dict[str, dict[str, Any]] = {}
     ready: dict[str, str] = {}
-    if args.endpoint and args.runtime != "zenoh":
-        raise InputError(f"--endpoint = {args.endpoint!r} needs --runtime zenoh",
-                         parameter="--endpoint", value=args.endpoint, allowed="with --runtime zenoh")
+    for option in ("endpoint", "zenoh_config", "router_config"):
+        value = getattr(args, option)
+        if value and args.runtime != "zenoh":
+            flag = "--" + option.replace("_", "-")
+            raise InputError(f"{flag} = {value!r} needs --runtime zenoh", parameter=flag,
+                             value=value, allowed="with --runtime zenoh")
     if args.scene and not args.twin:
         raise InputError(f"--scene = {args.scene!r} needs --twin", parameter="--scene",
                          value=args.scene, allowed="with --twin")
@@ -77,6 +92,21 @@ def router_endpoint(args: argparse.Namespace) -> str | None:
     return endpoint()
 
 
+def export_zenoh_configs(args: argparse.Namespace, router_endpoint: str) -> None:
+    """Export ``--zenoh-config`` and ``--router-config`` to every child, load both configs now
+    (a bad file fails before anything starts) and warn if the nodes would listen beyond loopback
+    without authentication."""
+    from tdcm_ros.runtime.zenoh_config import ROUTER_CONFIG_ENV, warn_if_exposed
+    from tdcm_ros.runtime.zenoh_runtime import CONFIG_ENV, session_config
+
+    if args.zenoh_config:
+        os.environ[CONFIG_ENV] = args.zenoh_config
+    if args.router_config:
+        os.environ[ROUTER_CONFIG_ENV] = args.router_config
+    session_config(mode="router", router_endpoint=router_endpoint)
+    warn_if_exposed(session_config(mode="peer", router_endpoint=router_endpoint), "peer")
+
+
 def run(args: argparse.Namespace) -> int:
     """Launch and wait; returns the exit status."""
     from tdcm_ros.runtime.launcher import launch
@@ -84,5 +114,8 @@ def run(args: argparse.Namespace) -> int:
 
     configure_logging()
     nodes, overrides, ready = plan(args, os.getpid())
-    return launch(nodes, params_file=args.params, runtime=args.runtime,
-                  endpoint=router_endpoint(args), overrides=overrides, ready_paths=ready)
+    endpoint = router_endpoint(args)
+    if endpoint is not None:
+        export_zenoh_configs(args, endpoint)
+    return launch(nodes, params_file=args.params, runtime=args.runtime, endpoint=endpoint,
+                  overrides=overrides, ready_paths=ready)

@@ -1,11 +1,16 @@
 """A zenoh router for the embedded runtime (stands in for ``ros2 run rmw_zenoh_cpp rmw_zenohd``).
 
-``python -m tdcm_ros.runtime.router [--listen tcp/127.0.0.1:7447]``; runs until SIGINT/SIGTERM.
+``python -m tdcm_ros.runtime.router [--listen tcp/127.0.0.1:7447] [--config router.json5]``; runs
+until SIGINT/SIGTERM. ``--config`` (or ``TDCM_ZENOH_ROUTER_CONFIG``, else ``TDCM_ZENOH_CONFIG``)
+names a zenoh JSON5 file, e.g. ``config/zenoh/router.json5`` (TLS, user/password, access control);
+the router listens on ``--listen`` whatever the file says. Listening beyond loopback without
+authentication logs a warning.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import socket
 import sys
@@ -14,16 +19,22 @@ from collections.abc import Sequence
 from types import FrameType
 
 from tdcm_ros.errors import InputError, TdcmError
-from tdcm_ros.runtime.zenoh_runtime import endpoint, open_session
+from tdcm_ros.runtime.run_node import configure_logging
+from tdcm_ros.runtime.zenoh_config import ROUTER_CONFIG_ENV, warn_if_exposed
+from tdcm_ros.runtime.zenoh_runtime import endpoint, open_session, session_config
+
+#: Protocols whose listeners a TCP connect reaches (TLS runs over TCP).
+TCP_PROTOCOLS = ("tcp", "tls")
 
 
 def tcp_address(locator: str) -> tuple[str, int]:
-    """``(host, port)`` of a ``tcp/host:port`` locator."""
+    """``(host, port)`` of a ``tcp/host:port`` or ``tls/host:port`` locator."""
     proto, _, address = locator.partition("/")
     host, _, port = address.rpartition(":")
-    if proto != "tcp" or not host or not port.isdigit():
-        raise InputError(f"endpoint {locator!r} is not tcp/<host>:<port>", parameter="endpoint",
-                         value=locator, allowed="tcp/<host>:<port>")
+    if proto not in TCP_PROTOCOLS or not host or not port.isdigit():
+        allowed = " or ".join(f"{p}/<host>:<port>" for p in TCP_PROTOCOLS)
+        raise InputError(f"endpoint {locator!r} is not {allowed}", parameter="endpoint",
+                         value=locator, allowed=allowed)
     return host.strip("[]"), int(port)
 
 
@@ -40,21 +51,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run a router on ``--listen`` (default ``TDCM_ZENOH_ENDPOINT`` or tcp/127.0.0.1:7447)."""
     parser = argparse.ArgumentParser(prog="tdcm_router", description=__doc__.splitlines()[0])
     parser.add_argument("--listen", default=None, help="endpoint, e.g. tcp/127.0.0.1:7447")
+    parser.add_argument("--config", default=None,
+                        help=f"zenoh JSON5 config of the router (sets {ROUTER_CONFIG_ENV})")
     args = parser.parse_args(argv)
+    configure_logging()
+    if args.config:
+        os.environ[ROUTER_CONFIG_ENV] = args.config
+    listen = args.listen or endpoint()
     stop = threading.Event()
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
         stop.set()
 
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, on_signal)
     try:
-        session = open_session(mode="router", router_endpoint=args.listen or endpoint())
+        warn_if_exposed(session_config(mode="router", router_endpoint=listen), "router")
+        session = open_session(mode="router", router_endpoint=listen)
     except TdcmError as error:
         print(f"tdcm_router: {error}", file=sys.stderr)
         return error.exit_code
-    print(f"tdcm_router: listening on {args.listen or endpoint()} (zid {session.zid()})",
-          file=sys.stderr, flush=True)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, on_signal)
+    print(f"tdcm_router: listening on {listen} (zid {session.zid()})", file=sys.stderr,
+          flush=True)
     while not stop.wait(0.2):
         pass
     session.close()

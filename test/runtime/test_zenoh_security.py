@@ -1,0 +1,269 @@
+"""Zenoh security on loopback with the shipped ``config/zenoh/`` files: TLS, user/password and the
+access-control list, with certificates made by ``openssl`` at test time; and the warning for
+listeners beyond loopback without authentication (checked on configs, nothing binds there)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import shutil
+import signal
+import subprocess
+import time
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack
+from pathlib import Path
+from typing import Any
+
+import pytest
+import zenoh
+from runtime_helpers import listening, wait_for
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime import zenoh_config
+from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.zenoh_runtime import CONFIG_ENV, ZenohContext
+
+Spawn = Callable[..., subprocess.Popen[bytes]]
+EXAMPLES = Path(__file__).resolve().parents[2] / "config" / "zenoh"
+PLACEHOLDER_DIR = "/etc/tdcm/zenoh/"
+PASSWORDS = {"operator": "op-pass-7f3a", "observer": "obs-pass-91c2"}
+SECTION = "Several hosts: TLS, authentication, access control"
+
+
+def openssl(folder: Path, *args: str) -> None:
+    subprocess.run(["openssl", *args], cwd=folder, check=True, capture_output=True, timeout=30)
+
+
+def make_certificates(folder: Path) -> None:
+    """A CA and a router certificate for localhost and 127.0.0.1 (EC P-256, one day)."""
+    ec = ("-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes")
+    openssl(folder, "req", "-x509", *ec, "-keyout", "ca.key", "-out", "ca.pem", "-days", "1",
+            "-subj", "/CN=tdcm test CA")
+    openssl(folder, "req", *ec, "-keyout", "router.key", "-out", "router.csr",
+            "-subj", "/CN=localhost")
+    (folder / "san.cnf").write_text("subjectAltName=DNS:localhost,IP:127.0.0.1\n")
+    openssl(folder, "x509", "-req", "-in", "router.csr", "-CA", "ca.pem", "-CAkey", "ca.key",
+            "-CAcreateserial", "-out", "router.pem", "-days", "1", "-extfile", "san.cnf")
+
+
+def render(example: str, folder: Path, name: str, user: str = "operator",
+           password: str | None = None) -> Path:
+    """The example file with the test's folder, user and password in place of placeholders."""
+    text = (EXAMPLES / example).read_text().replace(PLACEHOLDER_DIR, f"{folder}/")
+    text = text.replace('user: "operator"', f'user: "{user}"')
+    text = text.replace('"CHANGE-ME-operator"', f'"{password or PASSWORDS[user]}"')
+    path = folder / name
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture
+def secrets(tmp_path: Path) -> dict[str, Path]:
+    """Certificates, users.txt and the rendered configs: router, operator, observer, wrong."""
+    if shutil.which("openssl") is None:
+        pytest.skip("openssl is not installed")
+    make_certificates(tmp_path)
+    (tmp_path / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in PASSWORDS.items()))
+    return {"router": render("router.json5", tmp_path, "router.json5"),
+            "operator": render("peer.json5", tmp_path, "operator.json5"),
+            "observer": render("peer.json5", tmp_path, "observer.json5", user="observer"),
+            "wrong": render("peer.json5", tmp_path, "wrong.json5", password="not-the-password")}
+
+
+@pytest.fixture
+def tls_port(zenoh_env: dict[str, str]) -> int:
+    return int(zenoh_env["ZENOH_TEST_PORT"])
+
+
+@pytest.fixture
+def probes() -> Iterator[Callable[[Path, str], ZenohContext]]:
+    """``probe(config, endpoint)``: a peer context with that config; closed at teardown."""
+    with ExitStack() as stack:
+        def probe(config: Path, endpoint: str) -> ZenohContext:
+            session = zenoh.open(zenoh_config.build(mode="peer", endpoint=endpoint,
+                                                    path=str(config)))
+            context = ZenohContext(session)
+            stack.callback(context.close)
+            return context
+
+        yield probe
+
+
+def listen_to(context: ZenohContext, topic: str, type_name: str) -> list[Any]:
+    got: list[Any] = []
+    context.create_port("probe").create_subscription(topic, type_name, got.append)
+    return got
+
+
+def spin_until(contexts: list[ZenohContext], predicate: Callable[[], bool], timeout: float,
+               what: str) -> None:
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        for context in contexts:
+            context.spin_for(0.02)
+
+
+def test_tdcm_up_secure_graph_admits_only_authenticated_tls_peers(
+        secrets: dict[str, Path], tls_port: int, spawn: Spawn,
+        probes: Callable[[Path, str], ZenohContext]) -> None:
+    endpoint = f"tls/127.0.0.1:{tls_port}"
+    launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--endpoint", endpoint,
+                     "--zenoh-config", str(secrets["operator"]),
+                     "--router-config", str(secrets["router"]))
+    wait_for(lambda: listening(tls_port), 15.0, "the TLS router of tdcm up")
+    good = probes(secrets["operator"], endpoint)
+    wrong = probes(secrets["wrong"], endpoint)
+    plain = probes(secrets["operator"], f"tcp/127.0.0.1:{tls_port}")
+    heard = {name: listen_to(ctx, "chatter", "std_msgs/msg/String")
+             for name, ctx in (("good", good), ("wrong", wrong), ("plain", plain))}
+    spin_until([good], lambda: bool(heard["good"]), 20.0, "the talker over TLS")
+    spin_until([good, wrong, plain], lambda: len(heard["good"]) >= 3, 10.0, "two more messages")
+    assert heard["wrong"] == [] and heard["plain"] == []
+    assert list(good.session.info.routers_zid())
+    assert not list(wrong.session.info.routers_zid())
+    assert not list(plain.session.info.routers_zid())
+    launcher.send_signal(signal.SIGINT)
+    assert launcher.wait(15) == 0
+    assert b"beyond loopback" not in launcher.communicate(timeout=5)[1]
+
+
+def test_acl_denies_observer_commands_and_allows_operator(
+        secrets: dict[str, Path], tls_port: int, spawn: Spawn,
+        probes: Callable[[Path, str], ZenohContext]) -> None:
+    endpoint = f"tls/127.0.0.1:{tls_port}"
+    spawn("tdcm_ros.runtime.router", "--listen", endpoint, "--config", str(secrets["router"]))
+    wait_for(lambda: listening(tls_port), 15.0, "the TLS router")
+    driver = probes(secrets["operator"], endpoint)
+    setpoints = listen_to(driver, "tension_setpoint", "std_msgs/msg/Float64")
+    estops = listen_to(driver, "estop", "std_msgs/msg/Empty")
+    observer_port = probes(secrets["observer"], endpoint).create_port("observer")
+    operator_port = probes(secrets["operator"], endpoint).create_port("operator")
+    denied = observer_port.create_publisher("tension_setpoint", "std_msgs/msg/Float64")
+    allowed = observer_port.create_publisher("estop", "std_msgs/msg/Empty")
+    commands = operator_port.create_publisher("tension_setpoint", "std_msgs/msg/Float64")
+
+    def observer_sends() -> bool:
+        denied.publish(from_dict("std_msgs/msg/Float64", {"data": 1.0}))
+        allowed.publish(from_dict("std_msgs/msg/Empty", {}))
+        return len(estops) >= 10  # the observer's route to the driver works: keep going a while
+
+    spin_until([driver], observer_sends, 20.0, "the observer's estop messages")
+
+    def operator_sends() -> bool:
+        commands.publish(from_dict("std_msgs/msg/Float64", {"data": 2.0}))
+        return any(m.data == 2.0 for m in setpoints)
+
+    spin_until([driver], operator_sends, 20.0, "the operator's setpoint")
+    assert [m.data for m in setpoints if m.data != 2.0] == []
+
+
+@pytest.mark.parametrize("endpoint", ["tcp/0.0.0.0:7447", "tcp/[::]:7447",
+                                      "tls/192.168.1.20:7447", "tcp/robot.lan:7447"])
+def test_router_beyond_loopback_without_auth_is_exposed(endpoint: str,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(zenoh_config.ROUTER_CONFIG_ENV, raising=False)
+    config = zenoh_config.build(mode="router", endpoint=endpoint, path=None)
+    assert zenoh_config.exposed_endpoints(config, "router") == [endpoint]
+
+
+@pytest.mark.parametrize("endpoint", ["tcp/127.0.0.1:7447", "tcp/localhost:7447",
+                                      "tcp/[::1]:7447", "unixsock-stream//tmp/z.sock"])
+def test_loopback_router_is_not_exposed(endpoint: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(zenoh_config.ROUTER_CONFIG_ENV, raising=False)
+    config = zenoh_config.build(mode="router", endpoint=endpoint, path=None)
+    assert zenoh_config.exposed_endpoints(config, "router") == []
+
+
+def test_authentication_removes_the_exposure(secrets: dict[str, Path], tmp_path: Path,
+                                             monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv(zenoh_config.ROUTER_CONFIG_ENV, raising=False)
+    router = zenoh_config.build(mode="router", endpoint="tls/0.0.0.0:7447",
+                                path=str(secrets["router"]))  # usrpwd dictionary
+    assert zenoh_config.exposed_endpoints(router, "router") == []
+    tls_only = tmp_path / "tls_only.json5"
+    tls_only.write_text('{transport: {link: {tls: {enable_mtls: false}}}}')
+    mtls = tmp_path / "mtls.json5"
+    mtls.write_text('{transport: {link: {tls: {enable_mtls: true}}}}')
+    for path, exposed in ((tls_only, ["tls/0.0.0.0:7447"]), (mtls, [])):
+        config = zenoh_config.build(mode="router", endpoint="tls/0.0.0.0:7447", path=str(path))
+        assert zenoh_config.exposed_endpoints(config, "router") == exposed
+    tcp_mtls = zenoh_config.build(mode="router", endpoint="tcp/0.0.0.0:7447", path=str(mtls))
+    assert zenoh_config.exposed_endpoints(tcp_mtls, "router") == ["tcp/0.0.0.0:7447"]
+
+
+def test_peer_file_sets_role_keys_and_keeps_zenoh_default_listen_off_the_network(
+        tmp_path: Path, secrets: dict[str, Path]) -> None:
+    bare = tmp_path / "bare.json5"
+    bare.write_text('{mode: "client", connect: {endpoints: ["tcp/10.0.0.9:7447"]}}')
+    config = zenoh_config.build(mode="peer", endpoint="tls/127.0.0.1:7000", path=str(bare))
+    assert config.get_json("mode") == '"peer"'
+    assert config.get_json("connect/endpoints") == '["tls/127.0.0.1:7000"]'
+    assert zenoh_config.listen_endpoints(config, "peer") == [zenoh_config.LOOPBACK_LISTEN]
+    example = zenoh_config.build(mode="peer", endpoint="tls/127.0.0.1:7000",
+                                 path=str(secrets["operator"]))
+    assert zenoh_config.listen_endpoints(example, "peer") == []
+
+
+def test_router_main_warns_before_listening_beyond_loopback(
+        monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture) -> None:
+    from tdcm_ros.runtime import router
+
+    def refuse(**kwargs: Any) -> None:
+        raise RuntimePortError("not opened in this test")
+
+    for name in (CONFIG_ENV, zenoh_config.ROUTER_CONFIG_ENV):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setattr(router, "open_session", refuse)
+    with caplog.at_level(logging.WARNING, logger="tdcm.zenoh"):
+        assert router.main(["--listen", "tcp/0.0.0.0:7447"]) == 1
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warnings) == 1
+    assert "tcp/0.0.0.0:7447" in warnings[0] and SECTION in warnings[0]
+
+
+def test_tdcm_up_exports_configs_and_warns_for_exposed_nodes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        caplog: pytest.LogCaptureFixture) -> None:
+    from tdcm_ros.cli import up
+
+    for name in (CONFIG_ENV, zenoh_config.ROUTER_CONFIG_ENV):
+        monkeypatch.setenv(name, "")  # restored after the test
+    open_peer = tmp_path / "open_peer.json5"
+    open_peer.write_text('{listen: {endpoints: ["tcp/0.0.0.0:0"]}}')
+    args = argparse.Namespace(zenoh_config=str(open_peer), router_config=None)
+    with caplog.at_level(logging.WARNING, logger="tdcm.zenoh"):
+        up.export_zenoh_configs(args, "tcp/127.0.0.1:7447")
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warnings) == 1
+    assert "tcp/0.0.0.0:0" in warnings[0] and SECTION in warnings[0]
+    assert os.environ[CONFIG_ENV] == str(open_peer)
+
+
+def test_tdcm_up_rejects_a_bad_config_and_configs_on_rclpy(tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    from tdcm_ros.cli import up
+
+    for name in (CONFIG_ENV, zenoh_config.ROUTER_CONFIG_ENV):
+        monkeypatch.setenv(name, "")
+    parser = argparse.ArgumentParser()
+    up.register(parser.add_subparsers())
+    rclpy_args = parser.parse_args(["up", "--runtime", "rclpy", "--zenoh-config", "peer.json5"])
+    with pytest.raises(InputError) as error:
+        up.plan(rclpy_args, 1)
+    assert error.value.parameter == "--zenoh-config"
+    broken = tmp_path / "broken.json5"
+    broken.write_text("{transport: ")
+    with pytest.raises(RuntimePortError, match="cannot load zenoh config"):
+        up.export_zenoh_configs(parser.parse_args(["up", "--router-config", str(broken)]),
+                                "tcp/127.0.0.1:7447")
+
+
+def test_build_rejects_an_unknown_role() -> None:
+    with pytest.raises(InputError) as error:
+        zenoh_config.build(mode="client", endpoint="tcp/127.0.0.1:7447", path=None)
+    assert (error.value.parameter, error.value.value) == ("mode", "client")
