@@ -2,7 +2,9 @@
 
 One :class:`ZenohContext` per process = one zenoh session (peer mode, connected to a router at
 ``TDCM_ZENOH_ENDPOINT``, default ``tcp/127.0.0.1:7447``; multicast scouting off, listening on
-loopback only). ``TDCM_ZENOH_CONFIG`` names a zenoh JSON5 config file that replaces these defaults.
+loopback only). ``TDCM_ZENOH_CONFIG`` names a zenoh JSON5 config file (TLS, authentication, access
+control) whose settings stand, with the role's mode and endpoints set on top of it
+(:mod:`tdcm_ros.runtime.zenoh_config`).
 ``ROS_DOMAIN_ID`` selects the domain (default 0). Callbacks of every node run one at a time on the
 thread that calls :meth:`ZenohContext.spin`.
 
