@@ -11,40 +11,20 @@ import tempfile
 from pathlib import Path
 
 import pytest
+from bagio_samples import chunked_bags, sample_messages
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import SeekingReader
 
-from tdcm_ros.bagio import BagError, from_dict, serialize, to_dict
+from tdcm_ros.bagio import BagError, to_dict
 from tdcm_ros.bagio.reader import open_bag
-from tdcm_ros.bagio.writer import BagWriter
-
-T0 = 1_700_000_000_000_000_000
 
 
 @pytest.fixture(scope="module")
 def bags() -> dict[str, tuple[bytes, list[tuple[str, int, object]]]]:
     """Bytes of a small bag per chunk compression, with its messages (topic, log time, dict)."""
-    expected = []
-    for i in range(120):
-        expected.append(("/tension", T0 + 1000 * i, "geometry_msgs/msg/WrenchStamped",
-                         from_dict("geometry_msgs/msg/WrenchStamped",
-                                   {"header": {"frame_id": "f"}, "wrench": {"force": {"z": i}}})))
-        if i % 6 == 0:
-            expected.append(("/markers", T0 + 1000 * i + 1, "mocap4r2_msgs/msg/Markers",
-                             from_dict("mocap4r2_msgs/msg/Markers", {"frame_number": i, "markers": [
-                                 {"marker_name": "m3", "translation": {"z": 0.001 * i}}]})))
-    out = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for compression in ("zstd", "lz4", "none"):
-            path = Path(tmp) / compression
-            with BagWriter(path, chunk_size=1024, compression=compression) as writer:
-                for topic, stamp, msgtype, message in expected:
-                    writer.add_topic(topic, msgtype)
-                    writer.write(topic, stamp, serialize(message, msgtype))
-            out[compression] = ((path / f"{compression}_0.mcap").read_bytes(),
-                                [(t, s, to_dict(m)) for t, s, _, m in expected])
-    return out
+        return chunked_bags(sample_messages(120, 6), Path(tmp))
 
 
 def _read(path: Path) -> tuple[list[tuple[str, int, object]], list[str]] | None:

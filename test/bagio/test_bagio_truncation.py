@@ -6,46 +6,24 @@ import tempfile
 from pathlib import Path
 
 import pytest
+from bagio_samples import chunked_bags, sample_messages
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import SeekingReader
 from mcap.writer import Writer
 
-from tdcm_ros.bagio import BagError, from_dict, serialize, to_dict, typestore
+from tdcm_ros.bagio import BagError, serialize, to_dict, typestore
 from tdcm_ros.bagio.reader import open_bag
-from tdcm_ros.bagio.writer import BagWriter
 
-T0 = 1_700_000_000_000_000_000
 N = 300
-
-
-def _messages() -> list[tuple[str, int, str, object]]:
-    out: list[tuple[str, int, str, object]] = []
-    for i in range(N):
-        out.append(("/tension", T0 + 1000 * i, "geometry_msgs/msg/WrenchStamped",
-                    from_dict("geometry_msgs/msg/WrenchStamped",
-                              {"header": {"frame_id": f"f{i}"}, "wrench": {"force": {"z": i}}})))
-        if i % 7 == 0:
-            out.append(("/markers", T0 + 1000 * i + 1, "mocap4r2_msgs/msg/Markers",
-                        from_dict("mocap4r2_msgs/msg/Markers", {"frame_number": i, "markers": [
-                            {"marker_name": "m3", "translation": {"z": 0.001 * i}}]})))
-    return out
 
 
 @pytest.fixture(scope="module")
 def bag_bytes() -> dict[str, tuple[bytes, list[tuple[str, int, object]]]]:
     """Bytes of one bag per compression (small chunks) and an unchunked one, with the messages."""
-    expected = _messages()
-    out = {}
+    expected = sample_messages(N, 7)
     with tempfile.TemporaryDirectory() as tmp:
-        for compression in ("zstd", "lz4", "none"):
-            path = Path(tmp) / compression
-            with BagWriter(path, chunk_size=1024, compression=compression) as writer:
-                for topic, stamp, msgtype, message in expected:
-                    writer.add_topic(topic, msgtype)
-                    writer.write(topic, stamp, serialize(message, msgtype))
-            out[compression] = ((path / f"{compression}_0.mcap").read_bytes(),
-                                [(t, s, to_dict(m)) for t, s, _, m in expected])
+        out = chunked_bags(expected, Path(tmp))
         out["unchunked"] = (_unchunked(Path(tmp) / "unchunked.mcap", expected),
                             out["none"][1])
     return out

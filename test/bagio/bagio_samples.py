@@ -1,0 +1,42 @@
+"""Small bags shared by the bag reader's damage tests (uniquely named so imports never collide)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from tdcm_ros.bagio import from_dict, serialize, to_dict
+from tdcm_ros.bagio.writer import BagWriter
+
+T0 = 1_700_000_000_000_000_000  #: ns, log time of the first message
+Message = tuple[str, int, str, object]
+COMPRESSIONS = ("zstd", "lz4", "none")
+
+
+def sample_messages(count: int, marker_every: int) -> list[Message]:
+    """``count`` tensions 1 µs apart and a Markers message every ``marker_every`` of them."""
+    out: list[Message] = []
+    for i in range(count):
+        out.append(("/tension", T0 + 1000 * i, "geometry_msgs/msg/WrenchStamped",
+                    from_dict("geometry_msgs/msg/WrenchStamped",
+                              {"header": {"frame_id": f"f{i}"}, "wrench": {"force": {"z": i}}})))
+        if i % marker_every == 0:
+            out.append(("/markers", T0 + 1000 * i + 1, "mocap4r2_msgs/msg/Markers",
+                        from_dict("mocap4r2_msgs/msg/Markers", {"frame_number": i, "markers": [
+                            {"marker_name": "m3", "translation": {"z": 0.001 * i}}]})))
+    return out
+
+
+def chunked_bags(messages: list[Message], folder: Path
+                 ) -> dict[str, tuple[bytes, list[tuple[str, int, object]]]]:
+    """Per compression: the bytes of a bag of ``messages`` in 1 KiB chunks, and the messages as
+    (topic, log time, dict)."""
+    out = {}
+    for compression in COMPRESSIONS:
+        path = folder / compression
+        with BagWriter(path, chunk_size=1024, compression=compression) as writer:
+            for topic, stamp, msgtype, message in messages:
+                writer.add_topic(topic, msgtype)
+                writer.write(topic, stamp, serialize(message, msgtype))
+        out[compression] = ((path / f"{compression}_0.mcap").read_bytes(),
+                            [(t, s, to_dict(m)) for t, s, _, m in messages])
+    return out
