@@ -1,12 +1,24 @@
-"""Fixtures shared by every test directory: hostile YAML texts and a printing stopwatch."""
+"""Fixtures shared by every test directory: hostile YAML texts and a printing stopwatch.
+
+Hypothesis explores new random examples on every local run; under CI (``CI`` set) it is
+derandomized, so a CI run is reproducible and a red CI names a failure that reruns the same. What
+local runs find becomes a regression test of its own (e.g. the absurd chunk size in
+test/bagio/test_bagio_hostile.py).
+"""
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager, contextmanager
 
 import pytest
+from hypothesis import settings
+
+settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 NESTED_LEVELS = 5000
 HUGE_BYTES = 10_000_000

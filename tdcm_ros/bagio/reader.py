@@ -84,14 +84,18 @@ class _Damaged(Exception):
     """A record of the data section is cut short or fails its check."""
 
 
+#: Largest uncompressed chunk (bytes) believed from a file; writers use chunks of a few MB.
+MAX_CHUNK_BYTES = 1 << 30
 # What record parsers and decompressors raise on damaged bytes (lz4 raises RuntimeError).
 _DAMAGE = (_Damaged, McapError, struct.error, ValueError, KeyError, IndexError, EOFError,
-           RuntimeError, zstandard.ZstdError)
+           RuntimeError, OverflowError, zstandard.ZstdError)
 
 
 def _decompress(compression: str, data: bytes, size: int) -> bytes:
     if not compression:
         return data
+    if not 0 <= size <= MAX_CHUNK_BYTES:
+        raise _Damaged(f"chunk claims {size} bytes uncompressed; allowed: 0..{MAX_CHUNK_BYTES}")
     if compression == "zstd":
         return zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
     if compression == "lz4":

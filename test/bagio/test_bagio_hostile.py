@@ -7,6 +7,7 @@ hang (each example must finish within the hypothesis deadline).
 
 from __future__ import annotations
 
+import struct
 import tempfile
 from pathlib import Path
 
@@ -89,3 +90,25 @@ def test_a_flip_in_one_chunk_loses_that_chunk_only(
         assert got == [e for e in expected
                        if not chunk.message_start_time <= e[1] <= chunk.message_end_time]
         assert reader.message_count == len(got)
+
+
+@pytest.mark.parametrize("claimed", [2**63 + 1000, 2**62, 1 << 31])
+def test_a_chunk_claiming_an_absurd_uncompressed_size_is_skipped_with_a_warning(
+        bags: dict[str, tuple[bytes, list[tuple[str, int, object]]]], tmp_path: Path,
+        claimed: int) -> None:
+    """Found by the flip test in CI: a flipped bit in a zstd chunk's uncompressed-size field
+    made the decompressor raise ``OverflowError``."""
+    original, expected = bags["zstd"]
+    path = tmp_path / "absurd_size.mcap"
+    path.write_bytes(original)
+    with path.open("rb") as stream:
+        chunk = SeekingReader(stream).get_summary().chunk_indexes[1]  # type: ignore[union-attr]
+    damaged = bytearray(original)
+    # Chunk record: opcode (1), length (8), start and end time (8 + 8), uncompressed size (8).
+    struct.pack_into("<Q", damaged, chunk.chunk_start_offset + 25, claimed)
+    path.write_bytes(bytes(damaged))
+    reader = open_bag(path)
+    got = [(t, s, to_dict(m)) for t, s, m in reader.messages()]
+    assert any(f"corrupt chunk at byte {chunk.chunk_start_offset}" in w for w in reader.warnings)
+    assert got == [e for e in expected
+                   if not chunk.message_start_time <= e[1] <= chunk.message_end_time]
