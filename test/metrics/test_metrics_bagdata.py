@@ -10,30 +10,20 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mcap.reader import SeekingReader
+from metrics_samples import TRUE_E, small_recording
 
 from tdcm_ros.bagio import deserialize, serialize
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
-from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.synthetic_bag import write_recording
-from tdcm_ros.model import preset
 
-TRUE_E = 0.7e9
-DESIGN = preset("paper-experiment").with_overrides(E=TRUE_E)
 Change = Callable[[str, int, bytes], list[tuple[int, bytes]]]
-
-
-def _recording(**kw: object) -> object:
-    args = {"levels": (0.0, 8.0, 16.0), "hold_s": 2.0, "trials": 2, "tension_hz": 250.0,
-            "mocap_hz": 50.0, "marker_noise_m": 5e-5, "seed": 3}
-    args.update(kw)
-    return simulate(DESIGN, **args)
 
 
 @pytest.fixture(scope="module")
 def clean(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return write_recording(_recording(), tmp_path_factory.mktemp("hazards") / "clean")
+    return write_recording(small_recording(seed=3), tmp_path_factory.mktemp("hazards") / "clean")
 
 
 def _evaluate(capsys: pytest.CaptureFixture[str], path: Path) -> tuple[int, dict]:
@@ -73,7 +63,7 @@ def _with_tension_sec(seconds: Callable[[int], int | None]) -> Change:
 
 def test_zero_and_nan_markers_are_occluded_counted_and_not_used(
         clean: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    rec = _recording()
+    rec = small_recording(seed=3)
     positions = rec.markers.positions
     positions[::3, 2] = 0.0  # the tip marker reported at the origin: occluded in the live stream
     positions[1::7, 0, 1] = np.nan  # a NaN coordinate

@@ -7,26 +7,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from metrics_samples import TRUE_E, small_recording
 
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
 from tdcm_ros.metrics.api import evaluate_paths
 from tdcm_ros.metrics.options import options_from_sets
-from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.synthetic_bag import write_recording
-from tdcm_ros.model import preset
 
-TRUE_E = 0.7e9
-DESIGN = preset("paper-experiment").with_overrides(E=TRUE_E)
 ISSUE_KEYS = {"mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m", "n_trials",
               "n_steps", "steps"}
-
-
-def small_recording(**kw: object) -> object:
-    args = {"levels": (0.0, 8.0, 16.0), "hold_s": 2.0, "trials": 2, "tension_hz": 250.0,
-            "mocap_hz": 50.0, "marker_noise_m": 5e-5, "seed": 1}
-    args.update(kw)
-    return simulate(DESIGN, **args)
 
 
 @pytest.fixture(scope="module")
