@@ -60,7 +60,7 @@ def _flag_values(args: Sequence[str], flags: tuple[str, ...]) -> list[str]:
     return [args[i + 1] for i in range(len(args) - 1) if args[i] in flags]
 
 
-def _plain(value: Any) -> Any:
+def plain_value(value: Any) -> Any:
     """rclpy array values (``array.array``, tuples) as lists; scalars unchanged."""
     return list(value) if not isinstance(value, str | bytes) and hasattr(value, "__iter__") else value
 
@@ -171,7 +171,7 @@ class RclpyNodePort:
                                                 ignore_override=from_file).value
         except (InvalidParameterTypeException, InvalidParameterValueException) as error:
             raise InputError(f"{name}: {error}", parameter=name, allowed=spec.kind) from error
-        return self._params.declare(spec, _plain(value))
+        return self._params.declare(spec, plain_value(value))
 
     def get_parameter(self, name: str) -> ParamValue:
         """Current value."""
@@ -201,7 +201,7 @@ class RclpyNodePort:
     def _on_set(self, parameters: list[Any]) -> Any:
         from rcl_interfaces.msg import SetParametersResult
 
-        changes = {p.name: _plain(p.value) for p in parameters if p.name in self._params.specs}
+        changes = {p.name: plain_value(p.value) for p in parameters if p.name in self._params.specs}
         if not changes:
             return SetParametersResult(successful=True)
         try:
@@ -403,7 +403,7 @@ def _get(context: RclpyContext, client: Any, node_fqn: str, name: str, timeout: 
     value = context.spin_until_future(client.get_parameters([name]), timeout).values[0]
     if value.type == ParameterType.PARAMETER_NOT_SET:
         raise InputError(f"{node_fqn}: parameter {name!r} is not declared", parameter=name)
-    return _plain(parameter_value_to_python(value))
+    return plain_value(parameter_value_to_python(value))
 
 
 def _set(context: RclpyContext, client: Any, name: str, value: Any,
@@ -429,7 +429,7 @@ def _list(context: RclpyContext, client: Any, timeout: float) -> dict[str, dict[
     listing = {}
     for name, value, desc in zip(names, values, descriptors, strict=True):
         ranges = [*desc.floating_point_range, *desc.integer_range]
-        listing[name] = {"value": _plain(parameter_value_to_python(value)),
+        listing[name] = {"value": plain_value(parameter_value_to_python(value)),
                          "description": desc.description, "read_only": bool(desc.read_only),
                          "range": [ranges[0].from_value, ranges[0].to_value] if ranges else None}
     return listing

@@ -17,6 +17,7 @@ from typing import Any
 from tdcm_ros.bagio import serialize
 from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
 from tdcm_ros.runtime.rclpy_runtime import message_class as native_class
+from tdcm_ros.runtime.rclpy_runtime import plain_value
 from tdcm_ros.runtime.rclpy_runtime import qos_profile as profile
 
 
@@ -110,8 +111,7 @@ class PlainParameterClient:
         from rclpy.parameter import parameter_value_to_python
 
         response = self.ctx.wait(self.client.get_parameters([name]), self.timeout)
-        value = parameter_value_to_python(response.values[0])
-        return list(value) if isinstance(value, list | tuple) or hasattr(value, "tolist") else value
+        return plain_value(parameter_value_to_python(response.values[0]))
 
     def set(self, name: str, value: Any) -> dict[str, Any]:
         from rclpy.parameter import Parameter

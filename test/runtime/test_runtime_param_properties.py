@@ -83,7 +83,7 @@ def test_rclpy_parameter_sets_of_any_value(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setenv("ROS_DOMAIN_ID", str(private_domain_id()))
     from rclpy.parameter import Parameter
 
-    from tdcm_ros.runtime.rclpy_runtime import RclpyContext
+    from tdcm_ros.runtime.rclpy_runtime import RclpyContext, plain_value
 
     values = (st.none() | st.booleans() | st.integers(-2**63, 2**63 - 1) | st.floats()
               | st.text(max_size=20) | st.lists(st.integers(-2**63, 2**63 - 1), max_size=4)
@@ -105,12 +105,8 @@ def test_rclpy_parameter_sets_of_any_value(monkeypatch: pytest.MonkeyPatch) -> N
             except Exception as error:  # noqa: BLE001 - only rclpy's own refusals may raise
                 assert type(error).__module__.startswith("rclpy"), error
             assert_consistent(port.get_parameter)
-            assert_consistent(lambda n: _plain(port.node.get_parameter(n).value))
+            assert_consistent(lambda n: plain_value(port.node.get_parameter(n).value))
 
         check()
     finally:
         context.close()
-
-
-def _plain(value: Any) -> Any:
-    return list(value) if isinstance(value, list | tuple) or hasattr(value, "tolist") else value
