@@ -103,6 +103,22 @@ def wait_until(predicate: Callable[[], bool], timeout: float, spin: Callable[[fl
     return True
 
 
+def typed_within(what: str, call: Callable[[], object], budget_s: float) -> Failures:
+    """Run ``call``: the package's typed errors are fine; an untyped escape, or more than
+    ``budget_s`` s, is a failure described with ``what``."""
+    failures: Failures = []
+    start = time.perf_counter()
+    try:
+        call()
+    except TdcmError:
+        pass
+    except Exception as error:  # noqa: BLE001 - an untyped escape is what we count
+        failures.append(f"{what}: {type(error).__name__}: {str(error)[:80]}")
+    if (took := time.perf_counter() - start) > budget_s:
+        failures.append(f"{what}: {took:.2f} s (budget {budget_s:g} s)")
+    return failures
+
+
 # --- device -------------------------------------------------------------------------------------
 
 def campaign_reconnect(tries: int, rng: random.Random, tmp: Path) -> Failures:
@@ -341,15 +357,7 @@ def campaign_yaml(tries: int, rng: random.Random, tmp: Path) -> Failures:
         path.write_text(text)
         for what, load in (("scene", lambda text=text: scene_from_text(text)),
                            ("params", lambda: node_parameters(path, "/model_node"))):
-            start = time.perf_counter()
-            try:
-                load()
-            except TdcmError:
-                pass
-            except Exception as error:  # noqa: BLE001 - an untyped escape is what we count
-                failures.append(f"{what}: {type(error).__name__}: {str(error)[:80]}")
-            if (took := time.perf_counter() - start) > 1.0:
-                failures.append(f"{what}: {took:.2f} s for {text[:40]!r}...")
+            failures += typed_within(f"{what} {text[:40]!r}", load, 1.0)
     return failures
 
 
@@ -460,16 +468,8 @@ def campaign_bag(tries: int, rng: random.Random, tmp: Path) -> Failures:
                 data[rng.randrange(len(data))] ^= 1 << rng.randrange(8)
         path = tmp / f"flipped_{attempt}.mcap"
         path.write_bytes(bytes(data))
-        start = time.perf_counter()
-        try:
-            open_bag(path)
-            evaluate_paths([path])
-        except TdcmError:
-            pass
-        except Exception as error:  # noqa: BLE001 - an untyped escape is what we count
-            failures.append(f"{type(error).__name__}: {str(error)[:80]}")
-        if (took := time.perf_counter() - start) > 20.0:
-            failures.append(f"{took:.1f} s for one bag")
+        failures += typed_within(f"bag {attempt}", lambda path=path: (open_bag(path),
+                                                                    evaluate_paths([path])), 20.0)
         path.unlink()
     return failures
 
