@@ -1,8 +1,8 @@
 """Test-side peers on rclpy: plain rclpy nodes, as a user's own node would be.
 
 They subscribe and publish the rosidl-generated message classes (so every message crosses
-rosidl's own typesupport, not rosbags; the class lookup and QoS mapping are the package's small
-helpers, which hold no transport logic), and reach node parameters through
+rosidl's own typesupport, not rosbags; the class lookup, the QoS mapping and the context that
+spins them are the package's, which hold no node logic), and reach node parameters through
 ``rclpy.parameter_client.AsyncParameterClient`` (what ``ros2 param`` uses). The port shape
 (``create_subscription``/``create_publisher``/``spin_for``) matches the zenoh context, so one
 probe class serves both runtimes.
@@ -16,8 +16,8 @@ from typing import Any
 
 from tdcm_ros.bagio import serialize
 from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
+from tdcm_ros.runtime.rclpy_runtime import RclpyContext, plain_value
 from tdcm_ros.runtime.rclpy_runtime import message_class as native_class
-from tdcm_ros.runtime.rclpy_runtime import plain_value
 from tdcm_ros.runtime.rclpy_runtime import qos_profile as profile
 
 
@@ -51,44 +51,21 @@ class PlainPort:
                                                           profile(qos)), type_name)
 
 
-class PlainRclpyContext:
-    """An rclpy context of plain nodes spun by one executor (domain from ``ROS_DOMAIN_ID``)."""
+class PlainRclpyContext(RclpyContext):
+    """The package's rclpy context (one executor, domain from ``ROS_DOMAIN_ID``) spinning plain
+    rclpy nodes: ``create_port`` gives a :class:`PlainPort`, not the package's node port."""
 
-    def __init__(self) -> None:
-        import rclpy
-        from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
+    def create_port(self, name: str, namespace: str = "/",  # type: ignore[override]
+                    overrides: Any = None) -> PlainPort:
+        return PlainPort(self.create_node(name, namespace))
 
-        self.context = Context()
-        rclpy.init(context=self.context)
-        self.executor = SingleThreadedExecutor(context=self.context)
-        self.nodes: list[Any] = []
-
-    def create_port(self, name: str, namespace: str = "/") -> PlainPort:
-        from rclpy.node import Node
-
-        node = Node(name, namespace=namespace, context=self.context)
-        self.nodes.append(node)
-        self.executor.add_node(node)
-        return PlainPort(node)
-
-    def spin_for(self, seconds: float) -> None:
-        end = time.monotonic() + seconds
-        while (left := end - time.monotonic()) > 0:
-            self.executor.spin_once(timeout_sec=min(left, 0.05))
+    @property
+    def nodes(self) -> list[Any]:
+        """The plain nodes made so far."""
+        return self._nodes
 
     def wait(self, future: Any, timeout: float) -> Any:
-        end = time.monotonic() + timeout
-        while not future.done():
-            assert time.monotonic() < end, f"no answer within {timeout} s"
-            self.executor.spin_once(timeout_sec=0.05)
-        return future.result()
-
-    def close(self) -> None:
-        self.executor.shutdown()
-        for node in self.nodes:
-            node.destroy_node()
-        self.context.try_shutdown()
+        return self.spin_until_future(future, timeout)
 
 
 class PlainParameterClient:
