@@ -18,7 +18,8 @@ automatically: call :meth:`TensionDriver.clear_faults`.
 Arming: the driver starts armed. It disarms -- target and setpoint 0 N, schedule cancelled, mode
 R sent, setpoints and schedules refused -- on an e-stop and on every event after which the device's
 state is unknown: the link lost while connected (port error, ``link_timeout``, a version
-mismatch), a device reboot (a banner nobody asked for, or the device clock running backwards)
+mismatch), a device reboot (a banner nobody asked for once telemetry has flowed, or the device
+clock running backwards)
 and a freeze (no telemetry for the device's own watchdog time while the host kept stepping).
 Disarmed, it commands mode R whatever the device reports. Only :meth:`TensionDriver.clear_faults`
 (the operator's arm command, accepted while connected) arms it again, at a target of 0 N: a new
@@ -432,10 +433,12 @@ class TensionDriver:
             self._disarm(f"device silent for {silence:.2f} s (frozen?)")
 
     def _on_banner(self, banner: Banner, now: float) -> None:
-        """Complete the handshake; a banner nobody asked for while connected is a reboot."""
+        """Complete the handshake; a banner nobody asked for while connected is a reboot, unless
+        no telemetry was ever received: then it is the boot banner of a device that reset when
+        its port was opened (a UNO does), arriving with the answer to the driver's request."""
         solicited = self._info_pending > 0
         self._info_pending = max(0, self._info_pending - 1)
-        if self._link is LinkState.CONNECTED and not solicited:
+        if self._link is LinkState.CONNECTED and not solicited and self._latest is not None:
             self._warn("device rebooted: it sent a boot banner")
             self._latest = None  # the old frames' clock is not the new boot's
             if self._armed:

@@ -253,3 +253,19 @@ def test_a_freeze_is_not_a_reboot_and_never_re_tensions(tmp_path: Path, seconds:
     finally:
         bench.driver.close()
         bench.pty.stop()
+
+
+def test_a_boot_banner_when_the_port_opens_is_not_a_reboot(bench: Bench) -> None:
+    """A UNO resets when its port is opened: its boot banner can arrive after the host flushed
+    the port and asked for the banner, so two banners answer one request. Nothing was tensioned
+    on this connection yet, so this is the handshake, not a reboot: the driver stays armed."""
+    bench.driver.step()  # opens the port, flushes it and asks for the banner
+    bench.twin.reboot()  # the reset's boot banner comes before the answer to the request
+    bench.run_until_connected()
+    bench.run(0.5)
+    status = bench.driver.step().status
+    assert status.armed and not any("reboot" in w for w in bench.warnings), bench.warnings
+    bench.driver.enable()
+    assert bench.driver.set_setpoint(8.0) == 8.0
+    bench.run(3.0)
+    assert bench.twin.plant.tension == pytest.approx(8.0, abs=0.3)
