@@ -7,15 +7,21 @@ Typical use::
     world = scene.world()
     frame = world.markers(stamp_s=0.0, true_tension=20.0)   # MarkerFrame in `mocap`
 
-``scene.design`` is the estimator's design, ``scene.true_design`` the world's;
-``scene.plant_config()`` the device twin's plant with the actuation effects.
+A scene declares; ``scene.compile(stages)`` finalises it into a :class:`CompiledScene` (the
+listed effects built in file order, their loading and plant parts merged; two effects setting
+one field raise :class:`EffectConflictError`). ``scene.world()`` runs the compiled mechanics,
+sensing and timing stages; ``scene.plant_config()`` is the device twin's plant with the
+actuation stage. ``scene.design`` is the estimator's design, ``scene.true_design`` the world's.
 """
 
+from tdcm_ros.scenes.compiled import CompiledScene
 from tdcm_ros.scenes.effects import CONSTRUCTED, REGISTRY, STAGES
-from tdcm_ros.scenes.errors import InvalidSceneError, SceneError
+from tdcm_ros.scenes.errors import EffectConflictError, InvalidSceneError, SceneError
 from tdcm_ros.scenes.load import SCENE_NAMES, load_scene, scene_from_text
+from tdcm_ros.scenes.parts import LoadingPart, PlantPart
 from tdcm_ros.scenes.scene import Scene
 from tdcm_ros.scenes.world import MarkerFrame, World
 
-__all__ = ["CONSTRUCTED", "REGISTRY", "SCENE_NAMES", "STAGES", "InvalidSceneError", "MarkerFrame",
+__all__ = ["CONSTRUCTED", "REGISTRY", "SCENE_NAMES", "STAGES", "CompiledScene",
+           "EffectConflictError", "InvalidSceneError", "LoadingPart", "MarkerFrame", "PlantPart",
            "Scene", "SceneError", "World", "load_scene", "scene_from_text"]

@@ -30,9 +30,9 @@ from scipy.spatial.transform import Rotation
 from tdcm_ros.device.protocol import Heartbeat, Mode, SetMode, SetSetpoint, encode
 from tdcm_ros.device.twin import DeviceTwin
 from tdcm_ros.scenes.effects import REGISTRY, STAGES
-from tdcm_ros.scenes.effects.sensing import Pose
 from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS
 from tdcm_ros.scenes.scene import Scene
+from tdcm_ros.scenes.stages import Pose
 from tdcm_ros.scenes.world import World
 
 Array = NDArray[np.float64]
@@ -112,7 +112,8 @@ def _twin_hold(scene: Scene, setpoint: float, repeats: int) -> tuple[float, floa
 
 def _to_base(points: Array, pose: Pose) -> Array:
     """Points (k, 3) m from ``mocap`` into tdcm_base through the transform ``pose``."""
-    return Rotation.from_quat(pose[1]).inv().apply(points - pose[0])
+    base: Array = Rotation.from_quat(pose[1]).inv().apply(points - pose[0])
+    return base
 
 
 def _sensing_frames(scene: Scene, top: float, samples: int) -> tuple[Array, World]:
@@ -173,11 +174,11 @@ def _measure(scene: Scene, name: str, top: float, true_tip: Array, base_solve: f
         return EffectReport(name, cls.stage, effect.cost_s, cls.cost_unit, change,
                             f"tip marker seen in {seen:.1%} of {samples} frames")
     world = scene.world()
-    effect = world.timing[0]
+    latency = world.timing[0]
     delays = {topic: [world.delay_s(topic) for _ in range(samples)] for topic in LATENCY_TOPICS}
     note = ", ".join(f"{topic} {np.mean(d) * 1e3:.2f} ms (max {np.max(d) * 1e3:.2f})"
                      for topic, d in delays.items())
-    return EffectReport(name, cls.stage, effect.cost_s, "message", None, note)
+    return EffectReport(name, cls.stage, latency.cost_s, "message", None, note)
 
 
 def format_table(report: Explanation) -> str:

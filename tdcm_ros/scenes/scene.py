@@ -1,13 +1,17 @@
 """A scene: the simulated world (design, true material, bench, sensors, effects) and the
-design the estimator uses. :func:`parse_scene` validates a mapping read from YAML."""
+design the estimator uses. :func:`parse_scene` validates a mapping read from YAML.
+
+A scene declares; it builds nothing. :meth:`Scene.compile` finalises it (see
+:mod:`tdcm_ros.scenes.compiled`); :meth:`Scene.world` and :meth:`Scene.plant_config` compile
+the stages they run, each time afresh (a world's effects keep their own state and seed)."""
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,22 +21,19 @@ from tdcm_ros.device.plant import PlantConfig
 from tdcm_ros.device.schedule import StepSchedule
 from tdcm_ros.errors import reject_unknown
 from tdcm_ros.model import FIELD_SPECS, Design, parse_field, preset
+from tdcm_ros.scenes.compiled import WORLD_STAGES, Bench, CompiledScene, compile_scene
 from tdcm_ros.scenes.effects import (
     REGISTRY,
     STAGES,
-    Effect,
     EffectContext,
-    build,
     check_names,
+    parse_effect,
 )
-from tdcm_ros.scenes.effects.actuation import ActuationEffect
-from tdcm_ros.scenes.effects.base import parse_effect
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param, as_mapping, parse_params
 from tdcm_ros.scenes.schema import SECTIONS, TOP_KEYS
-
-if TYPE_CHECKING:
-    from tdcm_ros.scenes.world import World
+from tdcm_ros.scenes.stages import Metered
+from tdcm_ros.scenes.world import World
 
 Array = NDArray[np.float64]
 SEED = Param("seed", "", "random seed", 0, kind="int", low=0, high=2**32 - 1)
@@ -79,13 +80,23 @@ class Scene:
         """Listed effects, optionally of one stage, in file order."""
         return tuple(n for n in self.effects if stage is None or REGISTRY[n].stage == stage)
 
-    def build_effects(self, stage: str) -> list[Effect]:
-        """Construct this scene's effects of ``stage`` (one of STAGES)."""
-        if stage not in STAGES:
-            raise InvalidSceneError(f"stage {stage!r} unknown; allowed: {', '.join(STAGES)}",
-                                    parameter="stage", value=stage, allowed=", ".join(STAGES))
-        context = self.context()
-        return [build(name, self.effects[name], context) for name in self.effect_names(stage)]
+    @property
+    def bench(self) -> Bench:
+        """The world of this scene without its effects."""
+        return Bench(true_design=self.true_design, marker_labels=self.marker_labels,
+                     marker_arc_lengths=self.marker_arc_lengths,
+                     marker_radius=self.marker_radius, marker_side=self.marker_side_rad,
+                     mocap_pose=self.mocap_pose)
+
+    def compile(self, stages: Collection[str] = STAGES) -> CompiledScene:
+        """Build this scene's effects of ``stages`` (of STAGES) in file order and merge their
+        parts; raises :class:`~tdcm_ros.scenes.errors.EffectConflictError` when two effects
+        set one field of the loading or of the plant."""
+        return compile_scene(self.bench, self.effects, self.context(), stages)
+
+    def build_effects(self, stage: str) -> list[Metered]:
+        """Construct this scene's effects of ``stage`` (one of STAGES), in file order."""
+        return list(self.compile((stage,)).stage(stage))
 
     def without(self, *names: str) -> Scene:
         """The same scene without the effects ``names`` (each must be listed)."""
@@ -100,17 +111,12 @@ class Scene:
     def plant_config(self) -> PlantConfig:
         """The device twin's plant: the twin's nominal bench with an exact load cell
         (``noise`` 0), sampled at ``tension_rate_hz``, then the listed actuation effects."""
-        plant: dict[str, Any] = {"noise": 0.0, "sample_period": 1.0 / self.tension_rate_hz,
-                                 "seed": self.seed}
-        for effect in self.build_effects("actuation"):
-            cast(ActuationEffect, effect).apply(plant)
-        return PlantConfig(**plant)
+        nominal = PlantConfig(noise=0.0, sample_period=1.0 / self.tension_rate_hz, seed=self.seed)
+        return self.compile(("actuation",)).plant.over(nominal)
 
     def world(self) -> World:
-        """A fresh, seeded simulated world of this scene."""
-        from tdcm_ros.scenes.world import World
-
-        return World(self)
+        """A fresh, seeded simulated world of this scene (its non-actuation stages compiled)."""
+        return World(self.compile(WORLD_STAGES))
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready summary (SI units)."""

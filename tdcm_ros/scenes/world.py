@@ -1,9 +1,11 @@
-"""The simulated world of a scene: the true body under the listed mechanics, seen by the
-listed sensing effects, with the listed timing effects.
+"""The simulated world of a compiled scene: the true body under the listed mechanics, seen by
+the listed sensing effects, with the listed timing effects.
 
-Stateful and seeded: friction history, dropout bursts and every random draw depend only on the
-scene's seed and the sequence of calls. Shapes are warm-started from the previous solve and,
-unless a stateful effect (friction) makes the shape depend on history, cached by tension.
+Built from a :class:`~tdcm_ros.scenes.compiled.CompiledScene` (``Scene.world()`` compiles one);
+it walks the bundle's per-stage effects and nothing else. Stateful and seeded: friction
+history, dropout bursts and every random draw depend only on the scene's seed and the sequence
+of calls. Shapes are warm-started from the previous solve and, unless a mechanics effect keeps
+a history (friction) that makes the shape depend on the path, cached by tension.
 """
 
 from __future__ import annotations
@@ -12,7 +14,6 @@ import math
 from collections import OrderedDict
 from dataclasses import dataclass
 from time import perf_counter
-from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,14 +24,10 @@ from tdcm_ros.model import SolveResult, solve
 from tdcm_ros.model.limits import check_tension
 from tdcm_ros.model.loading import Loading
 from tdcm_ros.nodes.shape_messages import surface_points
-from tdcm_ros.scenes.effects import Effect
-from tdcm_ros.scenes.effects.mechanics import MechanicsEffect
-from tdcm_ros.scenes.effects.sensing import Pose, SensingEffect
-from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS, Latency
+from tdcm_ros.scenes.compiled import CompiledScene
+from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS
 from tdcm_ros.scenes.errors import InvalidSceneError
-
-if TYPE_CHECKING:
-    from tdcm_ros.scenes.scene import Scene
+from tdcm_ros.scenes.stages import Mechanics, Metered, Pose, Sensing, Timing
 
 Array = NDArray[np.float64]
 CACHE_SIZE = 512
@@ -48,41 +45,54 @@ class MarkerFrame:
 class World:
     """See the module docstring; build with :meth:`Scene.world`."""
 
-    def __init__(self, scene: Scene) -> None:
-        self.scene = scene
-        self.mechanics = cast(list[MechanicsEffect], scene.build_effects("mechanics"))
-        self.sensing = cast(list[SensingEffect], scene.build_effects("sensing"))
-        self.timing = cast(list[Latency], scene.build_effects("timing"))
-        self.loading = self._loading()
-        self._stateful = any(effect.stateful for effect in self.mechanics)
+    def __init__(self, compiled: CompiledScene) -> None:
+        self.compiled = compiled
+        self.bench = compiled.bench
         self._cache: OrderedDict[float, SolveResult] = OrderedDict()
         self._last: SolveResult | None = None
         self.solves = 0  #: solver calls made (cache hits excluded)
         self.solve_time_s = 0.0  #: wall time in those calls (s)
-        self.true_mocap_to_base: Pose = scene.mocap_pose
-        published = scene.mocap_pose
+        self.true_mocap_to_base: Pose = self.bench.mocap_pose
+        published = self.bench.mocap_pose
         for effect in self.sensing:
             published = effect.published(published)
         self.mocap_to_base: Pose = published
-        self._rotation = Rotation.from_quat(scene.mocap_pose[1])
+        self._rotation = Rotation.from_quat(self.bench.mocap_pose[1])
 
     @property
-    def effects(self) -> list[Effect]:
+    def loading(self) -> Loading | None:
+        """What the listed mechanics effects add to the solve; None without any."""
+        return self.compiled.loading
+
+    @property
+    def mechanics(self) -> tuple[Mechanics, ...]:
+        """The listed mechanics effects, in file order."""
+        return self.compiled.mechanics
+
+    @property
+    def sensing(self) -> tuple[Sensing, ...]:
+        """The listed sensing effects, in file order."""
+        return self.compiled.sensing
+
+    @property
+    def timing(self) -> tuple[Timing, ...]:
+        """The listed timing effects, in file order."""
+        return self.compiled.timing
+
+    @property
+    def effects(self) -> list[Metered]:
         """Every effect instance of this world (actuation runs in the twin, not here)."""
         return [*self.mechanics, *self.sensing, *self.timing]
 
-    def _loading(self) -> Loading | None:
-        if not self.mechanics:
-            return None
-        fields: dict[str, Any] = {}
-        for effect in self.mechanics:
-            effect.contribute(fields)
-        return Loading(**fields)
+    @property
+    def _stateful(self) -> bool:
+        return bool(self.compiled.histories)
 
     def solve(self, true_tension: float) -> SolveResult:
         """The true body's shape at base tension ``true_tension`` (N), frame tdcm_base.
 
-        Raises the model's typed errors at a physical limit or on non-convergence.
+        Raises the model's typed errors at a physical limit or on non-convergence; only a
+        converged result advances the mechanics effects' histories.
         """
         tension = check_tension(true_tension)
         cached = self._lookup(tension)
@@ -90,13 +100,13 @@ class World:
             return cached
         started = perf_counter()
         try:
-            result = solve(self.scene.true_design, tension, warm_start=self._warm_start(tension),
+            result = solve(self.bench.true_design, tension, warm_start=self._warm_start(tension),
                            loading=self.loading)
         finally:
             self.solves += 1
             self.solve_time_s += perf_counter() - started
-        for effect in self.mechanics:
-            effect.commit()
+        for history in self.compiled.histories:
+            history.advance(result)
         self._last = result
         if not self._stateful:
             self._cache[tension] = result
@@ -124,9 +134,9 @@ class World:
 
     def body_markers(self, result: SolveResult) -> Array:
         """True marker centres (k, 3) m in tdcm_base on the shape ``result``."""
-        scene = self.scene
-        s = np.asarray(scene.marker_arc_lengths, dtype=float)
-        radius, side = scene.marker_radius, scene.marker_side_rad
+        bench = self.bench
+        s = np.asarray(bench.marker_arc_lengths, dtype=float)
+        radius, side = bench.marker_radius, bench.marker_side
         for effect in self.sensing:
             s, radius, side = effect.placement(s, radius, side)
         points, _ = surface_points(result, s, radius, side)
@@ -141,7 +151,7 @@ class World:
         positions = self._rotation.apply(body) + self.true_mocap_to_base[0]
         for effect in self.sensing:
             positions = effect.observe(positions, stamp_s)
-        return MarkerFrame(labels=self.scene.marker_labels, positions=positions)
+        return MarkerFrame(labels=self.bench.marker_labels, positions=positions)
 
     def delay_s(self, topic: str) -> float:
         """Latency (s) of one message on ``topic``; 0.0 when the scene lists no latency."""

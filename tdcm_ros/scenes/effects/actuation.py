@@ -1,27 +1,23 @@
-"""Actuation effects: they set fields of the device twin's
-:class:`~tdcm_ros.device.plant.PlantConfig` (SI units; load cell in counts)."""
+"""Actuation effects: each returns the part of the device twin's
+:class:`~tdcm_ros.device.plant.PlantConfig` it sets (a :class:`~tdcm_ros.scenes.parts.PlantPart`,
+SI units; load cell in counts); the twin's plant runs them per sample."""
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
-
 from tdcm_ros.scenes.effects.base import Effect, register
 from tdcm_ros.scenes.params import Param
+from tdcm_ros.scenes.parts import PlantPart
 
 
 class ActuationEffect(Effect):
-    """Maps its parameters onto PlantConfig fields; the twin's plant runs them per sample."""
+    """Base of the actuation effects (:class:`~tdcm_ros.scenes.stages.Actuation`)."""
 
     stage = "actuation"
     cost_unit = "plant step"
-    #: scene parameter -> PlantConfig field
-    fields: ClassVar[dict[str, str]] = {}
 
-    def apply(self, plant: dict[str, Any]) -> None:
-        """Write this effect's values into the PlantConfig keyword arguments ``plant``."""
-        with self.timed():
-            for param, field in self.fields.items():
-                plant[field] = self.values[param]
+    def plant_part(self) -> PlantPart:
+        """The fields of the twin's ``PlantConfig`` this effect sets."""
+        raise NotImplementedError
 
 
 @register
@@ -38,7 +34,11 @@ class ActuatorDynamics(ActuationEffect):
         Param("deadband_m", "m", "dead zone: the actuator stops this short of its command", 0.0, low=0.0,
               high=0.01),
     )
-    fields: ClassVar[dict[str, str]] = {"lag_s": "lag", "rate_m_per_s": "rate", "deadband_m": "deadband"}
+
+    def plant_part(self) -> PlantPart:
+        with self.timed():
+            v = self.values
+            return PlantPart(lag=v["lag_s"], rate=v["rate_m_per_s"], deadband=v["deadband_m"])
 
 
 @register
@@ -55,8 +55,12 @@ class LoadCell(ActuationEffect):
               kind="int", low=1, high=10000),
         Param("drift_n_per_s", "N/s", "linear drift of the reading", 0.0, low=-1.0, high=1.0),
     )
-    fields: ClassVar[dict[str, str]] = {"noise_n": "noise", "bias_n": "bias", "quantum_counts": "quantum",
-              "drift_n_per_s": "drift"}
+
+    def plant_part(self) -> PlantPart:
+        with self.timed():
+            v = self.values
+            return PlantPart(noise=v["noise_n"], bias=v["bias_n"], quantum=v["quantum_counts"],
+                             drift=v["drift_n_per_s"])
 
 
 @register
@@ -71,4 +75,8 @@ class TendonCompliance(ActuationEffect):
         Param("slack_m", "m", "actuator travel before the tendon carries load", 0.002, low=0.0,
               high=0.02),
     )
-    fields: ClassVar[dict[str, str]] = {"stiffness_n_per_m": "stiffness", "slack_m": "slack"}
+
+    def plant_part(self) -> PlantPart:
+        with self.timed():
+            v = self.values
+            return PlantPart(stiffness=v["stiffness_n_per_m"], slack=v["slack_m"])

@@ -1,7 +1,10 @@
 """The effect registry and the base class every effect derives from.
 
-An effect is a small class registered by name with :func:`register`. Nothing builds one
-except :func:`build`, called by a scene for the effects it lists; :data:`CONSTRUCTED` counts
+An effect is a small class registered by name with :func:`register`; it derives from its
+stage's base class (``MechanicsEffect``, ``ActuationEffect``, ``SensingEffect``,
+``TimingEffect``), which implements the stage's protocol (:mod:`tdcm_ros.scenes.stages`).
+Nothing builds one except :func:`build`, called by the compile step
+(:mod:`tdcm_ros.scenes.compiled`) for the effects a scene lists; :data:`CONSTRUCTED` counts
 constructions per name so tests can check that an unlisted effect never exists. Each
 instance counts its calls and the wall time spent in them (:attr:`Effect.calls`,
 :attr:`Effect.time_s`).

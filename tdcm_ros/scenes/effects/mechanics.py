@@ -1,24 +1,24 @@
 """Mechanics effects: what the world's solve includes beyond the paper's base model.
 
-Each contributes fields of :class:`tdcm_ros.model.loading.Loading` (SI units, frame
-``tdcm_base``); the world builds one ``Loading`` from the listed effects only.
+Each returns the part of :class:`tdcm_ros.model.loading.Loading` it sets (a
+:class:`~tdcm_ros.scenes.parts.LoadingPart`, SI units, frame ``tdcm_base``); compiling a scene
+merges the parts of the listed effects only into the world's one ``Loading``.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any, ClassVar
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import Any
 
 from tdcm_ros.model.loading import NotchContact as NotchContactLaw
 from tdcm_ros.scenes.effects.base import Effect, EffectContext, register
+from tdcm_ros.scenes.effects.friction import FrictionState, StickSlipTension
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param
+from tdcm_ros.scenes.parts import LoadingPart
+from tdcm_ros.scenes.stages import SolveHistory
 
-Array = NDArray[np.float64]
 G_STANDARD = 9.80665
 
 
@@ -33,75 +33,39 @@ def planar(where: str, vector: tuple[float, ...]) -> tuple[float, float]:
 
 
 class MechanicsEffect(Effect):
-    """A load on the body inside the world's solve; ``stateful`` ones keep history between
-    solves (the world then cannot cache shapes by tension)."""
+    """Base of the mechanics effects (:class:`~tdcm_ros.scenes.stages.Mechanics`): a load on
+    the body inside the world's solve. ``history`` is None unless the effect keeps state
+    between solves (the world then cannot cache shapes by tension)."""
 
     stage = "mechanics"
     cost_unit = "solve"
-    stateful: ClassVar[bool] = False
+    history: SolveHistory | None = None
 
-    def contribute(self, loading: dict[str, Any]) -> None:
-        """Set this effect's fields of the ``Loading`` keyword arguments."""
+    def loading_part(self) -> LoadingPart:
+        """The fields of the world's ``Loading`` this effect sets."""
         raise NotImplementedError
-
-    def commit(self) -> None:
-        """The last solve converged and is the world's new state (stateful effects only)."""
 
 
 @register
 class TendonFriction(MechanicsEffect):
-    """Capstan friction between tendon and channel, stick-slip with loading/unloading hysteresis.
-
-    Where the tendon slips, the tension obeys the capstan law ``|dT/dw| = mu T`` against the
-    motion: pulled in (loading) it falls toward the tip, ``T_base exp(-mu w)``; paid out
-    (unloading) it rises, ``T_base exp(mu w)``, with ``w`` the tendon's turning from the base.
-    Where it sticks, the tension keeps its previous value. Both together: the new profile is
-    the previous one clipped to ``[T_base exp(-mu w), T_base exp(mu w)]`` (a play operator per
-    point), which starts from a slack tendon. The stuck state is kept per node (the solver asks
-    for the tension just before and just after each kink; the state is the latter), so a stuck
-    kink carries no friction jump: an error of about ``mu`` times the kink's turning.
-    """
+    """Capstan friction between tendon and channel, stick-slip with loading/unloading
+    hysteresis (see :mod:`tdcm_ros.scenes.effects.friction`): its ``history`` is the
+    :class:`FrictionState`, the profile it hands the model a :class:`StickSlipTension` over it."""
 
     name = "tendon_friction"
     summary = "capstan tension loss along the tendon, with stick-slip hysteresis"
-    stateful = True
     params = (Param("mu", "", "capstan friction coefficient tendon/channel", 0.05, low=0.0,
                     high=2.0),)
+    history: FrictionState
 
     def __init__(self, values: Mapping[str, Any], context: EffectContext) -> None:
         super().__init__(values, context)
-        self.mu = float(self.values["mu"])
-        self._state: tuple[Array, Array] | None = None
-        self._pending: tuple[Array, Array] | None = None
+        self.history = FrictionState()
 
-    def contribute(self, loading: dict[str, Any]) -> None:
-        loading["tension_profile"] = self
-
-    def __call__(self, s: Array, wrap_angle: Array, tension_base: float) -> Array:
-        """Tension at each node (N) for base tension ``tension_base`` (N)."""
+    def loading_part(self) -> LoadingPart:
         with self.timed():
-            low = tension_base * np.exp(-self.mu * wrap_angle)
-            high = tension_base * np.exp(self.mu * wrap_angle)
-            out = np.clip(self._previous(s), low, high)
-            self._pending = (np.array(s, dtype=float), out)
-            return out
-
-    def _previous(self, s: Array) -> Array:
-        if self._state is None:
-            return np.zeros_like(s, dtype=float)
-        s_prev, t_prev = self._state
-        if s_prev.shape == np.shape(s) and np.array_equal(s_prev, s):
-            return t_prev
-        return np.interp(s, s_prev, t_prev)
-
-    def commit(self) -> None:
-        if self._pending is not None:
-            self._state = self._pending
-
-    @property
-    def tension_along(self) -> tuple[Array, Array] | None:
-        """``(s, T)`` of the last committed solve, or ``None`` before the first."""
-        return self._state
+            return LoadingPart(tension_profile=StickSlipTension(float(self.values["mu"]),
+                                                                self.history))
 
 
 @register
@@ -124,12 +88,12 @@ class Gravity(MechanicsEffect):
                                     parameter=f"{where}.direction", value=[0, 0, 0],
                                     allowed="a non-zero [x, 0, z]")
 
-    def contribute(self, loading: dict[str, Any]) -> None:
+    def loading_part(self) -> LoadingPart:
         with self.timed():
             x, _, z = self.values["direction"]
             norm = math.hypot(x, z)
             weight = self.context.density * self.values["g"]
-            loading["body_force_density"] = (weight * x / norm, weight * z / norm)
+            return LoadingPart(body_force_density=(weight * x / norm, weight * z / norm))
 
 
 @register
@@ -148,11 +112,10 @@ class TipLoad(MechanicsEffect):
     def validate(cls, where: str, values: Mapping[str, Any], context: EffectContext) -> None:
         planar(f"{where}.force_n", values["force_n"])
 
-    def contribute(self, loading: dict[str, Any]) -> None:
+    def loading_part(self) -> LoadingPart:
         with self.timed():
             x, _, z = self.values["force_n"]
-            loading["tip_force"] = (x, z)
-            loading["tip_moment"] = self.values["moment_nm"]
+            return LoadingPart(tip_force=(x, z), tip_moment=self.values["moment_nm"])
 
 
 @register
@@ -165,6 +128,6 @@ class NotchContact(MechanicsEffect):
     params = (Param("stiffness_factor", "", "closed-notch stiffness / (E I0 of the uncut tube)",
                     1.0, low=0.0, low_open=True, high=1e6),)
 
-    def contribute(self, loading: dict[str, Any]) -> None:
+    def loading_part(self) -> LoadingPart:
         with self.timed():
-            loading["notch_contact"] = NotchContactLaw(self.values["stiffness_factor"])
+            return LoadingPart(notch_contact=NotchContactLaw(self.values["stiffness_factor"]))

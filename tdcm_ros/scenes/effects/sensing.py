@@ -18,13 +18,14 @@ from scipy.spatial.transform import Rotation
 from tdcm_ros.scenes.effects.base import Effect, EffectContext, register
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param
+from tdcm_ros.scenes.stages import Pose
 
 Array = NDArray[np.float64]
-Pose = tuple[Array, Array]  # translation (3,) m, quaternion (x, y, z, w)
 
 
 class SensingEffect(Effect):
-    """A property of the markers or the motion capture; see the module docstring."""
+    """Base of the sensing effects (:class:`~tdcm_ros.scenes.stages.Sensing`): a property of
+    the markers or the motion capture; each hook defaults to "no change"."""
 
     stage = "sensing"
     cost_unit = "sample"

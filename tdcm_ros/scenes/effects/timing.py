@@ -13,14 +13,23 @@ from tdcm_ros.scenes.params import Param
 LATENCY_TOPICS = ("markers", "tension")
 
 
+class TimingEffect(Effect):
+    """Base of the timing effects (:class:`~tdcm_ros.scenes.stages.Timing`)."""
+
+    stage = "timing"
+    cost_unit = "message"
+
+    def delay(self, topic: str) -> float:
+        """One delay draw (s) for ``topic`` (one of :data:`LATENCY_TOPICS`)."""
+        raise NotImplementedError
+
+
 @register
-class Latency(Effect):
+class Latency(TimingEffect):
     """Delay of each message of a topic: ``mean + jitter * u``, ``u`` uniform in [-1, 1]."""
 
     name = "latency"
-    stage = "timing"
     summary = "per-topic delay with uniform jitter"
-    cost_unit = "message"
     params = tuple(
         Param(f"{topic}{suffix}", "s", f"{what} of the {topic} topic", 0.0, low=0.0, high=10.0)
         for topic in LATENCY_TOPICS
@@ -38,8 +47,7 @@ class Latency(Effect):
                     allowed=f"[0, {mean:g}] s")
 
     def delay(self, topic: str) -> float:
-        """One delay draw (s) for ``topic`` (one of :data:`LATENCY_TOPICS`)."""
         with self.timed():
-            mean = self.values[f"{topic}_s"]
-            jitter = self.values[f"{topic}_jitter_s"]
+            mean: float = self.values[f"{topic}_s"]
+            jitter: float = self.values[f"{topic}_jitter_s"]
             return mean + jitter * float(self.rng.uniform(-1.0, 1.0)) if jitter else mean
