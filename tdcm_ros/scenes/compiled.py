@@ -47,7 +47,7 @@ class Bench:
     marker_labels: tuple[str, ...]
     marker_arc_lengths: tuple[float, ...]
     marker_radius: float
-    marker_side: float
+    marker_side_rad: float
     mocap_pose: Pose = field(repr=False)
 
 

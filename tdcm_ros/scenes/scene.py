@@ -85,7 +85,7 @@ class Scene:
         """The world of this scene without its effects."""
         return Bench(true_design=self.true_design, marker_labels=self.marker_labels,
                      marker_arc_lengths=self.marker_arc_lengths,
-                     marker_radius=self.marker_radius, marker_side=self.marker_side_rad,
+                     marker_radius=self.marker_radius, marker_side_rad=self.marker_side_rad,
                      mocap_pose=self.mocap_pose)
 
     def compile(self, stages: Collection[str] = STAGES) -> CompiledScene:

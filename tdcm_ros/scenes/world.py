@@ -136,7 +136,7 @@ class World:
         """True marker centres (k, 3) m in tdcm_base on the shape ``result``."""
         bench = self.bench
         s = np.asarray(bench.marker_arc_lengths, dtype=float)
-        radius, side = bench.marker_radius, bench.marker_side
+        radius, side = bench.marker_radius, bench.marker_side_rad
         for effect in self.sensing:
             s, radius, side = effect.placement(s, radius, side)
         points, _ = surface_points(result, s, radius, side)
