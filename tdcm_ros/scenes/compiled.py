@@ -12,8 +12,7 @@ from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-from tdcm_ros.model import Design
-from tdcm_ros.model.loading import Loading
+from tdcm_ros.model import Design, Loading
 from tdcm_ros.scenes.effects import REGISTRY, STAGES, Effect, EffectContext, build
 from tdcm_ros.scenes.effects.actuation import ActuationEffect
 from tdcm_ros.scenes.effects.mechanics import MechanicsEffect
