@@ -89,11 +89,11 @@ def compile_scene(bench: Bench, effects: Mapping[str, Mapping[str, Any]], contex
 
     mechanics = listed("mechanics", MechanicsEffect)
     actuation = listed("actuation", ActuationEffect)
-    loading = merge(LoadingPart, ((e.name, e.loading_part()) for e in mechanics))
+    loading_part = merge(LoadingPart, ((e.name, e.loading_part()) for e in mechanics))
     return CompiledScene(
         bench=bench, mechanics=mechanics, actuation=actuation,
         sensing=listed("sensing", SensingEffect), timing=listed("timing", TimingEffect),
-        loading=loading.loading() if mechanics else None,
+        loading=loading_part.loading() if mechanics else None,
         plant=merge(PlantPart, ((e.name, e.plant_part()) for e in actuation)),
         histories=tuple(e.history for e in mechanics if e.history is not None))
 
