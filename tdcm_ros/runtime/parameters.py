@@ -11,11 +11,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Generic, TypeVar, cast
 
 from tdcm_ros.errors import InputError
 
 ParamValue = bool | int | float | str | list[bool] | list[int] | list[float] | list[str]
+#: The type of one parameter: that of its default (a declared value keeps it).
+P = TypeVar("P", bound=ParamValue)
 Validator = Callable[[Any], None]
 SetCallback = Callable[[Mapping[str, Any]], None]
 _WIDENING = {("float", "int"), ("list[float]", "list[int]")}
@@ -51,11 +53,11 @@ def _kind(value: Any) -> str:
 
 
 @dataclass(frozen=True)
-class ParamSpec:
+class ParamSpec(Generic[P]):
     """A declared parameter. ``range`` is inclusive ``(low, high)`` in the parameter's unit."""
 
     name: str
-    default: ParamValue
+    default: P
     description: str = ""
     range: tuple[float, float] | None = None
     validator: Validator | None = None
@@ -66,7 +68,7 @@ class ParamSpec:
         """``bool``, ``int``, ``float``, ``str`` or ``list[...]``."""
         return _kind(self.default)
 
-    def coerce(self, value: Any) -> ParamValue:
+    def coerce(self, value: Any) -> P:
         """The value converted to this parameter's type and checked; raises ``InputError``."""
         kind, given = self.kind, _kind(value)
         compatible = (given == kind or (kind, given) in _WIDENING
@@ -96,7 +98,7 @@ class ParamSpec:
                                      allowed=f"[{low}, {high}]")
         if self.validator is not None:
             self.validator(coerced)
-        return coerced
+        return cast(P, coerced)  # the kind checks above give it the default's type
 
 
 class ParameterStore:
@@ -104,11 +106,11 @@ class ParameterStore:
 
     def __init__(self, overrides: Mapping[str, Any] | None = None) -> None:
         self._overrides = dict(overrides or {})
-        self._specs: dict[str, ParamSpec] = {}
+        self._specs: dict[str, ParamSpec[Any]] = {}
         self._values: dict[str, ParamValue] = {}
         self._callbacks: list[SetCallback] = []
 
-    def declare(self, spec: ParamSpec, value: Any = None) -> ParamValue:
+    def declare(self, spec: ParamSpec[P], value: Any = None) -> P:
         """Declare ``spec``; its value is ``value`` if given (a runtime resolved it), else the
         override (YAML) if any, else the default; checked against the spec."""
         if spec.name in self._specs:
@@ -130,7 +132,7 @@ class ParameterStore:
         self._callbacks.append(callback)
 
     @property
-    def specs(self) -> Mapping[str, ParamSpec]:
+    def specs(self) -> Mapping[str, ParamSpec[Any]]:
         """Declared specs by name."""
         return dict(self._specs)
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, Literal, Protocol
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.parameters import ParamValue, SetCallback, Validator
+from tdcm_ros.runtime.parameters import P, SetCallback, Validator
 
 Reliability = Literal["reliable", "best_effort"]
 Durability = Literal["volatile", "transient_local"]
@@ -95,16 +95,21 @@ class NodePort(Protocol):
 
     node_name: str
     namespace: str
-    logger: Logger
 
-    def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
+    @property
+    def logger(self) -> Logger:
+        """The node's logger."""
+
+    def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> ParamValue:
-        """Declare a parameter; returns its value (YAML override or default), checked."""
+                          read_only: bool = False) -> P:
+        """Declare a parameter; returns its value (YAML override or default), checked, of the
+        default's type."""
 
-    def get_parameter(self, name: str) -> ParamValue:
-        """Current value of a declared parameter."""
+    def get_parameter(self, name: str) -> Any:
+        """Current value of a declared parameter, of its default's type (``Any`` statically:
+        the type depends on the name)."""
 
     def add_on_set_parameters(self, callback: SetCallback) -> None:
         """Add a check run on each runtime change ``{name: value}``; raise ``InputError`` to reject."""

@@ -28,6 +28,7 @@ from tdcm_ros.runtime import wire
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.guard import CallbackGuard
 from tdcm_ros.runtime.parameters import (
+    P,
     ParameterStore,
     ParamSpec,
     ParamValue,
@@ -35,7 +36,7 @@ from tdcm_ros.runtime.parameters import (
     Validator,
 )
 from tdcm_ros.runtime.params import node_parameters
-from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
+from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
 from tdcm_ros.runtime.wire import RawSample
 from tdcm_ros.yamlio import load_yaml
 
@@ -152,10 +153,10 @@ class RclpyNodePort:
         node.add_pre_set_parameters_callback(self._widen)
         node.add_on_set_parameters_callback(self._on_set)
 
-    def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
+    def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> ParamValue:
+                          read_only: bool = False) -> P:
         """Declare on the rclpy node with the checked override or default; returns the value."""
         from rclpy.exceptions import (
             InvalidParameterTypeException,
@@ -274,6 +275,10 @@ class RclpyNodePort:
     def now_ns(self) -> int:
         """The node clock (ROS time if ``use_sim_time``), ns."""
         return int(self.node.get_clock().now().nanoseconds)
+
+
+#: The type checker holds the port to the protocol every node is written against.
+_CONTRACT: type[NodePort] = RclpyNodePort
 
 
 class RclpyContext:

@@ -49,13 +49,14 @@ from tdcm_ros.runtime.names import (
     resolve_topic,
 )
 from tdcm_ros.runtime.parameters import (
+    P,
     ParameterStore,
     ParamSpec,
     ParamValue,
     SetCallback,
     Validator,
 )
-from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
+from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
 from tdcm_ros.runtime.wire import RawSample
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
@@ -290,10 +291,10 @@ class ZenohNodePort:
             param_key(context.domain_id, self.fqn, "*"), self._on_param_query)
 
     # parameters
-    def declare_parameter(self, name: str, default: ParamValue, *, description: str = "",
+    def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> ParamValue:
+                          read_only: bool = False) -> P:
         """Declare a parameter; returns the YAML override or the default, validated."""
         return self._params.declare(ParamSpec(name, default, description, range, validator,
                                               read_only))
@@ -404,6 +405,10 @@ class ZenohNodePort:
         self._entities.clear()
         self._queryable.undeclare()
         self._token.undeclare()
+
+
+#: The type checker holds the port to the protocol every node is written against.
+_CONTRACT: type[NodePort] = ZenohNodePort
 
 
 class ZenohContext:

@@ -19,6 +19,7 @@ from runtime_helpers import stop, wait_for
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.guard import CallbackGuard
+from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.port import NodeLogic, QoS
 from tdcm_ros.runtime.run_node import LOOP_DIED, run_node
 
@@ -78,8 +79,8 @@ class _DyingContext:
     def __init__(self) -> None:
         self.closed = False
 
-    def create_port(self, name: str, namespace: str, overrides: Any) -> Any:
-        return type("Port", (), {"logger": logging.getLogger("dying"), "node_name": name})()
+    def create_port(self, name: str, namespace: str, overrides: Any) -> MemoryPort:
+        return MemoryPort(overrides, name=name, namespace=namespace)
 
     def spin(self) -> None:
         raise RuntimeError("executor internals broke")

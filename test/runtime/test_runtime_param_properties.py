@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from conftest import private_domain_id, require_rclpy
+from graph_fixtures import private_domain_id, require_rclpy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -8,7 +8,7 @@ import sys
 from typing import Any
 
 import pytest
-from conftest import REPO, private_domain_id, require_rclpy
+from graph_fixtures import REPO, private_domain_id, require_rclpy
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.talker import Talker

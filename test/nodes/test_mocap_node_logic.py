@@ -4,22 +4,28 @@ arc-length labelling on the predicted axis, CSV replay timing and configuration 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
 from mocap_helpers import DATA, nexus_text, straight_and_bent
-from mocap_memory_port import MemoryPort
 
 import tdcm_ros.scenes
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
 from tdcm_ros.mocap import read_nexus_csv
 from tdcm_ros.nodes.mocap_node import MocapNode
+from tdcm_ros.runtime.memory_port import MemoryPort
 
 LABELS = ("m1", "m2", "m3")
 ARCS = (0.015, 0.033, 0.053)
 SAMPLE = str(DATA / "nexus_trial.csv")
 RELABEL = {"source": "relabel", "relabel.input_topic": "/vicon/markers"}
+
+
+def mocap_port(overrides: dict[str, Any]) -> MemoryPort:
+    """An in-memory port named like the node's executable."""
+    return MemoryPort(overrides, name="mocap_node")
 
 
 def xyz(message) -> np.ndarray:
@@ -78,7 +84,7 @@ def wrench(tension: float):
 def test_sim_source_samples_the_scene_world_at_its_rate_with_its_delay(monkeypatch):
     scene = DoubleScene()
     monkeypatch.setattr(tdcm_ros.scenes, "load_scene", lambda name: scene)
-    port = MemoryPort({"source": "sim", "sim.scene": "double"})
+    port = mocap_port({"source": "sim", "sim.scene": "double"})
     node = MocapNode(port)
     (tf,) = port.messages("/tf_static")
     t = tf.transforms[0].transform.translation
@@ -92,7 +98,7 @@ def test_sim_source_samples_the_scene_world_at_its_rate_with_its_delay(monkeypat
     port.advance(0.2)
     calls = scene.the_world.calls
     assert len(calls) == 25 and np.allclose(np.diff([s for s, _ in calls]), 0.02, atol=1e-6)
-    published = port.published["markers"]
+    published = port.sent("markers")
     assert len(published) == 22                   # samples of the last 50 ms are still delayed
     for (sent_ns, message), (stamp_s, tension) in zip(published, calls, strict=False):
         assert abs(stamp(message) - stamp_s * 1e9) < 1e3      # float s since the epoch
@@ -111,7 +117,7 @@ def test_sim_source_samples_the_scene_world_at_its_rate_with_its_delay(monkeypat
 def test_arc_length_labelling_follows_the_predicted_axis():
     # Registration: tdcm_base is rotated 90 deg about mocap x and offset.
     rpy = [math.pi / 2, 0.0, 0.0]
-    port = MemoryPort({"source": "relabel", "relabel.input_topic": "/vicon/markers",
+    port = mocap_port({"source": "relabel", "relabel.input_topic": "/vicon/markers",
                        "labelling.mode": "arc_length", "labelling.axis": "predicted",
                        "labelling.max_distance": 0.005, "registration.mode": "rpy",
                        "registration.rpy": rpy, "registration.translation": [1.0, 2.0, 3.0]})
@@ -145,7 +151,7 @@ def test_arc_length_labelling_follows_the_predicted_axis():
 
 
 def test_csv_replay_through_the_node_publishes_every_row_once():
-    port = MemoryPort({"source": "csv", "csv.path": SAMPLE, "csv.rate_scale": 2.0,
+    port = mocap_port({"source": "csv", "csv.path": SAMPLE, "csv.rate_scale": 2.0,
                        "csv.start_delay_s": 0.5,
                        "labelling.map": ["TDCM:M1=m1", "TDCM:M2=m2", "TDCM:M3=m3"]})
     MocapNode(port)
@@ -176,7 +182,7 @@ def test_registration_estimated_from_recordings_is_published_on_tf_static(tmp_pa
     names = ["TDCM:M1", "TDCM:M2", "TDCM:M3"]
     (tmp_path / "zero.csv").write_text(nexus_text(names, np.repeat(zero[None], 3, axis=0)))
     (tmp_path / "bent.csv").write_text(nexus_text(names, np.stack([zero, bent])))
-    port = MemoryPort({**RELABEL, "labelling.map": ["M1=m1", "M2=m2", "M3=m3"],
+    port = mocap_port({**RELABEL, "labelling.map": ["M1=m1", "M2=m2", "M3=m3"],
                        "registration.mode": "estimate",
                        "registration.zero_csv": str(tmp_path / "zero.csv"),
                        "registration.bent_csv": str(tmp_path / "bent.csv")})
@@ -205,7 +211,7 @@ def test_registration_estimated_from_recordings_is_published_on_tf_static(tmp_pa
 ])
 def test_bad_configuration_is_a_typed_error_naming_the_parameter(values, parameter):
     with pytest.raises(InputError) as caught:
-        MocapNode(MemoryPort(values))
+        MocapNode(mocap_port(values))
     assert caught.value.parameter == parameter
 
 
@@ -216,7 +222,7 @@ def test_sim_source_with_the_real_ideal_scene_publishes_the_model_markers():
     from tdcm_ros.scenes import load_scene
 
     scene = load_scene("ideal")
-    port = MemoryPort({"source": "sim", "sim.scene": "ideal"})
+    port = mocap_port({"source": "sim", "sim.scene": "ideal"})
     MocapNode(port)
     port.deliver("sim/tension_true", wrench(15.0))
     port.advance(0.1)
@@ -239,10 +245,10 @@ def test_shipped_config_file_starts_the_node():
 
     config = Path(__file__).resolve().parents[2] / "config" / "mocap_node.yaml"
     values = node_parameters(str(config), "/mocap_node")
-    port = MemoryPort(values)
+    port = mocap_port(values)
     MocapNode(port)
     port.advance(0.05)
     assert port.messages("markers") and port.messages("/tf_static")
-    relabel = MemoryPort({**values, "source": "relabel"})
+    relabel = mocap_port({**values, "source": "relabel"})
     MocapNode(relabel)
     assert "/vicon/markers" in relabel.subscriptions

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -17,55 +16,15 @@ from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.synthetic import Recording, simulate
 from tdcm_ros.model import preset
 from tdcm_ros.nodes.metrics_node import MetricsNode
-from tdcm_ros.runtime.parameters import ParamSpec
+from tdcm_ros.runtime.memory_port import MemoryPort
 
 DESIGN = preset("paper-experiment").with_overrides(E=0.7e9)
 
 
-class Port:
-    """A NodePort in memory: parameters checked like the runtimes, messages kept per topic."""
-
-    node_name = "metrics_node"
-    namespace = "/"
-
-    def __init__(self, overrides: dict[str, Any] | None = None) -> None:
-        self.overrides = {"design.E": DESIGN.E, **(overrides or {})}
-        self.params: dict[str, Any] = {}
-        self.published: dict[str, list[Any]] = {}
-        self.subs: dict[str, Callable[[Any], None]] = {}
-        self.timers: list[Callable[[], None]] = []
-        self.clock_ns = 0
-
-    def declare_parameter(self, name: str, default: Any, **kw: Any) -> Any:
-        spec = ParamSpec(name, default, kw.get("description", ""), kw.get("range"),
-                         kw.get("validator"), kw.get("read_only", False))
-        self.params[name] = spec.coerce(self.overrides.get(name, default))
-        return self.params[name]
-
-    def get_parameter(self, name: str) -> Any:
-        return self.params[name]
-
-    def add_on_set_parameters(self, callback: Any) -> None:
-        pass
-
-    def create_publisher(self, topic: str, type_name: str, qos: Any = None) -> Any:
-        sink = self.published.setdefault(topic, [])
-
-        class Pub:
-            def publish(self, message: Any) -> None:
-                sink.append(message)
-
-        return Pub()
-
-    def create_subscription(self, topic: str, type_name: str, callback: Any,
-                            qos: Any = None) -> None:
-        self.subs[topic] = callback
-
-    def create_timer(self, period: float, callback: Callable[[], None]) -> None:
-        self.timers.append(callback)
-
-    def now_ns(self) -> int:
-        return self.clock_ns
+def metrics_port(overrides: dict[str, Any] | None = None) -> MemoryPort:
+    """An in-memory port of metrics_node on the simulated robot's modulus, clock at 0."""
+    return MemoryPort({"design.E": DESIGN.E, **(overrides or {})}, name="metrics_node",
+                      start_ns=0)
 
 
 def _hdr(stamp_s: float, frame: str) -> dict[str, Any]:
@@ -73,18 +32,18 @@ def _hdr(stamp_s: float, frame: str) -> dict[str, Any]:
     return {"stamp": {"sec": ns // 10**9, "nanosec": ns % 10**9}, "frame_id": frame}
 
 
-def feed(port: Port, node: MetricsNode, rec: Recording, every_s: float = 0.5) -> None:
+def feed(port: MemoryPort, node: MetricsNode, rec: Recording, every_s: float = 0.5) -> None:
     """Deliver the recording in stamp order, running the update timer every ``every_s``."""
     tension, markers = rec.tension, rec.markers
     labels = markers.labels
     fi, next_update = 0, every_s
     for t, x in zip(tension.stamps_s, tension.tension_n, strict=True):
         port.clock_ns = round(t * 1e9)
-        port.subs["tension"](from_dict("geometry_msgs/msg/WrenchStamped", {
+        port.deliver("tension", from_dict("geometry_msgs/msg/WrenchStamped", {
             "header": _hdr(t, "tdcm_tendon"), "wrench": {"force": {"z": float(x)}}}))
         while fi < markers.stamps_s.size and markers.stamps_s[fi] <= t:
             rows = markers.positions[fi]
-            port.subs["markers"](from_dict("mocap4r2_msgs/msg/Markers", {
+            port.deliver("markers", from_dict("mocap4r2_msgs/msg/Markers", {
                 "header": _hdr(markers.stamps_s[fi], "mocap"), "frame_number": fi,
                 "markers": [{"marker_name": labels[i], "marker_index": i,
                              "translation": {"x": r[0], "y": r[1], "z": r[2]}}
@@ -123,9 +82,9 @@ def test_streaming_matches_the_offline_evaluation(recording: Recording) -> None:
 
 
 def test_node_publishes_errors_and_the_running_table(recording: Recording) -> None:
-    port = Port()
+    port = metrics_port()
     node = MetricsNode(port)
-    port.subs["/tf_static"](from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
+    port.deliver("/tf_static", from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
         "header": _hdr(0.0, "mocap"), "child_frame_id": "tdcm_base",
         "transform": {"translation": dict(zip("xyz", recording.registration.translation,
                                               strict=True)),
@@ -153,9 +112,9 @@ def test_node_publishes_errors_and_the_running_table(recording: Recording) -> No
 
 
 def test_node_estimates_the_registration_without_tf(recording: Recording) -> None:
-    port = Port({"registration.source": "estimate"})
+    port = metrics_port({"registration.source": "estimate"})
     node = MetricsNode(port)
-    assert "/tf_static" not in port.subs
+    assert "/tf_static" not in port.subscriptions
     feed(port, node, recording)
     table = json.loads(port.published["metrics/table"][-1].data)
     assert table["details"]["sources"][0]["registration"]["method"] == "estimated"
@@ -163,7 +122,7 @@ def test_node_estimates_the_registration_without_tf(recording: Recording) -> Non
 
 
 def test_stale_inputs_and_no_registration_warn() -> None:
-    port = Port({"registration.source": "tf_static", "stale_s": 0.5})
+    port = metrics_port({"registration.source": "tf_static", "stale_s": 0.5})
     node = MetricsNode(port)
     port.clock_ns = 10**10
     node.report()
@@ -186,4 +145,4 @@ def test_bad_parameters_are_rejected(name: str, value: Any, match: str) -> None:
     if name == "registration.rotation":
         overrides["registration.source"] = "parameter"
     with pytest.raises(InputError, match=match):
-        MetricsNode(Port(overrides))
+        MetricsNode(metrics_port(overrides))

@@ -158,7 +158,7 @@ def test_node_survives_its_peer_restarting(runtime, context, graph_env):
     spawn_node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", MODEL],
                                   env=graph_env)
     probe = Probe(context)
-    peer = Path(__file__).with_name("peer_publisher.py")
+    peer = Path(__file__).resolve().parents[1] / "runtime" / "peer_publisher.py"
     try:
         for _ in range(2):
             publisher = subprocess.Popen([sys.executable, str(peer), "16.0"], env=graph_env)

@@ -1,0 +1,153 @@
+"""An in-memory :class:`~tdcm_ros.runtime.port.NodePort` with a manual clock: node logic runs
+in-process, with no zenoh and no rclpy (tests, examples, offline replays).
+
+Parameters are checked by the same :class:`ParameterStore` as both runtimes. Messages make a CDR
+round trip on the way in (:meth:`MemoryPort.deliver`) and out (``publish``), as a transport
+would carry them, and are kept per topic as the node names it (not resolved). Timers fire only
+when the clock is moved with :meth:`MemoryPort.advance`::
+
+    port = MemoryPort({"period": 0.1}, name="talker")
+    node = Talker(port)
+    port.advance(1.0)                      # ten ticks
+    port.messages("chatter")
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import defaultdict
+from collections.abc import Callable
+from typing import Any
+
+from tdcm_ros.bagio import deserialize, serialize
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.names import fully_qualified_node_name
+from tdcm_ros.runtime.parameters import (
+    P,
+    ParameterStore,
+    ParamSpec,
+    ParamValue,
+    SetCallback,
+    Validator,
+)
+from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
+
+
+class MemoryPublisher:
+    """A publisher whose messages land in its port's :attr:`MemoryPort.published`."""
+
+    def __init__(self, port: MemoryPort, topic: str, type_name: str, qos: QoS) -> None:
+        self.port, self.topic, self.type_name, self.qos = port, topic, type_name, qos
+
+    def publish(self, message: Any) -> None:
+        """Keep the message after a CDR round trip, stamped with the port's clock."""
+        self.publish_cdr(serialize(message, self.type_name))
+
+    def publish_cdr(self, data: bytes) -> None:
+        """Keep the decoded CDR bytes, stamped with the port's clock."""
+        self.port.published[self.topic].append(deserialize(data, self.type_name))
+        self.port.sent_ns[self.topic].append(self.port.clock_ns)
+
+
+class MemoryTimer:
+    """A periodic timer due every ``period_ns`` of the port's clock."""
+
+    def __init__(self, period_ns: int, callback: Callable[[], None], now_ns: int) -> None:
+        self.period_ns, self.callback = period_ns, callback
+        self.due_ns = now_ns + period_ns
+        self.cancelled = False
+
+    def cancel(self) -> None:
+        """Stop the timer; it does not fire again."""
+        self.cancelled = True
+
+
+class MemoryPort:
+    """NodePort of one node: parameters from ``overrides``, a clock at ``start_ns`` (ns since
+    the UNIX epoch), published messages and their send times (ns) per topic."""
+
+    def __init__(self, overrides: dict[str, Any] | None = None, *, name: str = "node",
+                 namespace: str = "/", start_ns: int = 1_700_000_000_000_000_000) -> None:
+        self.node_name, self.namespace = name, namespace
+        self.logger = logging.getLogger(fully_qualified_node_name(namespace, name))
+        self.store = ParameterStore(overrides)
+        self.clock_ns = start_ns
+        self.published: defaultdict[str, list[Any]] = defaultdict(list)
+        self.sent_ns: defaultdict[str, list[int]] = defaultdict(list)
+        self.publishers: dict[str, MemoryPublisher] = {}
+        self.subscriptions: dict[str, tuple[str, Callable[[Any], None], QoS]] = {}
+        self.timers: list[MemoryTimer] = []
+
+    def declare_parameter(self, name: str, default: P, *, description: str = "",
+                          range: tuple[float, float] | None = None,
+                          validator: Validator | None = None,
+                          read_only: bool = False) -> P:
+        """Declare a parameter; returns the override or the default, checked."""
+        return self.store.declare(ParamSpec(name, default, description, range, validator,
+                                            read_only))
+
+    def get_parameter(self, name: str) -> ParamValue:
+        """Current value of a declared parameter."""
+        return self.store.get(name)
+
+    def add_on_set_parameters(self, callback: SetCallback) -> None:
+        """Add a check run on each change made with :meth:`ParameterStore.set` on :attr:`store`."""
+        self.store.add_on_set(callback)
+
+    def create_publisher(self, topic: str, type_name: str,
+                         qos: QoS = DEFAULT_QOS) -> MemoryPublisher:
+        """A publisher on ``topic``; its messages go to ``published[topic]``."""
+        self.publishers[topic] = MemoryPublisher(self, topic, type_name, qos)
+        return self.publishers[topic]
+
+    def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
+                            qos: QoS = DEFAULT_QOS) -> None:
+        """Subscribe; :meth:`deliver` hands ``callback`` the messages."""
+        self.subscriptions[topic] = (type_name, callback, qos)
+
+    def create_timer(self, period: float, callback: Callable[[], None]) -> MemoryTimer:
+        """Call ``callback`` every ``period`` s of the port's clock (see :meth:`advance`)."""
+        if not period > 0:
+            raise InputError(f"timer period = {period!r} s must be > 0", parameter="period",
+                             value=period, allowed="> 0 s")
+        timer = MemoryTimer(round(period * 1e9), callback, self.clock_ns)
+        self.timers.append(timer)
+        return timer
+
+    def now_ns(self) -> int:
+        """The port's clock, ns since the UNIX epoch."""
+        return self.clock_ns
+
+    def deliver(self, topic: str, message: Any) -> None:
+        """Hand ``message`` to the subscription on ``topic`` after a CDR round trip."""
+        if topic not in self.subscriptions:
+            raise RuntimePortError(f"no subscription on {topic!r}; subscribed: "
+                                   f"{sorted(self.subscriptions)}")
+        type_name, callback, _ = self.subscriptions[topic]
+        callback(deserialize(serialize(message, type_name), type_name))
+
+    def advance(self, seconds: float) -> None:
+        """Move the clock forward by ``seconds`` (s), firing the timers due in time order."""
+        end = self.clock_ns + round(seconds * 1e9)
+        while True:
+            live = [t for t in self.timers if not t.cancelled and t.due_ns <= end]
+            if not live:
+                break
+            timer = min(live, key=lambda t: t.due_ns)
+            self.clock_ns = timer.due_ns
+            timer.due_ns += timer.period_ns
+            timer.callback()
+        self.clock_ns = end
+
+    def messages(self, topic: str) -> list[Any]:
+        """The messages published on ``topic`` so far, in order."""
+        return list(self.published[topic])
+
+    def sent(self, topic: str) -> list[tuple[int, Any]]:
+        """``(send time (ns), message)`` of each message published on ``topic``."""
+        return list(zip(self.sent_ns[topic], self.published[topic], strict=True))
+
+
+#: The type checker holds the port to the protocol every node is written against.
+_CONTRACT: type[NodePort] = MemoryPort

@@ -1,0 +1,168 @@
+"""Fixtures for multi-process node tests on both runtimes (test/runtime and test/nodes import
+them into their conftest.py; ``pythonpath`` in setup.cfg puts this folder on the import path).
+
+``runtime`` runs a test twice: on the embedded zenoh runtime (a router on a private loopback
+port) and on rclpy (a private ``ROS_DOMAIN_ID``, discovery on this host only). Nodes started with
+``spawn`` pick the runtime up from ``TDCM_RUNTIME``; ``context`` is the test's own peer on that
+runtime (a zenoh context, or plain rclpy nodes); ``params`` is a parameter client (the zenoh
+one, or rclpy's ``AsyncParameterClient``). The rclpy half is marked ``rclpy``; where rclpy is not
+importable it is skipped, unless ``TDCM_REQUIRE_RCLPY=1`` (CI's ROS step), where that fails.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from runtime_helpers import free_port, listening, stop, wait_for
+
+REPO = Path(__file__).resolve().parents[2]
+RUNTIMES = ["zenoh", pytest.param("rclpy", marks=pytest.mark.rclpy)]
+_domains = itertools.count()
+
+
+def private_domain_id() -> int:
+    """A ROS domain id in 100..199 that differs between tests and between parallel runs."""
+    return 100 + (os.getpid() * 7 + next(_domains)) % 100
+
+
+def require_rclpy() -> None:
+    """Skip without rclpy, or fail when ``TDCM_REQUIRE_RCLPY=1``."""
+    try:
+        import rclpy  # noqa: F401
+    except ImportError as error:
+        if os.environ.get("TDCM_REQUIRE_RCLPY") == "1":
+            pytest.fail(f"TDCM_REQUIRE_RCLPY=1 but rclpy is not importable: {error}")
+        pytest.skip("rclpy is not importable (no ROS 2 Jazzy); run .ci/ros.sh for the rclpy half")
+
+
+def _base_env(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("TDCM_ZENOH_CONFIG", raising=False)
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
+        [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])]))
+
+
+@pytest.fixture
+def zenoh_env(monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
+    """Environment (also applied to this process) pointing at a private router port."""
+    port = free_port()
+    monkeypatch.setenv("TDCM_ZENOH_ENDPOINT", f"tcp/127.0.0.1:{port}")
+    monkeypatch.setenv("TDCM_RUNTIME", "zenoh")
+    monkeypatch.setenv("ROS_DOMAIN_ID", "0")
+    _base_env(monkeypatch)
+    return {**os.environ, "ZENOH_TEST_PORT": str(port)}
+
+
+@pytest.fixture(params=RUNTIMES)
+def runtime(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> str:
+    """``zenoh`` or ``rclpy``; sets the environment the test and its children share."""
+    if request.param == "rclpy":
+        require_rclpy()
+        monkeypatch.setenv("TDCM_RUNTIME", "rclpy")
+        monkeypatch.setenv("ROS_DOMAIN_ID", str(private_domain_id()))
+        monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        _base_env(monkeypatch)
+    else:
+        request.getfixturevalue("router")
+    return str(request.param)
+
+
+@pytest.fixture
+def graph_env(runtime: str) -> dict[str, str]:
+    """The environment of the chosen runtime, for children."""
+    return dict(os.environ)
+
+
+def _spawner(env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen[bytes]]]:
+    children: list[subprocess.Popen[bytes]] = []
+
+    def start(*args: str) -> subprocess.Popen[bytes]:
+        child = subprocess.Popen([sys.executable, "-m", *args], env=env, cwd=REPO,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        children.append(child)
+        return child
+
+    yield start
+    for child in children:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+
+
+@pytest.fixture
+def spawn(request: pytest.FixtureRequest) -> Iterator[Callable[..., subprocess.Popen[bytes]]]:
+    """Start ``python -m <args>`` children (runtime of the test, else zenoh); stopped at teardown."""
+    name = "graph_env" if "runtime" in request.fixturenames else "zenoh_env"
+    yield from _spawner(request.getfixturevalue(name))
+
+
+@pytest.fixture
+def router(zenoh_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
+    """A zenoh router (tdcm_ros.runtime.router) on the private port."""
+    pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
+    port = int(zenoh_env["ZENOH_TEST_PORT"])
+    process = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.router", "--listen",
+                                f"tcp/127.0.0.1:{port}"], env=zenoh_env, cwd=REPO,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        wait_for(lambda: listening(port), 10.0, "the router")
+        yield process
+    finally:
+        if process.poll() is None:
+            stop(process)
+
+
+@pytest.fixture
+def context(request: pytest.FixtureRequest) -> Iterator[Any]:
+    """The test's own peer on the test's runtime (zenoh when the test has no ``runtime``)."""
+    if "runtime" in request.fixturenames and request.getfixturevalue("runtime") == "rclpy":
+        from plain_rclpy import PlainRclpyContext
+
+        ctx: Any = PlainRclpyContext()
+    else:
+        request.getfixturevalue("router")
+        from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+        ctx = ZenohContext()
+    yield ctx
+    ctx.close()
+
+
+class ZenohParameterClient:
+    """The embedded runtime's parameter client, in the same shape as the rclpy one."""
+
+    def __init__(self, ctx: Any, node_fqn: str) -> None:
+        self.ctx, self.node_fqn = ctx, node_fqn
+
+    def _call(self, op: str, request: dict[str, Any]) -> dict[str, Any]:
+        from tdcm_ros.runtime.zenoh_runtime import call_parameters
+
+        return call_parameters(self.ctx.session, self.ctx.domain_id, self.node_fqn, op, request)
+
+    def get(self, name: str) -> Any:
+        return self._call("get", {"name": name})["value"]
+
+    def set(self, name: str, value: Any) -> dict[str, Any]:
+        return self._call("set", {"name": name, "value": value})
+
+    def names(self) -> list[str]:
+        return sorted(self._call("list", {})["parameters"])
+
+
+@pytest.fixture
+def params(context: Any) -> Callable[[str], Any]:
+    """``params("/node")``: a parameter client of that node on the test's runtime."""
+    from plain_rclpy import PlainParameterClient, PlainRclpyContext
+
+    def client(node_fqn: str) -> Any:
+        if isinstance(context, PlainRclpyContext):
+            return PlainParameterClient(context, node_fqn)
+        return ZenohParameterClient(context, node_fqn)
+
+    return client

@@ -1,0 +1,66 @@
+"""The in-memory port: parameters checked like the runtimes, timers on its manual clock, messages
+through a CDR round trip."""
+
+from __future__ import annotations
+
+import pytest
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime.memory_port import MemoryPort
+from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+
+START_NS = 1_000_000_000
+
+
+class Echo(NodeLogic):
+    """Republishes ``in`` on ``out`` and counts ticks of a ``period`` timer."""
+
+    default_name = "echo"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        self.period = port.declare_parameter("period", 0.5, range=(0.01, 10.0))
+        self.out = port.create_publisher("out", "std_msgs/msg/String", QoS(depth=5))
+        port.create_subscription("in", "std_msgs/msg/String", self.out.publish)
+        self.ticks: list[int] = []
+        self.timer = port.create_timer(self.period, lambda: self.ticks.append(port.now_ns()))
+
+
+def test_overrides_are_checked_and_int_widens_to_float() -> None:
+    assert Echo(MemoryPort({"period": 2})).period == 2.0
+    with pytest.raises(InputError, match=r"period = 20 is out of range; allowed: \[0.01, 10.0\]"):
+        Echo(MemoryPort({"period": 20}))
+
+
+def test_timers_fire_in_time_order_until_cancelled() -> None:
+    port = MemoryPort({"period": 0.25}, start_ns=START_NS)
+    node = Echo(port)
+    port.advance(1.0)
+    assert node.ticks == [START_NS + k * 250_000_000 for k in (1, 2, 3, 4)]
+    assert port.now_ns() == START_NS + 1_000_000_000
+    node.timer.cancel()
+    port.advance(1.0)
+    assert len(node.ticks) == 4
+
+
+def test_a_delivered_message_round_trips_and_is_kept_with_its_send_time() -> None:
+    port = MemoryPort(start_ns=START_NS)
+    Echo(port)
+    port.deliver("in", from_dict("std_msgs/msg/String", {"data": "hi"}))
+    (message,) = port.messages("out")
+    assert message.data == "hi" and port.sent("out") == [(START_NS, message)]
+    assert port.publishers["out"].qos.depth == 5
+
+
+def test_delivering_to_a_topic_nobody_subscribed_names_the_subscriptions() -> None:
+    port = MemoryPort()
+    Echo(port)
+    with pytest.raises(RuntimePortError, match=r"no subscription on 'other'; subscribed: \['in'\]"):
+        port.deliver("other", from_dict("std_msgs/msg/String", {"data": "x"}))
+
+
+def test_a_timer_period_must_be_positive() -> None:
+    with pytest.raises(InputError, match="timer period = 0 s must be > 0"):
+        MemoryPort().create_timer(0, lambda: None)
