@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.baselines import ShootingOptions, get_method
+from tdcm_ros.model.baselines import OdeMethod, ShootingOptions, get_method, solve_with
 from tdcm_ros.model.design import MM, PRESETS, Design, preset
 from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import build_grid
@@ -91,16 +91,16 @@ class Config:
 
     def run(self, design: Design, tension: float) -> tuple[Array, bool]:
         """Tip position (m) and the method's own convergence flag for one case."""
-        method = get_method(self.method)
         if self.options is None:
-            result = method(design, tension, settings=self.settings, strict=False) \
-                if self.method == "algorithm1" else method(design, tension, settings=self.settings)
+            result = solve_with(self.method, design, tension, settings=self.settings,
+                                strict=False) if self.method == "algorithm1" \
+                else get_method(self.method)(design, tension, settings=self.settings)
         else:
             options = self.options
             if self.max_step_per_notch is not None:
                 options = ShootingOptions(**{**asdict(options),
                                              "max_step": self.max_step_per_notch * design.w_n})
-            result = method(design, tension, options=options, strict=False)
+            result = solve_with(self.method, design, tension, options=options, strict=False)
         return result.tip_position, result.converged
 
 
@@ -111,7 +111,7 @@ def _alg1(label: str, default: bool = False, **knobs: Any) -> Config:
                   default=default)
 
 
-def _shoot(variant: str, rtol: float, method: str = "RK45",
+def _shoot(variant: str, rtol: float, method: OdeMethod = "RK45",
            max_step_per_notch: float | None = None) -> Config:
     label = f"shooting-{variant} rtol={rtol:g}"
     if method != "RK45":

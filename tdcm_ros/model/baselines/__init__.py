@@ -21,6 +21,7 @@ from tdcm_ros.model.baselines.constant_curvature import solve_constant_curvature
 from tdcm_ros.model.baselines.pseudo_rigid_body import solve_pseudo_rigid_body
 from tdcm_ros.model.baselines.shooting import (
     DEFAULT_OPTIONS,
+    OdeMethod,
     ShootingOptions,
     solve_shooting_segmented,
     solve_shooting_whole,
@@ -28,13 +29,16 @@ from tdcm_ros.model.baselines.shooting import (
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidSettingsError
 from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import solve
 
 
 class Method(Protocol):
-    """A model: ``(design, tension (N), *, settings, ...) -> SolveResult``."""
+    """A model: ``(design, tension (N), *, settings) -> SolveResult``. A method may take keyword
+    options of its own besides (:func:`solve_with` passes them on by name)."""
 
-    def __call__(self, design: Design, tension: float, /, **options: Any) -> SolveResult: ...
+    def __call__(self, design: Design, tension: float, /, *,
+                 settings: SolverSettings = ...) -> SolveResult: ...
 
 
 METHODS: dict[str, Method] = {
@@ -64,6 +68,7 @@ __all__ = [
     "DEFAULT_OPTIONS",
     "METHODS",
     "Method",
+    "OdeMethod",
     "ShootingOptions",
     "get_method",
     "solve_constant_curvature",

@@ -31,6 +31,7 @@ import bisect
 import math
 from dataclasses import dataclass
 from time import perf_counter
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,7 +50,8 @@ from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS
 
 Array = NDArray[np.float64]
-ODE_METHODS = ("RK45", "DOP853", "RK23", "LSODA", "Radau", "BDF")
+OdeMethod = Literal["RK45", "DOP853", "RK23", "LSODA", "Radau", "BDF"]
+ODE_METHODS: tuple[OdeMethod, ...] = get_args(OdeMethod)
 VARIANTS = ("whole", "segmented")
 
 
@@ -66,7 +68,7 @@ class ShootingOptions:
     rtol: float = 1e-6
     atol: float = 1e-12
     max_step: float = math.inf
-    ode_method: str = "RK45"
+    ode_method: OdeMethod = "RK45"
     root_tol: float = 1e-10
     max_shots: int = 200
 
@@ -208,8 +210,9 @@ def _solve(design: Design, tension: float, settings: SolverSettings, options: Sh
                            residual_history=(), converged=True, strategy=name,
                            solve_time_s=perf_counter() - started)
     shooter = _Shooter(grid, t, variant, options)
-    found = root(shooter.residual, np.array([0.0, -1.0, 1.0]), method="hybr",
-                 options={"xtol": options.root_tol, "maxfev": options.max_shots})
+    found = root(  # type: ignore[call-overload]  # scipy-stubs misspell hybr's maxfev (maxffev)
+        shooter.residual, np.array([0.0, -1.0, 1.0]), method="hybr",
+        options={"xtol": options.root_tol, "maxfev": options.max_shots})
     states, ok = shooter.shoot(found.x[:2] * t, float(found.x[2]) * design.R_c * t)
     converged = bool(found.success) and ok
     if not converged and (strict or not ok):
