@@ -33,11 +33,14 @@ _COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
 
 
 class QosLike(Protocol):
-    """What a topic's offered QoS needs (``tdcm_ros.runtime.port.QoS`` fits)."""
+    """What a topic's offered QoS needs (``tdcm_ros.runtime.port.QoS`` fits); read only."""
 
-    depth: int
-    reliability: str
-    durability: str
+    @property
+    def depth(self) -> int: ...
+    @property
+    def reliability(self) -> str: ...
+    @property
+    def durability(self) -> str: ...
 
 
 @dataclass(frozen=True)

@@ -65,7 +65,8 @@ def format_report(ev: Evaluation) -> str:
     lines.append(f"{'trial':>5} {'tension N':>9} {'frames':>6} {'meas mm':>8} {'pred mm':>8} "
                  f"{'err mm':>7} {'shape mm':>8}  note")
     for r in ev.records:
-        err = (r.predicted_deflection_m - r.measured_deflection_m) if r.usable else None
+        measured, predicted = r.measured_deflection_m, r.predicted_deflection_m
+        err = predicted - measured if predicted is not None and measured is not None else None
         lines.append(f"{r.trial:>5} {r.tension_n:>9.3f} {r.frames:>6} "
                      f"{_mm(r.measured_deflection_m):>8} {_mm(r.predicted_deflection_m):>8} "
                      f"{_mm(err):>7} {_mm(r.shape_error_m):>8}  {r.note}")

@@ -83,8 +83,9 @@ def run_effects(args: argparse.Namespace) -> int:
     from tdcm_ros.scenes import REGISTRY
     from tdcm_ros.scenes.params import param_table
 
-    data = {name: {"stage": cls.stage, "summary": cls.summary, "cost_unit": cls.cost_unit,
-                   "params": param_table(cls.params)} for name, cls in REGISTRY.items()}
+    data: dict[str, dict[str, Any]] = {
+        name: {"stage": cls.stage, "summary": cls.summary, "cost_unit": cls.cost_unit,
+               "params": param_table(cls.params)} for name, cls in REGISTRY.items()}
     if args.json:
         print(json.dumps(data))
         return 0

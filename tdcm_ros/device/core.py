@@ -138,9 +138,10 @@ class TensionCore:
 
     def receive(self, data: bytes, now_ms: int) -> None:
         """Bytes from the host."""
-        for command in self.decoder.feed(data):
+        for message in self.decoder.feed(data):
             self.last_rx_ms = now_ms
-            self._execute(command)
+            if isinstance(message, Command):  # always: the decoder accepts commands only
+                self._execute(message)
 
     def _on_reject(self, error: FrameError) -> None:
         if error.reason is not Reject.NOISE:

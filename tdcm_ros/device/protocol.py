@@ -52,25 +52,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from tdcm_ros.device import constants as c
-from tdcm_ros.device.errors import DeviceInputError, FrameError
+from tdcm_ros.device.errors import DeviceInputError, FrameError, Reject
 from tdcm_ros.errors import out_of_range
-
-
-class Reject(enum.Enum):
-    """Why a line was rejected; the value is the code sent in a NACK."""
-
-    NOISE = "NOISE"        #: bytes outside any frame (counted, never NACKed)
-    PARTIAL = "PARTIAL"    #: a frame cut short by the next '$'
-    LONG = "LONG"          #: longer than MAX_LINE
-    CHARS = "CHARS"        #: a byte outside printable ASCII
-    FRAME = "FRAME"        #: '*HH' missing or misplaced, or no version field
-    CKSUM = "CKSUM"        #: checksum mismatch
-    VER = "VER"            #: unsupported protocol version
-    TYPE = "TYPE"          #: unknown message type (or wrong direction)
-    FIELDS = "FIELDS"      #: wrong number or syntax of fields
-    RANGE = "RANGE"        #: a value outside its range
-    MODE = "MODE"          #: command not allowed in the current mode (device reply)
-    FAULT = "FAULT"        #: command refused because of a fault (device reply)
 
 
 class Mode(enum.Enum):

@@ -34,7 +34,7 @@ class Transport(Protocol):
 class SerialTransport:
     """A :class:`Transport` over a pyserial port object."""
 
-    def __init__(self, port: serial.SerialBase, url: str) -> None:
+    def __init__(self, port: serial.Serial, url: str) -> None:
         self._port = port
         self.url = url
 

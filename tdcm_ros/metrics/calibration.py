@@ -189,7 +189,8 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
     if np.all(first == FAILED_RESIDUAL_M):
         _model_markers(design_at(np.ones(n)), data, options)  # raises the model's own error
     fit = least_squares(residuals, np.ones(n), bounds=(low, high), x_scale="jac",
-                        diff_step=1e-4, xtol=1e-10, ftol=1e-12)
+                        diff_step=1e-4,  # type: ignore[arg-type]  # scipy-stubs gap: scalar is array_like
+                        xtol=1e-10, ftol=1e-12)
     dof = m - n
     s2 = float(fit.fun @ fit.fun) / dof
     jtj = np.asarray(fit.jac).T @ np.asarray(fit.jac)  # relative units: parameter / start

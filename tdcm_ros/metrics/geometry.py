@@ -74,7 +74,7 @@ class MarkerLayout:
                                f"values in (0, L = {length:g}] m")
 
 
-def deflection(points_base: ArrayLike, rest_offset: Sequence[float], axis: str = "marker"
+def deflection(points_base: ArrayLike, rest_offset: Sequence[float] | Array, axis: str = "marker"
                ) -> Array:
     """Deflection (m) of marker points (..., 3) in ``tdcm_base``.
 

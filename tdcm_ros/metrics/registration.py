@@ -21,7 +21,6 @@ not the roll about the axis. Without a bent frame the roll must come from ``x_hi
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,8 +48,8 @@ class Registration:
     (estimated only, else 0).
     """
 
-    translation: tuple[float, float, float]
-    quaternion: tuple[float, float, float, float]
+    translation: tuple[float, ...]  # 3 entries, checked on construction
+    quaternion: tuple[float, ...]  # 4 entries, checked on construction
     method: str = "given"
     residual_m: float = 0.0
 
@@ -102,7 +101,7 @@ def _visible(points: Array, name: str) -> NDArray[np.bool_]:
     return np.all(np.isfinite(points), axis=1)
 
 
-def estimate_registration(zero_markers: ArrayLike, arc_lengths: Sequence[float], *,
+def estimate_registration(zero_markers: ArrayLike, arc_lengths: ArrayLike, *,
                           radius: float, side_rad: float,
                           bent_markers: ArrayLike | None = None,
                           x_hint: ArrayLike | None = None,

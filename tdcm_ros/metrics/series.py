@@ -77,7 +77,7 @@ class MarkerSeries:
 
     def require_visible(self) -> None:
         """Raise :class:`MarkersNotVisibleError` naming the markers never seen."""
-        never = [label for label, seen in zip(self.labels, self.visible().any(axis=0),
+        never = [label for label, seen in zip(self.labels, np.any(self.visible(), axis=0),
                                               strict=True) if not seen]
         if never:
             raise MarkersNotVisibleError(

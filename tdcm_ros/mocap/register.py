@@ -50,7 +50,8 @@ def given_registration(translation: Sequence[float], *, quaternion: Sequence[flo
             raise out_of_range("registration.rpy", list(rpy), "3 finite angles", unit="rad",
                                error=RegistrationError)
         quaternion = tuple(Rotation.from_euler("xyz", angles).as_quat())
-    return Registration(tuple(translation), tuple(quaternion))  # type: ignore[arg-type]
+    assert quaternion is not None  # given, or made from rpy: exactly one of them is (above)
+    return Registration(tuple(translation), tuple(quaternion))
 
 
 def labelled_positions(trajectories: Trajectories, name_map: NameMap) -> Array:

@@ -69,11 +69,6 @@ class CsvReplay:
     def _due_ns(self) -> int:
         return self.start_ns + self.passes * self._pass_ns + int(self._offsets_ns[self.next_row])
 
-    @property
-    def pending(self) -> bool:
-        """True while sampled frames wait for their delay."""
-        return bool(self._queue)
-
     def due(self, now_ns: int) -> list[RawFrame]:
         """Rows due at ``now_ns``, in order (at most :data:`MAX_BURST`)."""
         frames: list[RawFrame] = []
@@ -93,8 +88,10 @@ class MarkerFrame(Protocol):
     """What a scene world returns (see CONTRACTS.md): labels and (k, 3) m positions in ``mocap``,
     NaN rows not visible."""
 
-    labels: tuple[str, ...]
-    positions: Array
+    @property
+    def labels(self) -> tuple[str, ...]: ...
+    @property
+    def positions(self) -> Array: ...
 
 
 class MarkerWorld(Protocol):

@@ -135,7 +135,7 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
     shape = tuple(v.size for v in values)
     designs = []
     for index in np.ndindex(*shape):
-        overrides = {name: _scalar(name, values[a][index[a]]) for a, name in enumerate(fields)}
+        overrides = {name: _scalar(name, values[a].item(index[a])) for a, name in enumerate(fields)}
         designs.append(couple(base.with_overrides(**overrides), coupling, pitch))
     result = solve_batch(designs, np.broadcast_to(t, (len(designs), t.size)), settings=settings)
     status = _classify(result.status, result.max_bending_strain, strain_limit)

@@ -70,7 +70,8 @@ class Grid:
     peak_s: Array
     notch_left_node: IntArray
     notch_right_node: IntArray
-    _queries: dict[bytes, Query] = field(default_factory=dict, compare=False, repr=False)
+    _queries: dict[bytes, Query] = field(default_factory=dict, init=False, compare=False,
+                                         repr=False)
 
     @property
     def constrained_cells(self) -> IntArray:
@@ -275,8 +276,8 @@ def _build_grid(design: Design, routing: str, cells_per_notch: int, cells_per_tu
     sigma_a = np.where(is_notch, design.profile.sigma(u_a, w_n), seg_length * u_a)
     s_a = seg_start + sigma_a
     s_nodes = np.append(s_a, design.length)
-    for first in seg_first_cell[1:-1]:
-        s_nodes[first] = seg_start[first]
+    for cell in seg_first_cell[1:-1]:
+        s_nodes[cell] = seg_start[cell]
 
     gauss_x, gauss_wt = np.polynomial.legendre.leggauss(quad_order)
     gauss_u = 0.5 * (gauss_x + 1.0)

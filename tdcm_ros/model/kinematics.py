@@ -13,6 +13,7 @@ Internally a planar point is the complex number ``z + i x``; the tangent is then
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,6 +22,7 @@ from tdcm_ros.model.grid import Grid
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
+Scalar = TypeVar("Scalar", np.float64, np.complex128)
 
 
 @dataclass(frozen=True)
@@ -58,7 +60,7 @@ def integrate(grid: Grid, m_a: Array, m_b: Array) -> PlanarShape:
     return PlanarShape(p=p, theta=theta, tangent=tangent)
 
 
-def _cumsum0(values: NDArray[np.generic]) -> NDArray[np.generic]:
+def _cumsum0(values: NDArray[Scalar]) -> NDArray[Scalar]:
     """Cumulative sum along the last axis with a leading zero."""
     out = np.zeros(values.shape[:-1] + (values.shape[-1] + 1,), dtype=values.dtype)
     np.cumsum(values, axis=-1, out=out[..., 1:])

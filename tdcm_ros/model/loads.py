@@ -36,7 +36,7 @@ class KinkAngleError(ModelLimitError):
     kind = "kink_angle"
 
 
-def closed_form(grid: Grid, shape: PlanarShape, tension: Array) -> tuple[Array, Array]:
+def closed_form(grid: Grid, shape: PlanarShape, tension: float | Array) -> tuple[Array, Array]:
     """Per-cell end moments ``(m_a, m_b)`` (N m) from ``m = (p_c - p) x (-T t_c)``.
 
     ``tension`` (N) is a scalar or has the shape's batch dimensions.

@@ -83,8 +83,9 @@ class DeviceTwinNode(NodeLogic):
         values: dict[str, Any] = {}
         for field in fields(PlantConfig):
             unit = PLANT_UNITS.get(field.name, "")
+            default: Any = field.default  # every PlantConfig field has one
             values[field.name] = declare(
-                f"plant.{field.name}", type(field.default)(getattr(base, field.name)),
+                f"plant.{field.name}", type(default)(getattr(base, field.name)),
                 read_only=True, description=f"PlantConfig.{field.name}" + (f" ({unit})" * bool(unit)))
         try:
             plant = PlantConfig(**values)

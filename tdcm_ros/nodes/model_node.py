@@ -29,12 +29,12 @@ from tdcm_ros.errors import InputError, PhysicsError
 from tdcm_ros.model import FIELD_SPECS, SolveResult, SolverSettings, preset, solve
 from tdcm_ros.model.design import PRESETS, Design
 from tdcm_ros.nodes.shape_messages import header, midline_messages
-from tdcm_ros.runtime.parameters import one_of
+from tdcm_ros.runtime.parameters import ParamValue, one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
-SOLVER_FIELDS = {"routing": "paper", "loads": "closed", "cells_per_notch": 4,
+SOLVER_FIELDS: dict[str, ParamValue] = {"routing": "paper", "loads": "closed", "cells_per_notch": 4,
                  "cells_per_tube": 1, "quad_order": 4, "tol": 1e-10, "max_iter": 200}
 
 

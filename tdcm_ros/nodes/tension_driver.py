@@ -144,7 +144,7 @@ class TensionDriverNode(NodeLogic):
     def _param(self, changes: Mapping[str, Any], name: str) -> Any:
         return changes[name] if name in changes else self.port.get_parameter(name)
 
-    def _driver_values(self, changes: Mapping[str, Any]) -> dict[str, float]:
+    def _driver_values(self, changes: Mapping[str, Any]) -> dict[str, Any]:
         return {name: float(self._param(changes, name)) for name in DRIVER_PARAMS}
 
     def _schedule(self, changes: Mapping[str, Any]) -> StepSchedule:

@@ -86,7 +86,7 @@ def _sweep(scene: Scene, repeats: int) -> tuple[Array, float]:
             started = perf_counter()
             result = world.solve(level)
             times[r, k] = perf_counter() - started
-        tip = result.tip_position
+            tip = result.tip_position
     return tip, float(np.mean(np.min(times, axis=0)))
 
 
