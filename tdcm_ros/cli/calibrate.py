@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tdcm_ros.cli.evaluate import add_input_arguments, fail
 from tdcm_ros.errors import PhysicsError, TdcmError
-from tdcm_ros.metrics.api import Topics, calibrate_paths
-from tdcm_ros.metrics.calibration import Calibration, parse_fit
-from tdcm_ros.metrics.options import options_from_sets
+
+if TYPE_CHECKING:
+    from tdcm_ros.metrics.calibration import Calibration
 
 UNUSABLE_FIT_EXIT = PhysicsError.exit_code
 """Exit status when the fit did not converge or a parameter is not identifiable (numerics)."""
@@ -63,6 +63,10 @@ def format_report(cal: Calibration) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Calibrate; known errors become one line and a non-zero exit status."""
+    from tdcm_ros.metrics.api import Topics, calibrate_paths
+    from tdcm_ros.metrics.calibration import parse_fit
+    from tdcm_ros.metrics.options import options_from_sets
+
     try:
         names = parse_fit(args.fit)
         options = options_from_sets(args.set)

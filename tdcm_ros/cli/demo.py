@@ -16,7 +16,6 @@ import socket
 import time
 from pathlib import Path
 
-from tdcm_ros.demo.plan import RECORDED_TOPICS, make_plan
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 
@@ -35,8 +34,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--no-calibrate", action="store_true", help="skip the calibration of E")
     parser.add_argument("--bag", default=None,
                         help="where the recorder writes the bag (default OUT/bag; must not exist)")
-    parser.add_argument("--record", default=",".join(RECORDED_TOPICS),
-                        help="comma-separated topics to record (default: %(default)s)")
+    parser.add_argument("--record", default=None,
+                        help="comma-separated topics to record (default: the demo graph's "
+                             "topics, tdcm_ros.demo.plan.RECORDED_TOPICS)")
     parser.add_argument("--endpoint", default=None,
                         help="zenoh router endpoint (default: a private router on a free port)")
     parser.add_argument("--runtime", choices=RUNTIMES,
@@ -67,6 +67,7 @@ def _check_new(bag: Path, option: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the demo; returns the exit status."""
+    from tdcm_ros.demo.plan import RECORDED_TOPICS, make_plan
     from tdcm_ros.demo.report import report
     from tdcm_ros.demo.run import record_live
     from tdcm_ros.runtime.run_node import configure_logging, resolve_runtime
@@ -78,7 +79,8 @@ def run(args: argparse.Namespace) -> int:
     started = time.monotonic()
     scene = load_scene(args.scene)
     out = _out_dir(args.out, scene.name)
-    topics = tuple(t.strip() for t in args.record.split(",") if t.strip())
+    topics = RECORDED_TOPICS if args.record is None else tuple(
+        t.strip() for t in args.record.split(",") if t.strip())
     plan = make_plan(scene, args.scene, out, trials=args.trials, hold_s=args.hold,
                      bag=Path(args.bag) if args.bag else None, recorded_topics=topics)
     _check_new(plan.bag, "--bag" if args.bag else "--out")

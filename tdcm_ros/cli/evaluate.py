@@ -5,12 +5,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tdcm_ros.errors import TdcmError
-from tdcm_ros.metrics.api import Topics, evaluate_paths
-from tdcm_ros.metrics.evaluation import Evaluation
-from tdcm_ros.metrics.options import EvaluateOptions, options_from_sets
+
+if TYPE_CHECKING:
+    from tdcm_ros.metrics.evaluation import Evaluation
+    from tdcm_ros.metrics.options import EvaluateOptions
 
 SET_HELP = ("override in SI units: a design field (E=1.2e9, w_d=0.0014) or design.preset=NAME, "
             "steps.tolerance_n, steps.min_hold_s, steps.settle_s, steps.zero_n, "
@@ -97,6 +98,9 @@ def fail(command: str, error: TdcmError, as_json: bool) -> int:
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate; known errors become one line and a non-zero exit status."""
+    from tdcm_ros.metrics.api import Topics, evaluate_paths
+    from tdcm_ros.metrics.options import options_from_sets
+
     try:
         options = options_from_sets(args.set)
         ev = evaluate_paths(args.bags, options,

@@ -8,7 +8,6 @@ import sys
 from typing import Any
 
 from tdcm_ros.errors import InputError, TdcmError
-from tdcm_ros.figures import plot_file
 from tdcm_ros.model import (
     PRESETS,
     SolverSettings,
@@ -71,6 +70,8 @@ def run(args: argparse.Namespace) -> int:
         design = preset(args.design).with_overrides(**overrides)
         settings = SolverSettings(routing=args.routing, loads=args.loads)
         if args.plot:
+            from tdcm_ros.figures import plot_file
+
             plot_file("--plot", args.plot)
         result = solve(design, _tension(args.tension), settings=settings)
     except TdcmError as error:
