@@ -1,6 +1,7 @@
 """Evaluation benchmark (issue 6): ``tdcm evaluate`` on a simulated 10-minute bag.
 
-Run: ``python bench/bench_evaluate.py [--repeats 3] [--minutes 10] [--calibrate]``. Simulates
+Run: ``python bench/bench_evaluate.py [--repeats 3] [--minutes 10] [--calibrate]``
+(``--write BAG`` only writes the bag, for ``bench_evaluate_memory.py``). Simulates
 the paper-experiment robot (E = 0.7 GPa) over repeated 0-20 N staircases (10 s holds) with
 1 kHz tension and 100 Hz mocap (3 markers, 5 % occlusion, noise), writes it as a rosbag2 MCAP
 bag with /tf_static (not timed), then times the whole evaluation (read the bag, detect steps,
@@ -28,6 +29,28 @@ from tdcm_ros.metrics.synthetic_bag import write_recording
 from tdcm_ros.model import preset
 
 TARGET_S = 5.0
+HOLD_S = 10.0
+BENCH_E = 0.7e9
+"""Young's modulus (Pa) of the simulated robot; evaluate with ``--set E=0.7e9``."""
+
+
+def write_bench_bag(minutes: float, path: Path) -> tuple[Path, str]:
+    """Simulate about ``minutes`` of 0-20 N staircases (whole trials of 10 s holds, 1 kHz
+    tension, 100 Hz mocap, 5 % occlusion) and write them as the bag folder ``path``; returns it
+    and a one-line description."""
+    trials = max(1, round(minutes * 60.0 / (HOLD_S * len(PAPER_LEVELS))))
+    design = preset("paper-experiment").with_overrides(E=BENCH_E)
+    rec = simulate(design, hold_s=HOLD_S, trials=trials, tension_hz=1000.0, mocap_hz=100.0,
+                   occlusion=0.05, seed=0)
+    span = rec.tension.stamps_s[-1] - rec.tension.stamps_s[0]
+    bag = write_recording(rec, path)
+    return bag, (f"{span / 60:.2f} min, {rec.tension.stamps_s.size} tension samples (1 kHz), "
+                 f"{rec.markers.stamps_s.size} marker frames (100 Hz), {bag_bytes(bag) / 1e6:.1f} MB")
+
+
+def bag_bytes(bag: Path) -> int:
+    """Size of a bag folder's files (bytes)."""
+    return sum(f.stat().st_size for f in bag.iterdir() if f.is_file())
 
 
 def main() -> None:
@@ -35,19 +58,16 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--minutes", type=float, default=10.0)
     parser.add_argument("--calibrate", action="store_true", help="also time tdcm calibrate")
+    parser.add_argument("--write", type=Path, metavar="BAG",
+                        help="only write the bench bag (--minutes long) to the new folder BAG")
     args = parser.parse_args()
-    hold_s = 10.0
-    trials = max(1, round(args.minutes * 60.0 / (hold_s * len(PAPER_LEVELS))))
-    design = preset("paper-experiment").with_overrides(E=0.7e9)
-    rec = simulate(design, hold_s=hold_s, trials=trials, tension_hz=1000.0, mocap_hz=100.0,
-                   occlusion=0.05, seed=0)
-    span = rec.tension.stamps_s[-1] - rec.tension.stamps_s[0]
-    options = options_from_sets(["E=0.7e9"])
+    if args.write:
+        print(f"wrote {args.write}: {write_bench_bag(args.minutes, args.write)[1]}")
+        return
+    options = options_from_sets([f"E={BENCH_E:g}"])
     with tempfile.TemporaryDirectory() as tmp:
-        bag = write_recording(rec, Path(tmp) / "bench")
-        size = sum(f.stat().st_size for f in bag.iterdir())
-        print(f"bag: {span / 60:.2f} min, {rec.tension.stamps_s.size} tension samples (1 kHz), "
-              f"{rec.markers.stamps_s.size} marker frames (100 Hz), {size / 1e6:.1f} MB")
+        bag, described = write_bench_bag(args.minutes, Path(tmp) / "bench")
+        print(f"bag: {described}")
         loads, evals = [], []
         for _ in range(args.repeats):
             started = time.perf_counter()

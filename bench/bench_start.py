@@ -26,6 +26,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import IO
 
 TARGET_S = 0.3
 LIBRARY = ("import json; from tdcm_ros.model import preset, solve; "
@@ -35,12 +36,14 @@ LIBRARY = ("import json; from tdcm_ros.model import preset, solve; "
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def run_once(command: list[str], root: Path) -> tuple[float, float]:
+def run_once(command: list[str], root: Path, stdout: IO[bytes] | int | None = subprocess.DEVNULL
+             ) -> tuple[float, float]:
     """Wall time (s) from spawn to exit and peak RSS (MiB) of one child running ``command`` on
-    the checkout ``root``; it must succeed."""
+    the checkout ``root`` (its standard output to ``stdout``); it must succeed. The peak counts
+    at least this process's RSS at the spawn, so keep this process small."""
     env = {**os.environ, "PYTHONPATH": str(root)}
     started = time.perf_counter()
-    child = subprocess.Popen(command, stdout=subprocess.DEVNULL, env=env, cwd=root)
+    child = subprocess.Popen(command, stdout=stdout, env=env, cwd=root)
     _, status, usage = os.wait4(child.pid, 0)
     elapsed = time.perf_counter() - started
     child.returncode = os.waitstatus_to_exitcode(status)

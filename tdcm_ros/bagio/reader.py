@@ -19,7 +19,7 @@ from __future__ import annotations
 import heapq
 import io
 import itertools
-import mmap
+import os
 import struct
 import zlib
 from collections.abc import Iterable, Iterator, Sequence
@@ -89,6 +89,31 @@ MAX_CHUNK_BYTES = 1 << 30
 # What record parsers and decompressors raise on damaged bytes (lz4 raises RuntimeError).
 _DAMAGE = (_Damaged, McapError, struct.error, ValueError, KeyError, IndexError, EOFError,
            RuntimeError, OverflowError, zstandard.ZstdError)
+
+
+class _FileBytes:
+    """An open file read by byte ranges on demand (``os.pread``): only the ranges asked for are
+    in memory, where every page of a memory map that was read would count in the process's
+    resident size until it is unmapped."""
+
+    def __init__(self, stream: IO[bytes]) -> None:
+        self._fd = stream.fileno()
+        self._size = os.fstat(self._fd).st_size
+
+    def __len__(self) -> int:
+        return self._size
+
+    def __getitem__(self, span: slice) -> bytes:
+        start, stop, _ = span.indices(self._size)
+        parts: list[bytes] = []
+        while start < stop and (part := os.pread(self._fd, stop - start, start)):
+            parts.append(part)
+            start += len(part)
+        return b"".join(parts)
+
+    def unpack(self, layout: struct.Struct, pos: int) -> tuple[Any, ...]:
+        """``layout`` at byte ``pos``; struct.error when the file ends first."""
+        return layout.unpack(self[pos:pos + layout.size])
 
 
 def _decompress(compression: str, data: bytes, size: int) -> bytes:
@@ -225,12 +250,12 @@ class _McapSource:
         return unit
 
     @staticmethod
-    def _chunk_body(buf: bytes | mmap.mmap, index: ChunkIndex) -> bytes:
+    def _chunk_body(buf: _FileBytes, index: ChunkIndex) -> bytes:
         """The body of the chunk record the summary indexes at ``index.chunk_start_offset``."""
         pos, end = index.chunk_start_offset, index.chunk_start_offset + index.chunk_length
         if pos < 0 or end > len(buf) or end < pos + 9:
             raise _Damaged(f"the indexed chunk at byte {pos} lies outside the file")
-        op, length = _RECORD.unpack_from(buf, pos)
+        op, length = buf.unpack(_RECORD, pos)
         if op != _OP_CHUNK or pos + 9 + length != end:
             raise _Damaged(f"no chunk record of {index.chunk_length} bytes at byte {pos}")
         return buf[pos + 9:end]
@@ -238,8 +263,8 @@ class _McapSource:
     def _check_chunks(self) -> None:
         """Check every indexed chunk (size, CRC; records too where no CRC was written) and
         skip the damaged ones, before any message is read."""
-        with self.path.open("rb") as stream, mmap.mmap(stream.fileno(), 0,
-                                                          access=mmap.ACCESS_READ) as buf:
+        with self.path.open("rb") as stream:
+            buf = _FileBytes(stream)
             for index in self._chunks:
                 try:
                     content, crc_checked = self._content(self._chunk_body(buf, index))
@@ -248,13 +273,13 @@ class _McapSource:
                 except _DAMAGE as error:
                     self._skip(index.chunk_start_offset, error, self._indexed_counts(buf, index))
 
-    def _indexed_counts(self, buf: bytes | mmap.mmap, index: ChunkIndex) -> dict[str, int] | None:
+    def _indexed_counts(self, buf: _FileBytes, index: ChunkIndex) -> dict[str, int] | None:
         """Messages per topic of a chunk from its message index records; None if unreadable."""
         lost: dict[str, int] = {}
         try:
             for channel, offset in index.message_index_offsets.items():
-                op, _ = _RECORD.unpack_from(buf, offset)
-                found, size = _INDEX.unpack_from(buf, offset + _RECORD.size)
+                op, _ = buf.unpack(_RECORD, offset)
+                found, size = buf.unpack(_INDEX, offset + _RECORD.size)
                 if op != _OP_INDEX or found != channel or channel not in self._channels:
                     return None
                 topic = self._channels[channel].topic
@@ -288,7 +313,7 @@ class _McapSource:
             self._skip(pos, error, None)
             return []
 
-    def _units(self, buf: bytes | mmap.mmap, wanted: set[int] | None) -> Iterator[Unit]:
+    def _units(self, buf: _FileBytes, wanted: set[int] | None) -> Iterator[Unit]:
         """Messages chunk by chunk, each unit complete and checked, up to the data end: the
         summary's chunks (checked at open) if the file is complete, else a linear pass."""
         if self.complete:
@@ -300,7 +325,7 @@ class _McapSource:
         while pos < end:
             if pos + 9 > end:
                 raise _Damaged(f"the file ends inside a record header at byte {pos}")
-            op, length = _RECORD.unpack_from(buf, pos)
+            op, length = buf.unpack(_RECORD, pos)
             body, after = pos + 9, pos + 9 + length
             if after > end:
                 raise _Damaged(f"the record (opcode {op:#x}) at byte {pos} needs {length} "
@@ -317,10 +342,9 @@ class _McapSource:
     def _scan(self) -> None:
         """Learn topics and counts from every complete chunk; note where the readable part ends."""
         messages = 0
-        with self.path.open("rb") as stream, mmap.mmap(stream.fileno(), 0,
-                                                          access=mmap.ACCESS_READ) as buf:
+        with self.path.open("rb") as stream:
             try:
-                for unit in self._units(buf, None):
+                for unit in self._units(_FileBytes(stream), None):
                     for _, channel, _ in unit:
                         self.counts[self._channels[channel].topic] += 1
                     if unit:
@@ -345,9 +369,8 @@ class _McapSource:
         if not wanted:
             return
         names = {cid: self._channels[cid].topic for cid in wanted}
-        with self.path.open("rb") as stream, mmap.mmap(stream.fileno(), 0,
-                                                          access=mmap.ACCESS_READ) as buf:
-            units = self._units(buf, wanted)
+        with self.path.open("rb") as stream:
+            units = self._units(_FileBytes(stream), wanted)
             if not self.ordered:
                 units = iter([sorted(itertools.chain.from_iterable(self._until_cut(units)),
                                      key=itemgetter(0))])

@@ -11,17 +11,24 @@
 Stamps are the header stamps (s since the epoch); a topic whose header stamps are all zero uses
 the bag's log times instead (said in a warning). Messages are left out, counted in a warning:
 
-- duplicates: the same topic, stamp and payload bytes as an earlier message;
+- duplicates: the same topic, stamp and payload bytes as an earlier message (payloads are
+  compared by a keyed 64-bit hash, :func:`hash`, as they are decoded: two different payloads
+  under one stamp collide with probability 2^-64);
 - implausible stamps: at or before 0 s, at or beyond 2^31 - 1 s (the int32 ``sec`` maximum), or more
   than :data:`FAR_S` from the median stamp of the topic's other messages. A topic with no
   plausible stamp at all is an error naming it, the count and a stamp.
+
+A topic is read in batches of :data:`BATCH` messages, each decoded into arrays and its payloads
+dropped, so memory holds a few numbers per message rather than the bag's bytes.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import itertools
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -40,6 +47,8 @@ MAX_STAMP_S = 2.0**31 - 1.0
 """Stamps (s since the epoch) at or beyond this are implausible: the int32 ``sec`` maximum."""
 FAR_S = 86_400.0
 """Stamps farther than this (s) from the median stamp of their topic are implausible."""
+BATCH = 8192
+"""Messages of a topic decoded at a time (their payloads are then dropped)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,26 +64,18 @@ class BagSource:
     occluded: dict[str, int] = field(default_factory=dict)
 
 
-def _stamps_ns(header_ns: np.ndarray, log_ns: np.ndarray, topic: str, warnings: list[str]
-               ) -> np.ndarray:
-    """The stamps (ns since the epoch) of a topic: its header stamps, or its log times when
-    the header stamps are all zero."""
-    if np.all(header_ns == 0):
-        warnings.append(f"{topic}: header stamps are all zero; using the bag's log times")
-        return log_ns
-    return header_ns
-
-
-def _unique(stamps_ns: np.ndarray, payloads: Sequence[bytes], topic: str, warnings: list[str]
+def _unique(stamps_ns: np.ndarray, digests: np.ndarray, topic: str, warnings: list[str]
             ) -> np.ndarray:
     """Mask of the messages kept: each is dropped that repeats an earlier one's stamp (ns) and
-    payload bytes."""
-    keep = np.ones(len(payloads), dtype=bool)
+    payload (its ``digests`` entry, see the module docstring)."""
+    keep = np.ones(len(digests), dtype=bool)
+    if np.all(np.diff(stamps_ns) > 0):  # strictly increasing: no stamp is shared
+        return keep
     order = np.argsort(stamps_ns, kind="stable")
     equal = np.flatnonzero(np.diff(stamps_ns[order]) == 0)  # positions equal to the next
-    seen: set[tuple[int, bytes]] = set()
+    seen: set[tuple[int, int]] = set()
     for n in order[np.union1d(equal, equal + 1)].tolist():  # only stamps shared, in order
-        key = (int(stamps_ns[n]), payloads[n])
+        key = (int(stamps_ns[n]), int(digests[n]))
         keep[n] = key not in seen
         seen.add(key)
     if dropped := int((~keep).sum()):
@@ -102,31 +103,59 @@ def _plausible(stamps_ns: np.ndarray, path: Path, topic: str, warnings: list[str
     return keep
 
 
-def _usable(header_ns: np.ndarray, log_ns: np.ndarray, payloads: Sequence[bytes], path: Path,
-            topic: str, warnings: list[str]) -> tuple[np.ndarray, np.ndarray]:
-    """Stamps (s since the epoch) of a topic and the mask of its messages kept: neither
-    duplicated nor implausibly stamped."""
-    stamps_ns = _stamps_ns(header_ns, log_ns, topic, warnings)
-    keep = _unique(stamps_ns, payloads, topic, warnings)
+def _batches(reader: BagReader, name: str) -> Iterator[tuple[np.ndarray, np.ndarray, list[bytes]]]:
+    """Log times (ns), payload hashes and CDR payloads of one topic, in log-time order, at most
+    :data:`BATCH` messages at a time."""
+    messages = reader.raw_messages([name])
+    while batch := list(itertools.islice(messages, BATCH)):
+        payloads = [cdr for _, _, cdr in batch]
+        yield (np.fromiter((log_ns for _, log_ns, _ in batch), np.int64, len(batch)),
+               np.fromiter(map(hash, payloads), np.int64, len(batch)), payloads)
+
+
+Decoded = TypeVar("Decoded")
+
+
+def _read(reader: BagReader, name: str,
+          decode: Callable[[list[bytes]], tuple[np.ndarray, Decoded]]
+          ) -> tuple[np.ndarray, bool, np.ndarray, list[Decoded]]:
+    """Read topic ``name`` batch by batch; ``decode`` turns a batch's payloads into their header
+    stamps (ns) and values. Returns the stamps (ns since the epoch), whether they are the log
+    times (every header stamp is zero; log times are kept only while that may be the case),
+    the payload hashes and the values of every batch."""
+    headers, logs, digests, values = [], [], [], []
+    for log_ns, digest, payloads in _batches(reader, name):
+        header_ns, value = decode(payloads)
+        headers.append(header_ns)
+        digests.append(digest)
+        values.append(value)
+        if header_ns.any():
+            logs = None
+        elif logs is not None:
+            logs.append(log_ns)
+    return (np.concatenate(headers if logs is None else logs), logs is not None,
+            np.concatenate(digests), values)
+
+
+def _usable(stamps_ns: np.ndarray, from_log: bool, digests: np.ndarray, path: Path, topic: str,
+            warnings: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """The stamps (s since the epoch) of the messages kept, neither duplicated nor implausibly
+    stamped, and the mask of those kept."""
+    if from_log:
+        warnings.append(f"{topic}: header stamps are all zero; using the bag's log times")
+    keep = _unique(stamps_ns, digests, topic, warnings)
     keep[keep] = _plausible(stamps_ns[keep], path, topic, warnings)
-    return stamps_ns * 1e-9, keep
-
-
-def _payloads(reader: BagReader, name: str) -> tuple[np.ndarray, list[bytes]]:
-    """Log times (ns) and CDR payloads of one topic, in log-time order."""
-    log, data = [], []
-    for _, log_ns, cdr in reader.raw_messages([name]):
-        log.append(log_ns)
-        data.append(cdr)
-    return np.asarray(log, dtype=np.int64), data
+    return stamps_ns[keep] * 1e-9, keep
 
 
 def _tension(reader: BagReader, topic: str, warnings: list[str]) -> TensionSeries:
     name = require_topic(reader, topic, [TENSION_TYPE])
-    log, data = _payloads(reader, name)
-    header_ns, force_z = wrench_force_z(data)
-    stamps, keep = _usable(header_ns, log, data, reader.path, name, warnings)
-    return TensionSeries.of(stamps[keep], force_z[keep])
+    stamps_ns, from_log, digests, parts = _read(reader, name, wrench_force_z)
+    stamps, keep = _usable(stamps_ns, from_log, digests, reader.path, name, warnings)
+    del stamps_ns, digests  # the series below copies its inputs: free what it does not need
+    force = np.concatenate(parts)[keep]
+    del parts
+    return TensionSeries.of(stamps, force)
 
 
 def _occlude(rows: np.ndarray, reported: np.ndarray, labels: Sequence[str], topic: str,
@@ -143,17 +172,13 @@ def _occlude(rows: np.ndarray, reported: np.ndarray, labels: Sequence[str], topi
     return counts
 
 
-def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: list[str]
-             ) -> tuple[MarkerSeries, dict[str, int]]:
-    """Marker frames of ``topic`` and the occluded positions per label."""
-    name = require_topic(reader, topic, [MARKERS_TYPE])
-    index = {label: i for i, label in enumerate(labels)}
-    log, payloads = _payloads(reader, name)
+def _frames(payloads: Sequence[bytes], index: dict[str, int], frames: set[str],
+            unknown: set[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Header stamps (ns), positions (n, k, 3) m (NaN where not reported) and the reported mask
+    (n, k) of Markers payloads; their frame ids and unknown marker names are added to the sets."""
     header = np.zeros(len(payloads), dtype=np.int64)
-    rows = np.full((len(payloads), len(labels), 3), np.nan)
+    rows = np.full((len(payloads), len(index), 3), np.nan)
     reported = np.zeros(rows.shape[:2], dtype=bool)
-    frames: set[str] = set()
-    unknown: set[str] = set()
     for n, data in enumerate(payloads):
         header[n], frame, names, xyz = markers_frame(data)
         frames.add(frame)
@@ -163,6 +188,22 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
                 unknown.add(marker_name or "(unnamed)")
             else:
                 rows[n, i], reported[n, i] = p, True
+    return header, rows, reported
+
+
+def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: list[str]
+             ) -> tuple[MarkerSeries, dict[str, int]]:
+    """Marker frames of ``topic`` and the occluded positions per label."""
+    name = require_topic(reader, topic, [MARKERS_TYPE])
+    index = {label: i for i, label in enumerate(labels)}
+    frames: set[str] = set()
+    unknown: set[str] = set()
+
+    def decode(payloads: list[bytes]) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+        header, rows, reported = _frames(payloads, index, frames, unknown)
+        return header, (rows, reported)
+
+    stamps_ns, from_log, digests, decoded = _read(reader, name, decode)
     if unknown:
         warnings.append(f"{name}: ignored markers not in the layout ({', '.join(labels)}): "
                         f"{', '.join(sorted(unknown))}")
@@ -171,10 +212,13 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
                            "allowed: one frame", parameter="markers_topic", value=sorted(frames),
                            allowed="one frame_id")
     frame = frames.pop() if frames else "mocap"
-    stamps, keep = _usable(header, log, payloads, reader.path, name, warnings)
-    rows = rows[keep]
-    occluded = _occlude(rows, reported[keep], labels, name, warnings)
-    return MarkerSeries.of(stamps[keep], labels, rows, frame_id=frame), occluded
+    stamps, keep = _usable(stamps_ns, from_log, digests, reader.path, name, warnings)
+    del stamps_ns, digests  # the series below copies its inputs: free what it does not need
+    rows = np.concatenate([r for r, _ in decoded])[keep]
+    reported = np.concatenate([r for _, r in decoded])[keep]
+    del decoded
+    occluded = _occlude(rows, reported, labels, name, warnings)
+    return MarkerSeries.of(stamps, labels, rows, frame_id=frame), occluded
 
 
 def _registration(reader: BagReader, parent: str, warnings: list[str]) -> Registration | None:

@@ -1,0 +1,96 @@
+"""Memory benchmark (issue 15 item 5): peak RSS of ``tdcm evaluate`` against the bag's size.
+
+Run: ``python bench/bench_evaluate_memory.py [--minutes 10 30] [--bags DIR] [--baseline DIR]``.
+Writes simulated bags (``bench_evaluate.py --write``, in a child so that this process stays
+small: a child's peak RSS from ``os.wait4`` counts at least its parent's RSS at the spawn; kept in
+``--bags DIR`` and reused when there, else in a temporary folder; not measured), then runs
+``python -m tdcm_ros evaluate BAG --set E=0.7e9 --json`` as a child per bag and reads its peak
+RSS from ``os.wait4``. ``--baseline DIR`` runs the same on another checkout (e.g. the main branch
+before this change) and says whether both print the same JSON.
+
+Prints per bag: its size, the peak RSS, their ratio (the target is <= 3), the ratio of the peak
+above the import floor (a child importing the evaluation modules and nothing else) to the bag,
+and between consecutive bags the marginal ratio: extra peak RSS per extra bag byte.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+from bench_start import ROOT, run_once
+
+TARGET_RATIO = 3.0
+MIB = 2.0**20
+FLOOR = "import tdcm_ros.cli.evaluate, tdcm_ros.metrics.api"
+BENCH_SET = "E=0.7e9"
+"""The simulated robot's Young's modulus (``bench_evaluate.BENCH_E``)."""
+
+
+def bag_bytes(bag: Path) -> int:
+    """Size of a bag folder's files (bytes)."""
+    return sum(f.stat().st_size for f in bag.iterdir() if f.is_file())
+
+
+def bags(folder: Path, minutes: list[float]) -> list[Path]:
+    """The bench bags of ``minutes`` in ``folder``, written when missing."""
+    found = []
+    for m in minutes:
+        path = folder / f"bench_{m:g}min"
+        if not path.exists():
+            run_once([sys.executable, str(Path(__file__).with_name("bench_evaluate.py")),
+                      "--minutes", f"{m:g}", "--write", str(path)], ROOT, None)
+        found.append(path)
+    return found
+
+
+def measure(root: Path, bag: Path, out: Path) -> float:
+    """Peak RSS (MiB) of ``tdcm evaluate BAG --json`` on the checkout ``root``; JSON to ``out``."""
+    command = [sys.executable, "-m", "tdcm_ros", "evaluate", str(bag), "--set", BENCH_SET, "--json"]
+    with out.open("wb") as stream:
+        return run_once(command, root, stream)[1]
+
+
+def report(name: str, root: Path, paths: list[Path], scratch: Path) -> list[str]:
+    """Print the rows of one checkout; returns the JSON outputs per bag."""
+    floor = run_once([sys.executable, "-c", FLOOR], root)[1]
+    print(f"{name} ({root}): import floor {floor:.1f} MiB")
+    print(f"  {'bag':<16} {'size MiB':>9} {'peak MiB':>9} {'peak/bag':>9} {'(peak-floor)/bag':>17}")
+    outputs, previous = [], None
+    for bag in paths:
+        out = scratch / f"{name}_{bag.name}.json"
+        peak, size = measure(root, bag, out), bag_bytes(bag) / MIB
+        outputs.append(out.read_text())
+        verdict = "met" if peak / size <= TARGET_RATIO else "NOT met"
+        print(f"  {bag.name:<16} {size:9.1f} {peak:9.1f} {peak / size:9.2f} "
+              f"{(peak - floor) / size:17.2f}   (target peak/bag <= {TARGET_RATIO:g}: {verdict})")
+        if previous is not None:
+            print(f"  {'':<16} marginal: {(peak - previous[1]) / (size - previous[0]):.2f} MiB "
+                  f"of peak per MiB of bag from {previous[2]}")
+        previous = (size, peak, bag.name)
+    return outputs
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--minutes", type=float, nargs="+", default=[10.0, 30.0],
+                        help="lengths of the simulated bags (min)")
+    parser.add_argument("--bags", type=Path, metavar="DIR",
+                        help="folder keeping the bags between runs (default: a temporary one)")
+    parser.add_argument("--baseline", type=Path, metavar="DIR",
+                        help="another checkout measured on the same bags")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = args.bags or Path(tmp)
+        folder.mkdir(exist_ok=True)
+        paths = bags(folder, sorted(args.minutes))
+        ours = report("this", ROOT, paths, Path(tmp))
+        if args.baseline:
+            theirs = report("baseline", args.baseline.resolve(), paths, Path(tmp))
+            print(f"same JSON from both checkouts: {'yes' if ours == theirs else 'NO'}")
+
+
+if __name__ == "__main__":
+    main()
