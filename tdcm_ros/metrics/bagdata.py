@@ -28,10 +28,10 @@ import itertools
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypeVar
 
 import numpy as np
 
+from tdcm_ros.bagio.errors import BagError
 from tdcm_ros.bagio.reader import BagReader, open_bag, require_topic
 from tdcm_ros.metrics.cdr import markers_frame, wrench_force_z
 from tdcm_ros.metrics.errors import MetricsError
@@ -64,8 +64,7 @@ class BagSource:
     occluded: dict[str, int] = field(default_factory=dict)
 
 
-def _unique(stamps_ns: np.ndarray, digests: np.ndarray, topic: str, warnings: list[str]
-            ) -> np.ndarray:
+def _unique(stamps_ns: np.ndarray, digests: np.ndarray) -> np.ndarray:
     """Mask of the messages kept: each is dropped that repeats an earlier one's stamp (ns) and
     payload (its ``digests`` entry, see the module docstring)."""
     keep = np.ones(len(digests), dtype=bool)
@@ -78,9 +77,6 @@ def _unique(stamps_ns: np.ndarray, digests: np.ndarray, topic: str, warnings: li
         key = (int(stamps_ns[n]), int(digests[n]))
         keep[n] = key not in seen
         seen.add(key)
-    if dropped := int((~keep).sum()):
-        warnings.append(f"{topic}: {dropped} duplicated messages (same stamp and payload as an "
-                        "earlier one) left out")
     return keep
 
 
@@ -113,49 +109,87 @@ def _batches(reader: BagReader, name: str) -> Iterator[tuple[np.ndarray, np.ndar
                np.fromiter(map(hash, payloads), np.int64, len(batch)), payloads)
 
 
-Decoded = TypeVar("Decoded")
+class _Column:
+    """Rows appended batch by batch into one array, grown by doubling past ``capacity`` (no list
+    of parts joined at the end: that join would hold every row twice)."""
+
+    def __init__(self, capacity: int) -> None:
+        self._capacity = max(capacity, 1)
+        self._data: np.ndarray | None = None
+        self._size = 0
+
+    def extend(self, rows: np.ndarray) -> None:
+        if self._data is None:
+            self._data = np.empty((self._capacity, *rows.shape[1:]), rows.dtype)
+        end = self._size + len(rows)
+        if end > len(self._data):
+            grown = np.empty((max(end, 2 * len(self._data)), *rows.shape[1:]), rows.dtype)
+            grown[:self._size] = self._data[:self._size]
+            self._data = grown
+        self._data[self._size:end] = rows
+        self._size = end
+
+    def array(self) -> np.ndarray:
+        """The rows so far (a view)."""
+        return np.empty(0) if self._data is None else self._data[:self._size]
 
 
-def _read(reader: BagReader, name: str,
-          decode: Callable[[list[bytes]], tuple[np.ndarray, Decoded]]
-          ) -> tuple[np.ndarray, bool, np.ndarray, list[Decoded]]:
+def _read(reader: BagReader, name: str, decode: Callable[[list[bytes]], tuple[np.ndarray, ...]]
+          ) -> tuple[np.ndarray, bool, np.ndarray, list[np.ndarray]]:
     """Read topic ``name`` batch by batch; ``decode`` turns a batch's payloads into their header
-    stamps (ns) and values. Returns the stamps (ns since the epoch), whether they are the log
-    times (every header stamp is zero; log times are kept only while that may be the case),
-    the payload hashes and the values of every batch."""
-    headers, logs, digests, values = [], [], [], []
+    stamps (ns) and value arrays (one row per message). Returns the stamps (ns since the epoch),
+    whether they are the log times (every header stamp is zero; log times are kept only while
+    that may be the case), the mask of the messages that are not duplicates and the values."""
+    capacity = reader.counts.get(name, 0)
+    header, log, digests = _Column(capacity), _Column(capacity), _Column(capacity)
+    values: list[_Column] = []
+    from_log = True
     for log_ns, digest, payloads in _batches(reader, name):
-        header_ns, value = decode(payloads)
-        headers.append(header_ns)
-        digests.append(digest)
-        values.append(value)
-        if header_ns.any():
-            logs = None
-        elif logs is not None:
-            logs.append(log_ns)
-    return (np.concatenate(headers if logs is None else logs), logs is not None,
-            np.concatenate(digests), values)
+        header_ns, *decoded = decode(payloads)
+        values = values or [_Column(capacity) for _ in decoded]
+        for column, rows in zip(values, decoded, strict=True):
+            column.extend(rows)
+        header.extend(header_ns)
+        digests.extend(digest)
+        from_log = from_log and not header_ns.any()
+        if from_log:
+            log.extend(log_ns)
+    stamps_ns = (log if from_log else header).array()
+    if not stamps_ns.size:
+        raise BagError(f"{reader.path}: topic {name} has no readable messages")
+    return stamps_ns, from_log, _unique(stamps_ns, digests.array()), [c.array() for c in values]
 
 
-def _usable(stamps_ns: np.ndarray, from_log: bool, digests: np.ndarray, path: Path, topic: str,
+def _usable(stamps_ns: np.ndarray, from_log: bool, unique: np.ndarray, path: Path, topic: str,
             warnings: list[str]) -> tuple[np.ndarray, np.ndarray]:
-    """The stamps (s since the epoch) of the messages kept, neither duplicated nor implausibly
-    stamped, and the mask of those kept."""
+    """The stamps (s since the epoch) of the messages kept, neither duplicated (``unique``, which
+    becomes the mask of those kept) nor implausibly stamped, and that mask."""
     if from_log:
         warnings.append(f"{topic}: header stamps are all zero; using the bag's log times")
-    keep = _unique(stamps_ns, digests, topic, warnings)
-    keep[keep] = _plausible(stamps_ns[keep], path, topic, warnings)
-    return stamps_ns[keep] * 1e-9, keep
+    if dropped := int((~unique).sum()):
+        warnings.append(f"{topic}: {dropped} duplicated messages (same stamp and payload as an "
+                        "earlier one) left out")
+    keep = unique
+    keep[keep] = _plausible(stamps_ns if keep.all() else stamps_ns[keep], path, topic, warnings)
+    stamps = (stamps_ns if keep.all() else stamps_ns[keep]).astype(np.float64)
+    stamps *= 1e-9
+    return stamps, keep
+
+
+def _tension_series(stamps: np.ndarray, force: np.ndarray) -> TensionSeries:
+    """:meth:`TensionSeries.of`, without its sorted and filtered copies when the stamps (s)
+    already ascend and every tension (N) is finite, as in a bag read in log-time order."""
+    if stamps.size and np.all(np.diff(stamps) >= 0) and np.all(np.isfinite(force)):
+        return TensionSeries(stamps, force)
+    return TensionSeries.of(stamps, force)
 
 
 def _tension(reader: BagReader, topic: str, warnings: list[str]) -> TensionSeries:
     name = require_topic(reader, topic, [TENSION_TYPE])
-    stamps_ns, from_log, digests, parts = _read(reader, name, wrench_force_z)
-    stamps, keep = _usable(stamps_ns, from_log, digests, reader.path, name, warnings)
-    del stamps_ns, digests  # the series below copies its inputs: free what it does not need
-    force = np.concatenate(parts)[keep]
-    del parts
-    return TensionSeries.of(stamps, force)
+    stamps_ns, from_log, unique, (force,) = _read(reader, name, wrench_force_z)
+    stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
+    del stamps_ns  # free the stamps (ns) before the series is built
+    return _tension_series(stamps, force if keep.all() else force[keep])
 
 
 def _occlude(rows: np.ndarray, reported: np.ndarray, labels: Sequence[str], topic: str,
@@ -199,11 +233,8 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
     frames: set[str] = set()
     unknown: set[str] = set()
 
-    def decode(payloads: list[bytes]) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-        header, rows, reported = _frames(payloads, index, frames, unknown)
-        return header, (rows, reported)
-
-    stamps_ns, from_log, digests, decoded = _read(reader, name, decode)
+    stamps_ns, from_log, unique, (rows, reported) = _read(
+        reader, name, lambda payloads: _frames(payloads, index, frames, unknown))
     if unknown:
         warnings.append(f"{name}: ignored markers not in the layout ({', '.join(labels)}): "
                         f"{', '.join(sorted(unknown))}")
@@ -212,11 +243,9 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
                            "allowed: one frame", parameter="markers_topic", value=sorted(frames),
                            allowed="one frame_id")
     frame = frames.pop() if frames else "mocap"
-    stamps, keep = _usable(stamps_ns, from_log, digests, reader.path, name, warnings)
-    del stamps_ns, digests  # the series below copies its inputs: free what it does not need
-    rows = np.concatenate([r for r, _ in decoded])[keep]
-    reported = np.concatenate([r for _, r in decoded])[keep]
-    del decoded
+    stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
+    if not keep.all():
+        rows, reported = rows[keep], reported[keep]
     occluded = _occlude(rows, reported, labels, name, warnings)
     return MarkerSeries.of(stamps, labels, rows, frame_id=frame), occluded
 

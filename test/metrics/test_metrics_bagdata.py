@@ -1,5 +1,6 @@
 """Hazards in evaluated bags: occluded markers (NaN, exactly zero), duplicated messages, a corrupt
-chunk (evaluate and ``bag info`` warn the same) and implausible stamps."""
+chunk (evaluate and ``bag info`` warn the same) and implausible stamps; reading in batches gives
+the messages decoded one by one, whatever the batch size."""
 
 from __future__ import annotations
 
@@ -13,9 +14,11 @@ from mcap.reader import SeekingReader
 from metrics_samples import TRUE_E, small_recording
 
 from tdcm_ros.bagio import deserialize, serialize
-from tdcm_ros.bagio.reader import open_bag
+from tdcm_ros.bagio.reader import BagReader, open_bag
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
+from tdcm_ros.metrics import bagdata
+from tdcm_ros.metrics.bagdata import BagSource, load_bag
 from tdcm_ros.metrics.synthetic_bag import write_recording
 
 Change = Callable[[str, int, bytes], list[tuple[int, bytes]]]
@@ -135,3 +138,76 @@ def test_all_implausible_stamps_are_an_error_naming_them(
     count = open_bag(clean).counts["/tension"]
     assert f"/tension: all {count} stamps are implausible (e.g. {float(sec):.9g} s)" in err
     assert "no tension hold" not in err and len(err.strip().splitlines()) == 1
+
+
+LABELS = ("m1", "m2", "m3")
+
+
+def _same_source(a: BagSource, b: BagSource) -> None:
+    np.testing.assert_array_equal(a.tension.stamps_s, b.tension.stamps_s)
+    np.testing.assert_array_equal(a.tension.tension_n, b.tension.tension_n)
+    np.testing.assert_array_equal(a.markers.stamps_s, b.markers.stamps_s)
+    np.testing.assert_array_equal(a.markers.positions, b.markers.positions)
+    assert a.warnings == b.warnings and a.occluded == b.occluded
+
+
+@pytest.mark.parametrize("batch", [1, 7])
+def test_any_batch_size_and_understated_counts_read_the_same_bag(
+        clean: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, batch: int) -> None:
+    twice = _rewrite(clean, tmp_path / "twice", lambda _t, s, d: [(s, d), (s, d)])
+    whole = [load_bag(path, labels=LABELS) for path in (clean, twice)]
+    assert bagdata.BATCH > open_bag(twice).counts["/tension"]  # one batch per topic above
+
+    def understated(path: Path) -> BagReader:  # the arrays start at 1 row and must grow
+        reader = open_bag(path)
+        reader.counts = dict.fromkeys(reader.counts, 1)
+        return reader
+
+    monkeypatch.setattr(bagdata, "BATCH", batch)
+    monkeypatch.setattr(bagdata, "open_bag", understated)
+    for path, reference in zip((clean, twice), whole, strict=True):
+        _same_source(load_bag(path, labels=LABELS), reference)
+    assert any("/tension: " in w and "duplicated messages" in w for w in whole[1].warnings)
+
+
+def test_the_series_are_the_messages_decoded_one_by_one(tmp_path: Path) -> None:
+    path = write_recording(small_recording(seed=4, occlusion=0.2), tmp_path / "occluded")
+    reader = open_bag(path)
+    tension = [(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec, m.wrench.force.z)
+               for _, _, m in reader.messages(["/tension"])]
+    frames = [(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec,
+               {k.marker_name: (k.translation.x, k.translation.y, k.translation.z)
+                for k in m.markers}) for _, _, m in reader.messages(["/markers"])]
+    expected = np.full((len(frames), len(LABELS), 3), np.nan)
+    for n, (_, seen) in enumerate(frames):
+        for i, label in enumerate(LABELS):
+            expected[n, i] = seen.get(label, np.nan)
+    source = load_bag(path, labels=LABELS)
+    np.testing.assert_array_equal(source.tension.stamps_s,
+                                  np.array([s for s, _ in tension], dtype=np.int64) * 1e-9)
+    np.testing.assert_array_equal(source.tension.tension_n, [f for _, f in tension])
+    np.testing.assert_array_equal(source.markers.stamps_s,
+                                  np.array([s for s, _ in frames], dtype=np.int64) * 1e-9)
+    np.testing.assert_array_equal(source.markers.positions, expected)
+    assert np.isnan(expected).any() and not source.warnings
+
+
+@pytest.mark.parametrize("nonzero_at", [None, "first", "last"])
+def test_log_times_replace_header_stamps_only_when_every_one_is_zero(
+        clean: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, nonzero_at: str | None
+        ) -> None:
+    count = open_bag(clean).counts["/tension"]
+    at = {None: -1, "first": 0, "last": count - 1}[nonzero_at]
+    sec = 1_700_000_100
+    path = _rewrite(clean, tmp_path / "zero", _with_tension_sec(lambda n: sec if n == at else 0))
+    monkeypatch.setattr(bagdata, "BATCH", 5)  # the one non-zero stamp in the first or last batch
+    source = load_bag(path, labels=LABELS)
+    zero_warning = "/tension: header stamps are all zero; using the bag's log times"
+    if nonzero_at:
+        assert zero_warning not in source.warnings
+        np.testing.assert_array_equal(source.tension.stamps_s, [sec])
+    else:
+        assert zero_warning in source.warnings and source.tension.stamps_s.size == count
+        logs = [stamp for _, stamp, _ in open_bag(path).raw_messages(["/tension"])]
+        np.testing.assert_array_equal(source.tension.stamps_s,
+                                      np.array(logs, dtype=np.int64) * 1e-9)
