@@ -206,24 +206,35 @@ class CellRows:
 
     def local_sigma(self, u: Array) -> Array:
         """Arc length from each row's segment start (m) at ``u``."""
-        return np.where(per_row(self.is_notch, u), self.members.sigma(self.member, u),
-                        per_row(self.seg_length, u) * u)
+        out = per_row(self.seg_length, u) * u
+        member, notch = self._notch_points(u)
+        if member.size:
+            out[notch] = self.members.sigma(member, u[notch])
+        return out
 
     def jacobian(self, u: Array) -> Array:
         """``ds/du`` (m) at ``u``."""
-        return np.where(per_row(self.is_notch, u), self.members.dsigma_du(self.member, u),
-                        per_row(self.seg_length, u) + 0.0 * u)
+        out = per_row(self.seg_length, u) + 0.0 * u
+        member, notch = self._notch_points(u)
+        if member.size:
+            out[notch] = self.members.dsigma_du(member, u[notch])
+        return out
 
     def compliance(self, u: Array) -> Array:
         """``1/(E I)`` (1/(N m^2)) at ``u``."""
         m = self.members
-        member = np.broadcast_to(per_row(self.member, u), u.shape)
+        every = np.broadcast_to(per_row(self.member, u), u.shape)
+        inertia = m.tube_moment[every]
+        member, notch = self._notch_points(u)
+        if member.size:
+            inertia[notch] = notched_moment(m.h1(member, u[notch]), m.R_outer[member],
+                                            m.r_inner[member])
+        return 1.0 / (m.E[every] * inertia)
+
+    def _notch_points(self, u: Array) -> tuple[IntArray, NDArray[np.bool_]]:
+        """Members of the points of ``u`` inside notches (flat), and the mask of those points."""
         notch = np.broadcast_to(per_row(self.is_notch, u), u.shape)
-        inertia = m.tube_moment[member]
-        if np.any(notch):
-            cut = member[notch]
-            inertia[notch] = notched_moment(m.h1(cut, u[notch]), m.R_outer[cut], m.r_inner[cut])
-        return 1.0 / (m.E[member] * inertia)
+        return np.broadcast_to(per_row(self.member, u), u.shape)[notch], notch
 
 
 def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Array
