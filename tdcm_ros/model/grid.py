@@ -10,7 +10,11 @@ For each cell the grid stores:
   ``m_a C0 + m_b C1`` (``xi = (s - a)/(b - a)``);
 - at each quadrature point ``s_q``, the partial integrals ``A0_q``, ``A1_q`` of the same
   integrands from ``a`` to ``s_q``, so the tangent angle there is known exactly and the
-  cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it.
+  cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it;
+- on cells the tendon crosses as a chord, ``A0_T``, ``A1_T``, ``C0_T``, ``C1_T``: the same per
+  newton of tension for the chord moment's non-linear part (``m'' = -T c m``, see
+  :func:`_chord_terms`). A kernel that uses them takes ``A0 + T A0_T`` etc. in place of
+  ``A0``; they are zero where the tendon follows the body.
 
 Grids depend only on the design and the discretisation settings and are cached. Where the
 cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s job;
@@ -76,6 +80,10 @@ class Grid:
     C1: Array
     A0: Array
     A1: Array
+    A0_T: Array
+    A1_T: Array
+    C0_T: Array
+    C1_T: Array
     c_start: Array
     c_end: Array
     peak_c: Array
@@ -305,12 +313,52 @@ def _prototype_integrals(table: Prototypes, quad_order: int) -> dict[str, Array]
     probe_c = rows.compliance(probe_u)
     arg = np.argmax(probe_c, axis=1)
     every = np.arange(u_a.size)
+    chord = _chord_terms(table.chord, quad_order, w_q / gauss_w, w_q, xi_q, c_q, a0, a1)
     return {"gauss_u": gauss_u, "gauss_w": gauss_w, "s_q": s_q, "w_q": w_q, "xi_q": xi_q,
             "c_q": c_q, "C0": np.sum(w_q * (1.0 - xi_q) * c_q, axis=1),
-            "C1": np.sum(w_q * xi_q * c_q, axis=1), "A0": a0, "A1": a1,
+            "C1": np.sum(w_q * xi_q * c_q, axis=1), "A0": a0, "A1": a1, **chord,
             "c_start": rows.compliance(u_a), "c_end": rows.compliance(u_b),
             "peak_c": probe_c[every, arg],
             "peak_s": rows.local_sigma(probe_u[every, arg])}
+
+
+def _chord_terms(chord: NDArray[np.bool_], quad_order: int, ds_du: Array, w_q: Array,
+                 xi_q: Array, c_q: Array, a0: Array, a1: Array) -> dict[str, Array]:
+    """``A0_T``, ``A1_T`` (at the Gauss points) and ``C0_T``, ``C1_T`` (per cell) of chord cells.
+
+    On a chord the moment obeys ``m'' = -T c m`` (the tendon's pull on a curving body), so it is
+    not linear: ``m = m_a (1 - xi) + m_b xi + T (m_a G0 + m_b G1)`` to first order in
+    ``T c h^2``, with ``G0'' = -c (1 - xi)``, ``G1'' = -c xi`` and ``G = 0`` at both cell ends,
+    i.e. ``G0(s) = xi int_a^b A0 ds - int_a^s A0 ds``. The extra bend is ``T (m_a C0_T + m_b
+    C1_T)`` with ``C0_T = int c G0 ds``, and ``A0_T(s) = int_a^s c G0`` at the Gauss points
+    (rad/(N^2 m)); zero where the tendon follows the body. Partial integrals use the Gauss
+    points' spectral integration matrix. ``ds_du`` (m) is each Gauss point's ds per unit of
+    the cell's own reference coordinate.
+    """
+    matrix = _integration_matrix(quad_order)
+
+    def partial(values: Array) -> Array:
+        return np.sum((values * ds_du)[:, None, :] * matrix[None, :, :], axis=-1)
+
+    out = {}
+    for name, a in (("0", a0), ("1", a1)):
+        g = xi_q * np.sum(w_q * a, axis=1, keepdims=True) - partial(a)
+        out[f"A{name}_T"] = np.where(chord[:, None], partial(c_q * g), 0.0)
+        out[f"C{name}_T"] = np.where(chord, np.sum(w_q * c_q * g, axis=1), 0.0)
+    return out
+
+
+@lru_cache(maxsize=32)
+def _integration_matrix(quad_order: int) -> Array:
+    """``S[q, k] = int_0^{u_q} l_k(u) du`` on [0, 1] for the Lagrange basis ``l_k`` of the
+    ``quad_order`` Gauss-Legendre points ``u_q``: partial integrals exact for polynomials of
+    degree ``quad_order - 1``."""
+    legendre = np.polynomial.legendre
+    x, _ = legendre.leggauss(quad_order)
+    basis = np.linalg.inv(legendre.legvander(x, quad_order - 1))
+    matrix = 0.5 * legendre.legval(x, legendre.legint(basis, lbnd=-1.0)).T
+    matrix.setflags(write=False)
+    return matrix
 
 
 @dataclass(frozen=True, eq=False)
@@ -349,6 +397,10 @@ class GridStack:
     C1: Array
     A0: Array
     A1: Array
+    A0_T: Array
+    A1_T: Array
+    C0_T: Array
+    C1_T: Array
     c_start: Array
     c_end: Array
     peak_c: Array
@@ -398,5 +450,6 @@ def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStac
         gauss_u=cells["gauss_u"], gauss_w=cells["gauss_w"],
         s_q=spread(cells["s_q"], 0.0, tip), peak_s=spread(cells["peak_s"], 0.0, tip),
         **{name: spread(cells[name], 0.0) for name in
-           ("w_q", "xi_q", "c_q", "C0", "C1", "A0", "A1", "c_start", "c_end", "peak_c")},
+           ("w_q", "xi_q", "c_q", "C0", "C1", "A0", "A1", "A0_T", "A1_T", "C0_T", "C1_T",
+            "c_start", "c_end", "peak_c")},
         notch_left_node=table.notch_left_node, notch_right_node=table.notch_right_node)

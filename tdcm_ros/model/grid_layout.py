@@ -144,14 +144,16 @@ class Prototypes:
     """The cells of each member's four segment kinds, flat, in the segment's own coordinates.
 
     Per prototype cell (shape (p,)): ``member``, ``is_notch``, ``u_a``/``u_b`` (its ends in
-    ``u``), ``a``/``length`` (its start from the segment start and its length, m) and
-    ``seg_length`` (m); ``seg_start`` is 0. ``first`` (M, 4) is each kind's first prototype cell
-    and ``count`` (M, 4) its cell count (0 for an absent segment).
+    ``u``), ``a``/``length`` (its start from the segment start and its length, m),
+    ``seg_length`` (m) and ``chord`` (the tendon crosses it as a chord); ``seg_start`` is 0.
+    ``first`` (M, 4) is each kind's first prototype cell and ``count`` (M, 4) its cell count
+    (0 for an absent segment).
     """
 
     members: Members
     member: IntArray
     is_notch: BoolArray
+    chord: BoolArray
     u_a: Array
     u_b: Array
     a: Array
@@ -229,7 +231,8 @@ def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
     b = np.where(is_notch, members.sigma(member, u_b), length_of_segment * u_b)
     b = np.where(u_b == 1.0, length_of_segment, b)
     kind_counts = counts.sum(axis=-1)
-    return Prototypes(members=members, member=member, is_notch=is_notch, u_a=u_a, u_b=u_b, a=a,
+    return Prototypes(members=members, member=member, is_notch=is_notch,
+                      chord=~constrained_kind[seg_kind], u_a=u_a, u_b=u_b, a=a,
                       length=b - a, seg_length=length_of_segment, seg_start=np.zeros(a.size),
                       first=(np.cumsum(kind_counts.ravel()) - kind_counts.ravel()
                              ).reshape(m_count, 4),

@@ -15,7 +15,8 @@ from tdcm_ros.model.grid import build_grid, build_grids
 
 PER_CELL = ("s_nodes", "is_notch", "notch_index", "seg_start", "seg_length", "u_a", "u_b",
             "constrained", "chord_start_node", "chord_end_node", "s_q", "w_q", "xi_q", "c_q",
-            "C0", "C1", "A0", "A1", "c_start", "c_end", "peak_c", "peak_s")
+            "C0", "C1", "A0", "A1", "A0_T", "A1_T", "C0_T", "C1_T", "c_start", "c_end", "peak_c",
+            "peak_s")
 PREVIOUS_DEFAULT = SolverSettings(grid="uniform", cells_per_notch=4, cells_per_tube=1,
                                   quad_order=4)
 
@@ -138,7 +139,7 @@ def test_many_design_build_equals_each_single_build_bit_for_bit(designs, routing
         # Padding: zero-length cells at the tip that carry nothing.
         pad = slice(n, width)
         assert np.all(stack.s_nodes[m, n:] == design.length)
-        for name in ("C0", "C1", "A0", "A1", "w_q", "c_q"):
+        for name in ("C0", "C1", "A0", "A1", "w_q", "c_q", "A0_T", "C1_T"):
             assert not np.any(getattr(stack, name)[m, pad])
         assert np.all(stack.constrained[m, pad]) and not np.any(stack.is_notch[m, pad])
         assert np.all(stack.notch_left_node[m, design.N:] == n)
@@ -164,3 +165,47 @@ def test_many_design_build_rejects_bad_input_naming_it():
     assert "1e-300" in str(info.value)
     with pytest.raises(InvalidSettingsError, match="grid"):
         SolverSettings(grid="graded")
+
+
+def test_chord_terms_in_a_tube_match_the_closed_form():
+    # Constant c over a cell of length h: G0 = c h^2 (xi/3 - xi^2/2 + xi^3/6) and
+    # G1 = c h^2 (xi/6 - xi^3/6), so C0_T = C1_T = c^2 h^3 / 24, A0_T(xi) = c^2 h^3 (xi^2/6 -
+    # xi^3/6 + xi^4/24) and A1_T(xi) = c^2 h^3 (xi^2/12 - xi^4/24).
+    design = preset("paper-experiment")
+    grid = build_grid(design, SolverSettings(routing="paper"))
+    tubes = np.flatnonzero(~grid.is_notch)
+    assert np.all(np.isin(tubes, grid.chord_cells))
+    c = 1.0 / (design.E * design.tube_second_moment)
+    h = grid.length[tubes]
+    xi = grid.xi_q[tubes]
+    assert np.allclose(grid.C0_T[tubes], c**2 * h**3 / 24.0, rtol=1e-12, atol=0.0)
+    assert np.allclose(grid.C1_T[tubes], c**2 * h**3 / 24.0, rtol=1e-12, atol=0.0)
+    scale = (c**2 * h**3)[:, None]
+    assert np.allclose(grid.A0_T[tubes], scale * (xi**2 / 6 - xi**3 / 6 + xi**4 / 24),
+                       rtol=1e-11, atol=0.0)
+    assert np.allclose(grid.A1_T[tubes], scale * (xi**2 / 12 - xi**4 / 24), rtol=1e-11,
+                       atol=0.0)
+    # Where the tendon follows the body (the notches, under paper routing) there is no term.
+    notch = np.flatnonzero(grid.is_notch)
+    assert not np.any(grid.C0_T[notch]) and not np.any(grid.A1_T[notch])
+
+
+def test_chord_terms_in_a_notch_match_a_fine_trapezoid_integration():
+    design = preset("paper-experiment")
+    grid = build_grid(design, SolverSettings(routing="free"))
+    for k in grid.chord_cells[grid.is_notch[grid.chord_cells]][:6]:
+        cells = np.full(20001, k)
+        u = np.linspace(grid.u_a[k], grid.u_b[k], cells.size)
+        s = grid.seg_start[k] + grid.local_sigma(cells, u)
+        c = grid.compliance(cells, u)
+        xi = (s - s[0]) / (s[-1] - s[0])
+
+        def cumulative(f, s=s):
+            return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(s))])
+
+        for shape, c_t, a_t in ((1.0 - xi, grid.C0_T, grid.A0_T), (xi, grid.C1_T, grid.A1_T)):
+            inner = cumulative(cumulative(c * shape))
+            g = xi * inner[-1] - inner
+            total = cumulative(c * g)
+            assert c_t[k] == pytest.approx(total[-1], rel=1e-6)
+            assert np.allclose(a_t[k], np.interp(grid.s_q[k], s, total), rtol=1e-5)
