@@ -26,6 +26,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -47,6 +48,7 @@ from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+Scalar = TypeVar("Scalar", bound=np.generic)
 #: ``(cells, A0_s, A1_s, A0_r, A1_r, w_r)`` of :meth:`Grid.query`.
 Query = tuple[IntArray, Array, Array, Array, Array, Array]
 
@@ -356,7 +358,8 @@ def _integration_matrix(quad_order: int) -> Array:
     legendre = np.polynomial.legendre
     x, _ = legendre.leggauss(quad_order)
     basis = np.linalg.inv(legendre.legvander(x, quad_order - 1))
-    matrix = 0.5 * legendre.legval(x, legendre.legint(basis, lbnd=-1.0)).T
+    matrix = np.asarray(0.5 * legendre.legval(x, legendre.legint(basis, lbnd=-1.0)).T,
+                        dtype=np.float64)
     matrix.setflags(write=False)
     return matrix
 
@@ -429,8 +432,8 @@ def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStac
     at = (table.member, slot)
     tip = np.broadcast_to(members.length[:, None], (count.size, width))
 
-    def spread(values: NDArray[np.generic], pad: float | bool,
-               like: NDArray[np.generic] | None = None) -> NDArray[np.generic]:
+    def spread(values: NDArray[Scalar], pad: float | bool,
+               like: Array | IntArray | None = None) -> NDArray[Scalar]:
         out = np.full((count.size, width) + values.shape[1:], pad, dtype=values.dtype)
         if like is not None:
             out[...] = like.reshape(like.shape + (1,) * (values.ndim - 1))
