@@ -19,6 +19,8 @@ def register(subparsers: Any) -> None:
                     "Algorithm 1's settings and the baselines, on every preset and hard "
                     "designs at 4-20 N (SI units).")
     accuracy.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    accuracy.add_argument("--markdown", action="store_true",
+                          help="also print the table as Markdown (the README's), first")
     accuracy.add_argument("--plot", metavar="FILE", help="write the Pareto plot to a .png, .pdf "
                           "or .svg file in an existing folder")
     accuracy.add_argument("--quick", action="store_true",
@@ -29,7 +31,12 @@ def register(subparsers: Any) -> None:
 def run_accuracy(args: argparse.Namespace) -> int:
     """Run the accuracy bench; the table (or JSON) on stdout, progress on stderr."""
     from tdcm_ros.figures import plot_file
-    from tdcm_ros.model.accuracy import format_table, plot_pareto, run_bench
+    from tdcm_ros.model.accuracy import (
+        format_markdown,
+        format_table,
+        plot_pareto,
+        run_bench,
+    )
 
     if args.plot:
         plot_file("--plot", args.plot)  # before the bench: a bad path fails at once
@@ -42,6 +49,8 @@ def run_accuracy(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(report.to_json(), default=float))
     else:
+        if args.markdown:
+            print(format_markdown(report) + "\n")
         print(format_table(report))
         if args.plot:
             print(f"Pareto plot written to {args.plot}")

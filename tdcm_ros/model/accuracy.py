@@ -5,7 +5,8 @@ tension); its tip error (m) is measured against a converged reference **of the m
 discretises**, and its median wall time per solve (s) in the same run:
 
 - ``paper/closed``, ``free/closed``, ``paper/literal``: Algorithm 1 with ``REFERENCE``
-  (64 cells per notch, 16 per tube, 12 Gauss points, tol 1e-13) in that routing/load form;
+  (adaptive grid, 64 cells per notch, 16 per tube, 12 Gauss points, tol 1e-13) in that
+  routing/load form;
 - ``constrained`` (the shooting baselines' Rucker tendon, on the offset curve everywhere):
   the moment is exactly ``R_c T``, so the reference is the exact integration of
   ``kappa = R_c T / (E I)`` on the same ``REFERENCE`` grid;
@@ -42,6 +43,10 @@ Array = NDArray[np.float64]
 REFERENCE = SolverSettings(cells_per_notch=64, cells_per_tube=16, quad_order=12, tol=1e-13,
                            max_iter=2000)
 COARSER = REFERENCE.with_overrides(cells_per_notch=32, cells_per_tube=8, quad_order=8)
+#: The two grids :func:`converged_tip` extrapolates from (adaptive: 64 and 32 cells per notch).
+RICHARDSON_FINE = SolverSettings(grid="adaptive", cells_per_notch=64, cells_per_tube=16,
+                                 quad_order=8, tol=1e-14, max_iter=2000)
+RICHARDSON_HALF = RICHARDSON_FINE.with_overrides(cells_per_notch=32, cells_per_tube=8)
 PACKAGE_MODEL = "paper/closed"
 SHOOTING_TENSIONS = (4.0, 20.0)
 TIME_TIE = 0.9
@@ -58,6 +63,8 @@ HARD_DESIGNS: dict[str, Design] = {
                                                  w_d=1.5 * MM),
     # R_c * kappa = 0.95 at 20 N at the notch centres: close to the tendon singularity.
     "hard-near-singular": _BASE.with_overrides(w_d=0.6 * MM),
+    # 64 notches (0.39 m): errors per notch and per chord add up along the body.
+    "hard-n64": _BASE.with_overrides(N=64),
 }
 
 
@@ -78,7 +85,8 @@ class Config:
         """The accuracy knobs that matter for this method (JSON-ready)."""
         if self.method == "algorithm1":
             s = self.settings
-            return {"routing": s.routing, "loads": s.loads, "cells_per_notch": s.cells_per_notch,
+            return {"routing": s.routing, "loads": s.loads, "grid": s.grid,
+                    "cells_per_notch": s.cells_per_notch,
                     "cells_per_tube": s.cells_per_tube, "quad_order": s.quad_order, "tol": s.tol}
         if self.options is not None:
             o = self.options
@@ -125,23 +133,29 @@ def _shoot(variant: str, rtol: float, method: OdeMethod = "RK45",
 
 def configs(quick: bool = False) -> list[Config]:
     """Every configuration of the bench (a subset with ``quick``)."""
-    out = [_alg1("algorithm1 default (cpn=4 cpt=1 q=4 tol=1e-10)", default=True)]
+    out = [_alg1("algorithm1 default (adaptive cpn=4 cpt=1 q=6 tol=1e-10)", default=True),
+           _alg1("algorithm1 previous default (uniform cpn=4 cpt=1 q=4)", grid="uniform",
+                 quad_order=4)]
     cells = (1, 2, 8) if quick else (1, 2, 8, 16, 32)
     out += [_alg1(f"algorithm1 cpn={c}", cells_per_notch=c) for c in cells]
-    quads = (2,) if quick else (1, 2, 3, 6, 8)
+    quads = (2,) if quick else (1, 2, 3, 4, 8)
     out += [_alg1(f"algorithm1 q={q}", quad_order=q) for q in quads]
     if not quick:
-        out += [_alg1("algorithm1 cpn=2 q=3", cells_per_notch=2, quad_order=3),
-                _alg1("algorithm1 cpn=8 q=6", cells_per_notch=8, quad_order=6),
+        out += [_alg1("algorithm1 cpn=2 q=4", cells_per_notch=2, quad_order=4),
+                _alg1("algorithm1 cpn=8 q=8", cells_per_notch=8, quad_order=8),
                 _alg1("algorithm1 cpn=16 cpt=4 q=8", cells_per_notch=16, cells_per_tube=4,
                       quad_order=8),
-                _alg1("algorithm1 cpt=4", cells_per_tube=4)]
+                _alg1("algorithm1 cpt=4", cells_per_tube=4),
+                _alg1("algorithm1 uniform cpn=8 q=6", grid="uniform", cells_per_notch=8),
+                _alg1("algorithm1 uniform cpn=16 cpt=4 q=8", grid="uniform",
+                      cells_per_notch=16, cells_per_tube=4, quad_order=8)]
     tols = (1e-6,) if quick else (1e-4, 1e-6, 1e-8, 1e-12)
     out += [_alg1(f"algorithm1 tol={t:g}", tol=t) for t in tols]
     out += [_alg1("algorithm1 loads=literal", loads="literal"),
             _alg1("algorithm1 routing=free", routing="free")]
     if not quick:
-        out += [_alg1("algorithm1 loads=literal cpn=16", loads="literal", cells_per_notch=16)]
+        out += [_alg1("algorithm1 loads=literal cpn=16", loads="literal", cells_per_notch=16),
+                _alg1("algorithm1 routing=free cpn=16", routing="free", cells_per_notch=16)]
     out += [Config(label="constant-curvature", method="constant-curvature",
                    model="constant-curvature"),
             Config(label="pseudo-rigid-body", method="pseudo-rigid-body",
@@ -175,6 +189,20 @@ def constrained_tip(design: Design, tension: float, settings: SolverSettings) ->
     moment = np.full(grid.n_cells, design.R_c * tension)
     tip = integrate(grid, moment, moment).p[-1]
     return np.array([tip.imag, 0.0, tip.real])
+
+
+def converged_tip(design: Design, tension: float, routing: str, loads: str
+                  ) -> tuple[Array, float]:
+    """Tip (m) of Algorithm 1 converged in the grid, and its uncertainty (m).
+
+    Richardson extrapolation of ``RICHARDSON_FINE`` and ``RICHARDSON_HALF`` (half the cells):
+    the chord moments, linear per cell, converge at second order, so ``fine + (fine - half)/3``;
+    the uncertainty is ``|fine - half| / 3``, the fine grid's own estimated error (the
+    extrapolated tip is better still where the second order term dominates).
+    """
+    fine, half = (solve(design, tension, settings=st.with_overrides(routing=routing, loads=loads),
+                        strict=False).tip_position for st in (RICHARDSON_FINE, RICHARDSON_HALF))
+    return fine + (fine - half) / 3.0, float(np.linalg.norm(fine - half)) / 3.0
 
 
 def _reference_tip(model: str, design: Design, tension: float, settings: SolverSettings
@@ -388,8 +416,8 @@ def format_table(report: Report) -> str:
     """The report as plain text (errors in m, times in ms)."""
     lines = [f"designs: {', '.join(report.designs)}",
              f"tensions (N): {', '.join(f'{t:g}' for t in report.tensions)}",
-             "reference: Algorithm 1, cells_per_notch=64, cells_per_tube=16, quad_order=12, "
-             "tol=1e-13; max tip change vs 32/8 cells, q=8: "
+             "reference: Algorithm 1, adaptive grid, cells_per_notch=64, cells_per_tube=16, "
+             "quad_order=12, tol=1e-13; max tip change vs 32/8 cells, q=8: "
              + ", ".join(f"{k} {v:.1e} m"
                          for k, v in report.reference["max_tip_change_to_coarser_m"].items()),
              "",
@@ -411,6 +439,18 @@ def format_table(report: Report) -> str:
               "where shooting fails:"]
     lines += [f"  - {f}" for f in report.shooting_findings]
     lines += ["", f"timing: {report.timing_note}"]
+    return "\n".join(lines)
+
+
+def format_markdown(report: Report) -> str:
+    """The configurations as a Markdown table (errors in m, times in ms), fastest first."""
+    header = ("| configuration | model | worst tip error (m) | median error (m) | median ms | "
+              "Pareto front |")
+    lines = [header, "|---|---|---|---|---|---|"]
+    for r in sorted(report.rows, key=lambda r: r.median_time_s):
+        label = f"**{r.label}**" if r.default else r.label
+        lines.append(f"| {label} | {r.model} | {r.max_error_m:.2e} | {r.median_error_m:.2e} | "
+                     f"{r.median_time_s * 1e3:.3f} | {'yes' if r.on_front else ''} |")
     return "\n".join(lines)
 
 

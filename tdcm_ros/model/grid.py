@@ -10,30 +10,48 @@ For each cell the grid stores:
   ``m_a C0 + m_b C1`` (``xi = (s - a)/(b - a)``);
 - at each quadrature point ``s_q``, the partial integrals ``A0_q``, ``A1_q`` of the same
   integrands from ``a`` to ``s_q``, so the tangent angle there is known exactly and the
-  cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it.
+  cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it;
+- on cells the tendon crosses as a chord, ``A0_T``, ``A1_T``, ``C0_T``, ``C1_T``: the same per
+  newton of tension for the chord moment's non-linear part (``m'' = -T c m``, see
+  :func:`_chord_terms`). A kernel that uses them takes ``A0 + T A0_T`` etc. in place of
+  ``A0``; they are zero where the tendon follows the body.
 
-Grids depend only on the design and the discretisation settings and are cached.
+Grids depend only on the design and the discretisation settings and are cached. Where the
+cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s job;
+:func:`build_grids` builds many designs' grids at once into a :class:`GridStack`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.grid_layout import (
+    PEAK_SAMPLES,
+    CellTable,
+    Members,
+    Prototypes,
+    cell_table,
+    per_row,
+    prototypes,
+)
 from tdcm_ros.model.section import notched_moment
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
+Scalar = TypeVar("Scalar", bound=np.generic)
 #: ``(cells, A0_s, A1_s, A0_r, A1_r, w_r)`` of :meth:`Grid.query`.
 Query = tuple[IntArray, Array, Array, Array, Array, Array]
 
-PEAK_SAMPLES = 17
 #: Distinct query station sets a grid keeps (see :meth:`Grid.query`).
 QUERY_CACHE_SIZE = 8
 
@@ -64,6 +82,10 @@ class Grid:
     C1: Array
     A0: Array
     A1: Array
+    A0_T: Array
+    A1_T: Array
+    C0_T: Array
+    C1_T: Array
     c_start: Array
     c_end: Array
     peak_c: Array
@@ -99,25 +121,29 @@ class Grid:
         """Cell lengths (m)."""
         return np.diff(self.s_nodes)
 
+    @cached_property
+    def members(self) -> Members:
+        """The design as a one-member :class:`Members`."""
+        return Members.of([self.design])
+
+    def rows(self, cells: IntArray) -> CellRows:
+        """Cell data of ``cells`` (one row each) for the per-row geometry functions."""
+        return CellRows(members=self.members, member=np.zeros(cells.shape, np.int64),
+                        is_notch=self.is_notch[cells], seg_start=self.seg_start[cells],
+                        seg_length=self.seg_length[cells], a=self.s_nodes[cells],
+                        length=self.s_nodes[cells + 1] - self.s_nodes[cells])
+
     def local_sigma(self, cells: IntArray, u: Array) -> Array:
         """Arc length from each cell's segment start (m) at reference coordinate ``u``."""
-        w_n = self.design.w_n
-        notch = self.is_notch[cells]
-        return np.where(notch, self.design.profile.sigma(u, w_n), self.seg_length[cells] * u)
+        return self.rows(cells).local_sigma(u)
 
     def jacobian(self, cells: IntArray, u: Array) -> Array:
         """``ds/du`` (m) at ``u`` in each cell's segment."""
-        notch = self.is_notch[cells]
-        return np.where(notch, self.design.profile.dsigma_du(u, self.design.w_n),
-                        self.seg_length[cells] + 0.0 * u)
+        return self.rows(cells).jacobian(u)
 
     def compliance(self, cells: IntArray, u: Array) -> Array:
         """``1/(E I)`` (1/(N m^2)) at reference coordinate ``u`` of each cell's segment."""
-        d = self.design
-        notch = self.is_notch[cells]
-        h1 = d.profile.h1(u, d.w_n, d.w_d)
-        inertia = np.where(notch, notched_moment(h1, d.R_outer, d.r_inner), d.tube_second_moment)
-        return 1.0 / (d.E * inertia)
+        return self.rows(cells).compliance(u)
 
     def u_of_s(self, cells: IntArray, s: Array) -> Array:
         """Inverse of :meth:`local_sigma`: reference coordinate of arc length ``s`` (m)."""
@@ -150,14 +176,14 @@ class Grid:
         Returns ``(A0_s, A1_s, A0_r, A1_r, w_r)``: ``A0``/``A1`` at ``s`` (shape (k,)), at the
         Gauss points of ``[a, s]`` (shape (k, Q)), and those points' ds weights (m).
         """
+        rows = self.rows(cells)
         ua = self.u_a[cells][:, None]
         us = self.u_of_s(cells, s)[:, None]
         u_r = ua + (us - ua) * self.gauss_u[None, :]
-        cells_r = np.broadcast_to(cells[:, None], u_r.shape)
-        w_r = _exact_length((us - ua) * self.gauss_w[None, :] * self.jacobian(cells_r, u_r),
+        w_r = _exact_length((us - ua) * self.gauss_w[None, :] * rows.jacobian(u_r),
                             s - self.s_nodes[cells])
-        a0_r, a1_r = _nested(self, cells_r, ua, u_r)
-        a0_s, a1_s = _nested(self, cells[:, None], ua, us)
+        a0_r, a1_r = _nested(rows, self.gauss_u, self.gauss_w, ua, u_r)
+        a0_s, a1_s = _nested(rows, self.gauss_u, self.gauss_w, ua, us)
         return a0_s[:, 0], a1_s[:, 0], a0_r, a1_r, w_r
 
 
@@ -168,163 +194,265 @@ def _exact_length(weights: Array, length: Array) -> Array:
     return weights * np.where(total > 0.0, length[..., None] / np.where(total > 0, total, 1.0), 0.0)
 
 
-def _nested(grid: Grid, cells: IntArray, ua: Array, u_end: Array) -> tuple[Array, Array]:
+@dataclass(frozen=True)
+class CellRows:
+    """Cells lined up with the first axis of a ``u`` array: each row's member, segment (m) and
+    span along s (``a``, ``length``, m); the geometry of those cells at any ``u`` there."""
+
+    members: Members
+    member: IntArray
+    is_notch: NDArray[np.bool_]
+    seg_start: Array
+    seg_length: Array
+    a: Array
+    length: Array
+
+    @classmethod
+    def of(cls, table: Prototypes) -> CellRows:
+        """One row per prototype cell of ``table``."""
+        return cls(members=table.members, member=table.member, is_notch=table.is_notch,
+                   seg_start=table.seg_start, seg_length=table.seg_length, a=table.a,
+                   length=table.length)
+
+    def local_sigma(self, u: Array) -> Array:
+        """Arc length from each row's segment start (m) at ``u``."""
+        out = per_row(self.seg_length, u) * u
+        member, notch = self._notch_points(u)
+        if member.size:
+            out[notch] = self.members.sigma(member, u[notch])
+        return out
+
+    def jacobian(self, u: Array) -> Array:
+        """``ds/du`` (m) at ``u``."""
+        out = per_row(self.seg_length, u) + 0.0 * u
+        member, notch = self._notch_points(u)
+        if member.size:
+            out[notch] = self.members.dsigma_du(member, u[notch])
+        return out
+
+    def compliance(self, u: Array) -> Array:
+        """``1/(E I)`` (1/(N m^2)) at ``u``."""
+        m = self.members
+        every = np.broadcast_to(per_row(self.member, u), u.shape)
+        inertia = m.tube_moment[every]
+        member, notch = self._notch_points(u)
+        if member.size:
+            inertia[notch] = notched_moment(m.h1(member, u[notch]), m.R_outer[member],
+                                            m.r_inner[member])
+        return 1.0 / (m.E[every] * inertia)
+
+    def _notch_points(self, u: Array) -> tuple[IntArray, NDArray[np.bool_]]:
+        """Members of the points of ``u`` inside notches (flat), and the mask of those points."""
+        notch = np.broadcast_to(per_row(self.is_notch, u), u.shape)
+        return np.broadcast_to(per_row(self.member, u), u.shape)[notch], notch
+
+
+def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Array
+            ) -> tuple[Array, Array]:
     """``A0``, ``A1`` from reference coordinate ``ua`` to each ``u_end`` of the same cell.
 
-    ``cells`` and ``u_end`` share a shape; ``ua`` broadcasts against them.
+    ``u_end`` has one row per cell of ``rows``; ``ua`` broadcasts against it.
     """
     span = u_end - ua
-    inner_u = ua[..., None] + span[..., None] * grid.gauss_u
-    inner_cells = np.broadcast_to(cells[..., None], inner_u.shape)
-    inner_ds = span[..., None] * grid.gauss_w * grid.jacobian(inner_cells, inner_u)
-    a_cell = grid.s_nodes[inner_cells]
-    length = grid.s_nodes[inner_cells + 1] - a_cell
-    s_inner = grid.seg_start[inner_cells] + grid.local_sigma(inner_cells, inner_u)
-    xi = (s_inner - a_cell) / length
-    c = grid.compliance(inner_cells, inner_u)
+    inner_u = ua[..., None] + span[..., None] * gauss_u
+    inner_ds = span[..., None] * gauss_w * rows.jacobian(inner_u)
+    s_inner = per_row(rows.seg_start, inner_u) + rows.local_sigma(inner_u)
+    xi = (s_inner - per_row(rows.a, inner_u)) / per_row(rows.length, inner_u)
+    c = rows.compliance(inner_u)
     return np.sum(inner_ds * (1.0 - xi) * c, axis=-1), np.sum(inner_ds * xi * c, axis=-1)
-
-
-def _segments(design: Design) -> list[tuple[bool, int, float, float]]:
-    """(is_notch, notch index or -1, start, end) of every non-empty segment, base to tip (m)."""
-    left, right = design.notch_bounds()
-    segments: list[tuple[bool, int, float, float]] = []
-    if design.w_base > 0.0:
-        segments.append((False, -1, 0.0, float(left[0])))
-    for i in range(design.N):
-        segments.append((True, i, float(left[i]), float(right[i])))
-        if i < design.N - 1 and design.w_t > 0.0:
-            segments.append((False, -1, float(right[i]), float(left[i + 1])))
-    if design.w_tip > 0.0:
-        segments.append((False, -1, float(right[-1]), design.length))
-    return segments
-
-
-def _check_custom_profile(design: Design) -> None:
-    if design.profile.name in ("circular", "rectangular"):
-        return
-    u = np.linspace(0.0, 1.0, 65)
-    try:
-        h1 = design.profile.h1(u, design.w_n, design.w_d)
-    except Exception as exc:  # a user callable may raise anything: report it as bad input
-        raise InvalidDesignError(f"h1(s) raised {exc!r}", parameter="h1(s)", value=None,
-                                 allowed="a function of sigma in [0, w_n] m") from exc
-    if h1.shape != u.shape or not np.all(np.isfinite(h1)) or np.any(h1 <= 0.0):
-        bad = h1[~(np.isfinite(h1) & (h1 > 0.0))] if h1.shape == u.shape else h1
-        raise InvalidDesignError(
-            f"h1(s) must be finite and > 0 m across the notch, got {np.ravel(bad)[:3]!r}",
-            parameter="h1(s)", value=np.ravel(bad)[:3].tolist(), allowed="(0, inf) m")
-
-
-def _check_rigidity(design: Design) -> None:
-    """Raise :class:`InvalidDesignError` unless the flexural rigidity ``E I`` (N m^2) is at least
-    the smallest normal double at ``PEAK_SAMPLES`` stations of a notch and in the tubes, so the
-    compliance ``1/(E I)`` is finite (a backbone or wall thinner than floating point resolves)."""
-    u = np.linspace(0.0, 1.0, PEAK_SAMPLES)
-    h1 = design.profile.h1(u, design.w_n, design.w_d)
-    rigidity = design.E * np.append(notched_moment(h1, design.R_outer, design.r_inner),
-                                    design.tube_second_moment)
-    floor = float(np.finfo(float).tiny)
-    if not np.all(rigidity >= floor):
-        least = float(np.min(rigidity))
-        raise InvalidDesignError(
-            f"E*I = {least:.3g} N m^2 (E = {design.E:g} Pa, w_d = {design.w_d:g} m, R_outer = "
-            f"{design.R_outer:g} m, r_inner = {design.r_inner:g} m) is out of range; allowed: "
-            f"[{floor:.3g}, inf) N m^2, so that 1/(E I) is finite",
-            parameter="E*I", value=least, allowed=f"[{floor:.3g}, inf) N m^2")
 
 
 def build_grid(design: Design, settings: SolverSettings) -> Grid:
     """The (cached) grid for ``design`` under ``settings``' routing and discretisation."""
-    return _build_grid(design, settings.routing, settings.cells_per_notch,
+    return _build_grid(design, settings.routing, settings.grid, settings.cells_per_notch,
                        settings.cells_per_tube, settings.quad_order)
 
 
 @lru_cache(maxsize=512)
-def _build_grid(design: Design, routing: str, cells_per_notch: int, cells_per_tube: int,
-                quad_order: int) -> Grid:
-    _check_custom_profile(design)
-    _check_rigidity(design)
-    segments = _segments(design)
-    is_notch_l: list[bool] = []
-    notch_l: list[int] = []
-    start_l: list[float] = []
-    len_l: list[float] = []
-    ua_l: list[float] = []
-    ub_l: list[float] = []
-    seg_first_cell: list[int] = []
-    for notch, index, start, end in segments:
-        count = cells_per_notch if notch else cells_per_tube
-        seg_first_cell.append(len(ua_l))
-        u = np.linspace(0.0, 1.0, count + 1)
-        for k in range(count):
-            is_notch_l.append(notch)
-            notch_l.append(index)
-            start_l.append(start)
-            len_l.append(end - start)
-            ua_l.append(float(u[k]))
-            ub_l.append(float(u[k + 1]))
-    seg_first_cell.append(len(ua_l))
-    is_notch = np.array(is_notch_l)
-    n = is_notch.size
-    cells = np.arange(n)
-    seg_start = np.array(start_l)
-    seg_length = np.array(len_l)
-    u_a = np.array(ua_l)
-    u_b = np.array(ub_l)
-    w_n = design.w_n
-    sigma_a = np.where(is_notch, design.profile.sigma(u_a, w_n), seg_length * u_a)
-    s_a = seg_start + sigma_a
-    s_nodes = np.append(s_a, design.length)
-    for cell in seg_first_cell[1:-1]:
-        s_nodes[cell] = seg_start[cell]
+def _build_grid(design: Design, routing: str, kind: str, cells_per_notch: int,
+                cells_per_tube: int, quad_order: int) -> Grid:
+    proto = prototypes(Members.of([design]), routing, kind, cells_per_notch, cells_per_tube)
+    table = cell_table(proto, routing)
+    cells = _cell_integrals(table, quad_order)
+    constrained = table.constrained
+    return Grid(design=design, s_nodes=np.append(table.a, design.length),
+                is_notch=table.is_notch, notch_index=table.notch_index,
+                seg_start=table.seg_start, seg_length=table.seg_length, u_a=table.u_a,
+                u_b=table.u_b, constrained=constrained,
+                chord_cells=np.flatnonzero(~constrained),
+                chord_start_node=table.chord_start_node, chord_end_node=table.chord_end_node,
+                notch_left_node=table.notch_left_node[0],
+                notch_right_node=table.notch_right_node[0], **cells)
 
+
+def _cell_integrals(table: CellTable, quad_order: int) -> dict[str, Array]:
+    """Every per-cell integral of the module docstring for all cells of ``table``: computed
+    once per prototype cell, in its segment's coordinates, and copied to its cells."""
+    proto = _prototype_integrals(table.prototypes, quad_order)
+    cells = {name: values[table.prototype] for name, values in proto.items()
+             if name not in ("gauss_u", "gauss_w")}
+    for name in ("s_q", "peak_s"):
+        cells[name] = per_row(table.seg_start, cells[name]) + cells[name]
+    return {**cells, "gauss_u": proto["gauss_u"], "gauss_w": proto["gauss_w"]}
+
+
+def _prototype_integrals(table: Prototypes, quad_order: int) -> dict[str, Array]:
+    """The integrals of every prototype cell; ``s_q``, ``peak_s`` from its segment's start."""
     gauss_x, gauss_wt = np.polynomial.legendre.leggauss(quad_order)
     gauss_u = 0.5 * (gauss_x + 1.0)
     gauss_w = 0.5 * gauss_wt
-
-    partial = Grid(design=design, s_nodes=s_nodes, is_notch=is_notch,
-                   notch_index=np.array(notch_l), seg_start=seg_start, seg_length=seg_length,
-                   u_a=u_a, u_b=u_b, constrained=np.zeros(n, bool),
-                   chord_cells=np.zeros(0, np.int64), chord_start_node=np.zeros(n, np.int64),
-                   chord_end_node=np.zeros(n, np.int64), gauss_u=gauss_u, gauss_w=gauss_w,
-                   **{k: np.zeros(0) for k in ("s_q", "w_q", "xi_q", "c_q", "C0", "C1", "A0",
-                                                "A1", "c_start", "c_end", "peak_c", "peak_s")},
-                   notch_left_node=np.zeros(0, np.int64), notch_right_node=np.zeros(0, np.int64))
-
+    rows = CellRows.of(table)
+    u_a, u_b = table.u_a, table.u_b
     span = (u_b - u_a)[:, None]
     uq = u_a[:, None] + span * gauss_u[None, :]
-    cq_cells = np.broadcast_to(cells[:, None], uq.shape)
-    length = np.diff(s_nodes)
-    w_q = _exact_length(span * gauss_w[None, :] * partial.jacobian(cq_cells, uq), length)
-    s_q = seg_start[:, None] + partial.local_sigma(cq_cells, uq)
-    xi_q = (s_q - s_nodes[:-1, None]) / length[:, None]
-    c_q = partial.compliance(cq_cells, uq)
-    big_c0 = np.sum(w_q * (1.0 - xi_q) * c_q, axis=1)
-    big_c1 = np.sum(w_q * xi_q * c_q, axis=1)
-    a0, a1 = _nested(partial, cq_cells, u_a[:, None], uq)
-
-    c_start = partial.compliance(cells, u_a)
-    c_end = partial.compliance(cells, u_b)
+    length = table.length
+    w_q = _exact_length(span * gauss_w[None, :] * rows.jacobian(uq), length)
+    s_q = rows.local_sigma(uq)
+    xi_q = (s_q - table.a[:, None]) / length[:, None]
+    c_q = rows.compliance(uq)
+    a0, a1 = _nested(rows, gauss_u, gauss_w, u_a[:, None], uq)
     probe_u = u_a[:, None] + span * np.linspace(0.0, 1.0, PEAK_SAMPLES)[None, :]
-    probe_cells = np.broadcast_to(cells[:, None], probe_u.shape)
-    probe_c = partial.compliance(probe_cells, probe_u)
+    probe_c = rows.compliance(probe_u)
     arg = np.argmax(probe_c, axis=1)
-    peak_c = probe_c[cells, arg]
-    peak_s = seg_start + partial.local_sigma(cells, probe_u[cells, arg])
+    every = np.arange(u_a.size)
+    chord = _chord_terms(table.chord, quad_order, w_q / gauss_w, w_q, xi_q, c_q, a0, a1)
+    return {"gauss_u": gauss_u, "gauss_w": gauss_w, "s_q": s_q, "w_q": w_q, "xi_q": xi_q,
+            "c_q": c_q, "C0": np.sum(w_q * (1.0 - xi_q) * c_q, axis=1),
+            "C1": np.sum(w_q * xi_q * c_q, axis=1), "A0": a0, "A1": a1, **chord,
+            "c_start": rows.compliance(u_a), "c_end": rows.compliance(u_b),
+            "peak_c": probe_c[every, arg],
+            "peak_s": rows.local_sigma(probe_u[every, arg])}
 
-    constrained = is_notch if routing == "paper" else ~is_notch
-    seg_of_cell = np.repeat(np.arange(len(segments)), np.diff(seg_first_cell))
-    first = np.array(seg_first_cell)
-    chord_start = first[seg_of_cell]
-    chord_end = first[seg_of_cell + 1]
-    notch_left = np.array([first[j] for j, seg in enumerate(segments) if seg[0]])
-    notch_right = np.array([first[j + 1] for j, seg in enumerate(segments) if seg[0]])
 
-    return Grid(design=design, s_nodes=s_nodes, is_notch=is_notch, notch_index=np.array(notch_l),
-                seg_start=seg_start, seg_length=seg_length, u_a=u_a, u_b=u_b,
-                constrained=constrained, chord_cells=np.flatnonzero(~constrained),
-                chord_start_node=chord_start, chord_end_node=chord_end, gauss_u=gauss_u,
-                gauss_w=gauss_w, s_q=s_q, w_q=w_q, xi_q=xi_q, c_q=c_q, C0=big_c0, C1=big_c1,
-                A0=a0, A1=a1, c_start=c_start, c_end=c_end, peak_c=peak_c, peak_s=peak_s,
-                notch_left_node=notch_left, notch_right_node=notch_right)
+def _chord_terms(chord: NDArray[np.bool_], quad_order: int, ds_du: Array, w_q: Array,
+                 xi_q: Array, c_q: Array, a0: Array, a1: Array) -> dict[str, Array]:
+    """``A0_T``, ``A1_T`` (at the Gauss points) and ``C0_T``, ``C1_T`` (per cell) of chord cells.
+
+    On a chord the moment obeys ``m'' = -T c m`` (the tendon's pull on a curving body), so it is
+    not linear: ``m = m_a (1 - xi) + m_b xi + T (m_a G0 + m_b G1)`` to first order in
+    ``T c h^2``, with ``G0'' = -c (1 - xi)``, ``G1'' = -c xi`` and ``G = 0`` at both cell ends,
+    i.e. ``G0(s) = xi int_a^b A0 ds - int_a^s A0 ds``. The extra bend is ``T (m_a C0_T + m_b
+    C1_T)`` with ``C0_T = int c G0 ds``, and ``A0_T(s) = int_a^s c G0`` at the Gauss points
+    (rad/(N^2 m)); zero where the tendon follows the body. Partial integrals use the Gauss
+    points' spectral integration matrix. ``ds_du`` (m) is each Gauss point's ds per unit of
+    the cell's own reference coordinate.
+    """
+    matrix = _integration_matrix(quad_order)
+
+    def partial(values: Array) -> Array:
+        return np.sum((values * ds_du)[:, None, :] * matrix[None, :, :], axis=-1)
+
+    out = {}
+    for name, a in (("0", a0), ("1", a1)):
+        g = xi_q * np.sum(w_q * a, axis=1, keepdims=True) - partial(a)
+        out[f"A{name}_T"] = np.where(chord[:, None], partial(c_q * g), 0.0)
+        out[f"C{name}_T"] = np.where(chord, np.sum(w_q * c_q * g, axis=1), 0.0)
+    return out
+
+
+@lru_cache(maxsize=32)
+def _integration_matrix(quad_order: int) -> Array:
+    """``S[q, k] = int_0^{u_q} l_k(u) du`` on [0, 1] for the Lagrange basis ``l_k`` of the
+    ``quad_order`` Gauss-Legendre points ``u_q``: partial integrals exact for polynomials of
+    degree ``quad_order - 1``."""
+    legendre = np.polynomial.legendre
+    x, _ = legendre.leggauss(quad_order)
+    basis = np.linalg.inv(legendre.legvander(x, quad_order - 1))
+    matrix = np.asarray(0.5 * legendre.legval(x, legendre.legint(basis, lbnd=-1.0)).T,
+                        dtype=np.float64)
+    matrix.setflags(write=False)
+    return matrix
+
+
+@dataclass(frozen=True, eq=False)
+class GridStack:
+    """The grids of M designs with a leading member axis, padded to ``C`` cells (SI units).
+
+    Fields have :class:`Grid`'s names and meanings with a leading axis of length M: per cell
+    (M, C), per node (M, C + 1), per Gauss point (M, C, Q), per notch (M, max N); ``gauss_u``,
+    ``gauss_w`` (Q,) are shared. Member ``m`` owns its first ``n_cells[m]`` cells, equal bit
+    for bit to ``build_grid(designs[m], settings)``'s. The padding cells past them have zero
+    length at the member's tip (``s_nodes = L``) and carry nothing: ``C0 = C1 = A0 = A1 =
+    w_q = 0``, zero compliance, ``is_notch`` false, ``constrained`` true (no chord),
+    ``notch_index`` -1, chord nodes = the tip node; padding notches (``N < max N``) have both
+    nodes at the tip node. ``chord_cells`` is not stacked: use ``~constrained``.
+    """
+
+    designs: tuple[Design, ...]
+    n_cells: IntArray
+    s_nodes: Array
+    is_notch: NDArray[np.bool_]
+    notch_index: IntArray
+    seg_start: Array
+    seg_length: Array
+    u_a: Array
+    u_b: Array
+    constrained: NDArray[np.bool_]
+    chord_start_node: IntArray
+    chord_end_node: IntArray
+    gauss_u: Array
+    gauss_w: Array
+    s_q: Array
+    w_q: Array
+    xi_q: Array
+    c_q: Array
+    C0: Array
+    C1: Array
+    A0: Array
+    A1: Array
+    A0_T: Array
+    A1_T: Array
+    C0_T: Array
+    C1_T: Array
+    c_start: Array
+    c_end: Array
+    peak_c: Array
+    peak_s: Array
+    notch_left_node: IntArray
+    notch_right_node: IntArray
+
+    @property
+    def length(self) -> Array:
+        """Cell lengths (m), shape (M, C); 0 in the padding."""
+        return np.diff(self.s_nodes, axis=-1)
+
+
+def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStack:
+    """Grids of many designs at once (numpy over the member axis); see :class:`GridStack`."""
+    if len(designs) == 0:
+        raise out_of_range("number of designs", 0, "[1, inf)", error=InvalidDesignError)
+    members = Members.of(designs)
+    table = cell_table(prototypes(members, settings.routing, settings.grid,
+                                  settings.cells_per_notch, settings.cells_per_tube),
+                       settings.routing)
+    cells = _cell_integrals(table, settings.quad_order)
+    count = table.count
+    width = int(count.max())
+    slot = np.arange(table.member.size) - table.first[table.member]
+    at = (table.member, slot)
+    tip = np.broadcast_to(members.length[:, None], (count.size, width))
+
+    def spread(values: NDArray[Scalar], pad: float | bool,
+               like: Array | IntArray | None = None) -> NDArray[Scalar]:
+        out = np.full((count.size, width) + values.shape[1:], pad, dtype=values.dtype)
+        if like is not None:
+            out[...] = like.reshape(like.shape + (1,) * (values.ndim - 1))
+        out[at] = values
+        return out
+
+    s_nodes = np.concatenate([spread(table.a, 0.0, tip), members.length[:, None]], axis=1)
+    tip_node = np.broadcast_to(count[:, None], (count.size, width))
+    return GridStack(
+        designs=members.designs, n_cells=count, s_nodes=s_nodes,
+        is_notch=spread(table.is_notch, False), notch_index=spread(table.notch_index, -1),
+        seg_start=spread(table.seg_start, 0.0, tip), seg_length=spread(table.seg_length, 0.0),
+        u_a=spread(table.u_a, 0.0), u_b=spread(table.u_b, 0.0),
+        constrained=spread(table.constrained, True),
+        chord_start_node=spread(table.chord_start_node, 0, tip_node),
+        chord_end_node=spread(table.chord_end_node, 0, tip_node),
+        gauss_u=cells["gauss_u"], gauss_w=cells["gauss_w"],
+        s_q=spread(cells["s_q"], 0.0, tip), peak_s=spread(cells["peak_s"], 0.0, tip),
+        **{name: spread(cells[name], 0.0) for name in
+           ("w_q", "xi_q", "c_q", "C0", "C1", "A0", "A1", "A0_T", "A1_T", "C0_T", "C1_T",
+            "c_start", "c_end", "peak_c")},
+        notch_left_node=table.notch_left_node, notch_right_node=table.notch_right_node)

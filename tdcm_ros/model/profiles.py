@@ -16,6 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
+#: A width (m): one number, or one per row of ``u`` (broadcasting against it).
+Width = float | Array
 
 
 @dataclass(frozen=True)
@@ -28,15 +30,15 @@ class CircularProfile:
 
     name: str = "circular"
 
-    def sigma(self, u: Array, w_n: float) -> Array:
+    def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
         return 0.5 * w_n * (1.0 - np.cos(np.pi * u))
 
-    def dsigma_du(self, u: Array, w_n: float) -> Array:
+    def dsigma_du(self, u: Array, w_n: Width) -> Array:
         """Jacobian d(sigma)/du (m)."""
         return 0.5 * w_n * np.pi * np.sin(np.pi * u)
 
-    def h1(self, u: Array, w_n: float, w_d: float) -> Array:
+    def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u``."""
         return 0.5 * (w_n + w_d) - 0.5 * w_n * np.sin(np.pi * u)
 
@@ -47,15 +49,15 @@ class RectangularProfile:
 
     name: str = "rectangular"
 
-    def sigma(self, u: Array, w_n: float) -> Array:
+    def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
         return w_n * u
 
-    def dsigma_du(self, u: Array, w_n: float) -> Array:
+    def dsigma_du(self, u: Array, w_n: Width) -> Array:
         """Jacobian d(sigma)/du (m)."""
         return np.full_like(u, w_n)
 
-    def h1(self, u: Array, w_n: float, w_d: float) -> Array:
+    def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u``."""
         return np.full_like(u, 0.5 * w_d)
 
@@ -72,15 +74,15 @@ class CustomProfile:
     half_width: Callable[[Array], Array] = field(compare=True)
     name: str = "custom"
 
-    def sigma(self, u: Array, w_n: float) -> Array:
+    def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
         return w_n * u
 
-    def dsigma_du(self, u: Array, w_n: float) -> Array:
+    def dsigma_du(self, u: Array, w_n: Width) -> Array:
         """Jacobian d(sigma)/du (m)."""
         return np.full_like(u, w_n)
 
-    def h1(self, u: Array, w_n: float, w_d: float) -> Array:
+    def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u`` from the user's function."""
         return np.asarray(self.half_width(w_n * u), dtype=float) * np.ones_like(u)
 

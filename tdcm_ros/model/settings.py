@@ -12,6 +12,7 @@ from tdcm_ros.model.errors import InvalidSettingsError
 ROUTINGS = ("paper", "free")
 LOAD_FORMS = ("closed", "literal")
 ACCELERATIONS = ("auto", "anderson", "relaxation", "none")
+GRID_KINDS = ("adaptive", "uniform")
 
 
 @dataclass(frozen=True)
@@ -23,6 +24,9 @@ class SolverSettings:
       and on the offset curve inside the tubes.
     - ``loads``: ``closed`` uses the tendon's equilibrium form ``m = (p_c - p) x (-T t_c)``;
       ``literal`` sums eqs. 8-10 (anchor, distributed and kink forces) on the grid.
+    - ``grid``: ``adaptive`` also puts cell boundaries where a notch's ``h1`` crosses
+      ``r_inner`` or ``R_outer`` and gives segments where the tendon runs as a chord more cells;
+      ``uniform`` cuts every segment into equal steps of its profile coordinate.
     - ``cells_per_notch`` / ``cells_per_tube``: cells per segment; cell boundaries always fall on
       every ``l_i`` and ``r_i``.
     - ``quad_order``: Gauss-Legendre points per cell for compliance and position integrals.
@@ -34,9 +38,10 @@ class SolverSettings:
 
     routing: str = "paper"
     loads: str = "closed"
+    grid: str = "adaptive"
     cells_per_notch: int = 4
     cells_per_tube: int = 1
-    quad_order: int = 4
+    quad_order: int = 6
     tol: float = 1e-10
     max_iter: int = 200
     acceleration: str = "auto"
@@ -45,7 +50,8 @@ class SolverSettings:
     continuation_steps: int = 8
 
     def __post_init__(self) -> None:
-        choices = {"routing": ROUTINGS, "loads": LOAD_FORMS, "acceleration": ACCELERATIONS}
+        choices = {"routing": ROUTINGS, "loads": LOAD_FORMS, "acceleration": ACCELERATIONS,
+                   "grid": GRID_KINDS}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise out_of_range(name, getattr(self, name), " | ".join(allowed),

@@ -1,0 +1,157 @@
+"""Tip error of the default grid against a converged reference, and its time per solve
+against today's (``grid=uniform``) default, in the same run (issue 15, item 4).
+
+Run: ``python bench/grid_accuracy.py [--quick] [--settings k=v,k=v ...]``.
+
+Cases: every preset with ``N`` in ``--notches`` (default 1, 8, 64; ``paper-experiment`` also
+2, 4, 16, 32) and the accuracy bench's hard designs, at 4 and 20 N, both routings, both load
+forms. The reference of each case is :func:`converged_tip` (Richardson extrapolation of two
+fine adaptive grids; its own uncertainty is printed). Cases the model refuses at that load
+(notch closure, the tendon singularity, eq. 7's 45 degree kink limit) are counted, not hidden.
+An independent check of the references' compliance integration: the constrained tendon's
+tip from the reference grid against ``shooting-segmented`` at rtol 1e-11.
+Single-threaded: BLAS threads are pinned to one before NumPy loads.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np
+
+from tdcm_ros.model import PRESETS, SolverSettings, solve
+from tdcm_ros.model.accuracy import (
+    HARD_DESIGNS,
+    REFERENCE,
+    constrained_tip,
+    converged_tip,
+)
+from tdcm_ros.model.baselines import ShootingOptions, solve_with
+from tdcm_ros.model.errors import ModelError, ModelLimitError
+
+TODAY = SolverSettings(grid="uniform", cells_per_notch=4, cells_per_tube=1, quad_order=4)
+TENSIONS = (4.0, 20.0)
+TARGET_M = 1e-7
+MODELS = (("paper", "closed"), ("free", "closed"), ("paper", "literal"), ("free", "literal"))
+
+
+def cases(notches: list[int], quick: bool) -> dict[str, object]:
+    """Designs by name: presets at every ``N`` in ``notches``, and the hard designs."""
+    names = ["paper-experiment", "fig3-wd-1.2"] if quick else list(PRESETS)
+    out: dict[str, object] = {}
+    for name in names:
+        counts = sorted(set(notches) | ({2, 4, 16, 32} if name == "paper-experiment"
+                                        and not quick else set()))
+        for n in counts:
+            out[f"{name} N={n}"] = PRESETS[name].with_overrides(N=n)
+    if not quick:
+        out.update(HARD_DESIGNS)
+        out["fully-notched N=8"] = PRESETS["paper-experiment"].with_overrides(w_t=0.0)
+    return out
+
+
+def median_time(design: object, tension: float, settings: SolverSettings, repeats: int
+                ) -> tuple[np.ndarray, float]:
+    """Tip (m) and median wall time (s) of ``repeats`` solves (grid built beforehand)."""
+    tip = solve(design, tension, settings=settings, strict=False).tip_position
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        solve(design, tension, settings=settings, strict=False)
+        times.append(time.perf_counter() - start)
+    return tip, float(np.median(times))
+
+
+def parse_settings(text: str) -> SolverSettings:
+    """``k=v,k=v`` overrides of the default settings."""
+    overrides: dict[str, object] = {}
+    for item in filter(None, text.split(",")):
+        key, value = item.split("=")
+        overrides[key] = value if key in ("grid", "routing", "loads") else (
+            float(value) if "." in value or "e" in value else int(value))
+    return SolverSettings().with_overrides(**overrides)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="two presets, closed loads")
+    parser.add_argument("--notches", default="1,8,64")
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--over", type=float, default=None,
+                        help="also list the cases whose error exceeds this (m)")
+    parser.add_argument("--settings", nargs="*", default=[""],
+                        help="candidate grids as k=v,k=v overrides of the default ('' = it)")
+    args = parser.parse_args()
+    candidates = {text or "default": parse_settings(text) for text in args.settings}
+    designs = cases([int(n) for n in args.notches.split(",")], args.quick)
+    models = MODELS[:2] if args.quick else MODELS
+    print(f"today's default: {TODAY}\n")
+    header = (f"{'model':<15}{'cases':>6}{'refused':>8}{'ref unc (m)':>12}"
+              f"{'today err':>11}{'today ms':>9}")
+    header += "".join(f"{(label[:14] + ' err'):>19}{'<=0.1um':>8}{'time/today':>11}"
+                      for label in candidates)
+    print(header)
+    worst_case: dict[str, tuple[float, str]] = {label: (0.0, "") for label in candidates}
+    for routing, loads in models:
+        unc = today_err = 0.0
+        today_t: list[float] = []
+        errs = {label: 0.0 for label in candidates}
+        within = {label: 0 for label in candidates}
+        ratios: dict[str, list[float]] = {label: [] for label in candidates}
+        count = refused = 0
+        for name, design in designs.items():
+            for tension in TENSIONS:
+                try:
+                    reference, uncertainty = converged_tip(design, tension, routing, loads)
+                    base = TODAY.with_overrides(routing=routing, loads=loads)
+                    tip_today, t_today = median_time(design, tension, base, args.repeats)
+                    runs = {label: median_time(design, tension, st.with_overrides(
+                        routing=routing, loads=loads), args.repeats)
+                        for label, st in candidates.items()}
+                except ModelLimitError:
+                    refused += 1
+                    continue
+                count += 1
+                unc = max(unc, uncertainty)
+                today_err = max(today_err, float(np.linalg.norm(tip_today - reference)))
+                today_t.append(t_today)
+                for label, (tip, elapsed) in runs.items():
+                    err = float(np.linalg.norm(tip - reference))
+                    errs[label] = max(errs[label], err)
+                    within[label] += err <= TARGET_M
+                    ratios[label].append(elapsed / t_today)
+                    if args.over is not None and err > args.over:
+                        print(f"  {label}: {err:.2e} m {routing}/{loads} {name} @ {tension:g} N")
+                    if err > worst_case[label][0]:
+                        worst_case[label] = (err, f"{routing}/{loads} {name} @ {tension:g} N")
+        line = (f"{routing + '/' + loads:<15}{count:>6}{refused:>8}{unc:>12.1e}"
+                f"{today_err:>11.2e}{np.median(today_t) * 1e3:>9.3f}")
+        line += "".join(f"{errs[label]:>19.2e}{within[label]:>8}{np.median(ratios[label]):>11.2f}"
+                        for label in candidates)
+        print(line, flush=True)
+    for label, (err, where) in worst_case.items():
+        print(f"\nworst case of {label}: {err:.2e} m, {where}")
+    print("\nindependent check (constrained tendon, reference grid vs shooting-segmented "
+          "rtol 1e-11):")
+    options = ShootingOptions(rtol=1e-11, atol=1e-14)
+    for name in ("paper-experiment N=8", "fig3-wd-1.2 N=8", "paper-experiment N=1"):
+        if name not in designs:
+            continue
+        design = designs[name]
+        try:
+            shot = solve_with("shooting-segmented", design, 20.0, options=options,
+                              strict=False).tip_position
+        except ModelError as exc:
+            print(f"  {name}: shooting failed ({exc})")
+            continue
+        grid_tip = constrained_tip(design, 20.0, REFERENCE)
+        print(f"  {name} @ 20 N: |grid - shooting| = {np.linalg.norm(grid_tip - shot):.2e} m")
+
+
+if __name__ == "__main__":
+    main()

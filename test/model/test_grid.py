@@ -1,0 +1,211 @@
+"""Grid layouts: the adaptive default's boundaries and accuracy, and the many-design build."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from tdcm_ros.model import CustomProfile, SolverSettings, preset, solve
+from tdcm_ros.model.accuracy import converged_tip
+from tdcm_ros.model.design import MM
+from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
+from tdcm_ros.model.grid import build_grid, build_grids
+
+PER_CELL = ("s_nodes", "is_notch", "notch_index", "seg_start", "seg_length", "u_a", "u_b",
+            "constrained", "chord_start_node", "chord_end_node", "s_q", "w_q", "xi_q", "c_q",
+            "C0", "C1", "A0", "A1", "A0_T", "A1_T", "C0_T", "C1_T", "c_start", "c_end", "peak_c",
+            "peak_s")
+PREVIOUS_DEFAULT = SolverSettings(grid="uniform", cells_per_notch=4, cells_per_tube=1,
+                                  quad_order=4)
+
+
+def circular_crossing(design, level):
+    """``u`` in (0, 0.5) where eq. 13's ``h1`` equals ``level`` (m)."""
+    return float(np.arcsin((design.w_n + design.w_d - 2.0 * level) / design.w_n) / np.pi)
+
+
+def test_adaptive_boundaries_include_the_r_inner_crossings():
+    design = preset("paper-experiment")
+    grid = build_grid(design, SolverSettings())
+    u_star = circular_crossing(design, design.r_inner)
+    assert 0.0 < u_star < 0.5
+    for i, (left, right) in enumerate(zip(*design.notch_bounds())):
+        cells = np.flatnonzero(grid.notch_index == i)
+        bounds = np.append(grid.u_a[cells], grid.u_b[cells[-1]])
+        for u in (u_star, 1.0 - u_star):
+            assert np.min(np.abs(bounds - u)) <= 1e-15
+            s = left + design.profile.sigma(np.array(u), design.w_n)
+            assert np.min(np.abs(grid.s_nodes - s)) <= 1e-15
+        h1 = design.profile.h1(bounds, design.w_n, design.w_d)
+        assert np.sum(np.isclose(h1, design.r_inner, rtol=1e-14, atol=0.0)) == 2
+    uniform = build_grid(design, SolverSettings(grid="uniform"))
+    assert np.min(np.abs(uniform.u_a - u_star)) > 1e-3
+
+
+def test_adaptive_boundaries_include_the_r_outer_crossings():
+    # (w_n + w_d)/2 = 4.2 mm > R_outer: the cut vanishes near the notch edges.
+    design = preset("paper-experiment").with_overrides(w_n=6.0 * MM, w_d=2.4 * MM)
+    grid = build_grid(design, SolverSettings())
+    cells = np.flatnonzero(grid.notch_index == 0)
+    bounds = np.append(grid.u_a[cells], grid.u_b[cells[-1]])
+    for level in (design.r_inner, design.R_outer):
+        u = circular_crossing(design, level)
+        assert np.min(np.abs(bounds - u)) <= 1e-15
+        assert np.min(np.abs(bounds - (1.0 - u))) <= 1e-15
+
+
+def test_custom_profile_crossings_are_found_by_search():
+    circular = preset("paper-experiment")
+    w_n, w_d = circular.w_n, circular.w_d
+
+    def h1(sigma):
+        return 0.5 * (w_n + w_d) - np.sqrt(np.maximum(sigma * (w_n - sigma), 0.0))
+
+    custom = circular.with_overrides(profile=CustomProfile(h1))
+    grid = build_grid(custom, SolverSettings())
+    cells = np.flatnonzero(grid.notch_index == 0)
+    bounds = np.append(grid.u_a[cells], grid.u_b[cells[-1]])
+    # The custom profile's u is sigma / w_n; the crossing is where sigma (w_n - sigma) =
+    # ((w_n + w_d)/2 - r_inner)^2.
+    depth = 0.5 * (w_n + w_d) - circular.r_inner
+    sigma = 0.5 * (w_n - np.sqrt(w_n**2 - 4.0 * depth**2))
+    for u in (sigma / w_n, 1.0 - sigma / w_n):
+        assert np.min(np.abs(bounds - u)) <= 1e-12
+
+
+def test_rectangular_notches_have_no_crossings():
+    design = preset("paper-experiment").with_overrides(profile="rectangular")
+    grid = build_grid(design, SolverSettings(routing="free"))
+    # Chord notches: CHORD_CELL_FACTOR x cells_per_notch equal cells, no extra boundary.
+    cells = np.flatnonzero(grid.notch_index == 0)
+    assert np.allclose(np.diff(grid.u_a[cells]), 1.0 / cells.size, rtol=1e-12)
+
+
+@pytest.mark.parametrize("loads", ["closed", "literal"])
+@pytest.mark.parametrize("name", ["paper-experiment", "fig3-wd-1.2", "fig2-wn-1"])
+@pytest.mark.parametrize("notches", [1, 8, 64])
+def test_default_grid_is_within_0p1_um_under_paper_routing(name, notches, loads):
+    design = preset(name).with_overrides(N=notches)
+    reference, uncertainty = converged_tip(design, 20.0, "paper", loads)
+    assert uncertainty < 1e-8
+    tip = solve(design, 20.0, settings=SolverSettings(loads=loads)).tip_position
+    assert np.linalg.norm(tip - reference) < 1e-7
+
+
+@pytest.mark.parametrize("notches", [1, 8, 64])
+def test_default_grid_improves_free_routing_several_fold(notches):
+    # Free routing's chord moments are linear per cell (second order): the default does not
+    # reach 0.1 um there (see bench/grid_accuracy.py), but it errs far less than before.
+    design = preset("paper-experiment").with_overrides(N=notches)
+    reference, _ = converged_tip(design, 20.0, "free", "closed")
+    errors = [np.linalg.norm(solve(design, 20.0, settings=s.with_overrides(routing="free"))
+                             .tip_position - reference)
+              for s in (SolverSettings(), PREVIOUS_DEFAULT)]
+    assert errors[0] < errors[1] / 8.0
+
+
+designs_strategy = st.builds(
+    lambda n, w_n, w_d, w_t, w_base, w_tip, r_inner, profile: preset(
+        "paper-experiment").with_overrides(N=n, w_n=w_n * MM, w_d=w_d * MM, w_t=w_t * MM,
+                                           w_base=w_base * MM, w_tip=w_tip * MM,
+                                           r_inner=r_inner * MM, profile=profile),
+    st.integers(1, 12), st.floats(0.5, 6.0), st.floats(0.3, 7.0),
+    st.sampled_from([0.0, 0.05, 4.0]), st.sampled_from([0.0, 5.0]),
+    st.sampled_from([0.0, 4.0]), st.sampled_from([0.0, 0.8, 1.55]),
+    st.sampled_from(["circular", "rectangular"]))
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(designs=st.lists(designs_strategy, min_size=1, max_size=6),
+       routing=st.sampled_from(["paper", "free"]), kind=st.sampled_from(["adaptive", "uniform"]),
+       quad_order=st.integers(2, 6))
+def test_many_design_build_equals_each_single_build_bit_for_bit(designs, routing, kind,
+                                                               quad_order):
+    cfg = SolverSettings(routing=routing, grid=kind, quad_order=quad_order)
+    stack = build_grids(designs, cfg)
+    width = int(stack.n_cells.max())
+    for m, design in enumerate(designs):
+        grid = build_grid(design, cfg)
+        n = grid.n_cells
+        assert stack.n_cells[m] == n
+        for name in PER_CELL:
+            single = getattr(grid, name)
+            stacked = getattr(stack, name)[m][:single.shape[0]]
+            assert stacked.dtype == single.dtype and stacked.tobytes() == single.tobytes(), name
+        assert np.array_equal(stack.notch_left_node[m, :design.N], grid.notch_left_node)
+        assert np.array_equal(stack.notch_right_node[m, :design.N], grid.notch_right_node)
+        # Padding: zero-length cells at the tip that carry nothing.
+        pad = slice(n, width)
+        assert np.all(stack.s_nodes[m, n:] == design.length)
+        for name in ("C0", "C1", "A0", "A1", "w_q", "c_q", "A0_T", "C1_T"):
+            assert not np.any(getattr(stack, name)[m, pad])
+        assert np.all(stack.constrained[m, pad]) and not np.any(stack.is_notch[m, pad])
+        assert np.all(stack.notch_left_node[m, design.N:] == n)
+    assert np.array_equal(stack.gauss_u, build_grid(designs[0], cfg).gauss_u)
+
+
+def test_many_design_build_with_mixed_custom_profiles():
+    base = preset("paper-experiment")
+    designs = [base, base.with_overrides(profile=CustomProfile(lambda s: 0.0 * s + 1.0 * MM)),
+               base.with_overrides(N=3, profile="rectangular")]
+    stack = build_grids(designs, SolverSettings())
+    for m, design in enumerate(designs):
+        grid = build_grid(design, SolverSettings())
+        assert stack.A0[m, :grid.n_cells].tobytes() == grid.A0.tobytes()
+
+
+def test_many_design_build_rejects_bad_input_naming_it():
+    with pytest.raises(InvalidDesignError, match="number of designs = 0"):
+        build_grids([], SolverSettings())
+    soft = preset("paper-experiment").with_overrides(E=1e-300)
+    with pytest.raises(InvalidDesignError, match="E\\*I") as info:
+        build_grids([preset("paper-experiment"), soft], SolverSettings())
+    assert "1e-300" in str(info.value)
+    with pytest.raises(InvalidSettingsError, match="grid"):
+        SolverSettings(grid="graded")
+
+
+def test_chord_terms_in_a_tube_match_the_closed_form():
+    # Constant c over a cell of length h: G0 = c h^2 (xi/3 - xi^2/2 + xi^3/6) and
+    # G1 = c h^2 (xi/6 - xi^3/6), so C0_T = C1_T = c^2 h^3 / 24, A0_T(xi) = c^2 h^3 (xi^2/6 -
+    # xi^3/6 + xi^4/24) and A1_T(xi) = c^2 h^3 (xi^2/12 - xi^4/24).
+    design = preset("paper-experiment")
+    grid = build_grid(design, SolverSettings(routing="paper"))
+    tubes = np.flatnonzero(~grid.is_notch)
+    assert np.all(np.isin(tubes, grid.chord_cells))
+    c = 1.0 / (design.E * design.tube_second_moment)
+    h = grid.length[tubes]
+    xi = grid.xi_q[tubes]
+    assert np.allclose(grid.C0_T[tubes], c**2 * h**3 / 24.0, rtol=1e-12, atol=0.0)
+    assert np.allclose(grid.C1_T[tubes], c**2 * h**3 / 24.0, rtol=1e-12, atol=0.0)
+    scale = (c**2 * h**3)[:, None]
+    assert np.allclose(grid.A0_T[tubes], scale * (xi**2 / 6 - xi**3 / 6 + xi**4 / 24),
+                       rtol=1e-11, atol=0.0)
+    assert np.allclose(grid.A1_T[tubes], scale * (xi**2 / 12 - xi**4 / 24), rtol=1e-11,
+                       atol=0.0)
+    # Where the tendon follows the body (the notches, under paper routing) there is no term.
+    notch = np.flatnonzero(grid.is_notch)
+    assert not np.any(grid.C0_T[notch]) and not np.any(grid.A1_T[notch])
+
+
+def test_chord_terms_in_a_notch_match_a_fine_trapezoid_integration():
+    design = preset("paper-experiment")
+    grid = build_grid(design, SolverSettings(routing="free"))
+    for k in grid.chord_cells[grid.is_notch[grid.chord_cells]][:6]:
+        cells = np.full(20001, k)
+        u = np.linspace(grid.u_a[k], grid.u_b[k], cells.size)
+        s = grid.seg_start[k] + grid.local_sigma(cells, u)
+        c = grid.compliance(cells, u)
+        xi = (s - s[0]) / (s[-1] - s[0])
+
+        def cumulative(f, s=s):
+            return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(s))])
+
+        for shape, c_t, a_t in ((1.0 - xi, grid.C0_T, grid.A0_T), (xi, grid.C1_T, grid.A1_T)):
+            inner = cumulative(cumulative(c * shape))
+            g = xi * inner[-1] - inner
+            total = cumulative(c * g)
+            assert c_t[k] == pytest.approx(total[-1], rel=1e-6)
+            assert np.allclose(a_t[k], np.interp(grid.s_q[k], s, total), rtol=1e-5)
