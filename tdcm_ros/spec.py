@@ -178,11 +178,12 @@ class Spec:
 def spec_field(default: Any = dataclasses.MISSING, *, unit: str = "", description: str = "",
                kind: str | None = None, low: float = -math.inf, high: float = math.inf,
                low_open: bool = False, high_open: bool = False, size: int = 3,
-               choices: Sequence[str] = ()) -> Any:
-    """A dataclass field declared with its spec (named after the field; ``kind`` inferred from
-    the default when not given). Collect them with :func:`specs_of`."""
+               choices: Sequence[str] = (), name: str = "") -> Any:
+    """A dataclass field declared with its spec: the parameter is named after the field unless
+    ``name`` is given (e.g. ``align.tolerance_s``); ``kind`` is inferred from the default when not
+    given. Collect them with :func:`specs_of`."""
     given = None if default is dataclasses.MISSING else default
-    spec = Spec("", unit, description, given, kind or kind_of(given), low, high, low_open, size,
+    spec = Spec(name, unit, description, given, kind or kind_of(given), low, high, low_open, size,
                 tuple(choices), high_open)
     return dataclasses.field(default=default, metadata={_METADATA_KEY: spec})
 
@@ -206,17 +207,24 @@ def kind_of(value: Any) -> str:
 def specs_of(cls: Any) -> dict[str, Spec]:
     """Specs of the dataclass ``cls`` declared with :func:`spec_field`, by field name, in field
     order (fields declared otherwise, e.g. an object-valued field, are not parameters)."""
-    return {f.name: dataclasses.replace(f.metadata[_METADATA_KEY], name=f.name)
-            for f in dataclasses.fields(cls) if _METADATA_KEY in f.metadata}
+    specs = {f.name: f.metadata[_METADATA_KEY] for f in dataclasses.fields(cls)
+             if _METADATA_KEY in f.metadata}
+    return {field: spec if spec.name else dataclasses.replace(spec, name=field)
+            for field, spec in specs.items()}
+
+
+def by_name(*specs: Spec) -> dict[str, Spec]:
+    """``specs`` keyed by their names (a group of parameters that are not dataclass fields)."""
+    return {spec.name: spec for spec in specs}
 
 
 def check_fields(instance: Any, specs: Mapping[str, Spec], *, prefix: str = "",
                  error: type[InputError] = InputError) -> None:
     """Check every spec'd field of the (frozen) dataclass ``instance`` and store its normalised
-    value; errors name the field as ``prefix + name``."""
-    for name, spec in specs.items():
-        value = spec.check(getattr(instance, name), f"{prefix}{name}", error=error)
-        object.__setattr__(instance, name, value)
+    value; errors name the parameter as ``prefix + spec.name``."""
+    for field, spec in specs.items():
+        value = spec.check(getattr(instance, field), f"{prefix}{spec.name}", error=error)
+        object.__setattr__(instance, field, value)
 
 
 def as_mapping(where: str, raw: Any, *, error: type[InputError] = InputError
