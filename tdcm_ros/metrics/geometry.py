@@ -34,7 +34,8 @@ class MarkerLayout:
     arc_lengths: tuple[float, ...] = spec_field((0.015, 0.033, 0.053), unit="m", low=0.0,
                                                 low_open=True, description=(
                                                     "marker arc lengths from the base, increasing"))
-    ball_radius: float = spec_field(0.001, unit="m", low=0.0, description="marker ball radius")
+    ball_radius: float = spec_field(0.001, unit="m", low=0.0, high=0.05,
+                                    description="marker ball radius")
     side_deg: float = spec_field(180.0, unit="deg", low=-360.0, high=360.0, description=(
         "marker side around the body z axis from the tendon side"))
 
