@@ -122,12 +122,12 @@ class Spec:
                 raise self._wrong_type(where, value, error)
             items = list(items)
             if not items or (self.kind == "vector" and len(items) != self.size):
-                raise out_of_range(where, value, self.allowed(), error=error)
+                raise out_of_range(where, value, self.allowed(), unit=self.unit, error=error)
             if self.kind == "names":
                 if not all(isinstance(v, str) and v for v in items) or len(set(items)) != len(items):
-                    raise out_of_range(where, value, self.allowed(), error=error)
+                    raise out_of_range(where, value, self.allowed(), unit=self.unit, error=error)
                 return tuple(items)
-            return tuple(self._scalar(item, value, where, error, from_text) for item in items)
+            return tuple(self._scalar(item, item, where, error, from_text) for item in items)
         return self._scalar(value, value, where, error, from_text)
 
     def _scalar(self, value: Any, whole: Any, where: str, error: type[InputError],
@@ -142,13 +142,13 @@ class Spec:
             if not isinstance(value, str):
                 raise self._wrong_type(where, whole, error)
             if self.choices and value not in self.choices:
-                raise out_of_range(where, whole, self.allowed(), error=error)
+                raise out_of_range(where, whole, self.allowed(), unit=self.unit, error=error)
             return value
         number = self._number(value, whole, where, error, from_text)
         below = number <= self.low if self.low_open else number < self.low
         above = number >= self.high if self.high_open else number > self.high
         if not math.isfinite(number) or below or above:
-            raise out_of_range(where, whole, self.allowed(), error=error)
+            raise out_of_range(where, whole, self.allowed(), unit=self.unit, error=error)
         return number
 
     def _number(self, value: Any, whole: Any, where: str, error: type[InputError],

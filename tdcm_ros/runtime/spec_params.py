@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from functools import partial
 from typing import Any
 
+from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.parameters import ParamValue
 from tdcm_ros.runtime.port import NodePort
 from tdcm_ros.spec import Spec
@@ -29,6 +30,19 @@ def ros_value(spec: Spec, value: Any) -> ParamValue:
     return float(value) if spec.kind == "float" else value
 
 
+def checked(spec: Spec, prefix: str, value: Any) -> Any:
+    """``value`` checked and normalised by ``spec``; in a group (``prefix`` given) the error
+    names the full parameter before the field's own message, e.g. ``steps.zero_n: zero_n = ...``."""
+    try:
+        return spec.check(value)
+    except InputError as error:
+        if not prefix:
+            raise
+        name = f"{prefix}{spec.name}"
+        raise InputError(f"{name}: {error}", parameter=name, value=error.value,
+                         allowed=error.allowed) from error
+
+
 def declare_specs(port: NodePort, specs: Mapping[str, Spec], *, prefix: str = "",
                   defaults: Mapping[str, Any] | None = None, read_only: bool = False
                   ) -> dict[str, Any]:
@@ -39,9 +53,9 @@ def declare_specs(port: NodePort, specs: Mapping[str, Spec], *, prefix: str = ""
         name = f"{prefix}{spec.name}"
         default = (defaults or {}).get(key, spec.default)
         value = port.declare_parameter(name, ros_value(spec, default), description=description(spec),
-                                       range=spec.bounds, validator=partial(spec.check, where=name),
+                                       range=spec.bounds, validator=partial(checked, spec, prefix),
                                        read_only=read_only)
-        values[key] = spec.check(value, name)
+        values[key] = checked(spec, prefix, value)
     return values
 
 
@@ -53,6 +67,6 @@ def read_specs(port: NodePort, specs: Mapping[str, Spec], *, prefix: str = "",
     values: dict[str, Any] = {}
     for key, spec in specs.items():
         name = f"{prefix}{spec.name}"
-        values[key] = spec.check(pending[name] if name in pending else port.get_parameter(name),
-                                 name)
+        values[key] = checked(spec, prefix, pending[name] if name in pending
+                              else port.get_parameter(name))
     return values
