@@ -28,7 +28,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs
+from tdcm_ros.runtime.spec_params import declare_specs, grouped
 from tdcm_ros.spec import Spec, by_name
 
 #: Parameters of the node besides the plant group (all fixed at start).
@@ -42,6 +42,10 @@ TWIN_SPECS = by_name(
     Spec("publish_period_s", "s", "how often the samples are published; every load-cell sample "
          "is published", 0.01, low=0.001, high=1.0),
     Spec("diagnostics_period_s", "s", "/diagnostics period", 1.0, low=0.05, high=60.0))
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(TWIN_SPECS), **grouped(PLANT_SPECS, "plant.")}
 
 
 def scene_bench(scene: str) -> tuple[PlantConfig, Callable[[], float]]:

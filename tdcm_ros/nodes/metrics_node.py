@@ -47,7 +47,7 @@ from tdcm_ros.model.design import PRESETS
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs
+from tdcm_ros.runtime.spec_params import declare_specs, grouped
 from tdcm_ros.spec import Spec, by_name
 
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
@@ -77,6 +77,12 @@ TUNABLE_SPECS = by_name(Spec("stale_s", "s", "inputs older than this are stale; 
 
 def _stamp_s(message: Any) -> float:
     return int(message.header.stamp.sec) + int(message.header.stamp.nanosec) * 1e-9
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(PRESET_SPECS), **grouped(FIELD_SPECS, "design."),
+              **grouped(LAYOUT_SPECS, "markers."), **grouped(STEP_SPECS, "steps."),
+              **grouped(OPTION_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS)}
 
 
 class MetricsNode(NodeLogic):

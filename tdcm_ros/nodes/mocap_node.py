@@ -50,7 +50,7 @@ from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs
+from tdcm_ros.runtime.spec_params import declare_specs, grouped
 from tdcm_ros.spec import Spec, by_name
 
 SOURCES = ("csv", "relabel", "sim")
@@ -111,6 +111,9 @@ MOCAP_SPECS = by_name(
     Spec("markers.side_deg", "deg", "marker side around the body z axis from the tendon side",
          180.0, low=-360.0, high=360.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
+
+#: Every parameter of the node by full name (parameter files are checked against it).
+PARAMETERS = grouped(MOCAP_SPECS)
 
 
 def _stamp_ns(message: Any) -> int:

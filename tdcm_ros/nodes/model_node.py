@@ -40,7 +40,7 @@ from tdcm_ros.model.design import PRESETS, Design
 from tdcm_ros.nodes.shape_messages import header, midline_messages
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, read_specs
+from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 from tdcm_ros.spec import Spec, by_name
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
@@ -68,6 +68,11 @@ TUNABLE_SPECS = by_name(
          high=3600.0),
     Spec("input.max_future_s", "s", "inputs stamped further ahead of the clock are dropped", 0.5,
          low=0.0, high=3600.0))
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(FIXED_SPECS), **grouped(FIELD_SPECS, "design."),
+              **grouped(SOLVER_SPECS, "solver."), **grouped(TUNABLE_SPECS)}
 
 
 class ModelNode(NodeLogic):

@@ -52,7 +52,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, read_specs
+from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 from tdcm_ros.spec import Spec, by_name
 
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
@@ -76,6 +76,11 @@ TUNABLE_SPECS = by_name(
     Spec("frame_id", description="frame of `tension`", default="tdcm_tendon", kind="str"),
     Spec("enabled", description="hold the setpoint (device mode T) when no fault", default=True,
          kind="bool"))
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(DRIVER_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS),
+              **grouped(SCHEDULE_SPECS, "schedule.")}
 
 
 class TensionDriverNode(NodeLogic):

@@ -18,6 +18,11 @@ from tdcm_ros.runtime.port import NodePort
 from tdcm_ros.spec import Spec
 
 
+def grouped(specs: Mapping[str, Spec], prefix: str = "") -> dict[str, Spec]:
+    """A group's specs by full parameter name (``prefix + spec.name``)."""
+    return {f"{prefix}{spec.name}": spec for spec in specs.values()}
+
+
 def description(spec: Spec) -> str:
     """The parameter description shown over ROS: the spec's, with its unit."""
     return f"{spec.description} ({spec.unit})" if spec.unit else spec.description
