@@ -98,7 +98,7 @@ class Spec:
         elif self.kind == "int":
             text = f"an integer{joined}"
         else:
-            text = span if interval else f"a finite number{joined}"
+            text = span or "a finite number"
         return f"{text} {self.unit}".rstrip()
 
     def check(self, value: Any, where: str | None = None, *,
@@ -114,59 +114,62 @@ class Spec:
         return self._normalise(value, where or self.name, error, from_text=True)
 
     def _normalise(self, value: Any, where: str, error: type[InputError], from_text: bool) -> Any:
-        if self.kind in _SEQUENCES:
-            items = value
-            if from_text and isinstance(value, str):
-                items = [part.strip() for part in value.split(",") if part.strip()]
-            if isinstance(items, (str, bytes, Mapping)) or not isinstance(items, Collection):
-                raise self._wrong_type(where, value, error)
-            items = list(items)
-            if not items or (self.kind == "vector" and len(items) != self.size):
-                raise out_of_range(where, value, self.allowed(), unit=self.unit, error=error)
-            if self.kind == "names":
-                if not all(isinstance(v, str) and v for v in items) or len(set(items)) != len(items):
-                    raise out_of_range(where, value, self.allowed(), unit=self.unit, error=error)
-                return tuple(items)
-            return tuple(self._scalar(item, item, where, error, from_text) for item in items)
-        return self._scalar(value, value, where, error, from_text)
+        if self.kind not in _SEQUENCES:
+            return self._scalar(value, where, error, from_text, shown_unit="")
+        items = value
+        if from_text and isinstance(value, str):
+            items = [part.strip() for part in value.split(",") if part.strip()]
+        if isinstance(items, (str, bytes, Mapping)) or not isinstance(items, Collection):
+            raise self._wrong_type(where, value, error)
+        items = list(items)
+        if not items or (self.kind == "vector" and len(items) != self.size):
+            raise out_of_range(where, value, self.allowed(), error=error)
+        if self.kind == "names":
+            if not all(isinstance(v, str) and v for v in items) or len(set(items)) != len(items):
+                raise out_of_range(where, value, self.allowed(), error=error)
+            return tuple(items)
+        # an element out of range is named with its unit: ``levels = -4.0 N is out of range``
+        return tuple(self._scalar(item, where, error, from_text, shown_unit=self.unit)
+                     for item in items)
 
-    def _scalar(self, value: Any, whole: Any, where: str, error: type[InputError],
-                from_text: bool) -> Any:
+    def _scalar(self, value: Any, where: str, error: type[InputError], from_text: bool,
+                shown_unit: str) -> Any:
         if self.kind == "bool":
             if from_text and isinstance(value, str) and value.lower() in _TRUE + _FALSE:
                 return value.lower() in _TRUE
             if not isinstance(value, bool):
-                raise self._wrong_type(where, whole, error)
+                raise self._wrong_type(where, value, error)
             return value
         if self.kind == "str":
             if not isinstance(value, str):
-                raise self._wrong_type(where, whole, error)
+                raise self._wrong_type(where, value, error)
             if self.choices and value not in self.choices:
-                raise out_of_range(where, whole, self.allowed(), unit=self.unit, error=error)
+                raise out_of_range(where, value, self.allowed(), error=error)
             return value
-        number = self._number(value, whole, where, error, from_text)
+        number = self._number(value, where, error, from_text)
         below = number <= self.low if self.low_open else number < self.low
         above = number >= self.high if self.high_open else number > self.high
         if not math.isfinite(number) or below or above:
-            raise out_of_range(where, whole, self.allowed(), unit=self.unit, error=error)
+            raise out_of_range(where, value, self.allowed(), unit=shown_unit, error=error)
         return number
 
-    def _number(self, value: Any, whole: Any, where: str, error: type[InputError],
+    def _number(self, value: Any, where: str, error: type[InputError],
                 from_text: bool) -> float | int:
+        given = value
         if from_text and isinstance(value, str):
             try:
                 value = float(value)
             except ValueError:
-                raise self._wrong_type(where, whole, error) from None
+                raise self._wrong_type(where, given, error) from None
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise self._wrong_type(where, whole, error)
+            raise self._wrong_type(where, given, error)
         if self.kind == "float" or self.kind in _SEQUENCES:
             return float(value)
         if isinstance(value, numbers.Integral):
             return int(value)
         if from_text and math.isfinite(value) and float(value) == int(value):
             return int(value)
-        raise self._wrong_type(where, whole, error)
+        raise self._wrong_type(where, given, error)
 
     def _wrong_type(self, where: str, value: Any, error: type[InputError]) -> InputError:
         noun = {"float": "a number", "int": "an integer", "bool": "true or false",
