@@ -215,3 +215,32 @@ def test_parse_mapping_fills_defaults_and_refuses_unknown_keys() -> None:
 def test_bounds_are_the_finite_range_a_ros_descriptor_shows(spec: Spec) -> None:
     assert spec.bounds == (spec.low, spec.high)
     assert Spec("x", low=0.0).bounds is None and Spec("s", kind="str").bounds is None
+
+
+def _settings_classes() -> list[type]:
+    from tdcm_ros.device.driver import DriverConfig
+    from tdcm_ros.device.plant import PlantConfig
+    from tdcm_ros.device.schedule import StepSchedule
+    from tdcm_ros.metrics.geometry import MarkerLayout
+    from tdcm_ros.metrics.options import EvaluateOptions
+    from tdcm_ros.metrics.steps import StepSettings
+    from tdcm_ros.model import Design, SolverSettings
+    return [Design, SolverSettings, StepSettings, MarkerLayout, EvaluateOptions, DriverConfig,
+            PlantConfig, StepSchedule]
+
+
+#: Fields that hold objects or groups, not parameters.
+NOT_PARAMETERS = {"profile", "design", "solver", "steps", "layout"}
+
+
+@pytest.mark.parametrize("cls", _settings_classes(), ids=lambda c: c.__name__)
+def test_every_settings_field_is_declared_with_a_spec(cls: type) -> None:
+    """A field added without ``spec_field`` would be unchecked and unknown to nodes and --set."""
+    from dataclasses import fields
+
+    missing = {f.name for f in fields(cls)} - set(specs_of(cls)) - NOT_PARAMETERS
+    assert not missing, f"{cls.__name__}: declare {sorted(missing)} with spec_field"
+    instance_defaults = {name: spec.default for name, spec in specs_of(cls).items()
+                         if spec.default is not None}
+    for name, default in instance_defaults.items():
+        specs_of(cls)[name].check(default)  # every default is allowed by its own spec
