@@ -14,7 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import CubicSpline
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.spec import check_fields, spec_field, specs_of
@@ -111,6 +110,10 @@ def measured_midline(markers_base: ArrayLike, layout: MarkerLayout, radius: floa
     the body frame taken from the spline's tangent there (repeated until it settles). ``None``
     when the tip marker or every other marker is missing (NaN).
     """
+    # scipy.interpolate on use only: model_node imports this module for MARKER_SPECS, and the
+    # import alone costs it about a second of start-up
+    from scipy.interpolate import CubicSpline
+
     p = np.asarray(markers_base, dtype=float)
     seen = ~np.isnan(p[:, 0])
     if not seen[-1] or seen.sum() < 2:
