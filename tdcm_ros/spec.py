@@ -167,8 +167,9 @@ class Spec:
             return float(value)
         if isinstance(value, numbers.Integral):
             return int(value)
-        if from_text and math.isfinite(value) and float(value) == int(value):
-            return int(value)
+        number = float(value)
+        if from_text and number.is_integer():
+            return int(number)
         raise self._wrong_type(where, given, error)
 
     def _wrong_type(self, where: str, value: Any, error: type[InputError]) -> InputError:
