@@ -376,7 +376,7 @@ def random_design(rng: random.Random) -> dict[str, Any]:
             scaled = getattr(base, name) * math.exp(rng.uniform(-2.3, 2.3))
             values[name] = max(1, round(scaled)) if spec.integer else scaled
             continue
-        low = spec.low if spec.low_inclusive else spec.low + (1 if spec.integer else 1e-12)
+        low = spec.low if not spec.low_open else spec.low + (1 if spec.integer else 1e-12)
         if spec.integer:
             values[name] = rng.choice([int(low), int(spec.high), rng.randint(int(low), 64)])
         else:

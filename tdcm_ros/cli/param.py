@@ -1,4 +1,5 @@
-"""``tdcm param get|set|list NODE ...``: parameters of running nodes, on either runtime.
+"""``tdcm param get|set|list NODE ...``: parameters of running nodes, on either runtime;
+``tdcm param specs NODE``: a node's parameters from their specs, without running it.
 
 On zenoh it uses the embedded runtime's parameter queryables; on rclpy the node's
 rcl_interfaces parameter services (what ``ros2 param`` uses). ``--runtime`` defaults to
@@ -38,6 +39,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     listing = verbs.add_parser("list", parents=[common], help="list parameters with values")
     listing.add_argument("node")
     listing.set_defaults(handler=run_list)
+    specs = verbs.add_parser("specs", help="print a node's parameters from their specs (offline): "
+                                           "name, unit, default, allowed values, meaning")
+    specs.add_argument("node")
+    specs.set_defaults(handler=run_specs)
 
 
 def _call(args: argparse.Namespace, op: str, request: dict[str, Any]) -> dict[str, Any]:
@@ -79,4 +84,20 @@ def run_list(args: argparse.Namespace) -> int:
     for name, info in sorted(_call(args, "list", {})["parameters"].items()):
         note = f"  # {info['description']}" if info["description"] else ""
         print(f"  {name}: {json.dumps(info['value'])}{note}")
+    return 0
+
+
+def run_specs(args: argparse.Namespace) -> int:
+    """Print the node's parameters as a Markdown table, from the specs it declares them with."""
+    import importlib
+
+    from tdcm_ros.runtime.registry import node_target
+    from tdcm_ros.spec import spec_table
+
+    module = importlib.import_module(node_target(args.node).partition(":")[0])
+    print("| parameter | unit | default | allowed | meaning |\n|---|---|---|---|---|")
+    for name, row in zip(module.PARAMETERS, spec_table(module.PARAMETERS.values()), strict=True):
+        default = "(derived)" if row["default"] == "None" else row["default"]
+        cells = (f"`{name}`", row["unit"], default, row["allowed"], row["description"])
+        print("| " + " | ".join(cell.replace("|", "\\|") for cell in cells) + " |")
     return 0

@@ -10,6 +10,7 @@ from typing import Any
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.model import (
     PRESETS,
+    SOLVER_SPECS,
     SolverSettings,
     TensionRangeError,
     parse_field,
@@ -17,7 +18,6 @@ from tdcm_ros.model import (
     solve,
 )
 from tdcm_ros.model.profiles import PROFILE_NAMES
-from tdcm_ros.model.settings import ROUTINGS
 
 
 def register(subparsers: Any) -> None:
@@ -31,9 +31,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override a design field in SI units, e.g. --set E=1.2e9")
     parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
-    parser.add_argument("--routing", choices=ROUTINGS, default="paper", help="tendon routing")
-    parser.add_argument("--loads", choices=("closed", "literal"), default="closed",
-                        help="tendon load form")
+    for name in ("routing", "loads"):  # choices and defaults from the settings' specs
+        spec = SOLVER_SPECS[name]
+        parser.add_argument(f"--{name}", choices=spec.choices, default=spec.default,
+                            help=spec.description)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.add_argument("--plot", metavar="FILE", help="draw midline and curvature to a .png, "
                         ".pdf or .svg file in an existing folder")

@@ -32,7 +32,7 @@ import enum
 import logging
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.errors import (
@@ -62,6 +62,7 @@ from tdcm_ros.device.protocol import (
 from tdcm_ros.device.schedule import StepSchedule
 from tdcm_ros.device.transport import Transport, open_transport
 from tdcm_ros.errors import out_of_range
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 _LOG = logging.getLogger(__name__)
 INFO_RETRY = 0.5        #: s between banner requests during the handshake
@@ -92,32 +93,36 @@ class Level(enum.IntEnum):
 class DriverConfig:
     """Driver parameters (SI: N, N/s, s). ``port`` is a device path, pty path or pyserial URL."""
 
-    port: str = "/dev/ttyACM0"
-    baudrate: int = c.BAUD_RATE
-    tension_max: float = 20.0
-    setpoint_rate: float = 40.0
-    heartbeat_period: float = 0.1
-    handshake_timeout: float = 3.0
-    stale_timeout: float = 0.25
-    link_timeout: float = 2.0
-    backoff_initial: float = 0.5
-    backoff_max: float = 8.0
+    port: str = spec_field("/dev/ttyACM0", description="device path, pty path or pyserial URL")
+    baudrate: int = spec_field(c.BAUD_RATE, unit="baud", low=1200, high=4_000_000,
+                               description="serial line rate")
+    tension_max: float = spec_field(20.0, unit="N", low=0.001, high=c.SETPOINT_MAX_MN / 1000,
+                                    description="largest setpoint")
+    setpoint_rate: float = spec_field(40.0, unit="N/s", low=0.1, high=1000.0,
+                                      description="setpoint ramp rate")
+    heartbeat_period: float = spec_field(
+        0.1, unit="s", low=0.01, high=c.WATCHDOG_MS / 2000, high_open=True,
+        description="heartbeat period, below half the device watchdog")
+    handshake_timeout: float = spec_field(3.0, unit="s", low=0.1, high=60.0,
+                                          description="time allowed for the banner")
+    stale_timeout: float = spec_field(0.25, unit="s", low=0.02, high=10.0,
+                                      description="telemetry age reported as stale")
+    link_timeout: float = spec_field(2.0, unit="s", low=0.1, high=60.0,
+                                     description="telemetry silence that drops the link")
+    backoff_initial: float = spec_field(0.5, unit="s", low=0.01, high=60.0,
+                                        description="first reconnect delay")
+    backoff_max: float = spec_field(8.0, unit="s", low=0.01, high=600.0,
+                                    description="largest reconnect delay")
 
     def __post_init__(self) -> None:
-        for field in fields(self):
-            value = getattr(self, field.name)
-            if field.name != "port" and not (math.isfinite(value) and value > 0):
-                raise out_of_range(field.name, value, "finite and > 0", error=DeviceInputError)
-        if self.tension_max > c.SETPOINT_MAX_MN / 1000:
-            raise out_of_range("tension_max", self.tension_max,
-                               f"(0, {c.SETPOINT_MAX_MN / 1000}]", unit="N", error=DeviceInputError)
-        if self.heartbeat_period >= c.WATCHDOG_MS / 1000 / 2:
-            raise out_of_range("heartbeat_period", self.heartbeat_period,
-                               f"< {c.WATCHDOG_MS / 2000} (half the device watchdog)", unit="s",
-                               error=DeviceInputError)
+        check_fields(self, DRIVER_SPECS, error=DeviceInputError)
         if self.backoff_max < self.backoff_initial:
             raise out_of_range("backoff_max", self.backoff_max, f">= backoff_initial "
                                f"({self.backoff_initial})", unit="s", error=DeviceInputError)
+
+
+#: Specs of the driver parameters, by field name.
+DRIVER_SPECS = specs_of(DriverConfig)
 
 
 @dataclass(frozen=True)

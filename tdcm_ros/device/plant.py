@@ -17,44 +17,42 @@ from __future__ import annotations
 
 import math
 import random
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.errors import DeviceInputError
 from tdcm_ros.errors import out_of_range
-
-_POSITIVE = ("stroke", "lag", "rate", "stiffness", "counts_per_newton", "sample_period")
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 
 @dataclass(frozen=True)
 class PlantConfig:
     """Plant parameters, SI units (m, s, N); load cell in counts."""
 
-    stroke: float = 0.02
-    lag: float = 0.03
-    rate: float = 0.025
-    stiffness: float = 2000.0
-    slack: float = 0.002
-    counts_per_newton: float = 1000.0
-    tare_counts: int = 8000
-    noise: float = 0.01
-    quantum: int = 1
-    sample_period: float = 0.0125
-    seed: int = 0
-    deadband: float = 0.0
-    bias: float = 0.0
-    drift: float = 0.0
+    stroke: float = spec_field(0.02, unit="m", low=0.0, low_open=True,
+                               description="actuator travel over the pulse range")
+    lag: float = spec_field(0.03, unit="s", low=0.0, low_open=True,
+                            description="first-order lag of the actuator")
+    rate: float = spec_field(0.025, unit="m/s", low=0.0, low_open=True,
+                             description="actuator speed limit")
+    stiffness: float = spec_field(2000.0, unit="N/m", low=0.0, low_open=True,
+                                  description="tendon stiffness past the slack")
+    slack: float = spec_field(0.002, unit="m", low=0.0, description="travel before the tendon loads")
+    counts_per_newton: float = spec_field(1000.0, unit="counts/N", low=0.0, low_open=True,
+                                          description="load-cell gain")
+    tare_counts: int = spec_field(8000, unit="counts", description="load-cell reading at 0 N")
+    noise: float = spec_field(0.01, unit="N", low=0.0,
+                              description="standard deviation of the load-cell noise")
+    quantum: int = spec_field(1, unit="counts", low=1, description="load-cell resolution")
+    sample_period: float = spec_field(0.0125, unit="s", low=0.0, low_open=True,
+                                      description="load-cell sample period")
+    seed: int = spec_field(0, description="seed of the noise generator")
+    deadband: float = spec_field(0.0, unit="m", low=0.0, description="actuator dead zone")
+    bias: float = spec_field(0.0, unit="N", description="load-cell offset")
+    drift: float = spec_field(0.0, unit="N/s", description="load-cell linear drift")
 
     def __post_init__(self) -> None:
-        for field in fields(self):
-            value = getattr(self, field.name)
-            if not math.isfinite(value):
-                raise out_of_range(field.name, value, "a finite number", error=DeviceInputError)
-            if field.name in _POSITIVE and value <= 0:
-                raise out_of_range(field.name, value, "> 0", error=DeviceInputError)
-        for name in ("slack", "noise", "deadband"):
-            if getattr(self, name) < 0:
-                raise out_of_range(name, getattr(self, name), ">= 0", error=DeviceInputError)
+        check_fields(self, PLANT_SPECS, error=DeviceInputError)
         if self.deadband >= self.stroke:
             raise out_of_range("deadband", self.deadband, f"< stroke ({self.stroke} m)", unit="m",
                                error=DeviceInputError)
@@ -65,6 +63,10 @@ class PlantConfig:
     def scale_mcpn(self) -> int:
         """The calibration scale matching this load cell, in 1e-3 counts per N."""
         return round(self.counts_per_newton * 1000)
+
+
+#: Specs of the plant parameters, by field name.
+PLANT_SPECS = specs_of(PlantConfig)
 
 
 class Plant:

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 from tdcm_ros.device.errors import DeviceInputError
-from tdcm_ros.errors import out_of_range
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 
 @dataclass(frozen=True)
@@ -16,21 +15,14 @@ class StepSchedule:
     The default is the paper's 0 -> 20 N in 4 N steps. After the last trial the setpoint is 0 N.
     """
 
-    levels: tuple[float, ...] = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)
-    hold: float = 5.0
-    trials: int = 1
+    levels: tuple[float, ...] = spec_field((0.0, 4.0, 8.0, 12.0, 16.0, 20.0), unit="N", low=0.0,
+                                           description="staircase levels, in order")
+    hold: float = spec_field(5.0, name="hold_s", unit="s", low=0.01, high=86_400.0,
+                             description="hold time of each level")
+    trials: int = spec_field(1, low=1, high=10_000, description="repetitions of the staircase")
 
     def __post_init__(self) -> None:
-        if not self.levels:
-            raise out_of_range("levels", self.levels, "at least one level", error=DeviceInputError)
-        for level in self.levels:
-            if not (math.isfinite(level) and level >= 0):
-                raise out_of_range("levels", level, "finite and >= 0", unit="N",
-                                   error=DeviceInputError)
-        if not (math.isfinite(self.hold) and self.hold > 0):
-            raise out_of_range("hold", self.hold, "> 0", unit="s", error=DeviceInputError)
-        if self.trials < 1:
-            raise out_of_range("trials", self.trials, ">= 1", error=DeviceInputError)
+        check_fields(self, SCHEDULE_SPECS, error=DeviceInputError)
 
     @property
     def duration(self) -> float:
@@ -43,3 +35,7 @@ class StepSchedule:
             return None
         index = int(max(elapsed, 0.0) // self.hold) % len(self.levels)
         return self.levels[index]
+
+
+#: Specs of the schedule parameters, by field name.
+SCHEDULE_SPECS = specs_of(StepSchedule)

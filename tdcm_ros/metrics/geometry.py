@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import CubicSpline
 
 from tdcm_ros.errors import out_of_range
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 Array = NDArray[np.float64]
 DEFLECTION_AXES = ("marker", "body")
@@ -28,25 +28,24 @@ class MarkerLayout:
     """Where the markers sit: ``labels`` (last = tip marker), ``arc_lengths`` (m, increasing),
     ``ball_radius`` (m) and ``side_deg`` (deg from the tendon side)."""
 
-    labels: tuple[str, ...] = ("m1", "m2", "m3")
-    arc_lengths: tuple[float, ...] = (0.015, 0.033, 0.053)
-    ball_radius: float = 0.001
-    side_deg: float = 180.0
+    labels: tuple[str, ...] = spec_field(("m1", "m2", "m3"), description=(
+        "marker labels, base to tip (the last is the tip marker)"))
+    arc_lengths: tuple[float, ...] = spec_field((0.015, 0.033, 0.053), unit="m", low=0.0,
+                                                low_open=True, description=(
+                                                    "marker arc lengths from the base, increasing"))
+    ball_radius: float = spec_field(0.001, unit="m", low=0.0, high=0.05,
+                                    description="marker ball radius")
+    side_deg: float = spec_field(180.0, unit="deg", low=-360.0, high=360.0, description=(
+        "marker side around the body z axis from the tendon side"))
 
     def __post_init__(self) -> None:
-        s = np.asarray(self.arc_lengths, dtype=float)
-        if len(self.labels) != s.size or s.size == 0 or len(set(self.labels)) != s.size:
+        check_fields(self, MARKER_SPECS, prefix="markers.")
+        if len(self.labels) != len(self.arc_lengths):
             raise out_of_range("markers.labels", list(self.labels),
-                               f"{s.size} distinct labels, one per arc length")
-        if not np.all(np.isfinite(s)) or s[0] <= 0.0 or np.any(np.diff(s) <= 0.0):
+                               f"{len(self.arc_lengths)} distinct labels, one per arc length")
+        if any(b <= a for a, b in zip(self.arc_lengths, self.arc_lengths[1:], strict=False)):
             raise out_of_range("markers.arc_lengths", list(self.arc_lengths),
                                "increasing values > 0", unit="m")
-        if not (math.isfinite(self.ball_radius) and self.ball_radius >= 0.0):
-            raise out_of_range("markers.ball_radius", self.ball_radius, "[0, inf)", unit="m")
-        if not (math.isfinite(self.side_deg) and -360.0 <= self.side_deg <= 360.0):
-            raise out_of_range("markers.side_deg", self.side_deg, "[-360, 360] deg")
-        object.__setattr__(self, "labels", tuple(self.labels))
-        object.__setattr__(self, "arc_lengths", tuple(float(v) for v in s))
 
     @property
     def side_rad(self) -> float:
@@ -72,6 +71,10 @@ class MarkerLayout:
         if self.arc_lengths[-1] > length + 1e-12:
             raise out_of_range("markers.arc_lengths", list(self.arc_lengths),
                                f"values in (0, L = {length:g}] m")
+
+
+#: Specs of the marker layout, by field name.
+MARKER_SPECS = specs_of(MarkerLayout)
 
 
 def deflection(points_base: ArrayLike, rest_offset: Sequence[float] | Array, axis: str = "marker"
@@ -107,6 +110,10 @@ def measured_midline(markers_base: ArrayLike, layout: MarkerLayout, radius: floa
     the body frame taken from the spline's tangent there (repeated until it settles). ``None``
     when the tip marker or every other marker is missing (NaN).
     """
+    # scipy.interpolate on use only: model_node imports this module for MARKER_SPECS, and the
+    # import alone costs it about a second of start-up
+    from scipy.interpolate import CubicSpline
+
     p = np.asarray(markers_base, dtype=float)
     seen = ~np.isnan(p[:, 0])
     if not seen[-1] or seen.sum() < 2:

@@ -13,16 +13,23 @@ Names (SI units):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field, fields, replace
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from typing import Any
 
-import numpy as np
-
-from tdcm_ros.errors import InputError, out_of_range
-from tdcm_ros.metrics.geometry import DEFLECTION_AXES, MarkerLayout
-from tdcm_ros.metrics.steps import StepSettings
-from tdcm_ros.model import FIELD_SPECS, Design, SolverSettings, parse_field, preset
+from tdcm_ros.errors import InputError
+from tdcm_ros.metrics.geometry import DEFLECTION_AXES, MARKER_SPECS, MarkerLayout
+from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
+from tdcm_ros.model import (
+    FIELD_SPECS,
+    SOLVER_SPECS,
+    Design,
+    InvalidSettingsError,
+    SolverSettings,
+    parse_field,
+    preset,
+)
+from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of
 
 DEFAULT_PRESET = "paper-experiment"
 
@@ -35,26 +42,19 @@ class EvaluateOptions:
     solver: SolverSettings = field(default_factory=SolverSettings)
     steps: StepSettings = field(default_factory=StepSettings)
     layout: MarkerLayout = field(default_factory=MarkerLayout)
-    align_tolerance_s: float = 0.02
-    """Largest gap (s) between a marker frame and its nearest tension sample."""
-    mape_threshold_m: float = 1e-3
-    """Steps measured below this tip deflection (m) are left out of MAPE."""
-    stations: int = 50
-    """Arc-length stations (from the base to the tip marker) of the shape error."""
-    deflection_axis: str = "marker"
-    """``marker``: distance from the tip marker's rest line; ``body``: from the body axis."""
+    align_tolerance_s: float = spec_field(
+        0.02, name="align.tolerance_s", unit="s", low=0.0, high=10.0,
+        description="largest gap between a marker frame and its nearest tension sample")
+    mape_threshold_m: float = spec_field(
+        1e-3, unit="m", low=1e-9, high=1.0,
+        description="steps measured below this tip deflection are left out of MAPE")
+    stations: int = spec_field(50, low=2, high=10_000, description=(
+        "arc-length stations (from the base to the tip marker) of the shape error"))
+    deflection_axis: str = spec_field("marker", choices=DEFLECTION_AXES, description=(
+        "marker: distance from the tip marker's rest line; body: from the body axis"))
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.align_tolerance_s) and self.align_tolerance_s >= 0.0):
-            raise out_of_range("align.tolerance_s", self.align_tolerance_s, "[0, inf) s")
-        if not (np.isfinite(self.mape_threshold_m) and self.mape_threshold_m > 0.0):
-            raise out_of_range("mape_threshold_m", self.mape_threshold_m, "(0, inf) m")
-        if isinstance(self.stations, bool) or not isinstance(self.stations, int) \
-                or not 2 <= self.stations <= 10_000:
-            raise out_of_range("stations", self.stations, "integer in [2, 10000]")
-        if self.deflection_axis not in DEFLECTION_AXES:
-            raise out_of_range("deflection_axis", self.deflection_axis,
-                               " | ".join(DEFLECTION_AXES))
+        check_fields(self, OPTION_SPECS)
         self.layout.check_within(self.design.length)
 
     def with_design(self, design: Design) -> EvaluateOptions:
@@ -62,39 +62,22 @@ class EvaluateOptions:
         return replace(self, design=design)
 
 
-def _split_list(text: str) -> list[str]:
-    return [part.strip() for part in text.split(",") if part.strip()]
+#: Specs of the evaluation options that are not a design, solver, step or marker group.
+OPTION_SPECS = specs_of(EvaluateOptions)
 
 
-def _number(name: str, text: str, kind: type = float) -> Any:
-    try:
-        return kind(text)
-    except ValueError:
-        raise InputError(f"{name} = {text!r} is not {'an integer' if kind is int else 'a number'}",
-                         parameter=name, value=text, allowed=kind.__name__) from None
-
-
-def _typed(name: str, current: Any, text: str) -> Any:
-    if isinstance(current, bool):
-        return text.lower() in ("1", "true", "yes")
-    if isinstance(current, int):
-        return _number(name, text, int)
-    if isinstance(current, float):
-        return _number(name, text)
-    return text
-
-
-_TOP = {"align.tolerance_s": "align_tolerance_s", "mape_threshold_m": "mape_threshold_m",
-        "stations": "stations", "deflection_axis": "deflection_axis"}
+#: Every ``--set`` group but the design: name prefix -> (specs by field, error class).
+_GROUPS: dict[str, tuple[Mapping[str, Spec], type[InputError]]] = {
+    "solver.": (SOLVER_SPECS, InvalidSettingsError), "steps.": (STEP_SPECS, InputError),
+    "markers.": (MARKER_SPECS, InputError), "": (OPTION_SPECS, InputError)}
+#: ``--set`` name -> (group prefix, field, spec, error class), derived from the specs.
+_SETTABLE = {f"{prefix}{spec.name}": (prefix, field, spec, error)
+             for prefix, (specs, error) in _GROUPS.items() for field, spec in specs.items()}
 
 
 def known_names() -> list[str]:
     """Every accepted ``--set`` name (design fields also bare)."""
-    names = ["design.preset", *(f"design.{n}" for n in [*FIELD_SPECS, "profile"])]
-    names += [f"solver.{f.name}" for f in fields(SolverSettings)]
-    names += [f"steps.{f.name}" for f in fields(StepSettings)]
-    names += [f"markers.{f.name}" for f in fields(MarkerLayout)]
-    return names + list(_TOP)
+    return ["design.preset", *(f"design.{n}" for n in [*FIELD_SPECS, "profile"]), *_SETTABLE]
 
 
 def options_from_sets(pairs: Sequence[str], base: EvaluateOptions | None = None
@@ -122,21 +105,12 @@ def options_from_sets(pairs: Sequence[str], base: EvaluateOptions | None = None
             design = preset(text)
     design_over = {n[7:]: parse_field(n[7:], t) for n, t in parsed if n.startswith("design.")
                    and n != "design.preset"}
-    groups: dict[str, dict[str, Any]] = {"solver": {}, "steps": {}, "markers": {}}
-    top: dict[str, Any] = {}
+    groups: dict[str, dict[str, Any]] = {prefix: {} for prefix in _GROUPS}
     for name, text in parsed:
-        head, _, tail = name.partition(".")
-        if name in _TOP:
-            attr = _TOP[name]
-            top[attr] = _typed(name, getattr(opts, attr), text)
-        elif head == "markers" and tail in ("labels", "arc_lengths"):
-            items = _split_list(text)
-            groups["markers"][tail] = tuple(items) if tail == "labels" else tuple(
-                _number(name, v) for v in items)
-        elif head in groups:
-            target = {"solver": opts.solver, "steps": opts.steps, "markers": opts.layout}[head]
-            groups[head][tail] = _typed(name, getattr(target, tail), text)
+        if name in _SETTABLE:
+            prefix, field, spec, error = _SETTABLE[name]
+            groups[prefix][field] = spec.parse(text, name, error=error)
     return replace(opts, design=design.with_overrides(**design_over),
-                   solver=opts.solver.with_overrides(**groups["solver"]),
-                   steps=replace(opts.steps, **groups["steps"]),
-                   layout=replace(opts.layout, **groups["markers"]), **top)
+                   solver=opts.solver.with_overrides(**groups["solver."]),
+                   steps=replace(opts.steps, **groups["steps."]),
+                   layout=replace(opts.layout, **groups["markers."]), **groups[""])

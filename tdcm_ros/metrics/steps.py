@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.ndimage import maximum_filter1d, median_filter, minimum_filter1d
 
-from tdcm_ros.errors import out_of_range
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 Array = NDArray[np.float64]
 _MEDIAN_PASSES = 4
@@ -38,29 +38,23 @@ _MEDIAN_PASSES = 4
 class StepSettings:
     """Parameters of step detection (SI units), validated on construction."""
 
-    tolerance_n: float = 0.3
-    """Half-width of the band around the hold's median (N)."""
-    min_hold_s: float = 1.0
-    """Shortest hold, after the transient is dropped (s)."""
-    settle_s: float = 0.25
-    """Steadiness window and the settling time dropped at the start of a hold (s)."""
-    zero_n: float = 0.5
-    """Tension at or below which the tendon counts as released (N): trial boundaries."""
-    despike_samples: int = 5
-    """Median filter length (samples) applied before the steadiness test (1 = off)."""
+    tolerance_n: float = spec_field(0.3, unit="N", low=0.0, low_open=True, description=(
+        "half-width of the band around the hold's median"))
+    min_hold_s: float = spec_field(1.0, unit="s", low=0.0, low_open=True, description=(
+        "shortest hold, after the transient is dropped"))
+    settle_s: float = spec_field(0.25, unit="s", low=0.0, low_open=True, description=(
+        "steadiness window and the settling time dropped at the start of a hold"))
+    zero_n: float = spec_field(0.5, unit="N", low=0.0, description=(
+        "tension at or below which the tendon counts as released (trial boundaries)"))
+    despike_samples: int = spec_field(5, low=1, high=1001, description=(
+        "median filter length (samples) applied before the steadiness test (1 = off)"))
 
     def __post_init__(self) -> None:
-        for name, low in (("tolerance_n", 0.0), ("min_hold_s", 0.0), ("settle_s", 0.0)):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > low):
-                raise out_of_range(f"steps.{name}", value, "(0, inf)")
-        if not (isinstance(self.zero_n, (int, float)) and np.isfinite(self.zero_n)
-                and self.zero_n >= 0.0):
-            raise out_of_range("steps.zero_n", self.zero_n, "[0, inf) N")
-        if isinstance(self.despike_samples, bool) or not isinstance(self.despike_samples, int) \
-                or not 1 <= self.despike_samples <= 1001:
-            raise out_of_range("steps.despike_samples", self.despike_samples,
-                               "integer in [1, 1001]")
+        check_fields(self, STEP_SPECS, prefix="steps.")
+
+
+#: Specs of the step detection settings, by field name.
+STEP_SPECS = specs_of(StepSettings)
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,6 @@ from tdcm_ros.model.design import (
     FIELD_SPECS,
     PRESETS,
     Design,
-    FieldSpec,
     parse_field,
     preset,
 )
@@ -34,19 +33,19 @@ from tdcm_ros.model.loading import (
 )
 from tdcm_ros.model.profiles import CircularProfile, CustomProfile, RectangularProfile
 from tdcm_ros.model.result import SolveResult
-from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
 
 __all__ = [
     "DEFAULT_SETTINGS",
     "FIELD_SPECS",
     "PRESETS",
+    "SOLVER_SPECS",
     "Capstan",
     "CircularProfile",
     "ConvergenceError",
     "CustomProfile",
     "Design",
-    "FieldSpec",
     "InvalidDesignError",
     "InvalidLoadingError",
     "InvalidSettingsError",

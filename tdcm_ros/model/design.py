@@ -9,7 +9,6 @@ features are often softer: treat ``E`` as a calibration parameter (``tdcm calibr
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
@@ -20,6 +19,7 @@ from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import CircularProfile, NotchProfile, profile_from_name
 from tdcm_ros.model.section import tube_moment
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
@@ -28,88 +28,38 @@ MIN_SEGMENT_M = 1e-6
 
 
 @dataclass(frozen=True)
-class FieldSpec:
-    """Unit, meaning and allowed range of one numeric design field."""
-
-    name: str
-    unit: str
-    description: str
-    low: float
-    high: float
-    low_inclusive: bool
-    integer: bool = False
-
-    def allowed(self) -> str:
-        """The allowed range as text, e.g. ``(0, 1] m``."""
-        bracket = "[" if self.low_inclusive else "("
-        return f"{bracket}{self.low:g}, {self.high:g}] {self.unit}".rstrip()
-
-    def check(self, value: Any) -> None:
-        """Raise :class:`InvalidDesignError` unless ``value`` is a finite number in range."""
-        if self.integer:
-            ok_type = isinstance(value, (int, np.integer)) and not isinstance(value, bool)
-        else:
-            ok_type = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-                value, bool
-            )
-        if not ok_type:
-            kind = "an integer" if self.integer else "a number"
-            raise InvalidDesignError(
-                f"{self.name} = {value!r} is not {kind}; allowed: {self.allowed()}",
-                parameter=self.name, value=value, allowed=self.allowed(),
-            )
-        v = float(value)
-        below = v < self.low if self.low_inclusive else v <= self.low
-        if not math.isfinite(v) or below or v > self.high:
-            raise out_of_range(self.name, value, self.allowed(), unit="", error=InvalidDesignError)
-
-
-FIELD_SPECS: dict[str, FieldSpec] = {
-    spec.name: spec
-    for spec in (
-        FieldSpec("w_base", "m", "length of the proximal tube segment", 0.0, 1.0, True),
-        FieldSpec("w_tip", "m", "length of the distal tube segment", 0.0, 1.0, True),
-        FieldSpec("w_n", "m", "notch width along the body", MIN_SEGMENT_M, 1.0, True),
-        FieldSpec("w_t", "m", "tube length between adjacent notches", 0.0, 1.0, True),
-        FieldSpec("w_d", "m", "backbone width (minimum, at the notch centre)", 0.0, 1.0, False),
-        FieldSpec("N", "", "number of notches", 1, 1000, True, integer=True),
-        FieldSpec("R_outer", "m", "outer radius of the tube", 0.0, 0.5, False),
-        FieldSpec("r_inner", "m", "inner radius of the tube (0 for a solid rod)", 0.0, 0.5, True),
-        FieldSpec("R_c", "m", "tendon offset from the midline, on the +x side", 0.0, 0.5, False),
-        FieldSpec("E", "Pa", "Young's modulus (calibration parameter)", 0.0, 1e12, False),
-    )
-}
-
-
-@dataclass(frozen=True)
 class Design:
     """A notched TD-CM design in SI units (m, Pa), validated on construction."""
 
-    w_base: float
-    w_tip: float
-    w_n: float
-    w_t: float
-    w_d: float
-    N: int
-    R_outer: float
-    r_inner: float
-    R_c: float
-    E: float = 1.85e9
+    w_base: float = spec_field(unit="m", description="length of the proximal tube segment",
+                               low=0.0, high=1.0)
+    w_tip: float = spec_field(unit="m", description="length of the distal tube segment",
+                              low=0.0, high=1.0)
+    w_n: float = spec_field(unit="m", description="notch width along the body",
+                            low=MIN_SEGMENT_M, high=1.0)
+    w_t: float = spec_field(unit="m", description="tube length between adjacent notches",
+                            low=0.0, high=1.0)
+    w_d: float = spec_field(unit="m", description="backbone width (minimum, at the notch centre)",
+                            low=0.0, high=1.0, low_open=True)
+    N: int = spec_field(kind="int", description="number of notches", low=1, high=1000)
+    R_outer: float = spec_field(unit="m", description="outer radius of the tube", low=0.0,
+                                high=0.5, low_open=True)
+    r_inner: float = spec_field(unit="m", description="inner radius of the tube (0 for a solid rod)",
+                                low=0.0, high=0.5)
+    R_c: float = spec_field(unit="m", description="tendon offset from the midline, on the +x side",
+                            low=0.0, high=0.5, low_open=True)
+    E: float = spec_field(1.85e9, unit="Pa", description="Young's modulus (calibration parameter)",
+                          low=0.0, high=1e12, low_open=True)
     profile: NotchProfile = field(default_factory=CircularProfile)
 
     def __post_init__(self) -> None:
-        for spec in FIELD_SPECS.values():
-            spec.check(getattr(self, spec.name))
+        check_fields(self, FIELD_SPECS, error=InvalidDesignError)
         self._check_cross_fields()
         if not hasattr(self.profile, "h1"):
             raise InvalidDesignError(
                 f"profile = {self.profile!r} is not a notch profile; allowed: circular, "
                 "rectangular, or CustomProfile(h1)", parameter="profile", value=self.profile,
                 allowed="circular | rectangular | CustomProfile")
-        object.__setattr__(self, "N", int(self.N))
-        for name, spec in FIELD_SPECS.items():
-            if not spec.integer:
-                object.__setattr__(self, name, float(getattr(self, name)))
 
     def _check_cross_fields(self) -> None:
         """Ranges that depend on other fields: radii inside ``R_outer`` (m), the backbone
@@ -159,6 +109,10 @@ class Design:
         return data
 
 
+#: Specs of the numeric design fields (all but ``profile``), by name.
+FIELD_SPECS = specs_of(Design)
+
+
 def parse_field(name: str, text: str) -> Any:
     """Parse a ``NAME=VALUE`` override value from text in SI units (``N`` as an integer)."""
     if name == "profile":
@@ -168,11 +122,7 @@ def parse_field(name: str, text: str) -> Any:
         allowed = ", ".join([*FIELD_SPECS, "profile"])
         raise InvalidDesignError(f"unknown design field {name!r}; allowed: {allowed}",
                                  parameter=name, value=text, allowed=allowed)
-    try:
-        return int(text) if spec.integer else float(text)
-    except ValueError as exc:
-        raise InvalidDesignError(f"{name} = {text!r} is not a number; allowed: {spec.allowed()}",
-                                 parameter=name, value=text, allowed=spec.allowed()) from exc
+    return spec.parse(text, error=InvalidDesignError)
 
 
 def _simulation_design(w_n_mm: float, w_d_mm: float) -> Design:

@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
-from tdcm_ros.errors import out_of_range, reject_unknown
+from tdcm_ros.errors import reject_unknown
 from tdcm_ros.model.errors import InvalidSettingsError
+from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 ROUTINGS = ("paper", "free")
 LOAD_FORMS = ("closed", "literal")
@@ -36,39 +36,26 @@ class SolverSettings:
       relaxation and load continuation as fall-backs), or one strategy only.
     """
 
-    routing: str = "paper"
-    loads: str = "closed"
-    grid: str = "adaptive"
-    cells_per_notch: int = 4
-    cells_per_tube: int = 1
-    quad_order: int = 6
-    tol: float = 1e-10
-    max_iter: int = 200
-    acceleration: str = "auto"
-    relaxation: float = 0.5
-    anderson_depth: int = 5
-    continuation_steps: int = 8
+    routing: str = spec_field("paper", choices=ROUTINGS, description="tendon routing")
+    loads: str = spec_field("closed", choices=LOAD_FORMS, description="load form")
+    grid: str = spec_field("adaptive", choices=GRID_KINDS,
+                           description="cell layout: adaptive (boundaries at profile kinks) or uniform")
+    cells_per_notch: int = spec_field(4, low=1, high=512, description="cells per notch")
+    cells_per_tube: int = spec_field(1, low=1, high=512, description="cells per tube segment")
+    quad_order: int = spec_field(6, low=1, high=32, description="Gauss-Legendre points per cell")
+    tol: float = spec_field(1e-10, unit="m", low=0.0, high=1e-2, low_open=True,
+                            description="convergence tolerance on the midline nodes")
+    max_iter: int = spec_field(200, low=1, high=100000, description="largest number of iterations")
+    acceleration: str = spec_field("auto", choices=ACCELERATIONS,
+                                   description="convergence strategy")
+    relaxation: float = spec_field(0.5, low=0.0, high=1.0, low_open=True,
+                                   description="damping factor of the relaxation strategy")
+    anderson_depth: int = spec_field(5, low=1, high=50, description="iterates Anderson mixes")
+    continuation_steps: int = spec_field(8, low=0, high=1024,
+                                         description="load continuation steps (fall-back)")
 
     def __post_init__(self) -> None:
-        choices = {"routing": ROUTINGS, "loads": LOAD_FORMS, "acceleration": ACCELERATIONS,
-                   "grid": GRID_KINDS}
-        for name, allowed in choices.items():
-            if getattr(self, name) not in allowed:
-                raise out_of_range(name, getattr(self, name), " | ".join(allowed),
-                                   error=InvalidSettingsError)
-        integers = {"cells_per_notch": (1, 512), "cells_per_tube": (1, 512),
-                    "quad_order": (1, 32), "max_iter": (1, 100000), "anderson_depth": (1, 50),
-                    "continuation_steps": (0, 1024)}
-        for name, (low, high) in integers.items():
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-                raise out_of_range(name, value, f"integer in [{low}, {high}]",
-                                   error=InvalidSettingsError)
-        if not (isinstance(self.tol, (int, float)) and math.isfinite(self.tol)
-                and 0.0 < self.tol <= 1e-2):
-            raise out_of_range("tol", self.tol, "(0, 0.01] m", error=InvalidSettingsError)
-        if not (isinstance(self.relaxation, (int, float)) and 0.0 < self.relaxation <= 1.0):
-            raise out_of_range("relaxation", self.relaxation, "(0, 1]", error=InvalidSettingsError)
+        check_fields(self, SOLVER_SPECS, error=InvalidSettingsError)
 
     def with_overrides(self, **overrides: Any) -> SolverSettings:
         """A validated copy with fields replaced; unknown names raise."""
@@ -79,3 +66,7 @@ class SolverSettings:
     def to_dict(self) -> dict[str, Any]:
         """All settings as a plain dict."""
         return asdict(self)
+
+
+#: Specs of every solver setting, by name (declared on the fields above).
+SOLVER_SPECS = specs_of(SolverSettings)

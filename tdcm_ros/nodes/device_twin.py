@@ -18,22 +18,34 @@ import os
 import sys
 import tempfile
 from collections.abc import Callable
-from dataclasses import fields
-from typing import Any
+from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.device.driver import fault_names
-from tdcm_ros.device.plant import PlantConfig
+from tdcm_ros.device.plant import PLANT_SPECS, PlantConfig
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
+from tdcm_ros.runtime.spec_params import declare_specs, grouped
+from tdcm_ros.spec import Spec, by_name
 
-PLANT_UNITS = {"stroke": "m", "lag": "s", "rate": "m/s", "stiffness": "N/m", "slack": "m",
-               "counts_per_newton": "counts/N", "tare_counts": "counts", "noise": "N",
-               "quantum": "counts", "sample_period": "s", "deadband": "m",
-               "bias": "N", "drift": "N/s"}
+#: Parameters of the node besides the plant group (all fixed at start).
+TWIN_SPECS = by_name(
+    Spec("scene", description="scene name or YAML path giving the plant (optional)", default="",
+         kind="str"),
+    Spec("link", description="symlink to the pty (empty: <tmp>/tdcm_twin_<pid>)", default="",
+         kind="str"),
+    Spec("speed", description="simulated time / real time", default=1.0, low=0.01, high=100.0),
+    Spec("frame_id", description="frame of sim/tension_true", default="tdcm_tendon", kind="str"),
+    Spec("publish_period_s", "s", "how often the samples are published; every load-cell sample "
+         "is published", 0.01, low=0.001, high=1.0),
+    Spec("diagnostics_period_s", "s", "/diagnostics period", 1.0, low=0.05, high=60.0))
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(TWIN_SPECS), **grouped(PLANT_SPECS, "plant.")}
 
 
 def scene_bench(scene: str) -> tuple[PlantConfig, Callable[[], float]]:
@@ -76,36 +88,23 @@ class DeviceTwinNode(NodeLogic):
 
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
-        declare = port.declare_parameter
-        scene = str(declare("scene", "", read_only=True,
-                            description="scene name or YAML path giving the plant (optional)"))
+        own = declare_specs(port, TWIN_SPECS, read_only=True)
+        scene = str(own["scene"])
         base, line_delay = scene_bench(scene) if scene.strip() else (PlantConfig(), None)
-        values: dict[str, Any] = {}
-        for field in fields(PlantConfig):
-            unit = PLANT_UNITS.get(field.name, "")
-            default: Any = field.default  # every PlantConfig field has one
-            values[field.name] = declare(
-                f"plant.{field.name}", type(default)(getattr(base, field.name)),
-                read_only=True, description=f"PlantConfig.{field.name}" + (f" ({unit})" * bool(unit)))
+        values = declare_specs(port, PLANT_SPECS, prefix="plant.", defaults=asdict(base),
+                               read_only=True)
         try:
             plant = PlantConfig(**values)
         except InputError as error:
             name = f"plant.{error.parameter}"
             raise InputError(f"{name}: {error}", parameter=name, value=error.value,
                              allowed=error.allowed) from error
-        link = str(declare("link", "", read_only=True,
-                           description="symlink to the pty (empty: <tmp>/tdcm_twin_<pid>)"))
-        link = link.strip() or default_link()
+        link = str(own["link"]).strip() or default_link()
         check_link(link)
-        speed = float(declare("speed", 1.0, range=(0.01, 100.0), read_only=True,
-                              description="simulated time / real time"))
-        self.frame_id = str(declare("frame_id", "tdcm_tendon", read_only=True,
-                                    description="frame of sim/tension_true"))
-        period = float(declare("publish_period_s", 0.01, range=(0.001, 1.0), read_only=True,
-                               description="how often the samples are published (s); every "
-                                           "load-cell sample is published"))
-        diag_period = float(declare("diagnostics_period_s", 1.0, range=(0.05, 60.0),
-                                    read_only=True, description="/diagnostics period (s)"))
+        speed = float(own["speed"])
+        self.frame_id = str(own["frame_id"])
+        period = float(own["publish_period_s"])
+        diag_period = float(own["diagnostics_period_s"])
         self.truth = port.create_publisher("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
                                            QoS(depth=100))
         self.diagnostics = port.create_publisher("/diagnostics",

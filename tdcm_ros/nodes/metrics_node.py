@@ -29,6 +29,7 @@ import json
 import math
 import sys
 from collections import Counter
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -36,25 +37,52 @@ import numpy as np
 from tdcm_ros.bagio import from_dict, msg_class
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.evaluation import Evaluation
-from tdcm_ros.metrics.geometry import DEFLECTION_AXES, MarkerLayout
-from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.geometry import MARKER_SPECS, MarkerLayout
+from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions
 from tdcm_ros.metrics.registration import Registration
-from tdcm_ros.metrics.steps import StepSettings
+from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.model import FIELD_SPECS, preset
 from tdcm_ros.model.design import PRESETS
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime.parameters import one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
+from tdcm_ros.runtime.spec_params import declare_specs, grouped
+from tdcm_ros.spec import Spec, by_name
 
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
 TABLE_TOPICS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m")
 BASE_FRAME = "tdcm_base"
+#: The design preset the design.* fields start from.
+PRESET_SPECS = by_name(Spec("design.preset", description="design preset the fields start from",
+                            default="paper-experiment", kind="str", choices=tuple(PRESETS)))
+#: The marker layout as parameters: ``markers.radius`` is the layout's ball radius.
+LAYOUT_SPECS = {**MARKER_SPECS, "ball_radius": replace(MARKER_SPECS["ball_radius"], name="radius")}
+#: Parameters fixed at start, besides the evaluation options.
+FIXED_SPECS = by_name(
+    Spec("registration.source", description="auto, tf_static, parameter or estimate",
+         default="auto", kind="str", choices=REGISTRATION_SOURCES),
+    Spec("registration.translation", "m", "tdcm_base origin in mocap, source=parameter",
+         (0.0, 0.0, 0.0), kind="vector"),
+    Spec("registration.rotation", "", "tdcm_base orientation in mocap (x, y, z, w)",
+         (0.0, 0.0, 0.0, 1.0), kind="vector", size=4),
+    Spec("update_period_s", "s", "period of step detection", 0.5, low=0.01, high=60.0),
+    Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0),
+    Spec("max_buffer_s", "s", "longest buffered stretch without a step", 120.0, low=1.0,
+         high=3600.0))
+#: Parameters a client may change at run time.
+TUNABLE_SPECS = by_name(Spec("stale_s", "s", "inputs older than this are stale; changeable at run "
+                             "time", 1.0, low=0.01, high=3600.0))
 
 
 def _stamp_s(message: Any) -> float:
     return int(message.header.stamp.sec) + int(message.header.stamp.nanosec) * 1e-9
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(PRESET_SPECS), **grouped(FIELD_SPECS, "design."),
+              **grouped(LAYOUT_SPECS, "markers."), **grouped(STEP_SPECS, "steps."),
+              **grouped(OPTION_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS)}
 
 
 class MetricsNode(NodeLogic):
@@ -65,23 +93,13 @@ class MetricsNode(NodeLogic):
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
         self.options = self._options()
-        declare = port.declare_parameter
-        self.source = str(declare("registration.source", "auto", read_only=True,
-                                  description="auto, tf_static, parameter or estimate",
-                                  validator=one_of("registration.source",
-                                                    REGISTRATION_SOURCES)))
-        translation = declare("registration.translation", [0.0, 0.0, 0.0], read_only=True,
-                              description="tdcm_base origin in mocap (m), source=parameter")
-        rotation = declare("registration.rotation", [0.0, 0.0, 0.0, 1.0], read_only=True,
-                           description="tdcm_base orientation in mocap (x, y, z, w)")
-        declare("stale_s", 1.0, range=(0.01, 3600.0),
-                description="inputs older than this are stale (s); changeable at run time")
-        update_s = float(declare("update_period_s", 0.5, range=(0.01, 60.0), read_only=True,
-                                 description="period of step detection (s)"))
-        diag_s = float(declare("diagnostics_period_s", 1.0, range=(0.05, 60.0), read_only=True,
-                               description="diagnostics period (s)"))
-        buffer_s = float(declare("max_buffer_s", 120.0, range=(1.0, 3600.0), read_only=True,
-                                 description="longest buffered stretch without a step (s)"))
+        fixed = declare_specs(port, FIXED_SPECS, read_only=True)
+        declare_specs(port, TUNABLE_SPECS)
+        self.source = str(fixed["registration.source"])
+        translation, rotation = fixed["registration.translation"], fixed["registration.rotation"]
+        update_s = float(fixed["update_period_s"])
+        diag_s = float(fixed["diagnostics_period_s"])
+        buffer_s = float(fixed["max_buffer_s"])
         given = None
         if self.source == "parameter":
             given = Registration(tuple(translation), tuple(rotation), method="parameter")
@@ -113,42 +131,15 @@ class MetricsNode(NodeLogic):
 
     def _options(self) -> EvaluateOptions:
         """Evaluation options from the (read-only) parameters; bad values raise InputError."""
-        declare = self.port.declare_parameter
-        name = str(declare("design.preset", "paper-experiment", read_only=True,
-                           description="design preset the fields start from",
-                           validator=one_of("design.preset", tuple(PRESETS))))
-        base = preset(name)
-        fields = {f: declare(f"design.{f}", getattr(base, f), read_only=True,
-                             range=(spec.low, spec.high),
-                             description=f"{spec.description} ({spec.unit or 'count'})")
-                  for f, spec in FIELD_SPECS.items()}
-        layout = MarkerLayout(
-            labels=tuple(declare("markers.labels", ["m1", "m2", "m3"], read_only=True,
-                                 description="marker labels, base to tip")),
-            arc_lengths=tuple(declare("markers.arc_lengths", [0.015, 0.033, 0.053],
-                                      read_only=True, description="marker arc lengths (m)")),
-            ball_radius=float(declare("markers.radius", 0.001, range=(0.0, 0.05),
-                                      read_only=True, description="marker ball radius (m)")),
-            side_deg=float(declare("markers.side_deg", 180.0, range=(-360.0, 360.0),
-                                   read_only=True, description="marker side (deg)")))
-        defaults = StepSettings()
-        steps = StepSettings(**{
-            f: declare(f"steps.{f}", getattr(defaults, f), read_only=True,
-                       description=f"step detection: {f}")
-            for f in ("tolerance_n", "min_hold_s", "settle_s", "zero_n", "despike_samples")})
-        return EvaluateOptions(
-            design=base.with_overrides(**fields), steps=steps, layout=layout,
-            align_tolerance_s=float(declare("align.tolerance_s", 0.02, range=(0.0, 10.0),
-                                            read_only=True,
-                                            description="nearest-stamp tolerance (s)")),
-            mape_threshold_m=float(declare("mape_threshold_m", 1e-3, range=(1e-9, 1.0),
-                                           read_only=True,
-                                           description="MAPE leaves out smaller deflections (m)")),
-            stations=int(declare("stations", 50, range=(2, 10_000), read_only=True,
-                                 description="arc-length stations of the shape error")),
-            deflection_axis=str(declare("deflection_axis", "marker", read_only=True,
-                                        description="marker or body",
-                                        validator=one_of("deflection_axis", DEFLECTION_AXES))))
+        port = self.port
+        base = preset(str(declare_specs(port, PRESET_SPECS, read_only=True)["design.preset"]))
+        design = base.with_overrides(**declare_specs(
+            port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
+        layout = MarkerLayout(**declare_specs(port, LAYOUT_SPECS, prefix="markers.",
+                                              read_only=True))
+        steps = StepSettings(**declare_specs(port, STEP_SPECS, prefix="steps.", read_only=True))
+        return EvaluateOptions(design=design, steps=steps, layout=layout,
+                               **declare_specs(port, OPTION_SPECS, read_only=True))
 
     def _on_tension(self, message: Any) -> None:
         value = float(message.wrench.force.z)

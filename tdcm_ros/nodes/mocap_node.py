@@ -25,7 +25,6 @@ from __future__ import annotations
 import math
 import sys
 from collections import Counter
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -49,9 +48,10 @@ from tdcm_ros.mocap import (
 from tdcm_ros.mocap.labelling import Labeller
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.names import resolve_topic
-from tdcm_ros.runtime.parameters import one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
+from tdcm_ros.runtime.spec_params import declare_specs, grouped
+from tdcm_ros.spec import Spec, by_name
 
 SOURCES = ("csv", "relabel", "sim")
 LABELLING_MODES = ("name", "arc_length")
@@ -59,14 +59,61 @@ AXES = ("straight", "predicted")
 REGISTRATION_MODES = ("quaternion", "rpy", "estimate")
 MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
 USE_BOTH = 2   # mocap4r2_msgs/Marker.id_type: name and index are both meaningful
+#: Every parameter of the node (all fixed at start).
+MOCAP_SPECS = by_name(
+    Spec("source", description="csv, relabel or sim", default="csv", kind="str", choices=SOURCES),
+    Spec("frame_id", description="frame of the markers (Vicon world)", default="mocap",
+         kind="str"),
+    Spec("base_frame_id", description="child frame of the published registration",
+         default="tdcm_base", kind="str"),
+    Spec("csv.path", description="Vicon Nexus CSV export (source csv)", default="", kind="str"),
+    Spec("csv.rate_scale", description="replay speed, times real time", default=1.0, low=0.01,
+         high=100.0),
+    Spec("csv.loop", description="replay again from the start", default=False, kind="bool"),
+    Spec("csv.start_delay_s", "s", "wait before the first frame, lets subscribers connect", 1.0,
+         low=0.0, high=3600.0),
+    Spec("relabel.input_topic", description="Markers topic of the live Vicon driver "
+         "(source relabel)", default="/markers", kind="str"),
+    Spec("relabel.input_scale", description="m per input position unit (0.001 if the driver "
+         "sends mm)", default=1.0, low=1e-6, high=1e3),
+    Spec("sim.scene", description="scene name or YAML path (sim)", default="ideal", kind="str"),
+    Spec("labelling.mode", description="name or arc_length", default="name", kind="str",
+         choices=LABELLING_MODES),
+    Spec("labelling.labels", description="published labels, base to tip",
+         default=("m1", "m2", "m3"), kind="names"),
+    Spec("labelling.map", description="'Vicon name=label' entries; name: Subject:Marker or "
+         "Marker", default=("m1=m1", "m2=m2", "m3=m3"), kind="names"),
+    Spec("labelling.arc_lengths", "m", "arc length of each label", (0.015, 0.033, 0.053),
+         kind="list", low=0.0, high=2.0),
+    Spec("labelling.axis", description="arc_length axis: straight or predicted (latest axis "
+         "topic)", default="straight", kind="str", choices=AXES),
+    Spec("labelling.axis_topic", description="PoseArray midline in base_frame_id (axis "
+         "predicted)", default="midline_poses", kind="str"),
+    Spec("labelling.body_length", "m", "length of the straight axis", 0.053, low=1e-3, high=2.0),
+    Spec("labelling.max_distance", "m", "largest marker distance from the label's axis point",
+         0.03, low=1e-4, high=1.0),
+    Spec("registration.mode", description="quaternion, rpy or estimate (ignored by source sim)",
+         default="quaternion", kind="str", choices=REGISTRATION_MODES),
+    Spec("registration.translation", "m", "tdcm_base origin in mocap", (0.0, 0.0, 0.0),
+         kind="vector", low=-1e3, high=1e3),
+    Spec("registration.quaternion", description="tdcm_base orientation in mocap (x, y, z, w)",
+         default=(0.0, 0.0, 0.0, 1.0), kind="vector", size=4, low=-1.0, high=1.0),
+    Spec("registration.rpy", "rad", "roll, pitch, yaw (fixed axes)", (0.0, 0.0, 0.0),
+         kind="vector", low=-2 * math.pi, high=2 * math.pi),
+    Spec("registration.zero_csv", description="zero-tension Nexus CSV (mode estimate)",
+         default="", kind="str"),
+    Spec("registration.bent_csv", description="bent-body Nexus CSV fixing the roll (mode "
+         "estimate)", default="", kind="str"),
+    Spec("registration.x_hint", "", "mocap direction of +x if no bent_csv (mode estimate; "
+         "0 = unset)", (0.0, 0.0, 0.0), kind="vector", low=-1e3, high=1e3),
+    Spec("markers.radius", "m", "marker centre distance from the midline", 0.00492, low=0.0,
+         high=0.1),
+    Spec("markers.side_deg", "deg", "marker side around the body z axis from the tendon side",
+         180.0, low=-360.0, high=360.0),
+    Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
 
-
-def _length(name: str, size: int) -> Callable[[Any], None]:
-    def check(value: Any) -> None:
-        if len(value) != size:
-            raise InputError(f"{name} = {value!r} needs {size} values", parameter=name,
-                             value=value, allowed=f"{size} numbers")
-    return check
+#: Every parameter of the node by full name (parameter files are checked against it).
+PARAMETERS = grouped(MOCAP_SPECS)
 
 
 def _stamp_ns(message: Any) -> int:
@@ -80,7 +127,7 @@ class MocapNode(NodeLogic):
 
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
-        self._declare()
+        declare_specs(port, MOCAP_SPECS, read_only=True)
         get = port.get_parameter
         self.source_name = str(get("source"))
         self.frame_id = str(get("frame_id"))
@@ -103,67 +150,6 @@ class MocapNode(NodeLogic):
         self.labeller = self._labeller()
         self._publish_tf()
         port.create_timer(float(get("diagnostics_period_s")), self.report)
-
-    def _declare(self) -> None:
-        declare = self.port.declare_parameter
-        declare("source", "csv", read_only=True, description="csv, relabel or sim",
-                validator=one_of("source", SOURCES))
-        declare("frame_id", "mocap", read_only=True, description="frame of the markers (Vicon world)")
-        declare("base_frame_id", "tdcm_base", read_only=True,
-                description="child frame of the published registration")
-        declare("csv.path", "", read_only=True, description="Vicon Nexus CSV export (source csv)")
-        declare("csv.rate_scale", 1.0, range=(0.01, 100.0), read_only=True,
-                description="replay speed, times real time")
-        declare("csv.loop", False, read_only=True, description="replay again from the start")
-        declare("csv.start_delay_s", 1.0, range=(0.0, 3600.0), read_only=True,
-                description="wait before the first frame (s), lets subscribers connect")
-        declare("relabel.input_topic", "/markers", read_only=True,
-                description="Markers topic of the live Vicon driver (source relabel)")
-        declare("relabel.input_scale", 1.0, range=(1e-6, 1e3), read_only=True,
-                description="m per input position unit (0.001 if the driver sends mm)")
-        declare("sim.scene", "ideal", read_only=True, description="scene name or YAML path (sim)")
-        declare("labelling.mode", "name", read_only=True, description="name or arc_length",
-                validator=one_of("labelling.mode", LABELLING_MODES))
-        declare("labelling.labels", ["m1", "m2", "m3"], read_only=True,
-                description="published labels, base to tip")
-        declare("labelling.map", ["m1=m1", "m2=m2", "m3=m3"], read_only=True,
-                description="'Vicon name=label' entries; name: Subject:Marker or Marker")
-        declare("labelling.arc_lengths", [0.015, 0.033, 0.053], range=(0.0, 2.0), read_only=True,
-                description="arc length of each label (m)")
-        declare("labelling.axis", "straight", read_only=True,
-                description="arc_length axis: straight or predicted (latest axis topic)",
-                validator=one_of("labelling.axis", AXES))
-        declare("labelling.axis_topic", "midline_poses", read_only=True,
-                description="PoseArray midline in base_frame_id (axis predicted)")
-        declare("labelling.body_length", 0.053, range=(1e-3, 2.0), read_only=True,
-                description="length of the straight axis (m)")
-        declare("labelling.max_distance", 0.03, range=(1e-4, 1.0), read_only=True,
-                description="largest marker distance from the label's axis point (m)")
-        declare("registration.mode", "quaternion", read_only=True,
-                description="quaternion, rpy or estimate (ignored by source sim)",
-                validator=one_of("registration.mode", REGISTRATION_MODES))
-        declare("registration.translation", [0.0, 0.0, 0.0], range=(-1e3, 1e3), read_only=True,
-                description="tdcm_base origin in mocap (m)",
-                validator=_length("registration.translation", 3))
-        declare("registration.quaternion", [0.0, 0.0, 0.0, 1.0], range=(-1.0, 1.0),
-                read_only=True, description="tdcm_base orientation in mocap (x, y, z, w)",
-                validator=_length("registration.quaternion", 4))
-        declare("registration.rpy", [0.0, 0.0, 0.0], range=(-2 * math.pi, 2 * math.pi),
-                read_only=True, description="roll, pitch, yaw (rad, fixed axes)",
-                validator=_length("registration.rpy", 3))
-        declare("registration.zero_csv", "", read_only=True,
-                description="zero-tension Nexus CSV (mode estimate)")
-        declare("registration.bent_csv", "", read_only=True,
-                description="bent-body Nexus CSV fixing the roll (mode estimate)")
-        declare("registration.x_hint", [0.0, 0.0, 0.0], range=(-1e3, 1e3), read_only=True,
-                description="mocap direction of +x if no bent_csv (mode estimate; 0 = unset)",
-                validator=_length("registration.x_hint", 3))
-        declare("markers.radius", 0.00492, range=(0.0, 0.1), read_only=True,
-                description="marker centre distance from the midline (m)")
-        declare("markers.side_deg", 180.0, range=(-360.0, 360.0), read_only=True,
-                description="marker side around the body z axis from the tendon side (deg)")
-        declare("diagnostics_period_s", 1.0, range=(0.05, 60.0), read_only=True,
-                description="diagnostics period (s)")
 
     # -- registration and labelling ---------------------------------------------------------
 

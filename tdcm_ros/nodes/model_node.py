@@ -20,22 +20,59 @@ import math
 import sys
 from collections import Counter
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError, PhysicsError
-from tdcm_ros.model import FIELD_SPECS, SolveResult, SolverSettings, preset, solve
+from tdcm_ros.metrics.geometry import MARKER_SPECS
+from tdcm_ros.model import (
+    FIELD_SPECS,
+    SOLVER_SPECS,
+    SolveResult,
+    SolverSettings,
+    preset,
+    solve,
+)
 from tdcm_ros.model.design import PRESETS, Design
 from tdcm_ros.nodes.shape_messages import header, midline_messages
-from tdcm_ros.runtime.parameters import ParamValue, one_of
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
+from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
+from tdcm_ros.spec import Spec, by_name
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
-SOLVER_FIELDS: dict[str, ParamValue] = {"routing": "paper", "loads": "closed", "cells_per_notch": 4,
-                 "cells_per_tube": 1, "quad_order": 4, "tol": 1e-10, "max_iter": 200}
+#: Parameters fixed at start, besides the design and solver groups.
+FIXED_SPECS = by_name(
+    Spec("input.tension_type", description="message type on `tension`", default=TENSION_TYPES[0],
+         kind="str", choices=TENSION_TYPES),
+    Spec("design.preset", description="design preset the fields start from",
+         default="paper-experiment", kind="str", choices=tuple(PRESETS)),
+    Spec("process_period_s", "s", "solver timer period", 0.001, low=1e-4, high=1.0),
+    Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
+#: Parameters a client may change at run time, besides the design and solver groups.
+TUNABLE_SPECS = by_name(
+    Spec("frame_id", description="frame of all outputs", default="tdcm_base", kind="str"),
+    Spec("output.samples", description="poses along the midline", default=54, kind="int",
+         low=2, high=10_000),
+    Spec("markers.arc_lengths", "m", "arc lengths of the predicted markers",
+         MARKER_SPECS["arc_lengths"].default, kind="list"),
+    Spec("markers.placement", description="surface or midline", default="surface", kind="str",
+         choices=("surface", "midline")),
+    replace(MARKER_SPECS["ball_radius"], name="markers.radius"),
+    replace(MARKER_SPECS["side_deg"], name="markers.side_deg"),
+    Spec("input.tension_max", "N", "largest valid tension", 200.0, low=0.0, high=1e6),
+    Spec("input.max_age_s", "s", "inputs older than this are stale; 0 disables", 0.5, low=0.0,
+         high=3600.0),
+    Spec("input.max_future_s", "s", "inputs stamped further ahead of the clock are dropped", 0.5,
+         low=0.0, high=3600.0))
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(FIXED_SPECS), **grouped(FIELD_SPECS, "design."),
+              **grouped(SOLVER_SPECS, "solver."), **grouped(TUNABLE_SPECS)}
 
 
 class ModelNode(NodeLogic):
@@ -45,38 +82,14 @@ class ModelNode(NodeLogic):
 
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
-        declare = port.declare_parameter
-        self.tension_type = str(declare(
-            "input.tension_type", TENSION_TYPES[0], read_only=True,
-            description="message type on `tension`", validator=one_of("input.tension_type",
-                                                                      TENSION_TYPES)))
-        declare("frame_id", "tdcm_base", description="frame of all outputs")
-        base_name = str(declare("design.preset", "paper-experiment", read_only=True,
-                                description="design preset the fields start from",
-                                validator=one_of("design.preset", tuple(PRESETS))))
-        base = preset(base_name)
-        for name, spec in FIELD_SPECS.items():
-            declare(f"design.{name}", getattr(base, name), range=(spec.low, spec.high),
-                    description=f"{spec.description} ({spec.unit or 'count'})")
-        for name, default in SOLVER_FIELDS.items():
-            declare(f"solver.{name}", default, description=f"SolverSettings.{name}")
-        declare("output.samples", 54, range=(2, 10_000), description="poses along the midline")
-        declare("markers.arc_lengths", [0.015, 0.033, 0.053],
-                description="arc lengths (m) of the predicted markers")
-        declare("markers.placement", "surface", description="surface or midline",
-                validator=one_of("markers.placement", ("surface", "midline")))
-        declare("markers.radius", 0.001, range=(0.0, 0.05), description="marker ball radius (m)")
-        declare("markers.side_deg", 180.0, range=(-360.0, 360.0),
-                description="marker side around the body z axis from the tendon side (deg)")
-        declare("input.tension_max", 200.0, range=(0.0, 1e6), description="largest valid tension (N)")
-        declare("input.max_age_s", 0.5, range=(0.0, 3600.0),
-                description="inputs older than this are stale (s); 0 disables")
-        declare("input.max_future_s", 0.5, range=(0.0, 3600.0),
-                description="inputs stamped further ahead of the clock are dropped (s)")
-        period = float(declare("process_period_s", 0.001, range=(1e-4, 1.0), read_only=True,
-                               description="solver timer period (s)"))
-        diag_period = float(declare("diagnostics_period_s", 1.0, range=(0.05, 60.0),
-                                    read_only=True, description="diagnostics period (s)"))
+        fixed = declare_specs(port, FIXED_SPECS, read_only=True)
+        self.tension_type = str(fixed["input.tension_type"])
+        base = preset(str(fixed["design.preset"]))
+        declare_specs(port, FIELD_SPECS, prefix="design.", defaults=base.to_dict())
+        declare_specs(port, SOLVER_SPECS, prefix="solver.")
+        declare_specs(port, TUNABLE_SPECS)
+        period = float(fixed["process_period_s"])
+        diag_period = float(fixed["diagnostics_period_s"])
         self.design, self.settings = self._config({})
         port.add_on_set_parameters(self._on_set)
 
@@ -99,17 +112,14 @@ class ModelNode(NodeLogic):
         port.create_timer(period, self.process)
         port.create_timer(diag_period, self.report)
 
-    def _param(self, changes: Mapping[str, Any], name: str) -> Any:
-        return changes[name] if name in changes else self.port.get_parameter(name)
-
     def _config(self, changes: Mapping[str, Any]) -> tuple[Design, SolverSettings]:
         """Design and settings from the current parameters with ``changes`` applied."""
-        base = preset(str(self._param(changes, "design.preset")))
-        design = base.with_overrides(**{name: self._param(changes, f"design.{name}")
-                                        for name in FIELD_SPECS})
-        settings = SolverSettings(**{name: self._param(changes, f"solver.{name}")
-                                     for name in SOLVER_FIELDS})
-        arcs = self._param(changes, "markers.arc_lengths")
+        base = preset(str(self.port.get_parameter("design.preset")))
+        design = base.with_overrides(**read_specs(self.port, FIELD_SPECS, prefix="design.",
+                                                  changes=changes))
+        settings = SolverSettings(**read_specs(self.port, SOLVER_SPECS, prefix="solver.",
+                                               changes=changes))
+        arcs = changes.get("markers.arc_lengths", self.port.get_parameter("markers.arc_lengths"))
         if not arcs or any(not 0.0 <= float(s) <= design.length for s in arcs):
             raise InputError(f"markers.arc_lengths = {arcs!r} out of range; allowed: values in "
                              f"[0, {design.length:g}] m", parameter="markers.arc_lengths",

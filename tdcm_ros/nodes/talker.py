@@ -12,6 +12,13 @@ from typing import Any
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
+from tdcm_ros.runtime.spec_params import declare_specs
+from tdcm_ros.spec import Spec, by_name
+
+#: Every parameter of the node.
+PARAMETERS = by_name(
+    Spec("period", "s", "publishing period", 0.5, low=1e-3, high=60.0),
+    Spec("prefix", description="text before the counter", default="hello", kind="str"))
 
 
 class Talker(NodeLogic):
@@ -21,9 +28,7 @@ class Talker(NodeLogic):
 
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
-        self.period = float(port.declare_parameter(
-            "period", 0.5, description="publishing period (s)", range=(1e-3, 60.0)))
-        port.declare_parameter("prefix", "hello", description="text before the counter")
+        self.period = float(declare_specs(port, PARAMETERS)["period"])
         port.add_on_set_parameters(self._on_set)
         self.count = 0
         self.publisher = port.create_publisher("chatter", "std_msgs/msg/String", QoS(depth=10))

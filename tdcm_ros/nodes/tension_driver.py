@@ -36,8 +36,8 @@ from dataclasses import replace
 from typing import Any
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.device import constants as c
 from tdcm_ros.device.driver import (
+    DRIVER_SPECS,
     DriverConfig,
     DriverStatus,
     Level,
@@ -47,28 +47,40 @@ from tdcm_ros.device.driver import (
 )
 from tdcm_ros.device.errors import ProtocolVersionError
 from tdcm_ros.device.protocol import Telemetry
-from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.device.schedule import SCHEDULE_SPECS, StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
 from tdcm_ros.runtime.run_node import main_for
+from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
+from tdcm_ros.spec import Spec, by_name
 
-#: DriverConfig fields as parameters: (range, description); all but port/baudrate change at runtime
-DRIVER_PARAMS: dict[str, tuple[tuple[float, float], str]] = {
-    "tension_max": ((0.001, c.SETPOINT_MAX_MN / 1000), "largest setpoint (N)"),
-    "setpoint_rate": ((0.1, 1000.0), "setpoint ramp rate (N/s)"),
-    "heartbeat_period": ((0.01, c.WATCHDOG_MS / 2000 - 0.001),
-                         "heartbeat period (s), below half the device watchdog"),
-    "handshake_timeout": ((0.1, 60.0), "time allowed for the banner (s)"),
-    "stale_timeout": ((0.02, 10.0), "telemetry age reported as stale (s)"),
-    "link_timeout": ((0.1, 60.0), "telemetry silence that drops the link (s)"),
-    "backoff_initial": ((0.01, 60.0), "first reconnect delay (s)"),
-    "backoff_max": ((0.01, 600.0), "largest reconnect delay (s)"),
-}
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
 #: parameters that bound the force on the tendon: fixed at run time unless safety.limits_writable
 SAFETY_LIMITS = ("tension_max", "setpoint_rate")
 LIMITS_WRITABLE = "safety.limits_writable"
+#: DriverConfig fields fixed at start (the link); the others change at run time.
+LINK_FIELDS = ("port", "baudrate")
+#: Parameters of the node fixed at start, besides the link.
+FIXED_SPECS = by_name(
+    Spec(LIMITS_WRITABLE, description="allow run-time changes of the safety limits "
+         f"{', '.join(SAFETY_LIMITS)}", default=False, kind="bool"),
+    Spec("schedule.autostart", description="run the schedule once the device is connected",
+         default=False, kind="bool"),
+    Spec("step_period_s", "s", "driver step period; telemetry is 50 Hz", 0.005, low=0.001,
+         high=0.02),
+    Spec("state_period_s", "s", "device_state period", 0.1, low=0.01, high=10.0),
+    Spec("diagnostics_period_s", "s", "/diagnostics period", 0.5, low=0.05, high=60.0))
+#: Parameters of the node a client may change at run time, besides the driver and schedule.
+TUNABLE_SPECS = by_name(
+    Spec("frame_id", description="frame of `tension`", default="tdcm_tendon", kind="str"),
+    Spec("enabled", description="hold the setpoint (device mode T) when no fault", default=True,
+         kind="bool"))
+
+#: Every parameter of the node by full name, as declared below (parameter files are checked
+#: against it).
+PARAMETERS = {**grouped(DRIVER_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS),
+              **grouped(SCHEDULE_SPECS, "schedule.")}
 
 
 class TensionDriverNode(NodeLogic):
@@ -78,37 +90,22 @@ class TensionDriverNode(NodeLogic):
 
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
-        declare = port.declare_parameter
-        defaults = DriverConfig()
-        url = str(declare("port", defaults.port, read_only=True,
-                          description="device path, pty path or pyserial URL",
-                          validator=_non_empty("port")))
-        baudrate = int(declare("baudrate", defaults.baudrate, range=(1200, 4_000_000),
-                               read_only=True, description="serial line rate (baud)"))
-        self.limits_writable = bool(declare(
-            LIMITS_WRITABLE, False, read_only=True,
-            description=f"allow run-time changes of the safety limits {', '.join(SAFETY_LIMITS)}"))
-        for name, (limits, text) in DRIVER_PARAMS.items():
-            locked = name in SAFETY_LIMITS and not self.limits_writable
-            declare(name, float(getattr(defaults, name)), range=limits,
-                    description=text + (f"; read-only unless {LIMITS_WRITABLE}" if locked else ""))
-        declare("frame_id", "tdcm_tendon", description="frame of `tension`")
-        declare("enabled", True, description="hold the setpoint (device mode T) when no fault")
-        declare("schedule.levels", list(StepSchedule().levels),
-                description="staircase levels (N), in order")
-        declare("schedule.hold_s", StepSchedule().hold, range=(0.01, 86_400.0),
-                description="hold time of each level (s)")
-        declare("schedule.trials", StepSchedule().trials, range=(1, 10_000),
-                description="repetitions of the staircase")
-        autostart = bool(declare("schedule.autostart", False, read_only=True,
-                                 description="run the schedule once the device is connected"))
-        step_period = float(declare("step_period_s", 0.005, range=(0.001, 0.02), read_only=True,
-                                    description="driver step period (s); telemetry is 50 Hz"))
-        state_period = float(declare("state_period_s", 0.1, range=(0.01, 10.0), read_only=True,
-                                     description="device_state period (s)"))
-        diag_period = float(declare("diagnostics_period_s", 0.5, range=(0.05, 60.0),
-                                    read_only=True, description="/diagnostics period (s)"))
-        config = DriverConfig(port=url, baudrate=baudrate, **self._driver_values({}))
+        link = declare_specs(port, {name: DRIVER_SPECS[name] for name in LINK_FIELDS},
+                             read_only=True)
+        url = str(link["port"])
+        _non_empty("port")(url)
+        fixed = declare_specs(port, FIXED_SPECS, read_only=True)
+        self.limits_writable = bool(fixed[LIMITS_WRITABLE])
+        self.driver_specs = {name: self._noted(spec) for name, spec in DRIVER_SPECS.items()
+                             if name not in LINK_FIELDS}
+        declare_specs(port, self.driver_specs)
+        declare_specs(port, TUNABLE_SPECS)
+        declare_specs(port, SCHEDULE_SPECS, prefix="schedule.")
+        autostart = bool(fixed["schedule.autostart"])
+        step_period = float(fixed["step_period_s"])
+        state_period = float(fixed["state_period_s"])
+        diag_period = float(fixed["diagnostics_period_s"])
+        config = DriverConfig(**link, **self._driver_values({}))
         self.schedule = self._schedule({})
         port.add_on_set_parameters(self._on_set)
 
@@ -141,24 +138,20 @@ class TensionDriverNode(NodeLogic):
                          config.tension_max)
 
     # --- parameters -------------------------------------------------------------------------
-    def _param(self, changes: Mapping[str, Any], name: str) -> Any:
-        return changes[name] if name in changes else self.port.get_parameter(name)
+    def _noted(self, spec: Spec) -> Spec:
+        """A driver spec, its description noting a safety limit locked at run time."""
+        if spec.name in SAFETY_LIMITS and not self.limits_writable:
+            return replace(spec, description=f"{spec.description}; read-only unless "
+                                             f"{LIMITS_WRITABLE}")
+        return spec
 
     def _driver_values(self, changes: Mapping[str, Any]) -> dict[str, Any]:
-        return {name: float(self._param(changes, name)) for name in DRIVER_PARAMS}
+        return read_specs(self.port, self.driver_specs, changes=changes)
 
     def _schedule(self, changes: Mapping[str, Any]) -> StepSchedule:
         """The schedule from the parameters; raises ``InputError`` naming the parameter."""
-        try:
-            return StepSchedule(levels=tuple(float(v) for v in
-                                             self._param(changes, "schedule.levels")),
-                                hold=float(self._param(changes, "schedule.hold_s")),
-                                trials=int(self._param(changes, "schedule.trials")))
-        except InputError as error:
-            name = {"levels": "schedule.levels", "hold": "schedule.hold_s",
-                    "trials": "schedule.trials"}.get(str(error.parameter), "schedule")
-            raise InputError(f"{name}: {error}", parameter=name, value=error.value,
-                             allowed=error.allowed) from error
+        return StepSchedule(**read_specs(self.port, SCHEDULE_SPECS, prefix="schedule.",
+                                         changes=changes))
 
     def _on_set(self, changes: Mapping[str, Any]) -> None:
         """Validate runtime changes as a whole, then apply them (raising keeps the old values)."""

@@ -181,11 +181,3 @@ class ParameterStore:
         """Record changes already validated (used by the rclpy adapter after its callback)."""
         self._values.update(changes)
 
-
-def one_of(name: str, allowed: tuple[str, ...]) -> Callable[[Any], None]:
-    """A parameter validator accepting only the values in ``allowed``."""
-    def check(value: Any) -> None:
-        if value not in allowed:
-            raise InputError(f"{name} = {value!r} is invalid; allowed: {', '.join(allowed)}",
-                             parameter=name, value=value, allowed=", ".join(allowed))
-    return check

@@ -30,7 +30,7 @@ from tdcm_ros.scenes.effects import (
     parse_effect,
 )
 from tdcm_ros.scenes.errors import InvalidSceneError
-from tdcm_ros.scenes.params import Param, as_mapping, parse_params
+from tdcm_ros.scenes.params import Param, as_mapping, parse_params, parse_value
 from tdcm_ros.scenes.schema import SECTIONS, TOP_KEYS
 from tdcm_ros.scenes.stages import Metered
 from tdcm_ros.scenes.world import World
@@ -148,7 +148,7 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
         if not isinstance(value, str) or (key == "name" and not value):
             raise InvalidSceneError(f"{key} = {value!r} is not a string", parameter=key,
                                     value=value, allowed="a string")
-    seed = SEED.parse("seed", data.get("seed", 0))
+    seed = parse_value("seed", SEED, data.get("seed", 0))
     sections = {key: parse_params(key, specs, data.get(key))
                 for key, specs in SECTIONS.items() if key != "design"}
     design = _design(data.get("design"))

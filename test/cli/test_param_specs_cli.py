@@ -1,0 +1,35 @@
+"""``tdcm param specs NODE``: every parameter of a node, from the specs it declares them with."""
+
+from __future__ import annotations
+
+import importlib
+
+import pytest
+
+from tdcm_ros.cli.main import main
+from tdcm_ros.runtime.registry import NODES
+
+
+@pytest.mark.parametrize("node", sorted(NODES))
+def test_every_parameter_of_the_node_is_one_row(node: str, capsys: pytest.CaptureFixture[str]
+                                                ) -> None:
+    assert main(["param", "specs", node]) == 0
+    rows = capsys.readouterr().out.splitlines()[2:]
+    module = importlib.import_module(NODES[node].partition(":")[0])
+    assert [row.split(" | ")[0].strip("| `") for row in rows] == list(module.PARAMETERS)
+    assert all(row.count(" | ") == 4 for row in rows)  # choices' bars are escaped
+
+
+def test_a_row_shows_unit_default_and_range(capsys: pytest.CaptureFixture[str]) -> None:
+    main(["param", "specs", "model_node"])
+    rows = {row.split(" | ")[0].strip("| `"): row for row in capsys.readouterr().out.splitlines()}
+    assert rows["solver.tol"] == ("| `solver.tol` | m | 1e-10 | (0, 0.01] m | convergence "
+                                  "tolerance on the midline nodes |")
+    assert "| 1850000000.0 |" in rows["design.E"]  # Design's default E
+    assert "| (derived) |" in rows["design.w_n"]   # no default: the preset gives it
+    assert "paper \\| free" in rows["solver.routing"]
+
+
+def test_an_unknown_node_is_an_input_error(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["param", "specs", "nope"]) == 2
+    assert "unknown node 'nope'" in capsys.readouterr().err
