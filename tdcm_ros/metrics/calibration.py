@@ -30,8 +30,7 @@ from tdcm_ros.metrics.evaluation import Evaluation, model_tension
 from tdcm_ros.metrics.measure import MeasuredStep
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.registration import Registration
-from tdcm_ros.model import FIELD_SPECS, Design, SolveResult, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import FIELD_SPECS, Design, SolveResult, solve, surface_points
 
 Array = NDArray[np.float64]
 MAX_CONDITION = 1e10

@@ -1,7 +1,7 @@
 """Evaluation: measured steps against the model re-run at each step's mean tension.
 
 Per step: the measured markers in ``tdcm_base``, the model's markers at the same surface points
-(:func:`tdcm_ros.nodes.shape_messages.surface_points`), both tip deflections and the shape error;
+(:func:`tdcm_ros.model.surface_points`), both tip deflections and the shape error;
 then Table I (:mod:`tdcm_ros.metrics.table`). A step is *flagged* (left out of every metric,
 kept in the per-step table with a note) when its tip marker was never visible or the model has
 no solution at its tension.
@@ -27,8 +27,7 @@ from tdcm_ros.metrics.registration import (
 )
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.table import TableMetrics, table_metrics
-from tdcm_ros.model import Design, SolveResult, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import Design, SolveResult, solve, surface_points
 
 Array = NDArray[np.float64]
 

@@ -11,8 +11,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.metrics.geometry import MarkerLayout
-from tdcm_ros.model import Design, SolveResult, SolverSettings, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import Design, SolveResult, SolverSettings, solve, surface_points
 
 Array = NDArray[np.float64]
 

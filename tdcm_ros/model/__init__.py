@@ -35,6 +35,7 @@ from tdcm_ros.model.profiles import CircularProfile, CustomProfile, RectangularP
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
+from tdcm_ros.model.surface import offset_points, surface_points
 
 __all__ = [
     "DEFAULT_SETTINGS",
@@ -60,7 +61,9 @@ __all__ = [
     "TendonSingularityError",
     "TensionProfile",
     "TensionRangeError",
+    "offset_points",
     "parse_field",
     "preset",
     "solve",
+    "surface_points",
 ]

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.bagio import from_dict, msg_class
-from tdcm_ros.model import SolveResult
+from tdcm_ros.model import SolveResult, offset_points
 
 Array = NDArray[np.float64]
 
@@ -43,22 +43,6 @@ def _poses(positions: Array, quats: Array) -> list[Any]:
     return [pose(position=point(x=p[0], y=p[1], z=p[2]),
                  orientation=quaternion(x=q[0], y=q[1], z=q[2], w=q[3]))
             for p, q in zip(positions.tolist(), quats.tolist(), strict=True)]
-
-
-def _offset(positions: Array, quats: Array, radius: float, side_rad: float) -> Array:
-    """Points ``radius`` (m) off midline poses at ``side_rad`` around the body z axis."""
-    theta = 2.0 * np.arctan2(quats[:, 1], quats[:, 3])
-    body_x = np.stack([np.cos(theta), np.zeros_like(theta), -np.sin(theta)], axis=1)
-    body_y = np.array([0.0, 1.0, 0.0])
-    return positions + radius * (np.cos(side_rad) * body_x + np.sin(side_rad) * body_y)
-
-
-def surface_points(result: SolveResult, s: Array, radius: float, side_rad: float
-                   ) -> tuple[Array, Array]:
-    """Points at arc lengths ``s`` (m), ``radius`` (m) off the midline at angle ``side_rad``
-    around the body z axis from the body x axis (0 = tendon side); with their orientations."""
-    positions, quats = result.pose_at(s)
-    return _offset(positions, quats, radius, side_rad), quats
 
 
 @lru_cache(maxsize=16)
@@ -96,8 +80,8 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     yield "midline_poses", pose_array(header=hdr, poses=poses)
     tip = _poses(result.tip_position[None, :], result.tip_quaternion[None, :])[0]
     yield "tip_pose", pose_stamped(header=hdr, pose=tip)
-    markers = _poses(_offset(positions[samples:], quats[samples:], marker_radius,
-                             marker_side_rad), quats[samples:])
+    markers = _poses(offset_points(positions[samples:], quats[samples:], marker_radius,
+                                   marker_side_rad), quats[samples:])
     yield "predicted_markers", pose_array(header=hdr, poses=markers)
     body = _marker(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
                    (0.85, 0.85, 0.9, 0.8), [p.position for p in poses])

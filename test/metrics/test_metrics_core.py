@@ -17,8 +17,7 @@ from tdcm_ros.metrics.geometry import (
 )
 from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.table import table_metrics
-from tdcm_ros.model import preset, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import preset, solve, surface_points
 
 DESIGN = preset("paper-experiment")
 LAYOUT = MarkerLayout()

@@ -15,8 +15,7 @@ from tdcm_ros.metrics.registration import (
     RegistrationError,
     estimate_registration,
 )
-from tdcm_ros.model import preset, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import preset, solve, surface_points
 
 DESIGN = preset("paper-experiment")
 ARCS = np.array([0.015, 0.033, 0.053])

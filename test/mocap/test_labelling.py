@@ -20,8 +20,7 @@ from tdcm_ros.mocap import (
     straight_axis,
     visible,
 )
-from tdcm_ros.model import preset, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import preset, solve, surface_points
 
 LABELS = ("m1", "m2", "m3")
 ARCS = (0.015, 0.033, 0.053)

@@ -217,8 +217,7 @@ def test_bad_configuration_is_a_typed_error_naming_the_parameter(values, paramet
 
 def test_sim_source_with_the_real_ideal_scene_publishes_the_model_markers():
     from tdcm_ros.metrics.registration import Registration
-    from tdcm_ros.model import solve
-    from tdcm_ros.nodes.shape_messages import surface_points
+    from tdcm_ros.model import solve, surface_points
     from tdcm_ros.scenes import load_scene
 
     scene = load_scene("ideal")

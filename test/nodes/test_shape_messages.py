@@ -7,8 +7,8 @@ import math
 import numpy as np
 
 from tdcm_ros.bagio import deserialize, serialize
-from tdcm_ros.model import preset, solve
-from tdcm_ros.nodes.shape_messages import midline_messages, surface_points
+from tdcm_ros.model import preset, solve, surface_points
+from tdcm_ros.nodes.shape_messages import midline_messages
 
 TYPES = {"midline": "nav_msgs/msg/Path", "midline_poses": "geometry_msgs/msg/PoseArray",
          "tip_pose": "geometry_msgs/msg/PoseStamped",

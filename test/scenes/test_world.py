@@ -11,8 +11,7 @@ from scene_helpers import make_scene
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import PhysicsError
-from tdcm_ros.model import NotchClosureError, solve
-from tdcm_ros.nodes.shape_messages import surface_points
+from tdcm_ros.model import NotchClosureError, solve, surface_points
 from tdcm_ros.scenes import CONSTRUCTED, REGISTRY, load_scene
 
 LEVELS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)
