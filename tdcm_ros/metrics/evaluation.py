@@ -20,13 +20,13 @@ from tdcm_ros.errors import TdcmError
 from tdcm_ros.metrics.geometry import deflection, measured_midline, station_distance
 from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.metrics.registration import (
+from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.table import TableMetrics, table_metrics
+from tdcm_ros.mocap.registration import (
     Registration,
     RegistrationError,
     estimate_registration,
 )
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
-from tdcm_ros.metrics.table import TableMetrics, table_metrics
 from tdcm_ros.model import Design, SolveResult, solve, surface_points
 
 Array = NDArray[np.float64]

@@ -26,10 +26,10 @@ from tdcm_ros.metrics.evaluation import (
 from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.measure import MeasuredStep, average_markers
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.steps import assign_trials, detect_steps
 from tdcm_ros.metrics.table import TableMetrics
+from tdcm_ros.mocap.registration import Registration
 
 Array = NDArray[np.float64]
 

@@ -1,4 +1,5 @@
-"""ROS-free motion capture: Vicon Nexus CSV reading, labelling, occlusion, registration, sources.
+"""ROS-free motion capture: Vicon Nexus CSV reading, labelling, occlusion, sources, and the
+registration of the ``mocap`` frame to ``tdcm_base``.
 
 Never imports rclpy; ``tdcm_ros.nodes.mocap_node`` puts it on a runtime.
 """
@@ -15,6 +16,11 @@ from tdcm_ros.mocap.labelling import (
 from tdcm_ros.mocap.nexus_csv import Trajectories, parse_nexus_csv, read_nexus_csv
 from tdcm_ros.mocap.occlusion import visible
 from tdcm_ros.mocap.register import estimate_from_recordings, given_registration
+from tdcm_ros.mocap.registration import (
+    Registration,
+    RegistrationError,
+    estimate_registration,
+)
 from tdcm_ros.mocap.sources import CsvReplay, RawFrame, SimSource, SourceError
 
 __all__ = [
@@ -27,10 +33,13 @@ __all__ = [
     "NameLabeller",
     "NameMap",
     "RawFrame",
+    "Registration",
+    "RegistrationError",
     "SimSource",
     "SourceError",
     "Trajectories",
     "estimate_from_recordings",
+    "estimate_registration",
     "given_registration",
     "parse_nexus_csv",
     "project_on_polyline",

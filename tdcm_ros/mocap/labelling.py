@@ -28,9 +28,9 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.mocap.errors import LabelError
 from tdcm_ros.mocap.occlusion import visible
+from tdcm_ros.mocap.registration import Registration
 
 Array = NDArray[np.float64]
 _UNREACHABLE = 1e9

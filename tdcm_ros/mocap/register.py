@@ -1,6 +1,6 @@
 """The static ``mocap`` -> ``tdcm_base`` transform: given, or estimated from recordings.
 
-The transform is a :class:`tdcm_ros.metrics.registration.Registration`: the pose of
+The transform is a :class:`tdcm_ros.mocap.registration.Registration`: the pose of
 ``tdcm_base`` in ``mocap`` (``p_mocap = R p_base + t``), published by ``mocap_node`` on
 ``/tf_static`` with parent ``mocap`` and child ``tdcm_base``.
 
@@ -8,7 +8,7 @@ The transform is a :class:`tdcm_ros.metrics.registration.Registration`: the pose
   axes x, y, z as ROS ``setRPY``);
 - **estimated**: from a zero-tension Nexus CSV recording (mean marker positions fix the body
   axis and origin) plus a bent recording (its most deflected frame fixes the bending plane) or
-  an ``x_hint``; see :func:`tdcm_ros.metrics.registration.estimate_registration`.
+  an ``x_hint``; see :func:`tdcm_ros.mocap.registration.estimate_registration`.
 """
 
 from __future__ import annotations
@@ -21,15 +21,15 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.metrics.registration import (
-    Registration,
-    RegistrationError,
-    estimate_registration,
-)
 from tdcm_ros.mocap.errors import LabelError
 from tdcm_ros.mocap.labelling import NameMap
 from tdcm_ros.mocap.nexus_csv import Trajectories, read_nexus_csv
 from tdcm_ros.mocap.occlusion import visible
+from tdcm_ros.mocap.registration import (
+    Registration,
+    RegistrationError,
+    estimate_registration,
+)
 
 Array = NDArray[np.float64]
 

@@ -39,9 +39,9 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.evaluation import Evaluation
 from tdcm_ros.metrics.geometry import MARKER_SPECS, MarkerLayout
 from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions
-from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
 from tdcm_ros.metrics.streaming import RunningEvaluation
+from tdcm_ros.mocap.registration import Registration
 from tdcm_ros.model import FIELD_SPECS, preset
 from tdcm_ros.model.design import PRESETS
 from tdcm_ros.nodes.shape_messages import header

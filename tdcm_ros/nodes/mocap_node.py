@@ -31,7 +31,6 @@ import numpy as np
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
-from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.mocap import (
     ArcLengthLabeller,
     CsvReplay,
@@ -46,6 +45,7 @@ from tdcm_ros.mocap import (
     straight_axis,
 )
 from tdcm_ros.mocap.labelling import Labeller
+from tdcm_ros.mocap.registration import Registration
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS

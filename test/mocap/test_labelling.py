@@ -10,7 +10,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.mocap import (
     ArcLengthLabeller,
     LabelError,
@@ -20,6 +19,7 @@ from tdcm_ros.mocap import (
     straight_axis,
     visible,
 )
+from tdcm_ros.mocap.registration import Registration
 from tdcm_ros.model import preset, solve, surface_points
 
 LABELS = ("m1", "m2", "m3")

@@ -9,7 +9,6 @@ import pytest
 from mocap_helpers import DATA, nexus_text, straight_and_bent
 from scipy.spatial.transform import Rotation
 
-from tdcm_ros.metrics.registration import Registration, RegistrationError
 from tdcm_ros.mocap import (
     CsvReplay,
     LabelError,
@@ -20,6 +19,7 @@ from tdcm_ros.mocap import (
     given_registration,
     read_nexus_csv,
 )
+from tdcm_ros.mocap.registration import Registration, RegistrationError
 
 LABELS = ("m1", "m2", "m3")
 ARCS = (0.015, 0.033, 0.053)

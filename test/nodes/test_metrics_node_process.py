@@ -24,9 +24,9 @@ from tdcm_ros.bagio import from_dict
 from tdcm_ros.metrics.evaluation import evaluate_series, metrics_of
 from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.metrics.registration import Registration
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.synthetic import Recording, simulate
+from tdcm_ros.mocap.registration import Registration
 from tdcm_ros.model import preset
 from tdcm_ros.runtime.port import QoS
 

@@ -174,7 +174,7 @@ def test_csv_replay_through_the_node_publishes_every_row_once():
 def test_registration_estimated_from_recordings_is_published_on_tf_static(tmp_path):
     from scipy.spatial.transform import Rotation
 
-    from tdcm_ros.metrics.registration import Registration
+    from tdcm_ros.mocap.registration import Registration
 
     truth = Registration((0.4, 0.1, 1.2),
                          tuple(Rotation.from_euler("xyz", [0.2, 2.8, -1.0]).as_quat()))
@@ -216,7 +216,7 @@ def test_bad_configuration_is_a_typed_error_naming_the_parameter(values, paramet
 
 
 def test_sim_source_with_the_real_ideal_scene_publishes_the_model_markers():
-    from tdcm_ros.metrics.registration import Registration
+    from tdcm_ros.mocap.registration import Registration
     from tdcm_ros.model import solve, surface_points
     from tdcm_ros.scenes import load_scene
 

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from tdcm_ros.metrics.registration import (
+from tdcm_ros.mocap.registration import (
     Registration,
     RegistrationError,
     estimate_registration,
