@@ -5,13 +5,10 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tdcm_ros.cli.evaluate import add_input_arguments, fail
 from tdcm_ros.errors import PhysicsError, TdcmError
-
-if TYPE_CHECKING:
-    from tdcm_ros.metrics.calibration import Calibration
 
 UNUSABLE_FIT_EXIT = PhysicsError.exit_code
 """Exit status when the fit did not converge or a parameter is not identifiable (numerics)."""
@@ -33,39 +30,12 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def _metric(value: float | None, scale: float, unit: str) -> str:
-    return "-" if value is None else f"{value * scale:.3f} {unit}"
-
-
-def format_report(cal: Calibration) -> str:
-    """Warnings (not identifiable, not converged) first, then fitted values with intervals,
-    residuals, Table I before/after and the evaluation's warnings."""
-    steps = cal.before.metrics.n_steps + cal.before.metrics.n_flagged
-    lines = [f"warning: {w}" for w in cal.warnings]
-    lines += [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
-             f"residual RMS {cal.residual_rms_m * 1e3:.4f} mm")]
-    level = f"{cal.confidence:.0%}"
-    for p in cal.parameters:
-        lines.append(f"  {p.name} = {p.value:.5g} {p.unit}  ({level} interval "
-                     f"{p.ci_low:.5g} .. {p.ci_high:.5g}; start {p.initial:.5g})")
-    b, a = cal.before.metrics, cal.after.metrics
-    rows = [("MAPE", b.mape_pct, a.mape_pct, 1.0, "%"), ("RMSE", b.rmse_m, a.rmse_m, 1e3, "mm"),
-            ("MAE", b.mae_m, a.mae_m, 1e3, "mm"),
-            ("Shape error", b.shape_error_m, a.shape_error_m, 1e3, "mm"),
-            ("Deflection mean", b.deflection_mean_m, a.deflection_mean_m, 1e3, "mm"),
-            ("  model", b.predicted_deflection_mean_m, a.predicted_deflection_mean_m, 1e3, "mm")]
-    lines += ["", f"{'Table I':<16} {'before':>12} {'after':>12}"]
-    lines += [f"{name:<16} {_metric(x, k, u):>12} {_metric(y, k, u):>12}"
-              for name, x, y, k, u in rows]
-    lines += [f"warning: {w}" for w in cal.after.warnings]
-    return "\n".join(lines)
-
-
 def run(args: argparse.Namespace) -> int:
     """Calibrate; known errors become one line and a non-zero exit status."""
     from tdcm_ros.metrics.api import Topics, calibrate_paths
     from tdcm_ros.metrics.calibration import parse_fit
     from tdcm_ros.metrics.options import options_from_sets
+    from tdcm_ros.metrics.report import format_calibration
 
     try:
         names = parse_fit(args.fit)
@@ -74,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
                               topics=Topics(args.tension_topic, args.markers_topic))
     except TdcmError as error:
         return fail("calibrate", error, args.json)
-    print(json.dumps(cal.to_json()) if args.json else format_report(cal))
+    print(json.dumps(cal.to_json()) if args.json else format_calibration(cal))
     if cal.warnings:
         print(f"tdcm calibrate: the fit is not usable: {'; '.join(cal.warnings)}",
               file=sys.stderr)

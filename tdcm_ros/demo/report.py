@@ -19,9 +19,9 @@ def scene_options(plan: DemoPlan) -> EvaluateOptions:
 
 def report(plan: DemoPlan, *, calibrate: bool) -> None:
     """Print Table I and the per-step table, write ``plots/`` and ``metrics.json``; calibrate."""
-    from tdcm_ros.cli.evaluate import format_report
     from tdcm_ros.metrics.api import evaluate_paths
     from tdcm_ros.metrics.plots import write_plots
+    from tdcm_ros.metrics.report import format_calibration, format_evaluation
 
     options = scene_options(plan)
     fit = None
@@ -31,13 +31,11 @@ def report(plan: DemoPlan, *, calibrate: bool) -> None:
         fit = calibrate_paths([plan.bag], ("E",), options)  # its `before` is the evaluation
     evaluation = fit.before if fit is not None else evaluate_paths([plan.bag], options)
     print(f"\n== evaluation of {plan.bag} (estimator: scene {plan.scene.name!r} nominal design) ==")
-    print(format_report(evaluation))
+    print(format_evaluation(evaluation))
     for path in write_plots(evaluation, plan.out / "plots"):
         print(f"plot written to {path}")
     results = {"scene": plan.scene.name, "before_calibration": evaluation.to_json()}
     if fit is not None:
-        from tdcm_ros.cli.calibrate import format_report as format_calibration
-
         print(f"\n== calibration of E on {plan.bag} (start: the scene's nominal E) ==")
         print(format_calibration(fit))
         results["calibration"] = fit.to_json()

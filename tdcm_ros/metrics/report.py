@@ -1,0 +1,79 @@
+"""Text reports of an evaluation and a calibration (lengths printed in mm, the rest SI)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tdcm_ros.metrics.calibration import Calibration
+    from tdcm_ros.metrics.evaluation import Evaluation
+    from tdcm_ros.metrics.options import EvaluateOptions
+
+
+def _mm(value: float | None, digits: int = 3) -> str:
+    return "-" if value is None else f"{value * 1e3:.{digits}f}"
+
+
+def format_evaluation(ev: Evaluation) -> str:
+    """The text report: setup, per-step table, Table I and warnings."""
+    opts: EvaluateOptions = ev.options
+    d = opts.design
+    lines = [(f"design: L = {d.length * 1e3:.3f} mm, w_d = {d.w_d * 1e3:.3f} mm, "
+             f"E = {d.E:.4g} Pa; deflection from the {opts.deflection_axis} axis")]
+    for source, reg in zip(ev.sources, ev.registrations, strict=True):
+        how = {"tf_static": "from /tf_static in the bag", "given": "given",
+               "estimated": f"estimated from the markers (axis-fit residual "
+                            f"{reg.residual_m * 1e3:.3f} mm)"}.get(reg.method, reg.method)
+        lines.append(f"registration mocap -> tdcm_base of {source}: {how}")
+    lines.append("")
+    lines.append(f"{'trial':>5} {'tension N':>9} {'frames':>6} {'meas mm':>8} {'pred mm':>8} "
+                 f"{'err mm':>7} {'shape mm':>8}  note")
+    for r in ev.records:
+        measured, predicted = r.measured_deflection_m, r.predicted_deflection_m
+        err = predicted - measured if predicted is not None and measured is not None else None
+        lines.append(f"{r.trial:>5} {r.tension_n:>9.3f} {r.frames:>6} "
+                     f"{_mm(r.measured_deflection_m):>8} {_mm(r.predicted_deflection_m):>8} "
+                     f"{_mm(err):>7} {_mm(r.shape_error_m):>8}  {r.note}")
+    m = ev.metrics
+    lines += ["", (f"Table I over {m.n_trials} trials, {m.n_steps} steps"
+                  f"{f' ({m.n_flagged} flagged steps left out)' if m.n_flagged else ''}:"),
+              (f"  MAPE            {'-' if m.mape_pct is None else f'{m.mape_pct:.2f} %'}"
+              f"  ({m.mape_excluded} steps below {m.mape_threshold_m * 1e3:g} mm left out)"),
+              f"  RMSE            {_mm(m.rmse_m)} mm",
+              f"  MAE             {_mm(m.mae_m)} mm",
+              f"  Shape error     {_mm(m.shape_error_m)} mm",
+              (f"  Deflection mean {_mm(m.deflection_mean_m, 2)} mm "
+              f"(model {_mm(m.predicted_deflection_mean_m, 2)} mm)")]
+    if any(ev.occluded.values()):
+        lines.append("occluded marker positions left out (NaN or exactly 0): " + ", ".join(
+            f"{label} {count}" for label, count in ev.occluded.items()))
+    lines += [f"warning: {w}" for w in ev.warnings]
+    return "\n".join(lines)
+
+
+def _metric(value: float | None, scale: float, unit: str) -> str:
+    return "-" if value is None else f"{value * scale:.3f} {unit}"
+
+
+def format_calibration(cal: Calibration) -> str:
+    """Warnings (not identifiable, not converged) first, then fitted values with intervals,
+    residuals, Table I before/after and the evaluation's warnings."""
+    steps = cal.before.metrics.n_steps + cal.before.metrics.n_flagged
+    lines = [f"warning: {w}" for w in cal.warnings]
+    lines += [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
+             f"residual RMS {cal.residual_rms_m * 1e3:.4f} mm")]
+    level = f"{cal.confidence:.0%}"
+    for p in cal.parameters:
+        lines.append(f"  {p.name} = {p.value:.5g} {p.unit}  ({level} interval "
+                     f"{p.ci_low:.5g} .. {p.ci_high:.5g}; start {p.initial:.5g})")
+    b, a = cal.before.metrics, cal.after.metrics
+    rows = [("MAPE", b.mape_pct, a.mape_pct, 1.0, "%"), ("RMSE", b.rmse_m, a.rmse_m, 1e3, "mm"),
+            ("MAE", b.mae_m, a.mae_m, 1e3, "mm"),
+            ("Shape error", b.shape_error_m, a.shape_error_m, 1e3, "mm"),
+            ("Deflection mean", b.deflection_mean_m, a.deflection_mean_m, 1e3, "mm"),
+            ("  model", b.predicted_deflection_mean_m, a.predicted_deflection_mean_m, 1e3, "mm")]
+    lines += ["", f"{'Table I':<16} {'before':>12} {'after':>12}"]
+    lines += [f"{name:<16} {_metric(x, k, u):>12} {_metric(y, k, u):>12}"
+              for name, x, y, k, u in rows]
+    lines += [f"warning: {w}" for w in cal.after.warnings]
+    return "\n".join(lines)
