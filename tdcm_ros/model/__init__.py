@@ -15,7 +15,6 @@ from tdcm_ros.model.design import (
     preset,
 )
 from tdcm_ros.model.errors import (
-    ConvergenceError,
     InvalidDesignError,
     InvalidSettingsError,
     ModelError,
@@ -32,7 +31,7 @@ from tdcm_ros.model.loading import (
     TensionProfile,
 )
 from tdcm_ros.model.profiles import CircularProfile, CustomProfile, RectangularProfile
-from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
 from tdcm_ros.model.surface import offset_points, surface_points

@@ -1,13 +1,12 @@
-"""Errors of the model subpackage: invalid input, physical limits, non-convergence."""
+"""Errors of the model subpackage: invalid input and physical limits.
+
+Non-convergence (:class:`~tdcm_ros.model.result.ConvergenceError`) lives beside the result it
+carries, so this module imports nothing of the model and sits under every other model module.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from tdcm_ros.errors import InputError, PhysicsError, TdcmError
-
-if TYPE_CHECKING:
-    from tdcm_ros.model.result import SolveResult
 
 
 class ModelError(TdcmError):
@@ -56,13 +55,3 @@ class NotchClosureError(ModelLimitError):
         super().__init__(message)
         self.notch = notch
         self.gap_m = gap_m
-
-
-class ConvergenceError(ModelError, PhysicsError):
-    """Algorithm 1 did not reach the tolerance; ``result`` holds the last finite iterate, if any."""
-
-    kind = "non_convergence"
-
-    def __init__(self, message: str, *, result: SolveResult | None = None) -> None:
-        super().__init__(message)
-        self.result = result

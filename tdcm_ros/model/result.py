@@ -8,7 +8,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.errors import PhysicsError
 from tdcm_ros.model.design import Design
+from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import quaternions_y
 from tdcm_ros.model.settings import SolverSettings
@@ -155,3 +157,13 @@ class SolveResult:
             "settings": self.settings.to_dict(),
             **({} if self.loading is None else {"loading": self.loading.describe()}),
         }
+
+
+class ConvergenceError(ModelError, PhysicsError):
+    """Algorithm 1 did not reach the tolerance; ``result`` holds the last finite iterate, if any."""
+
+    kind = "non_convergence"
+
+    def __init__(self, message: str, *, result: SolveResult | None = None) -> None:
+        super().__init__(message)
+        self.result = result

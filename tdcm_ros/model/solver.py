@@ -35,7 +35,6 @@ from numpy.typing import NDArray
 
 from tdcm_ros.model import loads
 from tdcm_ros.model.design import Design
-from tdcm_ros.model.errors import ConvergenceError
 from tdcm_ros.model.grid import Grid, build_grid
 from tdcm_ros.model.kinematics import PlanarShape, integrate
 from tdcm_ros.model.limits import (
@@ -45,7 +44,7 @@ from tdcm_ros.model.limits import (
     check_tension,
 )
 from tdcm_ros.model.loading import InvalidLoadingError, LoadedModel, Loading
-from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]

@@ -41,10 +41,10 @@ from scipy.optimize import root
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.baselines.common import node_result
 from tdcm_ros.model.design import Design
-from tdcm_ros.model.errors import ConvergenceError, InvalidSettingsError
+from tdcm_ros.model.errors import InvalidSettingsError
 from tdcm_ros.model.grid import Grid, build_grid
 from tdcm_ros.model.limits import check_tendon_singularity, check_tension
-from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.section import notched_moment
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS
