@@ -5,13 +5,58 @@
   served behind a pty;
 - :mod:`.transport` -- serial devices, ptys and pyserial URLs;
 - :mod:`.schedule`, :mod:`.driver` -- the transport-free logic of the ``tension_driver`` node.
+
+Separate entry points, kept out of this face: the scripts :mod:`.twin` (``python -m
+tdcm_ros.device.twin``: ``DeviceTwin``, ``PtyTwin``) and :mod:`.transcript`, and
+:mod:`.constants` (the firmware's constants, used as a namespace).
 """
 
+from tdcm_ros.device.driver import (
+    DriverConfig,
+    DriverStatus,
+    Level,
+    LinkState,
+    TensionDriver,
+    fault_names,
+)
 from tdcm_ros.device.errors import (
     DeviceError,
     FrameError,
     PortError,
     ProtocolVersionError,
 )
+from tdcm_ros.device.plant import PlantConfig
+from tdcm_ros.device.protocol import (
+    Fault,
+    Heartbeat,
+    Mode,
+    SetMode,
+    SetSetpoint,
+    Telemetry,
+    decode,
+    encode,
+)
+from tdcm_ros.device.schedule import StepSchedule
 
-__all__ = ["DeviceError", "FrameError", "PortError", "ProtocolVersionError"]
+__all__ = [
+    "DeviceError",
+    "DriverConfig",
+    "DriverStatus",
+    "Fault",
+    "FrameError",
+    "Heartbeat",
+    "Level",
+    "LinkState",
+    "Mode",
+    "PlantConfig",
+    "PortError",
+    "ProtocolVersionError",
+    "SetMode",
+    "SetSetpoint",
+    "StepSchedule",
+    "Telemetry",
+    "TensionDriver",
+    "decode",
+    "encode",
+    "fault_names",
+]

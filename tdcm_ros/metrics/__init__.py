@@ -1,1 +1,46 @@
-"""ROS-free evaluation of the model against motion capture (Table I metrics, never imports rclpy)."""
+"""ROS-free evaluation of the model against motion capture (Table I metrics, never imports rclpy).
+
+In memory: :class:`EvaluateOptions` (``--set`` syntax: :func:`options_from_sets`), steps and
+series in, an :class:`Evaluation` (Table I, per-step records) out, live with
+:class:`RunningEvaluation`; text with :func:`format_evaluation`, plots with :func:`write_plots`.
+
+Separate entry points, kept out of this face because they pull heavier libraries:
+
+- :mod:`tdcm_ros.metrics.api` -- evaluate and calibrate bags (``evaluate_paths``,
+  ``calibrate_paths``; reads MCAP);
+- :mod:`tdcm_ros.metrics.calibration` -- least-squares calibration (scipy.optimize, scipy.stats);
+- :mod:`tdcm_ros.metrics.synthetic`, :mod:`tdcm_ros.metrics.synthetic_bag` -- simulated
+  recordings and bags for tests, benchmarks and demos.
+"""
+
+from tdcm_ros.metrics.errors import MarkersNotVisibleError, MetricsError, NoStepsError
+from tdcm_ros.metrics.evaluation import Evaluation, StepRecord, evaluate_series
+from tdcm_ros.metrics.geometry import DEFLECTION_AXES, MarkerLayout
+from tdcm_ros.metrics.options import EvaluateOptions, options_from_sets
+from tdcm_ros.metrics.plots import write_plots
+from tdcm_ros.metrics.report import format_calibration, format_evaluation
+from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.steps import StepSettings
+from tdcm_ros.metrics.streaming import RunningEvaluation
+from tdcm_ros.metrics.table import TableMetrics
+
+__all__ = [
+    "DEFLECTION_AXES",
+    "EvaluateOptions",
+    "Evaluation",
+    "MarkerLayout",
+    "MarkerSeries",
+    "MarkersNotVisibleError",
+    "MetricsError",
+    "NoStepsError",
+    "RunningEvaluation",
+    "StepRecord",
+    "StepSettings",
+    "TableMetrics",
+    "TensionSeries",
+    "evaluate_series",
+    "format_calibration",
+    "format_evaluation",
+    "options_from_sets",
+    "write_plots",
+]

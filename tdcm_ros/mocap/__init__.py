@@ -8,6 +8,7 @@ from tdcm_ros.mocap.errors import CsvFormatError, LabelError, MocapError
 from tdcm_ros.mocap.labelling import (
     ArcLengthLabeller,
     LabelledFrame,
+    Labeller,
     NameLabeller,
     NameMap,
     project_on_polyline,
@@ -29,6 +30,7 @@ __all__ = [
     "CsvReplay",
     "LabelError",
     "LabelledFrame",
+    "Labeller",
     "MocapError",
     "NameLabeller",
     "NameMap",

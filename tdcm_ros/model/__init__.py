@@ -5,6 +5,10 @@ Typical use::
     from tdcm_ros.model import preset, solve
     result = solve(preset("paper-experiment"), 20.0)
     result.tip_position  # m, frame tdcm_base
+
+Separate entry points, kept out of this face because they pull scipy:
+:mod:`tdcm_ros.model.baselines` (the other models, by name) and :mod:`tdcm_ros.model.accuracy`
+(the accuracy/speed benchmark behind ``tdcm bench``).
 """
 
 from tdcm_ros.model.design import (
@@ -13,6 +17,13 @@ from tdcm_ros.model.design import (
     Design,
     parse_field,
     preset,
+)
+from tdcm_ros.model.design_space import (
+    DEFAULT_ALLOWABLE_STRAIN,
+    STATUSES,
+    DesignSpace,
+    design_curves,
+    sweep,
 )
 from tdcm_ros.model.errors import (
     InvalidDesignError,
@@ -23,6 +34,7 @@ from tdcm_ros.model.errors import (
     TendonSingularityError,
     TensionRangeError,
 )
+from tdcm_ros.model.limits import check_tension
 from tdcm_ros.model.loading import (
     Capstan,
     InvalidLoadingError,
@@ -30,22 +42,31 @@ from tdcm_ros.model.loading import (
     NotchContact,
     TensionProfile,
 )
-from tdcm_ros.model.profiles import CircularProfile, CustomProfile, RectangularProfile
+from tdcm_ros.model.profiles import (
+    PROFILE_NAMES,
+    CircularProfile,
+    CustomProfile,
+    RectangularProfile,
+)
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
 from tdcm_ros.model.surface import offset_points, surface_points
 
 __all__ = [
+    "DEFAULT_ALLOWABLE_STRAIN",
     "DEFAULT_SETTINGS",
     "FIELD_SPECS",
     "PRESETS",
+    "PROFILE_NAMES",
     "SOLVER_SPECS",
+    "STATUSES",
     "Capstan",
     "CircularProfile",
     "ConvergenceError",
     "CustomProfile",
     "Design",
+    "DesignSpace",
     "InvalidDesignError",
     "InvalidLoadingError",
     "InvalidSettingsError",
@@ -60,9 +81,12 @@ __all__ = [
     "TendonSingularityError",
     "TensionProfile",
     "TensionRangeError",
+    "check_tension",
+    "design_curves",
     "offset_points",
     "parse_field",
     "preset",
     "solve",
     "surface_points",
+    "sweep",
 ]

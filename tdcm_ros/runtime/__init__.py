@@ -1,11 +1,20 @@
 """Runtimes for transport-agnostic nodes: the port, the zenoh runtime, the rclpy adapter.
 
-Importing this package imports neither zenoh nor rclpy; each runtime module does on use.
-Run a node with :func:`tdcm_ros.runtime.run_node.run_node`.
+Importing this package imports neither zenoh nor rclpy. Run a graph of nodes with :func:`launch`.
+
+Separate entry points, kept out of this face: :mod:`tdcm_ros.runtime.run_node` (a script,
+``python -m tdcm_ros.runtime.run_node``: ``main_for``, ``open_context``, ``RUNTIMES``),
+:mod:`tdcm_ros.runtime.wire` (the rmw_zenoh wire format, used as a namespace), and, because they
+import their transport, :mod:`tdcm_ros.runtime.zenoh_runtime`, :mod:`tdcm_ros.runtime.zenoh_config`,
+:mod:`tdcm_ros.runtime.router` (zenoh; also a script) and :mod:`tdcm_ros.runtime.rclpy_runtime`
+(rclpy).
 """
 
 from tdcm_ros.runtime.errors import RuntimePortError
-from tdcm_ros.runtime.parameters import ParamSpec, SetResult
+from tdcm_ros.runtime.graph import NodeGraph
+from tdcm_ros.runtime.launcher import launch
+from tdcm_ros.runtime.names import resolve_topic
+from tdcm_ros.runtime.parameters import ParamSpec, SetResult, one_of
 from tdcm_ros.runtime.port import (
     DEFAULT_QOS,
     NodeLogic,
@@ -14,9 +23,13 @@ from tdcm_ros.runtime.port import (
     QoS,
     Timer,
 )
+from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES
 
 __all__ = [
+    "DEFAULT_NODE_SET",
     "DEFAULT_QOS",
+    "NODES",
+    "NodeGraph",
     "NodeLogic",
     "NodePort",
     "ParamSpec",
@@ -25,4 +38,7 @@ __all__ = [
     "RuntimePortError",
     "SetResult",
     "Timer",
+    "launch",
+    "one_of",
+    "resolve_topic",
 ]

@@ -17,11 +17,15 @@ actuation stage. ``scene.design`` is the estimator's design, ``scene.true_design
 from tdcm_ros.scenes.compiled import CompiledScene
 from tdcm_ros.scenes.effects import CONSTRUCTED, REGISTRY, STAGES
 from tdcm_ros.scenes.errors import EffectConflictError, InvalidSceneError, SceneError
+from tdcm_ros.scenes.explain import explain, format_table
 from tdcm_ros.scenes.load import SCENE_NAMES, load_scene, scene_from_text
+from tdcm_ros.scenes.params import param_table
 from tdcm_ros.scenes.parts import LoadingPart, PlantPart
+from tdcm_ros.scenes.paths import shipped_scenes
 from tdcm_ros.scenes.scene import Scene
 from tdcm_ros.scenes.world import MarkerFrame, World
 
 __all__ = ["CONSTRUCTED", "REGISTRY", "SCENE_NAMES", "STAGES", "CompiledScene",
            "EffectConflictError", "InvalidSceneError", "LoadingPart", "MarkerFrame", "PlantPart",
-           "Scene", "SceneError", "World", "load_scene", "scene_from_text"]
+           "Scene", "SceneError", "World", "explain", "format_table", "load_scene", "param_table",
+           "scene_from_text", "shipped_scenes"]
