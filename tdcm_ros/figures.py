@@ -22,12 +22,13 @@ from typing import Any
 import numpy as np
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.model import preset, solve
-from tdcm_ros.model.design_space import (
+from tdcm_ros.model import (
     DEFAULT_ALLOWABLE_STRAIN,
     STATUSES,
     DesignSpace,
     design_curves,
+    preset,
+    solve,
     sweep,
 )
 

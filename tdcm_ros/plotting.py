@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model import SolveResult
 
 
 def plot_solution(result: SolveResult, path: str | Path) -> Path:

@@ -32,10 +32,9 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Calibrate; known errors become one line and a non-zero exit status."""
+    from tdcm_ros.metrics import format_calibration, options_from_sets
     from tdcm_ros.metrics.api import Topics, calibrate_paths
     from tdcm_ros.metrics.calibration import parse_fit
-    from tdcm_ros.metrics.options import options_from_sets
-    from tdcm_ros.metrics.report import format_calibration
 
     try:
         names = parse_fit(args.fit)

@@ -67,9 +67,7 @@ def _check_new(bag: Path, option: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the demo; returns the exit status."""
-    from tdcm_ros.demo.plan import RECORDED_TOPICS, make_plan
-    from tdcm_ros.demo.report import report
-    from tdcm_ros.demo.run import record_live
+    from tdcm_ros.demo import RECORDED_TOPICS, make_plan, record_live, report
     from tdcm_ros.runtime.run_node import configure_logging, resolve_runtime
     from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV
     from tdcm_ros.scenes import load_scene

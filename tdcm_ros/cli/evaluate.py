@@ -53,9 +53,8 @@ def fail(command: str, error: TdcmError, as_json: bool) -> int:
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate; known errors become one line and a non-zero exit status."""
+    from tdcm_ros.metrics import format_evaluation, options_from_sets
     from tdcm_ros.metrics.api import Topics, evaluate_paths
-    from tdcm_ros.metrics.options import options_from_sets
-    from tdcm_ros.metrics.report import format_evaluation
 
     try:
         options = options_from_sets(args.set)
@@ -63,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
                             topics=Topics(args.tension_topic, args.markers_topic))
         plots = []
         if args.plots:
-            from tdcm_ros.metrics.plots import write_plots
+            from tdcm_ros.metrics import write_plots
 
             plots = write_plots(ev, args.plots)
     except TdcmError as error:

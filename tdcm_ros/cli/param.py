@@ -91,7 +91,7 @@ def run_specs(args: argparse.Namespace) -> int:
     """Print the node's parameters as a Markdown table, from the specs it declares them with."""
     import importlib
 
-    from tdcm_ros.runtime.registry import node_target
+    from tdcm_ros.runtime import node_target
     from tdcm_ros.spec import spec_table
 
     module = importlib.import_module(node_target(args.node).partition(":")[0])

@@ -40,8 +40,7 @@ def register(subparsers: Any) -> None:
 
 def run_list(args: argparse.Namespace) -> int:
     """Print the shipped scenes with their effects and description."""
-    from tdcm_ros.scenes import load_scene
-    from tdcm_ros.scenes.paths import shipped_scenes
+    from tdcm_ros.scenes import load_scene, shipped_scenes
 
     scenes = [load_scene(name) for name in shipped_scenes()]
     if args.json:
@@ -67,8 +66,7 @@ def run_validate(args: argparse.Namespace) -> int:
 
 def run_explain(args: argparse.Namespace) -> int:
     """Measure and print the table (or JSON)."""
-    from tdcm_ros.scenes import load_scene
-    from tdcm_ros.scenes.explain import explain, format_table
+    from tdcm_ros.scenes import explain, format_table, load_scene
 
     for name, value, low in (("--samples", args.samples, 1), ("--repeats", args.repeats, 1)):
         if not low <= value <= 100000:
@@ -80,8 +78,7 @@ def run_explain(args: argparse.Namespace) -> int:
 
 def run_effects(args: argparse.Namespace) -> int:
     """Print the effect registry: name, stage, summary and parameters."""
-    from tdcm_ros.scenes import REGISTRY
-    from tdcm_ros.scenes.params import param_table
+    from tdcm_ros.scenes import REGISTRY, param_table
 
     data: dict[str, dict[str, Any]] = {
         name: {"stage": cls.stage, "summary": cls.summary, "cost_unit": cls.cost_unit,

@@ -10,6 +10,7 @@ from typing import Any
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.model import (
     PRESETS,
+    PROFILE_NAMES,
     SOLVER_SPECS,
     SolverSettings,
     TensionRangeError,
@@ -17,7 +18,6 @@ from tdcm_ros.model import (
     preset,
     solve,
 )
-from tdcm_ros.model.profiles import PROFILE_NAMES
 
 
 def register(subparsers: Any) -> None:

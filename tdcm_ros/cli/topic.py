@@ -68,8 +68,7 @@ def graph_topics(timeout: float) -> dict[str, set[str]]:
     """
     import zenoh
 
-    from tdcm_ros.runtime import wire
-    from tdcm_ros.runtime.errors import RuntimePortError
+    from tdcm_ros.runtime import RuntimePortError, wire
 
     context = _context()
     alive: set[str] = set()

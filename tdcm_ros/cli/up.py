@@ -22,7 +22,7 @@ import tempfile
 from typing import Any
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES
+from tdcm_ros.runtime import DEFAULT_NODE_SET, NODES
 
 TWIN_NODES = ("device_twin", "tension_driver")
 
@@ -109,7 +109,7 @@ def export_zenoh_configs(args: argparse.Namespace, router_endpoint: str) -> None
 
 def run(args: argparse.Namespace) -> int:
     """Launch and wait; returns the exit status."""
-    from tdcm_ros.runtime.launcher import launch
+    from tdcm_ros.runtime import launch
     from tdcm_ros.runtime.run_node import configure_logging
 
     configure_logging()

@@ -8,9 +8,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.device import StepSchedule
 from tdcm_ros.errors import InputError
-from tdcm_ros.model.design import FIELD_SPECS
+from tdcm_ros.model import FIELD_SPECS
 from tdcm_ros.scenes import Scene
 
 #: Nodes in start order: consumers first, so nothing published at the start is missed; the

@@ -5,8 +5,7 @@ from __future__ import annotations
 import json
 
 from tdcm_ros.demo.plan import DemoPlan
-from tdcm_ros.metrics.geometry import MarkerLayout
-from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics import EvaluateOptions, MarkerLayout
 
 
 def scene_options(plan: DemoPlan) -> EvaluateOptions:
@@ -19,9 +18,8 @@ def scene_options(plan: DemoPlan) -> EvaluateOptions:
 
 def report(plan: DemoPlan, *, calibrate: bool) -> None:
     """Print Table I and the per-step table, write ``plots/`` and ``metrics.json``; calibrate."""
+    from tdcm_ros.metrics import format_calibration, format_evaluation, write_plots
     from tdcm_ros.metrics.api import evaluate_paths
-    from tdcm_ros.metrics.plots import write_plots
-    from tdcm_ros.metrics.report import format_calibration, format_evaluation
 
     options = scene_options(plan)
     fit = None

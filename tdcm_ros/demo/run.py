@@ -22,13 +22,10 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from tdcm_ros.bagio import from_dict
-from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio import BagError, from_dict
 from tdcm_ros.demo.plan import EVALUATED_TOPICS, NODE_ORDER, DemoPlan
 from tdcm_ros.errors import TdcmError
-from tdcm_ros.runtime.errors import RuntimePortError
-from tdcm_ros.runtime.graph import NodeGraph
-from tdcm_ros.runtime.names import resolve_topic
+from tdcm_ros.runtime import NodeGraph, RuntimePortError, resolve_topic
 
 log = logging.getLogger("tdcm.demo")
 #: Extra time (s) over the schedule before the demo gives up waiting for ``schedule_done``.
@@ -75,7 +72,7 @@ class Progress:
 
 def _watch(port: Any, progress: Progress) -> None:
     """Subscribe the topics the progress line shows."""
-    from tdcm_ros.runtime.port import QoS
+    from tdcm_ros.runtime import QoS
 
     def on_tension(message: Any) -> None:
         progress.tension = float(message.wrench.force.z)

@@ -12,6 +12,7 @@ tdcm_ros.device.twin``: ``DeviceTwin``, ``PtyTwin``) and :mod:`.transcript`, and
 """
 
 from tdcm_ros.device.driver import (
+    DRIVER_SPECS,
     DriverConfig,
     DriverStatus,
     Level,
@@ -25,7 +26,7 @@ from tdcm_ros.device.errors import (
     PortError,
     ProtocolVersionError,
 )
-from tdcm_ros.device.plant import PlantConfig
+from tdcm_ros.device.plant import PLANT_SPECS, PlantConfig
 from tdcm_ros.device.protocol import (
     Fault,
     Heartbeat,
@@ -36,9 +37,12 @@ from tdcm_ros.device.protocol import (
     decode,
     encode,
 )
-from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.device.schedule import SCHEDULE_SPECS, StepSchedule
 
 __all__ = [
+    "DRIVER_SPECS",
+    "PLANT_SPECS",
+    "SCHEDULE_SPECS",
     "DeviceError",
     "DriverConfig",
     "DriverStatus",

@@ -27,7 +27,7 @@ from tdcm_ros.metrics.evaluation import (
 )
 from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.mocap.registration import Registration
+from tdcm_ros.mocap import Registration
 
 
 @dataclass(frozen=True)

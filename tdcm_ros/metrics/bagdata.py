@@ -31,13 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio import BagError
 from tdcm_ros.bagio.reader import BagReader, open_bag, require_topic
 from tdcm_ros.metrics.cdr import markers_frame, wrench_force_z
 from tdcm_ros.metrics.errors import MetricsError
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
-from tdcm_ros.mocap.occlusion import visible
-from tdcm_ros.mocap.registration import Registration
+from tdcm_ros.mocap import Registration, visible
 
 TENSION_TYPE = "geometry_msgs/msg/WrenchStamped"
 MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"

@@ -29,7 +29,7 @@ from tdcm_ros.errors import InputError, TdcmError, out_of_range
 from tdcm_ros.metrics.evaluation import Evaluation, model_tension
 from tdcm_ros.metrics.measure import MeasuredStep
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.mocap.registration import Registration
+from tdcm_ros.mocap import Registration
 from tdcm_ros.model import FIELD_SPECS, Design, SolveResult, solve, surface_points
 
 Array = NDArray[np.float64]

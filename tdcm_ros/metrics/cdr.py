@@ -14,8 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import deserialize
-from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio import BagError, deserialize
 
 _TYPE = "geometry_msgs/msg/WrenchStamped"
 _LITTLE = (b"\x00\x01", b"\x00\x03")  # CDR_LE, PL_CDR_LE

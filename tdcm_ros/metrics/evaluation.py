@@ -22,7 +22,7 @@ from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.table import TableMetrics, table_metrics
-from tdcm_ros.mocap.registration import (
+from tdcm_ros.mocap import (
     Registration,
     RegistrationError,
     estimate_registration,

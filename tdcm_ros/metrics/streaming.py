@@ -29,7 +29,7 @@ from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.steps import assign_trials, detect_steps
 from tdcm_ros.metrics.table import TableMetrics
-from tdcm_ros.mocap.registration import Registration
+from tdcm_ros.mocap import Registration
 
 Array = NDArray[np.float64]
 

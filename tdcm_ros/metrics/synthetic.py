@@ -17,7 +17,7 @@ from tdcm_ros.errors import out_of_range
 from tdcm_ros.metrics.geometry import MarkerLayout
 from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
-from tdcm_ros.mocap.registration import Registration
+from tdcm_ros.mocap import Registration
 from tdcm_ros.model import Design, SolverSettings
 
 Array = NDArray[np.float64]

@@ -21,14 +21,12 @@ from collections.abc import Callable
 from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.device.driver import fault_names
-from tdcm_ros.device.plant import PLANT_SPECS, PlantConfig
+from tdcm_ros.device import PLANT_SPECS, PlantConfig, fault_names
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs, grouped
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, grouped
 from tdcm_ros.spec import Spec, by_name
 
 #: Parameters of the node besides the plant group (all fixed at start).

@@ -36,18 +36,21 @@ import numpy as np
 
 from tdcm_ros.bagio import from_dict, msg_class
 from tdcm_ros.errors import InputError
-from tdcm_ros.metrics.evaluation import Evaluation
-from tdcm_ros.metrics.geometry import MARKER_SPECS, MarkerLayout
-from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions
-from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
-from tdcm_ros.metrics.streaming import RunningEvaluation
-from tdcm_ros.mocap.registration import Registration
-from tdcm_ros.model import FIELD_SPECS, preset
-from tdcm_ros.model.design import PRESETS
+from tdcm_ros.metrics import (
+    MARKER_SPECS,
+    OPTION_SPECS,
+    STEP_SPECS,
+    EvaluateOptions,
+    Evaluation,
+    MarkerLayout,
+    RunningEvaluation,
+    StepSettings,
+)
+from tdcm_ros.mocap import Registration
+from tdcm_ros.model import FIELD_SPECS, PRESETS, preset
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs, grouped
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, grouped
 from tdcm_ros.spec import Spec, by_name
 
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")

@@ -35,22 +35,27 @@ from tdcm_ros.mocap import (
     ArcLengthLabeller,
     CsvReplay,
     LabelledFrame,
+    Labeller,
     NameLabeller,
     NameMap,
     RawFrame,
+    Registration,
     SimSource,
     estimate_from_recordings,
     given_registration,
     read_nexus_csv,
     straight_axis,
 )
-from tdcm_ros.mocap.labelling import Labeller
-from tdcm_ros.mocap.registration import Registration
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime.names import resolve_topic
-from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime import (
+    NodeLogic,
+    NodePort,
+    QoS,
+    declare_specs,
+    grouped,
+    resolve_topic,
+)
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, grouped
 from tdcm_ros.spec import Spec, by_name
 
 SOURCES = ("csv", "relabel", "sim")

@@ -27,20 +27,27 @@ import numpy as np
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError, PhysicsError
-from tdcm_ros.metrics.geometry import MARKER_SPECS
+from tdcm_ros.metrics import MARKER_SPECS
 from tdcm_ros.model import (
     FIELD_SPECS,
+    PRESETS,
     SOLVER_SPECS,
+    Design,
     SolveResult,
     SolverSettings,
     preset,
     solve,
 )
-from tdcm_ros.model.design import PRESETS, Design
 from tdcm_ros.nodes.shape_messages import header, midline_messages
-from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime import (
+    NodeLogic,
+    NodePort,
+    QoS,
+    declare_specs,
+    grouped,
+    read_specs,
+)
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 from tdcm_ros.spec import Spec, by_name
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")

@@ -10,9 +10,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs
 from tdcm_ros.spec import Spec, by_name
 
 #: Every parameter of the node.

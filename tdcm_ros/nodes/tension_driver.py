@@ -36,23 +36,30 @@ from dataclasses import replace
 from typing import Any
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.device.driver import (
+from tdcm_ros.device import (
     DRIVER_SPECS,
+    SCHEDULE_SPECS,
     DriverConfig,
     DriverStatus,
     Level,
     LinkState,
+    ProtocolVersionError,
+    StepSchedule,
+    Telemetry,
     TensionDriver,
     fault_names,
 )
-from tdcm_ros.device.errors import ProtocolVersionError
-from tdcm_ros.device.protocol import Telemetry
-from tdcm_ros.device.schedule import SCHEDULE_SPECS, StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime.port import NodeLogic, NodePort, QoS
+from tdcm_ros.runtime import (
+    NodeLogic,
+    NodePort,
+    QoS,
+    declare_specs,
+    grouped,
+    read_specs,
+)
 from tdcm_ros.runtime.run_node import main_for
-from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 from tdcm_ros.spec import Spec, by_name
 
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")

@@ -19,8 +19,7 @@ from typing import Any, Protocol
 
 from tdcm_ros.bagio.writer import OfferedQos
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime import wire
-from tdcm_ros.runtime.errors import RuntimePortError
+from tdcm_ros.runtime import RuntimePortError, wire
 
 #: Period (s) of the rclpy graph poll.
 POLL_PERIOD_S = 0.1

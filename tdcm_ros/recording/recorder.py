@@ -25,13 +25,10 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 
-from tdcm_ros.bagio.errors import BagError
-from tdcm_ros.bagio.typestore import normalize_type_name
+from tdcm_ros.bagio import BagError, normalize_type_name
 from tdcm_ros.bagio.writer import BagWriter, OfferedQos
 from tdcm_ros.recording.discovery import DISCOVERIES, check_runtime
-from tdcm_ros.runtime.errors import RuntimePortError
-from tdcm_ros.runtime.names import resolve_topic
-from tdcm_ros.runtime.port import QoS
+from tdcm_ros.runtime import QoS, RuntimePortError, resolve_topic
 from tdcm_ros.runtime.wire import RawSample
 
 NODE_NAME = "_tdcm_record"

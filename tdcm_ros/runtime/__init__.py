@@ -14,7 +14,7 @@ from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.graph import NodeGraph
 from tdcm_ros.runtime.launcher import launch
 from tdcm_ros.runtime.names import resolve_topic
-from tdcm_ros.runtime.parameters import ParamSpec, SetResult, one_of
+from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
 from tdcm_ros.runtime.port import (
     DEFAULT_QOS,
     NodeLogic,
@@ -23,7 +23,8 @@ from tdcm_ros.runtime.port import (
     QoS,
     Timer,
 )
-from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES
+from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
+from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 
 __all__ = [
     "DEFAULT_NODE_SET",
@@ -33,12 +34,16 @@ __all__ = [
     "NodeLogic",
     "NodePort",
     "ParamSpec",
+    "ParamValue",
     "Publisher",
     "QoS",
     "RuntimePortError",
     "SetResult",
     "Timer",
+    "declare_specs",
+    "grouped",
     "launch",
-    "one_of",
+    "node_target",
+    "read_specs",
     "resolve_topic",
 ]

@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from tdcm_ros.device.protocol import Heartbeat, Mode, SetMode, SetSetpoint, encode
+from tdcm_ros.device import Heartbeat, Mode, SetMode, SetSetpoint, encode
 from tdcm_ros.device.twin import DeviceTwin
 from tdcm_ros.scenes.effects import REGISTRY, STAGES
 from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS

@@ -13,7 +13,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, fields, replace
 from typing import Any, ClassVar, TypeVar
 
-from tdcm_ros.device.plant import PlantConfig
+from tdcm_ros.device import PlantConfig
 from tdcm_ros.model import Loading, NotchContact, TensionProfile
 from tdcm_ros.scenes.errors import EffectConflictError
 

@@ -17,8 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from tdcm_ros.device.plant import PlantConfig
-from tdcm_ros.device.schedule import StepSchedule
+from tdcm_ros.device import PlantConfig, StepSchedule
 from tdcm_ros.errors import reject_unknown
 from tdcm_ros.model import FIELD_SPECS, Design, parse_field, preset
 from tdcm_ros.scenes.compiled import WORLD_STAGES, Bench, CompiledScene, compile_scene

@@ -20,9 +20,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model import SolveResult, solve, surface_points
-from tdcm_ros.model.limits import check_tension
-from tdcm_ros.model.loading import Loading
+from tdcm_ros.model import Loading, SolveResult, check_tension, solve, surface_points
 from tdcm_ros.scenes.compiled import CompiledScene
 from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS
 from tdcm_ros.scenes.errors import InvalidSceneError

@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from tdcm_ros.model.loading import NotchContact as NotchContactLaw
+from tdcm_ros.model import NotchContact as NotchContactLaw
 from tdcm_ros.scenes.effects.base import Effect, EffectContext, register
 from tdcm_ros.scenes.effects.friction import FrictionState, StickSlipTension
 from tdcm_ros.scenes.errors import InvalidSceneError
