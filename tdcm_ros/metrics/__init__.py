@@ -15,7 +15,7 @@ Separate entry points, kept out of this face because they pull heavier libraries
 
 from tdcm_ros.metrics.errors import MarkersNotVisibleError, MetricsError, NoStepsError
 from tdcm_ros.metrics.evaluation import Evaluation, StepRecord, evaluate_series
-from tdcm_ros.metrics.geometry import DEFLECTION_AXES, MARKER_SPECS, MarkerLayout
+from tdcm_ros.metrics.geometry import DEFLECTION_AXES
 from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions, options_from_sets
 from tdcm_ros.metrics.plots import write_plots
 from tdcm_ros.metrics.report import format_calibration, format_evaluation
@@ -23,6 +23,7 @@ from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.table import TableMetrics
+from tdcm_ros.model import MARKER_SPECS, MarkerLayout
 
 __all__ = [
     "DEFLECTION_AXES",

@@ -10,8 +10,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.metrics.geometry import MarkerLayout
-from tdcm_ros.model import Design, SolveResult, SolverSettings, solve, surface_points
+from tdcm_ros.model import (
+    Design,
+    MarkerLayout,
+    SolveResult,
+    SolverSettings,
+    solve,
+    surface_points,
+)
 
 Array = NDArray[np.float64]
 

@@ -18,13 +18,15 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.metrics.geometry import DEFLECTION_AXES, MARKER_SPECS, MarkerLayout
+from tdcm_ros.metrics.geometry import DEFLECTION_AXES
 from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
 from tdcm_ros.model import (
     FIELD_SPECS,
+    MARKER_SPECS,
     SOLVER_SPECS,
     Design,
     InvalidSettingsError,
+    MarkerLayout,
     SolverSettings,
     parse_field,
     preset,

@@ -14,11 +14,10 @@ from numpy.typing import NDArray
 from scipy.signal import lfilter
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.metrics.geometry import MarkerLayout
 from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.mocap import Registration
-from tdcm_ros.model import Design, SolverSettings
+from tdcm_ros.model import Design, MarkerLayout, SolverSettings
 
 Array = NDArray[np.float64]
 PAPER_LEVELS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)

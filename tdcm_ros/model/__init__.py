@@ -42,6 +42,7 @@ from tdcm_ros.model.loading import (
     NotchContact,
     TensionProfile,
 )
+from tdcm_ros.model.markers import MARKER_SPECS, MarkerLayout
 from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
     CircularProfile,
@@ -57,6 +58,7 @@ __all__ = [
     "DEFAULT_ALLOWABLE_STRAIN",
     "DEFAULT_SETTINGS",
     "FIELD_SPECS",
+    "MARKER_SPECS",
     "PRESETS",
     "PROFILE_NAMES",
     "SOLVER_SPECS",
@@ -71,6 +73,7 @@ __all__ = [
     "InvalidLoadingError",
     "InvalidSettingsError",
     "Loading",
+    "MarkerLayout",
     "ModelError",
     "ModelLimitError",
     "NotchClosureError",
