@@ -27,6 +27,7 @@ KINDS = ("float", "int", "bool", "str", "names", "vector", "list")
 _SEQUENCES = ("names", "vector", "list")
 _TRUE, _FALSE = ("true", "yes", "on", "1"), ("false", "no", "off", "0")
 _METADATA_KEY = "tdcm_spec"
+_SAME: Any = object()  # renamed(): keep the default
 
 
 @dataclasses.dataclass(frozen=True)
@@ -66,6 +67,26 @@ class Spec:
         if self.numeric and math.isfinite(self.low) and math.isfinite(self.high):
             return (self.low, self.high)
         return None
+
+    def renamed(self, name: str, *, default: Any = _SAME) -> Spec:
+        """This parameter under another name (e.g. a scene file's key ``hold_s`` for the field
+        ``hold``), optionally with another default; unit, meaning and range stay the same."""
+        return dataclasses.replace(self, name=name,
+                                   default=self.default if default is _SAME else default)
+
+    def narrowed(self, *, low: float | None = None, high: float | None = None) -> Spec:
+        """This parameter with a tighter range (a closed bound; the other bound is kept). Raises
+        :class:`ValueError` if a bound would widen the range, so a narrowed value is always one
+        the source allows."""
+        if (low is not None and (low < self.low or (low == self.low and self.low_open))) or \
+                (high is not None and (high > self.high or (high == self.high and self.high_open))):
+            raise ValueError(f"spec {self.name!r}: [{low}, {high}] widens {self._span()}")
+        changes: dict[str, Any] = {}
+        if low is not None:
+            changes.update(low=low, low_open=False)
+        if high is not None:
+            changes.update(high=high, high_open=False)
+        return dataclasses.replace(self, **changes)
 
     def _span(self) -> str:
         low, high = math.isfinite(self.low), math.isfinite(self.high)

@@ -244,3 +244,33 @@ def test_every_settings_field_is_declared_with_a_spec(cls: type) -> None:
                          if spec.default is not None}
     for name, default in instance_defaults.items():
         specs_of(cls)[name].check(default)  # every default is allowed by its own spec
+
+
+@given(ranges(), st.floats(0.0, 1.0), st.floats(0.0, 1.0))
+def test_a_narrowed_spec_allows_only_values_its_source_allows(spec: Spec, a: float, b: float
+                                                             ) -> None:
+    span = spec.high - spec.low
+    low, high = sorted((spec.low + (0.01 + 0.49 * a) * span, spec.low + (0.5 + 0.49 * b) * span))
+    narrow = spec.narrowed(low=low, high=high)
+    assert (narrow.low, narrow.high, narrow.unit, narrow.name) == (low, high, "m", "x")
+    for value in np.linspace(spec.low, spec.high, 41):
+        if inside(narrow, float(value)):
+            assert inside(spec, float(value))
+
+
+@pytest.mark.parametrize("bounds", [{"low": -1.0}, {"high": 11.0}, {"low": 0.0}])
+def test_narrowing_may_not_widen_a_range(bounds: dict[str, float]) -> None:
+    source = Spec("lag", "s", low=0.0, low_open=True, high=10.0)
+    with pytest.raises(ValueError, match="'lag'.*widens"):
+        source.narrowed(**bounds)
+    assert source.narrowed(high=10.0) == source  # the same closed bound is no widening
+
+
+def test_a_renamed_spec_keeps_unit_meaning_and_range() -> None:
+    source = Spec("hold", "s", "hold time", 5.0, low=0.01, high=86_400.0)
+    renamed = source.renamed("hold_s")
+    assert renamed.name == "hold_s" and renamed.default == 5.0
+    assert source.renamed("hold_s", default=None).default is None
+    assert renamed.renamed("hold", default=5.0) == source
+    with pytest.raises(InputError, match=r"hold_s = 0.0 is out of range; allowed: \[0.01, 86400\] s"):
+        renamed.check(0.0)
