@@ -37,7 +37,8 @@ class PlantConfig:
                              description="actuator speed limit")
     stiffness: float = spec_field(2000.0, unit="N/m", low=0.0, low_open=True,
                                   description="tendon stiffness past the slack")
-    slack: float = spec_field(0.002, unit="m", low=0.0, description="travel before the tendon loads")
+    slack: float = spec_field(0.002, unit="m", low=0.0, description=(
+        "actuator travel before the tendon carries load"))
     counts_per_newton: float = spec_field(1000.0, unit="counts/N", low=0.0, low_open=True,
                                           description="load-cell gain")
     tare_counts: int = spec_field(8000, unit="counts", description="load-cell reading at 0 N")
@@ -47,7 +48,8 @@ class PlantConfig:
     sample_period: float = spec_field(0.0125, unit="s", low=0.0, low_open=True,
                                       description="load-cell sample period")
     seed: int = spec_field(0, description="seed of the noise generator")
-    deadband: float = spec_field(0.0, unit="m", low=0.0, description="actuator dead zone")
+    deadband: float = spec_field(0.0, unit="m", low=0.0, description=(
+        "dead zone: the actuator stops this short of its command"))
     bias: float = spec_field(0.0, unit="N", description="load-cell offset")
     drift: float = spec_field(0.0, unit="N/s", description="load-cell linear drift")
 

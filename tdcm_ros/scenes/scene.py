@@ -198,5 +198,5 @@ def _check_markers(markers: Mapping[str, Any], design: Design) -> None:
     if max(arcs) > design.length:
         raise InvalidSceneError(
             f"markers.arc_lengths_m = {list(arcs)!r} is invalid; allowed: within "
-            f"[0, {design.length:g}] m (the body length)", parameter="markers.arc_lengths_m",
-            value=list(arcs), allowed=f"[0, {design.length:g}] m")
+            f"(0, {design.length:g}] m (the body length)", parameter="markers.arc_lengths_m",
+            value=list(arcs), allowed=f"(0, {design.length:g}] m")

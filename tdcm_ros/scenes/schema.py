@@ -2,14 +2,20 @@
 
 A scene file is a YAML mapping with the keys of :data:`TOP_KEYS`; each section's parameters
 are :class:`~tdcm_ros.scenes.params.Param` tuples below, effects are checked against their
-own. :func:`schema_rows` lists everything for documentation.
+own. A key that sets a field of a package dataclass is derived from that field's spec (unit,
+meaning, range and default declared once there): renamed to the scene key (``hold_s``,
+``arc_lengths_m``), its default replaced or its range narrowed where a scene differs, as said
+beside it. :func:`schema_rows` lists everything for documentation.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
+
+from tdcm_ros.device import SCHEDULE_SPECS
+from tdcm_ros.model import FIELD_SPECS, MARKER_SPECS
 from tdcm_ros.scenes.params import Param
 
-PAPER_LEVELS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)
 NYLON12_DENSITY = 1010.0  # kg/m^3, Formlabs Nylon 12 powder, printed part
 
 TOP_KEYS: dict[str, str] = {
@@ -30,17 +36,19 @@ DESIGN = (
 )  # plus ``overrides``: Design fields in SI units, checked by Design.with_overrides
 
 MATERIAL = (
-    Param("E", "Pa", "true Young's modulus of the world (default: the design's E)", None,
-          low=0.0, low_open=True, high=1e12),
+    FIELD_SPECS["E"].renamed("E", default=None),  # the world's true E; None: the design's
     Param("density", "kg/m^3", "density of the body (for gravity)", NYLON12_DENSITY, low=0.0,
           low_open=True, high=1e5),
 )
 
 SCHEDULE = (
-    Param("levels", "N", "tension setpoints of one trial, in order", PAPER_LEVELS, kind="list",
-          low=0.0, high=22.0),
-    Param("hold_s", "s", "time each level is held", 4.0, low=0.0, low_open=True, high=3600.0),
-    Param("trials", "", "repetitions of the levels", 3, kind="int", low=1, high=1000),
+    SCHEDULE_SPECS["levels"],  # the paper's staircase
+    # range kept from the scene files' own, (0, 3600] s, not the driver's [0.01 s, 1 day]: a
+    # scene is simulated, so the cap bounds a world's run, and the range scene files and
+    # `tdcm scene` have always shown stays; StepSchedule still refuses a hold under 0.01 s
+    replace(SCHEDULE_SPECS["hold"], default=4.0, low=0.0, low_open=True, high=3600.0),
+    # a scene repeats the paper's 3 trials by default; at most 1000 bounds a simulated run
+    SCHEDULE_SPECS["trials"].renamed("trials", default=3).narrowed(high=1000),
 )
 
 SENSORS = (
@@ -51,13 +59,10 @@ SENSORS = (
 )
 
 MARKERS = (
-    Param("labels", "", "marker labels, one per arc length", ("m1", "m2", "m3"), kind="names"),
-    Param("arc_lengths_m", "m", "arc lengths of the marker cross-sections", (0.015, 0.033, 0.053),
-          kind="list", low=0.0, high=10.0),
-    Param("ball_radius_m", "m", "marker ball radius (centre = R_outer + this off the midline)",
-          0.001, low=0.0, high=0.05),
-    Param("side_deg", "deg", "angle around the body z axis from the tendon side (+x)", 180.0,
-          low=-360.0, high=360.0),
+    MARKER_SPECS["labels"],
+    MARKER_SPECS["arc_lengths"].renamed("arc_lengths_m"),
+    MARKER_SPECS["ball_radius"].renamed("ball_radius_m"),
+    MARKER_SPECS["side_deg"],
 )
 
 MOCAP_FRAME = (

@@ -1,12 +1,24 @@
 """Actuation effects: each returns the part of the device twin's
 :class:`~tdcm_ros.device.plant.PlantConfig` it sets (a :class:`~tdcm_ros.scenes.parts.PlantPart`,
-SI units; load cell in counts); the twin's plant runs them per sample."""
+SI units; load cell in counts); the twin's plant runs them per sample.
+
+Each parameter is the ``PlantConfig`` field's spec (unit, meaning, default) renamed to its scene
+key with the unit in it, its range capped: the plant takes any positive lag or spring, a scene
+keeps to a plausible bench so that a slip of a digit is refused rather than simulated.
+"""
 
 from __future__ import annotations
 
+from tdcm_ros.device import PLANT_SPECS
 from tdcm_ros.scenes.effects.base import Effect, register
-from tdcm_ros.scenes.params import Param
 from tdcm_ros.scenes.parts import PlantPart
+from tdcm_ros.spec import Spec
+
+
+def _scene_key(field: str, key: str, *, low: float | None = None, high: float | None = None
+               ) -> Spec:
+    """The plant field's spec as the scene key ``key``, its range narrowed to ``[low, high]``."""
+    return PLANT_SPECS[field].renamed(key).narrowed(low=low, high=high)
 
 
 class ActuationEffect(Effect):
@@ -27,12 +39,9 @@ class ActuatorDynamics(ActuationEffect):
     name = "actuator_dynamics"
     summary = "actuator lag, rate limit and deadband"
     params = (
-        Param("lag_s", "s", "first-order time constant of the actuator", 0.03, low=0.0,
-              low_open=True, high=10.0),
-        Param("rate_m_per_s", "m/s", "speed limit of the actuator", 0.025, low=0.0, low_open=True,
-              high=10.0),
-        Param("deadband_m", "m", "dead zone: the actuator stops this short of its command", 0.0, low=0.0,
-              high=0.01),
+        _scene_key("lag", "lag_s", high=10.0),
+        _scene_key("rate", "rate_m_per_s", high=10.0),
+        _scene_key("deadband", "deadband_m", high=0.01),
     )
 
     def plant_part(self) -> PlantPart:
@@ -48,12 +57,10 @@ class LoadCell(ActuationEffect):
     name = "load_cell"
     summary = "load-cell noise, bias, quantisation and drift"
     params = (
-        Param("noise_n", "N", "standard deviation of the reading noise", 0.01, low=0.0,
-              high=10.0),
-        Param("bias_n", "N", "constant offset of the reading", 0.0, low=-10.0, high=10.0),
-        Param("quantum_counts", "counts", "reading resolution (1000 counts per N)", 1,
-              kind="int", low=1, high=10000),
-        Param("drift_n_per_s", "N/s", "linear drift of the reading", 0.0, low=-1.0, high=1.0),
+        _scene_key("noise", "noise_n", high=10.0),
+        _scene_key("bias", "bias_n", low=-10.0, high=10.0),
+        _scene_key("quantum", "quantum_counts", high=10000),
+        _scene_key("drift", "drift_n_per_s", low=-1.0, high=1.0),
     )
 
     def plant_part(self) -> PlantPart:
@@ -70,10 +77,8 @@ class TendonCompliance(ActuationEffect):
     name = "tendon_compliance"
     summary = "tendon stiffness and slack between actuator and body"
     params = (
-        Param("stiffness_n_per_m", "N/m", "tendon spring rate after the slack is taken up",
-              2000.0, low=0.0, low_open=True, high=1e7),
-        Param("slack_m", "m", "actuator travel before the tendon carries load", 0.002, low=0.0,
-              high=0.02),
+        _scene_key("stiffness", "stiffness_n_per_m", high=1e7),
+        _scene_key("slack", "slack_m", high=0.02),
     )
 
     def plant_part(self) -> PlantPart:
