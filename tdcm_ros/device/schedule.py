@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tdcm_ros.device import constants as c
 from tdcm_ros.device.errors import DeviceInputError
 from tdcm_ros.spec import check_fields, spec_field, specs_of
 
@@ -16,9 +15,7 @@ class StepSchedule:
     The default is the paper's 0 -> 20 N in 4 N steps. After the last trial the setpoint is 0 N.
     """
 
-    # at most the device's largest setpoint: a higher level would be refused mid-run
     levels: tuple[float, ...] = spec_field((0.0, 4.0, 8.0, 12.0, 16.0, 20.0), unit="N", low=0.0,
-                                           high=c.SETPOINT_MAX_MN / 1000,
                                            description="tension setpoints of one trial, in order")
     hold: float = spec_field(5.0, name="hold_s", unit="s", low=0.01, high=86_400.0,
                              description="hold time of each level")

@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from tdcm_ros.device import SCHEDULE_SPECS
+from tdcm_ros.device.constants import SETPOINT_MAX_MN
 from tdcm_ros.model import FIELD_SPECS, MARKER_SPECS
 from tdcm_ros.scenes.params import Param
 
@@ -42,7 +43,10 @@ MATERIAL = (
 )
 
 SCHEDULE = (
-    SCHEDULE_SPECS["levels"],  # the paper's staircase
+    # the paper's staircase, at most the device's largest setpoint: the driver leaves that
+    # check to the device (its node parameters keep their own range and messages), a scene
+    # refuses a level the twin's device would reject when the file is loaded
+    SCHEDULE_SPECS["levels"].narrowed(high=SETPOINT_MAX_MN / 1000),
     # range kept from the scene files' own, (0, 3600] s, not the driver's [0.01 s, 1 day]: a
     # scene is simulated, so the cap bounds a world's run, and the range scene files and
     # `tdcm scene` have always shown stays; StepSchedule still refuses a hold under 0.01 s

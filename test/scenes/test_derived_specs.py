@@ -18,7 +18,7 @@ from tdcm_ros.spec import Spec
 #: scene key -> (source spec, the one change the scene makes: a default and/or a cap)
 DERIVED: dict[str, tuple[Spec, dict[str, Any]]] = {
     "material.E": (FIELD_SPECS["E"], {"default": None}),
-    "schedule.levels": (SCHEDULE_SPECS["levels"], {}),
+    "schedule.levels": (SCHEDULE_SPECS["levels"], {"high": 22.0}),
     "schedule.trials": (SCHEDULE_SPECS["trials"], {"default": 3, "high": 1000}),
     "markers.labels": (MARKER_SPECS["labels"], {}),
     "markers.arc_lengths_m": (MARKER_SPECS["arc_lengths"], {}),
