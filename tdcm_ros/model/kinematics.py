@@ -13,16 +13,16 @@ Internally a planar point is the complex number ``z + i x``; the tangent is then
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.model.cells import Cells
+from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.grid import Grid
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
-Scalar = TypeVar("Scalar", np.float64, np.complex128)
 
 
 @dataclass(frozen=True)
@@ -46,25 +46,32 @@ class PlanarShape:
         return self.p.real
 
 
-def integrate(grid: Grid, m_a: Array, m_b: Array) -> PlanarShape:
+def integrate(grid: Grid | Cells, m_a: Array, m_b: Array) -> PlanarShape:
     """Shape from per-cell end moments ``m_a``, ``m_b`` (N m), exactly for linear moments.
 
     Each cell's tangent angle at its Gauss points is ``theta_a + m_a A0 + m_b A1``; the cell's
-    displacement is the quadrature of the unit tangent over those points.
+    displacement is the quadrature of the unit tangent over those points
+    (:func:`tdcm_ros.model.kernel.integrate_row`). ``grid`` is one grid, whose moments may
+    carry leading batch axes, or :class:`Cells` of ``M`` members with moments (M, cells).
     """
-    phi = m_a[..., None] * grid.A0 + m_b[..., None] * grid.A1
-    local = np.sum(grid.w_q * np.exp(1j * phi), axis=-1)
-    theta = _cumsum0(m_a * grid.C0 + m_b * grid.C1)
-    tangent = np.exp(1j * theta)
-    p = _cumsum0(tangent[..., :-1] * local)
-    return PlanarShape(p=p, theta=theta, tangent=tangent)
-
-
-def _cumsum0(values: NDArray[Scalar]) -> NDArray[Scalar]:
-    """Cumulative sum along the last axis with a leading zero."""
-    out = np.zeros(values.shape[:-1] + (values.shape[-1] + 1,), dtype=values.dtype)
-    np.cumsum(values, axis=-1, out=out[..., 1:])
-    return out
+    cells = Cells.of(grid) if isinstance(grid, Grid) else grid
+    m_a = np.asarray(m_a, dtype=float)
+    lead = m_a.shape[:-1]
+    n = m_a.shape[-1]
+    rows = int(np.prod(lead, dtype=np.int64)) if lead else 1
+    a = np.ascontiguousarray(m_a.reshape(rows, n))
+    b = np.ascontiguousarray(np.asarray(m_b, dtype=float).reshape(rows, n))
+    fc, fq = cells.fc, cells.fq
+    if rows != cells.members:
+        fc = np.ascontiguousarray(np.broadcast_to(fc, (rows, *fc.shape[1:])))
+        fq = np.ascontiguousarray(np.broadcast_to(fq, (rows, *fq.shape[1:])))
+    p = np.empty((rows, n + 1), np.complex128)
+    theta = np.empty((rows, n + 1))
+    tangent = np.empty((rows, n + 1), np.complex128)
+    kernels().integrate(fc, fq, a, b, p, theta, tangent)
+    nodes = (*lead, n + 1)
+    return PlanarShape(p=p.reshape(nodes), theta=theta.reshape(nodes),
+                       tangent=tangent.reshape(nodes))
 
 
 def quaternions_y(theta: Array) -> Array:

@@ -11,6 +11,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.cells import Cells
+from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.errors import (
     NotchClosureError,
     TendonSingularityError,
@@ -63,18 +65,14 @@ def notch_gaps(grid: Grid, shape: PlanarShape) -> Array:
     """Smallest gap (m) between the two faces of every notch, on either side of the body.
 
     The faces are the planes normal to the tangent at ``l_i`` and ``r_i``; the gap is the
-    signed distance of each face's outer corner (at ``R_outer``) from the other face.
+    signed distance of each face's outer corner (at ``R_outer``) from the other face
+    (:func:`tdcm_ros.model.kernel.gaps_row`).
     """
-    left, right = grid.notch_left_node, grid.notch_right_node
-    t_l, t_r = shape.tangent[left], shape.tangent[right]
-    span = shape.p[right] - shape.p[left]
-    gaps = []
-    for side in (1.0, -1.0):
-        corner_offset = (1j * side * grid.design.R_outer) * (t_r - t_l)
-        delta = span + corner_offset
-        gaps.append((np.conj(t_l) * delta).real)
-        gaps.append((np.conj(t_r) * delta).real)
-    return np.minimum(np.minimum(gaps[0], gaps[1]), np.minimum(gaps[2], gaps[3]))
+    cells = Cells.of(grid)
+    out = np.empty((1, cells.notch.shape[2]))
+    kernels().gaps(cells.scal, np.ascontiguousarray(shape.p).reshape(1, -1),
+                   np.ascontiguousarray(shape.tangent).reshape(1, -1), cells.notch, out)
+    return out[0]
 
 
 def check_tendon_singularity(grid: Grid, tension: float) -> None:

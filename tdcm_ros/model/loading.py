@@ -49,8 +49,10 @@ from tdcm_ros.model import loads
 from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
-from tdcm_ros.model.limits import closure_angle
+from tdcm_ros.model.limits import check_closure, check_singularity, closure_angle
+from tdcm_ros.model.moment_model import PlainRun, Plan
 from tdcm_ros.model.section import notched_area, tube_area
+from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -228,7 +230,16 @@ def _contact(grid: Grid, contact: NotchContact) -> _Contact:
 
 
 class LoadedModel:
-    """A :class:`Loading` on one grid: the moment map and the contact law for the solver."""
+    """A :class:`Loading` on one grid: the moment map and the contact law for the solver (a
+    :class:`~tdcm_ros.model.moment_model.MomentModel`).
+
+    Its moments are known only on a solution, so the singularity is checked after iterating;
+    closure raises unless notch contact is on. Strategies: plain iteration (cheapest for small
+    loads) hands over to Anderson restarted from the initial iterate as soon as it slows,
+    within a quarter of ``max_iter``; continuation (adaptive steps, external loads ramped with
+    the tension) comes next and relaxation last, which on a scan of hard loadings rescued more
+    solves than the paper model's order.
+    """
 
     def __init__(self, grid: Grid, loading: Loading, tension_base: float) -> None:
         self.grid = grid
@@ -246,6 +257,45 @@ class LoadedModel:
     def has_contact(self) -> bool:
         """Whether the notch contact law is active."""
         return self._contact is not None
+
+    def check_before(self, tension: float) -> None:
+        """Nothing is known before iterating."""
+
+    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
+        """Singularity on the bending moments; closure unless notch contact is on."""
+        n = self.grid.n_cells
+        bend = self.bend_moments(x)
+        check_singularity(self.grid, bend[:n], bend[n:])
+        if self._contact is None:
+            check_closure(self.grid, shape, tension)
+
+    def plans(self, settings: SolverSettings) -> list[Plan]:
+        """Strategies in order (see the class docstring)."""
+        budget = settings.max_iter
+        if settings.acceleration != "auto":
+            mode = "picard" if settings.acceleration == "none" else settings.acceleration
+            return [Plan(settings.acceleration, mode, budget)]
+        plans = [Plan("picard+anderson", "auto", max(budget // 4, 1), restart=True)]
+        if settings.continuation_steps > 0:
+            plans.append(Plan("continuation", "continuation", budget, adaptive=True))
+        return [*plans, Plan("relaxation", "relaxation", budget)]
+
+    def warm_scale(self, previous: float, tension: float) -> float | None:
+        """The tension ratio; unscaled from a zero-tension result (external loads alone)."""
+        return tension / previous if previous > 0.0 else 1.0
+
+    def extras(self, x: Array, shape: PlanarShape, tension: float
+               ) -> tuple[Array | None, Array | None]:
+        """Per-cell contact scale (with contact) and node tensions (with a profile)."""
+        scale = self.contact_scale(x) if self._contact is not None else None
+        tensions = (self.node_tensions(shape, tension)[1]
+                    if self.loading.tension_profile is not None else None)
+        return scale, tensions
+
+    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
+              relaxation: float, slow: float) -> PlainRun | None:
+        """Not compiled: the solver iterates the moment map itself."""
+        return None
 
     def contact_scale(self, x: Array) -> Array:
         """Per-cell factor (<= 1) from actual to bending moments; ones without contact."""

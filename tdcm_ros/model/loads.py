@@ -23,6 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.model.cells import Cells
+from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.errors import ModelLimitError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
@@ -36,50 +38,50 @@ class KinkAngleError(ModelLimitError):
     kind = "kink_angle"
 
 
-def closed_form(grid: Grid, shape: PlanarShape, tension: float | Array) -> tuple[Array, Array]:
+def closed_form(grid: Grid | Cells, shape: PlanarShape, tension: float | Array
+                ) -> tuple[Array, Array]:
     """Per-cell end moments ``(m_a, m_b)`` (N m) from ``m = (p_c - p) x (-T t_c)``.
 
-    ``tension`` (N) is a scalar or has the shape's batch dimensions.
+    ``tension`` (N) is a scalar or has the shape's batch dimensions (one grid), or one per
+    member for :class:`Cells`.
     """
-    r_c = grid.design.R_c
     tension = np.asarray(tension, dtype=float)
-    m_a = np.empty(tension.shape + (grid.n_cells,))
-    m_a[...] = (r_c * tension)[..., None]
-    m_b = m_a.copy()
-    cells = grid.chord_cells
-    if cells.size == 0:
-        return m_a, m_b
-    p_c = shape.p + (1j * r_c) * shape.tangent
-    anchor = p_c[..., grid.chord_start_node[cells]]
-    chord = p_c[..., grid.chord_end_node[cells]] - anchor
-    chord = chord / np.abs(chord)
-    t = -tension[..., None]
-    # (p_c - p) x (-T u) about +y is -T Im(conj(p_c - p) u) with points as z + i x.
-    m_a[..., cells] = t * (np.conj(anchor - shape.p[..., cells]) * chord).imag
-    m_b[..., cells] = t * (np.conj(anchor - shape.p[..., cells + 1]) * chord).imag
-    return m_a, m_b
+    n = shape.p.shape[-1] - 1
+    t = np.ascontiguousarray(np.broadcast_to(tension[..., None], (*tension.shape, n)))
+    return closed_form_cells(grid, shape, t, t)
 
 
-def closed_form_cells(grid: Grid, shape: PlanarShape, t_a: Array, t_b: Array
+def closed_form_cells(grid: Grid | Cells, shape: PlanarShape, t_a: Array, t_b: Array
                       ) -> tuple[Array, Array]:
-    """:func:`closed_form` with a tension that varies along ``s`` (one unbatched shape).
+    """:func:`closed_form` with a tension that varies along ``s``
+    (:func:`tdcm_ros.model.kernel.moments_row`).
 
-    ``t_a``, ``t_b`` (N, shape (cells,)) are the tendon tensions at each cell's start and
-    end, one-sided like the moments. Equilibrium of the tendon piece beyond the cut still gives
-    ``m(s) = (p_c(s) - p(s)) x (-T(s) t_c(s))`` with ``T(s)`` the tension at the cut: friction
-    between tendon and channel is internal to the tendon + distal body. On a chord the
-    tendon runs free, so the caller passes the chord's one tension at both ends.
+    ``t_a``, ``t_b`` (N, shape (cells,), or the shape's batch dimensions first) are the tendon
+    tensions at each cell's start and end, one-sided like the moments. Equilibrium of the
+    tendon piece beyond the cut still gives ``m(s) = (p_c(s) - p(s)) x (-T(s) t_c(s))`` with
+    ``T(s)`` the tension at the cut: friction between tendon and channel is internal to the
+    tendon + distal body. On a chord the tendon runs free, so the caller passes the chord's
+    one tension at both ends.
     """
-    r_c = grid.design.R_c
-    m_a = r_c * t_a
-    m_b = r_c * t_b
-    cells = grid.chord_cells
-    if cells.size == 0:
-        return m_a, m_b
-    anchor, chord = _chords(grid, shape, cells)
-    m_a[cells] = -t_a[cells] * (np.conj(anchor - shape.p[cells]) * chord).imag
-    m_b[cells] = -t_b[cells] * (np.conj(anchor - shape.p[cells + 1]) * chord).imag
-    return m_a, m_b
+    cells = Cells.of(grid) if isinstance(grid, Grid) else grid
+    p = shape.p
+    lead = p.shape[:-1]
+    n = p.shape[-1] - 1
+    rows = int(np.prod(lead, dtype=np.int64)) if lead else 1
+    scal, ic = cells.scal, cells.ic
+    if rows != cells.members:
+        scal = np.ascontiguousarray(np.broadcast_to(scal, (rows, *scal.shape[1:])))
+        ic = np.ascontiguousarray(np.broadcast_to(ic, (rows, *ic.shape[1:])))
+
+    def flat(values: NDArray[np.generic]) -> NDArray[np.generic]:
+        return np.ascontiguousarray(np.broadcast_to(values, (*lead, values.shape[-1])
+                                                    ).reshape(rows, -1))
+
+    m_a = np.empty((rows, n))
+    m_b = np.empty((rows, n))
+    kernels().moments(scal, flat(p), flat(shape.tangent), flat(np.asarray(t_a, dtype=float)),
+                      flat(np.asarray(t_b, dtype=float)), ic, m_a, m_b)
+    return m_a.reshape(*lead, n), m_b.reshape(*lead, n)
 
 
 def tendon_wrap(grid: Grid, shape: PlanarShape) -> tuple[Array, Array]:

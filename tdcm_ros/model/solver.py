@@ -10,65 +10,57 @@ Anderson mixing once it slows; if that fails, damped relaxation; if that fails, 
 continuation (tension ramped in ``continuation_steps`` warm-started steps). Under a
 loading: plain iteration, handing over to Anderson restarted from the initial iterate if it
 slows (a quarter of ``max_iter``), then adaptive continuation, then relaxation.
-Failure after all of them raises :class:`ConvergenceError`. Physical limits are checked
-explicitly: the tendon-offset singularity before iterating and again on the solution, notch
-closure on the solution.
-
-A :class:`~tdcm_ros.model.loading.Loading` adds a tension varying along ``s``, external loads
-and notch contact (see :mod:`tdcm_ros.model.loading`); the same strategies drive it, and
-continuation ramps its external loads with the tension. Under a loading the singularity is
-checked on the solution (its moments are not known beforehand), and closure raises unless
-notch contact is on.
+Failure after all of them raises :class:`ConvergenceError`. The moment model
+(:mod:`tdcm_ros.model.moment_model`: closed form, literal sum, or a
+:class:`~tdcm_ros.model.loading.Loading`) supplies the moments, its strategy list and its
+physical-limit checks before and after iterating; the closed form's plain iteration runs in
+the compiled kernel (:func:`tdcm_ros.model.kernel.iterate`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 from time import perf_counter
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model import loads
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.grid import Grid, build_grid
+from tdcm_ros.model.kernel import CONVERGED, DIVERGING, NON_FINITE, SLOWED
 from tdcm_ros.model.kinematics import PlanarShape, integrate
-from tdcm_ros.model.limits import (
-    check_closure,
-    check_singularity,
-    check_tendon_singularity,
-    check_tension,
-)
+from tdcm_ros.model.limits import check_tension
 from tdcm_ros.model.loading import InvalidLoadingError, LoadedModel, Loading
+from tdcm_ros.model.moment_model import (
+    DIVERGENCE_GROWTH,
+    ClosedForm,
+    LiteralSum,
+    MomentModel,
+    Plan,
+)
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
-MomentMap = Callable[[PlanarShape, Array, float, float], Array]
-"""(shape, current moments, tension level (N), external load factor) -> new moments (N m)."""
 
 DEFAULT_SETTINGS = SolverSettings()
 SLOW_CONTRACTION = 0.3
 CONTINUATION_HALVINGS = 5
-DIVERGENCE_GROWTH = 1e3
+__all__ = ["DEFAULT_SETTINGS", "DIVERGENCE_GROWTH", "SLOW_CONTRACTION", "solve"]
 
 
 class _Problem(NamedTuple):
-    """What the strategies iterate: the moment map, and the map from the iterate to the moments
-    that bend the body (None: the iterate itself)."""
+    """What the strategies iterate: a moment model on its grid, under settings."""
 
     grid: Grid
     settings: SolverSettings
-    moments: MomentMap
-    bend: Callable[[Array], Array] | None
+    model: MomentModel
 
     def shape_of(self, x: Array) -> PlanarShape:
-        """Shape integrated from the stacked cell end moments ``x = [m_a, m_b]``."""
-        y = x if self.bend is None else self.bend(x)
+        """Shape integrated from the bending moments of ``x = [m_a, m_b]`` (N m)."""
+        y = self.model.bend_moments(x)
         n = self.grid.n_cells
         return integrate(self.grid, y[:n], y[n:])
 
@@ -111,18 +103,16 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
     """:func:`solve` for a checked base tension ``t_base`` (N); ``started`` is its start time
     (s, ``perf_counter``)."""
     grid = build_grid(design, settings)
-    n = grid.n_cells
-    model = _loaded_model(grid, settings, t_base, loading)
-    if model is None:
-        check_tendon_singularity(grid, t_base)
-    problem = _problem(grid, settings, model)
-    x0 = _initial_guess(grid, settings, t_base, warm_start, loaded=model is not None)
+    model = _model(grid, settings, t_base, loading)
+    model.check_before(t_base)
+    problem = _Problem(grid, settings, model)
+    x0 = _initial_guess(grid, settings, t_base, warm_start, model)
 
     runs: list[tuple[str, _Run]] = []
     budget = settings.max_iter
-    for name, run_strategy, share in _strategies(settings, loaded=model is not None):
-        run = run_strategy(problem, t_base, x0, min(budget, share))
-        runs.append((name, run))
+    for plan in model.plans(settings):
+        run = _run_plan(problem, plan, t_base, x0, min(budget, plan.budget))
+        runs.append((plan.name, run))
         budget -= len(run.history)
         if run.converged or budget <= 0:
             break
@@ -134,13 +124,7 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
             f"Algorithm 1 found no finite iterate at tension {t_base:g} N ({_reasons(runs)})")
     strategy, final = last
     if final.converged:
-        if model is not None:
-            bend = model.bend_moments(final.x)
-            check_singularity(grid, bend[:n], bend[n:])
-        elif settings.loads == "literal":
-            check_singularity(grid, final.x[:n], final.x[n:])
-        if model is None or not model.has_contact:
-            check_closure(grid, final.shape, t_base)
+        model.check_after(final.x, final.shape, t_base)
     result = _result(grid, settings, t_base, final, strategy, iterations, history,
                      perf_counter() - started, loading, model)
     if not final.converged and strict:
@@ -165,17 +149,16 @@ def _last_finite(runs: list[tuple[str, _Run]]) -> tuple[str, _Run] | None:
     return None
 
 
-def _loaded_model(grid: Grid, settings: SolverSettings, tension: float,
-                  loading: Loading | None) -> LoadedModel | None:
-    """The loading's model on this grid, or None for the paper's model."""
-    if loading is None:
-        return None
-    if not isinstance(loading, Loading):
+def _model(grid: Grid, settings: SolverSettings, tension: float,
+           loading: Loading | None) -> MomentModel:
+    """The moment model of ``settings.loads`` under ``loading`` (None or trivial: the
+    paper's)."""
+    if loading is not None and not isinstance(loading, Loading):
         raise InvalidLoadingError(f"loading = {loading!r} is not a Loading; allowed: None or "
                                   "Loading(...)", parameter="loading", value=loading,
                                   allowed="None | Loading")
-    if loading.is_trivial:
-        return None
+    if loading is None or loading.is_trivial:
+        return ClosedForm(grid) if settings.loads == "closed" else LiteralSum(grid)
     if settings.loads != "closed":
         raise InvalidLoadingError(
             f"loading is not supported with loads = {settings.loads!r}; allowed: loads=closed "
@@ -184,66 +167,24 @@ def _loaded_model(grid: Grid, settings: SolverSettings, tension: float,
     return LoadedModel(grid, loading, tension)
 
 
-def _problem(grid: Grid, settings: SolverSettings, model: LoadedModel | None) -> _Problem:
-    """The fixed-point problem of the paper's model (``model`` None) or of a loading."""
-    if model is None:
-        return _Problem(grid, settings, _moment_map(grid, settings), None)
-    return _Problem(grid, settings, model.moments,
-                    model.bend_moments if model.has_contact else None)
-
-
-def _moment_map(grid: Grid, settings: SolverSettings) -> MomentMap:
-    """The map from (shape, current moments, tension) to new moments for the chosen load form."""
-    n = grid.n_cells
-
-    def closed(shape: PlanarShape, x: Array, tension: float, factor: float) -> Array:
-        m_a, m_b = loads.closed_form(grid, shape, np.float64(tension))
-        return np.concatenate([m_a, m_b])
-
-    def literal(shape: PlanarShape, x: Array, tension: float, factor: float) -> Array:
-        m_a, m_b = loads.literal(grid, shape, tension, x[:n], x[n:])
-        return np.concatenate([m_a, m_b])
-
-    return closed if settings.loads == "closed" else literal
-
-
 def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
-                   warm_start: SolveResult | None, *, loaded: bool) -> Array:
-    """The tendon moment ``R_c T`` everywhere, or a compatible previous solution rescaled
-    (by the tension ratio; under a loading, unscaled from a zero-tension result)."""
+                   warm_start: SolveResult | None, model: MomentModel) -> Array:
+    """The tendon moment ``R_c T`` everywhere, or a compatible converged result rescaled by
+    the model's :meth:`~tdcm_ros.model.moment_model.MomentModel.warm_scale`."""
     if (warm_start is not None and warm_start.grid is grid and warm_start.settings == settings
-            and (warm_start.tension_n > 0.0 or loaded) and warm_start.converged):
-        scale = tension / warm_start.tension_n if warm_start.tension_n > 0.0 else 1.0
-        return np.concatenate([warm_start.cell_moments[:, 0], warm_start.cell_moments[:, 1]]) * scale
+            and warm_start.converged):
+        scale = model.warm_scale(warm_start.tension_n, tension)
+        if scale is not None:
+            moments = warm_start.cell_moments
+            return np.concatenate([moments[:, 0], moments[:, 1]]) * scale
     return np.full(2 * grid.n_cells, grid.design.R_c * tension)
 
 
-Strategy = Callable[[_Problem, float, Array, int], _Run]
-
-
-def _strategies(settings: SolverSettings, *, loaded: bool) -> list[tuple[str, Strategy, int]]:
-    """Strategies to try in order for ``settings.acceleration``, each with its iteration cap.
-
-    Under a loading the moment depends on the shape everywhere: plain iteration (cheapest for
-    small loads) hands over to Anderson restarted from the initial iterate as soon as it slows,
-    within a quarter of ``max_iter``; continuation (adaptive steps) comes next and relaxation
-    last, which on a scan of hard loadings rescued more solves than the base order.
-    """
-    budget = settings.max_iter
-    if settings.acceleration != "auto":
-        mode = "picard" if settings.acceleration == "none" else settings.acceleration
-        return [(settings.acceleration, partial(_iterate, mode=mode), budget)]
-    relaxation: tuple[str, Strategy, int] = (
-        "relaxation", partial(_iterate, mode="relaxation"), budget)
-    continuation: list[tuple[str, Strategy, int]] = []
-    if settings.continuation_steps > 0:
-        continuation.append(("continuation", partial(_continuation, adaptive=loaded), budget))
-    if loaded:
-        return [("picard+anderson", partial(_iterate, mode="auto", restart=True),
-                 max(budget // 4, 1)),
-                *continuation, relaxation]
-    return [("picard+anderson", partial(_iterate, mode="auto"), budget), relaxation,
-            *continuation]
+def _run_plan(problem: _Problem, plan: Plan, tension: float, x0: Array, budget: int) -> _Run:
+    """Run one strategy of the model's list."""
+    if plan.mode == "continuation":
+        return _continuation(problem, tension, x0, budget, adaptive=plan.adaptive)
+    return _iterate(problem, tension, x0, budget, mode=plan.mode, restart=plan.restart)
 
 
 def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
@@ -312,19 +253,29 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
     scales the external loads (continuation); ``tol`` (m) defaults to ``settings.tol``. With
     ``restart``, plain iteration that slows down (mode ``auto``) hands over to Anderson from
     ``x0`` rather than from wherever it has wandered."""
-    grid, settings, moment_map, bend = problem
+    grid, settings, model = problem
     tol = settings.tol if tol is None else tol
-    n = grid.n_cells
     x = x0
     shape = start = problem.shape_of(x)
     history: list[float] = []
     using = "picard" if mode == "auto" else mode
+    if using in ("picard", "relaxation"):
+        plain = model.plain(x, shape, tension, budget, tol,
+                            settings.relaxation if using == "relaxation" else 1.0,
+                            SLOW_CONTRACTION if mode == "auto" else 0.0)
+        if plain is not None:
+            x, shape, history = plain.x, plain.shape, plain.history
+            if plain.status != SLOWED:
+                return _plain_outcome(x, shape, history, plain.status)
+            using = "anderson"
+            if restart:
+                x, shape = x0, start
     d_x: list[Array] = []
     d_f: list[Array] = []
     last: tuple[Array, Array] | None = None
     length = grid.design.length
-    for _ in range(max(budget, 0)):
-        g = moment_map(shape, x, tension, factor)
+    for _ in range(max(budget - len(history), 0)):
+        g = model.moments(shape, x, tension, factor)
         f = g - x
         if using == "anderson":
             x_new = _anderson_step(x, f, last, d_x, d_f, settings.anderson_depth)
@@ -336,8 +287,7 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
             x_new = x + settings.relaxation * f
         else:
             x_new = g
-        y = x_new if bend is None else bend(x_new)
-        new_shape = integrate(grid, y[:n], y[n:])
+        new_shape = problem.shape_of(x_new)
         step = float(np.max(np.abs(new_shape.p - shape.p)))
         if not np.isfinite(step):
             return _Run(x, shape, history, False, "iterate became non-finite")
@@ -352,6 +302,18 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
             using = "anderson"
             if restart:
                 x, shape = x0, start
+    return _Run(x, shape, history, False,
+                f"budget exhausted, last step {history[-1]:.3g} m" if history else "no budget")
+
+
+def _plain_outcome(x: Array, shape: PlanarShape, history: list[float], status: int) -> _Run:
+    """The run of a compiled plain iteration that stopped with kernel ``status``."""
+    if status == CONVERGED:
+        return _Run(x, shape, history, True, "converged")
+    if status == NON_FINITE:
+        return _Run(x, shape, history, False, "iterate became non-finite")
+    if status == DIVERGING:
+        return _Run(x, shape, history, False, f"diverging (step {history[-1]:.3g} m)")
     return _Run(x, shape, history, False,
                 f"budget exhausted, last step {history[-1]:.3g} m" if history else "no budget")
 
@@ -383,15 +345,10 @@ def _anderson_step(x: Array, f: Array, last: tuple[Array, Array] | None, d_x: li
 
 def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, strategy: str,
             iterations: int, history: tuple[float, ...], elapsed: float,
-            loading: Loading | None, model: LoadedModel | None) -> SolveResult:
+            loading: Loading | None, model: MomentModel) -> SolveResult:
     n = grid.n_cells
     shape = run.shape
-    contact_scale = tendon_tension = None
-    if model is not None:
-        if model.has_contact:
-            contact_scale = model.contact_scale(run.x)
-        if model.loading.tension_profile is not None:
-            tendon_tension = model.node_tensions(shape, tension)[1]
+    contact_scale, tendon_tension = model.extras(run.x, shape, tension)
     positions = np.zeros((n + 1, 3))
     positions[:, 0] = shape.p.imag
     positions[:, 2] = shape.p.real

@@ -30,7 +30,7 @@ from tdcm_ros.model.loading import (
     NotchContact,
 )
 from tdcm_ros.model.section import notched_area, notched_moment, tube_area
-from tdcm_ros.model.solver import _continuation, _problem
+from tdcm_ros.model.solver import _continuation, _Problem
 
 RHO_G = 1010.0 * 9.81  # N/m^3, Nylon 12 under 1 g
 TIGHT = SolverSettings(tol=1e-14, max_iter=400)
@@ -493,7 +493,7 @@ def test_continuation_ramps_the_external_loads_with_the_tension(contact):
         return moments(shape, x, level, factor)
 
     model.moments = spy  # type: ignore[method-assign]
-    run = _continuation(_problem(grid, cfg, model), 5.0, np.zeros(2 * grid.n_cells), 400,
+    run = _continuation(_Problem(grid, cfg, model), 5.0, np.zeros(2 * grid.n_cells), 400,
                         adaptive=True)
     assert run.converged
     assert min(seen) < 0.2 and max(seen) == 1.0

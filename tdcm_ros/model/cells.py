@@ -1,0 +1,157 @@
+"""Grids with a leading member axis, packed for :mod:`tdcm_ros.model.kernel`.
+
+:class:`Cells` holds one grid (one member) or a stack of grids; it has the fields of
+:class:`~tdcm_ros.model.grid.Grid` the kernels read (``C0``, ``C1``, ``A0``, ``A1``, ``w_q``,
+``chord_start_node``, ``chord_end_node``, ``constrained``, ``notch_left_node``,
+``notch_right_node``), each with the member axis first. Grids of different cell or notch
+counts stack by padding with zero-length cells at the tip (they move no node) and with
+notches marked -1 (never checked).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.model.grid import Grid
+
+Array = NDArray[np.float64]
+Ints = NDArray[np.int64]
+
+
+@dataclass(frozen=True, eq=False)
+class Cells:
+    """Packed cell arrays of ``members`` grids (layout in :mod:`tdcm_ros.model.kernel`)."""
+
+    fc: Array
+    fq: Array
+    ic: Ints
+    notch: Ints
+    scal: Array
+
+    @classmethod
+    def of(cls, grid: Grid) -> Cells:
+        """The one-member cells of ``grid`` (cached per grid)."""
+        return _cells_of(grid)
+
+    @classmethod
+    def stack(cls, grids: Sequence[Grid]) -> Cells:
+        """Members = ``grids``, padded to the largest cell and notch counts."""
+        parts = [cls.of(g) for g in grids]
+        n = max(c.n_cells for c in parts)
+        k = max(c.notch.shape[2] for c in parts)
+        q = max(c.fq.shape[3] for c in parts)
+        fc = np.zeros((len(parts), 2, n))
+        fq = np.zeros((len(parts), 3, n, q))
+        ic = np.zeros((len(parts), 3, n), np.int64)
+        ic[:, 2] = 1
+        notch = np.full((len(parts), 2, k), -1, np.int64)
+        for j, c in enumerate(parts):
+            cells, notches, points = c.n_cells, c.notch.shape[2], c.fq.shape[3]
+            fc[j, :, :cells] = c.fc[0]
+            fq[j, :, :cells, :points] = c.fq[0]
+            ic[j, :, :cells] = c.ic[0]
+            notch[j, :, :notches] = c.notch[0]
+        return cls(fc=fc, fq=fq, ic=ic, notch=notch,
+                   scal=np.concatenate([c.scal for c in parts]))
+
+    def take(self, rows: Ints) -> Cells:
+        """The members ``rows`` (repeats allowed)."""
+        return Cells(fc=self.fc[rows], fq=self.fq[rows], ic=self.ic[rows],
+                     notch=self.notch[rows], scal=self.scal[rows])
+
+    @property
+    def members(self) -> int:
+        """Number of members."""
+        return int(self.fc.shape[0])
+
+    @property
+    def n_cells(self) -> int:
+        """Cells per member (padding included)."""
+        return int(self.fc.shape[2])
+
+    @property
+    def C0(self) -> Array:
+        """``int (1 - xi) c ds`` per cell (rad/(N m)), (members, cells)."""
+        return self.fc[:, 0]
+
+    @property
+    def C1(self) -> Array:
+        """``int xi c ds`` per cell (rad/(N m)), (members, cells)."""
+        return self.fc[:, 1]
+
+    @property
+    def A0(self) -> Array:
+        """``A0`` at the Gauss points (rad/(N m)), (members, cells, points)."""
+        return self.fq[:, 0]
+
+    @property
+    def A1(self) -> Array:
+        """``A1`` at the Gauss points (rad/(N m)), (members, cells, points)."""
+        return self.fq[:, 1]
+
+    @property
+    def w_q(self) -> Array:
+        """ds weights of the Gauss points (m), (members, cells, points)."""
+        return self.fq[:, 2]
+
+    @property
+    def chord_start_node(self) -> Ints:
+        """First node of each cell's tendon run, (members, cells)."""
+        return self.ic[:, 0]
+
+    @property
+    def chord_end_node(self) -> Ints:
+        """Last node of each cell's tendon run, (members, cells)."""
+        return self.ic[:, 1]
+
+    @property
+    def constrained(self) -> NDArray[np.bool_]:
+        """Cells where the tendon follows the offset curve, (members, cells)."""
+        return self.ic[:, 2] != 0
+
+    @property
+    def notch_left_node(self) -> Ints:
+        """Node at each notch's start (-1: padding), (members, notches)."""
+        return self.notch[:, 0]
+
+    @property
+    def notch_right_node(self) -> Ints:
+        """Node at each notch's end (-1: padding), (members, notches)."""
+        return self.notch[:, 1]
+
+    @property
+    def r_c(self) -> Array:
+        """Tendon offset ``R_c`` (m) per member."""
+        return self.scal[:, 0]
+
+    @property
+    def r_outer(self) -> Array:
+        """Outer radius (m) per member."""
+        return self.scal[:, 1]
+
+    @property
+    def length(self) -> Array:
+        """Body length (m) per member."""
+        return self.scal[:, 2]
+
+    @property
+    def constrained_peak_c(self) -> Array:
+        """Largest compliance (1/(N m^2)) where the tendon follows the body, per member."""
+        return self.scal[:, 3]
+
+
+@lru_cache(maxsize=512)
+def _cells_of(grid: Grid) -> Cells:
+    d = grid.design
+    return Cells(fc=np.stack([grid.C0, grid.C1])[None],
+                 fq=np.stack([grid.A0, grid.A1, grid.w_q])[None],
+                 ic=np.stack([grid.chord_start_node, grid.chord_end_node,
+                              grid.constrained.astype(np.int64)])[None],
+                 notch=np.stack([grid.notch_left_node, grid.notch_right_node]
+                                ).astype(np.int64).reshape(1, 2, -1),
+                 scal=np.array([[d.R_c, d.R_outer, d.length, grid.constrained_peak_c]]))

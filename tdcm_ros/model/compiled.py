@@ -1,0 +1,87 @@
+"""Which build of :mod:`tdcm_ros.model.kernel` runs: as plain Python, or compiled by numba.
+
+The kernels are one source. Compiling them needs numba (about 0.3 s and 90 MB just to import),
+so it happens lazily, on the first kernel call of a process that uses the compiled build, and
+the machine code is cached on disk (``cache=True``: next to the package when it is writable,
+else numba's user-wide cache or ``NUMBA_CACHE_DIR``; without any writable place the kernels
+are compiled uncached, never refused).
+
+The switch: environment variable ``TDCM_JIT`` (read once, at the first kernel call) or
+:func:`use_compiled`. ``TDCM_JIT=0`` runs the plain-Python build (no numba import: right for
+a one-shot command that solves once); ``1`` requires numba; unset (default) compiles when
+numba is importable and otherwise runs the plain build.
+"""
+
+from __future__ import annotations
+
+import os
+import types
+from typing import Any
+
+from tdcm_ros.errors import out_of_range
+from tdcm_ros.model import kernel
+from tdcm_ros.model.errors import InvalidSettingsError
+
+ENVIRONMENT = "TDCM_JIT"
+_CHOICES = {"0": False, "1": True, "": None}
+_state: dict[str, Any] = {"wanted": None, "chosen": False, "build": None}
+
+
+def use_compiled(flag: bool | None) -> None:
+    """Select the build for the rest of the process: True compiled (needs numba), False plain
+    Python, None the default (compiled if numba is importable). Overrides ``TDCM_JIT``."""
+    _state["wanted"] = flag
+    _state["build"] = None
+    _state["chosen"] = True
+
+
+def kernels() -> types.SimpleNamespace | types.ModuleType:
+    """The kernel functions of the selected build (attributes named as in :mod:`kernel`)."""
+    build = _state["build"]
+    if build is None:
+        build = _state["build"] = _select()
+    return build
+
+
+def is_compiled() -> bool:
+    """Whether the selected build is numba's."""
+    return kernels() is not kernel
+
+
+def _select() -> types.SimpleNamespace | types.ModuleType:
+    wanted = _state["wanted"]
+    if not _state.get("chosen"):
+        value = os.environ.get(ENVIRONMENT, "").strip()
+        if value not in _CHOICES:
+            raise out_of_range(ENVIRONMENT, value, "0 (plain Python) | 1 (numba) | unset",
+                               error=InvalidSettingsError)
+        wanted = _CHOICES[value]
+    if wanted is False:
+        return kernel
+    try:
+        import numba
+    except ImportError:
+        if wanted:
+            raise
+        return kernel
+    return _compile(numba)
+
+
+def _compile(numba: Any) -> types.SimpleNamespace:
+    """Each kernel function jitted, its calls to the others resolved to their jitted versions
+    (the plain functions keep theirs)."""
+    namespace = dict(vars(kernel))
+    compiled = {}
+    for name in kernel.KERNELS:
+        plain = getattr(kernel, name)
+        clone = types.FunctionType(plain.__code__, namespace, name, plain.__defaults__,
+                                   plain.__closure__)
+        clone.__qualname__ = plain.__qualname__
+        clone.__module__ = plain.__module__
+        clone.__doc__ = plain.__doc__
+        try:
+            jitted = numba.njit(cache=True)(clone)
+        except RuntimeError:  # no writable cache location: compile every process instead
+            jitted = numba.njit(cache=False)(clone)
+        namespace[name] = compiled[name] = jitted
+    return types.SimpleNamespace(**compiled)

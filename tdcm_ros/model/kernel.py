@@ -1,0 +1,197 @@
+"""Algorithm 1's grid-level kernels, written once for a leading member axis.
+
+Every function here is plain Python on NumPy arrays and scalars, in the subset of Python that
+numba compiles: :mod:`tdcm_ros.model.compiled` runs these same functions either as they are
+or compiled (lazily, on first use). A single solve is one member; a batch stacks many.
+
+Member arrays (SI units; ``M`` members, ``n`` cells, ``Q`` quadrature points, ``K`` notches):
+
+- ``fc`` (M, 2, n): the cells' ``C0``, ``C1`` (rad/(N m));
+- ``fq`` (M, 3, n, Q): ``A0``, ``A1`` (rad/(N m)) and ``w_q`` (m) at the Gauss points;
+- ``ic`` (M, 3, n): each cell's chord start node, chord end node, and 1 where the tendon
+  follows the offset curve (0 on a chord);
+- ``notch`` (M, 2, K): left and right node of every notch, -1 in padding;
+- ``scal`` (M, 4): ``R_c`` (m), ``R_outer`` (m), body length (m), constrained peak compliance.
+
+A zero-length padding cell (``C0 = C1 = A0 = A1 = w_q = 0``) is neutral: it moves no node.
+Planar points are complex numbers ``z + i x`` (see :mod:`tdcm_ros.model.kinematics`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+Complex = NDArray[np.complex128]
+Ints = NDArray[np.int64]
+
+RUNNING = 0
+CONVERGED = 1
+NON_FINITE = 2
+DIVERGING = 3
+SLOWED = 4
+EXHAUSTED = 5
+"""Statuses of :func:`iterate` per member."""
+
+
+def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, p: Complex, theta: Array,
+                  tangent: Complex) -> None:
+    """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m), exactly for
+    moments linear in each cell: writes nodes ``p`` (m), ``theta`` (rad) and ``tangent``."""
+    n = fc.shape[1]
+    nq = fq.shape[2]
+    pos = 0j
+    th = 0.0
+    t = 1.0 + 0j
+    p[0] = pos
+    theta[0] = th
+    tangent[0] = t
+    for i in range(n):
+        a = m_a[i]
+        b = m_b[i]
+        local = 0j
+        for q in range(nq):
+            phi = a * fq[0, i, q] + b * fq[1, i, q]
+            local += fq[2, i, q] * complex(math.cos(phi), math.sin(phi))
+        pos = pos + t * local
+        th = th + (a * fc[0, i] + b * fc[1, i])
+        t = complex(math.cos(th), math.sin(th))
+        p[i + 1] = pos
+        theta[i + 1] = th
+        tangent[i + 1] = t
+
+
+def moments_row(r_c: float, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
+                m_a: Array, m_b: Array) -> None:
+    """Tendon moment ``m = (p_c - p) x (-T t_c)`` (N m) at each cell's ends for one member,
+    with the tension ``t_a``, ``t_b`` (N) at each cell's start and end: ``R_c T`` where the
+    tendon follows the offset curve, ``T`` times the distance to the chord line elsewhere."""
+    n = ic.shape[1]
+    offset = 1j * r_c
+    for i in range(n):
+        if ic[2, i] != 0:
+            m_a[i] = r_c * t_a[i]
+            m_b[i] = r_c * t_b[i]
+        else:
+            start = ic[0, i]
+            end = ic[1, i]
+            anchor = p[start] + offset * tangent[start]
+            chord = p[end] + offset * tangent[end] - anchor
+            chord = chord / abs(chord)
+            m_a[i] = -t_a[i] * ((anchor - p[i]).conjugate() * chord).imag
+            m_b[i] = -t_b[i] * ((anchor - p[i + 1]).conjugate() * chord).imag
+
+
+def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Array) -> None:
+    """Smallest gap (m) between the two faces of every notch of one member, either side of
+    the body: the signed distance of each face's outer corner from the other face (``inf``
+    for padding notches)."""
+    for k in range(notch.shape[1]):
+        left = notch[0, k]
+        right = notch[1, k]
+        if left < 0:
+            out[k] = math.inf
+            continue
+        t_l = tangent[left]
+        t_r = tangent[right]
+        span = p[right] - p[left]
+        smallest = math.inf
+        for side in (1.0, -1.0):
+            delta = span + (1j * side * r_outer) * (t_r - t_l)
+            smallest = min(smallest, (t_l.conjugate() * delta).real,
+                           (t_r.conjugate() * delta).real)
+        out[k] = smallest
+
+
+def integrate(fc: Array, fq: Array, m_a: Array, m_b: Array, p: Complex, theta: Array,
+              tangent: Complex) -> None:
+    """:func:`integrate_row` for every member (``m_a``, ``m_b`` (M, n); outputs (M, n+1))."""
+    for j in range(m_a.shape[0]):
+        integrate_row(fc[j], fq[j], m_a[j], m_b[j], p[j], theta[j], tangent[j])
+
+
+def moments(scal: Array, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
+            m_a: Array, m_b: Array) -> None:
+    """:func:`moments_row` for every member (tensions and moments (M, n))."""
+    for j in range(m_a.shape[0]):
+        moments_row(scal[j, 0], p[j], tangent[j], t_a[j], t_b[j], ic[j], m_a[j], m_b[j])
+
+
+def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> None:
+    """:func:`gaps_row` for every member (``out`` (M, K))."""
+    for j in range(p.shape[0]):
+        gaps_row(scal[j, 1], p[j], tangent[j], notch[j], out[j])
+
+
+def iterate(fc: Array, fq: Array, ic: Ints, scal: Array, tension: Array, x: Array, p: Complex,
+            theta: Array, tangent: Complex, params: Array, budget: int, history: Array,
+            count: Ints, status: Ints) -> None:
+    """Plain (or damped) fixed-point iteration of the constant-tension tendon moment.
+
+    Per member: new moments ``g`` from the shape, ``x <- x + relaxation (g - x)``, new shape;
+    the step is the largest node displacement (m). ``x`` (M, 2n) and the shape ``p``,
+    ``theta``, ``tangent`` (M, n+1) hold the start and receive the last iterate; ``history``
+    (M, budget) the steps; ``count`` their number; ``status`` why each member stopped:
+    ``CONVERGED`` (step <= tol), ``NON_FINITE`` (the step is not finite: the previous iterate
+    is kept, no step recorded), ``DIVERGING`` (step > 2 L, or > growth x the smallest step
+    after 5 steps), ``SLOWED`` (``slow > 0`` and a step > slow x the previous one),
+    ``EXHAUSTED``. ``params`` = (tol (m), relaxation, slow, growth).
+    """
+    n = fc.shape[2]
+    tol = params[0]
+    relaxation = params[1]
+    slow = params[2]
+    growth = params[3]
+    g = np.empty(2 * n)
+    t_a = np.empty(n)
+    new_p = np.empty(n + 1, np.complex128)
+    new_theta = np.empty(n + 1)
+    new_tangent = np.empty(n + 1, np.complex128)
+    for j in range(x.shape[0]):
+        r_c = scal[j, 0]
+        limit = 2.0 * scal[j, 2]
+        t_a[:] = tension[j]
+        xj = x[j]
+        pj = p[j]
+        smallest = math.inf
+        status[j] = EXHAUSTED
+        count[j] = 0
+        for k in range(budget):
+            moments_row(r_c, pj, tangent[j], t_a, t_a, ic[j], g[:n], g[n:])
+            if relaxation != 1.0:
+                for i in range(2 * n):
+                    g[i] = xj[i] + relaxation * (g[i] - xj[i])
+            integrate_row(fc[j], fq[j], g[:n], g[n:], new_p, new_theta, new_tangent)
+            step = 0.0
+            for i in range(n + 1):
+                d = abs(new_p[i] - pj[i])
+                if not d <= step:
+                    step = d
+                    if math.isnan(d):
+                        break
+            if not math.isfinite(step):
+                status[j] = NON_FINITE
+                break
+            history[j, k] = step
+            count[j] = k + 1
+            xj[:] = g
+            pj[:] = new_p
+            theta[j, :] = new_theta
+            tangent[j, :] = new_tangent
+            smallest = min(smallest, step)
+            if step <= tol:
+                status[j] = CONVERGED
+                break
+            if step > limit or (k >= 5 and step > growth * smallest):
+                status[j] = DIVERGING
+                break
+            if slow > 0.0 and k >= 1 and step > slow * history[j, k - 1]:
+                status[j] = SLOWED
+                break
+
+
+KERNELS = ("integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps", "iterate")
+"""The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

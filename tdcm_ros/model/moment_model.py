@@ -1,0 +1,179 @@
+"""The moment models Algorithm 1 iterates: one interface, three implementations.
+
+A :class:`MomentModel` maps a shape to the cell end moments ``x = [m_a, m_b]`` (N m), says
+which moments bend the body, checks its own physical limits before and after iterating, and
+lists the convergence strategies that suit it. :func:`tdcm_ros.model.solver.solve` picks one:
+
+- :class:`ClosedForm`: the paper's model with the tendon's equilibrium form (eq. 11 closed);
+  its plain iteration runs in the compiled kernel (:func:`tdcm_ros.model.kernel.iterate`);
+- :class:`LiteralSum`: the paper's model as the literal sum of eqs. 8-10;
+- :class:`~tdcm_ros.model.loading.LoadedModel`: a :class:`~tdcm_ros.model.loading.Loading`.
+
+"No loading" is the closed form itself (the neutral case), not a branch of the solver.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.model import loads
+from tdcm_ros.model.cells import Cells
+from tdcm_ros.model.compiled import kernels
+from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.kinematics import PlanarShape
+from tdcm_ros.model.limits import (
+    check_closure,
+    check_singularity,
+    check_tendon_singularity,
+)
+from tdcm_ros.model.settings import SolverSettings
+
+Array = NDArray[np.float64]
+
+DIVERGENCE_GROWTH = 1e3
+"""A step this many times the smallest one so far (after 5 steps) is divergence."""
+
+class Plan(NamedTuple):
+    """One convergence strategy: ``mode`` (``auto``, ``picard``, ``anderson``,
+    ``relaxation`` or ``continuation``), its iteration cap, whether ``auto`` restarts Anderson
+    from the initial iterate and whether continuation adapts its steps."""
+
+    name: str
+    mode: str
+    budget: int
+    restart: bool = False
+    adaptive: bool = False
+
+
+class PlainRun(NamedTuple):
+    """Outcome of a compiled plain iteration: last iterate, its shape, steps (m), status."""
+
+    x: Array
+    shape: PlanarShape
+    history: list[float]
+    status: int
+
+
+class MomentModel(Protocol):
+    """What the solver needs from a model of the moments on one grid."""
+
+    grid: Grid
+
+    def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
+        """New ``[m_a, m_b]`` (N m) for ``shape``, produced by ``x``, at tension ``level`` (N)
+        with the external loads scaled by ``factor``."""
+        ...
+
+    def bend_moments(self, x: Array) -> Array:
+        """The moments (N m) that set the curvature."""
+        ...
+
+    def check_before(self, tension: float) -> None:
+        """Raise a limit error known before iterating."""
+        ...
+
+    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
+        """Raise a limit error of the converged solution."""
+        ...
+
+    def plans(self, settings: SolverSettings) -> list[Plan]:
+        """Strategies in order."""
+        ...
+
+    def warm_scale(self, previous: float, tension: float) -> float | None:
+        """Factor on a converged solution at ``previous`` N to start at ``tension`` N (None:
+        unusable)."""
+        ...
+
+    def extras(self, x: Array, shape: PlanarShape, tension: float
+               ) -> tuple[Array | None, Array | None]:
+        """``(contact_scale, tendon_tension)`` of a result, None where not applicable."""
+        ...
+
+    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
+              relaxation: float, slow: float) -> PlainRun | None:
+        """Plain (``relaxation`` 1) or damped iteration in the compiled kernel, handing over
+        when a step exceeds ``slow`` times the previous (0: never); None if unavailable."""
+        ...
+
+
+def paper_plans(settings: SolverSettings) -> list[Plan]:
+    """The paper model's strategies: Picard then Anderson, relaxation, continuation."""
+    budget = settings.max_iter
+    if settings.acceleration != "auto":
+        mode = "picard" if settings.acceleration == "none" else settings.acceleration
+        return [Plan(settings.acceleration, mode, budget)]
+    plans = [Plan("picard+anderson", "auto", budget), Plan("relaxation", "relaxation", budget)]
+    if settings.continuation_steps > 0:
+        plans.append(Plan("continuation", "continuation", budget))
+    return plans
+
+
+class ClosedForm:
+    """The paper's model, tendon moment in closed form; the neutral loading."""
+
+    def __init__(self, grid: Grid) -> None:
+        self.grid = grid
+        self.cells = Cells.of(grid)
+
+    def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
+        m_a, m_b = loads.closed_form(self.grid, shape, np.float64(level))
+        return np.concatenate([m_a, m_b])
+
+    def bend_moments(self, x: Array) -> Array:
+        return x
+
+    def check_before(self, tension: float) -> None:
+        check_tendon_singularity(self.grid, tension)
+
+    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
+        check_closure(self.grid, shape, tension)
+
+    def plans(self, settings: SolverSettings) -> list[Plan]:
+        return paper_plans(settings)
+
+    def warm_scale(self, previous: float, tension: float) -> float | None:
+        return tension / previous if previous > 0.0 else None
+
+    def extras(self, x: Array, shape: PlanarShape, tension: float
+               ) -> tuple[Array | None, Array | None]:
+        return None, None
+
+    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
+              relaxation: float, slow: float) -> PlainRun | None:
+        cells = self.cells
+        budget = max(budget, 0)
+        xs = x.reshape(1, -1).copy()
+        p = shape.p.reshape(1, -1).copy()
+        theta = shape.theta.reshape(1, -1).copy()
+        tangent = shape.tangent.reshape(1, -1).copy()
+        history = np.empty((1, max(budget, 1)))
+        count = np.zeros(1, np.int64)
+        status = np.zeros(1, np.int64)
+        kernels().iterate(cells.fc, cells.fq, cells.ic, cells.scal, np.array([level]), xs, p,
+                          theta, tangent, np.array([tol, relaxation, slow, DIVERGENCE_GROWTH]),
+                          budget, history, count, status)
+        return PlainRun(xs[0], PlanarShape(p=p[0], theta=theta[0], tangent=tangent[0]),
+                        history[0, :count[0]].tolist(), int(status[0]))
+
+
+class LiteralSum(ClosedForm):
+    """The paper's model, tendon moment as the literal sum of eqs. 8-10; its moments are
+    known only after iterating, so the singularity is also checked on the solution."""
+
+    def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
+        n = self.grid.n_cells
+        m_a, m_b = loads.literal(self.grid, shape, level, x[:n], x[n:])
+        return np.concatenate([m_a, m_b])
+
+    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
+        n = self.grid.n_cells
+        check_singularity(self.grid, x[:n], x[n:])
+        check_closure(self.grid, shape, tension)
+
+    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
+              relaxation: float, slow: float) -> PlainRun | None:
+        return None
