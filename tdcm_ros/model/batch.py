@@ -1,15 +1,14 @@
 """Vectorised Algorithm 1: many designs and tensions in one call, same answers as ``solve``.
 
 Designs whose grids share a cell layout (same ``N``, same present segments, same settings)
-are stacked: their per-cell integrals ``C0``, ``C1``, ``A0``, ``A1``, ``w_q`` gain a leading
-member axis and every member iterates at once. Each member follows exactly the iteration of
-:func:`tdcm_ros.model.solve` (closed-form loads, initial moment ``R_c T``, stop when no node
-moves more than ``tol``): plain (or, for ``acceleration="relaxation"``, damped) iteration
-runs vectorised; a member that ``solve`` would hand to Anderson mixing, relaxation or
+are stacked as :class:`~tdcm_ros.model.cells.Cells` (a leading member axis) and every member
+runs the kernels of :func:`tdcm_ros.model.solve` itself (:mod:`tdcm_ros.model.kernel`:
+closed-form loads, initial moment ``R_c T``, stop when no node moves more than ``tol``):
+plain (or, for ``acceleration="relaxation"``, damped) iteration runs in the kernel; a member that ``solve`` would hand to Anderson mixing, relaxation or
 continuation (it slowed down, diverged or ran out of budget), and every member under
 ``loads="literal"``, is solved by ``solve`` itself. The tendon-offset singularity (before
-iterating) and notch closure (on the solution) are checked per member with the same
-formulas as :mod:`tdcm_ros.model.limits`.
+iterating, the formula of :mod:`tdcm_ros.model.limits`) and notch closure (on the solution,
+the kernel's notch gaps) are checked per member.
 
 Nothing is raised for a member: each gets a status (``STATUSES``) and a message. Numbers are
 returned only for ``ok`` members; the others hold NaN.
@@ -24,6 +23,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tdcm_ros.model.cells import Cells
+from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import (
     InvalidDesignError,
@@ -32,7 +33,8 @@ from tdcm_ros.model.errors import (
     TensionRangeError,
 )
 from tdcm_ros.model.grid import PEAK_SAMPLES, Grid, build_grid
-from tdcm_ros.model.kinematics import PlanarShape
+from tdcm_ros.model.kernel import CONVERGED
+from tdcm_ros.model.kinematics import PlanarShape, integrate
 from tdcm_ros.model.limits import check_closure, check_tendon_singularity, check_tension
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import (
@@ -84,23 +86,14 @@ class BatchResult:
 
 @dataclass(frozen=True, eq=False)
 class _Stack:
-    """Arrays of designs sharing one cell layout, stacked on a leading axis (SI units).
-
-    ``strain0``/``strain1`` (designs, notch cells, samples) give the bending strain at
-    ``PEAK_SAMPLES`` points of every notch cell as ``|m_a S0 + m_b S1|``.
-    """
+    """Designs sharing one cell layout: their grids, their :class:`Cells` (one row per
+    design) and the strain coefficients ``strain0``/``strain1`` (designs, notch cells,
+    samples) giving the bending strain at ``PEAK_SAMPLES`` points of every notch cell as
+    ``|m_a S0 + m_b S1|``."""
 
     template: Grid
     grids: NDArray[np.object_]
-    C0: Array
-    C1: Array
-    A0: Array
-    A1: Array
-    w_q: Array
-    r_c: Array
-    r_outer: Array
-    length: Array
-    peak_c: Array
+    cells: Cells
     strain0: Array
     strain1: Array
 
@@ -108,26 +101,17 @@ class _Stack:
     def of(cls, grids: Sequence[Grid]) -> _Stack:
         """Stack ``grids`` (all of one layout)."""
         coefficients = [_strain_coefficients(g) for g in grids]
-        return cls(
-            template=grids[0], grids=_object_array(grids), C0=np.stack([g.C0 for g in grids]),
-            C1=np.stack([g.C1 for g in grids]), A0=np.stack([g.A0 for g in grids]),
-            A1=np.stack([g.A1 for g in grids]), w_q=np.stack([g.w_q for g in grids]),
-            r_c=np.array([g.design.R_c for g in grids]),
-            r_outer=np.array([g.design.R_outer for g in grids]),
-            length=np.array([g.design.length for g in grids]),
-            peak_c=np.array([g.constrained_peak_c for g in grids]),
-            strain0=np.stack([c[0] for c in coefficients]),
-            strain1=np.stack([c[1] for c in coefficients]))
+        return cls(template=grids[0], grids=_object_array(grids), cells=Cells.stack(grids),
+                   strain0=np.stack([c[0] for c in coefficients]),
+                   strain1=np.stack([c[1] for c in coefficients]))
 
     def take(self, rows: NDArray[np.int64]) -> _Stack:
         """The stack of designs ``rows`` (repeats allowed): one row per member."""
-        if rows.size == self.C0.shape[0] and np.array_equal(rows, np.arange(rows.size)):
+        if rows.size == self.cells.members and np.array_equal(rows, np.arange(rows.size)):
             return self
-        return _Stack(template=self.template, grids=self.grids[rows], C0=self.C0[rows], C1=self.C1[rows],
-                      A0=self.A0[rows], A1=self.A1[rows], w_q=self.w_q[rows],
-                      r_c=self.r_c[rows], r_outer=self.r_outer[rows],
-                      length=self.length[rows], peak_c=self.peak_c[rows],
-                      strain0=self.strain0[rows], strain1=self.strain1[rows])
+        return _Stack(template=self.template, grids=self.grids[rows],
+                      cells=self.cells.take(rows), strain0=self.strain0[rows],
+                      strain1=self.strain1[rows])
 
     def strain(self, m_a: Array, m_b: Array) -> Array:
         """Largest notch bending strain of each row from its cell end moments (N m)."""
@@ -279,7 +263,7 @@ def _solve_group(out: _Outcome, design_ids: list[int], stack: _Stack,
         except TensionRangeError as error:
             out.fail(np.array([m]), error)
     # limits.check_tendon_singularity, evaluated in the same order of operations.
-    r_c, peak = stack.r_c[rows], stack.peak_c[rows]
+    r_c, peak = stack.cells.r_c[rows], stack.cells.constrained_peak_c[rows]
     singular = ~bad & (r_c**2 * tension * peak >= 1.0) & (r_c * (r_c * tension) * peak >= 1.0)
     for m, row in zip(members[singular], rows[singular]):
         try:
@@ -296,118 +280,56 @@ def _solve_group(out: _Outcome, design_ids: list[int], stack: _Stack,
         _iterate(out, members[chunk], stack.take(rows[chunk]), settings)
 
 
-def _integrate(st: _Stack, m_a: Array, m_b: Array) -> tuple[ComplexArray, Array, ComplexArray]:
-    """:func:`kinematics.integrate` for stacked members: nodes ``p``, ``theta``, tangents."""
-    phi = m_a[..., None] * st.A0 + m_b[..., None] * st.A1
-    local = np.einsum("...q,...q->...", st.w_q, np.cos(phi)) + 1j * np.einsum(
-        "...q,...q->...", st.w_q, np.sin(phi))
-    theta = _cumsum0(m_a * st.C0 + m_b * st.C1)
-    tangent = np.exp(1j * theta)
-    p = _cumsum0(tangent[..., :-1] * local)
-    return p, theta, tangent
-
-
-def _cumsum0(values: Any) -> Any:
-    """Cumulative sum along the last axis with a leading zero."""
-    out = np.zeros(values.shape[:-1] + (values.shape[-1] + 1,), dtype=values.dtype)
-    np.cumsum(values, axis=-1, out=out[..., 1:])
-    return out
-
-
-def _closed_form(st: _Stack, p: ComplexArray, tangent: ComplexArray, tension: Array
-                 ) -> tuple[Array, Array]:
-    """:func:`loads.closed_form` with a per-member tendon offset ``R_c``."""
-    grid = st.template
-    m_a = np.empty(tension.shape + (grid.n_cells,))
-    m_a[...] = (st.r_c * tension)[:, None]
-    m_b = m_a.copy()
-    cells = grid.chord_cells
-    if cells.size == 0:
-        return m_a, m_b
-    p_c = p + (1j * st.r_c)[:, None] * tangent
-    anchor = p_c[:, grid.chord_start_node[cells]]
-    chord = p_c[:, grid.chord_end_node[cells]] - anchor
-    chord = chord / np.abs(chord)
-    t = -tension[:, None]
-    m_a[:, cells] = t * (np.conj(anchor - p[:, cells]) * chord).imag
-    m_b[:, cells] = t * (np.conj(anchor - p[:, cells + 1]) * chord).imag
-    return m_a, m_b
-
-
-def _min_gap(st: _Stack, p: ComplexArray, tangent: ComplexArray) -> Array:
-    """:func:`limits.notch_gaps` per member, reduced to the smallest gap (m)."""
-    left, right = st.template.notch_left_node, st.template.notch_right_node
-    t_l, t_r = tangent[:, left], tangent[:, right]
-    span = p[:, right] - p[:, left]
-    gaps = []
-    for side in (1.0, -1.0):
-        delta = span + (1j * side * st.r_outer)[:, None] * (t_r - t_l)
-        gaps.append((np.conj(t_l) * delta).real)
-        gaps.append((np.conj(t_r) * delta).real)
-    return np.min(np.minimum(np.minimum(gaps[0], gaps[1]), np.minimum(gaps[2], gaps[3])),
-                  axis=-1)
-
-
 def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack,
              settings: SolverSettings) -> None:
     """Algorithm 1 on one chunk (row ``i`` of ``st`` is member ``members[i]``).
 
-    Mirrors ``solver._iterate``: plain iteration (damped for ``relaxation``; one plain step
-    for ``anderson``); a member ``solve`` would switch to Anderson, or that diverges or
-    exhausts the budget, is queued for the single solve.
+    The kernel's plain iteration, as in ``solver._iterate`` (damped for ``relaxation``; one
+    plain step for ``anderson``); a member ``solve`` would switch to Anderson, or that
+    diverges, turns non-finite or exhausts the budget, is queued for the single solve.
     """
     mode = settings.acceleration
     budget = 1 if mode == "anderson" else settings.max_iter
+    cells = st.cells
+    n = cells.n_cells
     tension = out.tensions[members]
-    x_a = np.empty((members.size, st.template.n_cells))
-    x_a[...] = (st.r_c * tension)[:, None]
-    x_b = x_a.copy()
-    p, theta, tangent = _integrate(st, x_a, x_b)
-    previous = np.full(members.size, np.inf)
-    smallest = np.full(members.size, np.inf)
-    for k in range(1, budget + 1):
-        g_a, g_b = _closed_form(st, p, tangent, tension)
-        if mode == "relaxation":
-            g_a = x_a + settings.relaxation * (g_a - x_a)
-            g_b = x_b + settings.relaxation * (g_b - x_b)
-        new_p, theta, tangent = _integrate(st, g_a, g_b)
-        step = np.max(np.abs(new_p - p), axis=-1)
-        x_a, x_b, p = g_a, g_b, new_p
-        done = step <= settings.tol
-        smallest = np.minimum(smallest, step)
-        failing = (~np.isfinite(step) | (step > 2.0 * st.length)
-                   | ((k > 5) & (step > DIVERGENCE_GROWTH * smallest)))
-        if mode == "auto" and k >= 2:
-            failing |= step > SLOW_CONTRACTION * previous
-        if k == budget:
-            failing |= True
-        handoff = ~done & failing
-        if np.any(done):
-            _finish(out, members[done], st.take(np.flatnonzero(done)), x_a[done], x_b[done],
-                    p[done], theta[done], tangent[done], k)
-        for row in np.flatnonzero(handoff):
-            out.pending.append((int(members[row]), st.take(np.array([row]))))
-        keep = np.flatnonzero(~(done | handoff))
-        if keep.size == 0:
-            return
-        members, st, tension, previous, smallest = (members[keep], st.take(keep),
-                                                    tension[keep], step[keep], smallest[keep])
-        x_a, x_b, p, theta, tangent = x_a[keep], x_b[keep], p[keep], theta[keep], tangent[keep]
+    x = np.empty((members.size, 2 * n))
+    x[...] = (cells.r_c * tension)[:, None]
+    shape = integrate(cells, x[:, :n], x[:, n:])
+    p, theta, tangent = shape.p, shape.theta, shape.tangent
+    history = np.empty((members.size, budget))
+    count = np.zeros(members.size, np.int64)
+    status = np.zeros(members.size, np.int64)
+    params = np.array([settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
+                       SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH])
+    kernels().iterate(cells.fc, cells.fq, cells.ic, cells.scal, tension, x, p, theta, tangent,
+                      params, budget, history, count, status)
+    done = status == CONVERGED
+    for row in np.flatnonzero(~done):
+        out.pending.append((int(members[row]), st.take(np.array([row]))))
+    rows = np.flatnonzero(done)
+    if rows.size:
+        _finish(out, members[rows], st.take(rows), x[rows], PlanarShape(
+            p=p[rows], theta=theta[rows], tangent=tangent[rows]), count[rows])
 
 
-def _finish(out: _Outcome, members: NDArray[np.int64], st: _Stack, x_a: Array, x_b: Array,
-            p: ComplexArray, theta: Array, tangent: ComplexArray, iterations: int) -> None:
+def _finish(out: _Outcome, members: NDArray[np.int64], st: _Stack, x: Array,
+            shape: PlanarShape, iterations: NDArray[np.int64]) -> None:
     """Check closure (as :func:`limits.check_closure`) on converged members; store the rest."""
     out.iterations[members] = iterations
-    closed = _min_gap(st, p, tangent) <= 0.0
+    cells = st.cells
+    n = cells.n_cells
+    gaps = np.empty((members.size, cells.notch.shape[2]))
+    kernels().gaps(cells.scal, shape.p, shape.tangent, cells.notch, gaps)
+    closed = np.min(gaps, axis=1, initial=np.inf) <= 0.0
     for row in np.flatnonzero(closed):
         m = int(members[row])
-        grid = st.grids[row]
-        shape = PlanarShape(p=p[row], theta=theta[row], tangent=tangent[row])
+        row_shape = PlanarShape(p=shape.p[row], theta=shape.theta[row],
+                                tangent=shape.tangent[row])
         try:
-            check_closure(grid, shape, float(out.tensions[m]))
+            check_closure(st.grids[row], row_shape, float(out.tensions[m]))
         except ModelError as error:
             out.fail(np.array([m]), error)
     ok = ~closed
-    out.store(members[ok], p[ok, -1], theta[ok, -1], st.take(np.flatnonzero(ok)).strain(
-        x_a[ok], x_b[ok]))
+    out.store(members[ok], shape.p[ok, -1], shape.theta[ok, -1],
+              st.take(np.flatnonzero(ok)).strain(x[ok, :n], x[ok, n:]))
