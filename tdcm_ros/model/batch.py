@@ -34,7 +34,7 @@ from tdcm_ros.model.errors import (
 )
 from tdcm_ros.model.grid import PEAK_SAMPLES, Grid, build_grid
 from tdcm_ros.model.kernel import CONVERGED
-from tdcm_ros.model.kinematics import PlanarShape, integrate
+from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_tendon_singularity, check_tension
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import (
@@ -295,33 +295,32 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack,
     tension = out.tensions[members]
     x = np.empty((members.size, 2 * n))
     x[...] = (cells.r_c * tension)[:, None]
-    shape = integrate(cells, x[:, :n], x[:, n:])
-    p, theta, tangent = shape.p, shape.theta, shape.tangent
+    p = np.empty((members.size, n + 1), np.complex128)
+    theta = np.empty((members.size, n + 1))
+    tangent = np.empty((members.size, n + 1), np.complex128)
     history = np.empty((members.size, budget))
-    count = np.zeros(members.size, np.int64)
-    status = np.zeros(members.size, np.int64)
+    stats = np.empty((members.size, 2), np.int64)
+    gap = np.empty(members.size)
     params = np.array([settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
                        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH])
-    kernels().iterate(cells.fc, cells.fq, cells.ic, cells.scal, tension, x, p, theta, tangent,
-                      params, budget, history, count, status)
-    done = status == CONVERGED
+    kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, tension, x, p,
+                      theta, tangent, params, budget, history, stats, gap)
+    done = stats[:, 1] == CONVERGED
     for row in np.flatnonzero(~done):
         out.pending.append((int(members[row]), st.take(np.array([row]))))
     rows = np.flatnonzero(done)
     if rows.size:
         _finish(out, members[rows], st.take(rows), x[rows], PlanarShape(
-            p=p[rows], theta=theta[rows], tangent=tangent[rows]), count[rows])
+            p=p[rows], theta=theta[rows], tangent=tangent[rows]), stats[rows, 0], gap[rows])
 
 
 def _finish(out: _Outcome, members: NDArray[np.int64], st: _Stack, x: Array,
-            shape: PlanarShape, iterations: NDArray[np.int64]) -> None:
-    """Check closure (as :func:`limits.check_closure`) on converged members; store the rest."""
+            shape: PlanarShape, iterations: NDArray[np.int64], gap: Array) -> None:
+    """Raise closure (as :func:`limits.check_closure`) on converged members whose smallest
+    notch gap ``gap`` (m) is not positive; store the rest."""
     out.iterations[members] = iterations
-    cells = st.cells
-    n = cells.n_cells
-    gaps = np.empty((members.size, cells.notch.shape[2]))
-    kernels().gaps(cells.scal, shape.p, shape.tangent, cells.notch, gaps)
-    closed = np.min(gaps, axis=1, initial=np.inf) <= 0.0
+    n = st.cells.n_cells
+    closed = gap <= 0.0
     for row in np.flatnonzero(closed):
         m = int(members[row])
         row_shape = PlanarShape(p=shape.p[row], theta=shape.theta[row],

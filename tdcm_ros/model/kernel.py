@@ -126,15 +126,17 @@ def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> 
         gaps_row(scal[j, 1], p[j], tangent[j], notch[j], out[j])
 
 
-def iterate(fc: Array, fq: Array, ic: Ints, scal: Array, tension: Array, x: Array, p: Complex,
-            theta: Array, tangent: Complex, params: Array, budget: int, history: Array,
-            count: Ints, status: Ints) -> None:
+def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: Array, x: Array,
+            p: Complex, theta: Array, tangent: Complex, params: Array, budget: int,
+            history: Array, stats: Ints, gap: Array) -> None:
     """Plain (or damped) fixed-point iteration of the constant-tension tendon moment.
 
-    Per member: new moments ``g`` from the shape, ``x <- x + relaxation (g - x)``, new shape;
-    the step is the largest node displacement (m). ``x`` (M, 2n) and the shape ``p``,
-    ``theta``, ``tangent`` (M, n+1) hold the start and receive the last iterate; ``history``
-    (M, budget) the steps; ``count`` their number; ``status`` why each member stopped:
+    Per member: the shape of the start ``x`` (M, 2n), then repeatedly new moments ``g`` from
+    the shape, ``x <- x + relaxation (g - x)`` and the new shape; the step is the largest
+    node displacement (m). ``x`` and the shape ``p``, ``theta``, ``tangent`` (M, n+1)
+    receive the last iterate; ``history``
+    (M, budget) the steps; ``gap`` (M,) the smallest notch gap (m, :func:`gaps_row`) of the
+    last shape; ``stats`` (M, 2) the number of steps and why each member stopped:
     ``CONVERGED`` (step <= tol), ``NON_FINITE`` (the step is not finite: the previous iterate
     is kept, no step recorded), ``DIVERGING`` (step > 2 L, or > growth x the smallest step
     after 5 steps), ``SLOWED`` (``slow > 0`` and a step > slow x the previous one),
@@ -150,15 +152,17 @@ def iterate(fc: Array, fq: Array, ic: Ints, scal: Array, tension: Array, x: Arra
     new_p = np.empty(n + 1, np.complex128)
     new_theta = np.empty(n + 1)
     new_tangent = np.empty(n + 1, np.complex128)
+    notch_gaps = np.empty(notch.shape[2])
     for j in range(x.shape[0]):
         r_c = scal[j, 0]
         limit = 2.0 * scal[j, 2]
         t_a[:] = tension[j]
         xj = x[j]
         pj = p[j]
+        integrate_row(fc[j], fq[j], xj[:n], xj[n:], pj, theta[j], tangent[j])
         smallest = math.inf
-        status[j] = EXHAUSTED
-        count[j] = 0
+        stats[j, 1] = EXHAUSTED
+        stats[j, 0] = 0
         for k in range(budget):
             moments_row(r_c, pj, tangent[j], t_a, t_a, ic[j], g[:n], g[n:])
             if relaxation != 1.0:
@@ -173,25 +177,50 @@ def iterate(fc: Array, fq: Array, ic: Ints, scal: Array, tension: Array, x: Arra
                     if math.isnan(d):
                         break
             if not math.isfinite(step):
-                status[j] = NON_FINITE
+                stats[j, 1] = NON_FINITE
                 break
             history[j, k] = step
-            count[j] = k + 1
+            stats[j, 0] = k + 1
             xj[:] = g
             pj[:] = new_p
             theta[j, :] = new_theta
             tangent[j, :] = new_tangent
             smallest = min(smallest, step)
             if step <= tol:
-                status[j] = CONVERGED
+                stats[j, 1] = CONVERGED
                 break
             if step > limit or (k >= 5 and step > growth * smallest):
-                status[j] = DIVERGING
+                stats[j, 1] = DIVERGING
                 break
             if slow > 0.0 and k >= 1 and step > slow * history[j, k - 1]:
-                status[j] = SLOWED
+                stats[j, 1] = SLOWED
                 break
+        gaps_row(scal[j, 1], pj, tangent[j], notch[j], notch_gaps)
+        gap[j] = math.inf
+        for k in range(notch_gaps.size):
+            gap[j] = min(gap[j], notch_gaps[k])
 
 
-KERNELS = ("integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps", "iterate")
+def iterate_from(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: Array,
+                 x0: Array, tol: float, relaxation: float, slow: float, growth: float,
+                 budget: int) -> tuple[Array, Complex, Array, Complex, Array, Ints, Array]:
+    """:func:`iterate` from a copy of ``x0``, into new arrays: returns ``(x, p, theta,
+    tangent, history, stats, gap)``."""
+    members = x0.shape[0]
+    nodes = fc.shape[2] + 1
+    x = x0.copy()
+    p = np.empty((members, nodes), np.complex128)
+    theta = np.empty((members, nodes))
+    tangent = np.empty((members, nodes), np.complex128)
+    history = np.empty((members, max(budget, 1)))
+    stats = np.empty((members, 2), np.int64)
+    gap = np.empty(members)
+    params = np.array([tol, relaxation, slow, growth])
+    iterate(fc, fq, ic, notch, scal, tension, x, p, theta, tangent, params, budget, history,
+            stats, gap)
+    return x, p, theta, tangent, history, stats, gap
+
+
+KERNELS = ("integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps", "iterate",
+           "iterate_from")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -32,6 +32,8 @@ def check_tension(tension: Any) -> float:
     A tension is a real number (``int``, ``float``, ``fractions.Fraction`` or a NumPy integer or
     floating scalar), finite and ``>= 0``; ``bool``, strings and arrays are refused.
     """
+    if type(tension) is float and math.isfinite(tension) and tension >= 0.0:
+        return tension
     if isinstance(tension, (bool, np.bool_)) or not isinstance(tension, numbers.Real):
         raise TensionRangeError(
             f"tension = {tension!r} is not a real number; allowed: a finite number in [0, inf) N",

@@ -261,7 +261,8 @@ class LoadedModel:
     def check_before(self, tension: float) -> None:
         """Nothing is known before iterating."""
 
-    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
+    def check_after(self, x: Array, shape: PlanarShape, tension: float,
+                    min_gap: float | None = None) -> None:
         """Singularity on the bending moments; closure unless notch contact is on."""
         n = self.grid.n_cells
         bend = self.bend_moments(x)
@@ -292,8 +293,8 @@ class LoadedModel:
                     if self.loading.tension_profile is not None else None)
         return scale, tensions
 
-    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
-              relaxation: float, slow: float) -> PlainRun | None:
+    def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
+              slow: float) -> PlainRun | None:
         """Not compiled: the solver iterates the moment map itself."""
         return None
 

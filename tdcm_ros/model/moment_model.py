@@ -14,6 +14,8 @@ lists the convergence strategies that suit it. :func:`tdcm_ros.model.solver.solv
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from functools import lru_cache
 from typing import NamedTuple, Protocol
 
 import numpy as np
@@ -49,12 +51,14 @@ class Plan(NamedTuple):
 
 
 class PlainRun(NamedTuple):
-    """Outcome of a compiled plain iteration: last iterate, its shape, steps (m), status."""
+    """Outcome of a compiled plain iteration: last iterate, its shape, steps (m), status
+    (:mod:`tdcm_ros.model.kernel`) and the shape's smallest notch gap (m)."""
 
     x: Array
     shape: PlanarShape
     history: list[float]
     status: int
+    min_gap: float
 
 
 class MomentModel(Protocol):
@@ -75,11 +79,13 @@ class MomentModel(Protocol):
         """Raise a limit error known before iterating."""
         ...
 
-    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
-        """Raise a limit error of the converged solution."""
+    def check_after(self, x: Array, shape: PlanarShape, tension: float,
+                    min_gap: float | None = None) -> None:
+        """Raise a limit error of the converged solution; ``min_gap`` is its smallest notch
+        gap (m) if already known."""
         ...
 
-    def plans(self, settings: SolverSettings) -> list[Plan]:
+    def plans(self, settings: SolverSettings) -> Sequence[Plan]:
         """Strategies in order."""
         ...
 
@@ -93,23 +99,24 @@ class MomentModel(Protocol):
         """``(contact_scale, tendon_tension)`` of a result, None where not applicable."""
         ...
 
-    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
-              relaxation: float, slow: float) -> PlainRun | None:
+    def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
+              slow: float) -> PlainRun | None:
         """Plain (``relaxation`` 1) or damped iteration in the compiled kernel, handing over
         when a step exceeds ``slow`` times the previous (0: never); None if unavailable."""
         ...
 
 
-def paper_plans(settings: SolverSettings) -> list[Plan]:
+@lru_cache(maxsize=64)
+def paper_plans(settings: SolverSettings) -> tuple[Plan, ...]:
     """The paper model's strategies: Picard then Anderson, relaxation, continuation."""
     budget = settings.max_iter
     if settings.acceleration != "auto":
         mode = "picard" if settings.acceleration == "none" else settings.acceleration
-        return [Plan(settings.acceleration, mode, budget)]
+        return (Plan(settings.acceleration, mode, budget),)
     plans = [Plan("picard+anderson", "auto", budget), Plan("relaxation", "relaxation", budget)]
     if settings.continuation_steps > 0:
         plans.append(Plan("continuation", "continuation", budget))
-    return plans
+    return tuple(plans)
 
 
 class ClosedForm:
@@ -127,12 +134,15 @@ class ClosedForm:
         return x
 
     def check_before(self, tension: float) -> None:
-        check_tendon_singularity(self.grid, tension)
+        if self.grid.design.R_c ** 2 * tension * self.cells.constrained_peak_c[0] >= 1.0:
+            check_tendon_singularity(self.grid, tension)
 
-    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
-        check_closure(self.grid, shape, tension)
+    def check_after(self, x: Array, shape: PlanarShape, tension: float,
+                    min_gap: float | None = None) -> None:
+        if min_gap is None or min_gap <= 0.0:
+            check_closure(self.grid, shape, tension)
 
-    def plans(self, settings: SolverSettings) -> list[Plan]:
+    def plans(self, settings: SolverSettings) -> Sequence[Plan]:
         return paper_plans(settings)
 
     def warm_scale(self, previous: float, tension: float) -> float | None:
@@ -142,23 +152,14 @@ class ClosedForm:
                ) -> tuple[Array | None, Array | None]:
         return None, None
 
-    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
-              relaxation: float, slow: float) -> PlainRun | None:
+    def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
+              slow: float) -> PlainRun | None:
         cells = self.cells
-        budget = max(budget, 0)
-        xs = x.reshape(1, -1).copy()
-        p = shape.p.reshape(1, -1).copy()
-        theta = shape.theta.reshape(1, -1).copy()
-        tangent = shape.tangent.reshape(1, -1).copy()
-        history = np.empty((1, max(budget, 1)))
-        count = np.zeros(1, np.int64)
-        status = np.zeros(1, np.int64)
-        kernels().iterate(cells.fc, cells.fq, cells.ic, cells.scal, np.array([level]), xs, p,
-                          theta, tangent, np.array([tol, relaxation, slow, DIVERGENCE_GROWTH]),
-                          budget, history, count, status)
-        return PlainRun(xs[0], PlanarShape(p=p[0], theta=theta[0], tangent=tangent[0]),
-                        history[0, :count[0]].tolist(), int(status[0]))
-
+        x, p, theta, tangent, history, stats, gap = kernels().iterate_from(
+            cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, np.full(1, level),
+            x.reshape(1, -1), tol, relaxation, slow, DIVERGENCE_GROWTH, max(budget, 0))
+        return PlainRun(x[0], PlanarShape(p=p[0], theta=theta[0], tangent=tangent[0]),
+                        history[0, :stats[0, 0]].tolist(), int(stats[0, 1]), float(gap[0]))
 
 class LiteralSum(ClosedForm):
     """The paper's model, tendon moment as the literal sum of eqs. 8-10; its moments are
@@ -169,11 +170,12 @@ class LiteralSum(ClosedForm):
         m_a, m_b = loads.literal(self.grid, shape, level, x[:n], x[n:])
         return np.concatenate([m_a, m_b])
 
-    def check_after(self, x: Array, shape: PlanarShape, tension: float) -> None:
+    def check_after(self, x: Array, shape: PlanarShape, tension: float,
+                    min_gap: float | None = None) -> None:
         n = self.grid.n_cells
         check_singularity(self.grid, x[:n], x[n:])
         check_closure(self.grid, shape, tension)
 
-    def plain(self, x: Array, shape: PlanarShape, level: float, budget: int, tol: float,
-              relaxation: float, slow: float) -> PlainRun | None:
+    def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
+              slow: float) -> PlainRun | None:
         return None

@@ -38,6 +38,7 @@ from tdcm_ros.model.moment_model import (
     ClosedForm,
     LiteralSum,
     MomentModel,
+    PlainRun,
     Plan,
 )
 from tdcm_ros.model.result import ConvergenceError, SolveResult
@@ -74,6 +75,7 @@ class _Run:
     history: list[float]
     converged: bool
     reason: str
+    min_gap: float | None = None
 
 
 def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_SETTINGS,
@@ -124,7 +126,7 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
             f"Algorithm 1 found no finite iterate at tension {t_base:g} N ({_reasons(runs)})")
     strategy, final = last
     if final.converged:
-        model.check_after(final.x, final.shape, t_base)
+        model.check_after(final.x, final.shape, t_base, final.min_gap)
     result = _result(grid, settings, t_base, final, strategy, iterations, history,
                      perf_counter() - started, loading, model)
     if not final.converged and strict:
@@ -177,7 +179,9 @@ def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
         if scale is not None:
             moments = warm_start.cell_moments
             return np.concatenate([moments[:, 0], moments[:, 1]]) * scale
-    return np.full(2 * grid.n_cells, grid.design.R_c * tension)
+    x0 = np.empty(2 * grid.n_cells)
+    x0.fill(grid.design.R_c * tension)
+    return x0
 
 
 def _run_plan(problem: _Problem, plan: Plan, tension: float, x0: Array, budget: int) -> _Run:
@@ -255,21 +259,22 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
     ``x0`` rather than from wherever it has wandered."""
     grid, settings, model = problem
     tol = settings.tol if tol is None else tol
-    x = x0
-    shape = start = problem.shape_of(x)
-    history: list[float] = []
     using = "picard" if mode == "auto" else mode
+    plain = None
     if using in ("picard", "relaxation"):
-        plain = model.plain(x, shape, tension, budget, tol,
+        plain = model.plain(x0, tension, budget, tol,
                             settings.relaxation if using == "relaxation" else 1.0,
                             SLOW_CONTRACTION if mode == "auto" else 0.0)
-        if plain is not None:
-            x, shape, history = plain.x, plain.shape, plain.history
-            if plain.status != SLOWED:
-                return _plain_outcome(x, shape, history, plain.status)
-            using = "anderson"
-            if restart:
-                x, shape = x0, start
+    if plain is None:
+        x, shape, history = x0, problem.shape_of(x0), []
+    else:
+        x, shape, history = plain.x, plain.shape, plain.history
+        if plain.status != SLOWED:
+            return _plain_outcome(plain)
+        using = "anderson"
+        if restart:
+            x, shape = x0, problem.shape_of(x0)
+    start = shape  # what plain iteration that slows restarts from (restart=True)
     d_x: list[Array] = []
     d_f: list[Array] = []
     last: tuple[Array, Array] | None = None
@@ -306,13 +311,14 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
                 f"budget exhausted, last step {history[-1]:.3g} m" if history else "no budget")
 
 
-def _plain_outcome(x: Array, shape: PlanarShape, history: list[float], status: int) -> _Run:
-    """The run of a compiled plain iteration that stopped with kernel ``status``."""
-    if status == CONVERGED:
-        return _Run(x, shape, history, True, "converged")
-    if status == NON_FINITE:
+def _plain_outcome(plain: PlainRun) -> _Run:
+    """The run of a compiled plain iteration that stopped (not to hand over)."""
+    x, shape, history = plain.x, plain.shape, plain.history
+    if plain.status == CONVERGED:
+        return _Run(x, shape, history, True, "converged", plain.min_gap)
+    if plain.status == NON_FINITE:
         return _Run(x, shape, history, False, "iterate became non-finite")
-    if status == DIVERGING:
+    if plain.status == DIVERGING:
         return _Run(x, shape, history, False, f"diverging (step {history[-1]:.3g} m)")
     return _Run(x, shape, history, False,
                 f"budget exhausted, last step {history[-1]:.3g} m" if history else "no budget")
