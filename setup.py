@@ -27,6 +27,7 @@ setup(
     install_requires=[
         "numpy>=1.24",
         "scipy>=1.10",
+        "numba>=0.60",
         "rosbags>=0.10.4",
         "mcap>=1.1",
         "PyYAML>=6",

@@ -225,15 +225,17 @@ def test_a_failing_least_squares_is_a_typed_convergence_error(monkeypatch):
 
 def test_strict_false_never_returns_nan(monkeypatch):
     """Without any finite iterate there is nothing to return: a typed error, not NaN."""
-    from tdcm_ros.model import solver
-    from tdcm_ros.model.kinematics import integrate
+    from tdcm_ros.model import compiled, kernel
 
-    def poisoned(grid, m_a, m_b):
-        shape = integrate(grid, m_a, m_b)
-        return type(shape)(p=shape.p * np.nan, theta=shape.theta * np.nan,
-                           tangent=shape.tangent)
+    integrate_row = kernel.integrate_row
 
-    monkeypatch.setattr(solver, "integrate", poisoned)
+    def poisoned(fc, fq, m_a, m_b, p, theta, tangent):
+        integrate_row(fc, fq, m_a, m_b, p, theta, tangent)
+        p[:] = np.nan
+        theta[:] = np.nan
+
+    monkeypatch.setitem(compiled._state, "build", kernel)  # the plain build, poisoned below
+    monkeypatch.setattr(kernel, "integrate_row", poisoned)
     with pytest.raises(ConvergenceError, match="no finite iterate") as info:
         solve(preset("paper-experiment"), 20.0, strict=False)
     assert info.value.result is None

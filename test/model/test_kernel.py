@@ -1,0 +1,145 @@
+"""One kernel source: its plain and compiled builds agree, members are independent, padding
+cells are neutral, and the compiled code caches (or not) wherever the package lives."""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tdcm_ros.model import SolverSettings, compiled, kernel, preset, solve
+from tdcm_ros.model.cells import Cells
+from tdcm_ros.model.grid import build_grid
+from tdcm_ros.model.kinematics import integrate
+from tdcm_ros.model.limits import notch_gaps
+from tdcm_ros.model.loads import closed_form
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture
+def plain_build(monkeypatch):
+    """Run the plain-Python build for the test's duration."""
+    monkeypatch.setitem(compiled._state, "build", kernel)
+
+
+def tips(designs, tensions, routing):
+    """Tip positions (m) of single solves."""
+    cfg = SolverSettings(routing=routing)
+    return np.array([solve(d, t, settings=cfg).tip_position for d, t in zip(designs, tensions)])
+
+
+@pytest.mark.parametrize("routing", ["paper", "free"])
+def test_plain_and_compiled_builds_agree(routing, monkeypatch):
+    designs = [preset("paper-experiment"), preset("fig3-wd-1.2").with_overrides(N=3)]
+    fast = tips(designs, [20.0, 7.0], routing)
+    monkeypatch.setitem(compiled._state, "build", kernel)
+    slow = tips(designs, [20.0, 7.0], routing)
+    np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-15)
+
+
+@settings(max_examples=15, deadline=None)
+@given(n_a=st.integers(1, 6), n_b=st.integers(1, 6), scale=st.floats(0.0, 40.0),
+       routing=st.sampled_from(["paper", "free"]))
+def test_padded_stack_gives_each_member_its_own_answers(n_a, n_b, scale, routing):
+    """Grids of different cell and notch counts stack with zero-length padding cells that
+    move no node: each member's shape, moments and gaps equal its own grid's."""
+    cfg = SolverSettings(routing=routing)
+    base = preset("paper-experiment")
+    grids = [build_grid(base.with_overrides(N=n_a), cfg), build_grid(base.with_overrides(N=n_b), cfg)]
+    cells = Cells.stack(grids)
+    rng = np.random.default_rng(n_a * 7 + n_b)
+    moments = [rng.uniform(0.0, 1e-3 * scale, g.n_cells) for g in grids]
+    padded = np.zeros((2, cells.n_cells))
+    for j, m in enumerate(moments):
+        padded[j, :m.size] = m
+    shape = integrate(cells, padded, padded)
+    m_a, _ = closed_form(cells, shape, np.array([scale, scale]))
+    for j, (grid, m) in enumerate(zip(grids, moments)):
+        alone = integrate(grid, m, m)
+        n = grid.n_cells
+        np.testing.assert_array_equal(shape.p[j, :n + 1], alone.p)
+        np.testing.assert_array_equal(shape.p[j, n:], alone.p[-1])  # padding moves nothing
+        np.testing.assert_array_equal(m_a[j, :n], closed_form(grid, alone, scale)[0])
+        gaps = np.empty((1, cells.notch.shape[2]))
+        kernel.gaps(cells.scal[j:j + 1], shape.p[j:j + 1], shape.tangent[j:j + 1],
+                    cells.notch[j:j + 1], gaps)
+        np.testing.assert_array_equal(gaps[0, :grid.notch_left_node.size],
+                                      notch_gaps(grid, alone))
+        assert np.all(gaps[0, grid.notch_left_node.size:] == np.inf)
+
+
+def test_plain_build_iterates_like_the_compiled_one(plain_build):
+    result = solve(preset("paper-experiment"), 20.0, settings=SolverSettings(routing="free"))
+    assert not compiled.is_compiled()
+    assert result.converged and result.iterations == 4
+
+
+def test_bad_switch_value_is_a_typed_error(monkeypatch):
+    monkeypatch.setitem(compiled._state, "build", None)
+    monkeypatch.setitem(compiled._state, "chosen", False)
+    monkeypatch.setenv(compiled.ENVIRONMENT, "yes")
+    with pytest.raises(compiled.InvalidSettingsError, match="TDCM_JIT"):
+        compiled.kernels()
+
+
+SCRIPT = ("import sys; from tdcm_ros.model import preset, solve, compiled; "
+          "r = solve(preset('paper-experiment'), 20.0); "
+          "print(compiled.is_compiled(), 'numba' in sys.modules, r.iterations)")
+
+
+def run_copy(tmp_path, env_extra, readonly=True):
+    """Run SCRIPT against a copy of the package (read-only if asked); its stdout."""
+    root = tmp_path / "pkg"
+    shutil.copytree(REPO / "tdcm_ros", root / "tdcm_ros",
+                    ignore=shutil.ignore_patterns("__pycache__"))
+    if readonly:
+        for path in [root, *root.rglob("*")]:
+            path.chmod(0o555 if path.is_dir() else 0o444)
+    env = {**os.environ, "PYTHONPATH": str(root), "PYTHONDONTWRITEBYTECODE": "1", **env_extra}
+    try:
+        out = subprocess.run([sys.executable, "-c", SCRIPT], env=env, capture_output=True,
+                             text=True, timeout=300, check=True)
+    finally:
+        for path in [root, *root.rglob("*")]:
+            path.chmod(0o755 if path.is_dir() else 0o644)
+    return out.stdout.split()
+
+
+def test_compiled_code_caches_in_numba_cache_dir_when_the_package_is_read_only(tmp_path):
+    cache = tmp_path / "cache"
+    home = tmp_path / "home"
+    home.mkdir()
+    env = {"NUMBA_CACHE_DIR": str(cache), "HOME": str(home), "TDCM_JIT": "1"}
+    assert run_copy(tmp_path, env) == ["True", "True", "1"]
+    assert any(cache.rglob("*.nbi")), "no cache index written"
+    shutil.rmtree(tmp_path / "pkg")
+    assert run_copy(tmp_path, env) == ["True", "True", "1"]  # loads from that cache
+
+
+def test_compiles_uncached_when_no_cache_location_is_writable():
+    """numba refuses ``cache=True`` (RuntimeError) when no cache directory is writable; the
+    kernels are then compiled without a cache instead of failing."""
+    calls = []
+
+    class FakeNumba:
+        @staticmethod
+        def njit(cache):
+            calls.append(cache)
+            if cache:
+                raise RuntimeError("cannot cache function: no locator available")
+            return lambda function: function
+
+    build = compiled._compile(FakeNumba)
+    assert calls == [True, False] * len(kernel.KERNELS)
+    assert build.iterate.__code__ is kernel.iterate.__code__
+    assert build.iterate.__globals__["integrate_row"] is build.integrate_row
+
+
+def test_switch_off_never_imports_numba(tmp_path):
+    assert run_copy(tmp_path, {"TDCM_JIT": "0"}, readonly=False) == ["False", "False", "1"]
