@@ -11,6 +11,7 @@ Separate entry points, kept out of this face because they pull scipy:
 (the accuracy/speed benchmark behind ``tdcm bench``).
 """
 
+from tdcm_ros.model.compiled import use_compiled, warm_up
 from tdcm_ros.model.design import (
     FIELD_SPECS,
     PRESETS,
@@ -92,4 +93,6 @@ __all__ = [
     "solve",
     "surface_points",
     "sweep",
+    "use_compiled",
+    "warm_up",
 ]

@@ -37,6 +37,7 @@ from tdcm_ros.model import (
     SolverSettings,
     preset,
     solve,
+    warm_up,
 )
 from tdcm_ros.nodes.shape_messages import header, midline_messages
 from tdcm_ros.runtime import (
@@ -99,6 +100,7 @@ class ModelNode(NodeLogic):
         diag_period = float(fixed["diagnostics_period_s"])
         self.design, self.settings = self._config({})
         port.add_on_set_parameters(self._on_set)
+        warm_up()  # compile the solver's kernel now, not on the first message
 
         qos = QoS(depth=10)
         self.publishers = {topic: port.create_publisher(topic, type_name, qos) for topic, type_name
