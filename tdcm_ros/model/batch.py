@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -87,13 +88,13 @@ class BatchResult:
 @dataclass(frozen=True, eq=False)
 class _Stack:
     """Designs sharing one cell layout: their grids, their :class:`Cells` (one row per
-    design) and the strain coefficients ``strain0``/``strain1`` (designs, notch cells,
-    samples) giving the bending strain at ``PEAK_SAMPLES`` points of every notch cell as
-    ``|m_a S0 + m_b S1|``."""
+    design) and, per design, its notch cells ``notch_cells`` and the strain coefficients
+    ``strain0``/``strain1`` (designs, notch cells, samples) giving the bending strain at
+    ``PEAK_SAMPLES`` points of every notch cell as ``|m_a S0 + m_b S1|``."""
 
-    template: Grid
     grids: NDArray[np.object_]
     cells: Cells
+    notch_cells: NDArray[np.int64]
     strain0: Array
     strain1: Array
 
@@ -101,23 +102,18 @@ class _Stack:
     def of(cls, grids: Sequence[Grid]) -> _Stack:
         """Stack ``grids`` (all of one layout)."""
         coefficients = [_strain_coefficients(g) for g in grids]
-        return cls(template=grids[0], grids=_object_array(grids), cells=Cells.stack(grids),
+        return cls(grids=_object_array(grids), cells=Cells.stack(grids),
+                   notch_cells=np.stack([np.flatnonzero(g.is_notch) for g in grids]),
                    strain0=np.stack([c[0] for c in coefficients]),
                    strain1=np.stack([c[1] for c in coefficients]))
 
-    def take(self, rows: NDArray[np.int64]) -> _Stack:
-        """The stack of designs ``rows`` (repeats allowed): one row per member."""
-        if rows.size == self.cells.members and np.array_equal(rows, np.arange(rows.size)):
-            return self
-        return _Stack(template=self.template, grids=self.grids[rows],
-                      cells=self.cells.take(rows), strain0=self.strain0[rows],
-                      strain1=self.strain1[rows])
-
-    def strain(self, m_a: Array, m_b: Array) -> Array:
-        """Largest notch bending strain of each row from its cell end moments (N m)."""
-        notch = self.template.is_notch
-        return np.max(np.abs(m_a[:, notch, None] * self.strain0
-                             + m_b[:, notch, None] * self.strain1), axis=(1, 2))
+    def strain(self, rows: NDArray[np.int64], x: Array) -> Array:
+        """Largest notch bending strain of members of design ``rows`` from their cell end
+        moments ``x = [m_a, m_b]`` (N m)."""
+        out = np.empty(rows.size)
+        kernels().peak_strains(rows, self.notch_cells, self.strain0, self.strain1,
+                               np.ascontiguousarray(x), out)
+        return out
 
 
 def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
@@ -177,7 +173,7 @@ class _Outcome:
         self.strain = np.full(size, np.nan)
         self.iterations = np.zeros(size, np.int64)
         self.fallback = np.zeros(size, bool)
-        self.pending: list[tuple[int, _Stack]] = []
+        self.pending: list[tuple[int, _Stack, int]] = []
 
     def fail(self, members: NDArray[np.int64], error: ModelError) -> None:
         """Mark ``members`` with the status of ``error`` and its message."""
@@ -194,8 +190,9 @@ class _Outcome:
         self.strain[members] = strain
 
     def run_fallbacks(self, designs: list[Design], settings: SolverSettings) -> None:
-        """Solve every pending member (with its one-row stack) by the single :func:`solve`."""
-        for m, row in self.pending:
+        """Solve every pending member (with its stack and design row) by the single
+        :func:`solve`."""
+        for m, stack, row in self.pending:
             self.fallback[m] = True
             try:
                 result = solve(designs[m // self.per_design], float(self.tensions[m]),
@@ -207,7 +204,7 @@ class _Outcome:
             moments = result.cell_moments
             x, _, z = result.tip_position
             self.store(np.array([m]), np.array([z + 1j * x]), np.array([result.tip_angle_rad]),
-                       row.strain(moments[None, :, 0], moments[None, :, 1]))
+                       stack.strain(np.array([row]), moments.T.reshape(1, -1)))
             self.iterations[m] = result.iterations
 
     def result(self, shape: tuple[int, ...]) -> BatchResult:
@@ -235,6 +232,7 @@ def _layout_key(grid: Grid) -> tuple[bytes, ...]:
             grid.notch_left_node.tobytes(), grid.gauss_u.tobytes())
 
 
+@lru_cache(maxsize=512)
 def _strain_coefficients(grid: Grid) -> tuple[Array, Array]:
     """``S0``, ``S1`` (notch cells, samples): strain ``|m_a S0 + m_b S1|`` at ``PEAK_SAMPLES``
     points of every notch cell, ``S = (1 - xi | xi) * c * min(h1, R_outer)``."""
@@ -273,16 +271,16 @@ def _solve_group(out: _Outcome, design_ids: list[int], stack: _Stack,
     keep = ~(bad | singular)
     members, rows = members[keep], rows[keep]
     if settings.loads != "closed":
-        out.pending.extend((int(m), stack.take(np.array([r]))) for m, r in zip(members, rows))
+        out.pending.extend((int(m), stack, int(r)) for m, r in zip(members, rows))
         return
     for start in range(0, members.size, CHUNK):
         chunk = slice(start, start + CHUNK)
-        _iterate(out, members[chunk], stack.take(rows[chunk]), settings)
+        _iterate(out, members[chunk], stack, rows[chunk], settings)
 
 
-def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack,
+def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArray[np.int64],
              settings: SolverSettings) -> None:
-    """Algorithm 1 on one chunk (row ``i`` of ``st`` is member ``members[i]``).
+    """Algorithm 1 on one chunk (member ``members[i]`` is design row ``rows[i]`` of ``st``).
 
     The kernel's plain iteration, as in ``solver._iterate`` (damped for ``relaxation``; one
     plain step for ``anderson``); a member ``solve`` would switch to Anderson, or that
@@ -294,41 +292,25 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack,
     n = cells.n_cells
     tension = out.tensions[members]
     x = np.empty((members.size, 2 * n))
-    x[...] = (cells.r_c * tension)[:, None]
+    x[...] = (cells.r_c[rows] * tension)[:, None]
     p = np.empty((members.size, n + 1), np.complex128)
     theta = np.empty((members.size, n + 1))
     tangent = np.empty((members.size, n + 1), np.complex128)
-    history = np.empty((members.size, budget))
-    stats = np.empty((members.size, 2), np.int64)
-    gap = np.empty(members.size)
-    params = np.array([settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
-                       SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH])
-    kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, tension, x, p,
-                      theta, tangent, params, budget, history, stats, gap)
-    done = stats[:, 1] == CONVERGED
-    for row in np.flatnonzero(~done):
-        out.pending.append((int(members[row]), st.take(np.array([row]))))
-    rows = np.flatnonzero(done)
-    if rows.size:
-        _finish(out, members[rows], st.take(rows), x[rows], PlanarShape(
-            p=p[rows], theta=theta[rows], tangent=tangent[rows]), stats[rows, 0], gap[rows])
-
-
-def _finish(out: _Outcome, members: NDArray[np.int64], st: _Stack, x: Array,
-            shape: PlanarShape, iterations: NDArray[np.int64], gap: Array) -> None:
-    """Raise closure (as :func:`limits.check_closure`) on converged members whose smallest
-    notch gap ``gap`` (m) is not positive; store the rest."""
-    out.iterations[members] = iterations
-    n = st.cells.n_cells
-    closed = gap <= 0.0
-    for row in np.flatnonzero(closed):
-        m = int(members[row])
-        row_shape = PlanarShape(p=shape.p[row], theta=shape.theta[row],
-                                tangent=shape.tangent[row])
+    info = np.empty((members.size, 3 + budget))
+    kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension, x,
+                      p, theta, tangent, settings.tol,
+                      settings.relaxation if mode == "relaxation" else 1.0,
+                      SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info)
+    done = info[:, 1] == CONVERGED
+    out.pending.extend((int(members[i]), st, int(rows[i])) for i in np.flatnonzero(~done))
+    out.iterations[members[done]] = info[done, 0].astype(np.int64)
+    closed = done & (info[:, 2] <= 0.0)
+    for i in np.flatnonzero(closed):
+        m = int(members[i])
+        shape = PlanarShape(p=p[i], theta=theta[i], tangent=tangent[i])
         try:
-            check_closure(st.grids[row], row_shape, float(out.tensions[m]))
+            check_closure(st.grids[rows[i]], shape, float(out.tensions[m]))
         except ModelError as error:
             out.fail(np.array([m]), error)
-    ok = ~closed
-    out.store(members[ok], shape.p[ok, -1], shape.theta[ok, -1],
-              st.take(np.flatnonzero(ok)).strain(x[ok, :n], x[ok, n:]))
+    ok = done & ~closed
+    out.store(members[ok], p[ok, -1], theta[ok, -1], st.strain(rows[ok], x[ok]))

@@ -144,27 +144,24 @@ def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> 
         gaps_row(scal[j, 1], p[j], tangent[j], notch[j], out[j])
 
 
-def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: Array, x: Array,
-            p: Complex, theta: Array, tangent: Complex, params: Array, budget: int,
-            history: Array, stats: Ints, gap: Array) -> None:
+def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
+            tension: Array, x: Array, p: Complex, theta: Array, tangent: Complex, tol: float,
+            relaxation: float, slow: float, growth: float, info: Array) -> None:
     """Plain (or damped) fixed-point iteration of the constant-tension tendon moment.
 
-    Per member: the shape of the start ``x`` (M, 2n), then repeatedly new moments ``g`` from
+    Member ``j`` is design row ``rows[j]`` of the cell arrays at tension ``tension[j]`` (N).
+    Per member: the shape of the start ``x[j]`` (2n,), then repeatedly new moments ``g`` from
     the shape, ``x <- x + relaxation (g - x)`` and the new shape; the step is the largest
     node displacement (m). ``x`` and the shape ``p``, ``theta``, ``tangent`` (M, n+1)
-    receive the last iterate; ``history``
-    (M, budget) the steps; ``gap`` (M,) the smallest notch gap (m, :func:`gaps_row`) of the
-    last shape; ``stats`` (M, 2) the number of steps and why each member stopped:
-    ``CONVERGED`` (step <= tol), ``NON_FINITE`` (the step is not finite: the previous iterate
-    is kept, no step recorded), ``DIVERGING`` (step > 2 L, or > growth x the smallest step
-    after 5 steps), ``SLOWED`` (``slow > 0`` and a step > slow x the previous one),
-    ``EXHAUSTED``. ``params`` = (tol (m), relaxation, slow, growth).
+    receive the last iterate; ``info`` (M, 3 + budget) the number of steps, the status, the
+    smallest notch gap (m, :func:`gaps_row`) of the last shape, then the steps (m). Statuses:
+    ``CONVERGED`` (step <= tol (m)), ``NON_FINITE`` (the step is not finite: the previous
+    iterate is kept, no step recorded), ``DIVERGING`` (step > 2 L, or > ``growth`` x the
+    smallest step after 5 steps), ``SLOWED`` (``slow > 0`` and a step > ``slow`` x the
+    previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps).
     """
     n = fc.shape[2]
-    tol = params[0]
-    relaxation = params[1]
-    slow = params[2]
-    growth = params[3]
+    budget = info.shape[1] - 3
     g = np.empty(2 * n)
     t_a = np.empty(n)
     new_p = np.empty(n + 1, np.complex128)
@@ -172,21 +169,22 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: A
     new_tangent = np.empty(n + 1, np.complex128)
     notch_gaps = np.empty(notch.shape[2])
     for j in range(x.shape[0]):
-        r_c = scal[j, 0]
-        limit = 2.0 * scal[j, 2]
+        row = rows[j]
+        r_c = scal[row, 0]
+        limit = 2.0 * scal[row, 2]
         t_a[:] = tension[j]
         xj = x[j]
         pj = p[j]
-        integrate_row(fc[j], fq[j], xj[:n], xj[n:], pj, theta[j], tangent[j])
+        integrate_row(fc[row], fq[row], xj[:n], xj[n:], pj, theta[j], tangent[j])
         smallest = math.inf
-        stats[j, 1] = EXHAUSTED
-        stats[j, 0] = 0
+        status = EXHAUSTED
+        steps = 0
         for k in range(budget):
-            moments_row(r_c, pj, tangent[j], t_a, t_a, ic[j], g[:n], g[n:])
+            moments_row(r_c, pj, tangent[j], t_a, t_a, ic[row], g[:n], g[n:])
             if relaxation != 1.0:
                 for i in range(2 * n):
                     g[i] = xj[i] + relaxation * (g[i] - xj[i])
-            integrate_row(fc[j], fq[j], g[:n], g[n:], new_p, new_theta, new_tangent)
+            integrate_row(fc[row], fq[row], g[:n], g[n:], new_p, new_theta, new_tangent)
             step = 0.0
             for i in range(n + 1):
                 d = abs(new_p[i] - pj[i])
@@ -195,50 +193,52 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: A
                     if math.isnan(d):
                         break
             if not math.isfinite(step):
-                stats[j, 1] = NON_FINITE
+                status = NON_FINITE
                 break
-            history[j, k] = step
-            stats[j, 0] = k + 1
+            info[j, 3 + k] = step
+            steps = k + 1
             xj[:] = g
             pj[:] = new_p
             theta[j, :] = new_theta
             tangent[j, :] = new_tangent
             smallest = min(smallest, step)
             if step <= tol:
-                stats[j, 1] = CONVERGED
+                status = CONVERGED
                 break
             if step > limit or (k >= 5 and step > growth * smallest):
-                stats[j, 1] = DIVERGING
+                status = DIVERGING
                 break
-            if slow > 0.0 and k >= 1 and step > slow * history[j, k - 1]:
-                stats[j, 1] = SLOWED
+            if slow > 0.0 and k >= 1 and step > slow * info[j, 2 + k]:
+                status = SLOWED
                 break
-        gaps_row(scal[j, 1], pj, tangent[j], notch[j], notch_gaps)
-        gap[j] = math.inf
+        gaps_row(scal[row, 1], pj, tangent[j], notch[row], notch_gaps)
+        least = math.inf
         for k in range(notch_gaps.size):
-            gap[j] = min(gap[j], notch_gaps[k])
+            least = min(least, notch_gaps[k])
+        info[j, 0] = steps
+        info[j, 1] = status
+        info[j, 2] = least
 
 
-def iterate_from(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: Array,
-                 x0: Array, tol: float, relaxation: float, slow: float, growth: float,
-                 budget: int) -> tuple[Array, Complex, Array, Complex, Array, Ints, Array]:
-    """:func:`iterate` from a copy of ``x0``, into new arrays: returns ``(x, p, theta,
-    tangent, history, stats, gap)``."""
-    members = x0.shape[0]
-    nodes = fc.shape[2] + 1
-    x = x0.copy()
-    p = np.empty((members, nodes), np.complex128)
-    theta = np.empty((members, nodes))
-    tangent = np.empty((members, nodes), np.complex128)
-    history = np.empty((members, max(budget, 1)))
-    stats = np.empty((members, 2), np.int64)
-    gap = np.empty(members)
-    params = np.array([tol, relaxation, slow, growth])
-    iterate(fc, fq, ic, notch, scal, tension, x, p, theta, tangent, params, budget, history,
-            stats, gap)
-    return x, p, theta, tangent, history, stats, gap
+def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: Array) -> None:
+    """Largest ``|m_a S0 + m_b S1|`` of every member over its design's notch ``cells``
+    (design row, notch cells; -1 padding) and their samples: ``s0``, ``s1`` (design row,
+    notch cells, samples); moments ``x`` (M, 2n) N m."""
+    n = x.shape[1] // 2
+    for j in range(x.shape[0]):
+        row = rows[j]
+        largest = 0.0
+        for k in range(cells.shape[1]):
+            i = cells[row, k]
+            if i < 0:
+                continue
+            a = x[j, i]
+            b = x[j, n + i]
+            for q in range(s0.shape[2]):
+                largest = max(largest, abs(a * s0[row, k, q] + b * s1[row, k, q]))
+        out[j] = largest
 
 
-KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps", "iterate",
-           "iterate_from")
+KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
+           "iterate", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

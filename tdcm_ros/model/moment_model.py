@@ -37,6 +37,8 @@ Array = NDArray[np.float64]
 
 DIVERGENCE_GROWTH = 1e3
 """A step this many times the smallest one so far (after 5 steps) is divergence."""
+ONE_ROW = np.zeros(1, np.int64)
+"""The design rows of a single solve's one member."""
 
 class Plan(NamedTuple):
     """One convergence strategy: ``mode`` (``auto``, ``picard``, ``anderson``,
@@ -155,11 +157,20 @@ class ClosedForm:
     def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
               slow: float) -> PlainRun | None:
         cells = self.cells
-        x, p, theta, tangent, history, stats, gap = kernels().iterate_from(
-            cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, np.full(1, level),
-            x.reshape(1, -1), tol, relaxation, slow, DIVERGENCE_GROWTH, max(budget, 0))
+        budget = max(budget, 0)
+        x = x.reshape(1, -1).copy()
+        nodes = x.shape[1] // 2 + 1
+        p = np.empty((1, nodes), np.complex128)
+        theta = np.empty((1, nodes))
+        tangent = np.empty((1, nodes), np.complex128)
+        info = np.empty((1, 3 + budget))
+        kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, ONE_ROW,
+                          np.full(1, level), x, p, theta, tangent, tol, relaxation, slow,
+                          DIVERGENCE_GROWTH, info)
+        steps = info[0].tolist()
         return PlainRun(x[0], PlanarShape(p=p[0], theta=theta[0], tangent=tangent[0]),
-                        history[0, :stats[0, 0]].tolist(), int(stats[0, 1]), float(gap[0]))
+                        steps[3:3 + int(steps[0])], int(steps[1]), steps[2])
+
 
 class LiteralSum(ClosedForm):
     """The paper's model, tendon moment as the literal sum of eqs. 8-10; its moments are
