@@ -17,6 +17,7 @@ returned only for ``ok`` members; the others hold NaN.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
@@ -54,8 +55,10 @@ STATUSES = ("ok", "singularity", "closure", "non_convergence", "invalid")
 _STATUS_OF_KIND = {"tendon_singularity": "singularity", "notch_closure": "closure",
                    "non_convergence": "non_convergence", "invalid_design": "invalid",
                    "tension_out_of_range": "invalid"}
-CHUNK = 2048
-"""Members iterated together (bounds the working set; any size gives the same answers)."""
+CHUNK = 256
+"""Members iterated together: small enough that the chunk's arrays stay in cache (measured
+~1.7x faster than 2048); any size gives the same answers."""
+MAX_WORKERS = 64
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,11 +120,13 @@ class _Stack:
 
 
 def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
-                settings: SolverSettings = DEFAULT_SETTINGS) -> BatchResult:
+                settings: SolverSettings = DEFAULT_SETTINGS, workers: int = 1) -> BatchResult:
     """Solve every design at its tensions (N); ``tensions`` has shape ``(len(designs), ...)``.
 
     A 1-D ``tensions`` pairs design ``i`` with tension ``i``; a 2-D one gives each design a
     row of tensions (a design-space grid). Results have the shape of ``tensions``.
+    ``workers`` threads iterate chunks of members at once (the compiled kernel releases the
+    GIL); the answers do not depend on it.
     """
     designs = list(designs)
     for i, design in enumerate(designs):
@@ -144,6 +149,11 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             f"tensions of shape {t_all.shape} do not match {len(designs)} designs; allowed: "
             "shape (len(designs), ...)", parameter="tensions", value=t_all.shape,
             allowed=f"shape ({len(designs)}, ...)")
+    if isinstance(workers, bool) or not isinstance(workers, int) or \
+            not 1 <= workers <= MAX_WORKERS:
+        raise InvalidSettingsError(
+            f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
+            parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
     out = _Outcome(t_all.reshape(len(designs), -1))
     layouts: dict[tuple[bytes, ...], list[tuple[int, Grid]]] = {}
     for d, design in enumerate(designs):
@@ -153,8 +163,16 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             out.fail(d * out.per_design + np.arange(out.per_design), error)
             continue
         layouts.setdefault(_layout_key(grid), []).append((d, grid))
+    chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
     for group in layouts.values():
-        _solve_group(out, [d for d, _ in group], _Stack.of([g for _, g in group]), settings)
+        chunks += _screen_group(out, [d for d, _ in group], _Stack.of([g for _, g in group]),
+                                settings)
+    if workers == 1 or len(chunks) == 1:
+        for members, stack, rows in chunks:
+            _iterate(out, members, stack, rows, settings)
+    else:
+        with ThreadPoolExecutor(workers) as pool:
+            list(pool.map(lambda chunk: _iterate(out, *chunk, settings), chunks))
     out.run_fallbacks(designs, settings)
     return out.result(t_all.shape)
 
@@ -247,9 +265,11 @@ def _strain_coefficients(grid: Grid) -> tuple[Array, Array]:
     return (1.0 - xi) * weight, xi * weight
 
 
-def _solve_group(out: _Outcome, design_ids: list[int], stack: _Stack,
-                 settings: SolverSettings) -> None:
-    """Screen, then iterate (closed loads) or queue (literal loads) one layout group."""
+def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
+                  settings: SolverSettings
+                  ) -> list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]]:
+    """Screen one layout group, queue it for the single solve (literal loads) or return its
+    chunks ``(members, stack, design rows)`` to iterate (closed loads)."""
     k = out.per_design
     rows = np.repeat(np.arange(len(design_ids)), k)
     members = (np.asarray(design_ids)[:, None] * k + np.arange(k)[None, :]).ravel()
@@ -272,10 +292,9 @@ def _solve_group(out: _Outcome, design_ids: list[int], stack: _Stack,
     members, rows = members[keep], rows[keep]
     if settings.loads != "closed":
         out.pending.extend((int(m), stack, int(r)) for m, r in zip(members, rows))
-        return
-    for start in range(0, members.size, CHUNK):
-        chunk = slice(start, start + CHUNK)
-        _iterate(out, members[chunk], stack, rows[chunk], settings)
+        return []
+    return [(members[start:start + CHUNK], stack, rows[start:start + CHUNK])
+            for start in range(0, members.size, CHUNK)]
 
 
 def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArray[np.int64],

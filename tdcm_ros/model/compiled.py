@@ -2,7 +2,7 @@
 
 The kernels are one source. Compiling them needs numba (about 0.3 s and 90 MB just to import),
 so it happens lazily, on the first kernel call of a process that uses the compiled build, and
-the machine code is cached on disk (``cache=True``: next to the package when it is writable,
+the machine code (which releases the GIL, so threads can run it at once) is cached on disk (``cache=True``: next to the package when it is writable,
 else numba's user-wide cache or ``NUMBA_CACHE_DIR``; without any writable place the kernels
 are compiled uncached, never refused).
 
@@ -80,9 +80,9 @@ def _compile(numba: Any) -> types.SimpleNamespace:
         clone.__module__ = plain.__module__
         clone.__doc__ = plain.__doc__
         try:
-            jitted = numba.njit(cache=True)(clone)
+            jitted = numba.njit(cache=True, nogil=True)(clone)
         except RuntimeError:  # no writable cache location: compile every process instead
-            jitted = numba.njit(cache=False)(clone)
+            jitted = numba.njit(cache=False, nogil=True)(clone)
         namespace[name] = compiled[name] = jitted
     return types.SimpleNamespace(**compiled)
 

@@ -166,3 +166,21 @@ def test_members_that_slow_down_are_handed_to_the_single_solve():
     assert list(result.fallback) == [True, False]
     assert result.iterations[0] == one.iterations
     np.testing.assert_allclose(result.tip_position[0], one.tip_position, rtol=0, atol=1e-12)
+
+
+def test_threads_give_the_same_answers(monkeypatch):
+    designs = random_designs(seed=5, count=10)
+    tensions = np.linspace(0.0, 30.0, 10 * 7).reshape(10, 7)
+    monkeypatch.setattr(batch, "CHUNK", 4)  # many chunks for the threads to share
+    one = solve_batch(designs, tensions)
+    two = solve_batch(designs, tensions, workers=2)
+    np.testing.assert_array_equal(one.status, two.status)
+    np.testing.assert_array_equal(one.tip_position, two.tip_position)
+    np.testing.assert_array_equal(one.iterations, two.iterations)
+    np.testing.assert_array_equal(one.max_bending_strain, two.max_bending_strain)
+
+
+@pytest.mark.parametrize("workers", [0, 1.5, True, 65])
+def test_bad_worker_counts_raise_typed_errors(workers):
+    with pytest.raises(batch.InvalidSettingsError, match="workers"):
+        solve_batch([preset("paper-experiment")], [1.0], workers=workers)

@@ -129,7 +129,7 @@ def test_compiles_uncached_when_no_cache_location_is_writable():
 
     class FakeNumba:
         @staticmethod
-        def njit(cache):
+        def njit(cache, nogil):
             calls.append(cache)
             if cache:
                 raise RuntimeError("cannot cache function: no locator available")
