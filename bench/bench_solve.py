@@ -1,8 +1,12 @@
 """Single-solve benchmark (issue 2): median time of one solve and iterations to converge.
 
-Run: ``python bench/bench_solve.py [--repeats 2000]``. Prints the median and p90 time per solve
-on ``paper-experiment`` at 20 N with the default settings, the tip error of that solve
-against a converged reference, and the iterations across presets and hard designs.
+Run: ``python bench/bench_solve.py [--repeats 2000] [--baseline /work/main] [--rounds 3]``.
+Prints the median and p90 time per solve on ``paper-experiment`` at 20 N with the default
+settings (compiled kernel, and the plain-Python build of the same kernel, ``TDCM_JIT=0``),
+the tip error of that solve against a converged reference, and the iterations across presets
+and hard designs. ``--baseline`` times another checkout of the package (e.g. main's NumPy
+path) in the same run: baseline and this checkout alternate in fresh processes for
+``--rounds`` rounds and the ratio of their medians is printed.
 Single-threaded: BLAS threads are pinned to one before NumPy loads.
 """
 
@@ -10,7 +14,10 @@ from __future__ import annotations
 
 import argparse
 import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -45,10 +52,44 @@ def time_solves(repeats: int) -> np.ndarray:
     return times
 
 
+def median_in(checkout: Path, repeats: int, jit: str = "1") -> float:
+    """Median solve time (s) measured in a fresh process importing ``tdcm_ros`` from
+    ``checkout`` (``jit``: the ``TDCM_JIT`` switch, ignored by checkouts without it)."""
+    env = {**os.environ, "PYTHONPATH": str(checkout), "TDCM_JIT": jit}
+    out = subprocess.run([sys.executable, __file__, "--median-only", "--repeats", str(repeats)],
+                         env=env, capture_output=True, text=True, check=True)
+    return float(out.stdout.split()[-1])
+
+
+def compare(baseline: Path, repeats: int, rounds: int) -> None:
+    """Alternate baseline and this checkout; print medians and their ratio."""
+    here = Path(__file__).resolve().parents[1]
+    base, mine = [], []
+    for _ in range(rounds):
+        base.append(median_in(baseline, repeats))
+        mine.append(median_in(here, repeats))
+    b, m = float(np.median(base)), float(np.median(mine))
+    print(f"same-run comparison, {rounds} alternating rounds of {repeats} solves")
+    print(f"  baseline {baseline}: median {b * 1e6:8.1f} us  (rounds: "
+          + ", ".join(f"{t * 1e6:.1f}" for t in base) + ")")
+    print(f"  this checkout      : median {m * 1e6:8.1f} us  (rounds: "
+          + ", ".join(f"{t * 1e6:.1f}" for t in mine) + ")")
+    print(f"  speed-up           : {b / m:8.1f}x  (target >= 10x, <= 10 us)")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=2000)
+    parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. /work/main")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--median-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.median_only:
+        print(float(np.median(time_solves(args.repeats))))
+        return
+    if args.baseline is not None:
+        compare(args.baseline, args.repeats, args.rounds)
+    plain = median_in(Path(__file__).resolve().parents[1], max(args.repeats // 10, 20), "0")
     design = preset("paper-experiment")
     reference = solve(design, 20.0, settings=REFERENCE).tip_position
     finer = solve(design, 20.0, settings=FINER).tip_position
@@ -58,8 +99,9 @@ def main() -> None:
     solve(design.with_overrides(E=1.8e9), 20.0)
     first = time.perf_counter() - start
     print("paper-experiment, T = 20 N, default settings")
-    print(f"  median solve time      {np.median(times) * 1e6:8.1f} us   (target <= 200 us)")
+    print(f"  median solve time      {np.median(times) * 1e6:8.1f} us   (target <= 10 us)")
     print(f"  p90 solve time         {np.percentile(times, 90) * 1e6:8.1f} us")
+    print(f"  plain-Python build     {plain * 1e6:8.1f} us   (TDCM_JIT=0: no numba import)")
     print(f"  first solve of a new design (grid build) {first * 1e3:.2f} ms")
     print(f"  tip error vs reference {np.linalg.norm(default.tip_position - reference) * 1e9:8.2f}"
           " nm  (target <= 1000 nm)")
