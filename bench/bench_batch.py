@@ -1,6 +1,7 @@
 """Batch solver throughput on one core for paper-like designs, and its tip error.
 
-Run: ``python bench/bench_batch.py [--designs 40] [--tensions 250] [--repeat 5]``.
+Run: ``python bench/bench_batch.py [--designs 40] [--tensions 250] [--repeat 5]
+[--baseline /work/main] [--rounds 3]``.
 
 Workloads (default solver settings, whose tip error against a converged reference is printed):
 
@@ -8,6 +9,11 @@ Workloads (default solver settings, whose tip error against a converged referenc
   L = 53 mm) x ``tensions`` tensions in 0-20 N, grids already built (what a sweep costs once
   the design grid exists) and cold (grid building included);
 - many designs: one tension per design, grid building included (the worst case).
+
+The design-space case is also timed with two worker threads (``workers=2``; the ratio to one
+is printed). ``--baseline`` times another checkout (e.g. main's NumPy batch) on the warm
+design-space case in the same run: it and this checkout alternate in fresh processes for
+``--rounds`` rounds and the ratio of their median throughputs is printed.
 
 Tip error: the batch against single solves at the same settings (should be ~1e-17 m), and
 against converged single solves (128 cells per notch, 16 per tube, 12-point quadrature,
@@ -18,7 +24,10 @@ from __future__ import annotations
 
 import argparse
 import os
+import subprocess
+import sys
 from collections.abc import Callable
+from pathlib import Path
 from time import perf_counter
 from typing import Any
 
@@ -69,6 +78,12 @@ def run(args: argparse.Namespace) -> None:
     result = solve_batch(designs, tensions, settings=settings)
     warm = best_time(lambda: solve_batch(designs, tensions, settings=settings), args.repeat,
                      cold=False)
+    if args.throughput_only:
+        print(count / warm)
+        return
+    solve_batch(designs, tensions, settings=settings, workers=2)
+    two = best_time(lambda: solve_batch(designs, tensions, settings=settings, workers=2),
+                    args.repeat, cold=False)
     cold = best_time(lambda: solve_batch(designs, tensions, settings=settings), args.repeat,
                      cold=True)
     many = paper_like(args.many, rng)
@@ -96,6 +111,8 @@ def run(args: argparse.Namespace) -> None:
           f"fallback to single solve: {int(result.fallback.sum())}")
     print(f"design space {args.designs} designs x {args.tensions} tensions = {count} solves")
     print(f"  grids built  : {count / warm:10.0f} solves/s  ({warm * 1e3:.1f} ms)")
+    print(f"  two workers  : {count / two:10.0f} solves/s  ({two * 1e3:.1f} ms), "
+          f"{warm / two:.2f}x one worker (target >= 1.8x)")
     print(f"  incl. grids  : {count / cold:10.0f} solves/s  ({cold * 1e3:.1f} ms)")
     print(f"many designs {args.many} x 1 tension, incl. grids: {args.many / many_time:10.0f} "
           f"solves/s ({many_time * 1e3:.1f} ms)")
@@ -103,6 +120,33 @@ def run(args: argparse.Namespace) -> None:
     print(f"tip error vs single solve, same settings ({len(picks)} points): {same:.2e} m")
     print(f"tip error vs converged reference: max {max(converged) * 1e6:.3f} um, "
           f"median {np.median(converged) * 1e6:.3f} um (target <= 1 um)")
+
+
+def throughput_in(checkout: Path, args: argparse.Namespace) -> float:
+    """Warm design-space throughput (solves/s) in a fresh process importing ``tdcm_ros`` from
+    ``checkout``."""
+    env = {**os.environ, "PYTHONPATH": str(checkout)}
+    command = [sys.executable, __file__, "--throughput-only", "--designs", str(args.designs),
+               "--tensions", str(args.tensions), "--repeat", str(args.repeat)]
+    out = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
+    return float(out.stdout.split()[-1])
+
+
+def compare(args: argparse.Namespace) -> None:
+    """Alternate the baseline checkout and this one; print throughputs and their ratio."""
+    here = Path(__file__).resolve().parents[1]
+    base, mine = [], []
+    for _ in range(args.rounds):
+        base.append(throughput_in(args.baseline, args))
+        mine.append(throughput_in(here, args))
+    b, m = sorted(base)[len(base) // 2], sorted(mine)[len(mine) // 2]
+    print(f"same-run comparison, {args.designs} x {args.tensions}, grids built, one core, "
+          f"{args.rounds} alternating rounds")
+    print(f"  baseline {args.baseline}: {b:10.0f} solves/s (rounds: "
+          + ", ".join(f"{t:.0f}" for t in base) + ")")
+    print(f"  this checkout      : {m:10.0f} solves/s (rounds: "
+          + ", ".join(f"{t:.0f}" for t in mine) + ")")
+    print(f"  speed-up           : {m / b:10.1f}x  (target >= 250,000 solves/s)")
 
 
 def main() -> None:
@@ -113,8 +157,13 @@ def main() -> None:
     parser.add_argument("--many", type=int, default=2000, help="designs, one tension each")
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--sample", type=int, default=24, help="points checked at the reference")
+    parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. /work/main")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--throughput-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     os.environ.update({name: "1" for name in THREAD_VARIABLES})
+    if args.baseline is not None:
+        compare(args)
     run(args)
 
 
