@@ -167,9 +167,9 @@ class ClosedForm:
         kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, ONE_ROW,
                           np.full(1, level), x, p, theta, tangent, tol, relaxation, slow,
                           DIVERGENCE_GROWTH, info)
-        steps = info[0].tolist()
+        count, status, gap = info[0, :3].tolist()
         return PlainRun(x[0], PlanarShape(p=p[0], theta=theta[0], tangent=tangent[0]),
-                        steps[3:3 + int(steps[0])], int(steps[1]), steps[2])
+                        info[0, 3:3 + int(count)].tolist(), int(status), gap)
 
 
 class LiteralSum(ClosedForm):
