@@ -38,13 +38,9 @@ from tdcm_ros.model.grid import PEAK_SAMPLES, Grid, build_grid
 from tdcm_ros.model.kernel import CONVERGED
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_tendon_singularity, check_tension
+from tdcm_ros.model.moment_model import DIVERGENCE_GROWTH
 from tdcm_ros.model.settings import SolverSettings
-from tdcm_ros.model.solver import (
-    DEFAULT_SETTINGS,
-    DIVERGENCE_GROWTH,
-    SLOW_CONTRACTION,
-    solve,
-)
+from tdcm_ros.model.solver import DEFAULT_SETTINGS, SLOW_CONTRACTION, solve
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]

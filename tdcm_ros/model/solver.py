@@ -49,7 +49,6 @@ Array = NDArray[np.float64]
 DEFAULT_SETTINGS = SolverSettings()
 SLOW_CONTRACTION = 0.3
 CONTINUATION_HALVINGS = 5
-__all__ = ["DEFAULT_SETTINGS", "DIVERGENCE_GROWTH", "SLOW_CONTRACTION", "solve"]
 
 
 class _Problem(NamedTuple):
