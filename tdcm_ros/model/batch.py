@@ -168,7 +168,7 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             _iterate(out, members, stack, rows, settings)
     else:
         with ThreadPoolExecutor(workers) as pool:
-            list(pool.map(lambda chunk: _iterate(out, *chunk, settings), chunks))
+            list(pool.map(lambda c: _iterate(out, c[0], c[1], c[2], settings), chunks))
     out.run_fallbacks(designs, settings)
     return out.result(t_all.shape)
 
