@@ -220,6 +220,24 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
         info[j, 2] = least
 
 
+def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: float,
+                x0: Array, tol: float, relaxation: float, slow: float, growth: float,
+                budget: int) -> tuple[Array, Complex, Array, Complex, Array, int, float]:
+    """:func:`iterate` for one member (design row 0) at ``tension`` (N) from a copy of
+    ``x0`` (2n,), into new arrays: ``(x, p, theta, tangent, steps, status, smallest gap)``."""
+    nodes = fc.shape[2] + 1
+    x = x0.copy().reshape(1, x0.size)
+    p = np.empty((1, nodes), np.complex128)
+    theta = np.empty((1, nodes))
+    tangent = np.empty((1, nodes), np.complex128)
+    info = np.empty((1, 3 + budget))
+    iterate(fc, fq, ic, notch, scal, np.zeros(1, np.int64), np.full(1, tension), x, p, theta,
+            tangent, tol, relaxation, slow, growth, info)
+    count = int(info[0, 0])
+    return (x[0], p[0], theta[0], tangent[0], info[0, 3:3 + count].copy(), int(info[0, 1]),
+            info[0, 2])
+
+
 def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: Array) -> None:
     """Largest ``|m_a S0 + m_b S1|`` of every member over its design's notch ``cells``
     (design row, notch cells; -1 padding) and their samples: ``s0``, ``s1`` (design row,
@@ -240,5 +258,5 @@ def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: A
 
 
 KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
-           "iterate", "peak_strains")
+           "iterate", "iterate_one", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -37,8 +37,6 @@ Array = NDArray[np.float64]
 
 DIVERGENCE_GROWTH = 1e3
 """A step this many times the smallest one so far (after 5 steps) is divergence."""
-ONE_ROW = np.zeros(1, np.int64)
-"""The design rows of a single solve's one member."""
 
 class Plan(NamedTuple):
     """One convergence strategy: ``mode`` (``auto``, ``picard``, ``anderson``,
@@ -157,19 +155,11 @@ class ClosedForm:
     def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
               slow: float) -> PlainRun | None:
         cells = self.cells
-        budget = max(budget, 0)
-        x = x.reshape(1, -1).copy()
-        nodes = x.shape[1] // 2 + 1
-        p = np.empty((1, nodes), np.complex128)
-        theta = np.empty((1, nodes))
-        tangent = np.empty((1, nodes), np.complex128)
-        info = np.empty((1, 3 + budget))
-        kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, ONE_ROW,
-                          np.full(1, level), x, p, theta, tangent, tol, relaxation, slow,
-                          DIVERGENCE_GROWTH, info)
-        count, status, gap = info[0, :3].tolist()
-        return PlainRun(x[0], PlanarShape(p=p[0], theta=theta[0], tangent=tangent[0]),
-                        info[0, 3:3 + int(count)].tolist(), int(status), gap)
+        x, p, theta, tangent, steps, status, gap = kernels().iterate_one(
+            cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, level, x, tol, relaxation,
+            slow, DIVERGENCE_GROWTH, max(budget, 0))
+        return PlainRun(x, PlanarShape(p=p, theta=theta, tangent=tangent), steps.tolist(),
+                        status, gap)
 
 
 class LiteralSum(ClosedForm):
