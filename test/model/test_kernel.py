@@ -143,3 +143,12 @@ def test_compiles_uncached_when_no_cache_location_is_writable():
 
 def test_switch_off_never_imports_numba(tmp_path):
     assert run_copy(tmp_path, {"TDCM_JIT": "0"}, readonly=False) == ["False", "False", "1"]
+
+
+@settings(max_examples=300, deadline=None)
+@given(phi=st.one_of(st.floats(-0.04, 0.04), st.floats(-0.3, 0.3), st.floats(-40.0, 40.0)))
+def test_unit_is_exp_i_phi_within_one_ulp(phi):
+    """The Taylor branches of kernel.unit agree with libm's cos and sin to 1 ulp."""
+    value = kernel.unit(phi)
+    assert abs(value.real - np.cos(phi)) <= np.spacing(abs(np.cos(phi)))
+    assert abs(value.imag - np.sin(phi)) <= max(np.spacing(abs(np.sin(phi))), 0.0)
