@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.grid import Grid, GridStack
 
 Array = NDArray[np.float64]
 Ints = NDArray[np.int64]
@@ -58,6 +58,21 @@ class Cells:
             notch[j, :, :notches] = c.notch[0]
         return cls(fc=fc, fq=fq, ic=ic, notch=notch,
                    scal=np.concatenate([c.scal for c in parts]))
+
+    @classmethod
+    def of_stack(cls, stack: GridStack) -> Cells:
+        """Members = the designs of a :func:`~tdcm_ros.model.grid.build_grids` stack (its
+        zero-length padding cells and tip-node padding notches are neutral here too)."""
+        peak = np.where(stack.constrained & (stack.length > 0.0), stack.peak_c, 0.0)
+        return cls(fc=np.ascontiguousarray(np.stack([stack.C0, stack.C1], axis=1)),
+                   fq=np.ascontiguousarray(np.stack([stack.A0, stack.A1, stack.w_q], axis=1)),
+                   ic=np.ascontiguousarray(np.stack(
+                       [stack.chord_start_node, stack.chord_end_node,
+                        stack.constrained.astype(np.int64)], axis=1).astype(np.int64)),
+                   notch=np.ascontiguousarray(np.stack(
+                       [stack.notch_left_node, stack.notch_right_node], axis=1).astype(np.int64)),
+                   scal=np.array([[d.R_c, d.R_outer, d.length, float(np.max(row, initial=0.0))]
+                                  for d, row in zip(stack.designs, peak, strict=True)]))
 
     def take(self, rows: Ints) -> Cells:
         """The members ``rows`` (repeats allowed)."""

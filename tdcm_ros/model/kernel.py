@@ -113,11 +113,11 @@ def moments_row(r_c: float, p: Complex, tangent: Complex, t_a: Array, t_b: Array
 def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Array) -> None:
     """Smallest gap (m) between the two faces of every notch of one member, either side of
     the body: the signed distance of each face's outer corner from the other face (``inf``
-    for padding notches)."""
+    for padding notches: nodes -1, or both at one node)."""
     for k in range(notch.shape[1]):
         left = notch[0, k]
         right = notch[1, k]
-        if left < 0:
+        if left < 0 or left == right:
             out[k] = math.inf
             continue
         t_l = tangent[left]
