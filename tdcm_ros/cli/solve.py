@@ -14,6 +14,7 @@ from tdcm_ros.model import (
     SOLVER_SPECS,
     SolverSettings,
     TensionRangeError,
+    one_shot,
     parse_field,
     preset,
     solve,
@@ -74,6 +75,7 @@ def run(args: argparse.Namespace) -> int:
             from tdcm_ros.figures import plot_file
 
             plot_file("--plot", args.plot)
+        one_shot()  # one solve: the plain-Python kernel, numba not imported
         result = solve(design, _tension(args.tension), settings=settings)
     except TdcmError as error:
         if args.json:

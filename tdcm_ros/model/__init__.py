@@ -11,7 +11,7 @@ Separate entry points, kept out of this face because they pull scipy:
 (the accuracy/speed benchmark behind ``tdcm bench``).
 """
 
-from tdcm_ros.model.compiled import use_compiled, warm_up
+from tdcm_ros.model.compiled import one_shot, use_compiled, warm_up
 from tdcm_ros.model.design import (
     FIELD_SPECS,
     PRESETS,
@@ -88,6 +88,7 @@ __all__ = [
     "check_tension",
     "design_curves",
     "offset_points",
+    "one_shot",
     "parse_field",
     "preset",
     "solve",

@@ -35,6 +35,13 @@ def use_compiled(flag: bool | None) -> None:
     _state["chosen"] = True
 
 
+def one_shot() -> None:
+    """For a command that solves once: the plain build unless ``TDCM_JIT`` chooses (compiling
+    would cost ~1 s of numba import and cache loading, far more than it saves)."""
+    if not os.environ.get(ENVIRONMENT, "").strip():
+        use_compiled(False)
+
+
 def kernels() -> types.SimpleNamespace | types.ModuleType:
     """The kernel functions of the selected build (attributes named as in :mod:`kernel`)."""
     build = _state["build"]

@@ -182,3 +182,14 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
     assert np.all(results[0][1][:, 2] > 0.0)  # padding notches never read as closed
+
+
+def test_one_shot_picks_the_plain_build_unless_the_switch_is_set(monkeypatch):
+    for key in ("wanted", "chosen", "build"):
+        monkeypatch.setitem(compiled._state, key, compiled._state[key])
+    monkeypatch.setenv(compiled.ENVIRONMENT, "1")
+    compiled.one_shot()
+    assert compiled._state["chosen"] is False  # an explicit TDCM_JIT wins
+    monkeypatch.delenv(compiled.ENVIRONMENT)
+    compiled.one_shot()
+    assert compiled.kernels() is kernel and not compiled.is_compiled()
