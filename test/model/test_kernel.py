@@ -185,8 +185,9 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
 
 
 def test_one_shot_picks_the_plain_build_unless_the_switch_is_set(monkeypatch):
-    for key in ("wanted", "chosen", "build"):
+    for key in ("wanted", "build"):
         monkeypatch.setitem(compiled._state, key, compiled._state[key])
+    monkeypatch.setitem(compiled._state, "chosen", False)
     monkeypatch.setenv(compiled.ENVIRONMENT, "1")
     compiled.one_shot()
     assert compiled._state["chosen"] is False  # an explicit TDCM_JIT wins
