@@ -75,8 +75,8 @@ def run(args: argparse.Namespace) -> int:
             from tdcm_ros.figures import plot_file
 
             plot_file("--plot", args.plot)
-        one_shot()  # one solve: the plain-Python kernel, numba not imported
-        result = solve(design, _tension(args.tension), settings=settings)
+        with one_shot():  # one solve: the plain-Python kernel, numba not imported
+            result = solve(design, _tension(args.tension), settings=settings)
     except TdcmError as error:
         if args.json:
             print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))

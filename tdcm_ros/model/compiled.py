@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import os
 import types
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from tdcm_ros.errors import out_of_range
@@ -35,11 +37,20 @@ def use_compiled(flag: bool | None) -> None:
     _state["chosen"] = True
 
 
-def one_shot() -> None:
-    """For a command that solves once: the plain build unless ``TDCM_JIT`` chooses (compiling
-    would cost ~1 s of numba import and cache loading, far more than it saves)."""
-    if not os.environ.get(ENVIRONMENT, "").strip():
-        use_compiled(False)
+@contextmanager
+def one_shot() -> Iterator[None]:
+    """Inside, for a command that solves once: the plain build, unless ``TDCM_JIT`` or
+    :func:`use_compiled` chose or a build is already loaded (compiling would cost ~1 s of
+    numba import and cache loading, far more than it saves). The choice ends with the block."""
+    if _state["chosen"] or _state["build"] is not None or \
+            os.environ.get(ENVIRONMENT, "").strip():
+        yield
+        return
+    _state["build"] = kernel
+    try:
+        yield
+    finally:
+        _state["build"] = None
 
 
 def kernels() -> types.SimpleNamespace | types.ModuleType:

@@ -184,13 +184,17 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
     assert np.all(results[0][1][:, 2] > 0.0)  # padding notches never read as closed
 
 
-def test_one_shot_picks_the_plain_build_unless_the_switch_is_set(monkeypatch):
-    for key in ("wanted", "build"):
+def test_one_shot_picks_the_plain_build_only_inside_and_only_if_unchosen(monkeypatch):
+    for key in ("wanted", "chosen"):
         monkeypatch.setitem(compiled._state, key, compiled._state[key])
+    monkeypatch.setitem(compiled._state, "build", None)
     monkeypatch.setitem(compiled._state, "chosen", False)
+    monkeypatch.delenv(compiled.ENVIRONMENT, raising=False)
+    with compiled.one_shot():
+        assert compiled.kernels() is kernel
+    assert compiled._state["build"] is None  # the process is not switched for good
     monkeypatch.setenv(compiled.ENVIRONMENT, "1")
-    compiled.one_shot()
-    assert compiled._state["chosen"] is False  # an explicit TDCM_JIT wins
-    monkeypatch.delenv(compiled.ENVIRONMENT)
-    compiled.one_shot()
-    assert compiled.kernels() is kernel and not compiled.is_compiled()
+    with compiled.one_shot():
+        assert compiled.is_compiled()  # an explicit TDCM_JIT wins
+    with compiled.one_shot():
+        assert compiled.is_compiled()  # a loaded build is kept
