@@ -11,7 +11,7 @@ Separate entry points, kept out of this face because they pull scipy:
 (the accuracy/speed benchmark behind ``tdcm bench``).
 """
 
-from tdcm_ros.model.compiled import one_shot, use_compiled, warm_up
+from tdcm_ros.model.compiled import one_shot, use_compiled
 from tdcm_ros.model.design import (
     FIELD_SPECS,
     PRESETS,
@@ -52,7 +52,7 @@ from tdcm_ros.model.profiles import (
 )
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
-from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
+from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
 
 __all__ = [

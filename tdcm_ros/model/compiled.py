@@ -103,26 +103,3 @@ def _compile(numba: Any) -> types.SimpleNamespace:
             jitted = numba.njit(cache=False, nogil=True)(clone)
         namespace[name] = compiled[name] = jitted
     return types.SimpleNamespace(**compiled)
-
-
-def warm_up() -> bool:
-    """Compile (or load from the cache) every kernel a solve can reach, so that the first
-    real solve of a long-running process is not slow; returns :func:`is_compiled`. Under the
-    plain build it costs two small solves."""
-    import numpy as np
-
-    from tdcm_ros.model.design import preset
-    from tdcm_ros.model.grid import build_grid
-    from tdcm_ros.model.kinematics import integrate
-    from tdcm_ros.model.limits import notch_gaps
-    from tdcm_ros.model.settings import SolverSettings
-    from tdcm_ros.model.solver import solve
-
-    design = preset("paper-experiment")
-    settings = SolverSettings()
-    solve(design, 1.0, settings=settings)  # iterate_from
-    solve(design, 1.0, settings=settings.with_overrides(acceleration="anderson"))  # wrappers
-    grid = build_grid(design, settings)
-    zero = np.zeros(grid.n_cells)
-    notch_gaps(grid, integrate(grid, zero, zero))
-    return is_compiled()

@@ -27,11 +27,12 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.design import Design
+from tdcm_ros.model.compiled import is_compiled
+from tdcm_ros.model.design import Design, preset
 from tdcm_ros.model.grid import Grid, build_grid
 from tdcm_ros.model.kernel import CONVERGED, DIVERGING, NON_FINITE, SLOWED
 from tdcm_ros.model.kinematics import PlanarShape, integrate
-from tdcm_ros.model.limits import check_tension
+from tdcm_ros.model.limits import check_tension, notch_gaps
 from tdcm_ros.model.loading import InvalidLoadingError, LoadedModel, Loading
 from tdcm_ros.model.moment_model import (
     DIVERGENCE_GROWTH,
@@ -96,6 +97,18 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     t_base = check_tension(tension)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         return _solve(design, t_base, settings, warm_start, strict, loading, started)
+
+
+def warm_up() -> bool:
+    """Compile (or load from the cache) every kernel a solve can reach, so that the first
+    real solve of a long-running process is not slow; returns whether the kernels are the
+    compiled build. Under the plain build it costs two small solves."""
+    design = preset("paper-experiment")
+    result = solve(design, 1.0)  # kernel.iterate_one
+    solve(design, 1.0, settings=DEFAULT_SETTINGS.with_overrides(acceleration="anderson"))
+    notch_gaps(result.grid, integrate(result.grid, result.cell_moments[:, 0],
+                                      result.cell_moments[:, 1]))  # the wrappers
+    return is_compiled()
 
 
 def _solve(design: Design, t_base: float, settings: SolverSettings,
