@@ -92,3 +92,13 @@ def test_record_module_serves_both_of_its_commands(capsys: pytest.CaptureFixture
     with pytest.raises(SystemExit) as exited:
         main(["bag", "info", "-h"])
     assert exited.value.code == 0 and "usage: tdcm bag info" in capsys.readouterr().out
+
+
+def test_evaluate_child_runs_the_plain_kernel_without_numba() -> None:
+    """An evaluation solves once per step: it keeps numba (and its memory) out."""
+    bag = Path(tdcm_ros.__file__).resolve().parents[1] / "bags" / "paper_experiment"
+    done, imported = run_child("evaluate", str(bag), "--json")
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "scipy" in imported  # the import list was read (evaluation needs scipy)
+    assert "numba" not in imported
+    assert json.loads(done.stdout)["steps"]
