@@ -2,7 +2,7 @@
 
 :class:`Cells` holds one grid (one member) or a stack of grids; it has the fields of
 :class:`~tdcm_ros.model.grid.Grid` the kernels read (``C0``, ``C1``, ``A0``, ``A1``, ``w_q``,
-``chord_start_node``, ``chord_end_node``, ``constrained``, ``notch_left_node``,
+the chord terms ``C0_T``, ``C1_T``, ``A0_T``, ``A1_T``, ``chord_start_node``, ``chord_end_node``, ``constrained``, ``notch_left_node``,
 ``notch_right_node``), each with the member axis first. Grids of different cell or notch
 counts stack by padding with zero-length cells at the tip (they move no node) and with
 notches marked -1 (never checked).
@@ -45,8 +45,8 @@ class Cells:
         n = max(c.n_cells for c in parts)
         k = max(c.notch.shape[2] for c in parts)
         q = max(c.fq.shape[3] for c in parts)
-        fc = np.zeros((len(parts), 2, n))
-        fq = np.zeros((len(parts), 3, n, q))
+        fc = np.zeros((len(parts), 4, n))
+        fq = np.zeros((len(parts), 5, n, q))
         ic = np.zeros((len(parts), 3, n), np.int64)
         ic[:, 2] = 1
         notch = np.full((len(parts), 2, k), -1, np.int64)
@@ -64,8 +64,10 @@ class Cells:
         """Members = the designs of a :func:`~tdcm_ros.model.grid.build_grids` stack (its
         zero-length padding cells and tip-node padding notches are neutral here too)."""
         peak = np.where(stack.constrained & (stack.length > 0.0), stack.peak_c, 0.0)
-        return cls(fc=np.ascontiguousarray(np.stack([stack.C0, stack.C1], axis=1)),
-                   fq=np.ascontiguousarray(np.stack([stack.A0, stack.A1, stack.w_q], axis=1)),
+        return cls(fc=np.ascontiguousarray(np.stack(
+                       [stack.C0, stack.C1, stack.C0_T, stack.C1_T], axis=1)),
+                   fq=np.ascontiguousarray(np.stack(
+                       [stack.A0, stack.A1, stack.w_q, stack.A0_T, stack.A1_T], axis=1)),
                    ic=np.ascontiguousarray(np.stack(
                        [stack.chord_start_node, stack.chord_end_node,
                         stack.constrained.astype(np.int64)], axis=1).astype(np.int64)),
@@ -113,6 +115,26 @@ class Cells:
     def w_q(self) -> Array:
         """ds weights of the Gauss points (m), (members, cells, points)."""
         return self.fq[:, 2]
+
+    @property
+    def C0_T(self) -> Array:
+        """Chord term of ``C0`` per newton of tension (rad/(N^2 m)), (members, cells)."""
+        return self.fc[:, 2]
+
+    @property
+    def C1_T(self) -> Array:
+        """Chord term of ``C1`` per newton of tension (rad/(N^2 m)), (members, cells)."""
+        return self.fc[:, 3]
+
+    @property
+    def A0_T(self) -> Array:
+        """Chord term of ``A0`` at the Gauss points (rad/(N^2 m)), (members, cells, points)."""
+        return self.fq[:, 3]
+
+    @property
+    def A1_T(self) -> Array:
+        """Chord term of ``A1`` at the Gauss points (rad/(N^2 m)), (members, cells, points)."""
+        return self.fq[:, 4]
 
     @property
     def chord_start_node(self) -> Ints:
@@ -163,8 +185,8 @@ class Cells:
 @lru_cache(maxsize=512)
 def _cells_of(grid: Grid) -> Cells:
     d = grid.design
-    return Cells(fc=np.stack([grid.C0, grid.C1])[None],
-                 fq=np.stack([grid.A0, grid.A1, grid.w_q])[None],
+    return Cells(fc=np.stack([grid.C0, grid.C1, grid.C0_T, grid.C1_T])[None],
+                 fq=np.stack([grid.A0, grid.A1, grid.w_q, grid.A0_T, grid.A1_T])[None],
                  ic=np.stack([grid.chord_start_node, grid.chord_end_node,
                               grid.constrained.astype(np.int64)])[None],
                  notch=np.stack([grid.notch_left_node, grid.notch_right_node]

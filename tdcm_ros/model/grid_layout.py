@@ -7,9 +7,9 @@ coordinate ``u``. Two kinds of grid:
 - ``uniform``: one piece per segment, ``cells_per_notch`` or ``cells_per_tube`` cells;
 - ``adaptive``: a notch is also cut where its profile ``h1`` crosses ``r_inner`` or
   ``R_outer``, the kinks of ``I(h1)`` (eq. 12's ``h2 = min(h1, r_inner)`` clip gives ``I`` a
-  singular second derivative there, which no Gauss rule across it resolves); a segment where
-  the tendon runs as a chord (the bending moment varies inside it) gets
-  ``CHORD_CELL_FACTOR`` times its count, because the moment is linear per cell.
+  singular second derivative there, which no Gauss rule across it resolves). A segment where
+  the tendon runs as a chord needs no extra cells: the bending moment bows inside it, and the
+  grid's chord terms (:mod:`tdcm_ros.model.grid`) carry that.
 
 Lengths in m; ``u`` is dimensionless in [0, 1].
 """
@@ -38,8 +38,6 @@ MAX_CROSSINGS = 4
 #: Samples of a custom profile searched for crossings, and bisection steps per crossing.
 CROSSING_SAMPLES = 129
 BISECTION_STEPS = 60
-#: Under ``adaptive``, a segment carrying a tendon chord gets this many times its cell count.
-CHORD_CELL_FACTOR = 4
 
 
 @dataclass(frozen=True)
@@ -208,7 +206,6 @@ def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
     breaks = np.zeros((m_count, 4, MAX_CROSSINGS + 2))
     breaks[..., -1] = 1.0
     if kind == "adaptive":
-        per_kind = np.where(constrained_kind, per_kind, CHORD_CELL_FACTOR * per_kind)
         breaks[:, NOTCH, 1:-1] = np.sort(crossings(members), axis=1)
     width = np.diff(breaks, axis=-1)
     counts = np.where(width > 0.0, np.maximum(1, np.rint(per_kind[None, :, None] * width)), 0)

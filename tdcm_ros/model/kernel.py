@@ -6,14 +6,18 @@ or compiled (lazily, on first use). A single solve is one member; a batch stacks
 
 Member arrays (SI units; ``M`` members, ``n`` cells, ``Q`` quadrature points, ``K`` notches):
 
-- ``fc`` (M, 2, n): the cells' ``C0``, ``C1`` (rad/(N m));
-- ``fq`` (M, 3, n, Q): ``A0``, ``A1`` (rad/(N m)) and ``w_q`` (m) at the Gauss points;
+- ``fc`` (M, 4, n): the cells' ``C0``, ``C1`` (rad/(N m)) and chord terms ``C0_T``, ``C1_T``
+  (rad/(N^2 m));
+- ``fq`` (M, 5, n, Q): ``A0``, ``A1`` (rad/(N m)), ``w_q`` (m), ``A0_T``, ``A1_T``
+  (rad/(N^2 m)) at the Gauss points (:mod:`tdcm_ros.model.grid`: on a chord the moment is
+  not linear in the cell, ``m'' = -T c m``; the integrals are then ``A0 + T A0_T`` etc. with
+  ``T`` the chord's tension, and the chord terms are zero where the tendon follows the body);
 - ``ic`` (M, 3, n): each cell's chord start node, chord end node, and 1 where the tendon
   follows the offset curve (0 on a chord);
 - ``notch`` (M, 2, K): left and right node of every notch, -1 in padding;
 - ``scal`` (M, 4): ``R_c`` (m), ``R_outer`` (m), body length (m), constrained peak compliance.
 
-A zero-length padding cell (``C0 = C1 = A0 = A1 = w_q = 0``) is neutral: it moves no node.
+A zero-length padding cell (every one of those zero) is neutral: it moves no node.
 Planar points are complex numbers ``z + i x`` (see :mod:`tdcm_ros.model.kinematics`).
 """
 
@@ -62,31 +66,40 @@ def unit(phi: float) -> complex:
     return complex(c, s)
 
 
-def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, p: Complex, theta: Array,
-                  tangent: Complex) -> None:
-    """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m), exactly for
-    moments linear in each cell: writes nodes ``p`` (m), ``theta`` (rad) and ``tangent``."""
+def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Complex,
+                  theta: Array, tangent: Complex) -> None:
+    """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m) and each cell's
+    tendon tension ``t`` (N; it matters only on chords, where the moment inside the cell is
+    ``m'' = -T c m`` to first order, elsewhere exactly linear): writes nodes ``p`` (m),
+    ``theta`` (rad) and ``tangent``."""
     n = fc.shape[1]
     nq = fq.shape[2]
     pos = 0j
     th = 0.0
-    t = 1.0 + 0j
+    tan = 1.0 + 0j
     p[0] = pos
     theta[0] = th
-    tangent[0] = t
+    tangent[0] = tan
     for i in range(n):
         a = m_a[i]
         b = m_b[i]
         local = 0j
-        for q in range(nq):
-            phi = a * fq[0, i, q] + b * fq[1, i, q]
-            local += fq[2, i, q] * unit(phi)
-        pos = pos + t * local
-        th = th + (a * fc[0, i] + b * fc[1, i])
-        t = complex(math.cos(th), math.sin(th))
+        if fc[2, i] == 0.0 and fc[3, i] == 0.0:  # the tendon follows the body: linear
+            for q in range(nq):
+                local += fq[2, i, q] * unit(a * fq[0, i, q] + b * fq[1, i, q])
+            th = th + (a * fc[0, i] + b * fc[1, i])
+        else:
+            tension = t[i]
+            for q in range(nq):
+                phi = (a * (fq[0, i, q] + tension * fq[3, i, q])
+                       + b * (fq[1, i, q] + tension * fq[4, i, q]))
+                local += fq[2, i, q] * unit(phi)
+            th = th + (a * (fc[0, i] + tension * fc[2, i]) + b * (fc[1, i] + tension * fc[3, i]))
+        pos = pos + tan * local
+        tan = complex(math.cos(th), math.sin(th))
         p[i + 1] = pos
         theta[i + 1] = th
-        tangent[i + 1] = t
+        tangent[i + 1] = tan
 
 
 def moments_row(r_c: float, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
@@ -131,11 +144,12 @@ def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Arr
         out[k] = smallest
 
 
-def integrate(fc: Array, fq: Array, m_a: Array, m_b: Array, p: Complex, theta: Array,
-              tangent: Complex) -> None:
-    """:func:`integrate_row` for every member (``m_a``, ``m_b`` (M, n); outputs (M, n+1))."""
+def integrate(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Complex,
+              theta: Array, tangent: Complex) -> None:
+    """:func:`integrate_row` for every member (``m_a``, ``m_b``, tensions ``t`` (M, n);
+    outputs (M, n+1))."""
     for j in range(m_a.shape[0]):
-        integrate_row(fc[j], fq[j], m_a[j], m_b[j], p[j], theta[j], tangent[j])
+        integrate_row(fc[j], fq[j], m_a[j], m_b[j], t[j], p[j], theta[j], tangent[j])
 
 
 def moments(scal: Array, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
@@ -182,7 +196,7 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
         t_a[:] = tension[j]
         xj = x[j]
         pj = p[j]
-        integrate_row(fc[row], fq[row], xj[:n], xj[n:], pj, theta[j], tangent[j])
+        integrate_row(fc[row], fq[row], xj[:n], xj[n:], t_a, pj, theta[j], tangent[j])
         smallest = math.inf
         status = EXHAUSTED
         steps = 0
@@ -191,7 +205,7 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
             if relaxation != 1.0:
                 for i in range(2 * n):
                     g[i] = xj[i] + relaxation * (g[i] - xj[i])
-            integrate_row(fc[row], fq[row], g[:n], g[n:], new_p, new_theta, new_tangent)
+            integrate_row(fc[row], fq[row], g[:n], g[n:], t_a, new_p, new_theta, new_tangent)
             step = 0.0
             for i in range(n + 1):
                 d = abs(new_p[i] - pj[i])

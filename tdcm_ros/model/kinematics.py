@@ -46,13 +46,17 @@ class PlanarShape:
         return self.p.real
 
 
-def integrate(grid: Grid | Cells, m_a: Array, m_b: Array) -> PlanarShape:
-    """Shape from per-cell end moments ``m_a``, ``m_b`` (N m), exactly for linear moments.
+def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
+              tension: float | Array = 0.0) -> PlanarShape:
+    """Shape from per-cell end moments ``m_a``, ``m_b`` (N m) under tendon ``tension`` (N).
 
     Each cell's tangent angle at its Gauss points is ``theta_a + m_a A0 + m_b A1``; the cell's
     displacement is the quadrature of the unit tangent over those points
-    (:func:`tdcm_ros.model.kernel.integrate_row`). ``grid`` is one grid, whose moments may
-    carry leading batch axes, or :class:`Cells` of ``M`` members with moments (M, cells).
+    (:func:`tdcm_ros.model.kernel.integrate_row`). Exact for moments linear in a cell, i.e.
+    where the tendon follows the body; on a chord the moment bows (``m'' = -T c m``) and the
+    grid's chord terms, times ``tension`` (a scalar or one per cell, broadcast against the
+    moments; 0 treats every moment as linear), carry it. ``grid`` is one grid, whose moments
+    may carry leading batch axes, or :class:`Cells` of ``M`` members with moments (M, cells).
     """
     cells = Cells.of(grid) if isinstance(grid, Grid) else grid
     m_a = np.asarray(m_a, dtype=float)
@@ -61,6 +65,8 @@ def integrate(grid: Grid | Cells, m_a: Array, m_b: Array) -> PlanarShape:
     rows = int(np.prod(lead, dtype=np.int64)) if lead else 1
     a = np.ascontiguousarray(m_a.reshape(rows, n))
     b = np.ascontiguousarray(np.asarray(m_b, dtype=float).reshape(rows, n))
+    t = np.ascontiguousarray(np.broadcast_to(np.asarray(tension, dtype=float),
+                                             m_a.shape).reshape(rows, n))
     fc, fq = cells.fc, cells.fq
     if rows != cells.members:
         fc = np.ascontiguousarray(np.broadcast_to(fc, (rows, *fc.shape[1:])))
@@ -68,7 +74,7 @@ def integrate(grid: Grid | Cells, m_a: Array, m_b: Array) -> PlanarShape:
     p = np.empty((rows, n + 1), np.complex128)
     theta = np.empty((rows, n + 1))
     tangent = np.empty((rows, n + 1), np.complex128)
-    kernels().integrate(fc, fq, a, b, p, theta, tangent)
+    kernels().integrate(fc, fq, a, b, t, p, theta, tangent)
     nodes = (*lead, n + 1)
     return PlanarShape(p=p.reshape(nodes), theta=theta.reshape(nodes),
                        tangent=tangent.reshape(nodes))

@@ -252,6 +252,7 @@ class LoadedModel:
         self._body_cells = _body_cells(grid) if self._body != 0 else None
         self._contact = (None if loading.notch_contact is None
                          else _contact(grid, loading.notch_contact))
+        self._chord_tensions: tuple[float, Array] | None = None
 
     @property
     def has_contact(self) -> bool:
@@ -315,6 +316,17 @@ class LoadedModel:
         scale[cells] = factor[contact.notch]
         return scale
 
+    def chord_tension(self, level: float) -> float | Array:
+        """Tension (N) on the chords for the shape integration's chord terms (the moment on a
+        chord, external loads included, bows as ``m'' = -T c m``; the loads' own curvature of
+        their moment is carried by no cell, as on the rest of the body). Under a tension
+        profile the chord tensions depend on the shape: those of the last shape whose moments
+        were taken at this ``level``, per cell (the base tension before any)."""
+        last = self._chord_tensions
+        if self.loading.tension_profile is None or last is None or last[0] != level:
+            return level
+        return last[1]
+
     def bend_moments(self, x: Array) -> Array:
         """Moments (N m) that set the curvature: ``x`` with contact scaling applied."""
         if self._contact is None:
@@ -350,7 +362,9 @@ class LoadedModel:
         if self.loading.tension_profile is None:
             m_a, m_b = loads.closed_form(grid, shape, np.float64(level))
         else:
-            m_a, m_b = loads.closed_form_cells(grid, shape, *self.cell_tensions(shape, level))
+            t_a, t_b = self.cell_tensions(shape, level)
+            self._chord_tensions = (level, t_a)
+            m_a, m_b = loads.closed_form_cells(grid, shape, t_a, t_b)
         external = self._external(shape, factor)
         if external is not None:
             m_a = m_a + external[:-1]

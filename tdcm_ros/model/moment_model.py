@@ -75,6 +75,11 @@ class MomentModel(Protocol):
         """The moments (N m) that set the curvature."""
         ...
 
+    def chord_tension(self, level: float) -> float | Array:
+        """Tension (N) on the chords at base tension ``level`` (N), for the chord terms of
+        the shape integration: one value or one per cell."""
+        ...
+
     def check_before(self, tension: float) -> None:
         """Raise a limit error known before iterating."""
         ...
@@ -132,6 +137,9 @@ class ClosedForm:
 
     def bend_moments(self, x: Array) -> Array:
         return x
+
+    def chord_tension(self, level: float) -> float:
+        return level
 
     def check_before(self, tension: float) -> None:
         if self.grid.design.R_c ** 2 * tension * self.cells.constrained_peak_c[0] >= 1.0:

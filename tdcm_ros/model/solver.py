@@ -59,11 +59,12 @@ class _Problem(NamedTuple):
     settings: SolverSettings
     model: MomentModel
 
-    def shape_of(self, x: Array) -> PlanarShape:
-        """Shape integrated from the bending moments of ``x = [m_a, m_b]`` (N m)."""
+    def shape_of(self, x: Array, level: float) -> PlanarShape:
+        """Shape integrated from the bending moments of ``x = [m_a, m_b]`` (N m) at tension
+        ``level`` (N; it bows the moment on chords)."""
         y = self.model.bend_moments(x)
         n = self.grid.n_cells
-        return integrate(self.grid, y[:n], y[n:])
+        return integrate(self.grid, y[:n], y[n:], self.model.chord_tension(level))
 
 
 @dataclass
@@ -107,7 +108,7 @@ def warm_up() -> bool:
     result = solve(design, 1.0)  # kernel.iterate_one
     solve(design, 1.0, settings=DEFAULT_SETTINGS.with_overrides(acceleration="anderson"))
     notch_gaps(result.grid, integrate(result.grid, result.cell_moments[:, 0],
-                                      result.cell_moments[:, 1]))  # the wrappers
+                                      result.cell_moments[:, 1], 1.0))  # the wrappers
     return is_compiled()
 
 
@@ -213,7 +214,7 @@ def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
     steps = settings.continuation_steps
     x = np.full_like(x0, grid.design.R_c * tension / steps)
     history: list[float] = []
-    run = _Run(x, problem.shape_of(x), history, False, "no steps")
+    run = _Run(x, problem.shape_of(x, tension / steps), history, False, "no steps")
     previous = tension / steps
     for k in range(1, steps + 1):
         level = tension * k / steps
@@ -242,7 +243,7 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
     lam = 0.0
     x = np.zeros_like(x0)
     history: list[float] = []
-    run = _Run(x, problem.shape_of(x), history, False, "no steps")
+    run = _Run(x, problem.shape_of(x, 0.0), history, False, "no steps")
     tol = problem.settings.tol
     loose = max(tol, math.sqrt(tol * problem.grid.design.length))
     while lam < 1.0:
@@ -278,14 +279,14 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
                             settings.relaxation if using == "relaxation" else 1.0,
                             SLOW_CONTRACTION if mode == "auto" else 0.0)
     if plain is None:
-        x, shape, history = x0, problem.shape_of(x0), []
+        x, shape, history = x0, problem.shape_of(x0, tension), []
     else:
         x, shape, history = plain.x, plain.shape, plain.history
         if plain.status != SLOWED:
             return _plain_outcome(plain)
         using = "anderson"
         if restart:
-            x, shape = x0, problem.shape_of(x0)
+            x, shape = x0, problem.shape_of(x0, tension)
     start = shape  # what plain iteration that slows restarts from (restart=True)
     d_x: list[Array] = []
     d_f: list[Array] = []
@@ -304,7 +305,7 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
             x_new = x + settings.relaxation * f
         else:
             x_new = g
-        new_shape = problem.shape_of(x_new)
+        new_shape = problem.shape_of(x_new, tension)
         step = float(np.max(np.abs(new_shape.p - shape.p)))
         if not np.isfinite(step):
             return _Run(x, shape, history, False, "iterate became non-finite")

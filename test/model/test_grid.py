@@ -78,7 +78,7 @@ def test_custom_profile_crossings_are_found_by_search():
 def test_rectangular_notches_have_no_crossings():
     design = preset("paper-experiment").with_overrides(profile="rectangular")
     grid = build_grid(design, SolverSettings(routing="free"))
-    # Chord notches: CHORD_CELL_FACTOR x cells_per_notch equal cells, no extra boundary.
+    # Chord notches: cells_per_notch equal cells, no extra boundary.
     cells = np.flatnonzero(grid.notch_index == 0)
     assert np.allclose(np.diff(grid.u_a[cells]), 1.0 / cells.size, rtol=1e-12)
 
@@ -91,6 +91,18 @@ def test_default_grid_is_within_0p1_um_under_paper_routing(name, notches, loads)
     reference, uncertainty = converged_tip(design, 20.0, "paper", loads)
     assert uncertainty < 1e-8
     tip = solve(design, 20.0, settings=SolverSettings(loads=loads)).tip_position
+    assert np.linalg.norm(tip - reference) < 1e-7
+
+
+@pytest.mark.parametrize("loads", ["closed", "literal"])
+@pytest.mark.parametrize("name", ["paper-experiment", "fig3-wd-1.2", "fig2-wn-1"])
+@pytest.mark.parametrize("notches", [1, 8, 64])
+def test_default_grid_is_within_0p1_um_under_free_routing(name, notches, loads):
+    # The chord terms carry the chord moment's bow, so free routing needs no extra cells.
+    design = preset(name).with_overrides(N=notches)
+    reference, uncertainty = converged_tip(design, 20.0, "free", loads)
+    assert uncertainty < 1e-8
+    tip = solve(design, 20.0, settings=SolverSettings(routing="free", loads=loads)).tip_position
     assert np.linalg.norm(tip - reference) < 1e-7
 
 
