@@ -1,7 +1,9 @@
 """Vectorised Algorithm 1: many designs and tensions in one call, same answers as ``solve``.
 
-Designs whose grids share a cell layout (same ``N``, same present segments, same settings)
-are stacked as :class:`~tdcm_ros.model.cells.Cells` (a leading member axis) and every member
+Every design's grid is built at once (:func:`~tdcm_ros.model.grid.build_grids`, vectorised;
+a :class:`~tdcm_ros.model.grid.Grid` object is built only for a member whose limit check
+needs its error message); designs of one cell count are stacked as
+:class:`~tdcm_ros.model.cells.Cells` (a leading member axis) and every member
 runs the kernels of :func:`tdcm_ros.model.solve` itself (:mod:`tdcm_ros.model.kernel`:
 closed-form loads, initial moment ``R_c T``, stop when no node moves more than ``tol``):
 plain (or, for ``acceleration="relaxation"``, damped) iteration runs in the kernel; a member that ``solve`` would hand to Anderson mixing, relaxation or
@@ -19,8 +21,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import lru_cache
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -34,7 +34,15 @@ from tdcm_ros.model.errors import (
     ModelError,
     TensionRangeError,
 )
-from tdcm_ros.model.grid import PEAK_SAMPLES, Grid, build_grid
+from tdcm_ros.model.grid import (
+    PEAK_SAMPLES,
+    CellRows,
+    Grid,
+    GridStack,
+    build_grid,
+    build_grids,
+)
+from tdcm_ros.model.grid_layout import Members
 from tdcm_ros.model.kernel import CONVERGED
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_tendon_singularity, check_tension
@@ -86,25 +94,44 @@ class BatchResult:
 
 @dataclass(frozen=True, eq=False)
 class _Stack:
-    """Designs sharing one cell layout: their grids, their :class:`Cells` (one row per
-    design) and, per design, its notch cells ``notch_cells`` and the strain coefficients
+    """Designs of one cell count: their :class:`Cells` (one row per design) and, per design,
+    its notch cells ``notch_cells`` (-1: padding) and the strain coefficients
     ``strain0``/``strain1`` (designs, notch cells, samples) giving the bending strain at
     ``PEAK_SAMPLES`` points of every notch cell as ``|m_a S0 + m_b S1|``."""
 
-    grids: NDArray[np.object_]
+    designs: tuple[Design, ...]
+    settings: SolverSettings
     cells: Cells
     notch_cells: NDArray[np.int64]
     strain0: Array
     strain1: Array
 
     @classmethod
-    def of(cls, grids: Sequence[Grid]) -> _Stack:
-        """Stack ``grids`` (all of one layout)."""
-        coefficients = [_strain_coefficients(g) for g in grids]
-        return cls(grids=_object_array(grids), cells=Cells.stack(grids),
-                   notch_cells=np.stack([np.flatnonzero(g.is_notch) for g in grids]),
-                   strain0=np.stack([c[0] for c in coefficients]),
-                   strain1=np.stack([c[1] for c in coefficients]))
+    def split(cls, grids: GridStack, settings: SolverSettings) -> list[tuple[NDArray[np.int64],
+                                                                              _Stack]]:
+        """``(rows of grids, stack)`` for every cell count of ``grids``, trimmed to it."""
+        cells = Cells.of_stack(grids)
+        notch_cells, strain0, strain1 = _strain_coefficients(grids)
+        out = []
+        for count in np.unique(grids.n_cells):
+            rows = np.flatnonzero(grids.n_cells == count)
+            notches = int(max(grids.designs[r].N for r in rows))
+            width = int(np.max(np.sum(notch_cells[rows] >= 0, axis=1)))
+            part = Cells(fc=np.ascontiguousarray(cells.fc[rows, :, :count]),
+                         fq=np.ascontiguousarray(cells.fq[rows, :, :count]),
+                         ic=np.ascontiguousarray(cells.ic[rows, :, :count]),
+                         notch=np.ascontiguousarray(cells.notch[rows, :, :notches]),
+                         scal=cells.scal[rows])
+            out.append((rows, cls(designs=tuple(grids.designs[r] for r in rows),
+                                  settings=settings, cells=part,
+                                  notch_cells=np.ascontiguousarray(notch_cells[rows, :width]),
+                                  strain0=np.ascontiguousarray(strain0[rows, :width]),
+                                  strain1=np.ascontiguousarray(strain1[rows, :width]))))
+        return out
+
+    def grid(self, row: int) -> Grid:
+        """The :class:`Grid` of design ``row`` (built on demand, for an error message)."""
+        return build_grid(self.designs[row], self.settings)
 
     def strain(self, rows: NDArray[np.int64], x: Array) -> Array:
         """Largest notch bending strain of members of design ``rows`` from their cell end
@@ -151,18 +178,11 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
     out = _Outcome(t_all.reshape(len(designs), -1))
-    layouts: dict[tuple[bytes, ...], list[tuple[int, Grid]]] = {}
-    for d, design in enumerate(designs):
-        try:
-            grid = build_grid(design, settings)
-        except InvalidDesignError as error:
-            out.fail(d * out.per_design + np.arange(out.per_design), error)
-            continue
-        layouts.setdefault(_layout_key(grid), []).append((d, grid))
+    valid, grids = _grids(out, designs, settings)
     chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
-    for group in layouts.values():
-        chunks += _screen_group(out, [d for d, _ in group], _Stack.of([g for _, g in group]),
-                                settings)
+    if grids is not None:
+        for rows, stack in _Stack.split(grids, settings):
+            chunks += _screen_group(out, valid[rows].tolist(), stack, settings)
     if workers == 1 or len(chunks) == 1:
         for members, stack, rows in chunks:
             _iterate(out, members, stack, rows, settings)
@@ -232,33 +252,58 @@ class _Outcome:
             iterations=self.iterations.reshape(shape), fallback=self.fallback.reshape(shape))
 
 
-def _object_array(items: Sequence[Any]) -> NDArray[np.object_]:
-    """A 1-D object array of ``items`` (never a nested numeric array)."""
-    array = np.empty(len(items), dtype=object)
-    array[:] = list(items)
-    return array
+def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings
+           ) -> tuple[NDArray[np.int64], GridStack | None]:
+    """The designs whose grids build, and their grids built at once; the others' members are
+    marked invalid (each design is checked alone only if the whole set is refused)."""
+    valid = np.arange(len(designs))
+    try:
+        return valid, build_grids(designs, settings) if designs else None
+    except InvalidDesignError:
+        pass
+    kept = []
+    for d, design in enumerate(designs):
+        try:
+            Members.of([design])
+        except InvalidDesignError as error:
+            out.fail(d * out.per_design + np.arange(out.per_design), error)
+            continue
+        kept.append(d)
+    valid = np.array(kept, np.int64)
+    return valid, build_grids([designs[d] for d in kept], settings) if kept else None
 
 
-def _layout_key(grid: Grid) -> tuple[bytes, ...]:
-    """Grids with equal keys have the same cells, chords and notches, node for node."""
-    return (grid.is_notch.tobytes(), grid.constrained.tobytes(),
-            grid.chord_start_node.tobytes(), grid.chord_end_node.tobytes(),
-            grid.notch_left_node.tobytes(), grid.gauss_u.tobytes())
-
-
-@lru_cache(maxsize=512)
-def _strain_coefficients(grid: Grid) -> tuple[Array, Array]:
-    """``S0``, ``S1`` (notch cells, samples): strain ``|m_a S0 + m_b S1|`` at ``PEAK_SAMPLES``
-    points of every notch cell, ``S = (1 - xi | xi) * c * min(h1, R_outer)``."""
-    d = grid.design
-    cells = np.flatnonzero(grid.is_notch)
-    u = grid.u_a[cells, None] + (grid.u_b - grid.u_a)[cells, None] * np.linspace(
-        0.0, 1.0, PEAK_SAMPLES)[None, :]
-    cell_of = np.broadcast_to(cells[:, None], u.shape)
-    s = grid.seg_start[cell_of] + grid.local_sigma(cell_of, u)
-    xi = (s - grid.s_nodes[cell_of]) / grid.length[cell_of]
-    weight = grid.compliance(cell_of, u) * np.minimum(d.profile.h1(u, d.w_n, d.w_d), d.R_outer)
-    return (1.0 - xi) * weight, xi * weight
+def _strain_coefficients(grids: GridStack) -> tuple[NDArray[np.int64], Array, Array]:
+    """Per design: its notch cells (padded with -1) and ``S0``, ``S1`` (designs, notch cells,
+    samples): strain ``|m_a S0 + m_b S1|`` at ``PEAK_SAMPLES`` points of every notch cell,
+    ``S = (1 - xi | xi) * c * min(h1, R_outer)``. Every notch of a design has the same cells
+    in its own coordinates, so the samples are computed on the first notch and copied."""
+    member, cell = np.nonzero(grids.is_notch & (grids.notch_index == 0))
+    members = Members.of(grids.designs)
+    length = grids.s_nodes[member, cell + 1] - grids.s_nodes[member, cell]
+    seg_start = grids.seg_start[member, cell]
+    rows = CellRows(members=members, member=member, is_notch=np.ones(member.size, bool),
+                    seg_start=seg_start, seg_length=grids.seg_length[member, cell],
+                    a=grids.s_nodes[member, cell], length=length)
+    u_a, u_b = grids.u_a[member, cell], grids.u_b[member, cell]
+    u = u_a[:, None] + (u_b - u_a)[:, None] * np.linspace(0.0, 1.0, PEAK_SAMPLES)[None, :]
+    xi = (rows.local_sigma(u) - (rows.a - seg_start)[:, None]) / length[:, None]
+    weight = rows.compliance(u) * np.minimum(members.h1(member, u),
+                                             members.R_outer[member][:, None])
+    designs = len(grids.designs)
+    per_notch = np.bincount(member, minlength=designs)
+    every, cells = np.nonzero(grids.is_notch)
+    count = np.bincount(every, minlength=designs)
+    slot = np.arange(every.size) - np.repeat(np.cumsum(count) - count, count)
+    source = (np.cumsum(per_notch) - per_notch)[every] + slot % per_notch[every]
+    width = int(count.max(initial=0))
+    notch_cells = np.full((designs, width), -1, np.int64)
+    notch_cells[every, slot] = cells
+    s0 = np.zeros((designs, width, PEAK_SAMPLES))
+    s1 = np.zeros((designs, width, PEAK_SAMPLES))
+    s0[every, slot] = ((1.0 - xi) * weight)[source]
+    s1[every, slot] = (xi * weight)[source]
+    return notch_cells, s0, s1
 
 
 def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
@@ -281,7 +326,7 @@ def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
     singular = ~bad & (r_c**2 * tension * peak >= 1.0) & (r_c * (r_c * tension) * peak >= 1.0)
     for m, row in zip(members[singular], rows[singular]):
         try:
-            check_tendon_singularity(stack.grids[row], float(out.tensions[m]))
+            check_tendon_singularity(stack.grid(int(row)), float(out.tensions[m]))
         except ModelError as error:
             out.fail(np.array([m]), error)
     keep = ~(bad | singular)
@@ -324,7 +369,7 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
         m = int(members[i])
         shape = PlanarShape(p=p[i], theta=theta[i], tangent=tangent[i])
         try:
-            check_closure(st.grids[rows[i]], shape, float(out.tensions[m]))
+            check_closure(st.grid(int(rows[i])), shape, float(out.tensions[m]))
         except ModelError as error:
             out.fail(np.array([m]), error)
     ok = done & ~closed

@@ -184,3 +184,18 @@ def test_threads_give_the_same_answers(monkeypatch):
 def test_bad_worker_counts_raise_typed_errors(workers):
     with pytest.raises(batch.InvalidSettingsError, match="workers"):
         solve_batch([preset("paper-experiment")], [1.0], workers=workers)
+
+
+def test_stacked_designs_equal_designs_solved_alone():
+    # Grids of many designs are built at once and padded per cell count: each member's tip and
+    # strain equal those of a batch of its design alone.
+    designs = random_designs(seed=5, count=16)
+    tensions = np.random.default_rng(9).uniform(0.0, 30.0, 16)
+    together = solve_batch(designs, tensions)
+    for i, design in enumerate(designs):
+        alone = solve_batch([design], tensions[i:i + 1])
+        assert together.status[i] == alone.status[0]
+        np.testing.assert_allclose(together.tip_position[i], alone.tip_position[0], rtol=0,
+                                   atol=1e-12)
+        np.testing.assert_allclose(together.max_bending_strain[i], alone.max_bending_strain[0],
+                                   rtol=1e-12, atol=0)
