@@ -73,8 +73,10 @@ class Cells:
                         stack.constrained.astype(np.int64)], axis=1).astype(np.int64)),
                    notch=np.ascontiguousarray(np.stack(
                        [stack.notch_left_node, stack.notch_right_node], axis=1).astype(np.int64)),
-                   scal=np.array([[d.R_c, d.R_outer, d.length, float(np.max(row, initial=0.0))]
-                                  for d, row in zip(stack.designs, peak, strict=True)]))
+                   scal=np.stack([np.array([d.R_c for d in stack.designs]),
+                                  np.array([d.R_outer for d in stack.designs]),
+                                  np.array([d.length for d in stack.designs]),
+                                  np.max(peak, axis=1, initial=0.0)], axis=1))
 
     def take(self, rows: Ints) -> Cells:
         """The members ``rows`` (repeats allowed)."""
