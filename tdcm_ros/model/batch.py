@@ -21,6 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -63,6 +64,8 @@ CHUNK = 256
 """Members iterated together: small enough that the chunk's arrays stay in cache (measured
 ~1.7x faster than 2048); any size gives the same answers."""
 MAX_WORKERS = 64
+STACK_CACHE_SIZE = 4
+"""Design sets whose stacked grids are kept (:func:`_stacks`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,11 +181,12 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
     out = _Outcome(t_all.reshape(len(designs), -1))
-    valid, grids = _grids(out, designs, settings)
+    refused, stacks = _stacks(tuple(designs), settings) if designs else ((), ())
+    for d, error in refused:
+        out.fail(d * out.per_design + np.arange(out.per_design), error)
     chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
-    if grids is not None:
-        for rows, stack in _Stack.split(grids, settings):
-            chunks += _screen_group(out, valid[rows].tolist(), stack, settings)
+    for ids, stack in stacks:
+        chunks += _screen_group(out, ids.tolist(), stack, settings)
     if workers == 1 or len(chunks) == 1:
         for members, stack, rows in chunks:
             _iterate(out, members, stack, rows, settings)
@@ -252,25 +256,34 @@ class _Outcome:
             iterations=self.iterations.reshape(shape), fallback=self.fallback.reshape(shape))
 
 
-def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings
-           ) -> tuple[NDArray[np.int64], GridStack | None]:
-    """The designs whose grids build, and their grids built at once; the others' members are
-    marked invalid (each design is checked alone only if the whole set is refused)."""
+Refusal = tuple[int, InvalidDesignError]
+
+
+@lru_cache(maxsize=STACK_CACHE_SIZE)
+def _stacks(designs: tuple[Design, ...], settings: SolverSettings
+            ) -> tuple[tuple[Refusal, ...], tuple[tuple[NDArray[np.int64], _Stack], ...]]:
+    """The designs whose grids do not build (index, error), and the others' grids built at
+    once, split per cell count as ``(design indices, stack)``; each design is checked alone
+    only if the whole set is refused. Cached: a sweep asks for the same designs again."""
     valid = np.arange(len(designs))
+    refused: list[Refusal] = []
     try:
-        return valid, build_grids(designs, settings) if designs else None
+        grids = build_grids(designs, settings)
     except InvalidDesignError:
-        pass
-    kept = []
-    for d, design in enumerate(designs):
-        try:
-            Members.of([design])
-        except InvalidDesignError as error:
-            out.fail(d * out.per_design + np.arange(out.per_design), error)
-            continue
-        kept.append(d)
-    valid = np.array(kept, np.int64)
-    return valid, build_grids([designs[d] for d in kept], settings) if kept else None
+        kept = []
+        for d, design in enumerate(designs):
+            try:
+                Members.of([design])
+            except InvalidDesignError as error:
+                refused.append((d, error))
+                continue
+            kept.append(d)
+        valid = np.array(kept, np.int64)
+        if not kept:
+            return tuple(refused), ()
+        grids = build_grids([designs[d] for d in kept], settings)
+    return tuple(refused), tuple((valid[rows], stack)
+                                 for rows, stack in _Stack.split(grids, settings))
 
 
 def _strain_coefficients(grids: GridStack) -> tuple[NDArray[np.int64], Array, Array]:
