@@ -195,10 +195,11 @@ def converged_tip(design: Design, tension: float, routing: str, loads: str
                   ) -> tuple[Array, float]:
     """Tip (m) of Algorithm 1 converged in the grid, and its uncertainty (m).
 
-    Richardson extrapolation of ``RICHARDSON_FINE`` and ``RICHARDSON_HALF`` (half the cells):
-    the chord moments, linear per cell, converge at second order, so ``fine + (fine - half)/3``;
-    the uncertainty is ``|fine - half| / 3``, the fine grid's own estimated error (the
-    extrapolated tip is better still where the second order term dominates).
+    Richardson extrapolation of ``RICHARDSON_FINE`` and ``RICHARDSON_HALF`` (half the cells)
+    for a second-order error, ``fine + (fine - half)/3``; the uncertainty is
+    ``|fine - half| / 3``, the fine grid's own estimated error. With the grid's chord terms the
+    tip converges faster than second order (the moment's bow on chords is carried, not
+    resolved by cells), so the correction is itself within that uncertainty.
     """
     fine, half = (solve(design, tension, settings=st.with_overrides(routing=routing, loads=loads),
                         strict=False).tip_position for st in (RICHARDSON_FINE, RICHARDSON_HALF))
