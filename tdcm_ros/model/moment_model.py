@@ -130,6 +130,8 @@ class ClosedForm:
     def __init__(self, grid: Grid) -> None:
         self.grid = grid
         self.cells = Cells.of(grid)
+        self._r_c_squared = grid.design.R_c ** 2
+        self._peak_c = self.cells.constrained_peak_c[0]
 
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
         m_a, m_b = loads.closed_form(self.grid, shape, np.float64(level))
@@ -142,7 +144,7 @@ class ClosedForm:
         return level
 
     def check_before(self, tension: float) -> None:
-        if self.grid.design.R_c ** 2 * tension * self.cells.constrained_peak_c[0] >= 1.0:
+        if self._r_c_squared * tension * self._peak_c >= 1.0:
             check_tendon_singularity(self.grid, tension)
 
     def check_after(self, x: Array, shape: PlanarShape, tension: float,
@@ -166,8 +168,7 @@ class ClosedForm:
         x, p, theta, tangent, steps, status, gap = kernels().iterate_one(
             cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, level, x, tol, relaxation,
             slow, DIVERGENCE_GROWTH, max(budget, 0))
-        return PlainRun(x, PlanarShape(p=p, theta=theta, tangent=tangent), steps.tolist(),
-                        status, gap)
+        return PlainRun(x, PlanarShape(p, theta, tangent), steps.tolist(), status, gap)
 
 
 class LiteralSum(ClosedForm):

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from time import perf_counter
 from typing import NamedTuple
 
@@ -124,15 +125,15 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
     x0 = _initial_guess(grid, settings, t_base, warm_start, model)
 
     runs: list[tuple[str, _Run]] = []
+    history: list[float] = []
     budget = settings.max_iter
     for plan in model.plans(settings):
         run = _run_plan(problem, plan, t_base, x0, min(budget, plan.budget))
         runs.append((plan.name, run))
+        history += run.history
         budget -= len(run.history)
         if run.converged or budget <= 0:
             break
-    iterations = sum(len(r.history) for _, r in runs)
-    history = tuple(v for _, r in runs for v in r.history)
     last = _last_finite(runs)
     if last is None:
         raise ConvergenceError(
@@ -140,7 +141,7 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
     strategy, final = last
     if final.converged:
         model.check_after(final.x, final.shape, t_base, final.min_gap)
-    result = _result(grid, settings, t_base, final, strategy, iterations, history,
+    result = _result(grid, settings, t_base, final, strategy, tuple(history),
                      perf_counter() - started, loading, model)
     if not final.converged and strict:
         raise ConvergenceError(
@@ -173,13 +174,19 @@ def _model(grid: Grid, settings: SolverSettings, tension: float,
                                   "Loading(...)", parameter="loading", value=loading,
                                   allowed="None | Loading")
     if loading is None or loading.is_trivial:
-        return ClosedForm(grid) if settings.loads == "closed" else LiteralSum(grid)
+        return _paper_model(grid, settings.loads)
     if settings.loads != "closed":
         raise InvalidLoadingError(
             f"loading is not supported with loads = {settings.loads!r}; allowed: loads=closed "
             "(the literal sum of eqs. 8-10 assumes a constant tension and no external load)",
             parameter="loading", value=loading.describe(), allowed="loads=closed")
     return LoadedModel(grid, loading, tension)
+
+
+@lru_cache(maxsize=512)
+def _paper_model(grid: Grid, loads: str) -> MomentModel:
+    """The paper's moment model of ``loads`` on ``grid`` (cached: it holds only the grid)."""
+    return ClosedForm(grid) if loads == "closed" else LiteralSum(grid)
 
 
 def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
@@ -363,17 +370,14 @@ def _anderson_step(x: Array, f: Array, last: tuple[Array, Array] | None, d_x: li
 
 
 def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, strategy: str,
-            iterations: int, history: tuple[float, ...], elapsed: float,
-            loading: Loading | None, model: MomentModel) -> SolveResult:
-    n = grid.n_cells
+            history: tuple[float, ...], elapsed: float, loading: Loading | None,
+            model: MomentModel) -> SolveResult:
+    """The result of the strategy run ``run`` (its ``history``: every step of the solve)."""
     shape = run.shape
     contact_scale, tendon_tension = model.extras(run.x, shape, tension)
-    positions = np.zeros((n + 1, 3))
+    positions = np.zeros((grid.s_nodes.size, 3))
     positions[:, 0] = shape.p.imag
     positions[:, 2] = shape.p.real
-    return SolveResult(
-        design=grid.design, settings=settings, tension_n=tension, s=grid.s_nodes,
-        positions=positions, theta=shape.theta, cell_moments=run.x.reshape(2, n).T,
-        iterations=iterations, residual_history=history, converged=run.converged,
-        strategy=strategy, solve_time_s=elapsed, grid=grid, loading=loading,
-        contact_scale=contact_scale, tendon_tension=tendon_tension)
+    return SolveResult(grid.design, settings, tension, grid.s_nodes, positions, shape.theta,
+                       run.x.reshape(2, -1).T, len(history), history, run.converged, strategy,
+                       elapsed, grid, loading, contact_scale, tendon_tension)
