@@ -53,6 +53,9 @@ SLOW_CONTRACTION = 0.3
 CONTINUATION_HALVINGS = 5
 
 
+RECENT_PROBLEMS = 64
+
+
 class _Problem(NamedTuple):
     """What the strategies iterate: a moment model on its grid, under settings."""
 
@@ -66,6 +69,9 @@ class _Problem(NamedTuple):
         y = self.model.bend_moments(x)
         n = self.grid.n_cells
         return integrate(self.grid, y[:n], y[n:], self.model.chord_tension(level))
+
+
+_recent_problems: dict[tuple[int, int], tuple[Design, SolverSettings, _Problem]] = {}
 
 
 @dataclass
@@ -118,10 +124,9 @@ def _solve(design: Design, t_base: float, settings: SolverSettings,
            started: float) -> SolveResult:
     """:func:`solve` for a checked base tension ``t_base`` (N); ``started`` is its start time
     (s, ``perf_counter``)."""
-    grid = build_grid(design, settings)
-    model = _model(grid, settings, t_base, loading)
+    problem = _problem(design, settings, t_base, loading)
+    grid, _, model = problem
     model.check_before(t_base)
-    problem = _Problem(grid, settings, model)
     x0 = _initial_guess(grid, settings, t_base, warm_start, model)
 
     runs: list[tuple[str, _Run]] = []
@@ -163,6 +168,28 @@ def _last_finite(runs: list[tuple[str, _Run]]) -> tuple[str, _Run] | None:
                              and np.all(np.isfinite(run.shape.theta))):
             return name, run
     return None
+
+
+def _problem(design: Design, settings: SolverSettings, tension: float,
+             loading: Loading | None) -> _Problem:
+    """The grid of ``design`` under ``settings`` and its moment model under ``loading`` at
+    ``tension`` (N). Without a loading the problem is remembered per design and settings
+    object (the last :data:`RECENT_PROBLEMS` pairs; holding them keeps their ids unique), so
+    repeated solves skip hashing them for the grid cache (this memo sits in front of
+    :func:`~tdcm_ros.model.grid.build_grid`'s cache: code that swaps how grids are built must
+    clear both)."""
+    if loading is not None:
+        grid = build_grid(design, settings)
+        return _Problem(grid, settings, _model(grid, settings, tension, loading))
+    key = (id(design), id(settings))
+    known = _recent_problems.get(key)
+    if known is None:
+        grid = build_grid(design, settings)
+        if len(_recent_problems) >= RECENT_PROBLEMS:
+            _recent_problems.clear()
+        known = _recent_problems[key] = (
+            design, settings, _Problem(grid, settings, _model(grid, settings, tension, None)))
+    return known[2]
 
 
 def _model(grid: Grid, settings: SolverSettings, tension: float,
