@@ -344,7 +344,8 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
 
     The kernel's plain iteration, as in ``solver._iterate`` (damped for ``relaxation``; one
     plain step for ``anderson``); a member ``solve`` would switch to Anderson, or that
-    diverges, turns non-finite or exhausts the budget, is queued for the single solve.
+    diverges, turns non-finite or exhausts the budget, is queued for the single solve. The
+    kernel also returns each converged member's peak notch strain (no separate pass).
     """
     mode = settings.acceleration
     budget = 1 if mode == "anderson" else settings.max_iter
@@ -357,10 +358,12 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
     theta = np.empty((members.size, n + 1))
     tangent = np.empty((members.size, n + 1), np.complex128)
     info = np.empty((members.size, 3 + budget))
+    strain = np.empty(members.size)
     kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension, x,
                       p, theta, tangent, settings.tol,
                       settings.relaxation if mode == "relaxation" else 1.0,
-                      SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info)
+                      SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info,
+                      st.notch_cells, st.strain0, st.strain1, strain)
     done = info[:, 1] == CONVERGED
     out.pending.extend((int(members[i]), st, int(rows[i])) for i in np.flatnonzero(~done))
     out.iterations[members[done]] = info[done, 0].astype(np.int64)
@@ -373,4 +376,4 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
         except ModelError as error:
             out.fail(np.array([m]), error)
     ok = done & ~closed
-    out.store(members[ok], p[ok, -1], theta[ok, -1], st.strain(rows[ok], x[ok]))
+    out.store(members[ok], p[ok, -1], theta[ok, -1], strain[ok])

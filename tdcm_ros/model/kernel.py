@@ -167,7 +167,8 @@ def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> 
 
 def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
             tension: Array, x: Array, p: Complex, theta: Array, tangent: Complex, tol: float,
-            relaxation: float, slow: float, growth: float, info: Array) -> None:
+            relaxation: float, slow: float, growth: float, info: Array, strain_cells: Ints,
+            s0: Array, s1: Array, strain: Array) -> None:
     """Plain (or damped) fixed-point iteration of the constant-tension tendon moment.
 
     Member ``j`` is design row ``rows[j]`` of the cell arrays at tension ``tension[j]`` (N).
@@ -179,7 +180,10 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
     ``CONVERGED`` (step <= tol (m)), ``NON_FINITE`` (the step is not finite: the previous
     iterate is kept, no step recorded), ``DIVERGING`` (step > 2 L, or > ``growth`` x the
     smallest step after 5 steps), ``SLOWED`` (``slow > 0`` and a step > ``slow`` x the
-    previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps).
+    previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps). ``strain`` (M,)
+    receives, for a converged member, :func:`peak_strain_row` of its moments over
+    ``strain_cells``, ``s0``, ``s1`` (as for :func:`peak_strains`; zero notch cells give 0),
+    and is left untouched for the others.
     """
     n = fc.shape[2]
     budget = info.shape[1] - 3
@@ -239,6 +243,8 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
         info[j, 0] = steps
         info[j, 1] = status
         info[j, 2] = least
+        if status == CONVERGED:
+            strain[j] = peak_strain_row(strain_cells[row], s0[row], s1[row], xj)
 
 
 def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: float,
@@ -253,31 +259,38 @@ def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tensio
     tangent = np.empty((1, nodes), np.complex128)
     info = np.empty((1, 3 + budget))
     iterate(fc, fq, ic, notch, scal, np.zeros(1, np.int64), np.full(1, tension), x, p, theta,
-            tangent, tol, relaxation, slow, growth, info)
+            tangent, tol, relaxation, slow, growth, info, np.empty((1, 0), np.int64),
+            np.empty((1, 0, 0)), np.empty((1, 0, 0)), np.empty(1))
     count = int(info[0, 0])
     return (x[0], p[0], theta[0], tangent[0], info[0, 3:3 + count].copy(), int(info[0, 1]),
             info[0, 2])
 
 
+def peak_strain_row(cells: Ints, s0: Array, s1: Array, x: Array) -> float:
+    """Largest ``|m_a S0 + m_b S1|`` of one member over its notch ``cells`` (-1 padding) and
+    their samples ``s0``, ``s1`` (notch cells, samples), from its moments ``x`` (2n,) N m."""
+    n = x.shape[0] // 2
+    largest = 0.0
+    for k in range(cells.shape[0]):
+        i = cells[k]
+        if i < 0:
+            continue
+        a = x[i]
+        b = x[n + i]
+        for q in range(s0.shape[1]):
+            largest = max(largest, abs(a * s0[k, q] + b * s1[k, q]))
+    return largest
+
+
 def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: Array) -> None:
-    """Largest ``|m_a S0 + m_b S1|`` of every member over its design's notch ``cells``
-    (design row, notch cells; -1 padding) and their samples: ``s0``, ``s1`` (design row,
-    notch cells, samples); moments ``x`` (M, 2n) N m."""
-    n = x.shape[1] // 2
+    """:func:`peak_strain_row` of every member ``j`` (design row ``rows[j]`` of ``cells``
+    (design row, notch cells) and ``s0``, ``s1`` (design row, notch cells, samples)) from its
+    moments ``x[j]`` (M, 2n) N m."""
     for j in range(x.shape[0]):
         row = rows[j]
-        largest = 0.0
-        for k in range(cells.shape[1]):
-            i = cells[row, k]
-            if i < 0:
-                continue
-            a = x[j, i]
-            b = x[j, n + i]
-            for q in range(s0.shape[2]):
-                largest = max(largest, abs(a * s0[row, k, q] + b * s1[row, k, q]))
-        out[j] = largest
+        out[j] = peak_strain_row(cells[row], s0[row], s1[row], x[j])
 
 
 KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
-           "iterate", "iterate_one", "peak_strains")
+           "peak_strain_row", "iterate", "iterate_one", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

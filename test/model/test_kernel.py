@@ -177,7 +177,8 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
         info = np.empty((3, 3 + 200))
         compiled.kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows,
                                    np.full(3, 15.0), x, p, theta, tangent, 1e-10, 1.0, 0.3,
-                                   1e3, info)
+                                   1e3, info, np.full((3, 0), -1), np.empty((3, 0, 0)),
+                                   np.empty((3, 0, 0)), np.empty(3))
         results.append((p[:, -1], info[:, :3]))
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
