@@ -359,11 +359,11 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
     tangent = np.empty((members.size, n + 1), np.complex128)
     info = np.empty((members.size, 3 + budget))
     strain = np.empty(members.size)
-    kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension, x,
-                      p, theta, tangent, settings.tol,
-                      settings.relaxation if mode == "relaxation" else 1.0,
-                      SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info,
-                      st.notch_cells, st.strain0, st.strain1, strain)
+    kernels().iterate_strained(
+        cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension, x, p, theta,
+        tangent, settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
+        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, st.notch_cells,
+        st.strain0, st.strain1, strain)
     done = info[:, 1] == CONVERGED
     out.pending.extend((int(members[i]), st, int(rows[i])) for i in np.flatnonzero(~done))
     out.iterations[members[done]] = info[done, 0].astype(np.int64)

@@ -167,8 +167,7 @@ def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> 
 
 def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
             tension: Array, x: Array, p: Complex, theta: Array, tangent: Complex, tol: float,
-            relaxation: float, slow: float, growth: float, info: Array, strain_cells: Ints,
-            s0: Array, s1: Array, strain: Array) -> None:
+            relaxation: float, slow: float, growth: float, info: Array) -> None:
     """Plain (or damped) fixed-point iteration of the constant-tension tendon moment.
 
     Member ``j`` is design row ``rows[j]`` of the cell arrays at tension ``tension[j]`` (N).
@@ -180,10 +179,7 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
     ``CONVERGED`` (step <= tol (m)), ``NON_FINITE`` (the step is not finite: the previous
     iterate is kept, no step recorded), ``DIVERGING`` (step > 2 L, or > ``growth`` x the
     smallest step after 5 steps), ``SLOWED`` (``slow > 0`` and a step > ``slow`` x the
-    previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps). ``strain`` (M,)
-    receives, for a converged member, :func:`peak_strain_row` of its moments over
-    ``strain_cells``, ``s0``, ``s1`` (as for :func:`peak_strains`; zero notch cells give 0),
-    and is left untouched for the others.
+    previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps).
     """
     n = fc.shape[2]
     budget = info.shape[1] - 3
@@ -243,8 +239,22 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
         info[j, 0] = steps
         info[j, 1] = status
         info[j, 2] = least
-        if status == CONVERGED:
-            strain[j] = peak_strain_row(strain_cells[row], s0[row], s1[row], xj)
+
+
+def iterate_strained(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
+                     tension: Array, x: Array, p: Complex, theta: Array, tangent: Complex,
+                     tol: float, relaxation: float, slow: float, growth: float, info: Array,
+                     strain_cells: Ints, s0: Array, s1: Array, strain: Array) -> None:
+    """:func:`iterate`, then for every converged member ``j`` its peak notch strain
+    ``strain[j]`` (:func:`peak_strain_row` over ``strain_cells``, ``s0``, ``s1`` of design
+    row ``rows[j]``, as :func:`peak_strains`) in the same compiled call; the others' entries
+    are left untouched."""
+    iterate(fc, fq, ic, notch, scal, rows, tension, x, p, theta, tangent, tol, relaxation,
+            slow, growth, info)
+    for j in range(x.shape[0]):
+        if info[j, 1] == CONVERGED:
+            row = rows[j]
+            strain[j] = peak_strain_row(strain_cells[row], s0[row], s1[row], x[j])
 
 
 def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: float,
@@ -259,8 +269,7 @@ def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tensio
     tangent = np.empty((1, nodes), np.complex128)
     info = np.empty((1, 3 + budget))
     iterate(fc, fq, ic, notch, scal, np.zeros(1, np.int64), np.full(1, tension), x, p, theta,
-            tangent, tol, relaxation, slow, growth, info, np.empty((1, 0), np.int64),
-            np.empty((1, 0, 0)), np.empty((1, 0, 0)), np.empty(1))
+            tangent, tol, relaxation, slow, growth, info)
     count = int(info[0, 0])
     return (x[0], p[0], theta[0], tangent[0], info[0, 3:3 + count].copy(), int(info[0, 1]),
             info[0, 2])
@@ -300,5 +309,5 @@ def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: A
 
 
 KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
-           "peak_strain_row", "iterate", "iterate_one", "peak_strains")
+           "peak_strain_row", "iterate", "iterate_strained", "iterate_one", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

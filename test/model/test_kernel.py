@@ -177,8 +177,7 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
         info = np.empty((3, 3 + 200))
         compiled.kernels().iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows,
                                    np.full(3, 15.0), x, p, theta, tangent, 1e-10, 1.0, 0.3,
-                                   1e3, info, np.full((3, 0), -1), np.empty((3, 0, 0)),
-                                   np.empty((3, 0, 0)), np.empty(3))
+                                   1e3, info)
         results.append((p[:, -1], info[:, :3]))
     np.testing.assert_array_equal(results[0][0], results[1][0])
     np.testing.assert_array_equal(results[0][1], results[1][1])
@@ -199,3 +198,37 @@ def test_one_shot_picks_the_plain_build_only_inside_and_only_if_unchosen(monkeyp
         assert compiled.is_compiled()  # an explicit TDCM_JIT wins
     with compiled.one_shot():
         assert compiled.is_compiled()  # a loaded build is kept
+
+
+@pytest.mark.parametrize("build", ["plain", "compiled"])
+def test_iterate_strained_adds_the_peak_strain_of_converged_members_only(build):
+    from tdcm_ros.model.batch import _strain_coefficients
+    from tdcm_ros.model.grid import build_grids
+
+    code = kernel if build == "plain" else compiled.kernels()
+    base = preset("paper-experiment")
+    designs = [base.with_overrides(N=n, w_n=w) for n, w in ((2, 1e-3), (5, 2e-3), (8, 1.5e-3))]
+    grids = build_grids(designs, SolverSettings())
+    cells = Cells.of_stack(grids)
+    notch_cells, s0, s1 = _strain_coefficients(grids)
+    rows = np.array([0, 1, 2, 2], np.int64)
+    tension = np.array([15.0, 3.0, 9.0, 20.0])
+    n = cells.n_cells
+    for budget, converges in ((200, True), (0, False)):
+        x = np.ascontiguousarray(np.broadcast_to((cells.r_c[rows] * tension)[:, None],
+                                                 (4, 2 * n)))
+        shape = [np.empty((4, n + 1), complex), np.empty((4, n + 1)),
+                 np.empty((4, n + 1), complex)]
+        info = np.empty((4, 3 + budget))
+        strain = np.full(4, np.nan)
+        code.iterate_strained(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows,
+                              tension, x, *shape, 1e-10, 1.0, 0.3, 1e3, info, notch_cells,
+                              s0, s1, strain)
+        assert np.all((info[:, 1] == kernel.CONVERGED) == converges)
+        if converges:
+            separate = np.empty(4)
+            code.peak_strains(rows, notch_cells, s0, s1, x, separate)
+            np.testing.assert_array_equal(strain, separate)
+            assert np.all(strain > 0.0)
+        else:
+            assert np.all(np.isnan(strain))
