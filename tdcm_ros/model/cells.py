@@ -10,14 +10,15 @@ notches marked -1 (never checked).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.grid import Grid, GridStack
+from tdcm_ros.model.grid import CellArrays, Grid, GridStack
 
 Array = NDArray[np.float64]
 Ints = NDArray[np.int64]
@@ -64,19 +65,11 @@ class Cells:
         """Members = the designs of a :func:`~tdcm_ros.model.grid.build_grids` stack (its
         zero-length padding cells and tip-node padding notches are neutral here too)."""
         peak = np.where(stack.constrained & (stack.length > 0.0), stack.peak_c, 0.0)
-        return cls(fc=np.ascontiguousarray(np.stack(
-                       [stack.C0, stack.C1, stack.C0_T, stack.C1_T], axis=1)),
-                   fq=np.ascontiguousarray(np.stack(
-                       [stack.A0, stack.A1, stack.w_q, stack.A0_T, stack.A1_T], axis=1)),
-                   ic=np.ascontiguousarray(np.stack(
-                       [stack.chord_start_node, stack.chord_end_node,
-                        stack.constrained.astype(np.int64)], axis=1).astype(np.int64)),
-                   notch=np.ascontiguousarray(np.stack(
-                       [stack.notch_left_node, stack.notch_right_node], axis=1).astype(np.int64)),
-                   scal=np.stack([np.array([d.R_c for d in stack.designs]),
-                                  np.array([d.R_outer for d in stack.designs]),
-                                  np.array([d.length for d in stack.designs]),
-                                  np.max(peak, axis=1, initial=0.0)], axis=1))
+        return _packed(stack, lambda values: values, np.stack(
+            [np.array([d.R_c for d in stack.designs]),
+             np.array([d.R_outer for d in stack.designs]),
+             np.array([d.length for d in stack.designs]),
+             np.max(peak, axis=1, initial=0.0)], axis=1))
 
     def take(self, rows: Ints) -> Cells:
         """The members ``rows`` (repeats allowed)."""
@@ -187,10 +180,20 @@ class Cells:
 @lru_cache(maxsize=512)
 def _cells_of(grid: Grid) -> Cells:
     d = grid.design
-    return Cells(fc=np.stack([grid.C0, grid.C1, grid.C0_T, grid.C1_T])[None],
-                 fq=np.stack([grid.A0, grid.A1, grid.w_q, grid.A0_T, grid.A1_T])[None],
-                 ic=np.stack([grid.chord_start_node, grid.chord_end_node,
-                              grid.constrained.astype(np.int64)])[None],
-                 notch=np.stack([grid.notch_left_node, grid.notch_right_node]
-                                ).astype(np.int64).reshape(1, 2, -1),
-                 scal=np.array([[d.R_c, d.R_outer, d.length, grid.constrained_peak_c]]))
+    return _packed(grid, lambda values: values[None],
+                   np.array([[d.R_c, d.R_outer, d.length, grid.constrained_peak_c]]))
+
+
+def _packed(grids: CellArrays, member_axis: Callable[[NDArray[Any]], NDArray[Any]],
+            scal: Array) -> Cells:
+    """The kernel layout of ``grids``' arrays; ``member_axis`` gives each its leading member
+    axis (a stack has it already, one grid gets one of length 1)."""
+    def packed(*names: str) -> NDArray[Any]:
+        return np.ascontiguousarray(np.stack(
+            [member_axis(getattr(grids, name)) for name in names], axis=1))
+
+    return Cells(fc=packed("C0", "C1", "C0_T", "C1_T"),
+                 fq=packed("A0", "A1", "w_q", "A0_T", "A1_T"),
+                 ic=packed("chord_start_node", "chord_end_node", "constrained").astype(np.int64),
+                 notch=packed("notch_left_node", "notch_right_node").astype(np.int64),
+                 scal=scal)

@@ -57,10 +57,11 @@ QUERY_CACHE_SIZE = 8
 
 
 @dataclass(frozen=True, eq=False)
-class Grid:
-    """Cells of one design under one discretisation (see module docstring); SI units."""
+class CellArrays:
+    """The per-cell, per-node, per-Gauss-point and per-notch arrays of a grid (SI units; the
+    module docstring says what each is). :class:`Grid` holds them for one design,
+    :class:`GridStack` with a leading member axis."""
 
-    design: Design
     s_nodes: Array
     is_notch: NDArray[np.bool_]
     notch_index: IntArray
@@ -69,7 +70,6 @@ class Grid:
     u_a: Array
     u_b: Array
     constrained: NDArray[np.bool_]
-    chord_cells: IntArray
     chord_start_node: IntArray
     chord_end_node: IntArray
     gauss_u: Array
@@ -92,6 +92,14 @@ class Grid:
     peak_s: Array
     notch_left_node: IntArray
     notch_right_node: IntArray
+
+
+@dataclass(frozen=True, eq=False)
+class Grid(CellArrays):
+    """Cells of one design under one discretisation (see module docstring); SI units."""
+
+    design: Design
+    chord_cells: IntArray
     _queries: dict[bytes, Query] = field(default_factory=dict, init=False, compare=False,
                                          repr=False)
 
@@ -365,7 +373,7 @@ def _integration_matrix(quad_order: int) -> Array:
 
 
 @dataclass(frozen=True, eq=False)
-class GridStack:
+class GridStack(CellArrays):
     """The grids of M designs with a leading member axis, padded to ``C`` cells (SI units).
 
     Fields have :class:`Grid`'s names and meanings with a leading axis of length M: per cell
@@ -380,36 +388,6 @@ class GridStack:
 
     designs: tuple[Design, ...]
     n_cells: IntArray
-    s_nodes: Array
-    is_notch: NDArray[np.bool_]
-    notch_index: IntArray
-    seg_start: Array
-    seg_length: Array
-    u_a: Array
-    u_b: Array
-    constrained: NDArray[np.bool_]
-    chord_start_node: IntArray
-    chord_end_node: IntArray
-    gauss_u: Array
-    gauss_w: Array
-    s_q: Array
-    w_q: Array
-    xi_q: Array
-    c_q: Array
-    C0: Array
-    C1: Array
-    A0: Array
-    A1: Array
-    A0_T: Array
-    A1_T: Array
-    C0_T: Array
-    C1_T: Array
-    c_start: Array
-    c_end: Array
-    peak_c: Array
-    peak_s: Array
-    notch_left_node: IntArray
-    notch_right_node: IntArray
 
     @property
     def length(self) -> Array:
