@@ -53,9 +53,6 @@ SLOW_CONTRACTION = 0.3
 CONTINUATION_HALVINGS = 5
 
 
-RECENT_PROBLEMS = 64
-
-
 class _Problem(NamedTuple):
     """What the strategies iterate: a moment model on its grid, under settings."""
 
@@ -70,8 +67,6 @@ class _Problem(NamedTuple):
         n = self.grid.n_cells
         return integrate(self.grid, y[:n], y[n:], self.model.chord_tension(level))
 
-
-_recent_problems: dict[tuple[int, int], tuple[Design, SolverSettings, _Problem]] = {}
 
 
 @dataclass
@@ -172,24 +167,10 @@ def _last_finite(runs: list[tuple[str, _Run]]) -> tuple[str, _Run] | None:
 
 def _problem(design: Design, settings: SolverSettings, tension: float,
              loading: Loading | None) -> _Problem:
-    """The grid of ``design`` under ``settings`` and its moment model under ``loading`` at
-    ``tension`` (N). Without a loading the problem is remembered per design and settings
-    object (the last :data:`RECENT_PROBLEMS` pairs; holding them keeps their ids unique), so
-    repeated solves skip hashing them for the grid cache (this memo sits in front of
-    :func:`~tdcm_ros.model.grid.build_grid`'s cache: code that swaps how grids are built must
-    clear both)."""
-    if loading is not None:
-        grid = build_grid(design, settings)
-        return _Problem(grid, settings, _model(grid, settings, tension, loading))
-    key = (id(design), id(settings))
-    known = _recent_problems.get(key)
-    if known is None:
-        grid = build_grid(design, settings)
-        if len(_recent_problems) >= RECENT_PROBLEMS:
-            _recent_problems.clear()
-        known = _recent_problems[key] = (
-            design, settings, _Problem(grid, settings, _model(grid, settings, tension, None)))
-    return known[2]
+    """The (cached) grid of ``design`` under ``settings`` and its moment model under
+    ``loading`` at ``tension`` (N)."""
+    grid = build_grid(design, settings)
+    return _Problem(grid, settings, _model(grid, settings, tension, loading))
 
 
 def _model(grid: Grid, settings: SolverSettings, tension: float,
