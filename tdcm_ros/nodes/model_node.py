@@ -27,9 +27,9 @@ import numpy as np
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError, PhysicsError
-from tdcm_ros.metrics import MARKER_SPECS
 from tdcm_ros.model import (
     FIELD_SPECS,
+    MARKER_SPECS,
     PRESETS,
     SOLVER_SPECS,
     Design,
