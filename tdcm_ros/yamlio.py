@@ -10,12 +10,17 @@ hostile input fail fast with a typed error naming the source, the line and the l
 - text longer than :data:`MAX_INPUT_BYTES` (UTF-8) is rejected before parsing;
 - a mapping with the same key twice is an error (YAML 1.1 ``<<`` merge keys excepted).
 
+One reading differs from ``yaml.safe_load``: a number with an exponent is a float as in YAML 1.2
+(``1e9``, ``1.0e9``, ``-2E-3``, ``.5e3``), where YAML 1.1 wants a dot and a signed exponent and
+reads these as strings (:data:`EXPONENT_FLOAT`).
+
 Every failure, including plain syntax errors and scalars Python cannot build (e.g. the date
 ``2020-13-01``), is raised as ``error`` (default :class:`YamlInputError`).
 """
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import yaml
@@ -30,6 +35,10 @@ MAX_DEPTH_LEVELS = 64
 MAX_INPUT_BYTES = 64 * 1024
 
 _MERGE_TAG = "tag:yaml.org,2002:merge"
+_FLOAT_TAG = "tag:yaml.org,2002:float"
+#: plain scalars that are floats in YAML 1.2's core schema but strings in YAML 1.1: an exponent
+#: without a dot in the mantissa or without a sign (1e9, 1.0e9, -2E-3, .5e3, 1.e9)
+EXPONENT_FLOAT = re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$")
 #: what ``SafeConstructor`` raises for tagged scalars it cannot build
 _SCALAR_FAILURES = (ValueError, ArithmeticError, LookupError, AttributeError)
 
@@ -95,6 +104,11 @@ class _BoundedLoader(yaml.SafeLoader):
                                   key_node.start_mark, "each key once per mapping")
             first_line[key] = line
         return super().construct_mapping(node, deep=deep)
+
+
+# Appended after YAML 1.1's own resolvers (PyYAML copies the inherited table first, so
+# ``yaml.SafeLoader`` is unchanged): only scalars that 1.1 reads as strings become floats.
+_BoundedLoader.add_implicit_resolver(_FLOAT_TAG, EXPONENT_FLOAT, list("-+0123456789."))
 
 
 def _oversize(text: str, source: str) -> str | None:

@@ -80,3 +80,26 @@ def test_any_text_gives_a_value_or_a_typed_error(text: str) -> None:
         load_yaml(text, "cfg")
     except YamlInputError as error:
         assert str(error).startswith("cfg")
+
+
+@pytest.mark.parametrize("text", ["1e9", "1.0e9", "-2E-3", "+.5e3", "1.e9", "7e+0", "1.0e+9"])
+def test_a_number_with_an_exponent_is_a_float_as_in_yaml_1_2(text: str) -> None:
+    """YAML 1.1 (``yaml.safe_load``) reads ``1.0e9`` as a string; ``tdcm param set X E 1.0e9``
+    must set a float."""
+    value = load_yaml(text, "cfg")
+    assert isinstance(value, float) and value == float(text)
+    assert load_yaml(f"E: {text}\nlist: [{text}]", "cfg") == {"E": float(text), "list": [float(text)]}
+
+
+@pytest.mark.parametrize("text", ["1e", "e9", "1e9x", "1_000e3", "'1e9'", "0x1e9", "1e9.5"])
+def test_near_exponent_strings_keep_their_yaml_1_1_reading(text: str) -> None:
+    assert load_yaml(text, "cfg") == yaml.safe_load(text)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.floats(allow_nan=False, allow_infinity=False), st.sampled_from(["e", "E"]),
+       st.sampled_from(["", "+", "-"]))
+def test_exponent_spellings_of_any_float_read_back_exactly(x: float, e: str, sign: str) -> None:
+    mantissa, _, exponent = f"{x:.17e}".partition("e")
+    text = f"{mantissa}{e}{sign}{exponent.lstrip('+-')}"
+    assert load_yaml(text, "cfg") == float(text)
