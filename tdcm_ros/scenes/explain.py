@@ -13,6 +13,12 @@ schedule's top tension:
   per call (per frame; once per world for ``registration_error``); tip change = RMS distance between the tip marker as the estimator sees it
   (mapped to tdcm_base through the published transform), over frames where both see it.
 - timing: cost per message; no tip change (it shifts time, not position).
+
+A mechanics or actuation cost is a difference of two timings, so it carries their noise: the
+scene's own timing is measured twice and the difference between the two is the timing noise
+(at least the clock's resolution, and at least how much faster the scene ran with the effect
+than without). A cost not above the noise is reported as "below the timing noise" with the
+noise, never as a negative number.
 - material: the world's true E against the estimator's nominal E (not an effect; shown
   because it is usually the largest gap).
 """
@@ -20,7 +26,9 @@ schedule's top tension:
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import asdict, dataclass
+from functools import cached_property
 from time import perf_counter
 
 import numpy as np
@@ -39,9 +47,14 @@ Array = NDArray[np.float64]
 HEARTBEAT_S = 0.1
 
 
+#: the resolution of ``perf_counter`` (s): the smallest timing noise a difference can have
+CLOCK_RESOLUTION_S = time.get_clock_info("perf_counter").resolution
+
+
 @dataclass(frozen=True)
 class EffectReport:
-    """One row: cost per ``cost_unit`` (s) and tip change (m, None when not applicable)."""
+    """One row: cost per ``cost_unit`` (s, >= 0), tip change (m, None when not applicable) and,
+    for a cost measured as a difference of timings, the timing noise it is read against (s)."""
 
     name: str
     stage: str
@@ -49,6 +62,21 @@ class EffectReport:
     cost_unit: str
     tip_change_m: float | None
     note: str
+    noise_s: float | None = None
+
+    @property
+    def below_noise(self) -> bool:
+        """True when the cost is a timing difference not above its noise."""
+        return self.noise_s is not None and self.cost_s <= self.noise_s
+
+
+def timed_difference(with_s: float, without_s: float, repeat_s: float) -> tuple[float, float]:
+    """Cost (s, >= 0) of an effect timed as ``with_s - without_s`` and its noise (s): the
+    larger of ``|repeat_s - with_s|`` (the same work timed twice), the clock's resolution and
+    ``without_s - with_s`` (an effect does not make the work faster, so that is noise too)."""
+    difference = with_s - without_s
+    noise = max(abs(repeat_s - with_s), CLOCK_RESOLUTION_S, -difference)
+    return max(difference, 0.0), noise
 
 
 @dataclass(frozen=True)
@@ -126,10 +154,41 @@ def _sensing_frames(scene: Scene, top: float, samples: int) -> tuple[Array, Worl
     return tips, world
 
 
+class _Reference:
+    """The scene's own measurements every effect is compared with, each taken once, when first
+    needed, including a second timing of the same work (the timing noise)."""
+
+    def __init__(self, scene: Scene, top: float, repeats: int) -> None:
+        self.scene, self.top, self.repeats = scene, top, repeats
+
+    @cached_property
+    def sweep(self) -> tuple[Array, float]:
+        """True tip (m) and wall time per solve (s) of the scene's sweep, after one untimed
+        sweep (the process's first solves build caches: 37 ms instead of 0.4 ms per solve)."""
+        _sweep(self.scene, 1)
+        return _sweep(self.scene, self.repeats)
+
+    @cached_property
+    def repeat_solve_s(self) -> float:
+        """The wall time per solve of the same sweep, timed again (s)."""
+        return _sweep(self.scene, self.repeats)[1]
+
+    @cached_property
+    def hold(self) -> tuple[float, float]:
+        """True tension (N) and wall time per twin step (s) of the scene's hold."""
+        return _twin_hold(self.scene, self.top, self.repeats)
+
+    @cached_property
+    def repeat_step_s(self) -> float:
+        """The wall time per twin step of the same hold, timed again (s)."""
+        return _twin_hold(self.scene, self.top, self.repeats)[1]
+
+
 def explain(scene: Scene, *, samples: int = 400, repeats: int = 5) -> Explanation:
     """Measure every listed effect (see the module docstring)."""
     top = max(scene.schedule.levels)
-    true_tip, base_solve = _sweep(scene, repeats)
+    reference = _Reference(scene, top, repeats)
+    true_tip, base_solve = reference.sweep
     rows: list[EffectReport] = []
     if scene.true_design.E != scene.design.E:
         nominal_tip, _ = _sweep(scene.with_nominal_material(), 1)
@@ -139,30 +198,33 @@ def explain(scene: Scene, *, samples: int = 400, repeats: int = 5) -> Explanatio
             " GPa"))
     for stage in STAGES:
         for name in scene.effect_names(stage):
-            rows.append(_measure(scene, name, top, true_tip, base_solve, samples, repeats))
+            rows.append(_measure(scene, name, reference, samples))
     return Explanation(scene=scene.name, top_tension_n=top, rows=tuple(rows),
                        base_solve_s=base_solve, true_tip_m=tuple(true_tip.tolist()))
 
 
-def _measure(scene: Scene, name: str, top: float, true_tip: Array, base_solve: float,
-             samples: int, repeats: int) -> EffectReport:
+def _measure(scene: Scene, name: str, reference: _Reference, samples: int) -> EffectReport:
     cls = REGISTRY[name]
     without = scene.without(name)
+    top, repeats = reference.top, reference.repeats
     if cls.stage == "mechanics":
+        true_tip, base_solve = reference.sweep
         tip, per_solve = _sweep(without, repeats)
-        return EffectReport(name, cls.stage, base_solve - per_solve, "solve",
+        cost, noise = timed_difference(base_solve, per_solve, reference.repeat_solve_s)
+        return EffectReport(name, cls.stage, cost, "solve",
                             float(np.linalg.norm(true_tip - tip)),
                             f"tip deflection {np.hypot(*true_tip[:2]) * 1e3:.3f} mm with, "
-                            f"{np.hypot(*tip[:2]) * 1e3:.3f} mm without")
+                            f"{np.hypot(*tip[:2]) * 1e3:.3f} mm without", noise)
     if cls.stage == "actuation":
-        t_with, step_with = _twin_hold(scene, top, repeats)
+        t_with, step_with = reference.hold
         t_without, step_without = _twin_hold(without, top, repeats)
+        cost, noise = timed_difference(step_with, step_without, reference.repeat_step_s)
         world = scene.world()
         tip_with = world.solve(t_with).tip_position
         tip_without = world.solve(t_without).tip_position
-        return EffectReport(name, cls.stage, step_with - step_without, "twin step (1 ms)",
+        return EffectReport(name, cls.stage, cost, "twin step (1 ms)",
                             float(np.linalg.norm(tip_with - tip_without)),
-                            f"true tension {t_with:.3f} N with, {t_without:.3f} N without")
+                            f"true tension {t_with:.3f} N with, {t_without:.3f} N without", noise)
     if cls.stage == "sensing":
         tips, world = _sensing_frames(scene, top, samples)
         tips_without, _ = _sensing_frames(without, top, samples)
@@ -181,10 +243,26 @@ def _measure(scene: Scene, name: str, top: float, true_tip: Array, base_solve: f
     return EffectReport(name, cls.stage, latency.cost_s, "message", None, note)
 
 
+def _us(seconds: float) -> str:
+    """Microseconds with one decimal, or two significant digits between 0 and 1 us."""
+    us = seconds * 1e6
+    return f"{us:.2g}" if 0.0 < us < 1.0 else f"{us:.1f}"
+
+
+def format_cost(row: EffectReport) -> str:
+    """``"12.3 us"``; a timed difference with its noise, ``"241.9 ± 5.3 us"``, or
+    ``"< 0.21 us (below the timing noise)"`` when it is not above the noise."""
+    if row.noise_s is None:
+        return f"{_us(row.cost_s)} us"
+    if row.below_noise:
+        return f"< {_us(row.noise_s)} us (below the timing noise)"
+    return f"{_us(row.cost_s)} ± {_us(row.noise_s)} us"
+
+
 def format_table(report: Explanation) -> str:
     """The report as a plain-text table."""
     header = ("effect", "stage", "cost", "per", "tip change (mm)", "note")
-    lines = [(row.name, row.stage, f"{row.cost_s * 1e6:.1f} us", row.cost_unit,
+    lines = [(row.name, row.stage, format_cost(row), row.cost_unit,
               "-" if row.tip_change_m is None else f"{row.tip_change_m * 1e3:.4f}", row.note)
              for row in report.rows]
     widths = [max(len(str(r[i])) for r in [header, *lines]) for i in range(len(header))]
