@@ -12,6 +12,9 @@ from tdcm_ros.errors import PhysicsError, TdcmError
 
 UNUSABLE_FIT_EXIT = PhysicsError.exit_code
 """Exit status when the fit did not converge or a parameter is not identifiable (numerics)."""
+EXIT_MEANINGS = {"calibrate": {UNUSABLE_FIT_EXIT: "the fit did not converge or a parameter is "
+                                                  "not identifiable; the table is still printed"}}
+"""What ``calibrate`` means by an exit status (its ``--help`` epilog)."""
 
 
 def register(subparsers: Any) -> None:
@@ -43,9 +46,8 @@ def run(args: argparse.Namespace) -> int:
                               topics=Topics(args.tension_topic, args.markers_topic))
     except TdcmError as error:
         return fail("calibrate", error, args.json)
-    print(json.dumps(cal.to_json()) if args.json else format_calibration(cal))
-    if cal.warnings:
+    if cal.warnings:  # before the table: on a terminal it is read first, not scrolled past
         print(f"tdcm calibrate: the fit is not usable: {'; '.join(cal.warnings)}",
-              file=sys.stderr)
-        return UNUSABLE_FIT_EXIT
-    return 0
+              file=sys.stderr, flush=True)
+    print(json.dumps(cal.to_json()) if args.json else format_calibration(cal))
+    return UNUSABLE_FIT_EXIT if cal.warnings else 0

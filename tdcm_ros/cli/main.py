@@ -2,7 +2,9 @@
 
 Each subcommand lives in its own module exposing ``register(subparsers)``; that function adds
 its parser and sets ``handler`` (a callable taking the parsed namespace and returning an exit
-status). Known errors become a one-line message on stderr and the error's exit status.
+status). Known errors become a one-line message on stderr and the error's exit status. A module
+may declare ``EXIT_MEANINGS`` (command path, e.g. ``"topic echo"`` -> status -> what it means
+there); every ``--help`` ends with the statuses of :data:`EXIT_STATUSES` and those meanings.
 
 Only the module of the command being run is imported (``tdcm solve`` never loads the evaluation,
 the runtimes or scipy); ``tdcm``, ``tdcm -h`` and unknown commands import every module to list
@@ -14,10 +16,10 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from tdcm_ros import __version__
-from tdcm_ros.errors import TdcmError
+from tdcm_ros.errors import InputError, PhysicsError, TdcmError
 
 COMMANDS: dict[str, str] = {
     "demo": "tdcm_ros.cli.demo",
@@ -35,6 +37,36 @@ COMMANDS: dict[str, str] = {
 }
 """Command name -> module that registers it (in ``tdcm -h`` order)."""
 
+INTERRUPTED_EXIT = 130
+"""Exit status after Ctrl-C (128 + SIGINT, as shells report it)."""
+
+EXIT_STATUSES: dict[int, str] = {
+    0: "success",
+    TdcmError.exit_code: "failure",
+    InputError.exit_code: "bad input: usage, a parameter, a value or a file",
+    PhysicsError.exit_code: "a physical limit of the model, or numerics that did not converge",
+    INTERRUPTED_EXIT: "interrupted (Ctrl-C)",
+}
+"""Exit statuses common to every command (``--help`` epilogs, README)."""
+
+
+def exit_status_epilog(meanings: Mapping[int, str]) -> str:
+    """One paragraph listing the exit statuses, with what this command means by some."""
+    parts = [f"{code} {text}" + (f" ({meanings[code]})" if code in meanings else "")
+             for code, text in EXIT_STATUSES.items()]
+    return "exit status: " + "; ".join(parts) + "."
+
+
+def _add_exit_statuses(parser: argparse.ArgumentParser, path: str,
+                       meanings: Mapping[str, Mapping[int, str]]) -> None:
+    """Append the exit-status epilog to ``parser`` and to its verbs' parsers."""
+    epilog = exit_status_epilog(meanings.get(path, {}))
+    parser.epilog = f"{parser.epilog}\n\n{epilog}" if parser.epilog else epilog
+    for action in parser._actions:  # argparse keeps subparsers only there
+        if isinstance(action, argparse._SubParsersAction):
+            for verb, child in action.choices.items():
+                _add_exit_statuses(child, f"{path} {verb}", meanings)
+
 
 def _modules(argv: Sequence[str]) -> list[str]:
     """The modules to register for ``argv``: the named command's, else every one."""
@@ -46,12 +78,18 @@ def _modules(argv: Sequence[str]) -> list[str]:
 
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The top-level parser with the subcommands ``argv`` needs (``None``: every one)."""
-    parser = argparse.ArgumentParser(prog="tdcm", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="tdcm", description=__doc__.splitlines()[0],
+                                     epilog=exit_status_epilog({}))
     parser.add_argument("--version", action="version", version=f"tdcm_ros {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     modules = list(dict.fromkeys(COMMANDS.values())) if argv is None else _modules(argv)
     for module_name in modules:
-        importlib.import_module(module_name).register(subparsers)
+        module = importlib.import_module(module_name)
+        known = set(subparsers.choices)
+        module.register(subparsers)
+        for name in subparsers.choices.keys() - known:
+            _add_exit_statuses(subparsers.choices[name], name,
+                               getattr(module, "EXIT_MEANINGS", {}))
     return parser
 
 
@@ -65,7 +103,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"tdcm {args.command}: {error}", file=sys.stderr)
         return error.exit_code
     except KeyboardInterrupt:
-        return 130
+        return INTERRUPTED_EXIT
 
 
 if __name__ == "__main__":

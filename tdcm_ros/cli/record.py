@@ -19,6 +19,8 @@ from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
 
 EMPTY_BAG_EXIT = 1
 """Exit status of a recording that wrote no message (the empty bag is kept)."""
+EXIT_MEANINGS = {"record": {EMPTY_BAG_EXIT: "no message was recorded; the empty bag is kept"}}
+"""What ``record`` means by an exit status (its ``--help`` epilog)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

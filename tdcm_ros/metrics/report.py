@@ -56,10 +56,10 @@ def _metric(value: float | None, scale: float, unit: str) -> str:
 
 
 def format_calibration(cal: Calibration) -> str:
-    """Warnings (not identifiable, not converged) first, then fitted values with intervals,
-    residuals, Table I before/after and the evaluation's warnings."""
+    """Warnings first (not identifiable, not converged, then the evaluation's), then fitted
+    values with intervals, residuals and Table I before/after."""
     steps = cal.before.metrics.n_steps + cal.before.metrics.n_flagged
-    lines = [f"warning: {w}" for w in cal.warnings]
+    lines = [f"warning: {w}" for w in (*cal.warnings, *cal.after.warnings)]
     lines += [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
              f"residual RMS {cal.residual_rms_m * 1e3:.4f} mm")]
     level = f"{cal.confidence:.0%}"
@@ -75,5 +75,4 @@ def format_calibration(cal: Calibration) -> str:
     lines += ["", f"{'Table I':<16} {'before':>12} {'after':>12}"]
     lines += [f"{name:<16} {_metric(x, k, u):>12} {_metric(y, k, u):>12}"
               for name, x, y, k, u in rows]
-    lines += [f"warning: {w}" for w in cal.after.warnings]
     return "\n".join(lines)
