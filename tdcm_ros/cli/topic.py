@@ -1,13 +1,22 @@
-"""``tdcm topic list|echo|pub|hz``: poke the embedded (zenoh) graph like ``ros2 topic``."""
+"""``tdcm topic list|echo|pub|hz``: poke the embedded (zenoh) graph like ``ros2 topic``.
+
+As ``ros2 topic`` does, ``echo`` warns when no publisher of the topic shows up within
+``--wait-matching`` s (naming topics with similar names), and ``echo``/``pub`` given a type that
+is not the one the graph uses on the topic end with an input error (exit status 2) instead of
+waiting or publishing where no one listens.
+"""
 
 from __future__ import annotations
 
 import argparse
+import difflib
 import itertools
 import math
 import statistics
 import sys
+import threading
 import time
+from collections.abc import Collection
 from typing import Any
 
 import yaml
@@ -16,6 +25,10 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.yamlio import load_yaml
 
 TOOL_NODE = "_tdcm_topic"
+EXIT_MEANINGS = {f"topic {verb}": {InputError.exit_code: "also: the type given is not the one "
+                                                         "the graph uses on the topic"}
+                 for verb in ("echo", "pub")}
+"""What ``topic echo|pub`` mean by an exit status (their ``--help`` epilogs)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -33,6 +46,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     echo.add_argument("type", nargs="?", help="pkg/msg/Name (default: any type on the topic)")
     echo.add_argument("--once", action="store_true", help="print one message and exit")
     echo.add_argument("--count", type=int, default=0, help="exit after N messages")
+    echo.add_argument("--wait-matching", type=float, default=1.0,
+                      help="warn if no publisher of the topic is seen within this long (s)")
     echo.set_defaults(handler=run_echo)
 
     pub = verbs.add_parser("pub", help="publish a message given as YAML")
@@ -59,43 +74,81 @@ def _context() -> Any:
     return ZenohContext()
 
 
-def graph_topics(timeout: float) -> dict[str, set[str]]:
-    """Topic -> message types of the publishers and subscriptions seen within ``timeout`` s.
+class GraphWatch:
+    """The publishers and subscriptions of the domain from rmw_zenoh liveliness tokens: a
+    liveliness subscriber with history collects the present ones and those that show up while
+    it runs (a one-shot liveliness query right after the session opens can come back empty)."""
 
-    A liveliness subscriber with history collects the tokens (present ones and those that show
-    up while waiting); a one-shot liveliness query right after the session opens can come back
-    empty.
-    """
-    import zenoh
+    def __init__(self, context: Any) -> None:
+        from tdcm_ros.runtime import wire
 
-    from tdcm_ros.runtime import RuntimePortError, wire
+        self._alive: set[str] = set()
+        self._lock = threading.Lock()
+        self._subscriber = context.session.liveliness().declare_subscriber(
+            f"{wire.ADMIN_SPACE}/{context.domain_id}/**", self._seen, history=True)
 
-    context = _context()
-    alive: set[str] = set()
+    def _seen(self, sample: Any) -> None:
+        """Zenoh thread: a token appeared or went away."""
+        import zenoh
 
-    def seen(sample: zenoh.Sample) -> None:
         key = str(sample.key_expr)
-        if sample.kind == zenoh.SampleKind.DELETE:
-            alive.discard(key)
-        else:
-            alive.add(key)
+        with self._lock:
+            if sample.kind == zenoh.SampleKind.DELETE:
+                self._alive.discard(key)
+            else:
+                self._alive.add(key)
 
+    def topics(self, kinds: Collection[str] = ("MP", "MS"),
+               ignore_zid: str = "") -> dict[str, set[str]]:
+        """Topic -> message types of the endpoints of ``kinds`` (publishers ``MP``,
+        subscriptions ``MS``), leaving out those of the session ``ignore_zid``."""
+        from tdcm_ros.runtime import RuntimePortError, wire
+
+        with self._lock:
+            keys = sorted(self._alive)
+        topics: dict[str, set[str]] = {}
+        for key in keys:
+            try:
+                token = wire.parse_token(key)
+            except (RuntimePortError, ValueError):
+                continue
+            if token.kind in kinds and token.zid != ignore_zid:
+                topics.setdefault(token.topic, set()).add(token.type_name)
+        return topics
+
+    def close(self) -> None:
+        """Stop collecting."""
+        self._subscriber.undeclare()
+
+
+def graph_topics(timeout: float) -> dict[str, set[str]]:
+    """Topic -> message types of the publishers and subscriptions seen within ``timeout`` s."""
+    context = _context()
     try:
-        subscriber = context.session.liveliness().declare_subscriber(
-            f"{wire.ADMIN_SPACE}/{context.domain_id}/**", seen, history=True)
+        watch = GraphWatch(context)
         time.sleep(timeout)
-        subscriber.undeclare()
+        watch.close()
     finally:
         context.close()
-    topics: dict[str, set[str]] = {}
-    for key in sorted(alive):
-        try:
-            token = wire.parse_token(key)
-        except (RuntimePortError, ValueError):
-            continue
-        if token.kind in (wire.PUBLISHER, wire.SUBSCRIPTION):
-            topics.setdefault(token.topic, set()).add(token.type_name)
-    return topics
+    return watch.topics()
+
+
+def similar_topics(topic: str, topics: Collection[str]) -> str:
+    """``"; similar topics: /a, /b"`` for names close to ``topic``, else ``""``."""
+    near = difflib.get_close_matches(topic, sorted(topics), n=3, cutoff=0.6)
+    return f"; similar topics: {', '.join(near)}" if near else ""
+
+
+def check_type(topic: str, type_name: str | None, types: Collection[str], graph: str) -> None:
+    """``InputError`` if ``type_name`` is given, the graph uses ``topic`` with ``types`` (its
+    ``graph`` endpoints, e.g. "published") and ``type_name`` is not among them."""
+    from tdcm_ros.bagio import normalize_type_name
+
+    if type_name is None or not types or normalize_type_name(type_name) in types:
+        return
+    allowed = ", ".join(sorted(types))
+    raise InputError(f"topic {topic} is {graph} as {allowed}, not {type_name}; allowed: {allowed}",
+                     parameter="type", value=type_name, allowed=allowed)
 
 
 def run_list(args: argparse.Namespace) -> int:
@@ -112,7 +165,11 @@ def run_list(args: argparse.Namespace) -> int:
 def run_echo(args: argparse.Namespace) -> int:
     """Print each message as a YAML document until Ctrl-C, ``--once`` or ``--count``."""
     from tdcm_ros.bagio import BagError, deserialize, to_dict
+    from tdcm_ros.runtime.names import resolve_topic
 
+    if not args.wait_matching >= 0:
+        raise InputError(f"--wait-matching = {args.wait_matching} s must be >= 0",
+                         parameter="wait_matching", value=args.wait_matching, allowed=">= 0 s")
     limit = 1 if args.once else args.count
     context = _context()
     port = context.create_port(TOOL_NODE)
@@ -136,11 +193,27 @@ def run_echo(args: argparse.Namespace) -> int:
             context.request_stop()
 
     try:
+        watch = GraphWatch(context)
         port.create_raw_subscription(args.topic, args.type, show)
-        context.spin()
+        context.spin_for(args.wait_matching)
+        if not context.executor.stop.is_set():
+            _check_published(watch, resolve_topic(args.topic), args.type, args.wait_matching)
+            context.spin()
     finally:
         context.close()
     return 0
+
+
+def _check_published(watch: GraphWatch, topic: str, type_name: str | None, waited: float) -> None:
+    """After ``waited`` s: an error if the topic is published with other types only, a warning
+    (with similar names) if it is not published at all."""
+    publishers = watch.topics(kinds=("MP",))
+    types = publishers.get(topic, set())
+    check_type(topic, type_name, types, "published")
+    if not types:
+        print(f"WARNING: topic [{topic}] does not appear to be published yet (no publisher seen "
+              f"in {waited:g} s){similar_topics(topic, watch.topics())}; still waiting",
+              file=sys.stderr, flush=True)
 
 
 def run_pub(args: argparse.Namespace) -> int:
@@ -155,10 +228,17 @@ def run_pub(args: argparse.Namespace) -> int:
     times = 1 if args.once else args.times
     context = _context()
     try:
+        watch = GraphWatch(context)
         publisher = context.create_port(TOOL_NODE).create_publisher(args.topic, args.type)
         deadline = time.monotonic() + args.wait_matching
         while not publisher.matched() and time.monotonic() < deadline:
             time.sleep(0.02)
+        graph = watch.topics(ignore_zid=context.zid)
+        check_type(publisher.topic, args.type, graph.get(publisher.topic, set()), "used")
+        if not publisher.matched():
+            print(f"WARNING: no subscriber of {publisher.topic} matched within "
+                  f"{args.wait_matching:g} s{similar_topics(publisher.topic, graph)}; "
+                  f"publishing anyway", file=sys.stderr, flush=True)
         print(f"publisher: beginning loop\npublishing #1: {message}", flush=True)
         sent = 0
         while True:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import select
 import subprocess
 import time
 from collections.abc import Callable, Iterator
@@ -100,3 +101,62 @@ def test_bad_options_are_one_line_errors(argv, capsys):
     assert main(argv) != 0
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and argv[-2] in err
+
+
+def read_stderr_until(child: subprocess.Popen[bytes], phrase: str, timeout: float) -> str:
+    """What ``child`` wrote to stderr up to the line holding ``phrase`` (fails after ``timeout``
+    s, or if the child exits first)."""
+    assert child.stderr is not None
+    seen: list[str] = []
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([child.stderr], [], [], 0.1)
+        if ready:
+            line = child.stderr.readline().decode()
+            seen.append(line)
+            if phrase in line:
+                return "".join(seen)
+            if not line:
+                break
+    raise AssertionError(f"no {phrase!r} on stderr within {timeout} s: {''.join(seen)!r}")
+
+
+def test_echo_warns_about_an_unknown_topic_with_similar_names(port, spawn: Spawn):
+    port.create_publisher("chatter", "std_msgs/msg/String")
+    echo = spawn("tdcm_ros.cli.main", "topic", "echo", "chater", "--wait-matching", "0.5")
+    err = read_stderr_until(echo, "does not appear to be published yet", 20.0)
+    assert "WARNING: topic [/chater]" in err and "in 0.5 s" in err
+    assert "similar topics: /chatter" in err
+    assert echo.poll() is None  # still listening, as ros2 topic echo does
+
+
+def test_echo_with_a_type_the_topic_is_not_published_as_is_an_error(port, spawn: Spawn):
+    port.create_publisher("chatter", "std_msgs/msg/String")
+    echo = spawn("tdcm_ros.cli.main", "topic", "echo", "chatter", "std_msgs/msg/Float64",
+                 "--wait-matching", "0.5")
+    _, err = echo.communicate(timeout=20)
+    lines = err.decode().strip().splitlines()
+    assert echo.returncode == 2 and len(lines) == 1, err.decode()
+    assert "/chatter is published as std_msgs/msg/String, not std_msgs/msg/Float64" in lines[0]
+
+
+def test_pub_with_another_type_than_the_graph_is_an_error_not_a_publish(port, spawn: Spawn):
+    port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", lambda _: None)
+    pub = spawn("tdcm_ros.cli.main", "topic", "pub", "tension", "std_msgs/msg/Float64",
+                "{data: 1.0}", "--once", "--wait-matching", "0.5")
+    out, err = pub.communicate(timeout=20)
+    assert pub.returncode == 2, err.decode()
+    assert "/tension is used as geometry_msgs/msg/WrenchStamped, not std_msgs/msg/Float64" in (
+        err.decode())
+    assert "publishing" not in out.decode()
+
+
+def test_pub_without_a_matching_subscriber_warns_with_similar_names(port, spawn: Spawn):
+    port.create_subscription("tension", "std_msgs/msg/Float64", lambda _: None)
+    pub = spawn("tdcm_ros.cli.main", "topic", "pub", "tensoin", "std_msgs/msg/Float64",
+                "{data: 1.0}", "--once", "--wait-matching", "0.5")
+    out, err = pub.communicate(timeout=20)
+    assert pub.returncode == 0, err.decode()
+    assert "no subscriber of /tensoin matched within 0.5 s; similar topics: /tension" in (
+        err.decode())
+    assert "publishing #1" in out.decode()
