@@ -47,7 +47,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     echo.add_argument("--once", action="store_true", help="print one message and exit")
     echo.add_argument("--count", type=int, default=0, help="exit after N messages")
     echo.add_argument("--wait-matching", type=float, default=1.0,
-                      help="warn if no publisher of the topic is seen within this long (s)")
+                      help="warn if no publisher of the topic is seen within this long (s; "
+                           "default: 1)")
     echo.set_defaults(handler=run_echo)
 
     pub = verbs.add_parser("pub", help="publish a message given as YAML")

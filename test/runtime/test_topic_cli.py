@@ -160,3 +160,11 @@ def test_pub_without_a_matching_subscriber_warns_with_similar_names(port, spawn:
     assert "no subscriber of /tensoin matched within 0.5 s; similar topics: /tension" in (
         err.decode())
     assert "publishing #1" in out.decode()
+
+
+def test_echo_refuses_a_negative_wait(capsys):
+    from tdcm_ros.cli.main import main
+
+    assert main(["topic", "echo", "chatter", "--wait-matching", "-1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--wait-matching = -1.0 s must be >= 0" in err
