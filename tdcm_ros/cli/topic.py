@@ -166,7 +166,7 @@ def run_list(args: argparse.Namespace) -> int:
 def run_echo(args: argparse.Namespace) -> int:
     """Print each message as a YAML document until Ctrl-C, ``--once`` or ``--count``."""
     from tdcm_ros.bagio import BagError, deserialize, to_dict
-    from tdcm_ros.runtime.names import resolve_topic
+    from tdcm_ros.runtime import resolve_topic
 
     if not args.wait_matching >= 0:
         raise InputError(f"--wait-matching = {args.wait_matching} s must be >= 0",
