@@ -99,6 +99,20 @@ def test_tdcm_param_lists_gets_and_sets(runtime: str, graph_env: dict[str, str],
     assert missing.returncode != 0 and "nobody" in missing.stderr
 
 
+def test_tdcm_param_set_reads_exponent_floats(runtime: str, graph_env: dict[str, str],
+                                               spawn: Spawn) -> None:
+    """``tdcm param set NODE NAME 1.0e9``: an exponent without a dot or a sign is a float (YAML
+    1.2), not YAML 1.1's string, which the node rejects."""
+    spawn("tdcm_ros.runtime.run_node", TALKER)
+    deadline = time.monotonic() + 30
+    while (listing := tdcm_param(graph_env, "list", "talker")).returncode != 0:
+        assert time.monotonic() < deadline, listing.stderr
+    for text, value in (("2e-1", "0.2"), ("2.5e-1", "0.25"), ("1E0", "1.0")):
+        done = tdcm_param(graph_env, "set", "talker", "period", text)
+        assert done.returncode == 0, f"{text}: {done.stderr}"
+        assert tdcm_param(graph_env, "get", "talker", "period").stdout.strip() == value
+
+
 def test_subscriber_survives_publisher_restart(runtime: str, context: Any, spawn: Spawn,
                                                tmp_path: Path) -> None:
     texts: list[str] = []
