@@ -23,8 +23,13 @@ from typing import Any
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model import kernel
 from tdcm_ros.model.errors import InvalidSettingsError
+from tdcm_ros.model.quiet import quiet_fp
 
 ENVIRONMENT = "TDCM_JIT"
+PLAIN = types.SimpleNamespace(**{name: quiet_fp(getattr(kernel, name))
+                                 for name in kernel.KERNELS})
+"""The plain-Python build: NumPy scalar arithmetic in it would warn where the compiled
+build is silent, so each entry point runs under :func:`~tdcm_ros.model.quiet.quiet_fp`."""
 _CHOICES = {"0": False, "1": True, "": None}
 _state: dict[str, Any] = {"wanted": None, "chosen": False, "build": None}
 
@@ -46,14 +51,14 @@ def one_shot() -> Iterator[None]:
             os.environ.get(ENVIRONMENT, "").strip():
         yield
         return
-    _state["build"] = kernel
+    _state["build"] = PLAIN
     try:
         yield
     finally:
         _state["build"] = None
 
 
-def kernels() -> types.SimpleNamespace | types.ModuleType:
+def kernels() -> types.SimpleNamespace:
     """The kernel functions of the selected build (attributes named as in :mod:`kernel`)."""
     build = _state["build"]
     if build is None:
@@ -63,10 +68,10 @@ def kernels() -> types.SimpleNamespace | types.ModuleType:
 
 def is_compiled() -> bool:
     """Whether the selected build is numba's."""
-    return kernels() is not kernel
+    return kernels() is not PLAIN
 
 
-def _select() -> types.SimpleNamespace | types.ModuleType:
+def _select() -> types.SimpleNamespace:
     wanted = _state["wanted"]
     if not _state.get("chosen"):
         value = os.environ.get(ENVIRONMENT, "").strip()
@@ -75,13 +80,13 @@ def _select() -> types.SimpleNamespace | types.ModuleType:
                                error=InvalidSettingsError)
         wanted = _CHOICES[value]
     if wanted is False:
-        return kernel
+        return PLAIN
     try:
         import numba
     except ImportError:
         if wanted:
             raise
-        return kernel
+        return PLAIN
     return _compile(numba)
 
 

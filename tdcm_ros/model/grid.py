@@ -43,6 +43,7 @@ from tdcm_ros.model.grid_layout import (
     per_row,
     prototypes,
 )
+from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.section import notched_moment
 from tdcm_ros.model.settings import SolverSettings
 
@@ -277,6 +278,7 @@ def build_grid(design: Design, settings: SolverSettings) -> Grid:
 
 
 @lru_cache(maxsize=512)
+@quiet_fp
 def _build_grid(design: Design, routing: str, kind: str, cells_per_notch: int,
                 cells_per_tube: int, quad_order: int) -> Grid:
     proto = prototypes(Members.of([design]), routing, kind, cells_per_notch, cells_per_tube)

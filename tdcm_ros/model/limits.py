@@ -20,6 +20,7 @@ from tdcm_ros.model.errors import (
 )
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape, integrate
+from tdcm_ros.model.quiet import quiet_fp
 
 Array = NDArray[np.float64]
 
@@ -45,6 +46,7 @@ def check_tension(tension: Any) -> float:
     return value
 
 
+@quiet_fp
 def check_singularity(grid: Grid, m_a: Array, m_b: Array) -> None:
     """Raise :class:`TendonSingularityError` where the tendon follows the offset curve and
     ``R_c * kappa`` reaches 1 (the curve ``p + R_c x_b`` cusps). ``kappa`` uses each cell's
@@ -77,6 +79,7 @@ def notch_gaps(grid: Grid, shape: PlanarShape) -> Array:
     return out[0]
 
 
+@quiet_fp
 def check_tendon_singularity(grid: Grid, tension: float) -> None:
     """:func:`check_singularity` for the tendon's own moment ``R_c T`` (exact for the closed
     form on the offset curve), in O(1) from the grid's peak compliance."""
@@ -88,6 +91,7 @@ def check_tendon_singularity(grid: Grid, tension: float) -> None:
         check_singularity(grid, moment, moment)
 
 
+@quiet_fp
 def check_closure(grid: Grid, shape: PlanarShape, tension: float) -> None:
     """Raise :class:`NotchClosureError` if any notch's faces touch or overlap."""
     gaps = notch_gaps(grid, shape)

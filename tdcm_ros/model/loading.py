@@ -51,6 +51,7 @@ from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_singularity, closure_angle
 from tdcm_ros.model.moment_model import PlainRun, Plan
+from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.section import notched_area, tube_area
 from tdcm_ros.model.settings import SolverSettings
 
@@ -241,6 +242,7 @@ class LoadedModel:
     solves than the paper model's order.
     """
 
+    @quiet_fp
     def __init__(self, grid: Grid, loading: Loading, tension_base: float) -> None:
         self.grid = grid
         self.loading = loading
@@ -262,6 +264,7 @@ class LoadedModel:
     def check_before(self, tension: float) -> None:
         """Nothing is known before iterating."""
 
+    @quiet_fp
     def check_after(self, x: Array, shape: PlanarShape, tension: float,
                     min_gap: float | None = None) -> None:
         """Singularity on the bending moments; closure unless notch contact is on."""
@@ -286,6 +289,7 @@ class LoadedModel:
         """The tension ratio; unscaled from a zero-tension result (external loads alone)."""
         return tension / previous if previous > 0.0 else 1.0
 
+    @quiet_fp
     def extras(self, x: Array, shape: PlanarShape, tension: float
                ) -> tuple[Array | None, Array | None]:
         """Per-cell contact scale (with contact) and node tensions (with a profile)."""

@@ -130,8 +130,8 @@ class ClosedForm:
     def __init__(self, grid: Grid) -> None:
         self.grid = grid
         self.cells = Cells.of(grid)
-        self._r_c_squared = grid.design.R_c ** 2
-        self._peak_c = self.cells.constrained_peak_c[0]
+        self._r_c_squared = float(grid.design.R_c) ** 2
+        self._peak_c = float(self.cells.constrained_peak_c[0])  # Python floats: no warnings
 
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
         m_a, m_b = loads.closed_form(self.grid, shape, np.float64(level))

@@ -43,6 +43,7 @@ from tdcm_ros.model.moment_model import (
     PlainRun,
     Plan,
 )
+from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 
@@ -94,12 +95,13 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
 
     Floating-point overflow at hostile inputs is handled, not printed: a non-finite iterate ends
     its strategy, the limits compare an overflowed ``R_c kappa`` correctly, and no non-finite
-    value reaches LAPACK; so NumPy's overflow and invalid-value warnings are off inside.
+    value reaches LAPACK; so NumPy's overflow and invalid-value warnings are off on every
+    NumPy path of the solve (:func:`~tdcm_ros.model.quiet.quiet_fp`; the compiled kernel
+    raises none).
     """
     started = perf_counter()
     t_base = check_tension(tension)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        return _solve(design, t_base, settings, warm_start, strict, loading, started)
+    return _solve(design, t_base, settings, warm_start, strict, loading, started)
 
 
 def warm_up() -> bool:
@@ -192,6 +194,7 @@ def _model(grid: Grid, settings: SolverSettings, tension: float,
 
 
 @lru_cache(maxsize=512)
+@quiet_fp
 def _paper_model(grid: Grid, loads: str) -> MomentModel:
     """The paper's moment model of ``loads`` on ``grid`` (cached: it holds only the grid)."""
     return ClosedForm(grid) if loads == "closed" else LiteralSum(grid)
@@ -205,11 +208,16 @@ def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
             and warm_start.converged):
         scale = model.warm_scale(warm_start.tension_n, tension)
         if scale is not None:
-            moments = warm_start.cell_moments
-            return np.concatenate([moments[:, 0], moments[:, 1]]) * scale
+            return _rescaled(warm_start.cell_moments, scale)
     x0 = np.empty(2 * grid.n_cells)
     x0.fill(grid.design.R_c * tension)
     return x0
+
+
+@quiet_fp
+def _rescaled(moments: Array, scale: float) -> Array:
+    """Cell moments (cells, 2) N m as the iterate ``[m_a, m_b]`` times ``scale``."""
+    return np.concatenate([moments[:, 0], moments[:, 1]]) * scale
 
 
 def _run_plan(problem: _Problem, plan: Plan, tension: float, x0: Array, budget: int) -> _Run:
@@ -219,6 +227,7 @@ def _run_plan(problem: _Problem, plan: Plan, tension: float, x0: Array, budget: 
     return _iterate(problem, tension, x0, budget, mode=plan.mode, restart=plan.restart)
 
 
+@quiet_fp
 def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
                   adaptive: bool = False) -> _Run:
     """Ramp the tension (and any external loads) in equal steps, each warm-started from the
@@ -285,7 +294,7 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
     scales the external loads (continuation); ``tol`` (m) defaults to ``settings.tol``. With
     ``restart``, plain iteration that slows down (mode ``auto``) hands over to Anderson from
     ``x0`` rather than from wherever it has wandered."""
-    grid, settings, model = problem
+    settings, model = problem.settings, problem.model
     tol = settings.tol if tol is None else tol
     using = "picard" if mode == "auto" else mode
     plain = None
@@ -294,12 +303,25 @@ def _iterate(problem: _Problem, tension: float, x0: Array, budget: int, *, mode:
                             settings.relaxation if using == "relaxation" else 1.0,
                             SLOW_CONTRACTION if mode == "auto" else 0.0)
     if plain is None:
+        return _iterate_in_numpy(problem, tension, x0, None, budget, mode=mode, using=using,
+                                 factor=factor, tol=tol, restart=restart)
+    if plain.status != SLOWED:
+        return _plain_outcome(plain)
+    return _iterate_in_numpy(problem, tension, x0, plain, budget, mode=mode, using="anderson",
+                             factor=factor, tol=tol, restart=restart)
+
+
+@quiet_fp
+def _iterate_in_numpy(problem: _Problem, tension: float, x0: Array, plain: PlainRun | None,
+                      budget: int, *, mode: str, using: str, factor: float, tol: float,
+                      restart: bool) -> _Run:
+    """:func:`_iterate`'s update rule ``using`` run in NumPy from ``x0``, or from where the
+    compiled ``plain`` iteration slowed down (Anderson)."""
+    grid, settings, model = problem
+    if plain is None:
         x, shape, history = x0, problem.shape_of(x0, tension), []
     else:
         x, shape, history = plain.x, plain.shape, plain.history
-        if plain.status != SLOWED:
-            return _plain_outcome(plain)
-        using = "anderson"
         if restart:
             x, shape = x0, problem.shape_of(x0, tension)
     start = shape  # what plain iteration that slows restarts from (restart=True)

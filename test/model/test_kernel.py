@@ -32,7 +32,7 @@ def tips(designs, tensions, routing):
 def test_plain_and_compiled_builds_agree(routing, monkeypatch):
     designs = [preset("paper-experiment"), preset("fig3-wd-1.2").with_overrides(N=3)]
     fast = tips(designs, [20.0, 7.0], routing)
-    monkeypatch.setitem(compiled._state, "build", kernel)
+    monkeypatch.setitem(compiled._state, "build", compiled.PLAIN)
     slow = tips(designs, [20.0, 7.0], routing)
     np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-15)
 
@@ -71,7 +71,7 @@ def test_padded_stack_gives_each_member_its_own_answers(n_a, n_b, scale, routing
 def test_plain_build_iterates_like_the_compiled_one(monkeypatch):
     cfg = SolverSettings(routing="free")
     fast = solve(preset("paper-experiment"), 20.0, settings=cfg)
-    monkeypatch.setitem(compiled._state, "build", kernel)
+    monkeypatch.setitem(compiled._state, "build", compiled.PLAIN)
     slow = solve(preset("paper-experiment"), 20.0, settings=cfg)
     assert not compiled.is_compiled()
     assert slow.converged and slow.iterations == fast.iterations > 1
@@ -191,7 +191,7 @@ def test_one_shot_picks_the_plain_build_only_inside_and_only_if_unchosen(monkeyp
     monkeypatch.setitem(compiled._state, "chosen", False)
     monkeypatch.delenv(compiled.ENVIRONMENT, raising=False)
     with compiled.one_shot():
-        assert compiled.kernels() is kernel
+        assert compiled.kernels() is compiled.PLAIN
     assert compiled._state["build"] is None  # the process is not switched for good
     monkeypatch.setenv(compiled.ENVIRONMENT, "1")
     with compiled.one_shot():
