@@ -33,6 +33,7 @@ setup(
         "PyYAML>=6",
         "pyserial>=3.5",
         "eclipse-zenoh==1.6.2",
+        "xxhash>=3.0",
     ],
     extras_require={
         "plot": ["matplotlib>=3.7"],

@@ -13,15 +13,17 @@ Sources (ros2/rmw_zenoh, ``docs/design.md`` and ``rmw_zenoh_cpp/src/detail/``):
   ``(int64 sequence_number, int64 source_timestamp_ns, uint8[16] gid)`` = 8 + 8 + LEB128 length
   (``0x10``) + 16 bytes, integers little endian.
 
-The GID rmw_zenoh puts in the attachment is XXH3-128 of the endpoint's token; here it is the first
-16 bytes of BLAKE2b of the token (same role: stable per endpoint, unique, 16 bytes).
+The GID (publisher and attachment) is rmw_zenoh's: XXH3-128 of the entity's whole liveliness token,
+its low 64 bits then its high 64 bits, each little endian (``liveliness_utils.cpp`` ``Entity``,
+``simplified_xxhash3.cpp``).
 """
 
 from __future__ import annotations
 
-import hashlib
 import struct
 from dataclasses import dataclass
+
+import xxhash
 
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.port import QoS
@@ -140,8 +142,9 @@ def parse_token(key: str) -> TokenInfo:
 
 
 def gid_of(token: str) -> bytes:
-    """16-byte GID of an endpoint, derived from its liveliness token."""
-    return hashlib.blake2b(token.encode(), digest_size=GID_SIZE).digest()
+    """16-byte GID of an entity as rmw_zenoh computes it from its liveliness token: XXH3-128,
+    low 64 bits first, little endian (a little-endian 128-bit integer)."""
+    return xxhash.xxh3_128_intdigest(token.encode()).to_bytes(GID_SIZE, "little")
 
 
 def encode_attachment(sequence_number: int, source_timestamp_ns: int, gid: bytes) -> bytes:
