@@ -7,6 +7,10 @@ no zenoh import; nodes discover each other on ``ROS_DOMAIN_ID``).
 tension -> model runs with no hardware. Ctrl-C stops the nodes in reverse order: the driver
 releases the tendon before the twin goes away.
 
+``--connect ENDPOINT`` uses an existing router (a ROS machine's ``rmw_zenohd``, or tdcm's own
+router on another host) and never starts one; ``--endpoint`` starts one there unless one answers.
+Either is exported to the nodes as ``TDCM_ZENOH_ENDPOINT``.
+
 ``--zenoh-config FILE`` (exported as ``TDCM_ZENOH_CONFIG``) is the zenoh config of every node and
 ``--router-config FILE`` (``TDCM_ZENOH_ROUTER_CONFIG``) the router's, e.g. ``config/zenoh/``'s
 peer and router files (TLS, user/password, access control); the role's mode and endpoints are
@@ -35,9 +39,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"comma-separated node names from: {', '.join(sorted(NODES))}")
     parser.add_argument("--runtime", default="zenoh", choices=("zenoh", "rclpy"),
                         help="runtime of every node (default zenoh)")
-    parser.add_argument("--endpoint", default=None,
-                        help="zenoh router endpoint (default TDCM_ZENOH_ENDPOINT or "
-                             "tcp/127.0.0.1:7447; zenoh runtime only)")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--endpoint", default=None,
+                       help="zenoh router endpoint, started here unless one answers (default "
+                            "TDCM_ZENOH_ENDPOINT or tcp/127.0.0.1:7447; zenoh runtime only)")
+    where.add_argument("--connect", default=None, metavar="ENDPOINT",
+                       help="use the existing zenoh router at ENDPOINT (e.g. a ROS machine's "
+                            "rmw_zenohd, tcp/HOST:7447) and never start one; zenoh runtime only")
     parser.add_argument("--zenoh-config", default=None,
                         help="zenoh JSON5 config of every node (and of the router without "
                              "--router-config), e.g. config/zenoh/peer.json5; zenoh runtime only")
@@ -58,7 +66,7 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
     nodes = [n.strip() for n in args.nodes.split(",") if n.strip()]
     overrides: dict[str, dict[str, Any]] = {}
     ready: dict[str, str] = {}
-    for option in ("endpoint", "zenoh_config", "router_config"):
+    for option in ("endpoint", "connect", "zenoh_config", "router_config"):
         value = getattr(args, option)
         if value and args.runtime != "zenoh":
             flag = "--" + option.replace("_", "-")
@@ -87,8 +95,9 @@ def router_endpoint(args: argparse.Namespace) -> str | None:
         return None
     from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV, endpoint
 
-    if args.endpoint:
-        os.environ[ENDPOINT_ENV] = args.endpoint
+    chosen = args.endpoint or args.connect
+    if chosen:
+        os.environ[ENDPOINT_ENV] = chosen
     return endpoint()
 
 
@@ -118,4 +127,4 @@ def run(args: argparse.Namespace) -> int:
     if endpoint is not None:
         export_zenoh_configs(args, endpoint)
     return launch(nodes, params_file=args.params, runtime=args.runtime, endpoint=endpoint,
-                  overrides=overrides, ready_paths=ready)
+                  overrides=overrides, ready_paths=ready, start_router=not args.connect)

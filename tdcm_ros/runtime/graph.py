@@ -104,9 +104,10 @@ class NodeGraph:
         self.children.append(child)
         return child
 
-    def ensure_router(self, timeout: float = 10.0) -> None:
+    def ensure_router(self, timeout: float = 10.0, *, start: bool = True) -> None:
         """Start a router on ``endpoint`` unless one already answers there (zenoh runtime only;
-        ``timeout`` in s)."""
+        ``timeout`` in s). With ``start=False`` (an existing router, e.g. a ROS machine's
+        ``rmw_zenohd``) wait up to ``timeout`` for it to answer and never start one."""
         if self.runtime != "zenoh":
             return
         from tdcm_ros.runtime.router import is_listening
@@ -114,6 +115,17 @@ class NodeGraph:
         endpoint = self.endpoint
         if endpoint is None:
             raise RuntimePortError("the zenoh runtime needs a router endpoint")
+        if not start:
+            deadline = time.monotonic() + timeout
+            while not is_listening(endpoint):
+                if time.monotonic() > deadline or self.stop_event.is_set():
+                    raise RuntimePortError(
+                        f"no zenoh router answers at {endpoint} after {timeout:g} s (--connect "
+                        "starts none: start rmw_zenohd or tdcm's router there, or use --endpoint "
+                        "to let tdcm up start one)")
+                time.sleep(0.1)
+            log.info("connecting to the existing zenoh router at %s", endpoint)
+            return
         if is_listening(endpoint):
             return
         self.router = self.start("router", [sys.executable, "-m", "tdcm_ros.runtime.router",

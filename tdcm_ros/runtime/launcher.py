@@ -38,13 +38,15 @@ def report_exits(graph: NodeGraph, reported: set[str]) -> None:
 def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str = "zenoh",
            endpoint: str | None = None, grace: float = 5.0,
            overrides: Mapping[str, Mapping[str, Any]] | None = None,
-           ready_paths: Mapping[str, str] | None = None, ready_timeout: float = 30.0) -> int:
+           ready_paths: Mapping[str, str] | None = None, ready_timeout: float = 30.0,
+           start_router: bool = True) -> int:
     """Run ``nodes`` (registry names) until SIGINT/SIGTERM or until every node has exited.
 
     ``endpoint``: the zenoh router's (``None`` on rclpy); ``grace``: s from SIGINT to SIGKILL of
     a node; ``overrides``: node name -> parameter values over ``params_file``; ``ready_paths``:
     node name -> path it creates when ready (waited for, ``ready_timeout`` s, before the next
-    node).
+    node); ``start_router``: False to use only an existing router at ``endpoint`` (fails if
+    none answers within 10 s).
     """
     for name in nodes:
         node_target(name)  # unknown names fail before anything starts
@@ -58,7 +60,7 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
     graph = NodeGraph(endpoint=endpoint, runtime=runtime, params_file=params_file, grace=grace,
                       stop_event=stop)
     try:
-        graph.ensure_router()
+        graph.ensure_router(start=start_router)
         for name in nodes:
             if stop.is_set():
                 break
