@@ -64,6 +64,14 @@ CONFIG_ENV = "TDCM_ZENOH_CONFIG"
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 PARAM_SPACE = "@tdcm"
 PARAM_TIMEOUT_S = 5.0
+HEARTBEAT_PERIOD_S = 0.5
+"""Sporadic heartbeat of a reliable transient-local publisher (s): rmw_zenoh's
+``SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`` (``rmw_publisher_data.cpp``)."""
+
+
+def _reliability(qos: QoS) -> zenoh.Reliability:
+    return (zenoh.Reliability.RELIABLE if qos.reliability == "reliable"
+            else zenoh.Reliability.BEST_EFFORT)
 
 
 def domain_id() -> int:
@@ -191,12 +199,20 @@ class _Publisher:
         self._gid = wire.gid_of(self.token_key)
         self._seq = 0
         self._lock = threading.Lock()
+        # As rmw_zenoh (rmw_publisher_data.cpp): reliability from the QoS, congestion control
+        # drop; transient local keeps a cache of ``depth`` samples for late joiners and is
+        # detectable, and reliable + transient local also sends sporadic heartbeats (the last
+        # sequence number) so that subscribers detect and recover a lost last sample.
+        options: dict[str, Any] = {"reliability": _reliability(qos),
+                                   "congestion_control": zenoh.CongestionControl.DROP}
         if qos.durability == "transient_local":
+            miss = (zenoh.ext.MissDetectionConfig(sporadic_heartbeat=HEARTBEAT_PERIOD_S)
+                    if qos.reliability == "reliable" else None)
             self._pub: Any = zenoh.ext.declare_advanced_publisher(
                 context.session, self.key, cache=zenoh.ext.CacheConfig(qos.depth),
-                publisher_detection=True)
+                sample_miss_detection=miss, publisher_detection=True, **options)
         else:
-            self._pub = context.session.declare_publisher(self.key)
+            self._pub = context.session.declare_publisher(self.key, **options)
         self._token = context.session.liveliness().declare_token(self.token_key)
 
     def publish(self, message: Any) -> None:
@@ -240,10 +256,16 @@ class _Subscription:
                                         type_name, rihs, qos)
             self._token = context.session.liveliness().declare_token(token)
         if qos.durability == "transient_local":
+            # As rmw_zenoh (rmw_subscription_data.cpp): detectable, the late publishers'
+            # history of ``depth`` samples, and (reliable) recovery of a missed last sample
+            # from the publishers' heartbeats.
+            recovery = (zenoh.ext.RecoveryConfig(heartbeat=True)
+                        if qos.reliability == "reliable" else None)
             self._sub: Any = zenoh.ext.declare_advanced_subscriber(
                 context.session, self.key, self._on_sample,
                 history=zenoh.ext.HistoryConfig(detect_late_publishers=True,
-                                                max_samples=qos.depth))
+                                                max_samples=qos.depth),
+                recovery=recovery, subscriber_detection=True)
         else:
             self._sub = context.session.declare_subscriber(self.key, self._on_sample)
 
