@@ -206,7 +206,8 @@ class _Publisher:
         options: dict[str, Any] = {"reliability": _reliability(qos),
                                    "congestion_control": zenoh.CongestionControl.DROP}
         if qos.durability == "transient_local":
-            miss = (zenoh.ext.MissDetectionConfig(sporadic_heartbeat=HEARTBEAT_PERIOD_S)
+            miss = (zenoh.ext.MissDetectionConfig(heartbeat=None,
+                                                  sporadic_heartbeat=HEARTBEAT_PERIOD_S)
                     if qos.reliability == "reliable" else None)
             self._pub: Any = zenoh.ext.declare_advanced_publisher(
                 context.session, self.key, cache=zenoh.ext.CacheConfig(qos.depth),
@@ -259,7 +260,7 @@ class _Subscription:
             # As rmw_zenoh (rmw_subscription_data.cpp): detectable, the late publishers'
             # history of ``depth`` samples, and (reliable) recovery of a missed last sample
             # from the publishers' heartbeats.
-            recovery = (zenoh.ext.RecoveryConfig(heartbeat=True)
+            recovery = (zenoh.ext.RecoveryConfig(periodic_queries=None, heartbeat=True)
                         if qos.reliability == "reliable" else None)
             self._sub: Any = zenoh.ext.declare_advanced_subscriber(
                 context.session, self.key, self._on_sample,
