@@ -13,7 +13,8 @@ def scene_options(plan: DemoPlan) -> EvaluateOptions:
     scene = plan.scene
     return EvaluateOptions(design=scene.design, layout=MarkerLayout(
         labels=tuple(scene.marker_labels), arc_lengths=tuple(scene.marker_arc_lengths),
-        ball_radius=scene.marker_ball_radius, side_deg=scene.marker_side_deg))
+        ball_radius=scene.marker_ball_radius, side_deg=scene.marker_side_deg,
+        radial_offset=scene.marker_radial_offset))
 
 
 def report(plan: DemoPlan, *, calibrate: bool) -> None:
