@@ -28,7 +28,7 @@ the start (loading) of the next trial. Table I uses the loading steps (the paper
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -64,6 +64,17 @@ class StepSettings:
 
 #: Specs of the step detection settings, by field name.
 STEP_SPECS = specs_of(StepSettings)
+#: Fractions of a schedule's hold time given to the steadiness window and the shortest hold.
+SETTLE_PER_HOLD, MIN_HOLD_PER_HOLD = 0.1, 0.2
+
+
+def settings_for_hold(hold_s: float) -> StepSettings:
+    """Step settings for a schedule holding each level ``hold_s`` (s): the defaults, with
+    ``settle_s`` at most a tenth and ``min_hold_s`` at most a fifth of the hold, so a hold
+    shortened by its ramp, the actuator's settling and the steadiness windows is still found."""
+    base = StepSettings()
+    return replace(base, settle_s=min(base.settle_s, SETTLE_PER_HOLD * hold_s),
+                   min_hold_s=min(base.min_hold_s, MIN_HOLD_PER_HOLD * hold_s))
 
 
 @dataclass(frozen=True)

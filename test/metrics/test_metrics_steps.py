@@ -8,7 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.metrics.steps import StepSettings, assign_phases, detect_steps
+from tdcm_ros.metrics.steps import (
+    StepSettings,
+    assign_phases,
+    detect_steps,
+    settings_for_hold,
+)
 from tdcm_ros.metrics.synthetic import staircase
 
 
@@ -87,3 +92,12 @@ def test_a_descending_staircase_unloads_and_a_zero_hold_between_trials_loads() -
 def test_phases_follow_the_direction_within_a_trial() -> None:
     assert assign_phases([0.0, 4.0, 4.1, 2.0, 1.9, 6.0, 0.0], [0, 0, 0, 0, 0, 0, 1], 0.3) == [
         "loading", "loading", "loading", "unloading", "unloading", "loading", "loading"]
+
+
+def test_settings_for_a_hold_shrink_only_below_the_defaults() -> None:
+    short = settings_for_hold(1.0)
+    assert (short.settle_s, short.min_hold_s) == pytest.approx((0.1, 0.2))
+    assert settings_for_hold(10.0) == StepSettings()
+    t, x = staircase([0.0, 4.0, 8.0, 12.0], hold_s=1.0, trials=1, rate_hz=500.0, lag_s=0.05)
+    assert len(detect_steps(t, x)) < 4
+    assert [round(s.median_n) for s in detect_steps(t, x, short)] == [0, 4, 8, 12, 0]
