@@ -10,7 +10,7 @@ from typing import Any
 
 from tdcm_ros.device import StepSchedule
 from tdcm_ros.errors import InputError
-from tdcm_ros.metrics.steps import settings_for_hold
+from tdcm_ros.metrics import settings_for_hold
 from tdcm_ros.model import FIELD_SPECS
 from tdcm_ros.scenes import Scene
 

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys.store import Typestore
 
 from tdcm_ros.metrics.evaluation import evaluate_series
 from tdcm_ros.metrics.options import options_from_sets
@@ -33,7 +34,7 @@ EPOCH_NS = 1_600_000_000 * 10**9
 LEVELS = (0.0, 5.0, 10.0, 15.0, 20.0, 10.0)
 
 
-def _typestore():  # type: ignore[no-untyped-def]
+def _typestore() -> Typestore:
     """Jazzy's types plus mocap4r2_msgs, read from the .msg files as any lab's tool would."""
     store = get_typestore(Stores.ROS2_JAZZY)
     folder = REPO / "msg_defs" / "mocap4r2_msgs" / "msg"
