@@ -112,14 +112,34 @@ class Evaluation:
             return None
         return metrics_of(self.records, self.options, phase=UNLOADING)
 
+    def hysteresis_m(self) -> list[float | None]:
+        """Per record: for an unloading step, its measured tip deflection minus that of the
+        same trial's loading step nearest in tension within ``2 steps.tolerance_n`` (the same
+        level), in m; ``None`` for loading steps and where no such pair was measured."""
+        band = 2.0 * self.options.steps.tolerance_n
+        loading = [r for r in self.records
+                   if r.phase == LOADING and r.measured_deflection_m is not None]
+        out: list[float | None] = []
+        for r in self.records:
+            pairs = [p for p in loading if p.trial == r.trial
+                     and abs(p.tension_n - r.tension_n) <= band]
+            if r.phase != UNLOADING or r.measured_deflection_m is None or not pairs:
+                out.append(None)
+                continue
+            pair = min(pairs, key=lambda p: abs(p.tension_n - r.tension_n))
+            out.append(r.measured_deflection_m - float(pair.measured_deflection_m or 0.0))
+        return out
+
     def to_json(self) -> dict[str, Any]:
         """The ``--json`` document: the issue's keys first (Table I of the loading steps), then
-        extras: ``unloading`` (the same metrics of the unloading steps, or null)."""
+        extras: ``unloading`` (the same metrics of the unloading steps, or null) and each step's
+        ``hysteresis_m`` (:meth:`hysteresis_m`)."""
         m, unloading = self.metrics, self.unloading
         return {"mape_pct": m.mape_pct, "rmse_m": m.rmse_m, "mae_m": m.mae_m,
                 "shape_error_m": m.shape_error_m, "deflection_mean_m": m.deflection_mean_m,
                 "n_trials": m.n_trials, "n_steps": m.n_steps,
-                "steps": [r.to_json() for r in self.records],
+                "steps": [{**r.to_json(), "hysteresis_m": h}
+                          for r, h in zip(self.records, self.hysteresis_m(), strict=True)],
                 "unloading": None if unloading is None else unloading.to_dict(),
                 "details": {**m.to_dict(), "sources": [
                     {"source": name, "registration": registration_json(reg)}

@@ -47,6 +47,11 @@ def format_evaluation(ev: Evaluation) -> str:
     if unloading is not None:
         lines += [(f"Unloading steps (not in Table I; hysteresis): {unloading.n_steps} steps, "
                    f"MAE {_mm(unloading.mae_m)} mm, RMSE {_mm(unloading.rmse_m)} mm")]
+        paired = [h for h in ev.hysteresis_m() if h is not None]
+        if paired:
+            lines.append(f"  measured unloading - loading deflection at the same level: mean "
+                         f"{_mm(sum(paired) / len(paired))} mm, largest "
+                         f"{_mm(max(paired, key=abs))} mm over {len(paired)} steps")
     if any(ev.occluded.values()):
         lines.append("occluded marker positions left out (NaN or exactly 0): " + ", ".join(
             f"{label} {count}" for label, count in ev.occluded.items()))

@@ -148,3 +148,6 @@ def test_a_foreign_bag_gives_the_true_table_after_the_mapping(
     assert doc["deflection_mean_m"] == pytest.approx(abs(true_tip[0]), abs=5e-5)
     assert doc["rmse_m"] < 3e-5 and doc["mae_m"] < 3e-5 and doc["mape_pct"] < 1.0
     assert doc["shape_error_m"] < 1e-4
+    # no friction in the simulation: unloading meets loading at 10 N and 0 N within the noise
+    paired = [s["hysteresis_m"] for s in doc["steps"] if s["phase"] == "unloading"]
+    assert len(paired) == 3 and max(abs(h) for h in paired) < 3e-5

@@ -78,6 +78,7 @@ def test_text_report_and_plots(bag: Path, tmp_path: Path,
     out = capsys.readouterr().out
     assert "Table I over 2 trials, 6 loading steps" in out and "from /tf_static" in out
     assert "Unloading steps (not in Table I; hysteresis): 1 steps" in out
+    assert "measured unloading - loading deflection at the same level" in out
     assert (tmp_path / "p" / "shapes.png").stat().st_size > 1000
     assert (tmp_path / "p" / "error_vs_tension.png").stat().st_size > 1000
 
