@@ -151,3 +151,10 @@ def test_a_foreign_bag_gives_the_true_table_after_the_mapping(
     # no friction in the simulation: unloading meets loading at 10 N and 0 N within the noise
     paired = [s["hysteresis_m"] for s in doc["steps"] if s["phase"] == "unloading"]
     assert len(paired) == 3 and max(abs(h) for h in paired) < 3e-5
+
+
+def test_calibrate_takes_the_same_mapping(bag: Path) -> None:
+    done = tdcm("calibrate", str(bag), *TOPICS, *MAPPING, "--json")
+    assert done.returncode == 0, done.stderr
+    fitted = json.loads(done.stdout)["parameters"]["E"]["value"]
+    assert fitted == pytest.approx(DESIGN.E, rel=0.01)  # the simulated truth
