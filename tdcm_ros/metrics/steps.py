@@ -18,7 +18,7 @@ A *trial* is one staircase: a new trial starts at the first step at or below ``z
 (or the first step after the tension dipped to ``zero_n``) once the current trial has risen
 above ``zero_n``. Steps at zero after the last rise stay with the last trial.
 
-Each step is *loading* or *unloading* (:data:`PHASES`): a trial's first step loads; a later step
+Each step is *loading* or *unloading*: a trial's first step loads; a later step
 more than ``tolerance_n`` below the step before it unloads, more than ``tolerance_n`` above it
 loads, and within that band it keeps the phase of the step before. So the return to 0 N after a
 trial's last level is that trial's unloading step; a zero hold between two trials is one hold,
@@ -38,9 +38,8 @@ from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 Array = NDArray[np.float64]
 _MEDIAN_PASSES = 4
-LOADING, UNLOADING = "loading", "unloading"
 #: A step's phase: reached from below (loading) or from above (unloading) within its trial.
-PHASES = (LOADING, UNLOADING)
+LOADING, UNLOADING = "loading", "unloading"
 
 
 @dataclass(frozen=True)
@@ -196,7 +195,7 @@ def assign_trials(medians: Sequence[float], dips: Sequence[float], zero_n: float
 
 def assign_phases(medians: Sequence[float], trials: Sequence[int], tolerance_n: float
                   ) -> list[str]:
-    """Phase (:data:`PHASES`) of each step from its median tension (N) and trial: a trial's
+    """Phase (:data:`LOADING` or :data:`UNLOADING`) of each step from its median tension (N) and trial: a trial's
     first step loads; later steps load or unload as they lie more than ``tolerance_n`` above or
     below the step before, and keep its phase within that band."""
     phases: list[str] = []
