@@ -17,11 +17,12 @@ def scene_options(plan: DemoPlan) -> EvaluateOptions:
     """Evaluation options matching the run: the estimator's design, the marker layout and step
     settings derived from the schedule's hold time (:func:`settings_for_hold`)."""
     scene = plan.scene
-    return EvaluateOptions(design=scene.design, steps=settings_for_hold(plan.schedule.hold),
-                           layout=MarkerLayout(
+    layout = MarkerLayout(
         labels=tuple(scene.marker_labels), arc_lengths=tuple(scene.marker_arc_lengths),
         ball_radius=scene.marker_ball_radius, side_deg=scene.marker_side_deg,
-        radial_offset=scene.marker_radial_offset))
+        radial_offset=scene.marker_radial_offset)
+    return EvaluateOptions(design=scene.design, steps=settings_for_hold(plan.schedule.hold),
+                           layout=layout)
 
 
 def missed_holds(plan: DemoPlan, evaluation: Evaluation) -> str:
