@@ -32,6 +32,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--hold", type=float, default=None,
                         help="override the scene's hold time per level (s)")
     parser.add_argument("--no-calibrate", action="store_true", help="skip the calibration of E")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="evaluation setting over the scene's, as `tdcm evaluate --set` "
+                             "(step settings default to ones derived from the hold time)")
     parser.add_argument("--bag", default=None,
                         help="where the recorder writes the bag (default OUT/bag; must not exist)")
     parser.add_argument("--record", default=None,
@@ -67,7 +70,14 @@ def _check_new(bag: Path, option: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the demo; returns the exit status."""
-    from tdcm_ros.demo import RECORDED_TOPICS, make_plan, record_live, report
+    from tdcm_ros.demo import (
+        RECORDED_TOPICS,
+        make_plan,
+        record_live,
+        report,
+        scene_options,
+    )
+    from tdcm_ros.metrics import options_from_sets
     from tdcm_ros.runtime.run_node import configure_logging, resolve_runtime
     from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV
     from tdcm_ros.scenes import load_scene
@@ -82,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
     plan = make_plan(scene, args.scene, out, trials=args.trials, hold_s=args.hold,
                      bag=Path(args.bag) if args.bag else None, recorded_topics=topics)
     _check_new(plan.bag, "--bag" if args.bag else "--out")
+    options = options_from_sets(args.set, base=scene_options(plan))  # checked before the run
     out.mkdir(parents=True, exist_ok=True)
     endpoint = args.endpoint or _free_endpoint()
     os.environ[ENDPOINT_ENV] = endpoint
@@ -94,6 +105,6 @@ def run(args: argparse.Namespace) -> int:
              f"rclpy, ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}")
     print(f"  output: {plan.out}   runtime: {graph}")
     record_live(plan, endpoint=endpoint, runtime=runtime)
-    report(plan, calibrate=not args.no_calibrate)
+    report(plan, options, calibrate=not args.no_calibrate)
     print(f"tdcm demo: done in {time.monotonic() - started:.1f} s; outputs in {plan.out}")
     return 0

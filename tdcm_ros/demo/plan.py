@@ -10,6 +10,7 @@ from typing import Any
 
 from tdcm_ros.device import StepSchedule
 from tdcm_ros.errors import InputError
+from tdcm_ros.metrics import settings_for_hold
 from tdcm_ros.model import FIELD_SPECS
 from tdcm_ros.scenes import Scene
 
@@ -49,13 +50,17 @@ class DemoPlan:
         markers = {"markers.arc_lengths": [float(s) for s in scene.marker_arc_lengths],
                    "markers.side_deg": float(scene.marker_side_deg)}
         top = max(self.schedule.levels)
+        steps = settings_for_hold(self.schedule.hold)
+        live = {"steps.settle_s": steps.settle_s, "steps.min_hold_s": steps.min_hold_s}
+        if scene.marker_radial_offset is not None:
+            live["markers.radial_offset"] = scene.marker_radial_offset
         return {
             "model_node": {**design, **markers, "markers.radius": scene.marker_ball_radius},
             "mocap_node": {"source": "sim", "sim.scene": self.scene_ref,
                            "labelling.labels": list(scene.marker_labels),
                            "labelling.arc_lengths": [float(s) for s in scene.marker_arc_lengths]},
             "metrics_node": {**design, **markers, "markers.radius": scene.marker_ball_radius,
-                             "markers.labels": list(scene.marker_labels)},
+                             "markers.labels": list(scene.marker_labels), **live},
             "device_twin": {"scene": self.scene_ref, "link": self.link},
             "tension_driver": {"port": self.link, "tension_max": top,
                                "schedule.levels": [float(v) for v in self.schedule.levels],

@@ -5,23 +5,45 @@ from __future__ import annotations
 import json
 
 from tdcm_ros.demo.plan import DemoPlan
-from tdcm_ros.metrics import EvaluateOptions, MarkerLayout
+from tdcm_ros.metrics import (
+    EvaluateOptions,
+    Evaluation,
+    MarkerLayout,
+    settings_for_hold,
+)
 
 
 def scene_options(plan: DemoPlan) -> EvaluateOptions:
-    """Evaluation options matching the scene: the estimator's design and the marker layout."""
+    """Evaluation options matching the run: the estimator's design, the marker layout and step
+    settings derived from the schedule's hold time (:func:`settings_for_hold`)."""
     scene = plan.scene
-    return EvaluateOptions(design=scene.design, layout=MarkerLayout(
+    layout = MarkerLayout(
         labels=tuple(scene.marker_labels), arc_lengths=tuple(scene.marker_arc_lengths),
-        ball_radius=scene.marker_ball_radius, side_deg=scene.marker_side_deg))
+        ball_radius=scene.marker_ball_radius, side_deg=scene.marker_side_deg,
+        radial_offset=scene.marker_radial_offset)
+    return EvaluateOptions(design=scene.design, steps=settings_for_hold(plan.schedule.hold),
+                           layout=layout)
 
 
-def report(plan: DemoPlan, *, calibrate: bool) -> None:
-    """Print Table I and the per-step table, write ``plots/`` and ``metrics.json``; calibrate."""
+def missed_holds(plan: DemoPlan, evaluation: Evaluation) -> str:
+    """A warning when the evaluation found fewer loading steps than the schedule holds (the
+    step settings did not fit the run), else ``""``."""
+    scheduled = len(plan.schedule.levels) * plan.schedule.trials
+    found = sum(r.phase == "loading" for r in evaluation.records)
+    if found >= scheduled:
+        return ""
+    steps = evaluation.options.steps
+    return (f"warning: found {found} of the schedule's {scheduled} holds (steps.min_hold_s = "
+            f"{steps.min_hold_s:g} s, steps.settle_s = {steps.settle_s:g} s, steps.tolerance_n "
+            f"= {steps.tolerance_n:g} N); adjust them with --set steps.<name>=VALUE")
+
+
+def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool) -> None:
+    """Print Table I and the per-step table of the bag evaluated with ``options`` (see
+    :func:`scene_options`), write ``plots/`` and ``metrics.json``; calibrate."""
     from tdcm_ros.metrics import format_calibration, format_evaluation, write_plots
     from tdcm_ros.metrics.api import evaluate_paths
 
-    options = scene_options(plan)
     fit = None
     if calibrate:
         from tdcm_ros.metrics.api import calibrate_paths
@@ -30,6 +52,8 @@ def report(plan: DemoPlan, *, calibrate: bool) -> None:
     evaluation = fit.before if fit is not None else evaluate_paths([plan.bag], options)
     print(f"\n== evaluation of {plan.bag} (estimator: scene {plan.scene.name!r} nominal design) ==")
     print(format_evaluation(evaluation))
+    if warning := missed_holds(plan, evaluation):
+        print(warning)
     for path in write_plots(evaluation, plan.out / "plots"):
         print(f"plot written to {path}")
     results = {"scene": plan.scene.name, "before_calibration": evaluation.to_json()}

@@ -20,7 +20,7 @@ from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions, options_from
 from tdcm_ros.metrics.plots import write_plots
 from tdcm_ros.metrics.report import format_calibration, format_evaluation
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
-from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings
+from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings, settings_for_hold
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.table import TableMetrics
 from tdcm_ros.model import MARKER_SPECS, MarkerLayout
@@ -46,5 +46,6 @@ __all__ = [
     "format_calibration",
     "format_evaluation",
     "options_from_sets",
+    "settings_for_hold",
     "write_plots",
 ]

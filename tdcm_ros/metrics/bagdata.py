@@ -2,7 +2,8 @@
 
 - tension: ``geometry_msgs/msg/WrenchStamped`` (``wrench.force.z``, N);
 - markers: ``mocap4r2_msgs/msg/Markers`` (positions in the message's frame, matched to the
-  layout's labels by ``marker_name``; unknown names are ignored and counted in a warning). A
+  layout's labels by ``marker_name``; unknown names are ignored and counted in a warning; a
+  layout label never seen is an error listing the names the bag holds, with their frame counts). A
   position that is NaN or exactly ``(0, 0, 0)`` is an occluded marker, as mocap_node treats it
   (:func:`tdcm_ros.mocap.occlusion.visible`): missing, counted, never a measurement;
 - registration: the ``/tf_static`` transform whose child is ``tdcm_base`` and whose parent is the
@@ -25,6 +26,7 @@ dropped, so memory holds a few numbers per message rather than the bag's bytes.
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -206,20 +208,20 @@ def _occlude(rows: np.ndarray, reported: np.ndarray, labels: Sequence[str], topi
 
 
 def _frames(payloads: Sequence[bytes], index: dict[str, int], frames: set[str],
-            unknown: set[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            present: Counter[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Header stamps (ns), positions (n, k, 3) m (NaN where not reported) and the reported mask
-    (n, k) of Markers payloads; their frame ids and unknown marker names are added to the sets."""
+    (n, k) of Markers payloads; their frame ids are added to ``frames`` and the frames each
+    marker name is reported in are counted in ``present``."""
     header = np.zeros(len(payloads), dtype=np.int64)
     rows = np.full((len(payloads), len(index), 3), np.nan)
     reported = np.zeros(rows.shape[:2], dtype=bool)
     for n, data in enumerate(payloads):
         header[n], frame, names, xyz = markers_frame(data)
         frames.add(frame)
+        present.update({name or "(unnamed)" for name in names})
         for marker_name, p in zip(names, xyz, strict=True):
             i = index.get(marker_name)
-            if i is None:
-                unknown.add(marker_name or "(unnamed)")
-            else:
+            if i is not None:
                 rows[n, i], reported[n, i] = p, True
     return header, rows, reported
 
@@ -230,11 +232,11 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
     name = require_topic(reader, topic, [MARKERS_TYPE])
     index = {label: i for i, label in enumerate(labels)}
     frames: set[str] = set()
-    unknown: set[str] = set()
+    present: Counter[str] = Counter()
 
     stamps_ns, from_log, unique, (rows, reported) = _read(
-        reader, name, lambda payloads: _frames(payloads, index, frames, unknown))
-    if unknown:
+        reader, name, lambda payloads: _frames(payloads, index, frames, present))
+    if unknown := set(present) - set(labels):
         warnings.append(f"{name}: ignored markers not in the layout ({', '.join(labels)}): "
                         f"{', '.join(sorted(unknown))}")
     if len(frames) > 1:
@@ -246,7 +248,9 @@ def _markers(reader: BagReader, topic: str, labels: Sequence[str], warnings: lis
     if not keep.all():
         rows, reported = rows[keep], reported[keep]
     occluded = _occlude(rows, reported, labels, name, warnings)
-    return MarkerSeries.of(stamps, labels, rows, frame_id=frame), occluded
+    series = MarkerSeries.of(stamps, labels, rows, frame_id=frame)
+    series.require_visible(dict(present))
+    return series, occluded
 
 
 def _registration(reader: BagReader, parent: str, warnings: list[str]) -> Registration | None:

@@ -2,7 +2,8 @@
 
 Per step: the measured markers in ``tdcm_base``, the model's markers at the same surface points
 (:func:`tdcm_ros.model.surface_points`), both tip deflections and the shape error;
-then Table I (:mod:`tdcm_ros.metrics.table`). A step is *flagged* (left out of every metric,
+then Table I (:mod:`tdcm_ros.metrics.table`) over the loading steps; the unloading steps
+(:mod:`tdcm_ros.metrics.steps`) get the same metrics separately. A step is *flagged* (left out of every metric,
 kept in the per-step table with a note) when its tip marker was never visible or the model has
 no solution at its tension.
 """
@@ -21,6 +22,7 @@ from tdcm_ros.metrics.geometry import deflection, measured_midline, station_dist
 from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.steps import LOADING, UNLOADING
 from tdcm_ros.metrics.table import TableMetrics, table_metrics
 from tdcm_ros.mocap import (
     Registration,
@@ -57,7 +59,8 @@ def stations(options: EvaluateOptions) -> Array:
 
 @dataclass(frozen=True, eq=False)
 class StepRecord:
-    """One step of the evaluation (SI units, frame ``tdcm_base``); ``trial`` counts from 1."""
+    """One step of the evaluation (SI units, frame ``tdcm_base``); ``trial`` counts from 1,
+    ``phase`` is ``loading`` or ``unloading``."""
 
     trial: int
     tension_n: float
@@ -73,6 +76,7 @@ class StepRecord:
     predicted_midline: Array | None
     missing: tuple[str, ...]
     note: str
+    phase: str = LOADING
 
     @property
     def usable(self) -> bool:
@@ -81,7 +85,7 @@ class StepRecord:
 
     def to_json(self) -> dict[str, Any]:
         """``trial``, ``tension`` (N), ``measured``/``predicted`` tip deflection (m), extras."""
-        return {"trial": self.trial, "tension": self.tension_n,
+        return {"trial": self.trial, "phase": self.phase, "tension": self.tension_n,
                 "measured": self.measured_deflection_m, "predicted": self.predicted_deflection_m,
                 "shape_error_m": self.shape_error_m, "start_s": self.start_s,
                 "end_s": self.end_s, "frames": self.frames, "missing_markers": list(self.missing),
@@ -90,8 +94,8 @@ class StepRecord:
 
 @dataclass(frozen=True, eq=False)
 class Evaluation:
-    """Per-step records, Table I, the registration used per source, any warnings and the
-    occluded marker positions (NaN or exactly zero, left out) per label."""
+    """Per-step records, Table I (of the loading steps), the registration used per source, any
+    warnings and the occluded marker positions (NaN or exactly zero, left out) per label."""
 
     records: tuple[StepRecord, ...]
     metrics: TableMetrics
@@ -101,13 +105,42 @@ class Evaluation:
     sources: tuple[str, ...] = ("arrays",)
     occluded: dict[str, int] = field(default_factory=dict)
 
+    @property
+    def unloading(self) -> TableMetrics | None:
+        """The Table I metrics of the unloading steps (``None`` if there is none)."""
+        if not any(r.phase == UNLOADING for r in self.records):
+            return None
+        return metrics_of(self.records, self.options, phase=UNLOADING)
+
+    def hysteresis_m(self) -> list[float | None]:
+        """Per record: for an unloading step, its measured tip deflection minus that of the
+        same trial's loading step nearest in tension within ``2 steps.tolerance_n`` (the same
+        level), in m; ``None`` for loading steps and where no such pair was measured."""
+        band = 2.0 * self.options.steps.tolerance_n
+        loading = [r for r in self.records
+                   if r.phase == LOADING and r.measured_deflection_m is not None]
+        out: list[float | None] = []
+        for r in self.records:
+            pairs = [p for p in loading if p.trial == r.trial
+                     and abs(p.tension_n - r.tension_n) <= band]
+            if r.phase != UNLOADING or r.measured_deflection_m is None or not pairs:
+                out.append(None)
+                continue
+            pair = min(pairs, key=lambda p: abs(p.tension_n - r.tension_n))
+            out.append(r.measured_deflection_m - float(pair.measured_deflection_m or 0.0))
+        return out
+
     def to_json(self) -> dict[str, Any]:
-        """The ``--json`` document: the issue's keys first, then extras."""
-        m = self.metrics
+        """The ``--json`` document: the issue's keys first (Table I of the loading steps), then
+        extras: ``unloading`` (the same metrics of the unloading steps, or null) and each step's
+        ``hysteresis_m`` (:meth:`hysteresis_m`)."""
+        m, unloading = self.metrics, self.unloading
         return {"mape_pct": m.mape_pct, "rmse_m": m.rmse_m, "mae_m": m.mae_m,
                 "shape_error_m": m.shape_error_m, "deflection_mean_m": m.deflection_mean_m,
                 "n_trials": m.n_trials, "n_steps": m.n_steps,
-                "steps": [r.to_json() for r in self.records],
+                "steps": [{**r.to_json(), "hysteresis_m": h}
+                          for r, h in zip(self.records, self.hysteresis_m(), strict=True)],
+                "unloading": None if unloading is None else unloading.to_dict(),
                 "details": {**m.to_dict(), "sources": [
                     {"source": name, "registration": registration_json(reg)}
                     for name, reg in zip(self.sources, self.registrations, strict=True)],
@@ -187,15 +220,17 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
             shape_error_m=None if pred is None or midline is None else station_distance(
                 midline, pred.midline),
             measured_midline=midline, predicted_midline=None if pred is None else pred.midline,
-            missing=measured.missing, note=note))
+            missing=measured.missing, note=note, phase=measured.step.phase))
     return records, warnings
 
 
-def metrics_of(records: Sequence[StepRecord], options: EvaluateOptions) -> TableMetrics:
-    """Table I of the records."""
+def metrics_of(records: Sequence[StepRecord], options: EvaluateOptions, *,
+               phase: str = LOADING) -> TableMetrics:
+    """Table I of the records of ``phase`` (default: the loading steps, the paper's protocol)."""
     def col(values: list[float | None]) -> Array:
         return np.array([np.nan if v is None else v for v in values], dtype=float)
 
+    records = [r for r in records if r.phase == phase]
     return table_metrics(
         [r.trial for r in records], [r.tension_n for r in records],
         col([r.measured_deflection_m if r.usable else None for r in records]),

@@ -26,16 +26,16 @@ def format_evaluation(ev: Evaluation) -> str:
                             f"{reg.residual_m * 1e3:.3f} mm)"}.get(reg.method, reg.method)
         lines.append(f"registration mocap -> tdcm_base of {source}: {how}")
     lines.append("")
-    lines.append(f"{'trial':>5} {'tension N':>9} {'frames':>6} {'meas mm':>8} {'pred mm':>8} "
-                 f"{'err mm':>7} {'shape mm':>8}  note")
+    lines.append(f"{'trial':>5} {'phase':>9} {'tension N':>9} {'frames':>6} {'meas mm':>8} "
+                 f"{'pred mm':>8} {'err mm':>7} {'shape mm':>8}  note")
     for r in ev.records:
         measured, predicted = r.measured_deflection_m, r.predicted_deflection_m
         err = predicted - measured if predicted is not None and measured is not None else None
-        lines.append(f"{r.trial:>5} {r.tension_n:>9.3f} {r.frames:>6} "
+        lines.append(f"{r.trial:>5} {r.phase:>9} {r.tension_n:>9.3f} {r.frames:>6} "
                      f"{_mm(r.measured_deflection_m):>8} {_mm(r.predicted_deflection_m):>8} "
                      f"{_mm(err):>7} {_mm(r.shape_error_m):>8}  {r.note}")
-    m = ev.metrics
-    lines += ["", (f"Table I over {m.n_trials} trials, {m.n_steps} steps"
+    m, unloading = ev.metrics, ev.unloading
+    lines += ["", (f"Table I over {m.n_trials} trials, {m.n_steps} loading steps"
                   f"{f' ({m.n_flagged} flagged steps left out)' if m.n_flagged else ''}:"),
               (f"  MAPE            {'-' if m.mape_pct is None else f'{m.mape_pct:.2f} %'}"
               f"  ({m.mape_excluded} steps below {m.mape_threshold_m * 1e3:g} mm left out)"),
@@ -44,6 +44,14 @@ def format_evaluation(ev: Evaluation) -> str:
               f"  Shape error     {_mm(m.shape_error_m)} mm",
               (f"  Deflection mean {_mm(m.deflection_mean_m, 2)} mm "
               f"(model {_mm(m.predicted_deflection_mean_m, 2)} mm)")]
+    if unloading is not None:
+        lines += [(f"Unloading steps (not in Table I; hysteresis): {unloading.n_steps} steps, "
+                   f"MAE {_mm(unloading.mae_m)} mm, RMSE {_mm(unloading.rmse_m)} mm")]
+        paired = [h for h in ev.hysteresis_m() if h is not None]
+        if paired:
+            lines.append(f"  measured unloading - loading deflection at the same level: mean "
+                         f"{_mm(sum(paired) / len(paired))} mm, largest "
+                         f"{_mm(max(paired, key=abs))} mm over {len(paired)} steps")
     if any(ev.occluded.values()):
         lines.append("occluded marker positions left out (NaN or exactly 0): " + ", ".join(
             f"{label} {count}" for label, count in ev.occluded.items()))
@@ -58,7 +66,7 @@ def _metric(value: float | None, scale: float, unit: str) -> str:
 def format_calibration(cal: Calibration) -> str:
     """Warnings first (not identifiable, not converged, then the evaluation's), then fitted
     values with intervals, residuals and Table I before/after."""
-    steps = cal.before.metrics.n_steps + cal.before.metrics.n_flagged
+    steps = len(cal.before.records)  # loading and unloading steps are fitted alike
     lines = [f"warning: {w}" for w in (*cal.warnings, *cal.after.warnings)]
     lines += [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
              f"residual RMS {cal.residual_rms_m * 1e3:.4f} mm")]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -75,12 +75,25 @@ class MarkerSeries:
         """(n, k) True where the marker was seen."""
         return ~np.isnan(self.positions[:, :, 0])
 
-    def require_visible(self) -> None:
-        """Raise :class:`MarkersNotVisibleError` naming the markers never seen."""
+    def require_visible(self, present: Mapping[str, int] | None = None) -> None:
+        """Raise :class:`MarkersNotVisibleError` naming the markers never seen; ``present`` (the
+        marker names the data holds, with the frames each was seen in) is listed in the error
+        with the parameter that maps them onto the layout."""
         never = [label for label, seen in zip(self.labels, np.any(self.visible(), axis=0),
                                               strict=True) if not seen]
-        if never:
-            raise MarkersNotVisibleError(
-                f"markers {', '.join(never)} never come into view in {len(self.stamps_s)} "
-                "frames; allowed: each marker visible in at least one frame",
-                parameter="markers", value=never, allowed="visible in >= 1 frame")
+        if not never:
+            return
+        hint = ""
+        if present:
+            listed = ", ".join(f"{name} ({count} frames)" for name, count in
+                               sorted(present.items(), key=lambda item: (-item[1], item[0])))
+            likely = ",".join(sorted(sorted(present, key=lambda n: -present[n])
+                                     [:len(self.labels)]))
+            hint = (f"; the data holds markers {listed}; map them base to tip with "
+                    f"markers.labels (tdcm evaluate/calibrate: --set markers.labels={likely}; "
+                    "metrics_node: parameter markers.labels)")
+        raise MarkersNotVisibleError(
+            f"markers {', '.join(never)} never come into view in {len(self.stamps_s)} "
+            f"frames{hint}; allowed: each marker visible in at least one frame",
+            parameter="markers.labels" if present else "markers", value=never,
+            allowed="visible in >= 1 frame")

@@ -17,12 +17,18 @@ median for at least ``min_hold_s``, once the transients are excluded:
 A *trial* is one staircase: a new trial starts at the first step at or below ``zero_n``
 (or the first step after the tension dipped to ``zero_n``) once the current trial has risen
 above ``zero_n``. Steps at zero after the last rise stay with the last trial.
+
+Each step is *loading* or *unloading*: a trial's first step loads; a later step
+more than ``tolerance_n`` below the step before it unloads, more than ``tolerance_n`` above it
+loads, and within that band it keeps the phase of the step before. So the return to 0 N after a
+trial's last level is that trial's unloading step; a zero hold between two trials is one hold,
+the start (loading) of the next trial. Table I uses the loading steps (the paper's protocol).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -32,6 +38,8 @@ from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 Array = NDArray[np.float64]
 _MEDIAN_PASSES = 4
+#: A step's phase: reached from below (loading) or from above (unloading) within its trial.
+LOADING, UNLOADING = "loading", "unloading"
 
 
 @dataclass(frozen=True)
@@ -55,6 +63,17 @@ class StepSettings:
 
 #: Specs of the step detection settings, by field name.
 STEP_SPECS = specs_of(StepSettings)
+#: Fractions of a schedule's hold time given to the steadiness window and the shortest hold.
+SETTLE_PER_HOLD, MIN_HOLD_PER_HOLD = 0.1, 0.2
+
+
+def settings_for_hold(hold_s: float) -> StepSettings:
+    """Step settings for a schedule holding each level ``hold_s`` (s): the defaults, with
+    ``settle_s`` at most a tenth and ``min_hold_s`` at most a fifth of the hold, so a hold
+    shortened by its ramp, the actuator's settling and the steadiness windows is still found."""
+    base = StepSettings()
+    return replace(base, settle_s=min(base.settle_s, SETTLE_PER_HOLD * hold_s),
+                   min_hold_s=min(base.min_hold_s, MIN_HOLD_PER_HOLD * hold_s))
 
 
 @dataclass(frozen=True)
@@ -68,6 +87,7 @@ class Step:
     end_s: float
     median_n: float
     mean_n: float
+    phase: str = LOADING
 
     @property
     def duration_s(self) -> float:
@@ -145,20 +165,22 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
     previous_stops = [0, *(b for _, b in ranges)][:len(ranges)]
     dips = [float(x[prev:a].min()) if a > prev else np.inf
             for (a, _), prev in zip(ranges, previous_stops, strict=True)]
+    trials = assign_trials(medians, dips, cfg.zero_n)
     steps = []
-    for (start, stop), median, trial in zip(ranges, medians,
-                                            assign_trials(medians, dips, cfg.zero_n), strict=True):
+    for (start, stop), median, trial, phase in zip(
+            ranges, medians, trials, assign_phases(medians, trials, cfg.tolerance_n),
+            strict=True):
         held = x[start:stop]
         mean = float(np.mean(held[np.abs(held - median) <= cfg.tolerance_n]))
-        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median, mean))
+        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median, mean,
+                          phase))
     return steps
 
 
-def assign_trials(medians: Sequence[float], dips: Sequence[float], zero_n: float,
-                  *, final: bool = True) -> list[int]:
+def assign_trials(medians: Sequence[float], dips: Sequence[float], zero_n: float) -> list[int]:
     """Trial (0-based) of each step from its median tension and the lowest tension between it
-    and the previous step (``dips``, N). With ``final``, zero holds after the last rise stay
-    with the last staircase; otherwise (a live stream) they wait as the next trial's start."""
+    and the previous step (``dips``, N). Zero holds after the last rise stay with the last
+    staircase (its unloading); a live stream re-assigns them when the next rise comes."""
     trials: list[int] = []
     trial, risen = 0, False
     for median, dip in zip(medians, dips, strict=True):
@@ -166,6 +188,24 @@ def assign_trials(medians: Sequence[float], dips: Sequence[float], zero_n: float
             trial, risen = trial + 1, False
         risen = risen or median > zero_n
         trials.append(trial)
-    if final and trial > 0 and not risen:
+    if trial > 0 and not risen:
         trials = [k - 1 if k == trial else k for k in trials]
     return trials
+
+
+def assign_phases(medians: Sequence[float], trials: Sequence[int], tolerance_n: float
+                  ) -> list[str]:
+    """Phase (:data:`LOADING` or :data:`UNLOADING`) of each step from its median tension (N) and trial: a trial's
+    first step loads; later steps load or unload as they lie more than ``tolerance_n`` above or
+    below the step before, and keep its phase within that band."""
+    phases: list[str] = []
+    for k, (median, trial) in enumerate(zip(medians, trials, strict=True)):
+        if k == 0 or trials[k - 1] != trial:
+            phases.append(LOADING)
+        elif median < medians[k - 1] - tolerance_n:
+            phases.append(UNLOADING)
+        elif median > medians[k - 1] + tolerance_n:
+            phases.append(LOADING)
+        else:
+            phases.append(phases[-1])
+    return phases

@@ -4,8 +4,9 @@ Table I out, with the same definitions as the offline evaluation.
 Tension samples and marker frames are buffered; :meth:`RunningEvaluation.update` runs step
 detection on the buffer. A step is *finished* once the buffer reaches ``settle_s`` past its end
 (the tension left the band); finished steps are averaged, scored against the model and dropped
-from the buffer. Trials are assigned over all finished steps; a zero hold after a rise waits as
-the start of the next trial (a live stream cannot know it was the last). The buffer keeps at most
+from the buffer. Trials and phases are assigned over all finished steps at each update, as the
+offline evaluation does: a zero hold after a rise is the trial's unloading until the next rise
+makes it the start of the next trial (the running Table I then counts it as loading). The buffer keeps at most
 ``max_buffer_s`` of data (older samples are dropped when no step finishes, e.g. a long ramp).
 """
 
@@ -27,7 +28,7 @@ from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.measure import MeasuredStep, average_markers
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
-from tdcm_ros.metrics.steps import assign_trials, detect_steps
+from tdcm_ros.metrics.steps import assign_phases, assign_trials, detect_steps
 from tdcm_ros.metrics.table import TableMetrics
 from tdcm_ros.mocap import Registration
 
@@ -148,9 +149,12 @@ class RunningEvaluation:
             self.problem = f"waiting for a registration: {error}"
             return
         records, warnings = score_steps(self.measured, reg, self.options)
-        trials = assign_trials([m.tension_n for m in self.measured], self._dips,
-                               self.options.steps.zero_n, final=False)
-        self.records = [replace(r, trial=k + 1) for r, k in zip(records, trials, strict=True)]
+        tensions = [m.tension_n for m in self.measured]
+        trials = assign_trials(tensions, self._dips, self.options.steps.zero_n)
+        phases = assign_phases([m.step.median_n for m in self.measured], trials,
+                               self.options.steps.tolerance_n)
+        self.records = [replace(r, trial=k + 1, phase=phase)
+                        for r, k, phase in zip(records, trials, phases, strict=True)]
         self.metrics = metrics_of(self.records, self.options)
         self.used_registration = reg
         self.problem = warnings[-1] if warnings else ""

@@ -1,9 +1,10 @@
 """Where the markers sit on the body: the marker layout (labels, arc lengths, ball radius,
-side) and its specs, SI units.
+side, radial offset) and its specs, SI units.
 
-Markers sit on the body surface at arc lengths ``arc_lengths`` (m), ``radius = R_outer +
-ball_radius`` off the midline, at ``side_deg`` around the body z axis from the body x axis (0 =
-tendon side; the default 180 deg is opposite the tendon).
+Markers sit at arc lengths ``arc_lengths`` (m), ``radial_offset`` off the midline (default: on
+the body surface, ``R_outer + ball_radius``; 0: virtual markers on the midline, as a fitted
+spline or a marker tree gives them), at ``side_deg`` around the body z axis from the body x axis
+(0 = tendon side; the default 180 deg is opposite the tendon).
 """
 
 from __future__ import annotations
@@ -23,7 +24,8 @@ Array = NDArray[np.float64]
 @dataclass(frozen=True)
 class MarkerLayout:
     """Where the markers sit: ``labels`` (last = tip marker), ``arc_lengths`` (m, increasing),
-    ``ball_radius`` (m) and ``side_deg`` (deg from the tendon side)."""
+    ``ball_radius`` (m), ``side_deg`` (deg from the tendon side) and ``radial_offset`` (m from
+    the midline; ``None``: on the surface, ``R_outer + ball_radius``)."""
 
     labels: tuple[str, ...] = spec_field(("m1", "m2", "m3"), description=(
         "marker labels, base to tip (the last is the tip marker)"))
@@ -34,9 +36,14 @@ class MarkerLayout:
                                     description="marker ball radius")
     side_deg: float = spec_field(180.0, unit="deg", low=-360.0, high=360.0, description=(
         "marker side around the body z axis from the tendon side"))
+    radial_offset: float | None = spec_field(None, unit="m", low=0.0, high=0.05, description=(
+        "distance of the marker centres from the midline (default: R_outer + ball_radius, on "
+        "the surface; 0: on the midline)"))
 
     def __post_init__(self) -> None:
-        check_fields(self, MARKER_SPECS, prefix="markers.")
+        given = {k: s for k, s in MARKER_SPECS.items()
+                 if k != "radial_offset" or self.radial_offset is not None}
+        check_fields(self, given, prefix="markers.")
         if len(self.labels) != len(self.arc_lengths):
             raise out_of_range("markers.labels", list(self.labels),
                                f"{len(self.arc_lengths)} distinct labels, one per arc length")
@@ -55,8 +62,9 @@ class MarkerLayout:
         return np.asarray(self.arc_lengths)
 
     def radius(self, r_outer: float) -> float:
-        """Distance of the marker centres from the midline (m) for a body of radius ``r_outer``."""
-        return r_outer + self.ball_radius
+        """Distance of the marker centres from the midline (m) for a body of radius ``r_outer``
+        (m): ``radial_offset`` if given, else on the surface."""
+        return r_outer + self.ball_radius if self.radial_offset is None else self.radial_offset
 
     def rest_offset(self, r_outer: float) -> Array:
         """Offset (3,) m of every marker from the midline at zero tension (straight body)."""

@@ -59,7 +59,8 @@ BASE_FRAME = "tdcm_base"
 #: The design preset the design.* fields start from.
 PRESET_SPECS = by_name(Spec("design.preset", description="design preset the fields start from",
                             default="paper-experiment", kind="str", choices=tuple(PRESETS)))
-#: The marker layout as parameters: ``markers.radius`` is the layout's ball radius.
+#: The marker layout as parameters: ``markers.radius`` is the layout's ball radius;
+#: ``markers.radial_offset`` defaults to ``design.R_outer + markers.radius`` (on the surface).
 LAYOUT_SPECS = {**MARKER_SPECS, "ball_radius": replace(MARKER_SPECS["ball_radius"], name="radius")}
 #: Parameters fixed at start, besides the evaluation options.
 FIXED_SPECS = by_name(
@@ -138,8 +139,13 @@ class MetricsNode(NodeLogic):
         base = preset(str(declare_specs(port, PRESET_SPECS, read_only=True)["design.preset"]))
         design = base.with_overrides(**declare_specs(
             port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
-        layout = MarkerLayout(**declare_specs(port, LAYOUT_SPECS, prefix="markers.",
-                                              read_only=True))
+        given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}
+        fields = declare_specs(port, given, prefix="markers.", read_only=True)
+        # a ROS parameter has a value: the default offset is the surface's, of the values above
+        fields.update(declare_specs(
+            port, {"radial_offset": LAYOUT_SPECS["radial_offset"]}, prefix="markers.",
+            defaults={"radial_offset": design.R_outer + fields["ball_radius"]}, read_only=True))
+        layout = MarkerLayout(**fields)
         steps = StepSettings(**declare_specs(port, STEP_SPECS, prefix="steps.", read_only=True))
         return EvaluateOptions(design=design, steps=steps, layout=layout,
                                **declare_specs(port, OPTION_SPECS, read_only=True))

@@ -59,10 +59,14 @@ class Scene:
     mocap_pose: tuple[Array, Array] = field(repr=False)
     effects: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     source: Path | None = None
+    marker_radial_offset: float | None = None
 
     @property
     def marker_radius(self) -> float:
-        """Nominal distance of a marker centre from the midline (m): ``R_outer`` + ball."""
+        """Nominal distance of a marker centre from the midline (m): ``markers.radial_offset_m``
+        if given, else ``R_outer`` + ball (on the surface)."""
+        if self.marker_radial_offset is not None:
+            return self.marker_radial_offset
         return self.design.R_outer + self.marker_ball_radius
 
     @property
@@ -169,7 +173,7 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
         marker_labels=markers["labels"], marker_arc_lengths=markers["arc_lengths_m"],
         marker_ball_radius=markers["ball_radius_m"], marker_side_deg=markers["side_deg"],
         mocap_pose=(np.asarray(frame["translation_m"], dtype=float), quaternion),
-        source=source)
+        source=source, marker_radial_offset=markers["radial_offset_m"])
     raw_effects = as_mapping("effects", data.get("effects"))
     check_names(raw_effects)
     context = scene.context()

@@ -67,6 +67,7 @@ MARKERS = (
     MARKER_SPECS["arc_lengths"].renamed("arc_lengths_m"),
     MARKER_SPECS["ball_radius"].renamed("ball_radius_m"),
     MARKER_SPECS["side_deg"],
+    MARKER_SPECS["radial_offset"].renamed("radial_offset_m"),
 )
 
 MOCAP_FRAME = (

@@ -16,8 +16,11 @@ import pytest
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.cli.main import main
 from tdcm_ros.demo.plan import NODE_ORDER, RECORDED_TOPICS, make_plan
+from tdcm_ros.demo.report import missed_holds, scene_options
 from tdcm_ros.device.schedule import StepSchedule
 from tdcm_ros.errors import InputError
+from tdcm_ros.metrics.api import evaluate_paths
+from tdcm_ros.metrics.steps import StepSettings
 from tdcm_ros.runtime.registry import NODES
 from tdcm_ros.scenes import load_scene
 
@@ -149,3 +152,36 @@ def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
     assert set(overrides) == set(NODE_ORDER) <= set(NODES)
     assert overrides["tension_driver"]["port"] == overrides["device_twin"]["link"]
     assert overrides["model_node"]["design.E"] == pytest.approx(1.85e9)
+
+
+def test_a_short_hold_finds_every_level_and_the_demo_takes_set(tmp_path: Path) -> None:
+    """``--hold 1``: the step settings follow the schedule (the defaults' 1 s shortest hold
+    found 1 of 6 levels); ``--set`` reaches the evaluation as in ``tdcm evaluate``."""
+    done = _run_demo(tmp_path / "short", "--scene", "paper_experiment", "--hold", "1",
+                     "--no-calibrate", "--set", "mape_threshold_m=0.002")
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert "warning: found" not in done.stdout
+    metrics = json.loads((tmp_path / "short" / "metrics.json").read_text())["before_calibration"]
+    assert (metrics["n_trials"], metrics["n_steps"]) == (1, 6)
+    assert sorted(round(step["tension"]) for step in metrics["steps"]) == [0, 4, 8, 12, 16, 20]
+    assert metrics["details"]["mape_threshold_m"] == 0.002
+
+
+def test_demo_rejects_a_bad_set_before_the_run(tmp_path: Path,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["demo", "--out", str(tmp_path / "x"), "--set", "steps.min_hold_s=-1"]) == 2
+    err = capsys.readouterr().err
+    assert "steps.min_hold_s = '-1' is out of range; allowed: > 0 s" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_holds_the_evaluation_missed_are_reported(tmp_path: Path) -> None:
+    plan = make_plan(load_scene("paper_experiment"), "paper_experiment", tmp_path)
+    options = replace(scene_options(plan), steps=StepSettings(min_hold_s=3.9))
+    evaluation = evaluate_paths([REPO / "bags" / "paper_experiment"], options)
+    found = sum(r.phase == "loading" for r in evaluation.records)
+    assert found < 18
+    assert missed_holds(plan, evaluation).startswith(f"warning: found {found} of the "
+                                                     "schedule's 18 holds")
+    assert missed_holds(plan, evaluate_paths([REPO / "bags" / "paper_experiment"],
+                                             scene_options(plan))) == ""

@@ -9,6 +9,7 @@ import pytest
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.align import nearest_within
+from tdcm_ros.metrics.evaluation import evaluate_series
 from tdcm_ros.metrics.geometry import (
     MarkerLayout,
     deflection,
@@ -16,6 +17,8 @@ from tdcm_ros.metrics.geometry import (
     station_distance,
 )
 from tdcm_ros.metrics.lookup import MarkerTable
+from tdcm_ros.metrics.options import EvaluateOptions, options_from_sets
+from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.table import table_metrics
 from tdcm_ros.model import preset, solve, surface_points
 
@@ -126,3 +129,45 @@ def test_layout_validation() -> None:
         MarkerLayout(arc_lengths=(0.03, 0.02, 0.05))
     with pytest.raises(InputError, match="labels"):
         MarkerLayout(labels=("a", "a", "b"))
+
+
+def test_midline_markers_evaluate_with_a_zero_radial_offset() -> None:
+    """Virtual markers on the midline: evaluated as such (``markers.radial_offset=0``) only the
+    marker noise is left; evaluated as surface markers, the offset turning with the body shows
+    as a tip error of a few tenths of a millimetre."""
+    midline = MarkerLayout(radial_offset=0.0)
+    rec = simulate(DESIGN, layout=midline, levels=(0.0, 10.0, 20.0), hold_s=2.0, trials=1,
+                   tension_hz=250.0, mocap_hz=50.0, seed=3)
+    right = evaluate_series(rec.tension, rec.markers, EvaluateOptions(design=DESIGN,
+                                                                      layout=midline),
+                            rec.registration)
+    wrong = evaluate_series(rec.tension, rec.markers, EvaluateOptions(design=DESIGN),
+                            rec.registration)
+    assert right.metrics.rmse_m < 2e-5
+    assert wrong.metrics.rmse_m > 1e-4
+    assert options_from_sets(["markers.radial_offset=0"]).layout == midline
+
+
+def test_hysteresis_pairs_an_unloading_step_with_the_loading_one_at_its_level() -> None:
+    """Markers held 0.5 mm further off during the unloading 8 N hold (as friction would):
+    that step's hysteresis is 0.5 mm; loading steps and the final 0 N (paired with the first)
+    follow the data."""
+    rec = simulate(DESIGN, levels=(0.0, 8.0, 16.0, 8.0), hold_s=2.0, trials=1,
+                   tension_hz=250.0, mocap_hz=50.0, seed=4)
+    opts = EvaluateOptions(design=DESIGN)
+    plain = evaluate_series(rec.tension, rec.markers, opts, rec.registration)
+    tip_x = plain.records[2].measured_markers[-1, 0]  # the 16 N hold: the side it bends to
+    shift = np.array([0.5e-3 * np.sign(tip_x), 0.0, 0.0])
+    unloading = (rec.markers.stamps_s >= 6.0) & (rec.markers.stamps_s < 8.0)
+    positions = rec.markers.positions.copy()
+    positions[unloading] += rec.registration.to_mocap(shift) - rec.registration.to_mocap(
+        np.zeros(3))
+    frames = type(rec.markers).of(rec.markers.stamps_s, rec.markers.labels, positions)
+    ev = evaluate_series(rec.tension, frames, opts, rec.registration)
+    assert [r.phase for r in ev.records] == ["loading"] * 3 + ["unloading"] * 2
+    hysteresis = ev.hysteresis_m()
+    assert hysteresis[:3] == [None, None, None]
+    assert hysteresis[3] == pytest.approx(0.5e-3, abs=3e-5)
+    assert hysteresis[4] == pytest.approx(0.0, abs=3e-5)  # back at 0 N: no offset left
+    assert ev.unloading is not None and ev.unloading.n_steps == 2
+    assert [s["hysteresis_m"] for s in ev.to_json()["steps"]] == hysteresis

@@ -36,9 +36,12 @@ def test_json_has_the_issue_keys_and_small_errors(bag: Path,
     code, doc = run_json(capsys, str(bag), "--set", f"E={TRUE_E}")
     assert code == 0
     assert ISSUE_KEYS <= set(doc)
-    assert doc["n_trials"] == 2 and doc["n_steps"] == 7  # 0, 8, 16 twice and the final 0
-    assert {"trial", "tension", "measured", "predicted"} <= set(doc["steps"][0])
+    # Table I: 0, 8, 16 twice (loading); the final return to 0 is trial 2's unloading
+    assert doc["n_trials"] == 2 and doc["n_steps"] == 6
+    assert {"trial", "phase", "tension", "measured", "predicted"} <= set(doc["steps"][0])
     assert [s["trial"] for s in doc["steps"]] == [1, 1, 1, 2, 2, 2, 2]
+    assert [s["phase"] for s in doc["steps"]] == ["loading"] * 6 + ["unloading"]
+    assert doc["unloading"]["n_steps"] == 1 and doc["unloading"]["mae_m"] < 2e-5
     # model = truth: only the 0.05 mm marker noise (averaged over ~100 frames) is left
     assert doc["mae_m"] < 2e-5 and doc["rmse_m"] < 2e-5
     assert doc["mape_pct"] < 0.5
@@ -73,14 +76,16 @@ def test_text_report_and_plots(bag: Path, tmp_path: Path,
     assert main(["evaluate", str(bag), "--set", f"E={TRUE_E}", "--plots",
                  str(tmp_path / "p")]) == 0
     out = capsys.readouterr().out
-    assert "Table I over 2 trials, 7 steps" in out and "from /tf_static" in out
+    assert "Table I over 2 trials, 6 loading steps" in out and "from /tf_static" in out
+    assert "Unloading steps (not in Table I; hysteresis): 1 steps" in out
+    assert "measured unloading - loading deflection at the same level" in out
     assert (tmp_path / "p" / "shapes.png").stat().st_size > 1000
     assert (tmp_path / "p" / "error_vs_tension.png").stat().st_size > 1000
 
 
 def test_two_bags_number_trials_on(bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, doc = run_json(capsys, str(bag), str(bag), "--set", f"E={TRUE_E}")
-    assert code == 0 and doc["n_trials"] == 4 and doc["n_steps"] == 14
+    assert code == 0 and doc["n_trials"] == 4 and doc["n_steps"] == 12  # unloading: 2
 
 
 def _error(capsys: pytest.CaptureFixture[str], *args: str) -> str:

@@ -8,7 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.metrics.steps import StepSettings, detect_steps
+from tdcm_ros.metrics.steps import (
+    StepSettings,
+    assign_phases,
+    detect_steps,
+    settings_for_hold,
+)
 from tdcm_ros.metrics.synthetic import staircase
 
 
@@ -65,3 +70,34 @@ def test_settings_are_validated() -> None:
                 {"despike_samples": 0}, {"settle_s": float("inf")}):
         with pytest.raises(InputError, match="steps."):
             StepSettings(**bad)
+
+
+def test_the_return_to_zero_after_the_last_trial_is_its_unloading_step() -> None:
+    """3 trials of the paper's 6 levels: 18 loading steps; the final 0 N hold unloads."""
+    t, x = staircase([0.0, 4.0, 8.0, 12.0, 16.0, 20.0], hold_s=2.5, trials=3, rate_hz=200.0)
+    steps = detect_steps(t, x)
+    assert [s.phase for s in steps] == ["loading"] * 18 + ["unloading"]
+    assert (steps[-1].trial, round(steps[-1].median_n)) == (2, 0)
+
+
+def test_a_descending_staircase_unloads_and_a_zero_hold_between_trials_loads() -> None:
+    t, x = staircase([0.0, 8.0, 16.0, 8.0], hold_s=2.5, trials=2, rate_hz=200.0)
+    steps = detect_steps(t, x)
+    assert [(s.trial, round(s.median_n), s.phase) for s in steps] == [
+        (0, 0, "loading"), (0, 8, "loading"), (0, 16, "loading"), (0, 8, "unloading"),
+        (1, 0, "loading"), (1, 8, "loading"), (1, 16, "loading"), (1, 8, "unloading"),
+        (1, 0, "unloading")]
+
+
+def test_phases_follow_the_direction_within_a_trial() -> None:
+    assert assign_phases([0.0, 4.0, 4.1, 2.0, 1.9, 6.0, 0.0], [0, 0, 0, 0, 0, 0, 1], 0.3) == [
+        "loading", "loading", "loading", "unloading", "unloading", "loading", "loading"]
+
+
+def test_settings_for_a_hold_shrink_only_below_the_defaults() -> None:
+    short = settings_for_hold(1.0)
+    assert (short.settle_s, short.min_hold_s) == pytest.approx((0.1, 0.2))
+    assert settings_for_hold(10.0) == StepSettings()
+    t, x = staircase([0.0, 4.0, 8.0, 12.0], hold_s=1.0, trials=1, rate_hz=500.0, lag_s=0.05)
+    assert len(detect_steps(t, x)) < 4
+    assert [round(s.median_n) for s in detect_steps(t, x, short)] == [0, 4, 8, 12, 0]

@@ -14,7 +14,7 @@ from tdcm_ros.metrics.evaluation import evaluate_series
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.synthetic import Recording, simulate
-from tdcm_ros.model import preset
+from tdcm_ros.model import MarkerLayout, preset
 from tdcm_ros.nodes.metrics_node import MetricsNode
 from tdcm_ros.runtime.memory_port import MemoryPort
 
@@ -146,3 +146,22 @@ def test_bad_parameters_are_rejected(name: str, value: Any, match: str) -> None:
         overrides["registration.source"] = "parameter"
     with pytest.raises(InputError, match=match):
         MetricsNode(metrics_port(overrides))
+
+
+def test_node_maps_other_labels_and_midline_markers() -> None:
+    """A lab's Vicon names and virtual midline markers: ``markers.labels`` and
+    ``markers.radial_offset`` (default: on the surface, R_outer + ball radius)."""
+    assert MetricsNode(metrics_port()).options.layout.radius(DESIGN.R_outer) == pytest.approx(
+        DESIGN.R_outer + 0.001)
+    labels = ("tdcm:M15", "tdcm:M33", "tdcm:M53")
+    rec = simulate(DESIGN, layout=MarkerLayout(labels=labels, radial_offset=0.0),
+                   levels=(0.0, 6.0, 12.0), hold_s=2.5, trials=1, tension_hz=200.0,
+                   mocap_hz=50.0, seed=6)
+    port = metrics_port({"markers.labels": list(labels), "markers.radial_offset": 0.0,
+                         "registration.source": "parameter",
+                         "registration.translation": list(rec.registration.translation),
+                         "registration.rotation": list(rec.registration.quaternion)})
+    node = MetricsNode(port)
+    feed(port, node, rec)
+    table = json.loads(port.published["metrics/table"][-1].data)
+    assert table["n_steps"] == 3 and table["rmse_m"] < 2e-5

@@ -24,6 +24,7 @@ DERIVED: dict[str, tuple[Spec, dict[str, Any]]] = {
     "markers.arc_lengths_m": (MARKER_SPECS["arc_lengths"], {}),
     "markers.ball_radius_m": (MARKER_SPECS["ball_radius"], {}),
     "markers.side_deg": (MARKER_SPECS["side_deg"], {}),
+    "markers.radial_offset_m": (MARKER_SPECS["radial_offset"], {}),
     "effects.actuator_dynamics.lag_s": (PLANT_SPECS["lag"], {"high": 10.0}),
     "effects.actuator_dynamics.rate_m_per_s": (PLANT_SPECS["rate"], {"high": 10.0}),
     "effects.actuator_dynamics.deadband_m": (PLANT_SPECS["deadband"], {"high": 0.01}),

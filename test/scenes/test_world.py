@@ -191,3 +191,15 @@ def test_near_singular_schedule_solves_and_is_near_the_limit() -> None:
     assert top.converged and abs(top.tip_angle_rad) > 2.5  # curled past ~145 degrees
     with pytest.raises(PhysicsError):
         scene.without("tendon_friction").world().solve(19.0)
+
+
+def test_midline_markers_of_a_scene_sit_on_the_midline() -> None:
+    """``markers.radial_offset_m: 0``: the simulated mocap sees the midline points (virtual
+    markers, as a fitted spline gives them), not the surface."""
+    scene = make_scene(markers={"radial_offset_m": 0.0})
+    assert scene.marker_radius == 0.0
+    assert make_scene().marker_radius == pytest.approx(scene.design.R_outer + 0.001)
+    midline, _ = solve(scene.design, 12.0).pose_at(np.asarray(scene.marker_arc_lengths))
+    translation, quaternion = scene.mocap_pose
+    mocap = Rotation.from_quat(quaternion).apply(midline) + translation
+    assert np.max(np.abs(scene.world().markers(1.0, 12.0).positions - mocap)) <= 1e-12
