@@ -261,7 +261,7 @@ def test_strict_false_never_returns_nan(monkeypatch):
         p[:] = np.nan
         theta[:] = np.nan
 
-    monkeypatch.setitem(compiled._state, "build", kernel)  # the plain build, poisoned below
+    monkeypatch.setitem(compiled._state, "build", compiled.PLAIN)  # poisoned below
     monkeypatch.setattr(kernel, "integrate_row", poisoned)
     with pytest.raises(ConvergenceError, match="no finite iterate") as info:
         solve(preset("paper-experiment"), 20.0, strict=False)
