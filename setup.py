@@ -6,6 +6,12 @@ from pathlib import Path
 from setuptools import find_packages, setup
 
 PACKAGE = "tdcm_ros"
+#: The embedded runtime's Zenoh: from 1.5.0, the first Python release with the advanced publisher and
+#: subscriber (transient local, as rmw_zenoh does it), to 1.8.x, what Jazzy's rmw_zenoh 0.2.6-0.2.10
+#: vendor (1.5.0-1.8.0). 1.9.0 and 1.10.x fail the TLS/authentication test; 1.8.0 has no wheel on the
+#: registry (its source build needs Rust). CI runs the highest allowed and, in a throwaway venv, the
+#: lowest (.ci/zenoh_lowest.sh). Keep .ci/ros.sh and .ci/test.sh in step (test/test_dependencies.py).
+ZENOH_REQUIREMENT = "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9"
 
 setup(
     name=PACKAGE,
@@ -32,8 +38,11 @@ setup(
         "mcap>=1.1",
         "PyYAML>=6",
         "pyserial>=3.5",
-        "eclipse-zenoh==1.6.2",
         "xxhash>=3.0",
+        # the bag reader decompresses MCAP chunks itself (tdcm_ros/bagio/reader.py)
+        "lz4>=4",
+        "zstandard>=0.19",
+        ZENOH_REQUIREMENT,
     ],
     extras_require={
         "plot": ["matplotlib>=3.7"],
