@@ -1,17 +1,17 @@
 """Launch files parse, and every executable they name is a console script of the package."""
 
 import ast
-import re
 from pathlib import Path
 
 import yaml
+from setup_info import console_scripts as installed_scripts
 
 REPO = Path(__file__).resolve().parents[1]
 
 
 def console_scripts() -> set[str]:
-    text = (REPO / "setup.py").read_text()
-    return set(re.findall(r'"(\w+) = tdcm_ros[\w.]*:\w+"', text))
+    """What a colcon install puts into lib/tdcm_ros, where ``ros2 launch`` finds executables."""
+    return set(installed_scripts("install"))
 
 
 def test_launch_files_parse_and_name_existing_executables():
