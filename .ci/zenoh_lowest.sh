@@ -3,7 +3,7 @@
 # .ci/test.sh, has the highest). A throwaway virtual environment on top of this Python's packages
 # gets only eclipse-zenoh at the lower bound; a small interop subset runs in it: the wire format
 # (attachment), nodes in separate processes (messages, parameters, transient local to a late
-# joiner, a restarted publisher), TLS + authentication + ACL. ~30 s.
+# joiner, a restarted publisher), TLS + authentication + ACL, and the TF broadcasts. ~1 min.
 #
 #   bash .ci/zenoh_lowest.sh
 set -euo pipefail
@@ -25,4 +25,4 @@ GOT="$("$VENV/bin/python" -c 'from importlib.metadata import version; print(vers
 echo "=== interop subset on eclipse-zenoh $GOT (allowed: $REQUIREMENT)"
 PYTHONPATH="$PWD" "$VENV/bin/python" -m pytest -q -p no:cacheprovider -m "not rclpy" \
   test/runtime/test_runtime_wire.py test/runtime/test_runtime_multiprocess.py \
-  test/runtime/test_zenoh_security.py
+  test/runtime/test_zenoh_security.py test/nodes/test_tf_broadcasts.py
