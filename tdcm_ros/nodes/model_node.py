@@ -101,6 +101,20 @@ PARAMETERS = {**grouped(FIXED_SPECS), **grouped(TF_SPECS), **grouped(FIELD_SPECS
               **grouped(SOLVER_SPECS, "solver."), **grouped(TUNABLE_SPECS)}
 
 
+def _check_frame_names(names: Mapping[str, Any]) -> None:
+    """tf2's rule for frame ids: not empty, no leading ``/``; the two children must differ."""
+    for key in ("tf.tip_frame_id", "tf.tendon_frame_id", "tf.station_prefix"):
+        value = str(names[key])
+        if not value or value.startswith("/"):
+            raise InputError(f"{key} = {value!r} is not a tf2 frame id; allowed: a non-empty "
+                             f"name without a leading '/'", parameter=key, value=value,
+                             allowed="non-empty, no leading '/'")
+    if names["tf.tip_frame_id"] == names["tf.tendon_frame_id"]:
+        raise InputError(f"tf.tip_frame_id = tf.tendon_frame_id = {names['tf.tip_frame_id']!r}; "
+                         "allowed: two different frames", parameter="tf.tip_frame_id",
+                         value=names["tf.tip_frame_id"], allowed="differs from tf.tendon_frame_id")
+
+
 class ModelNode(NodeLogic):
     """Predicts the midline for each new tension; see the module docstring."""
 
@@ -110,6 +124,7 @@ class ModelNode(NodeLogic):
         super().__init__(port)
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
         self.tf_names = declare_specs(port, TF_SPECS, read_only=True)
+        _check_frame_names(self.tf_names)
         self.tension_type = str(fixed["input.tension_type"])
         base = preset(str(fixed["design.preset"]))
         declare_specs(port, FIELD_SPECS, prefix="design.", defaults=base.to_dict())

@@ -11,9 +11,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 import yaml
 
 from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
 from tdcm_ros.model import preset, solve
 from tdcm_ros.nodes import device_twin, mocap_node, tension_driver
 from tdcm_ros.nodes.metrics_node import BASE_FRAME
@@ -147,3 +149,15 @@ def test_every_frame_a_node_stamps_is_in_one_tf_tree() -> None:
     assert {"tdcm_base", "tdcm_tendon", "tdcm_tip", "mocap"} <= stamped | set(parents)
     roots = {frame: _root(frame, parents) for frame in stamped | set(parents)}
     assert set(roots.values()) == {"mocap"}, roots
+
+
+@pytest.mark.parametrize(("overrides", "name"), [
+    ({"tf.tip_frame_id": ""}, "tf.tip_frame_id"),
+    ({"tf.tendon_frame_id": "/tdcm_tendon"}, "tf.tendon_frame_id"),
+    ({"tf.tip_frame_id": "tdcm_tendon"}, "tf.tip_frame_id"),
+    ({"tf.stations": -1}, "tf.stations"),
+])
+def test_bad_frame_parameters_are_typed_errors_naming_the_parameter(overrides, name) -> None:
+    with pytest.raises(InputError) as caught:
+        ModelNode(MemoryPort(overrides, name="model_node"))
+    assert caught.value.parameter == name and name in str(caught.value)
