@@ -10,7 +10,7 @@ with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (na
 TF (``tf2_msgs/msg/TFMessage``, see :mod:`tdcm_ros.nodes.tf_messages`): on ``/tf_static``
 (transient local, depth 1, as tf2's StaticTransformBroadcaster) ``frame_id -> tf.tendon_frame_id``,
 the frame ``tension`` is stamped in, sent at start and again when ``frame_id`` or the design
-changes; on ``/tf`` (depth 100, as tf2's TransformBroadcaster) ``frame_id -> tf.tip_frame_id``
+changes (``tf.tendon: false`` leaves it to a URDF or another node); on ``/tf`` (depth 100, as tf2's TransformBroadcaster) ``frame_id -> tf.tip_frame_id``
 for every solve, stamped with the input's stamp, plus ``tf.stations`` midline frames.
 
 Keep-latest: the subscription only stores the newest valid tension; a timer solves it, warm
@@ -90,6 +90,8 @@ TF_SPECS = by_name(
          default="tdcm_tip", kind="str"),
     Spec("tf.tendon_frame_id", description="child frame of the static tendon transform "
          "(tension_driver's frame_id)", default="tdcm_tendon", kind="str"),
+    Spec("tf.tendon", description="broadcast the static tendon transform (off where a URDF "
+         "or another node does)", default=True, kind="bool"),
     Spec("tf.stations", description="midline frames on /tf at s = k L / n, k = 1..n; 0 = none",
          default=0, kind="int", low=0, high=1000),
     Spec("tf.station_prefix", description="station frame k is <prefix><k>",
@@ -180,7 +182,10 @@ class ModelNode(NodeLogic):
         self._publish_tendon_tf(str(changes.get("frame_id", self.port.get_parameter("frame_id"))))
 
     def _publish_tendon_tf(self, frame_id: str) -> None:
-        """Send the static ``frame_id -> tf.tendon_frame_id`` transform of the current design."""
+        """Send the static ``frame_id -> tf.tendon_frame_id`` transform of the current design
+        (unless ``tf.tendon`` is off)."""
+        if not self.tf_names["tf.tendon"]:
+            return
         self.tf_static.publish(tendon_tf(self.design, stamp_ns=self.port.now_ns(), parent=frame_id,
                                          child=str(self.tf_names["tf.tendon_frame_id"])))
 

@@ -161,3 +161,8 @@ def test_bad_frame_parameters_are_typed_errors_naming_the_parameter(overrides, n
     with pytest.raises(InputError) as caught:
         ModelNode(MemoryPort(overrides, name="model_node"))
     assert caught.value.parameter == name and name in str(caught.value)
+
+
+def test_the_tendon_broadcast_can_be_left_to_another_node() -> None:
+    port = _model_port(**{"tf.tendon": False})
+    assert not port.messages("/tf_static") and port.messages("/tf")
