@@ -1,11 +1,38 @@
 """ament_python package setup; also a plain ``pip install`` on machines without ROS."""
 
+import sys
 from glob import glob
 from pathlib import Path
 
 from setuptools import find_packages, setup
 
 PACKAGE = "tdcm_ros"
+#: The embedded runtime's Zenoh: from 1.5.0, the first Python release with the advanced publisher and
+#: subscriber (transient local, as rmw_zenoh does it), to 1.8.x, what Jazzy's rmw_zenoh 0.2.6-0.2.10
+#: vendor (1.5.0-1.8.0). 1.9.0 and 1.10.x fail the TLS/authentication test; 1.8.0 has no wheel on the
+#: registry (its source build needs Rust). CI runs the highest allowed and, in a throwaway venv, the
+#: lowest (.ci/zenoh_lowest.sh). Keep .ci/ros.sh and .ci/test.sh in step (test/test_dependencies.py).
+ZENOH_REQUIREMENT = "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9"
+
+#: The nodes, as ``ros2 run tdcm_ros <name>`` starts them.
+NODES = {
+    "model_node": "tdcm_ros.nodes.model_node:main",
+    "metrics_node": "tdcm_ros.nodes.metrics_node:main",
+    "mocap_node": "tdcm_ros.nodes.mocap_node:main",
+    "tension_driver": "tdcm_ros.nodes.tension_driver:main",
+    "device_twin": "tdcm_ros.nodes.device_twin:main",
+}
+#: Console scripts every install gets: prefixed, so a pip install puts no generic name on PATH.
+SCRIPTS = {
+    "tdcm": "tdcm_ros.cli.main:main",
+    "tdcm_node": "tdcm_ros.runtime.run_node:main",
+    "tdcm_talker": "tdcm_ros.nodes.talker:main",
+    **{f"tdcm_{name}": target for name, target in NODES.items()},
+}
+#: colcon (ament_python) installs with ``setup.py install`` or ``develop``, which setup.cfg points at
+#: lib/tdcm_ros, where ``ros2 run`` looks and which is not on PATH: only there the nodes also get
+#: their ROS names. pip builds a wheel (bdist_wheel, editable_wheel), whose scripts land on PATH.
+ROS_INSTALL = bool({"install", "develop"} & set(sys.argv[1:]))
 
 setup(
     name=PACKAGE,
@@ -32,8 +59,11 @@ setup(
         "mcap>=1.1",
         "PyYAML>=6",
         "pyserial>=3.5",
-        "eclipse-zenoh==1.6.2",
         "xxhash>=3.0",
+        # the bag reader decompresses MCAP chunks itself (tdcm_ros/bagio/reader.py)
+        "lz4>=4",
+        "zstandard>=0.19",
+        ZENOH_REQUIREMENT,
     ],
     extras_require={
         "plot": ["matplotlib>=3.7"],
@@ -49,15 +79,7 @@ setup(
     license="Apache-2.0",
     tests_require=["pytest"],
     entry_points={
-        "console_scripts": [
-            "tdcm = tdcm_ros.cli.main:main",
-            "tdcm_node = tdcm_ros.runtime.run_node:main",
-            "tdcm_talker = tdcm_ros.nodes.talker:main",
-            "model_node = tdcm_ros.nodes.model_node:main",
-            "metrics_node = tdcm_ros.nodes.metrics_node:main",
-            "mocap_node = tdcm_ros.nodes.mocap_node:main",
-            "tension_driver = tdcm_ros.nodes.tension_driver:main",
-            "device_twin = tdcm_ros.nodes.device_twin:main",
-        ],
+        "console_scripts": [f"{name} = {target}" for name, target in
+                            {**SCRIPTS, **(NODES if ROS_INSTALL else {})}.items()],
     },
 )

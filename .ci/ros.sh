@@ -49,11 +49,14 @@ ROS_PACKAGES=(
 )
 # The package's own dependencies (setup.py install_requires, plot and test extras). tdcm_ros itself
 # is NOT installed with pip: it must come from the colcon install space.
-PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "eclipse-zenoh==1.6.2" "xxhash>=3.0"
-                  matplotlib pytest hypothesis)
+PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "xxhash>=3.0"
+                  "lz4>=4" "zstandard>=0.19" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest hypothesis)
 # Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
 VENV_RECIPE_VERSION=2
-EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin tdcm_node)
+# What `ros2 run tdcm_ros <exe>` starts: the nodes' ROS names (colcon only, see setup.py) and the
+# prefixed names a pip install puts on PATH.
+EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin tdcm_node
+             tdcm_model_node tdcm_metrics_node tdcm_mocap_node tdcm_tension_driver tdcm_device_twin)
 
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }

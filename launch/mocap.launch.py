@@ -1,23 +1,37 @@
-"""ROS 2 launch: the mocap node with the package's parameter file.
+"""ROS 2 launch: the mocap node, relabelling the live motion-capture driver's markers by default.
 
-``ros2 launch tdcm_ros mocap.launch.py [params_file:=/path/to/params.yaml] [namespace:=/tdcm]``
+``ros2 launch tdcm_ros mocap.launch.py [source:=relabel|csv|sim] [driver_markers:=/vicon/markers]
+[params_file:=/path/to/params.yaml] [namespace:=/tdcm]``
+
+A real bench is the default (``source:=relabel``: the driver's ``mocap4r2_msgs/Markers`` in,
+labelled ``markers`` out); a simulated bench is asked for explicitly with ``source:=sim`` (a CSV
+replay with ``source:=csv``). ``source`` overrides the parameter file. The node's input
+``/vicon/markers`` (``relabel.input_topic``) is remapped to ``driver_markers``, e.g.
+``driver_markers:=/markers`` for MOCAP4ROS2's Vicon driver (then give this node a ``namespace``
+so that its own ``markers`` output does not land on ``/markers`` too).
 """
 
-import os
-
-from ament_index_python.packages import get_package_share_directory
 from launch.actions import DeclareLaunchArgument
-from launch.substitutions import LaunchConfiguration
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
 
 from launch import LaunchDescription
 
+#: mocap_node's ``source`` values; the first is the default here.
+SOURCES = ["relabel", "csv", "sim"]
+
 
 def generate_launch_description() -> LaunchDescription:
-    """The mocap node, parameters from ``params_file``, in ``namespace``."""
-    default_params = os.path.join(get_package_share_directory("tdcm_ros"), "config",
-                                  "mocap_node.yaml")
+    """The mocap node with ``source`` over ``params_file``, in ``namespace``."""
+    default_params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
+                                           "mocap_node.yaml"])
     return LaunchDescription([
+        DeclareLaunchArgument("source", default_value=SOURCES[0], choices=SOURCES,
+                              description="relabel: the live driver's markers (real bench); "
+                                          "csv: a Nexus CSV replay; sim: simulated markers"),
+        DeclareLaunchArgument("driver_markers", default_value="/vicon/markers",
+                              description="the live driver's Markers topic (source relabel)"),
         DeclareLaunchArgument("params_file", default_value=default_params,
                               description="ROS 2 parameter YAML for mocap_node"),
         DeclareLaunchArgument("namespace", default_value="",
@@ -25,5 +39,8 @@ def generate_launch_description() -> LaunchDescription:
                                           "apart from this node's output)"),
         Node(package="tdcm_ros", executable="mocap_node", name="mocap_node",
              namespace=LaunchConfiguration("namespace"),
-             parameters=[LaunchConfiguration("params_file")], output="screen"),
+             parameters=[LaunchConfiguration("params_file"),
+                         {"source": LaunchConfiguration("source")}],
+             remappings=[("/vicon/markers", LaunchConfiguration("driver_markers"))],
+             output="screen"),
     ])

@@ -1,26 +1,28 @@
 """ROS 2 launch: the model node with the package's parameter file.
 
-``ros2 launch tdcm_ros model.launch.py [params_file:=/path/to/params.yaml]``
+``ros2 launch tdcm_ros model.launch.py [params_file:=/path/to/params.yaml] [tension:=/bench/tension]``
+
+``tension`` remaps the node's input (a relative name, ``tension`` by default) to another topic.
 """
 
-import os
-
-from ament_index_python.packages import get_package_share_directory
 from launch.actions import DeclareLaunchArgument
-from launch.substitutions import LaunchConfiguration
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
 
 from launch import LaunchDescription
 
 
 def generate_launch_description() -> LaunchDescription:
-    """The model node, parameters from ``params_file``."""
-    default_params = os.path.join(get_package_share_directory("tdcm_ros"), "config",
-                                  "model_node.yaml")
-    params = LaunchConfiguration("params_file")
+    """The model node, parameters from ``params_file``, input remapped to ``tension``."""
+    default_params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
+                                           "model_node.yaml"])
     return LaunchDescription([
         DeclareLaunchArgument("params_file", default_value=default_params,
                               description="ROS 2 parameter YAML for model_node"),
+        DeclareLaunchArgument("tension", default_value="tension",
+                              description="topic of the tendon tension (WrenchStamped)"),
         Node(package="tdcm_ros", executable="model_node", name="model_node",
-             parameters=[params], output="screen"),
+             parameters=[LaunchConfiguration("params_file")],
+             remappings=[("tension", LaunchConfiguration("tension"))], output="screen"),
     ])

@@ -8,27 +8,25 @@ use ``tdcm up --twin`` (embedded runtime) or run the ``device_twin`` node and po
 its link.
 """
 
-import os
-
-from ament_index_python.packages import get_package_share_directory
 from launch.actions import DeclareLaunchArgument
-from launch.substitutions import LaunchConfiguration
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
 
 from launch import LaunchDescription
 
 
 def generate_launch_description() -> LaunchDescription:
     """tension_driver (``port`` overrides the file) and model_node."""
-    config = os.path.join(get_package_share_directory("tdcm_ros"), "config")
+    config = [FindPackageShare("tdcm_ros"), "config"]
     return LaunchDescription([
         DeclareLaunchArgument("port", default_value="/dev/ttyACM0",
                               description="serial device, pty path or pyserial URL"),
         DeclareLaunchArgument("params_file",
-                              default_value=os.path.join(config, "tension_driver.yaml"),
+                              default_value=PathJoinSubstitution([*config, "tension_driver.yaml"]),
                               description="ROS 2 parameter YAML for tension_driver"),
         DeclareLaunchArgument("model_params_file",
-                              default_value=os.path.join(config, "model_node.yaml"),
+                              default_value=PathJoinSubstitution([*config, "model_node.yaml"]),
                               description="ROS 2 parameter YAML for model_node"),
         Node(package="tdcm_ros", executable="tension_driver", name="tension_driver",
              parameters=[LaunchConfiguration("params_file"),

@@ -1,17 +1,20 @@
 """Launch files parse, and every executable they name is a console script of the package."""
 
 import ast
-import re
 from pathlib import Path
+from typing import Any
 
+import launch_fakes
+import pytest
 import yaml
+from setup_info import console_scripts as installed_scripts
 
 REPO = Path(__file__).resolve().parents[1]
 
 
 def console_scripts() -> set[str]:
-    text = (REPO / "setup.py").read_text()
-    return set(re.findall(r'"(\w+) = tdcm_ros[\w.]*:\w+"', text))
+    """What a colcon install puts into lib/tdcm_ros, where ``ros2 launch`` finds executables."""
+    return set(installed_scripts("install"))
 
 
 def test_launch_files_parse_and_name_existing_executables():
@@ -38,3 +41,82 @@ def test_config_files_are_ros_parameter_yaml_and_load_for_the_embedded_runtime()
             assert "ros__parameters" in body, (path, node)
             values = node_parameters(str(path), f"/{node}")
             assert values, (path, node)
+
+
+# -- the launch files run on stand-ins of launch/launch_ros (test/launch_fakes.py) -------------
+
+def _effective_parameters(node: launch_fakes.Node, arguments: dict[str, str]) -> dict[str, Any]:
+    """What the node starts with: its parameter files (``ros__parameters`` of ``/<name>``), then
+    the inline dicts, later entries winning, as launch_ros passes them."""
+    from tdcm_ros.runtime.params import node_parameters
+
+    values: dict[str, Any] = {}
+    for entry in launch_fakes.resolve(node.parameters, arguments):
+        if isinstance(entry, dict):
+            values.update(entry)
+        else:
+            assert Path(entry).is_file(), entry
+            values.update(node_parameters(entry, f"/{node.name}"))
+    return values
+
+
+def _node(path: Path, executable: str) -> launch_fakes.Node:
+    (node,) = [n for n in launch_fakes.nodes(launch_fakes.load(path)) if n.executable == executable]
+    return node
+
+
+def _mocap_source(path: Path, **given: str) -> str:
+    description = launch_fakes.load(path)
+    arguments = launch_fakes.launch_arguments(description, given)
+    (node,) = [n for n in launch_fakes.nodes(description) if n.executable == "mocap_node"]
+    return str(_effective_parameters(node, arguments)["source"])
+
+
+@pytest.mark.parametrize("name", ["mocap.launch.py", "bench.launch.py"])
+def test_real_bench_launch_files_default_to_the_live_mocap_driver(name: str) -> None:
+    assert _mocap_source(REPO / "launch" / name) == "relabel"
+
+
+def test_simulated_markers_are_an_explicit_launch_argument() -> None:
+    path = REPO / "launch" / "mocap.launch.py"
+    assert _mocap_source(path, source="sim") == "sim"
+    assert _mocap_source(path, source="csv") == "csv"
+    with pytest.raises(ValueError, match="source"):
+        _mocap_source(path, source="simulated")
+
+
+def test_the_driver_topic_is_remapped_onto_the_relabel_input() -> None:
+    path = REPO / "launch" / "mocap.launch.py"
+    description = launch_fakes.load(path)
+    node = _node(path, "mocap_node")
+    arguments = launch_fakes.launch_arguments(description, {"driver_markers": "/markers"})
+    remaps = dict(launch_fakes.resolve(node.remappings, arguments))
+    input_topic = _effective_parameters(node, arguments)["relabel.input_topic"]
+    assert remaps[input_topic] == "/markers"
+
+
+@pytest.mark.parametrize("path", sorted((REPO / "launch").glob("*.launch.py")), ids=lambda p: p.name)
+def test_launch_files_find_configs_with_find_package_share_and_pass_valid_parameters(
+        path: Path) -> None:
+    from tdcm_ros.nodes import (
+        device_twin,
+        metrics_node,
+        mocap_node,
+        model_node,
+        tension_driver,
+    )
+
+    specs = {"model_node": model_node.PARAMETERS, "metrics_node": metrics_node.PARAMETERS,
+             "mocap_node": mocap_node.PARAMETERS, "tension_driver": tension_driver.PARAMETERS,
+             "device_twin": device_twin.PARAMETERS}
+    tree = ast.parse(path.read_text())
+    imported = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
+    assert "ament_index_python.packages" not in imported, "use FindPackageShare"
+    description = launch_fakes.load(path)
+    arguments = launch_fakes.launch_arguments(description, {})
+    for node in launch_fakes.nodes(description):
+        values = _effective_parameters(node, arguments)
+        assert values, node.name
+        for name, value in values.items():
+            assert name in specs[node.executable], (path.name, node.name, name)
+            specs[node.executable][name].check(value, name)

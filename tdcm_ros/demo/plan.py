@@ -55,7 +55,9 @@ class DemoPlan:
         if scene.marker_radial_offset is not None:
             live["markers.radial_offset"] = scene.marker_radial_offset
         return {
-            "model_node": {**design, **markers, "markers.radius": scene.marker_ball_radius},
+            # The bag's /tf_static carries only the registration the evaluation reads.
+            "model_node": {**design, **markers, "markers.radius": scene.marker_ball_radius,
+                           "tf.tendon": False},
             "mocap_node": {"source": "sim", "sim.scene": self.scene_ref,
                            "labelling.labels": list(scene.marker_labels),
                            "labelling.arc_lengths": [float(s) for s in scene.marker_arc_lengths]},

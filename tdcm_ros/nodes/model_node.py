@@ -7,6 +7,12 @@ with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (na
 ``midline_poses`` (PoseArray), ``tip_pose`` (PoseStamped), ``predicted_markers`` (PoseArray),
 ``body_markers`` (visualization_msgs/MarkerArray) and ``/diagnostics``.
 
+TF (``tf2_msgs/msg/TFMessage``, see :mod:`tdcm_ros.nodes.tf_messages`): on ``/tf_static``
+(transient local, depth 1, as tf2's StaticTransformBroadcaster) ``frame_id -> tf.tendon_frame_id``,
+the frame ``tension`` is stamped in, sent at start and again when ``frame_id`` or the design
+changes (``tf.tendon: false`` leaves it to a URDF or another node); on ``/tf`` (depth 100, as tf2's TransformBroadcaster) ``frame_id -> tf.tip_frame_id``
+for every solve, stamped with the input's stamp, plus ``tf.stations`` midline frames.
+
 Keep-latest: the subscription only stores the newest valid tension; a timer solves it, warm
 started from the previous shape, so a burst never builds a queue (skipped inputs are counted
 as coalesced). Bad inputs (non-finite, negative, above ``input.tension_max``, older than
@@ -40,6 +46,7 @@ from tdcm_ros.model import (
     warm_up,
 )
 from tdcm_ros.nodes.shape_messages import header, midline_messages
+from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
 from tdcm_ros.runtime import (
     NodeLogic,
     NodePort,
@@ -77,10 +84,37 @@ TUNABLE_SPECS = by_name(
     Spec("input.max_future_s", "s", "inputs stamped further ahead of the clock are dropped", 0.5,
          low=0.0, high=3600.0))
 
+#: TF frames, fixed at start (the parent is ``frame_id``).
+TF_SPECS = by_name(
+    Spec("tf.tip_frame_id", description="child frame of the tip transform on /tf",
+         default="tdcm_tip", kind="str"),
+    Spec("tf.tendon_frame_id", description="child frame of the static tendon transform "
+         "(tension_driver's frame_id)", default="tdcm_tendon", kind="str"),
+    Spec("tf.tendon", description="broadcast the static tendon transform (off where a URDF "
+         "or another node does)", default=True, kind="bool"),
+    Spec("tf.stations", description="midline frames on /tf at s = k L / n, k = 1..n; 0 = none",
+         default=0, kind="int", low=0, high=1000),
+    Spec("tf.station_prefix", description="station frame k is <prefix><k>",
+         default="tdcm_station_", kind="str"))
+
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(FIXED_SPECS), **grouped(FIELD_SPECS, "design."),
+PARAMETERS = {**grouped(FIXED_SPECS), **grouped(TF_SPECS), **grouped(FIELD_SPECS, "design."),
               **grouped(SOLVER_SPECS, "solver."), **grouped(TUNABLE_SPECS)}
+
+
+def _check_frame_names(names: Mapping[str, Any]) -> None:
+    """tf2's rule for frame ids: not empty, no leading ``/``; the two children must differ."""
+    for key in ("tf.tip_frame_id", "tf.tendon_frame_id", "tf.station_prefix"):
+        value = str(names[key])
+        if not value or value.startswith("/"):
+            raise InputError(f"{key} = {value!r} is not a tf2 frame id; allowed: a non-empty "
+                             f"name without a leading '/'", parameter=key, value=value,
+                             allowed="non-empty, no leading '/'")
+    if names["tf.tip_frame_id"] == names["tf.tendon_frame_id"]:
+        raise InputError(f"tf.tip_frame_id = tf.tendon_frame_id = {names['tf.tip_frame_id']!r}; "
+                         "allowed: two different frames", parameter="tf.tip_frame_id",
+                         value=names["tf.tip_frame_id"], allowed="differs from tf.tendon_frame_id")
 
 
 class ModelNode(NodeLogic):
@@ -91,6 +125,8 @@ class ModelNode(NodeLogic):
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
+        self.tf_names = declare_specs(port, TF_SPECS, read_only=True)
+        _check_frame_names(self.tf_names)
         self.tension_type = str(fixed["input.tension_type"])
         base = preset(str(fixed["design.preset"]))
         declare_specs(port, FIELD_SPECS, prefix="design.", defaults=base.to_dict())
@@ -111,6 +147,10 @@ class ModelNode(NodeLogic):
                                ("body_markers", "visualization_msgs/msg/MarkerArray"))}
         self.diagnostics = port.create_publisher("/diagnostics",
                                                  "diagnostic_msgs/msg/DiagnosticArray", qos)
+        self.tf_static = port.create_publisher("/tf_static", TF_TYPE,
+                                               QoS(depth=1, durability="transient_local"))
+        self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
+        self._publish_tendon_tf(str(port.get_parameter("frame_id")))
         # A deep queue so every input is seen (and counted); the callback only stores the newest.
         port.create_subscription("tension", self.tension_type, self._on_tension, QoS(depth=100))
         self.pending: tuple[float, int] | None = None
@@ -139,6 +179,15 @@ class ModelNode(NodeLogic):
         """Validate a runtime change as a whole; raising keeps the old values."""
         self.design, self.settings = self._config(changes)
         self.previous = None
+        self._publish_tendon_tf(str(changes.get("frame_id", self.port.get_parameter("frame_id"))))
+
+    def _publish_tendon_tf(self, frame_id: str) -> None:
+        """Send the static ``frame_id -> tf.tendon_frame_id`` transform of the current design
+        (unless ``tf.tendon`` is off)."""
+        if not self.tf_names["tf.tendon"]:
+            return
+        self.tf_static.publish(tendon_tf(self.design, stamp_ns=self.port.now_ns(), parent=frame_id,
+                                         child=str(self.tf_names["tf.tendon_frame_id"])))
 
     def _on_tension(self, message: Any) -> None:
         """Store a valid tension (N) with its stamp (ns); an unstamped ``Float64`` takes the
@@ -199,13 +248,18 @@ class ModelNode(NodeLogic):
         placement = self.port.get_parameter("markers.placement")
         radius = (self.design.R_outer + float(self.port.get_parameter("markers.radius"))
                   if placement == "surface" else 0.0)
+        frame_id = str(self.port.get_parameter("frame_id"))
         for topic, message in midline_messages(
-                result, stamp_ns=stamp_ns, frame_id=str(self.port.get_parameter("frame_id")),
+                result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),
                 marker_s=np.asarray(self.port.get_parameter("markers.arc_lengths"), dtype=float),
                 marker_radius=radius,
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg")))):
             self.publishers[topic].publish(message)  # midline first: sent before the rest is built
+        self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
+                                tip=str(self.tf_names["tf.tip_frame_id"]),
+                                station_prefix=str(self.tf_names["tf.station_prefix"]),
+                                stations=int(self.tf_names["tf.stations"])))
 
     def report(self) -> None:
         """Publish the cumulative counters on ``/diagnostics``; the level is WARN, with the last

@@ -1,0 +1,67 @@
+"""``tf2_msgs/msg/TFMessage`` builders (rosbags objects) for the model node's TF tree.
+
+The tree under ``base`` (``tdcm_base`` by default, REP 103, SI units; see README Frames):
+
+- ``base -> tendon`` (static): where the tendon leaves the base, ``R_c`` (m) from the midline on
+  +x, its z axis along the tendon toward the actuator (``-z`` of the base), x kept: a rotation by
+  pi about x. ``tension`` (``wrench.force.z``) is stamped in this frame.
+- ``base -> tip`` (dynamic): the midline's tip pose of the latest solve, z along the tangent.
+- ``base -> <station_prefix><k>`` (dynamic, optional): midline poses at ``s = k L / n``,
+  ``k = 1 .. n``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.bagio import msg_class
+from tdcm_ros.model import Design, SolveResult
+
+Array = NDArray[np.float64]
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+#: Rotation of the tendon frame in the base frame, (x, y, z, w): pi about x.
+TENDON_ROTATION = (1.0, 0.0, 0.0, 0.0)
+
+
+def _transforms(stamp_ns: int, parent: str, children: list[str], positions: Array,
+                quaternions: Array) -> Any:
+    """A ``TFMessage`` of ``parent -> children[i]`` at positions (k, 3) m and quaternions
+    (k, 4) ``(x, y, z, w)``, all stamped ``stamp_ns`` (ns since the epoch)."""
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    header = msg_class("std_msgs/msg/Header")(
+        stamp=msg_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec), frame_id=parent)
+    vector = msg_class("geometry_msgs/msg/Vector3")
+    quaternion = msg_class("geometry_msgs/msg/Quaternion")
+    transform = msg_class("geometry_msgs/msg/Transform")
+    stamped = msg_class("geometry_msgs/msg/TransformStamped")
+    return msg_class(TF_TYPE)(transforms=[
+        stamped(header=header, child_frame_id=child,
+                transform=transform(translation=vector(x=p[0], y=p[1], z=p[2]),
+                                    rotation=quaternion(x=q[0], y=q[1], z=q[2], w=q[3])))
+        for child, p, q in zip(children, positions.tolist(), quaternions.tolist(), strict=True)])
+
+
+def tendon_tf(design: Design, *, stamp_ns: int, parent: str, child: str) -> Any:
+    """The static ``parent -> child`` transform of the tendon frame (see the module docstring)."""
+    return _transforms(stamp_ns, parent, [child], np.array([[design.R_c, 0.0, 0.0]]),
+                       np.array([TENDON_ROTATION]))
+
+
+def station_lengths(length: float, stations: int) -> Array:
+    """Arc lengths (m) ``k L / n`` of ``n = stations`` frames along a body of ``length`` m."""
+    return np.linspace(length / max(stations, 1), length, stations)  # last one exactly L
+
+
+def body_tf(result: SolveResult, *, stamp_ns: int, parent: str, tip: str,
+            station_prefix: str, stations: int) -> Any:
+    """``parent -> tip`` and, for ``stations > 0``, ``parent -> <station_prefix><k>``."""
+    children = [tip]
+    positions, quaternions = result.tip_position[None, :], result.tip_quaternion[None, :]
+    if stations > 0:
+        at, turn = result.pose_at(station_lengths(result.design.length, stations))
+        children += [f"{station_prefix}{k}" for k in range(1, stations + 1)]
+        positions, quaternions = np.vstack([positions, at]), np.vstack([quaternions, turn])
+    return _transforms(stamp_ns, parent, children, positions, quaternions)

@@ -1,0 +1,137 @@
+"""Tiny stand-ins for ``launch`` and ``launch_ros`` (not installable here), to run launch files.
+
+Each class takes the keyword arguments of the real one it stands for (an unknown keyword is a
+``TypeError``, as in launch), records them, and :func:`resolve` evaluates the substitutions the
+package's launch files use. ``FindPackageShare("tdcm_ros")`` resolves to the source tree, whose
+``config/`` is what setup.py installs under ``share/tdcm_ros/config``.
+"""
+
+from __future__ import annotations
+
+import os
+import runpy
+import sys
+import types
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+from unittest import mock
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+class LaunchDescription:
+    def __init__(self, initial_entities: list[Any] | None = None) -> None:
+        self.entities = list(initial_entities or [])
+
+
+class DeclareLaunchArgument:
+    def __init__(self, name: str, *, default_value: Any = None, description: str | None = None,
+                 choices: list[str] | None = None) -> None:
+        self.name, self.default_value, self.choices = name, default_value, choices
+        self.description = description
+
+
+class LaunchConfiguration:
+    def __init__(self, variable_name: str, *, default: Any = None) -> None:
+        self.variable_name, self.default = variable_name, default
+
+
+class PathJoinSubstitution:
+    def __init__(self, substitutions: list[Any]) -> None:
+        self.substitutions = list(substitutions)
+
+
+class FindPackageShare:
+    def __init__(self, package: str) -> None:
+        self.package = package
+
+
+class Node:
+    def __init__(self, *, executable: str, package: str | None = None, name: str | None = None,
+                 namespace: Any = None, exec_name: str | None = None,
+                 parameters: list[Any] | None = None, remappings: list[Any] | None = None,
+                 ros_arguments: list[Any] | None = None, arguments: list[Any] | None = None,
+                 output: str = "log", **_other: Any) -> None:
+        self.executable, self.package, self.name, self.namespace = executable, package, name, namespace
+        self.parameters = list(parameters or [])
+        self.remappings = list(remappings or [])
+
+
+def _share(package: str) -> str:
+    if package != "tdcm_ros":
+        raise LookupError(f"package {package!r} not found")
+    return str(REPO)
+
+
+def resolve(value: Any, arguments: Mapping[str, str]) -> Any:
+    """The value of a substitution (or a plain value) under the launch ``arguments``."""
+    if isinstance(value, LaunchConfiguration):
+        return arguments[value.variable_name]
+    if isinstance(value, PathJoinSubstitution):
+        return os.path.join(*(str(resolve(part, arguments)) for part in value.substitutions))
+    if isinstance(value, FindPackageShare):
+        return _share(value.package)
+    if isinstance(value, (list, tuple)):
+        return type(value)(resolve(item, arguments) for item in value)
+    if isinstance(value, dict):
+        return {key: resolve(item, arguments) for key, item in value.items()}
+    return value
+
+
+def _modules() -> dict[str, types.ModuleType]:
+    def module(name: str, **members: Any) -> types.ModuleType:
+        made = types.ModuleType(name)
+        made.__dict__.update(members)
+        return made
+
+    return {
+        "launch": module("launch", LaunchDescription=LaunchDescription),
+        "launch.actions": module("launch.actions", DeclareLaunchArgument=DeclareLaunchArgument),
+        "launch.substitutions": module("launch.substitutions",
+                                       LaunchConfiguration=LaunchConfiguration,
+                                       PathJoinSubstitution=PathJoinSubstitution),
+        "launch_ros": module("launch_ros"),
+        "launch_ros.actions": module("launch_ros.actions", Node=Node),
+        "launch_ros.substitutions": module("launch_ros.substitutions",
+                                           FindPackageShare=FindPackageShare),
+        # the older style (os.path.join over the share directory) still loads, to be judged
+        "ament_index_python": module("ament_index_python"),
+        "ament_index_python.packages": module("ament_index_python.packages",
+                                              get_package_share_directory=_share),
+    }
+
+
+@contextmanager
+def fake_launch() -> Iterator[None]:
+    """``launch``, ``launch_ros`` and ``ament_index_python`` replaced by the stand-ins."""
+    with mock.patch.dict(sys.modules, _modules()):
+        yield
+
+
+def load(path: Path) -> LaunchDescription:
+    """Run ``path``'s ``generate_launch_description()`` on the stand-ins."""
+    with fake_launch():
+        return runpy.run_path(str(path))["generate_launch_description"]()
+
+
+def launch_arguments(description: LaunchDescription, given: Mapping[str, str]) -> dict[str, str]:
+    """Declared arguments with their defaults, overridden by ``given``; an undeclared or an
+    off-``choices`` argument raises as ``ros2 launch`` refuses it."""
+    declared = [e for e in description.entities if isinstance(e, DeclareLaunchArgument)]
+    names = {d.name for d in declared}
+    unknown = set(given) - names
+    if unknown:
+        raise KeyError(f"undeclared launch arguments {sorted(unknown)}")
+    values = {d.name: str(resolve(d.default_value, {})) for d in declared
+              if d.default_value is not None}
+    values.update(given)
+    for d in declared:
+        if d.choices is not None and values.get(d.name) not in d.choices:
+            raise ValueError(f"{d.name}:={values.get(d.name)} not in {d.choices}")
+    return values
+
+
+def nodes(description: LaunchDescription) -> list[Node]:
+    return [e for e in description.entities if isinstance(e, Node)]
