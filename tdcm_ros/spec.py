@@ -238,6 +238,14 @@ def specs_of(cls: Any) -> dict[str, Spec]:
             for field, spec in specs.items()}
 
 
+def spelled_as(name: str, known: Iterable[str]) -> str | None:
+    """The name of ``known`` that ``name`` spells, ``-`` and ``_`` being the same character
+    (``paper_experiment`` is ``paper-experiment``, as pip treats package names); ``None`` if
+    none does."""
+    key = name.replace("_", "-")
+    return next((k for k in known if k.replace("_", "-") == key), None)
+
+
 def by_name(*specs: Spec) -> dict[str, Spec]:
     """``specs`` keyed by their names (a group of parameters that are not dataclass fields)."""
     return {spec.name: spec for spec in specs}
