@@ -32,6 +32,7 @@ setup(
         "mcap>=1.1",
         "PyYAML>=6",
         "pyserial>=3.5",
+        "tqdm>=4.60",
         "eclipse-zenoh==1.6.2",
         "xxhash>=3.0",
     ],

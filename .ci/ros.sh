@@ -50,7 +50,7 @@ ROS_PACKAGES=(
 # The package's own dependencies (setup.py install_requires, plot and test extras). tdcm_ros itself
 # is NOT installed with pip: it must come from the colcon install space.
 PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "eclipse-zenoh==1.6.2" "xxhash>=3.0"
-                  matplotlib pytest hypothesis)
+                  "tqdm>=4.60" matplotlib pytest hypothesis)
 # Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
 VENV_RECIPE_VERSION=2
 EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin tdcm_node)
