@@ -132,7 +132,7 @@ def error_figure(plt: Any, evaluation: Evaluation) -> Any:
     return fig
 
 
-def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = "--plots"
+def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = "--out"
                 ) -> list[Path]:
     """Write ``shapes.png`` (:func:`shapes_figure`) and ``error_vs_tension.png``
     (:func:`error_figure`) into ``directory`` (created if missing; its parent must exist;
