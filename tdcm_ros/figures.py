@@ -9,7 +9,7 @@
 
 Surfaces show feasible points only; infeasible ones are left out, never extrapolated.
 
-Also the checks of every plot output option (``--plot FILE``, ``--plots DIR``, ``--out DIR``):
+Also the checks of every plot output option (``--plot FILE``, ``--out DIR``):
 :func:`plot_file` and :func:`output_folder`. Nothing creates a parent folder it was not asked for.
 """
 
