@@ -51,7 +51,10 @@ DEFAULT_ALLOWABLE_STRAIN = NYLON12_ELONGATION_AT_BREAK["z"]
 and an elongation at break is a failure, not a working, strain."""
 COUPLINGS = ("none", "fixed-pitch")
 PROGRESS_UPDATES = 40
-"""Chunks a sweep with a progress hook is solved in (a few ms of overhead each)."""
+"""Most chunks a sweep with a progress hook is solved in."""
+PROGRESS_CHUNK_DESIGNS = 100
+"""Fewest designs in such a chunk: each ``solve_batch`` call builds its grids at a fixed cost
+of a few ms (bench/bench_progress.py), so a small sweep is solved in one batch."""
 STATUSES = ("ok", "strain", "closure", "singularity", "non_convergence", "invalid")
 
 
@@ -123,8 +126,9 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
     """Tip response of ``base`` with one or two fields varied (``{name: SI values}``) at every
     tension (N). Invalid axis values raise :class:`InvalidDesignError`.
 
-    With ``progress`` the designs are solved in :data:`PROGRESS_UPDATES` chunks, each reported
-    as ``progress("design sweep", designs solved, designs)``; the answers are the same."""
+    With ``progress`` the designs are solved in chunks (at most :data:`PROGRESS_UPDATES`, at
+    least :data:`PROGRESS_CHUNK_DESIGNS` designs each), each reported as ``progress("design
+    sweep", designs solved, designs)``; the answers are the same."""
     if not isinstance(base, Design):
         raise InvalidDesignError(f"base = {base!r} is not a Design", parameter="base",
                                  value=base, allowed="tdcm_ros.model.Design")
@@ -163,7 +167,7 @@ def _solve_reporting(designs: list[Design], tensions: Array, settings: SolverSet
     if progress is None:
         return solve_batch(designs, np.broadcast_to(tensions, (len(designs), tensions.size)),
                            settings=settings)
-    size = max(1, -(-len(designs) // PROGRESS_UPDATES))
+    size = max(PROGRESS_CHUNK_DESIGNS, -(-len(designs) // PROGRESS_UPDATES))
     parts = []
     report_progress(progress, "design sweep", 0, len(designs))
     for start in range(0, len(designs), size):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tdcm_ros.model import preset, sweep, within
-from tdcm_ros.model.design_space import PROGRESS_UPDATES
+from tdcm_ros.model.design_space import PROGRESS_CHUNK_DESIGNS
 
 MM = 1e-3
 
@@ -16,18 +16,22 @@ Calls = list[tuple[str, int, "int | None"]]
 
 def test_a_reported_sweep_counts_every_design_and_gives_the_same_space() -> None:
     calls: Calls = []
-    axes = {"w_n": np.linspace(0.5, 3.0, 9) * MM, "w_d": np.linspace(1.0, 2.0, 7) * MM}
+    axes = {"w_n": np.linspace(0.5, 3.0, 15) * MM, "w_d": np.linspace(1.0, 2.0, 15) * MM}
     tensions = [0.0, 10.0, 20.0]
     plain = sweep(preset("fig2-wn-1.9"), axes, tensions, coupling="fixed-pitch")
     reported = sweep(preset("fig2-wn-1.9"), axes, tensions, coupling="fixed-pitch",
                      progress=lambda *call: calls.append(call))
-    assert {stage for stage, _, _ in calls} == {"design sweep"}
-    done = [d for _, d, _ in calls]
-    assert done[0] == 0 and done[-1] == 63 and done == sorted(done)
-    assert {total for _, _, total in calls} == {63}
-    assert 2 < len(calls) <= PROGRESS_UPDATES + 1
+    assert PROGRESS_CHUNK_DESIGNS == 100
+    assert calls == [("design sweep", done, 225) for done in (0, 100, 200, 225)]
     for name in ("status", "message", "tip_deflection_m", "tip_angle_rad", "max_bending_strain"):
         np.testing.assert_array_equal(getattr(reported, name), getattr(plain, name), err_msg=name)
+
+
+def test_a_small_sweep_is_one_batch_reported_at_start_and_end() -> None:
+    calls: Calls = []
+    sweep(preset("fig3-wd-1.52"), {"w_d": np.linspace(1.0, 2.0, 7) * MM}, [5.0, 15.0],
+          progress=lambda *call: calls.append(call))
+    assert calls == [("design sweep", 0, 7), ("design sweep", 7, 7)]
 
 
 def test_within_shifts_a_part_into_its_stage() -> None:
