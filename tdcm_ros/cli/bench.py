@@ -25,7 +25,7 @@ def register(subparsers: Any) -> None:
                     "Algorithm 1's settings and the baselines, on every preset and hard "
                     "designs at 4-20 N (SI units).",
         epilog="examples:\n"
-               "  tdcm bench accuracy --quick               # a few seconds\n"
+               "  tdcm bench accuracy --quick               # ~10 s, a subset\n"
                "  tdcm bench accuracy --json -q > accuracy.json")
     accuracy.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     accuracy.add_argument("--markdown", action="store_true",
