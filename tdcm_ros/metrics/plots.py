@@ -49,9 +49,11 @@ def shapes_caption(evaluation: Evaluation) -> str:
     offset_mm = marker_offset_m(evaluation) * MM
     if offset_mm < 1e-6:
         return "Markers are on the midline: the measured midline is a spline through them."
-    side = evaluation.options.layout.side_deg
-    return (f"Markers are ball centres {offset_mm:.2f} mm from the midline (on the body surface: "
-            f"R_outer + ball radius), {side:g} deg around the body from the tendon side. The "
+    layout = evaluation.options.layout
+    source = ("on the body surface: R_outer + ball radius" if layout.radial_offset is None else
+              "markers.radial_offset")
+    return (f"Markers are ball centres {offset_mm:.2f} mm from the midline ({source}), "
+            f"{layout.side_deg:g} deg around the body from the tendon side. The "
             "measured midline is a spline through the markers moved back by that offset, so it "
             f"runs {offset_mm:.1f} mm from them by construction; compare markers with markers "
             "and midlines with midlines.")

@@ -74,7 +74,8 @@ def test_shapes_axes_have_units_a_tension_scale_and_readable_panels(
 def test_the_caption_states_the_offset_the_data_has(evaluation: Evaluation) -> None:
     offset = marker_offset_m(evaluation)
     assert offset == pytest.approx(3.92e-3 + 1e-3)
-    assert f"{offset * 1e3:.2f} mm from the midline" in shapes_caption(evaluation)
+    assert f"{offset * 1e3:.2f} mm from the midline (on the body surface" in shapes_caption(
+        evaluation)
     for record in evaluation.records:
         assert record.measured_midline is not None
         gap = np.linalg.norm(record.measured_markers[-1] - record.measured_midline[-1])
@@ -99,3 +100,14 @@ def test_write_plots_names_its_option_in_errors(evaluation: Evaluation, tmp_path
         write_plots(evaluation, tmp_path / "a" / "b", option="--plots")
     assert [p.name for p in write_plots(evaluation, tmp_path / "p")] == [
         "shapes.png", "error_vs_tension.png"]
+
+
+def test_the_caption_follows_markers_radial_offset(evaluation: Evaluation) -> None:
+    from dataclasses import replace
+
+    def with_offset(metres: float) -> Evaluation:
+        layout = replace(evaluation.options.layout, radial_offset=metres)
+        return replace(evaluation, options=replace(evaluation.options, layout=layout))
+
+    assert "2.50 mm from the midline (markers.radial_offset)" in shapes_caption(with_offset(2.5e-3))
+    assert shapes_caption(with_offset(0.0)).startswith("Markers are on the midline")
