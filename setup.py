@@ -59,6 +59,7 @@ setup(
         "mcap>=1.1",
         "PyYAML>=6",
         "pyserial>=3.5",
+        "tqdm>=4.60",
         "xxhash>=3.0",
         # the bag reader decompresses MCAP chunks itself (tdcm_ros/bagio/reader.py)
         "lz4>=4",

@@ -9,7 +9,7 @@
 
 Surfaces show feasible points only; infeasible ones are left out, never extrapolated.
 
-Also the checks of every plot output option (``--plot FILE``, ``--plots DIR``, ``--out DIR``):
+Also the checks of every plot output option (``--plot FILE``, ``--out DIR``):
 :func:`plot_file` and :func:`output_folder`. Nothing creates a parent folder it was not asked for.
 """
 
@@ -26,10 +26,13 @@ from tdcm_ros.model import (
     DEFAULT_ALLOWABLE_STRAIN,
     STATUSES,
     DesignSpace,
+    Progress,
     design_curves,
     preset,
+    report_progress,
     solve,
     sweep,
+    within,
 )
 
 MM = 1e-3
@@ -113,10 +116,12 @@ def _pyplot() -> Any:
     return plt
 
 
-def write_figures(out_dir: str | Path, *, points: int = 41, dpi: int = 130) -> list[Path]:
+def write_figures(out_dir: str | Path, *, points: int = 41, dpi: int = 130,
+                  progress: Progress | None = None) -> list[Path]:
     """Write ``fig2.png``, ``fig3.png`` and ``feasibility.png`` to ``out_dir``; return paths.
 
-    ``points`` is the grid size per sweep axis (field and tension).
+    ``points`` is the grid size per sweep axis (field and tension). ``progress`` gets one stage
+    per file: its sweep's designs, then one unit for drawing it.
     """
     if isinstance(points, bool) or not isinstance(points, int) or not 3 <= points <= 400:
         raise InputError(f"points = {points!r} is out of range; allowed: integer in [3, 400]",
@@ -124,19 +129,21 @@ def write_figures(out_dir: str | Path, *, points: int = 41, dpi: int = 130) -> l
     plt = _pyplot()
     out = output_folder("--out", out_dir)
     tensions = np.linspace(0.0, T_BASE, points)
-    paths = [_paper_figure(plt, spec, tensions, points, out / f"{spec.name}.png", dpi)
+    paths = [_paper_figure(plt, spec, tensions, points, out / f"{spec.name}.png", dpi, progress)
              for spec in FIGURES]
-    paths.append(_feasibility_figure(plt, points, out / "feasibility.png", dpi))
+    paths.append(_feasibility_figure(plt, points, out / "feasibility.png", dpi, progress))
     return paths
 
 
 def _paper_figure(plt: Any, spec: FigureSpec, tensions: np.ndarray, points: int, path: Path,
-                  dpi: int) -> Path:
+                  dpi: int, progress: Progress | None) -> Path:
     designs = {f"${spec.symbol}$ = {v / MM:g} mm": preset(name)
                for name, v in zip(spec.presets, spec.values_m)}
     base = preset(spec.presets[1])
     values = np.union1d(np.linspace(*spec.sweep_m, points), spec.values_m)
-    space = sweep(base, {spec.field: values}, tensions, coupling=spec.coupling)
+    units = values.size + 1  # the sweep's designs, then drawing
+    space = sweep(base, {spec.field: values}, tensions, coupling=spec.coupling,
+                  progress=within(progress, path.name, 0, units))
     curves = design_curves(designs, tensions)
 
     fig = plt.figure(figsize=(15, 5.2))
@@ -156,17 +163,18 @@ def _paper_figure(plt: Any, spec: FigureSpec, tensions: np.ndarray, points: int,
     ax_a.set_xlabel("x (mm)")
     ax_a.set_ylabel("z (mm)")
     ax_a.set_title(f"(a) midlines at T = {T_BASE:g} N")
-    ax_a.legend(fontsize=8, loc="lower right")
+    ax_a.legend(fontsize=9, loc="lower right")
     ax_b.set_xlabel("arc length s (mm)")
     ax_b.set_ylabel("curvature κ (1/m)")
     ax_b.set_title(f"(b) curvature along s at T = {T_BASE:g} N")
-    ax_b.legend(fontsize=8)
+    ax_b.legend(fontsize=9)
     _surface(ax_c, space, spec, curves, colours)
     fig.suptitle(f"{spec.name}: {spec.symbol} varied, E = {base.E / 1e9:g} GPa, "
                  f"L = {base.length / MM:g} mm", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
+    report_progress(progress, path.name, units, units)
     return path
 
 
@@ -185,19 +193,22 @@ def _surface(ax: Any, space: DesignSpace, spec: FigureSpec, curves: dict[str, An
     ax.set_zlabel("tip deflection d (mm)")
     ax.set_title("(c) design space and design curves")
     ax.view_init(elev=24, azim=-130)
-    ax.legend(fontsize=7, loc="upper left")
+    ax.legend(fontsize=8, loc="upper left")
 
 
-def _feasibility_figure(plt: Any, points: int, path: Path, dpi: int) -> Path:
+def _feasibility_figure(plt: Any, points: int, path: Path, dpi: int,
+                        progress: Progress | None) -> Path:
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
 
+    units = points * points + points + 1  # both sweeps' designs, then drawing
     by_width = sweep(preset("fig2-wn-1.9"),
                      {"w_n": np.geomspace(0.02 * MM, 5.5 * MM, points),
                       "w_d": np.linspace(0.3 * MM, 2.5 * MM, points)}, [T_BASE],
-                     coupling="fixed-pitch")
+                     coupling="fixed-pitch", progress=within(progress, path.name, 0, units))
     by_tension = sweep(preset("fig3-wd-1.52"), {"w_d": np.linspace(0.3 * MM, 2.5 * MM, points)},
-                       np.linspace(0.0, 2.0 * T_BASE, points))
+                       np.linspace(0.0, 2.0 * T_BASE, points),
+                       progress=within(progress, path.name, points * points, units))
     panels = [
         (by_width, by_width.values[1] / MM, "w_d (mm)", by_width.status[..., 0],
          by_width.max_bending_strain[..., 0],
@@ -215,17 +226,18 @@ def _feasibility_figure(plt: Any, points: int, path: Path, dpi: int) -> Path:
         valid = np.where(np.isin(status, ("ok", "strain")), strain, np.nan)
         contour = ax.contour(x, y, valid.T * 100.0, levels=[1, 2, 4, 6, 8], colors="k",
                              linewidths=0.6)
-        ax.clabel(contour, fmt="%g %%", fontsize=7)
+        ax.clabel(contour, fmt="%g %%", fontsize=8)
         ax.set_xlabel(f"{space.fields[0]} (mm)")
         ax.set_ylabel(y_label)
         ax.set_title(f"feasibility over {title}", fontsize=9)
     axes[0].set_xscale("log")
     handles = [Patch(color=STATUS_COLOURS[s], label=s.replace("_", " ")) for s in STATUSES]
-    fig.legend(handles=handles, loc="lower center", ncol=len(STATUSES), fontsize=8)
+    fig.legend(handles=handles, loc="lower center", ncol=len(STATUSES), fontsize=9)
     fig.suptitle("Feasibility: notch bending strain |κ|·min(h1, R_outer) (contours, %) against "
                  f"the allowable {DEFAULT_ALLOWABLE_STRAIN * 100:g} % (Nylon 12 elongation at "
                  "break, Z), notch closure, tendon-offset singularity", fontsize=9)
     fig.tight_layout(rect=(0, 0.07, 1, 1))
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
+    report_progress(progress, path.name, units, units)
     return path

@@ -44,7 +44,7 @@ class Spec:
     high: float = math.inf
     low_open: bool = False
     size: int = 3
-    choices: tuple[str, ...] = ()
+    choices: tuple[str, ...] = ()  # a str value matches one with "-" and "_" alike
     high_open: bool = False
 
     def __post_init__(self) -> None:
@@ -164,9 +164,12 @@ class Spec:
         if self.kind == "str":
             if not isinstance(value, str):
                 raise self._wrong_type(where, value, error)
-            if self.choices and value not in self.choices:
+            if not self.choices:
+                return value
+            chosen = spelled_as(value, self.choices)  # '-' and '_' alike: the choice's spelling
+            if chosen is None:
                 raise out_of_range(where, value, self.allowed(), error=error)
-            return value
+            return chosen
         number = self._number(value, where, error, from_text)
         below = number <= self.low if self.low_open else number < self.low
         above = number >= self.high if self.high_open else number > self.high
@@ -236,6 +239,14 @@ def specs_of(cls: Any) -> dict[str, Spec]:
              if _METADATA_KEY in f.metadata}
     return {field: spec if spec.name else dataclasses.replace(spec, name=field)
             for field, spec in specs.items()}
+
+
+def spelled_as(name: str, known: Iterable[str]) -> str | None:
+    """The name of ``known`` that ``name`` spells, ``-`` and ``_`` being the same character
+    (``paper_experiment`` is ``paper-experiment``, as pip treats package names); ``None`` if
+    none does."""
+    key = name.replace("_", "-")
+    return next((k for k in known if k.replace("_", "-") == key), None)
 
 
 def by_name(*specs: Spec) -> dict[str, Spec]:

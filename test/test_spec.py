@@ -274,3 +274,16 @@ def test_a_renamed_spec_keeps_unit_meaning_and_range() -> None:
     assert renamed.renamed("hold", default=5.0) == source
     with pytest.raises(InputError, match=r"hold_s = 0.0 is out of range; allowed: \[0.01, 86400\] s"):
         renamed.check(0.0)
+
+
+def test_a_choice_matches_with_hyphen_and_underscore_alike_and_keeps_its_spelling() -> None:
+    from tdcm_ros.nodes.model_node import PARAMETERS
+
+    preset_spec = PARAMETERS["design.preset"]
+    assert preset_spec.check("paper_experiment") == "paper-experiment"
+    assert preset_spec.parse("fig2_wn_1.9") == "fig2-wn-1.9"
+    snake = Spec("axis", kind="str", choices=("tip_marker", "body"))
+    assert snake.check("tip-marker") == "tip_marker"
+    with pytest.raises(InputError) as refused:
+        snake.check("tip marker")
+    assert "allowed: tip_marker | body" in str(refused.value)

@@ -4,20 +4,29 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from typing import Any
+
+from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
 
 
 def register(subparsers: Any) -> None:
     """Add the ``bench`` subcommand with its ``accuracy`` benchmark."""
-    parser = subparsers.add_parser("bench", help="benchmarks that print measured figures",
-                                   description="Benchmarks that print measured figures.")
+    parser = subparsers.add_parser(
+        "bench", help="benchmarks that print measured figures",
+        description="Benchmarks that print measured figures (the timing scripts behind the "
+                    "README's numbers are under bench/ in the source tree).",
+        epilog="examples:\n"
+               "  tdcm bench accuracy --quick\n"
+               "  tdcm bench accuracy --markdown --plot accuracy_pareto.png")
     benches = parser.add_subparsers(dest="bench", required=True, metavar="BENCH")
     accuracy = benches.add_parser(
         "accuracy", help="tip error vs time per solve for every method and setting",
         description="Tip error against a converged reference and median time per solve, for "
                     "Algorithm 1's settings and the baselines, on every preset and hard "
-                    "designs at 4-20 N (SI units).")
+                    "designs at 4-20 N (SI units).",
+        epilog="examples:\n"
+               "  tdcm bench accuracy --quick               # ~10 s, a subset\n"
+               "  tdcm bench accuracy --json -q > accuracy.json")
     accuracy.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     accuracy.add_argument("--markdown", action="store_true",
                           help="also print the table as Markdown (the README's), first")
@@ -25,6 +34,7 @@ def register(subparsers: Any) -> None:
                           "or .svg file in an existing folder")
     accuracy.add_argument("--quick", action="store_true",
                           help="a small subset (3 designs, 2 tensions, fewer knobs) for tests")
+    add_quiet_argument(accuracy)
     accuracy.set_defaults(handler=run_accuracy)
 
 
@@ -40,10 +50,8 @@ def run_accuracy(args: argparse.Namespace) -> int:
 
     if args.plot:
         plot_file("--plot", args.plot)  # before the bench: a bad path fails at once
-    def progress(label: str) -> None:
-        print(f"  running {label}", file=sys.stderr, flush=True)
-
-    report = run_bench(quick=args.quick, progress=progress)
+    with ProgressBars.of(args) as bars:
+        report = run_bench(quick=args.quick, progress=bars)
     if args.plot:
         plot_pareto(report, args.plot)
     if args.json:

@@ -7,7 +7,8 @@ import json
 import sys
 from typing import Any
 
-from tdcm_ros.cli.evaluate import add_input_arguments, fail
+from tdcm_ros.cli.evaluate import add_input_arguments, design_sets, fail
+from tdcm_ros.cli.progress import ProgressBars
 from tdcm_ros.errors import PhysicsError, TdcmError
 
 UNUSABLE_FIT_EXIT = PhysicsError.exit_code
@@ -23,7 +24,10 @@ def register(subparsers: Any) -> None:
         "calibrate", help="fit E (and other design fields) to bags by least squares",
         description="Least squares on the marker position residuals of every step; reports "
                     "each value with a confidence interval, Table I before and after, and warns "
-                    "when a parameter is not identifiable from the data.")
+                    "when a parameter is not identifiable from the data.",
+        epilog="examples:\n"
+               "  tdcm calibrate bags/paper_experiment\n"
+               "  tdcm calibrate run.mcap --fit E,w_d --confidence 0.9 --json")
     add_input_arguments(parser)
     parser.add_argument("--fit", default="E", metavar="NAME[,NAME]",
                         help="real-valued design fields to fit (default: E); start values from "
@@ -41,9 +45,11 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         names = parse_fit(args.fit)
-        options = options_from_sets(args.set)
-        cal = calibrate_paths(args.bags, names, options, confidence=args.confidence,
-                              topics=Topics(args.tension_topic, args.markers_topic))
+        options = options_from_sets(design_sets(args))
+        with ProgressBars.of(args) as bars:
+            cal = calibrate_paths(args.bags, names, options, confidence=args.confidence,
+                                  topics=Topics(args.tension_topic, args.markers_topic),
+                                  progress=bars)
     except TdcmError as error:
         return fail("calibrate", error, args.json)
     if cal.warnings:  # before the table: on a terminal it is read first, not scrolled past

@@ -7,7 +7,9 @@ import json
 import sys
 from typing import Any
 
-from tdcm_ros.errors import TdcmError
+from tdcm_ros.cli.deprecation import DeprecatedAlias
+from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
+from tdcm_ros.errors import InputError, TdcmError
 
 SET_HELP = ("override in SI units: a design field (E=1.2e9, w_d=0.0014) or design.preset=NAME, "
             "steps.tolerance_n, steps.min_hold_s, steps.settle_s, steps.zero_n, "
@@ -24,9 +26,24 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
                         help="geometry_msgs/msg/WrenchStamped topic (default: tension)")
     parser.add_argument("--markers-topic", default="markers",
                         help="mocap4r2_msgs/msg/Markers topic (default: markers)")
+    parser.add_argument("--design", metavar="NAME",
+                        help="design preset the model starts from (default: paper-experiment); "
+                             "the same as --set design.preset=NAME")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help=SET_HELP)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    add_quiet_argument(parser)
+
+
+def design_sets(args: argparse.Namespace) -> list[str]:
+    """``--set`` values with ``--design NAME`` first as ``design.preset=NAME`` (given once)."""
+    if args.design is None:
+        return list(args.set)
+    if any(pair.partition("=")[0].strip() == "design.preset" for pair in args.set):
+        raise InputError(f"--design {args.design!r} and --set design.preset=... both name the "
+                         "design; allowed: one of them", parameter="--design", value=args.design,
+                         allowed="--design NAME or --set design.preset=NAME, not both")
+    return [f"design.preset={args.design}", *args.set]
 
 
 def register(subparsers: Any) -> None:
@@ -35,11 +52,16 @@ def register(subparsers: Any) -> None:
         "evaluate", help="Table I metrics of bags against the model",
         description="Detect tension steps in the bags, average the markers per step and compare "
                     "them with the model at each step's mean tension (MAPE, RMSE, MAE, shape "
-                    "error, deflection mean).")
+                    "error, deflection mean).",
+        epilog="examples:\n"
+               "  tdcm evaluate bags/paper_experiment\n"
+               "  tdcm evaluate run.mcap --design paper-experiment --set E=0.7e9 --out plots\n"
+               "  tdcm evaluate trial1 trial2 --json > table1.json")
     add_input_arguments(parser)
-    parser.add_argument("--plots", metavar="DIR",
-                        help="write shapes.png and error_vs_tension.png into DIR (created if "
-                             "missing; its parent must exist; needs matplotlib)")
+    parser.add_argument("--out", metavar="DIR",
+                        help="write the plots shapes.png and error_vs_tension.png into DIR "
+                             "(created if missing; its parent must exist; needs matplotlib)")
+    parser.add_argument("--plots", metavar="DIR", action=DeprecatedAlias, replacement="--out")
     parser.set_defaults(handler=run)
 
 
@@ -58,17 +80,19 @@ def run(args: argparse.Namespace) -> int:
     from tdcm_ros.model import one_shot
 
     try:
-        options = options_from_sets(args.set)
+        options = options_from_sets(design_sets(args))
         # One solve per step (tens to hundreds): the plain kernel takes about as long as numba's
         # import and cache load, without its ~60 MiB (bench/bench_evaluate_memory.py).
-        with one_shot():
-            ev = evaluate_paths(args.bags, options,
+        with one_shot(), ProgressBars.of(args) as bars:
+            ev = evaluate_paths(args.bags, options, progress=bars,
                                 topics=Topics(args.tension_topic, args.markers_topic))
         plots = []
-        if args.plots:
+        out = args.out or args.plots  # --plots: the deprecated spelling
+        option = "--out" if args.out else "--plots"
+        if out:
             from tdcm_ros.metrics import write_plots
 
-            plots = write_plots(ev, args.plots)
+            plots = write_plots(ev, out, option=option)
     except TdcmError as error:
         return fail("evaluate", error, args.json)
     if args.json:

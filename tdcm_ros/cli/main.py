@@ -19,6 +19,9 @@ import sys
 from collections.abc import Mapping, Sequence
 
 from tdcm_ros import __version__
+from tdcm_ros.cli.deprecation import one_line_warnings
+from tdcm_ros.cli.help import TdcmParser
+from tdcm_ros.cli.progress import add_quiet_argument
 from tdcm_ros.errors import InputError, PhysicsError, TdcmError
 
 COMMANDS: dict[str, str] = {
@@ -67,6 +70,21 @@ def _add_exit_statuses(parser: argparse.ArgumentParser, path: str,
             for verb, child in action.choices.items():
                 _add_exit_statuses(child, f"{path} {verb}", meanings)
 
+DESCRIPTION = """\
+tdcm: the shape model of a notched tendon-driven continuum manipulator (Algorithm 1), its ROS 2
+nodes on an embedded zenoh runtime or on rclpy, and the tools around them. SI units throughout."""
+
+EPILOG = """\
+quick start:
+  tdcm demo                                  # the paper's experiment end to end, simulated
+  tdcm solve --tension 20 --plot shape.png   # one shape, summary and plot
+
+conventions: commands that write several files take --out DIR, a single figure is --plot FILE;
+a design is named by --design NAME wherever one is used (the same as --set design.preset=NAME);
+in preset and scene names - and _ are the same character (paper-experiment, the spelling these
+help texts use, is paper_experiment); long commands draw a progress bar on stderr when it is a
+terminal (-q/--quiet: none). 'tdcm COMMAND -h' shows a command's options and examples."""
+
 
 def _modules(argv: Sequence[str]) -> list[str]:
     """The modules to register for ``argv``: the named command's, else every one."""
@@ -78,9 +96,10 @@ def _modules(argv: Sequence[str]) -> list[str]:
 
 def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
     """The top-level parser with the subcommands ``argv`` needs (``None``: every one)."""
-    parser = argparse.ArgumentParser(prog="tdcm", description=__doc__.splitlines()[0],
-                                     epilog=exit_status_epilog({}))
+    parser = TdcmParser(prog="tdcm", description=DESCRIPTION,
+                        epilog=f"{EPILOG}\n\n{exit_status_epilog({})}")
     parser.add_argument("--version", action="version", version=f"tdcm_ros {__version__}")
+    add_quiet_argument(parser, top_level=True)
     subparsers = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     modules = list(dict.fromkeys(COMMANDS.values())) if argv is None else _modules(argv)
     for module_name in modules:
@@ -96,6 +115,7 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``tdcm``; returns the process exit status."""
     args_in = sys.argv[1:] if argv is None else list(argv)
+    one_line_warnings()
     args = build_parser(args_in).parse_args(args_in)
     try:
         return int(args.handler(args))

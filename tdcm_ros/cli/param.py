@@ -20,7 +20,15 @@ from tdcm_ros.yamlio import load_yaml
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``param`` with its verbs."""
-    parser = subparsers.add_parser("param", help="get, set or list node parameters")
+    parser = subparsers.add_parser(
+        "param", help="get, set or list node parameters",
+        description="Parameters of running nodes, on either runtime, the way ros2 param works; "
+                    "'specs' reads a node's parameters from their specs without running it.",
+        epilog="examples:\n"
+               "  tdcm param list /model_node\n"
+               "  tdcm param get /model_node design.preset\n"
+               "  tdcm param set /model_node design.E 1.2e+9\n"
+               "  tdcm param specs model_node               # offline: units, defaults, ranges")
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--runtime", choices=RUNTIMES,
                         default=os.environ.get(RUNTIME_ENV) or "zenoh",

@@ -28,7 +28,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "record", help="record topics into a rosbag2 MCAP bag (zenoh or rclpy)",
         description="Record topics (all when none are named, including ones that appear later) "
-                    "until Ctrl-C/SIGTERM, --duration or --max-messages; the bag is then closed.")
+                    "until Ctrl-C/SIGTERM, --duration or --max-messages; the bag is then closed.",
+        epilog="examples:\n"
+               "  tdcm record /tmp/run1                     # every topic, until Ctrl-C\n"
+               "  tdcm record /tmp/run2 tension markers /tf_static --duration 60")
     parser.add_argument("bag", help="bag folder to create (must not exist)")
     parser.add_argument("topics", nargs="*", help="topics to record (default: all)")
     parser.add_argument("--duration", type=float, default=0.0, help="stop after S seconds")
@@ -42,7 +45,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              f"if importable)")
     parser.set_defaults(handler=run_record)
 
-    bag = subparsers.add_parser("bag", help="inspect bags")
+    bag = subparsers.add_parser(
+        "bag", help="inspect bags",
+        description="Work with rosbag2 bags (MCAP storage): folders or .mcap files.",
+        epilog="examples:\n"
+               "  tdcm bag info bags/paper_experiment")
     verbs = bag.add_subparsers(dest="verb", required=True, metavar="VERB")
     info = verbs.add_parser("info", help="topics, types, message counts, warnings")
     info.add_argument("bag", help="rosbag2 folder or .mcap file")

@@ -14,7 +14,11 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "scene", help="list, validate and explain simulated scenes",
         description="Scenes describe the simulated world: design, true material, bench, "
-                    "sensors and the effects it contains (only those are computed).")
+                    "sensors and the effects it contains (only those are computed).",
+        epilog="examples:\n"
+               "  tdcm scene list\n"
+               "  tdcm scene validate my_bench.yaml\n"
+               "  tdcm scene explain paper-experiment")
     actions = parser.add_subparsers(dest="action", required=True, metavar="ACTION")
     listing = actions.add_parser("list", help="shipped scenes, one line each")
     listing.add_argument("--json", action="store_true", help="print one JSON object")

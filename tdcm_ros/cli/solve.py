@@ -12,6 +12,7 @@ from tdcm_ros.model import (
     PRESETS,
     PROFILE_NAMES,
     SOLVER_SPECS,
+    Design,
     SolverSettings,
     TensionRangeError,
     one_shot,
@@ -19,18 +20,27 @@ from tdcm_ros.model import (
     preset,
     solve,
 )
+from tdcm_ros.spec import spelled_as
+
+DEFAULT_DESIGN = "paper-experiment"
 
 
 def register(subparsers: Any) -> None:
     """Add the ``solve`` subcommand."""
     parser = subparsers.add_parser(
         "solve", help="shape of the manipulator for one tension",
-        description="Solve Algorithm 1 for one design and tendon tension (SI units).")
-    parser.add_argument("--design", default="paper-experiment", choices=list(PRESETS),
-                        help="design preset (default: paper-experiment)")
+        description="Solve Algorithm 1 for one design and tendon tension (SI units).",
+        epilog="examples:\n"
+               "  tdcm solve --tension 20\n"
+               "  tdcm solve --design fig2-wn-1.9 --tension 20 --json\n"
+               "  tdcm solve --tension 12 --set E=1.2e9 --plot shape.png")
+    parser.add_argument("--design", metavar="NAME",
+                        help=f"design preset: {', '.join(PRESETS)} (default: {DEFAULT_DESIGN}); "
+                             "the same as --set design.preset=NAME")
     parser.add_argument("--tension", required=True, type=str, help="tendon tension (N)")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a design field in SI units, e.g. --set E=1.2e9")
+                        help="override a design field in SI units, e.g. --set E=1.2e9 (or "
+                             "design.E=1.2e9, as evaluate takes it)")
     parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
     for name in ("routing", "loads"):  # choices and defaults from the settings' specs
         spec = SOLVER_SPECS[name]
@@ -42,15 +52,26 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def _overrides(pairs: list[str]) -> dict[str, Any]:
+def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
+    """The preset's name (``--design`` or ``--set design.preset``, once) and the design: that
+    preset with the ``--set`` fields (``NAME`` or ``design.NAME``) over it."""
     values: dict[str, Any] = {}
     for pair in pairs:
         name, sep, text = pair.partition("=")
+        name = name.strip().removeprefix("design.")
         if not sep or not name:
             raise InputError(f"--set {pair!r} is not NAME=VALUE", parameter="--set", value=pair,
                              allowed="NAME=VALUE with a design field name")
-        values[name.strip()] = parse_field(name.strip(), text.strip())
-    return values
+        if name != "preset":
+            values[name] = parse_field(name, text.strip())
+        elif named is not None:
+            raise InputError(f"--design {named!r} and --set {pair.strip()!r} both name the "
+                             "design; allowed: one of them", parameter="--design", value=named,
+                             allowed="--design NAME or --set design.preset=NAME, not both")
+        else:
+            named = text.strip()
+    design = preset(named or DEFAULT_DESIGN).with_overrides(**values)
+    return spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN, design
 
 
 def _tension(text: str) -> float:
@@ -66,10 +87,9 @@ def _tension(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     """Solve and report; typed errors become exit status 2 (input) or 3 (physics)."""
     try:
-        overrides = _overrides(args.set)
+        name, design = _design(args.design, args.set)
         if args.profile:
-            overrides["profile"] = args.profile
-        design = preset(args.design).with_overrides(**overrides)
+            design = design.with_overrides(profile=args.profile)
         settings = SolverSettings(routing=args.routing, loads=args.loads)
         if args.plot:
             from tdcm_ros.figures import plot_file
@@ -86,7 +106,7 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(result.summary()))
     else:
         x, _, z = result.tip_position * 1e3
-        print(f"design {args.design}: L = {design.length * 1e3:.3f} mm, E = {design.E:.4g} Pa, "
+        print(f"design {name}: L = {design.length * 1e3:.3f} mm, E = {design.E:.4g} Pa, "
               f"routing {settings.routing}, loads {settings.loads}")
         print(f"tension {result.tension_n:g} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
               f"angle {result.tip_angle_rad:.5f} rad, deflection "

@@ -33,7 +33,15 @@ EXIT_MEANINGS = {f"topic {verb}": {InputError.exit_code: "also: the type given i
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``topic`` with its verbs."""
-    parser = subparsers.add_parser("topic", help="list, echo, publish, measure topics (zenoh)")
+    parser = subparsers.add_parser(
+        "topic", help="list, echo, publish, measure topics (zenoh)",
+        description="Look at and poke the embedded (zenoh) graph the way ros2 topic does.",
+        epilog="examples:\n"
+               "  tdcm topic list -t\n"
+               "  tdcm topic echo tip_pose --once\n"
+               "  tdcm topic pub tension geometry_msgs/msg/WrenchStamped "
+               "'{wrench: {force: {z: 8.0}}}' --once\n"
+               "  tdcm topic hz markers --duration 5")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
 
     listing = verbs.add_parser("list", help="topics with a publisher or subscription")

@@ -33,7 +33,16 @@ TWIN_NODES = ("device_twin", "tension_driver")
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``up`` subcommand."""
-    parser = subparsers.add_parser("up", help="start the node set (Ctrl-C stops every process)")
+    parser = subparsers.add_parser(
+        "up", help="start the node set (Ctrl-C stops every process)",
+        description="Start the node set, each node its own process, on the embedded zenoh "
+                    "runtime (with a router unless one answers on the endpoint) or on rclpy. "
+                    "--twin adds the device twin and the tension driver wired to it, so the "
+                    "graph runs with no hardware. Ctrl-C stops the nodes in reverse order.",
+        epilog="examples:\n"
+               "  tdcm up --twin --schedule                 # simulated bench, runs the staircase\n"
+               "  tdcm up --params config/model_node.yaml --nodes model_node\n"
+               "  tdcm up --runtime rclpy --twin --scene friction-hysteresis")
     parser.add_argument("--params", help="ROS 2 parameter YAML (ros__parameters layout)")
     parser.add_argument("--nodes", default=",".join(DEFAULT_NODE_SET),
                         help=f"comma-separated node names from: {', '.join(sorted(NODES))}")

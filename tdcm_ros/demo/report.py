@@ -11,6 +11,7 @@ from tdcm_ros.metrics import (
     MarkerLayout,
     settings_for_hold,
 )
+from tdcm_ros.model import Progress
 
 
 def scene_options(plan: DemoPlan) -> EvaluateOptions:
@@ -38,9 +39,11 @@ def missed_holds(plan: DemoPlan, evaluation: Evaluation) -> str:
             f"= {steps.tolerance_n:g} N); adjust them with --set steps.<name>=VALUE")
 
 
-def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool) -> None:
+def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
+           progress: Progress | None = None) -> None:
     """Print Table I and the per-step table of the bag evaluated with ``options`` (see
-    :func:`scene_options`), write ``plots/`` and ``metrics.json``; calibrate."""
+    :func:`scene_options`), write ``plots/`` and ``metrics.json``; calibrate. ``progress``
+    follows the reading, the fit and the evaluations (see ``calibrate_paths``)."""
     from tdcm_ros.metrics import format_calibration, format_evaluation, write_plots
     from tdcm_ros.metrics.api import evaluate_paths
 
@@ -48,8 +51,10 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool) -> None
     if calibrate:
         from tdcm_ros.metrics.api import calibrate_paths
 
-        fit = calibrate_paths([plan.bag], ("E",), options)  # its `before` is the evaluation
-    evaluation = fit.before if fit is not None else evaluate_paths([plan.bag], options)
+        fit = calibrate_paths([plan.bag], ("E",), options,  # its `before` is the evaluation
+                              progress=progress)
+    evaluation = fit.before if fit is not None else evaluate_paths([plan.bag], options,
+                                                                   progress=progress)
     print(f"\n== evaluation of {plan.bag} (estimator: scene {plan.scene.name!r} nominal design) ==")
     print(format_evaluation(evaluation))
     if warning := missed_holds(plan, evaluation):

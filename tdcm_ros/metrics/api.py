@@ -28,6 +28,7 @@ from tdcm_ros.metrics.evaluation import (
 from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
+from tdcm_ros.model import Progress, report_progress
 
 
 @dataclass(frozen=True)
@@ -39,14 +40,20 @@ class Topics:
 
 
 def load_paths(paths: Sequence[str | Path], options: EvaluateOptions,
-               topics: Topics | None = None) -> list[BagSource]:
-    """Read every bag (in order); at least one path."""
+               topics: Topics | None = None, progress: Progress | None = None
+               ) -> list[BagSource]:
+    """Read every bag (in order); at least one path. ``progress``: stage ``reading bags``."""
     if not paths:
         raise InputError("no bag given; allowed: one or more bag folders or .mcap files",
                          parameter="BAG", value=[], allowed="one or more paths")
     names = topics or Topics()
-    return [load_bag(p, labels=options.layout.labels, tension_topic=names.tension,
-                     markers_topic=names.markers) for p in paths]
+    sources = []
+    for done, path in enumerate(paths):
+        report_progress(progress, "reading bags", done, len(paths))
+        sources.append(load_bag(path, labels=options.layout.labels, tension_topic=names.tension,
+                                markers_topic=names.markers))
+    report_progress(progress, "reading bags", len(paths), len(paths))
+    return sources
 
 
 def prepare(sources: Sequence[BagSource], options: EvaluateOptions,
@@ -82,26 +89,31 @@ def _evaluate(sources: Sequence[BagSource],
 
 
 def evaluate_paths(paths: Sequence[str | Path], options: EvaluateOptions | None = None, *,
-                   topics: Topics | None = None,
-                   registration: Registration | None = None) -> Evaluation:
+                   topics: Topics | None = None, registration: Registration | None = None,
+                   progress: Progress | None = None) -> Evaluation:
     """Evaluate bags (rosbag2 folders or ``.mcap`` files) against the model of
-    ``options.design``; see :class:`~tdcm_ros.metrics.evaluation.Evaluation`."""
+    ``options.design``; see :class:`~tdcm_ros.metrics.evaluation.Evaluation`.
+    ``progress``: stage ``reading bags``."""
     opts = options or EvaluateOptions()
-    return evaluate_sources(load_paths(paths, opts, topics), opts, registration)
+    return evaluate_sources(load_paths(paths, opts, topics, progress), opts, registration)
 
 
 def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
                     options: EvaluateOptions | None = None, *, topics: Topics | None = None,
-                    registration: Registration | None = None,
-                    confidence: float = 0.95) -> Calibration:
+                    registration: Registration | None = None, confidence: float = 0.95,
+                    progress: Progress | None = None) -> Calibration:
     """Fit the design fields ``fit`` (start: ``options.design``) to the bags' marker positions
-    by least squares; see :mod:`tdcm_ros.metrics.calibration`."""
+    by least squares; see :mod:`tdcm_ros.metrics.calibration`. ``progress``: stages ``reading
+    bags``, ``fitting NAMES`` (model evaluations) and ``Table I before and after`` (2)."""
     opts = options or EvaluateOptions()
-    sources = load_paths(paths, opts, topics)
+    sources = load_paths(paths, opts, topics, progress)
     prepared = prepare(sources, opts, registration)
     design, params, corr, condition, rms, count, warnings = calibrate_steps(
-        prepared, fit, opts, confidence=confidence)
+        prepared, fit, opts, confidence=confidence, progress=progress)
+    report_progress(progress, "Table I before and after", 0, 2)
     before = _evaluate(sources, prepared, opts)
+    report_progress(progress, "Table I before and after", 1, 2)
     after = _evaluate(sources, prepared, opts.with_design(design))
+    report_progress(progress, "Table I before and after", 2, 2)
     return Calibration(tuple(params), confidence, corr, condition, rms, count, not warnings,
                        before, after, tuple(warnings))

@@ -30,7 +30,15 @@ from tdcm_ros.metrics.evaluation import Evaluation, model_tension
 from tdcm_ros.metrics.measure import MeasuredStep
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
-from tdcm_ros.model import FIELD_SPECS, Design, SolveResult, solve, surface_points
+from tdcm_ros.model import (
+    FIELD_SPECS,
+    Design,
+    Progress,
+    SolveResult,
+    report_progress,
+    solve,
+    surface_points,
+)
 
 Array = NDArray[np.float64]
 MAX_CONDITION = 1e10
@@ -151,9 +159,11 @@ def _model_markers(design: Design, data: _Data, options: EvaluateOptions) -> Arr
 
 def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registration]],
                     names: Sequence[str], options: EvaluateOptions, *,
-                    confidence: float = 0.95) -> tuple[Design, list[FittedParameter], Array,
-                                                       float, float, int, list[str]]:
+                    confidence: float = 0.95, progress: Progress | None = None
+                    ) -> tuple[Design, list[FittedParameter], Array, float, float, int,
+                               list[str]]:
     """Fit ``names`` on measured steps with their registrations; see the module docstring.
+    ``progress`` counts the model evaluations (stage ``fitting NAMES``; no total known).
 
     Returns the fitted design, the parameters, their correlation matrix, the condition number
     of ``J^T J``, the residual RMS (m), the residual count and the identifiability warnings.
@@ -177,7 +187,13 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
         return start.with_overrides(**{nm: float(v) for nm, v in zip(names, scaled * x0,
                                                                       strict=True)})
 
+    stage = f"fitting {', '.join(names)}"
+    evaluations = 0
+
     def residuals(scaled: Array) -> Array:
+        nonlocal evaluations
+        evaluations += 1
+        report_progress(progress, stage, evaluations, None)
         try:
             predicted = _model_markers(design_at(scaled), data, options)
         except TdcmError:

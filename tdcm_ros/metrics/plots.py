@@ -1,7 +1,14 @@
-"""Evaluation plots (needs matplotlib, the ``plot`` extra): shapes per step, error vs tension."""
+"""Evaluation plots (needs matplotlib, the ``plot`` extra): shapes per step, error vs tension.
+
+Every figure explains itself: a legend entry for each kind of line and marker, axis labels with
+units, and (``shapes.png``) a caption saying why the markers are not on the measured midline:
+they are the ball centres on the body surface, ``R_outer + ball radius`` off the midline, while
+the measured midline is the spline through the markers moved back by that offset.
+"""
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -11,67 +18,133 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.figures import output_folder
 from tdcm_ros.metrics.evaluation import Evaluation
 
+MM = 1e3
+"""Metres to millimetres (plots are in mm)."""
+PANEL_SIZE_IN = (3.8, 8.5)
+"""Width and height of one trial's panel (inches)."""
+FONT_SIZE = 10
+"""Smallest font of the plots (pt): readable at 100 % zoom of a 120 dpi PNG."""
 
-def _pyplot(target: Path) -> Any:
+
+def _pyplot(target: Path, option: str) -> Any:
     try:
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError as exc:
-        raise InputError("--plots needs matplotlib: pip install 'tdcm_ros[plot]'",
-                         parameter="plots", value=str(target),
+        raise InputError(f"{option} needs matplotlib: pip install 'tdcm_ros[plot]'",
+                         parameter=option.lstrip("-"), value=str(target),
                          allowed="matplotlib installed") from exc
     return plt
 
 
-def write_plots(evaluation: Evaluation, directory: str | Path) -> list[Path]:
-    """Write ``shapes.png`` (measured and predicted midlines and markers, x-z plane of
-    ``tdcm_base``, one panel per trial) and ``error_vs_tension.png`` into ``directory`` (created
-    if missing; its parent must exist)."""
-    plt = _pyplot(Path(directory))
-    out = output_folder("--plots", directory)
+def marker_offset_m(evaluation: Evaluation) -> float:
+    """Distance of the marker centres from the midline in the evaluation's layout (m)."""
+    return float(evaluation.options.layout.radius(evaluation.options.design.R_outer))
+
+
+def shapes_caption(evaluation: Evaluation) -> str:
+    """Why the measured markers and the measured midline are apart (or not)."""
+    offset_mm = marker_offset_m(evaluation) * MM
+    if offset_mm < 1e-6:
+        return "Markers are on the midline: the measured midline is a spline through them."
+    layout = evaluation.options.layout
+    source = ("on the body surface: R_outer + ball radius" if layout.radial_offset is None else
+              "markers.radial_offset")
+    return (f"Markers are ball centres {offset_mm:.2f} mm from the midline ({source}), "
+            f"{layout.side_deg:g} deg around the body from the tendon side. The "
+            "measured midline is a spline through the markers moved back by that offset, so it "
+            f"runs {offset_mm:.1f} mm from them by construction; compare markers with markers "
+            "and midlines with midlines.")
+
+
+def shapes_figure(plt: Any, evaluation: Evaluation) -> Any:
+    """Measured and predicted midlines and markers, x-z plane of ``tdcm_base``, one panel per
+    trial, colour = the step's mean tension."""
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
+
     records = evaluation.records
-    trials = sorted({r.trial for r in records})
-    fig, axes = plt.subplots(1, len(trials), figsize=(4 * len(trials), 5), squeeze=False,
-                             sharey=True)
+    trials = sorted({r.trial for r in records}) or [1]
+    offset_mm = marker_offset_m(evaluation) * MM
+    tensions = [r.tension_n for r in records] or [0.0]
+    norm = Normalize(vmin=min(tensions), vmax=max(max(tensions), min(tensions) + 1e-9))
+    cmap = plt.get_cmap("viridis")
+    fig = plt.figure(figsize=(PANEL_SIZE_IN[0] * len(trials) + 1.5, PANEL_SIZE_IN[1]),
+                     layout="constrained")
+    axes = fig.subplots(1, len(trials), squeeze=False, sharey=True)
     for ax, trial in zip(axes[0], trials, strict=True):
         for r in (r for r in records if r.trial == trial):
+            colour = cmap(norm(r.tension_n))
             if r.predicted_midline is not None:
-                line = ax.plot(r.predicted_midline[:, 0] * 1e3, r.predicted_midline[:, 2] * 1e3,
-                               "-", lw=1.2, label=f"{r.tension_n:.1f} N model")[0]
-                colour = line.get_color()
-            else:
-                colour = "k"
+                ax.plot(r.predicted_midline[:, 0] * MM, r.predicted_midline[:, 2] * MM, "-",
+                        lw=1.4, color=colour)
             if r.measured_midline is not None:
-                ax.plot(r.measured_midline[:, 0] * 1e3, r.measured_midline[:, 2] * 1e3, "--",
-                        lw=1.2, color=colour)
-            ax.plot(r.measured_markers[:, 0] * 1e3, r.measured_markers[:, 2] * 1e3, "o",
-                    ms=4, mfc="none", color=colour)
-        ax.set_title(f"trial {trial}: model (solid), measured (dashed, markers o)", fontsize=8)
-        ax.set_xlabel("x (mm)")
+                ax.plot(r.measured_midline[:, 0] * MM, r.measured_midline[:, 2] * MM, "--",
+                        lw=1.4, color=colour)
+            ax.plot(r.measured_markers[:, 0] * MM, r.measured_markers[:, 2] * MM, "o", ms=6,
+                    mfc="none", mew=1.4, color=colour)
+            if r.predicted_markers is not None:
+                ax.plot(r.predicted_markers[:, 0] * MM, r.predicted_markers[:, 2] * MM, "x",
+                        ms=6, mew=1.4, color=colour)
+        ax.set_title(f"trial {trial}", fontsize=FONT_SIZE + 1)
+        ax.set_xlabel("x in tdcm_base (mm)", fontsize=FONT_SIZE)
         ax.set_aspect("equal")
-        ax.legend(fontsize=6, loc="best")
-    axes[0][0].set_ylabel("z (mm)")
-    fig.tight_layout()
-    shapes = out / "shapes.png"
-    fig.savefig(shapes, dpi=120)
-    plt.close(fig)
+        ax.grid(True, alpha=0.3)
+        ax.tick_params(labelsize=FONT_SIZE)
+    axes[0][0].set_ylabel("z in tdcm_base (mm)", fontsize=FONT_SIZE)
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=list(axes[0]), shrink=0.8)
+    bar.set_label("step mean tension (N)", fontsize=FONT_SIZE)
+    handles = [
+        Line2D([], [], color="k", ls="-", lw=1.4, label="model midline"),
+        Line2D([], [], color="k", ls="none", marker="x", ms=6, label="model markers"),
+        Line2D([], [], color="k", ls="--", lw=1.4,
+               label=f"measured midline (spline through the markers moved {offset_mm:.1f} mm "
+                     "to the midline)"),
+        Line2D([], [], color="k", ls="none", marker="o", mfc="none", ms=6,
+               label=f"measured markers (ball centres, {offset_mm:.1f} mm off the midline)"),
+    ]
+    fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=FONT_SIZE)
+    width = int(12 * fig.get_figwidth())  # characters of FONT_SIZE - 1 per line
+    fig.suptitle("Measured and model shapes at each step\n" + textwrap.fill(
+        shapes_caption(evaluation), width), fontsize=FONT_SIZE - 1)
+    return fig
 
-    fig, ax = plt.subplots(figsize=(6, 4))
-    usable = [r for r in records if r.usable]
-    for trial in trials:
+
+def error_figure(plt: Any, evaluation: Evaluation) -> Any:
+    """Tip deflection error (predicted - measured) against the step's mean tension, per trial."""
+    fig, ax = plt.subplots(figsize=(7.0, 4.5))
+    usable = [r for r in evaluation.records if r.usable]
+    for trial in sorted({r.trial for r in evaluation.records}):
         rows = [r for r in usable if r.trial == trial]
         tension = np.array([r.tension_n for r in rows])
         error = np.array([(r.predicted_deflection_m or 0.0) - (r.measured_deflection_m or 0.0)
                           for r in rows])
-        ax.plot(tension, error * 1e3, "o-", label=f"trial {trial}")
-    ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_xlabel("tension (N)")
-    ax.set_ylabel("tip deflection error, predicted - measured (mm)")
-    ax.legend(fontsize=8)
+        ax.plot(tension, error * MM, "o-", label=f"trial {trial}")
+    ax.axhline(0.0, color="k", lw=0.8, label="no error")
+    ax.set_xlabel("step mean tension (N)", fontsize=FONT_SIZE)
+    ax.set_ylabel("tip deflection error,\npredicted - measured (mm)", fontsize=FONT_SIZE)
+    ax.set_title("model error at each step", fontsize=FONT_SIZE + 1)
+    ax.tick_params(labelsize=FONT_SIZE)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=FONT_SIZE - 1)
     fig.tight_layout()
-    errors = out / "error_vs_tension.png"
-    fig.savefig(errors, dpi=120)
-    plt.close(fig)
-    return [shapes, errors]
+    return fig
+
+
+def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = "--out"
+                ) -> list[Path]:
+    """Write ``shapes.png`` (:func:`shapes_figure`) and ``error_vs_tension.png``
+    (:func:`error_figure`) into ``directory`` (created if missing; its parent must exist;
+    ``option`` names it in errors)."""
+    plt = _pyplot(Path(directory), option)
+    out = output_folder(option, directory)
+    paths = []
+    for name, make in (("shapes.png", shapes_figure), ("error_vs_tension.png", error_figure)):
+        fig = make(plt, evaluation)
+        fig.savefig(out / name, dpi=120)
+        plt.close(fig)
+        paths.append(out / name)
+    return paths

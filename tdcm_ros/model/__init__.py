@@ -50,6 +50,7 @@ from tdcm_ros.model.profiles import (
     CustomProfile,
     RectangularProfile,
 )
+from tdcm_ros.model.progress import Progress, report_progress, within
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
@@ -79,6 +80,7 @@ __all__ = [
     "ModelLimitError",
     "NotchClosureError",
     "NotchContact",
+    "Progress",
     "RectangularProfile",
     "SolveResult",
     "SolverSettings",
@@ -91,9 +93,11 @@ __all__ = [
     "one_shot",
     "parse_field",
     "preset",
+    "report_progress",
     "solve",
     "surface_points",
     "sweep",
     "use_compiled",
     "warm_up",
+    "within",
 ]

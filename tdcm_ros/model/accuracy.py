@@ -22,7 +22,7 @@ configuration's error. Timings are wall-clock on a shared machine and noisy.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from time import perf_counter
 from typing import Any
@@ -35,6 +35,7 @@ from tdcm_ros.model.design import MM, PRESETS, Design, preset
 from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import build_grid
 from tdcm_ros.model.kinematics import integrate
+from tdcm_ros.model.progress import Progress, report_progress
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
 
@@ -274,14 +275,18 @@ def _time_one(config: Config, design: Design, tension: float, repeats: int
     return tip, converged, float(np.median(times))
 
 
-def run_bench(*, quick: bool = False, progress: Callable[[str], None] | None = None) -> Report:
-    """Run every configuration on every case; see the module docstring."""
+def run_bench(*, quick: bool = False, progress: Progress | None = None) -> Report:
+    """Run every configuration on every case; see the module docstring. ``progress``: stages
+    ``reference solutions`` (one unit per model and case) and ``methods and settings`` (one
+    per configuration)."""
     cases = [(name, d, t) for name, d in designs(quick).items() for t in tensions(quick)]
     models = {"paper/closed", "free/closed", "paper/literal", "constrained"}
     refs: dict[tuple[str, str], Array] = {}
     ref_spread: dict[str, float] = {}
-    for model in sorted(models):
+    references = len(models) * len(cases)
+    for index, model in enumerate(sorted(models)):
         spread = 0.0
+        report_progress(progress, "reference solutions", index * len(cases), references)
         for name, design, t in cases:
             fine = _reference_tip(model, design, t, REFERENCE)
             coarse = _reference_tip(model, design, t, COARSER)
@@ -295,10 +300,11 @@ def run_bench(*, quick: bool = False, progress: Callable[[str], None] | None = N
             for n, _, t in cases)
         for model in sorted(models - {PACKAGE_MODEL})}
 
+    report_progress(progress, "reference solutions", references, references)
     rows = []
-    for config in configs(quick):
-        if progress is not None:
-            progress(config.label)
+    chosen = configs(quick)
+    for index, config in enumerate(chosen):
+        report_progress(progress, "methods and settings", index, len(chosen))
         ref_model = config.model if config.model in models else PACKAGE_MODEL
         repeats = 1 if config.options is not None else 5
         errors: dict[str, float] = {}
@@ -324,6 +330,7 @@ def run_bench(*, quick: bool = False, progress: Callable[[str], None] | None = N
                         median_time_s=float(np.median(times)) if times else math.inf,
                         solves=len(values), not_converged=not_converged, failed=failed,
                         default=config.default, errors_by_case=errors))
+    report_progress(progress, "methods and settings", len(chosen), len(chosen))
     _mark_front(rows)
     default = next(r for r in rows if r.default)
     return Report(designs=[n for n in designs(quick)], tensions=list(tensions(quick)),
@@ -489,7 +496,8 @@ def plot_pareto(report: Report, path: str) -> None:
             ax.annotate("default", (r.median_time_s, max(r.max_error_m, floor)),
                         xytext=(8, 8), textcoords="offset points", fontsize=9)
             ax.scatter([r.median_time_s], [max(r.max_error_m, floor)], s=160,
-                       facecolors="none", edgecolors="k", zorder=4)
+                       facecolors="none", edgecolors="k", zorder=4,
+                       label="the package's default setting")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("median time per solve (s)")
@@ -497,7 +505,7 @@ def plot_pareto(report: Report, path: str) -> None:
     ax.set_title(f"Accuracy vs time: {len(report.designs)} designs x "
                  f"{len(report.tensions)} tensions")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -19,7 +19,7 @@ from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import CircularProfile, NotchProfile, profile_from_name
 from tdcm_ros.model.section import tube_moment
-from tdcm_ros.spec import check_fields, spec_field, specs_of
+from tdcm_ros.spec import check_fields, spec_field, specs_of, spelled_as
 
 MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
@@ -145,10 +145,11 @@ PRESETS: dict[str, Design] = {
 
 
 def preset(name: str) -> Design:
-    """A named design: ``paper-experiment`` (Sec. III-B) or a Sec. III-A figure design."""
-    try:
-        return PRESETS[name]
-    except KeyError:
+    """A named design: ``paper-experiment`` (Sec. III-B) or a Sec. III-A figure design
+    (``-`` and ``_`` are the same in names: ``paper_experiment`` works too)."""
+    known = spelled_as(name, PRESETS) if isinstance(name, str) else None
+    if known is None:
         raise InvalidDesignError(
             f"unknown design preset {name!r}; allowed: {', '.join(PRESETS)}",
-            parameter="design", value=name, allowed=", ".join(PRESETS)) from None
+            parameter="design", value=name, allowed=", ".join(PRESETS))
+    return PRESETS[known]

@@ -23,6 +23,7 @@ every swept design gets ``w_t = w_tip = P - w_n``, so ``L = w_base + N P`` stays
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -32,10 +33,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model.batch import solve_batch
+from tdcm_ros.model.batch import BatchResult, solve_batch
 from tdcm_ros.model.design import FIELD_SPECS, Design
 from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
 from tdcm_ros.model.limits import check_tension
+from tdcm_ros.model.progress import Progress, report_progress
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS
 
@@ -48,6 +50,11 @@ DEFAULT_ALLOWABLE_STRAIN = NYLON12_ELONGATION_AT_BREAK["z"]
 """The lower (Z, across layers) datasheet value: the build direction of the body is unknown
 and an elongation at break is a failure, not a working, strain."""
 COUPLINGS = ("none", "fixed-pitch")
+PROGRESS_UPDATES = 40
+"""Most chunks a sweep with a progress hook is solved in."""
+PROGRESS_CHUNK_DESIGNS = 100
+"""Fewest designs in such a chunk: each ``solve_batch`` call builds its grids at a fixed cost
+of a few ms (bench/bench_progress.py), so a small sweep is solved in one batch."""
 STATUSES = ("ok", "strain", "closure", "singularity", "non_convergence", "invalid")
 
 
@@ -114,9 +121,14 @@ def couple(design: Design, coupling: str, pitch: float) -> Design:
 
 def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
           coupling: str = "none", allowable_strain: float = DEFAULT_ALLOWABLE_STRAIN,
-          settings: SolverSettings = DEFAULT_SETTINGS) -> DesignSpace:
+          settings: SolverSettings = DEFAULT_SETTINGS,
+          progress: Progress | None = None) -> DesignSpace:
     """Tip response of ``base`` with one or two fields varied (``{name: SI values}``) at every
-    tension (N). Invalid axis values raise :class:`InvalidDesignError`."""
+    tension (N). Invalid axis values raise :class:`InvalidDesignError`.
+
+    With ``progress`` the designs are solved in chunks (at most :data:`PROGRESS_UPDATES`, at
+    least :data:`PROGRESS_CHUNK_DESIGNS` designs each), each reported as ``progress("design
+    sweep", designs solved, designs)``; the answers are the same."""
     if not isinstance(base, Design):
         raise InvalidDesignError(f"base = {base!r} is not a Design", parameter="base",
                                  value=base, allowed="tdcm_ros.model.Design")
@@ -137,7 +149,7 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
     for index in np.ndindex(*shape):
         overrides = {name: _scalar(name, values[a].item(index[a])) for a, name in enumerate(fields)}
         designs.append(couple(base.with_overrides(**overrides), coupling, pitch))
-    result = solve_batch(designs, np.broadcast_to(t, (len(designs), t.size)), settings=settings)
+    result = _solve_reporting(designs, t, settings, progress)
     status = _classify(result.status, result.max_bending_strain, strain_limit)
     grid_shape = shape + (t.size,)
     return DesignSpace(
@@ -147,6 +159,24 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
         tip_deflection_m=result.tip_deflection_m.reshape(grid_shape),
         tip_angle_rad=result.tip_angle_rad.reshape(grid_shape),
         max_bending_strain=result.max_bending_strain.reshape(grid_shape))
+
+
+def _solve_reporting(designs: list[Design], tensions: Array, settings: SolverSettings,
+                     progress: Progress | None) -> BatchResult:
+    """``solve_batch`` of ``designs`` at every tension, in chunks reported to ``progress``."""
+    if progress is None:
+        return solve_batch(designs, np.broadcast_to(tensions, (len(designs), tensions.size)),
+                           settings=settings)
+    size = max(PROGRESS_CHUNK_DESIGNS, -(-len(designs) // PROGRESS_UPDATES))
+    parts = []
+    report_progress(progress, "design sweep", 0, len(designs))
+    for start in range(0, len(designs), size):
+        chunk = designs[start:start + size]
+        parts.append(solve_batch(chunk, np.broadcast_to(tensions, (len(chunk), tensions.size)),
+                                 settings=settings))
+        report_progress(progress, "design sweep", start + len(chunk), len(designs))
+    return BatchResult(**{f.name: np.concatenate([getattr(p, f.name) for p in parts])
+                          for f in dataclasses.fields(BatchResult)})
 
 
 def design_curves(designs: Mapping[str, Design], tensions: ArrayLike, *,

@@ -7,6 +7,7 @@ from pathlib import Path
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.paths import SUFFIXES, shipped_scenes
 from tdcm_ros.scenes.scene import Scene, parse_scene
+from tdcm_ros.spec import spelled_as
 from tdcm_ros.yamlio import load_yaml
 
 #: names of the shipped scenes found at import time
@@ -21,11 +22,13 @@ def scene_from_text(text: str, *, name: str = "scene", source: Path | None = Non
 
 
 def load_scene(scene: str | Path) -> Scene:
-    """A shipped scene by name (see :data:`SCENE_NAMES`) or a scene file by path."""
+    """A shipped scene by name (see :data:`SCENE_NAMES`; ``-`` and ``_`` are the same in names:
+    ``paper-experiment`` is ``paper_experiment``) or a scene file by path."""
     shipped = shipped_scenes()
     path = Path(scene)
-    if str(scene) in shipped:
-        path = shipped[str(scene)]
+    name = spelled_as(str(scene), shipped)
+    if name is not None:
+        path = shipped[name]
     elif not (path.suffix in SUFFIXES or path.exists()):
         allowed = ", ".join(shipped) + ", or a path to a .yaml file"
         raise InvalidSceneError(f"unknown scene {str(scene)!r}; allowed: {allowed}",
