@@ -7,8 +7,8 @@ by ``rate``. Each topic is published with the QoS its recorded publishers offere
 later still receives it, as long as the player runs). Playback starts ``start_offset_s`` after
 the bag's first log time; ``loop`` plays it again from there until stopped. With ``clock_hz`` > 0,
 ``/clock`` (rosgraph_msgs/msg/Clock) carries the bag time (log time) at that rate (Hz of wall
-time), once at the start of each pass and then periodically, so nodes with ``use_sim_time`` run
-on the bag's time. Topics whose type is unknown (no definition in the bag or the typestore) or
+time): the start offset's time during ``delay_s``, then once at the start of each pass and
+periodically, so nodes with ``use_sim_time`` run on the bag's time from before the first message. Topics whose type is unknown (no definition in the bag or the typestore) or
 that the runtime cannot publish (rclpy without the message package) are skipped with a warning.
 
 The player owns its context (``open_context(runtime)``, configured from the environment);
@@ -193,7 +193,11 @@ class Player:
 
     def run(self) -> int:
         """Play until the end (with ``loop``: until stopped); returns the messages published."""
-        if self._wait_until(time.monotonic() + self.options.delay_s, playing=False):
+        now = time.monotonic()
+        self._wall0 = now + self.options.delay_s  # /clock holds the start time until then
+        self._next_clock = now if self._clock is not None else math.inf
+        self._next_report = now
+        if self._wait_until(self._wall0):
             while self._play_pass() and self.options.loop:
                 pass
         self._report(time.monotonic())
@@ -217,21 +221,22 @@ class Player:
         return not self._stop.is_set()
 
     def _bag_ns(self, wall: float) -> int:
-        """Bag time (log time, ns) at monotonic time ``wall`` of the current pass."""
-        return self.base_ns + round((wall - self._wall0) * self.options.rate * 1e9)
+        """Bag time (log time, ns) at monotonic time ``wall`` of the current pass (the start
+        offset's time during ``delay_s``)."""
+        return self.base_ns + max(round((wall - self._wall0) * self.options.rate * 1e9), 0)
 
-    def _wait_until(self, due: float, *, playing: bool = True) -> bool:
-        """Wait for monotonic time ``due``, sending ``/clock`` ticks and progress reports when
-        ``playing``; False if stopped."""
+    def _wait_until(self, due: float) -> bool:
+        """Wait for monotonic time ``due``, sending ``/clock`` ticks and progress reports;
+        False if stopped."""
         while not self._stop.is_set():
             now = time.monotonic()
-            if playing and now >= self._next_clock:
+            if now >= self._next_clock:
                 self._tick(now)
-            if playing and now >= self._next_report:
+            if now >= self._next_report:
                 self._report(now)
             if now >= due:
                 return True
-            wake = min(due, self._next_clock, self._next_report) if playing else due
+            wake = min(due, self._next_clock, self._next_report)
             self._context.spin_for(min(max(wake - now, 0.0), STOP_LATENCY_S))
         return False
 
