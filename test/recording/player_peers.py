@@ -91,17 +91,22 @@ class RawPeer:
         return [at for t, _, at in self.got if t == topic]
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-            self.context.spin_for(0.05)
+        spin_until(self.context, predicate, timeout, what)
 
     def spin_while_running(self, process: subprocess.Popen[bytes], timeout: float) -> int:
         """Spin until ``process`` exits; its exit status."""
         self.spin_until(lambda: process.poll() is not None, timeout, "the player to exit")
         self.context.spin_for(0.3)
         return int(process.returncode)
+
+
+def spin_until(context: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
+    """Spin ``context`` until ``predicate()``; AssertionError naming ``what`` after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        context.spin_for(0.05)
 
 
 def interrupt(process: subprocess.Popen[bytes], timeout: float = 20.0) -> tuple[int, str]:

@@ -21,6 +21,7 @@ from typing import Any
 
 import pytest
 import yaml
+from player_peers import spin_until
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.bagio.reader import open_bag
@@ -44,7 +45,7 @@ STEP_ABS = {"start_s": 1e-6, "end_s": 1e-6, "tension": 0.01, "measured": 2e-6,
 #: (one run each, shared 2-core machine).
 RATE = {"zenoh": "4", "rclpy": "2"}
 #: wall time (s) for discovery before the first message (see test_player.py)
-DELAY = {"zenoh": "0.5", "rclpy": "3.0"}
+DELAY = {"zenoh": "0.5", "rclpy": "5.0"}
 Spawn = Callable[..., subprocess.Popen[bytes]]
 
 
@@ -91,13 +92,7 @@ class Outputs:
                                         {kv.key: kv.value for kv in status.values})
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        import time
-
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-            self.context.spin_for(0.1)
+        spin_until(self.context, predicate, timeout, what)
 
 
 def test_the_sample_bag_played_into_the_nodes_gives_evaluates_table(

@@ -32,7 +32,7 @@ REPO = Path(__file__).resolve().parents[2]
 PLAY = ("tdcm_ros.cli.main", "bag", "play")
 #: Wall time (s) between the player's publishers and its first message: lets the peer's
 #: subscriptions match them (DDS discovery on rclpy; the router's declarations on zenoh).
-DELAY = {"zenoh": "0.5", "rclpy": "3.0"}
+DELAY = {"zenoh": "0.5", "rclpy": "5.0"}
 
 
 @pytest.fixture
@@ -61,7 +61,9 @@ def test_the_peer_receives_the_bags_bytes_in_order(runtime: str, context: Any, s
         peer.subscribe(topic, type_name)
     player = play(spawn, runtime, bag, "--rate", "4")
     assert peer.spin_while_running(player, 60.0) == 0, player.stderr.read().decode()
-    peer.spin_until(lambda: len(peer.got) >= len(messages), 10.0, "every message")
+    peer.spin_until(lambda: len(peer.got) >= len(messages), 10.0,
+                    f"every message ({len(messages)}; the first ones are lost if the player's "
+                    f"publishers had not matched the peer within --delay)")
     for topic in TYPES:
         assert peer.on(topic) == as_received(runtime, on(messages, topic)), topic
     assert len(peer.got) == len(messages)
