@@ -16,10 +16,15 @@ import sys
 from types import FrameType
 from typing import Any
 
+from tdcm_ros.cli.main import INTERRUPTED_EXIT
 from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
 
 DEFAULT_CLOCK_HZ = 40.0
 """``--clock`` without a value: ``ros2 bag play --clock``'s default rate (Hz)."""
+
+EXIT_MEANINGS = {"bag play": {INTERRUPTED_EXIT: f"playback stopped; SIGTERM gives "
+                                                f"{128 + signal.SIGTERM}"}}
+"""What ``bag play`` means by an exit status (its ``--help`` epilog)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
