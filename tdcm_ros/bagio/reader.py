@@ -39,7 +39,9 @@ from mcap.summary import Summary
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
 from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio.qos import parse_profiles, recorded_qos
 from tdcm_ros.bagio.typestore import typestore
+from tdcm_ros.bagio.writer import OfferedQos
 from tdcm_ros.yamlio import load_yaml
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -141,6 +143,7 @@ class _McapSource:
         self.warnings: list[str] = []
         self.topics: dict[str, _TopicInfo] = {}
         self.counts: dict[str, int] = {}
+        self.profiles: dict[str, list[Any]] = {}
         self._channels: dict[int, Channel] = {}
         self._schemas: dict[int, Schema] = {}
         self._types: dict[int, str] = {}
@@ -149,6 +152,7 @@ class _McapSource:
         self._chunks: list[ChunkIndex] = []
         self._skipped: set[int] = set()  # byte offsets of the chunks left out as damaged
         self.ordered = True  # units (chunks, loose messages) do not overlap in time
+        self.time_range: tuple[int, int] | None = None  # first and last log time (ns) read
         with path.open("rb") as stream:
             if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
                 raise BagError(f"{path}: not an MCAP file (no MCAP magic at the start)")
@@ -199,6 +203,8 @@ class _McapSource:
                           schema.encoding if schema else "",
                           schema.data.decode("utf-8", "replace") if schema else "")
         self._types[channel.id] = info.msgtype
+        self.profiles.setdefault(channel.topic, parse_profiles(
+            channel.metadata.get("offered_qos_profiles", "")))
         known = self.topics.setdefault(channel.topic, info)
         self.counts.setdefault(channel.topic, 0)
         if known.msgtype != info.msgtype:
@@ -206,6 +212,8 @@ class _McapSource:
                                  f"({known.msgtype}, {info.msgtype}); reading {known.msgtype}")
 
     def _note_range(self, start: int, end: int) -> None:
+        first, last = self.time_range or (start, end)
+        self.time_range = (min(first, start), max(last, end))
         self.ordered = self.ordered and start >= self._last_end
         self._last_end = max(self._last_end, end)
 
@@ -403,7 +411,10 @@ class _RosbagsSource:
             raise BagError(f"{path}: cannot open rosbag2 bag ({_describe(error)})") from error
         self.topics: dict[str, _TopicInfo] = {}
         self.counts: dict[str, int] = {}
+        self.profiles: dict[str, list[Any]] = {}
         for connection in self._reader.connections:
+            self.profiles.setdefault(connection.topic, parse_profiles(
+                getattr(connection.ext, "offered_qos_profiles", [])))
             fmt = connection.msgdef.format.name.lower() if connection.msgdef else "none"
             encoding = {"msg": "ros2msg", "idl": "ros2idl"}.get(fmt, "")
             self.topics.setdefault(connection.topic, _TopicInfo(
@@ -411,6 +422,9 @@ class _RosbagsSource:
                 connection.msgdef.data if connection.msgdef else ""))
             self.counts[connection.topic] = self.counts.get(connection.topic, 0) + \
                 connection.msgcount
+        self.time_range: tuple[int, int] | None = (
+            (self._reader.start_time, self._reader.end_time - 1)
+            if self._reader.message_count else None)
 
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
         """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""
@@ -457,10 +471,12 @@ class BagReader:
         self.topics: dict[str, str] = {}
         self.counts: dict[str, int] = {}
         self._undecodable: dict[str, str] = {}
+        self._profiles: dict[str, list[Any]] = {}
         for source in self._sources:
             self.warnings.extend(source.warnings)
             for topic, info in source.topics.items():
                 self.topics.setdefault(topic, info.msgtype)
+                self._profiles.setdefault(topic, []).extend(source.profiles.get(topic, []))
                 self.counts[topic] = self.counts.get(topic, 0) + source.counts.get(topic, 0)
                 if topic not in self._undecodable and (why := _register(info.msgtype, info)):
                     self._undecodable[topic] = why
@@ -474,6 +490,22 @@ class BagReader:
     def message_count(self) -> int:
         """Messages in the readable part of the bag."""
         return sum(self.counts.values())
+
+    def qos(self, topic: str) -> OfferedQos:
+        """The QoS the bag's publishers of ``topic`` offered, folded into one profile
+        (:func:`tdcm_ros.bagio.qos.recorded_qos`); BagError if the topic is absent."""
+        return recorded_qos(self._profiles.get(self.resolve(topic), []))
+
+    @property
+    def time_range_ns(self) -> tuple[int, int]:
+        """Log times (ns since the epoch) of the first and the last message readable."""
+        ranges = [r for source in self._sources if (r := source.time_range) is not None]
+        return min(r[0] for r in ranges), max(r[1] for r in ranges)
+
+    @property
+    def undecodable(self) -> dict[str, str]:
+        """Topic -> why its messages cannot be decoded (also in ``warnings``)."""
+        return dict(self._undecodable)
 
     def resolve(self, topic: str) -> str:
         """The stored name of ``topic`` (``tension`` finds ``/tension``); BagError if absent."""

@@ -30,7 +30,7 @@ COMMANDS: dict[str, str] = {
     "up": "tdcm_ros.cli.up",
     "topic": "tdcm_ros.cli.topic",
     "record": "tdcm_ros.cli.record",
-    "bag": "tdcm_ros.cli.record",
+    "bag": "tdcm_ros.cli.bag",
     "param": "tdcm_ros.cli.param",
     "bench": "tdcm_ros.cli.bench",
     "figures": "tdcm_ros.cli.figures",

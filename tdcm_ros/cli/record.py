@@ -2,7 +2,7 @@
 
 ``--runtime`` defaults to ``TDCM_RUNTIME`` if set, else zenoh.
 
-Also ``tdcm bag info BAG``: topics, types, counts and warnings of a bag (folder or ``.mcap``).
+``tdcm bag info|play`` is in :mod:`tdcm_ros.cli.bag`.
 """
 
 from __future__ import annotations
@@ -44,29 +44,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"graph to record (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
                              f"if importable)")
     parser.set_defaults(handler=run_record)
-
-    bag = subparsers.add_parser(
-        "bag", help="inspect bags",
-        description="Work with rosbag2 bags (MCAP storage): folders or .mcap files.",
-        epilog="examples:\n"
-               "  tdcm bag info bags/paper_experiment")
-    verbs = bag.add_subparsers(dest="verb", required=True, metavar="VERB")
-    info = verbs.add_parser("info", help="topics, types, message counts, warnings")
-    info.add_argument("bag", help="rosbag2 folder or .mcap file")
-    info.set_defaults(handler=run_info)
-
-
-def run_info(args: argparse.Namespace) -> int:
-    """Print what ``open_bag`` finds in a bag."""
-    from tdcm_ros.bagio.reader import open_bag
-
-    reader = open_bag(args.bag)
-    print(f"bag: {reader.path}\nmessages: {reader.message_count}\ntopics:")
-    for topic in sorted(reader.topics):
-        print(f"  {topic} [{reader.topics[topic]}]: {reader.counts[topic]}")
-    for warning in reader.warnings:
-        print(f"warning: {warning}")
-    return 0
 
 
 def _check(args: argparse.Namespace) -> None:

@@ -16,6 +16,9 @@ from tdcm_ros.runtime.launcher import launch
 from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
 from tdcm_ros.runtime.port import (
+    CLOCK_QOS,
+    CLOCK_TOPIC,
+    CLOCK_TYPE,
     DEFAULT_QOS,
     NodeLogic,
     NodePort,
@@ -27,6 +30,9 @@ from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
 from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 
 __all__ = [
+    "CLOCK_QOS",
+    "CLOCK_TOPIC",
+    "CLOCK_TYPE",
     "DEFAULT_NODE_SET",
     "DEFAULT_QOS",
     "NODES",

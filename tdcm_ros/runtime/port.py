@@ -52,6 +52,11 @@ class QoS:
 
 
 DEFAULT_QOS = QoS()
+#: Where a node with ``use_sim_time`` takes its time from, as in ROS 2.
+CLOCK_TOPIC = "/clock"
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+#: rclcpp's ``ClockQoS``: the newest time only.
+CLOCK_QOS = QoS(depth=1, reliability="best_effort")
 
 
 class Publisher(Protocol):
@@ -125,7 +130,8 @@ class NodePort(Protocol):
         """Call ``callback`` every ``period`` seconds."""
 
     def now_ns(self) -> int:
-        """Current time of the node's clock, ns since the UNIX epoch."""
+        """Current time of the node's clock, ns since the UNIX epoch (with the ROS parameter
+        ``use_sim_time``: the latest ``/clock``, 0 before the first)."""
 
 
 class NodeLogic:

@@ -43,6 +43,8 @@ from tdcm_ros.yamlio import load_yaml
 #: Seconds a parameter client waits for a node's parameter services.
 PARAM_TIMEOUT_S = 5.0
 _NO_GID = bytes(wire.GID_SIZE)
+#: rclpy's own parameter that puts the node clock on ``/clock``.
+SIM_TIME = "use_sim_time"
 
 
 def message_class(type_name: str) -> Any:
@@ -152,6 +154,10 @@ class RclpyNodePort:
                                    self.create_publisher, self.now_ns)
         node.add_pre_set_parameters_callback(self._widen)
         node.add_on_set_parameters_callback(self._on_set)
+        if SIM_TIME in self._overrides:  # a --params file is read here, not by rcl
+            from rclpy.parameter import Parameter
+
+            node.set_parameters([Parameter(SIM_TIME, value=bool(self._overrides[SIM_TIME]))])
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,

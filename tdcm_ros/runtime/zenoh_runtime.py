@@ -56,7 +56,14 @@ from tdcm_ros.runtime.parameters import (
     SetCallback,
     Validator,
 )
-from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
+from tdcm_ros.runtime.port import (
+    CLOCK_QOS,
+    CLOCK_TOPIC,
+    CLOCK_TYPE,
+    DEFAULT_QOS,
+    NodePort,
+    QoS,
+)
 from tdcm_ros.runtime.wire import RawSample
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
@@ -312,6 +319,13 @@ class ZenohNodePort:
         self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
         self._queryable = context.session.declare_queryable(
             param_key(context.domain_id, self.fqn, "*"), self._on_param_query)
+        self._clock_ns = 0
+        self.use_sim_time = self.declare_parameter(
+            "use_sim_time", False, read_only=True,
+            description=f"take the time from {CLOCK_TOPIC} ({CLOCK_TYPE}) instead of the system "
+                        f"clock (0 until the first message), as ROS nodes do; fixed at start")
+        if self.use_sim_time:
+            self.create_subscription(CLOCK_TOPIC, CLOCK_TYPE, self._on_clock, CLOCK_QOS)
 
     # parameters
     def declare_parameter(self, name: str, default: P, *, description: str = "",
@@ -417,9 +431,12 @@ class ZenohNodePort:
         return self._context.executor.add_timer(period, self.guard.wrap(
             f"timer {getattr(callback, '__qualname__', period)}", callback))
 
+    def _on_clock(self, message: Any) -> None:
+        self._clock_ns = int(message.clock.sec) * 1_000_000_000 + int(message.clock.nanosec)
+
     def now_ns(self) -> int:
-        """System time, ns since the UNIX epoch."""
-        return time.time_ns()
+        """System time, ns since the UNIX epoch; with ``use_sim_time`` the latest ``/clock``."""
+        return self._clock_ns if self.use_sim_time else time.time_ns()
 
     def close(self) -> None:
         """Undeclare every endpoint, the parameter queryable and the node token."""

@@ -1,0 +1,146 @@
+"""``tdcm bag info BAG`` and ``tdcm bag play BAG``: describe a bag; play it into the live graph.
+
+``bag play`` publishes the bag's messages byte for byte on the embedded (zenoh) runtime or, with
+``--runtime rclpy``, on ROS 2 (default: ``TDCM_RUNTIME``, else zenoh), as ``ros2 bag play``
+does: ``--rate``, ``--start-offset``, ``--loop``, ``--topics``, ``--remap OLD:=NEW``, ``--clock
+[HZ]``, ``--delay``. A progress line goes to stderr when it is a terminal (not with
+``--quiet``); Ctrl-C (SIGINT) stops it with status 130, SIGTERM with 143.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import sys
+from types import FrameType
+from typing import Any
+
+from tdcm_ros.cli.main import INTERRUPTED_EXIT
+from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
+
+DEFAULT_CLOCK_HZ = 40.0
+"""``--clock`` without a value: ``ros2 bag play --clock``'s default rate (Hz)."""
+
+EXIT_MEANINGS = {"bag play": {INTERRUPTED_EXIT: f"playback stopped; SIGTERM gives "
+                                                f"{128 + signal.SIGTERM}"}}
+"""What ``bag play`` means by an exit status (its ``--help`` epilog)."""
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``bag`` with its verbs ``info`` and ``play``."""
+    bag = subparsers.add_parser("bag", help="describe a bag; play it into the live graph",
+                                description="Describe a rosbag2 bag (MCAP storage: a folder or "
+                                            "an .mcap file) or play it into the live graph "
+                                            "(zenoh or rclpy).",
+                                epilog="examples:\n"
+                                       "  tdcm bag info bags/paper_experiment\n"
+                                       "  tdcm bag play bags/paper_experiment --rate 2 --clock")
+    verbs = bag.add_subparsers(dest="verb", required=True, metavar="VERB")
+    info = verbs.add_parser("info", help="topics, types, message counts, warnings")
+    info.add_argument("bag", help="rosbag2 folder or .mcap file")
+    info.set_defaults(handler=run_info)
+
+    play = verbs.add_parser(
+        "play", help="publish a bag's messages into the live graph (zenoh or rclpy)",
+        description="Publish the bag's messages (their CDR bytes, unchanged) at the recorded "
+                    "spacing, each topic with the QoS its publishers offered when recorded. "
+                    "Ctrl-C stops (exit status 130).")
+    play.add_argument("bag", help="rosbag2 folder or .mcap file")
+    play.add_argument("--rate", type=float, default=1.0,
+                      help="factor of the recorded speed (> 0; default 1)")
+    play.add_argument("--start-offset", type=float, default=0.0, metavar="S",
+                      help="start S seconds after the bag's first message")
+    play.add_argument("--loop", action="store_true", help="play again from the start offset "
+                                                          "until Ctrl-C")
+    play.add_argument("--topics", nargs="+", default=[], metavar="TOPIC",
+                      help="play only these topics (bag names; default: all)")
+    play.add_argument("--remap", action="append", default=[], metavar="OLD:=NEW",
+                      help="publish bag topic OLD as NEW (repeatable)")
+    play.add_argument("--clock", type=float, nargs="?", const=DEFAULT_CLOCK_HZ, default=0.0,
+                      metavar="HZ", help=f"publish the bag time on /clock at HZ (default "
+                                         f"{DEFAULT_CLOCK_HZ:g}), for nodes with use_sim_time")
+    play.add_argument("--delay", type=float, default=0.0, metavar="S",
+                      help="wait S seconds between creating the publishers and the first "
+                           "message (lets subscribers discover them; useful on rclpy)")
+    play.add_argument("--quiet", action="store_true", help="no progress line")
+    play.add_argument("--runtime", choices=RUNTIMES,
+                      default=os.environ.get(RUNTIME_ENV) or "zenoh",
+                      help=f"graph to play into (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
+                           f"if importable)")
+    play.set_defaults(handler=run_play)
+
+
+def run_info(args: argparse.Namespace) -> int:
+    """Print what ``open_bag`` finds in a bag."""
+    from tdcm_ros.bagio.reader import open_bag
+
+    reader = open_bag(args.bag)
+    print(f"bag: {reader.path}\nmessages: {reader.message_count}\ntopics:")
+    for topic in sorted(reader.topics):
+        print(f"  {topic} [{reader.topics[topic]}]: {reader.counts[topic]}")
+    for warning in reader.warnings:
+        print(f"warning: {warning}")
+    return 0
+
+
+class ProgressLine:
+    """One line on stderr, rewritten in place: bag time played, span, rate, messages, pass."""
+
+    def __init__(self, rate: float, enabled: bool) -> None:
+        self.rate = rate
+        self.enabled = enabled
+        self.shown = False
+
+    def __call__(self, progress: Any) -> None:
+        if not self.enabled:
+            return
+        loop = f"  pass {progress.pass_number}" if progress.pass_number > 1 else ""
+        sys.stderr.write(f"\r[playing] {progress.bag_s:8.2f} / {progress.span_s:.2f} s  "
+                         f"x{self.rate:g}  {progress.published} messages{loop}\x1b[K")
+        sys.stderr.flush()
+        self.shown = True
+
+    def end(self) -> None:
+        if self.shown:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def run_play(args: argparse.Namespace) -> int:
+    """Play until the end, ``--loop`` until a signal; print what was published."""
+    stopped_by: list[int] = []
+    player: Any = None
+
+    def on_signal(signum: int, _: FrameType | None) -> None:
+        stopped_by.append(signum)
+        if player is not None:
+            player.request_stop()
+
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, on_signal)
+
+    from tdcm_ros.recording import Player, PlayOptions, parse_remap
+
+    options = PlayOptions(rate=args.rate, start_offset_s=args.start_offset, loop=args.loop,
+                          topics=tuple(args.topics),
+                          remap=tuple(parse_remap(r) for r in args.remap),
+                          clock_hz=args.clock, delay_s=args.delay)
+    runtime = resolve_runtime(args.runtime)
+    line = ProgressLine(args.rate, sys.stderr.isatty() and not args.quiet)
+    player = Player(args.bag, options, runtime=runtime, on_progress=line,
+                    on_topic=lambda topic, name, msgtype, qos: print(
+                        f"publishing {name} [{msgtype}] ({qos.reliability}, {qos.durability}, "
+                        f"depth {qos.depth})" + (f" from {topic}" if name != topic else ""),
+                        flush=True))
+    if stopped_by:
+        player.request_stop()
+    print(f"playing {player.reader.path} into the {runtime} graph at x{args.rate:g}"
+          f"{', looping' if args.loop else ''}; Ctrl-C to stop", flush=True)
+    try:
+        published = player.run()
+    finally:
+        line.end()
+        player.close()
+    print(f"{published} messages published on {len(player.topics)} topics", flush=True)
+    return 128 + stopped_by[0] if stopped_by else 0
