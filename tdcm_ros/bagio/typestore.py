@@ -1,4 +1,5 @@
-"""The one message model: the ``rosbags`` Jazzy typestore plus the ``.msg`` files of ``msg_defs/``.
+"""The one message model: the ``rosbags`` Jazzy typestore plus the ``.msg`` files of ``msg_defs/``
+and the service types of :mod:`tdcm_ros.bagio.services`.
 
 Every carrier (bags, the zenoh runtime, the rclpy adapter) moves the CDR bytes produced here.
 ``msg_defs`` is searched, in order, in the directories of ``TDCM_MSG_DEFS`` (``os.pathsep``
@@ -16,6 +17,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio.services import all_service_types
 from tdcm_ros.resources import resource_dirs
 
 STORE = Stores.ROS2_JAZZY
@@ -46,6 +48,7 @@ def typestore() -> Typestore:
             types.update(get_types_from_msg(path.read_text(encoding="utf-8"), name))
         except Exception as error:  # rosbags raises several parser error types
             raise BagError(f"cannot parse message definition {path}: {error}") from error
+    types.update(all_service_types())
     store.register(types)
     return store
 
