@@ -10,11 +10,14 @@ setpoints and the schedule state (key ``schedule_done``); ``/diagnostics`` the s
 counters every ``diagnostics_period_s``.
 
 Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
-warning, ramped at ``setpoint_rate``; cancels a running schedule), ``estop``
-(``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable),
-``clear_faults`` (``std_msgs/msg/Empty``: clear latched faults, arm, and re-enable if
-``enabled``), ``start_schedule`` (``std_msgs/msg/Empty``: (re)start the ``schedule.*``
-staircase). On shutdown the node releases the tendon and closes the port.
+warning, ramped at ``setpoint_rate``; cancels a running schedule) and ``estop``
+(``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable; a topic so any
+node can fire it without waiting). Commands are ``std_srvs/srv/Trigger`` services whose response
+says whether they were carried out and why not: ``~/start_schedule`` ((re)start the
+``schedule.*`` staircase; refused while disarmed or with a latched fault), ``~/clear_faults``
+(clear latched faults, arm, re-enable if ``enabled``; refused while the link is down),
+``~/release`` (slacken the tendon, cancel the schedule, until ``clear_faults``) and ``~/estop``
+(as the topic). On shutdown the node releases the tendon and closes the port.
 
 After a link loss, a device reboot or freeze, and an e-stop the driver is disarmed (see
 :mod:`tdcm_ros.device.driver`): the device is held released at a target of 0 N, setpoints and
@@ -31,7 +34,7 @@ import math
 import sys
 import time
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -62,6 +65,7 @@ from tdcm_ros.runtime import (
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
+TRIGGER = "std_srvs/srv/Trigger"
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
 #: parameters that bound the force on the tendon: fixed at run time unless safety.limits_writable
 SAFETY_LIMITS = ("tension_max", "setpoint_rate")
@@ -134,10 +138,10 @@ class TensionDriverNode(NodeLogic):
         port.create_subscription("tension_setpoint", "std_msgs/msg/Float64", self._on_setpoint,
                                  QoS(depth=10))
         port.create_subscription("estop", "std_msgs/msg/Empty", self._on_estop, QoS(depth=10))
-        port.create_subscription("clear_faults", "std_msgs/msg/Empty", self._on_clear,
-                                 QoS(depth=10))
-        port.create_subscription("start_schedule", "std_msgs/msg/Empty",
-                                 lambda _: self._start_schedule(), QoS(depth=10))
+        for name, command in (("start_schedule", self.start_schedule),
+                              ("clear_faults", self.clear_faults), ("release", self.release),
+                              ("estop", self.estop)):
+            port.create_service(f"~/{name}", TRIGGER, _answering(command))
         port.create_timer(step_period, self.step)
         port.create_timer(state_period, self.publish_state)
         port.create_timer(diag_period, self.report)
@@ -207,45 +211,76 @@ class TensionDriverNode(NodeLogic):
             self.counts["rejected_setpoints"] += 1
             self._warn(f"tension_setpoint = {newtons!r} N is not finite; ignored")
             return
-        if self.schedule_state in ("waiting", "running"):
-            self.schedule_state = "cancelled"
+        self._cancel_schedule()
         if not self.driver.armed:
             self.counts["rejected_setpoints"] += 1
         self._request(newtons)
 
     def _on_estop(self, _message: Any) -> None:
-        self.counts["estops"] += 1
-        self.driver.estop()
+        self.estop()
+
+    def _cancel_schedule(self) -> None:
         if self.schedule_state in ("waiting", "running"):
             self.schedule_state = "cancelled"
 
-    def _on_clear(self, _message: Any) -> None:
+    # --- commands (std_srvs/srv/Trigger services): (carried out, why / what) ------------------
+    def estop(self) -> tuple[bool, str]:
+        """Release at once (device e-stop, ESTOP latched), disarm, cancel the schedule."""
+        self.counts["estops"] += 1
+        self.driver.estop()
+        self._cancel_schedule()
+        return True, "e-stop sent: tendon released, ESTOP latched; call clear_faults to arm again"
+
+    def release(self) -> tuple[bool, str]:
+        """Slacken the tendon (mode R) and cancel the schedule; ``clear_faults`` holds again."""
+        self.driver.release()
+        self._cancel_schedule()
+        return True, "released: tendon slack; call clear_faults to hold tension again"
+
+    def clear_faults(self) -> tuple[bool, str]:
         """The operator's arm command: clear faults, arm, re-enable if ``enabled``."""
+        link = self.status.link if self.status else LinkState.DISCONNECTED
         if not self.driver.clear_faults():
-            return
+            return False, f"refused: link {link.value}; clear_faults needs the device connected"
         if bool(self.port.get_parameter("enabled")):
             self.driver.enable()
-        self.port.logger.info("faults cleared and armed on request (target %g N)",
-                              self.status.target if self.status else 0.0)
+        target = self.status.target if self.status else 0.0
+        self.port.logger.info("faults cleared and armed on request (target %g N)", target)
+        return True, (f"faults cleared and armed at target {target:g} N (the device keeps a "
+                      f"fault while still over its trip); a new setpoint is needed for tension")
 
-    def _start_schedule(self) -> None:
-        if self.status is not None and self.status.link is LinkState.CONNECTED:
-            self._run_schedule()
-        else:
+    def start_schedule(self) -> tuple[bool, str]:
+        """(Re)start the ``schedule.*`` staircase, or wait for the link; refused while disarmed
+        or with a fault latched, naming it."""
+        status = self.status
+        latest = status.telemetry if status else None
+        if not self.driver.armed:
+            reason = self.driver.disarm_reason
+            self.port.logger.warning("start_schedule refused: disarmed (%s)", reason)
+            return False, (f"refused: disarmed ({reason}); the tendon stays released; call "
+                           f"clear_faults first")
+        if latest is not None and latest.faults:
+            return False, (f"refused: fault latched ({fault_names(latest.faults)}, tension "
+                           f"{latest.tension:.1f} N, tension_max {self.driver.tension_max:g} N); "
+                           f"call clear_faults first")
+        if status is None or status.link is not LinkState.CONNECTED:
             self.schedule_state = "waiting"
+            return True, "waiting for the device link; the schedule starts once connected"
+        return self._run_schedule()
 
-    def _run_schedule(self) -> None:
+    def _run_schedule(self) -> tuple[bool, str]:
         for level in self.schedule.levels:
             if level > self.driver.tension_max:
                 self.counts["clamped_setpoints"] += 1
                 self.clamped_since_report = True
         if not self.driver.run_schedule(self.schedule):
             self.schedule_state = "cancelled"
-            return
+            return False, f"refused: {self.last_warning}"
         self.schedule_state = "running"
-        self.port.logger.info("schedule started: %s N, %g s each, %d trial(s)",
-                              list(self.schedule.levels), self.schedule.hold,
-                              self.schedule.trials)
+        text = (f"schedule started: {list(self.schedule.levels)} N, {self.schedule.hold:g} s "
+                f"each, {self.schedule.trials} trial(s)")
+        self.port.logger.info("%s", text)
+        return True, text
 
     # --- the step ---------------------------------------------------------------------------
     def step(self) -> None:
@@ -354,6 +389,14 @@ class TensionDriverNode(NodeLogic):
         """Release the tendon and close the port."""
         self.driver.close()
         self.port.logger.info("tendon released, port closed")
+
+
+def _answering(command: Callable[[], tuple[bool, str]]) -> Callable[[Any], Any]:
+    """A ``std_srvs/srv/Trigger`` handler running ``command``."""
+    def handle(_request: Any) -> Any:
+        success, message = command()
+        return from_dict(f"{TRIGGER}_Response", {"success": success, "message": message})
+    return handle
 
 
 def _non_empty(name: str) -> Any:

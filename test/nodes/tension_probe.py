@@ -1,4 +1,5 @@
-"""Test-side port for the tension nodes: publishes commands, collects what the nodes publish."""
+"""Test-side port for the tension nodes: publishes setpoints and e-stops, calls the driver's
+command services, collects what the nodes publish."""
 
 from __future__ import annotations
 
@@ -46,7 +47,7 @@ def driver_params(path: Path, **changes: Any) -> str:
 
 
 class Probe:
-    """Publishes setpoints/e-stops; records ``tension``, ``device_state``, ``/diagnostics``,
+    """Publishes setpoints/e-stops, calls command services; records ``tension``, ``device_state``, ``/diagnostics``,
     ``sim/tension_true`` and ``midline``."""
 
     def __init__(self, ctx: Any) -> None:
@@ -67,7 +68,6 @@ class Probe:
         port.create_subscription("midline", "nav_msgs/msg/Path", self.midlines.append)
         self._setpoint = port.create_publisher("tension_setpoint", "std_msgs/msg/Float64")
         self._estop = port.create_publisher("estop", "std_msgs/msg/Empty")
-        self._clear = port.create_publisher("clear_faults", "std_msgs/msg/Empty")
 
     def _on_diagnostics(self, array: Any) -> None:
         self.diagnostics.extend(s for s in array.status if "tension device" in s.name)
@@ -78,8 +78,13 @@ class Probe:
     def estop(self) -> None:
         self._estop.publish(from_dict("std_msgs/msg/Empty", {}))
 
+    def call(self, command: str, timeout: float = 10.0) -> Any:
+        """Call the driver's ``std_srvs/srv/Trigger`` service ``command``; its response."""
+        return self.ctx.call_service(f"/tension_driver/{command}", "std_srvs/srv/Trigger",
+                                     timeout=timeout)
+
     def clear_faults(self) -> None:
-        self._clear.publish(from_dict("std_msgs/msg/Empty", {}))
+        self.call("clear_faults")
 
     def state(self) -> dict[str, str]:
         """Values of the newest ``device_state`` (empty before the first)."""

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -19,7 +20,7 @@ from typing import Any
 
 import pytest
 from runtime_helpers import stop
-from tension_probe import DRIVER, Probe, driver_params, level, stamp_ns, values
+from tension_probe import DRIVER, REPO, Probe, driver_params, level, stamp_ns, values
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.plant import PlantConfig
@@ -352,3 +353,66 @@ def test_a_bad_parameter_file_exits_with_status_2(runtime, spawn, tmp_path) -> N
     assert node.wait(30) == 2
     assert node.stderr is not None
     assert "tension_max = 30.0 is out of range" in node.stderr.read().decode()
+
+
+COMMANDS = ("start_schedule", "clear_faults", "release", "estop")
+
+
+def test_commands_are_trigger_services_that_answer_why(runtime, spawn, probe, twin,
+                                                      tmp_path) -> None:
+    """Each command is a ``std_srvs/srv/Trigger`` service whose response says whether it was
+    carried out and why not; after an e-stop (a fault) the tendon stays released and the
+    schedule is refused until ``clear_faults``; ``release`` slackens and cancels the schedule."""
+    start_driver(spawn, tmp_path, twin, **{"schedule.levels": [0.0, 3.0],
+                                           "schedule.hold_s": 1.0, "schedule.trials": 5})
+    probe.connected()
+    core = twin.twin.core
+    served = dict(probe.ctx.service_names(2.0))
+    for command in COMMANDS:
+        assert served.get(f"/tension_driver/{command}") == "std_srvs/srv/Trigger", served
+    stopped = probe.call("estop")
+    assert stopped.success and "ESTOP latched" in stopped.message, stopped
+    assert core.mode is Mode.RELEASE and core.faults & Fault.ESTOP
+    refused = probe.call("start_schedule")
+    assert not refused.success, refused
+    assert "refused: disarmed (e-stop)" in refused.message, refused
+    assert "call clear_faults first" in refused.message, refused
+    time.sleep(0.5)
+    assert core.mode is Mode.RELEASE and core.setpoint_mn == 0  # nothing started
+    cleared = probe.call("clear_faults")
+    assert cleared.success and "armed at target 0 N" in cleared.message, cleared
+    probe.until(lambda: core.mode is Mode.TENSION, 10.0, "holding 0 N after clear_faults")
+    started = probe.call("start_schedule")
+    assert started.success and "schedule started: [0.0, 3.0] N" in started.message, started
+    probe.until(lambda: probe.state().get("schedule") == "running"
+                and probe.state().get("target") == "3.000", 10.0, "the schedule at 3 N")
+    released = probe.call("release")
+    assert released.success and "clear_faults" in released.message, released
+    probe.until(lambda: core.mode is Mode.RELEASE and probe.state().get("schedule")
+                == "cancelled", 10.0, "released, schedule cancelled")
+
+
+def test_service_cli_lists_and_calls_the_driver_commands(runtime, spawn, probe, twin,
+                                                         tmp_path) -> None:
+    """``tdcm service list -t`` shows the commands; ``tdcm service call`` prints the response
+    and exits 1 when the command was refused, 0 when carried out."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+
+    def tdcm(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "service", *args,
+                               "--runtime", runtime], check=False, capture_output=True,
+                              text=True, timeout=60, cwd=REPO)
+
+    listing = tdcm("list", "-t", "--timeout", "2")
+    assert listing.returncode == 0, listing.stderr
+    for command in COMMANDS:
+        assert f"/tension_driver/{command} [std_srvs/srv/Trigger]" in listing.stdout
+    estop = tdcm("call", "/tension_driver/estop", "std_srvs/srv/Trigger", "--timeout", "20")
+    assert estop.returncode == 0, estop.stderr
+    assert "success: true" in estop.stdout and "ESTOP latched" in estop.stdout
+    refused = tdcm("call", "/tension_driver/start_schedule", "--timeout", "20")
+    assert refused.returncode == 1, refused.stderr
+    assert "success: false" in refused.stdout and "call clear_faults first" in refused.stdout
+    missing = tdcm("call", "/tension_driver/no_such_command", "--timeout", "1")
+    assert missing.returncode != 0 and "no server" in missing.stderr, missing.stderr
