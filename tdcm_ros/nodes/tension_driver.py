@@ -44,7 +44,6 @@ from tdcm_ros.device import (
     SCHEDULE_SPECS,
     DriverConfig,
     DriverStatus,
-    Level,
     LinkState,
     ProtocolVersionError,
     StepSchedule,
@@ -53,6 +52,7 @@ from tdcm_ros.device import (
     fault_names,
 )
 from tdcm_ros.errors import InputError
+from tdcm_ros.nodes.driver_diagnostics import actuator, load_cell, serial_link
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
     NodeLogic,
@@ -62,6 +62,7 @@ from tdcm_ros.runtime import (
     grouped,
     read_specs,
 )
+from tdcm_ros.runtime.diagnostics import STATUS_TYPE, Diagnostics, Status, summary
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -122,7 +123,6 @@ class TensionDriverNode(NodeLogic):
 
         self.counts: Counter[str] = Counter()
         self.last_warning = ""
-        self.clamped_since_report = False
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
         self.driver = TensionDriver(config, clock=time.monotonic, warn=self._warn)
@@ -131,10 +131,14 @@ class TensionDriverNode(NodeLogic):
 
         self.tension = port.create_publisher("tension", "geometry_msgs/msg/WrenchStamped",
                                              QoS(depth=100))
-        self.state = port.create_publisher("device_state", "diagnostic_msgs/msg/DiagnosticStatus",
-                                           QoS(depth=10))
-        self.diagnostics = port.create_publisher("/diagnostics",
-                                                 "diagnostic_msgs/msg/DiagnosticArray", QoS(depth=10))
+        self.state = port.create_publisher("device_state", STATUS_TYPE, QoS(depth=10))
+        self.diagnostics = Diagnostics(port, diag_period)
+        self.clamps = self.diagnostics.window()
+        hardware = url
+        self.diagnostics.add("serial link", hardware,
+                             lambda: serial_link(self.status, self.counts))
+        self.diagnostics.add("load cell", hardware, lambda: load_cell(self.status))
+        self.diagnostics.add("actuator", hardware, self._check_actuator)
         port.create_subscription("tension_setpoint", "std_msgs/msg/Float64", self._on_setpoint,
                                  QoS(depth=10))
         port.create_subscription("estop", "std_msgs/msg/Empty", self._on_estop, QoS(depth=10))
@@ -144,7 +148,6 @@ class TensionDriverNode(NodeLogic):
             port.create_service(f"~/{name}", TRIGGER, _answering(command))
         port.create_timer(step_period, self.step)
         port.create_timer(state_period, self.publish_state)
-        port.create_timer(diag_period, self.report)
         port.logger.info("driving the tension device on %s (tension_max %g N)", url,
                          config.tension_max)
 
@@ -203,7 +206,6 @@ class TensionDriverNode(NodeLogic):
         applied = self.driver.set_setpoint(newtons)
         if applied != newtons and self.driver.armed:
             self.counts["clamped_setpoints"] += 1
-            self.clamped_since_report = True
 
     def _on_setpoint(self, message: Any) -> None:
         newtons = float(message.data)
@@ -272,7 +274,6 @@ class TensionDriverNode(NodeLogic):
         for level in self.schedule.levels:
             if level > self.driver.tension_max:
                 self.counts["clamped_setpoints"] += 1
-                self.clamped_since_report = True
         if not self.driver.run_schedule(self.schedule):
             self.schedule_state = "cancelled"
             return False, f"refused: {self.last_warning}"
@@ -327,63 +328,16 @@ class TensionDriverNode(NodeLogic):
         self.counts["telemetry_frames"] += len(frames)
 
     # --- state and diagnostics ----------------------------------------------------------------
-    def _status_dict(self, name: str, extra: Mapping[str, str]) -> dict[str, Any]:
-        status = self.status
-        if status is None:
-            return {"level": int(Level.STALE), "name": name, "message": "not stepped yet",
-                    "hardware_id": str(self.port.get_parameter("port")), "values": []}
-        latest, banner = status.telemetry, status.banner
-        values = {
-            "link": status.link.value,
-            "mode": latest.mode.name.lower() if latest else "",
-            "faults": fault_names(latest.faults) if latest else "",
-            "tension": f"{latest.tension:.3f}" if latest else "",
-            "pulse_us": str(latest.pulse_us) if latest else "",
-            "raw_counts": str(latest.raw) if latest else "",
-            "device_time": f"{latest.time:.3f}" if latest else "",
-            "target": f"{status.target:.3f}",
-            "setpoint": f"{status.setpoint:.3f}",
-            "tension_max": f"{self.driver.tension_max:g}",
-            "enabled": str(status.enabled).lower(),
-            "armed": str(status.armed).lower(),
-            "disarm_reason": status.disarm_reason,
-            "schedule": self.schedule_state,
-            "schedule_done": str(self.schedule_state == "done").lower(),
-            "firmware": banner.firmware if banner else "",
-            "cell": banner.cell if banner else "",
-            **extra,
-        }
-        hardware = f"{self.port.get_parameter('port')}"
-        return {"level": int(status.level), "name": name, "message": status.message,
-                "hardware_id": hardware,
-                "values": [{"key": k, "value": v} for k, v in values.items()]}
+    def _check_actuator(self) -> Status:
+        clamped = self.clamps.recent(self.counts["clamped_setpoints"], self.port.now_ns())
+        return actuator(self.status, tension_max=self.driver.tension_max,
+                        schedule_state=self.schedule_state, counts=self.counts,
+                        last_warning=self.last_warning, clamped_recently=clamped)
 
     def publish_state(self) -> None:
-        """Publish ``device_state``."""
-        self.state.publish(from_dict("diagnostic_msgs/msg/DiagnosticStatus",
-                                     self._status_dict(self.port.node_name, {})))
-
-    def report(self) -> None:
-        """Publish ``/diagnostics``: link, staleness, faults and counters (WARN after a clamp)."""
-        status = self.status
-        counters = {
-            "reconnects": status.reconnects if status else 0,
-            "rejected_lines": status.rejected_lines if status else 0,
-            "nacks": status.nacks if status else 0,
-            "disarms": status.disarms if status else 0,
-            **{key: self.counts[key] for key in ("clamped_setpoints", "rejected_setpoints",
-                                                 "estops", "version_mismatches",
-                                                 "telemetry_frames")},
-        }
-        extra = {k: str(v) for k, v in counters.items()}
-        extra["last_warning"] = self.last_warning
-        entry = self._status_dict(f"{self.port.node_name}: tension device", extra)
-        if self.clamped_since_report and entry["level"] < Level.WARN:
-            entry["level"] = int(Level.WARN)
-            entry["message"] += f"; setpoint clamped to [0, {self.driver.tension_max:g}] N"
-        self.clamped_since_report = False
-        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
-            "header": header(self.port.now_ns(), ""), "status": [entry]}))
+        """Publish ``device_state`` (deprecated): the components' statuses rolled into one."""
+        self.state.publish(from_dict(STATUS_TYPE, summary(
+            self.diagnostics.statuses(), self.port.node_name, str(self.port.get_parameter("port")))))
 
     def close(self) -> None:
         """Release the tendon and close the port."""

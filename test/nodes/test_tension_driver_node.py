@@ -416,3 +416,33 @@ def test_service_cli_lists_and_calls_the_driver_commands(runtime, spawn, probe, 
     assert "success: false" in refused.stdout and "call clear_faults first" in refused.stdout
     missing = tdcm("call", "/tension_driver/no_such_command", "--timeout", "1")
     assert missing.returncode != 0 and "no server" in missing.stderr, missing.stderr
+
+
+def test_diagnostics_report_each_component_and_recover(runtime, spawn, probe, twin,
+                                                       tmp_path) -> None:
+    """/diagnostics carries one status per hardware component (serial link, load cell,
+    actuator; hardware_id the port) whose level follows the component: an e-stop makes the
+    actuator ERROR until clear_faults, silence makes the load cell STALE until readings flow,
+    a clamped setpoint warns for the window only."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    names = ("serial link", "load cell", "actuator")
+    probe.until(lambda: all(probe.component_level(n) == 0 for n in names), 10.0,
+                "every component OK")
+    assert sorted(probe.components[-1]) == sorted(f"tension_driver: {n}" for n in names)
+    assert {s.hardware_id for s in probe.components[-1].values()} == {twin.port}
+    assert probe.call("estop").success
+    probe.until(lambda: probe.component_level("actuator") == 2, 10.0, "actuator ERROR")
+    assert "ESTOP" in probe.component("actuator").message
+    assert probe.component_level("serial link") == 0 and probe.component_level("load cell") == 0
+    probe.until(lambda: probe.component_level("actuator") == 0, 10.0, "actuator OK again",
+                action=probe.clear_faults)
+    probe.setpoint(30.0)  # above tension_max 20 N: clamped
+    probe.until(lambda: probe.component_level("actuator") == 1, 10.0, "actuator WARN")
+    assert "setpoint clamped to [0, 20] N" in probe.component("actuator").message
+    probe.until(lambda: probe.component_level("actuator") == 0, 10.0,
+                "actuator OK once the clamp left the window")
+    with twin.frozen():
+        probe.until(lambda: probe.component_level("load cell") == 3, 10.0, "load cell STALE")
+        assert "no telemetry for" in probe.component("load cell").message
+    probe.until(lambda: probe.component_level("load cell") == 0, 20.0, "load cell OK again")
