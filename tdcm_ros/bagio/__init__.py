@@ -6,13 +6,14 @@ that rmw_zenoh puts in its key expressions (``service_type_hash`` for ``pkg/srv/
 
 from tdcm_ros.bagio.convert import from_dict, to_dict
 from tdcm_ros.bagio.errors import BagError
-from tdcm_ros.bagio.services import normalize_service_type, service_type_hash
+from tdcm_ros.bagio.services import normalize_service_type
 from tdcm_ros.bagio.typestore import (
     deserialize,
     message_definition,
     msg_class,
     normalize_type_name,
     serialize,
+    service_type_hash,
     type_hash,
     type_name_of,
     typestore,

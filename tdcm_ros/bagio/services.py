@@ -5,16 +5,18 @@ rosbags' Jazzy store holds messages only. A service adds four types: ``Name_Requ
 ``uint8 structure_needs_at_least_one_member``), ``Name_Event`` (``service_msgs/msg/ServiceEventInfo
 info``, at most one request and one response) and ``Name`` (the three as ``request_message``,
 ``response_message``, ``event_message``). The RIHS01 hash of ``Name`` (REP 2011) is the one rmw
-implementations put in a service's key; :func:`service_type_hash` computes it.
+implementations put in a service's key; :func:`tdcm_ros.bagio.typestore.service_type_hash`
+computes it.
 """
 
 from __future__ import annotations
 
-from functools import cache
 from typing import Any
 
-from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys import get_types_from_msg
 from rosbags.typesys.base import Nodetype
+
+from tdcm_ros.bagio.errors import BagError
 
 #: ``.srv`` text (request ``---`` response) of every service type the package serves or calls.
 SERVICE_DEFINITIONS: dict[str, str] = {
@@ -28,8 +30,6 @@ _PLACEHOLDER = ("structure_needs_at_least_one_member", (Nodetype.BASE, ("uint8",
 
 def normalize_service_type(type_name: str) -> str:
     """Accept ``pkg/srv/Name`` or ``pkg/Name`` of a known service; return ``pkg/srv/Name``."""
-    from tdcm_ros.bagio.errors import BagError
-
     parts = type_name.strip().split("/")
     name = "/".join([parts[0], "srv", parts[1]] if len(parts) == 2 else parts)
     if name not in SERVICE_DEFINITIONS:
@@ -69,43 +69,3 @@ def all_service_types() -> dict[str, tuple[list[Any], list[Any]]]:
     for name, text in SERVICE_DEFINITIONS.items():
         types.update(service_typesdict(name, text))
     return types
-
-
-def _as_rosidl(desc: Any) -> Any:
-    """A field description with ``char`` as rosidl maps it (``uint8``) for hashing."""
-    kind, rest = desc
-    if kind == Nodetype.BASE:
-        return (kind, ("uint8", rest[1]) if rest[0] == "char" else rest)
-    if kind in (Nodetype.ARRAY, Nodetype.SEQUENCE):
-        return (kind, (_as_rosidl(rest[0]), rest[1]))
-    return desc
-
-
-@cache
-def service_type_hash(name: str) -> str:
-    """RIHS01 hash of service type ``pkg/srv/Name``.
-
-    Hashed in a store of its own: rosbags keeps ``char`` (in ``ServiceEventInfo.client_gid``)
-    as its own type where rosidl's type description has ``uint8``, so the Jazzy store's hash of
-    the event differs from ROS's.
-    """
-    from tdcm_ros.bagio.typestore import typestore
-
-    name = normalize_service_type(name)
-    source = typestore()
-    store = get_typestore(Stores.EMPTY)
-    pending, seen = [name], set()
-    types = {}
-    while pending:
-        current = pending.pop()
-        if current in seen:
-            continue
-        seen.add(current)
-        consts, fields = source.fielddefs[current]
-        types[current] = (consts, [(n, _as_rosidl(d)) for n, d in fields])
-        for _, desc in fields:
-            inner = desc[1][0] if desc[0] in (Nodetype.ARRAY, Nodetype.SEQUENCE) else desc
-            if inner[0] == Nodetype.NAME:
-                pending.append(inner[1])
-    store.register(types)
-    return str(store.hash_rihs01(name))

@@ -3,7 +3,7 @@
 On zenoh a service is rmw_zenoh's (a queryable and an ``SS`` liveliness token); on rclpy a real
 ROS 2 service. ``--runtime`` defaults to ``TDCM_RUNTIME`` if set, else zenoh. ``call`` exits 0
 when the service answered ``success: true``, 1 when it answered ``success: false`` (the reason is
-printed), and with the runtime error's status when nothing answered.
+printed) or nothing answered within ``--timeout`` (the error on stderr).
 """
 
 from __future__ import annotations

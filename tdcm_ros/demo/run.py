@@ -1,12 +1,12 @@
 """Run a demo plan: the live graph (embedded zenoh or rclpy), the bag, then evaluation and calibration.
 
 The demo process joins the graph itself (a node named ``_tdcm_demo`` on the same runtime) to print
-progress, to start the driver's schedule (its ``start_schedule`` service) once the bag holds every evaluated
-topic (so the first level is recorded whatever the runtime's discovery time), and to see the
-driver report ``schedule_done`` on ``device_state``. Children inherit the
-environment (``ROS_DOMAIN_ID``, ``ROS_AUTOMATIC_DISCOVERY_RANGE``, the zenoh endpoint). Ctrl-C
-stops the graph cleanly (the bag is closed and keeps everything received) and skips the
-evaluation.
+progress, to start the driver's schedule (its ``start_schedule`` service) once the bag holds
+every evaluated topic (so the first level is recorded whatever the runtime's discovery time), and
+to see the driver report ``schedule_done`` on ``/diagnostics`` (``tension_driver: actuator``).
+Children inherit the environment (``ROS_DOMAIN_ID``, ``ROS_AUTOMATIC_DISCOVERY_RANGE``, the zenoh
+endpoint). Ctrl-C stops the graph cleanly (the bag is closed and keeps everything received) and
+skips the evaluation.
 """
 
 from __future__ import annotations
@@ -37,6 +37,8 @@ READY_TIMEOUT_S = 60.0
 #: Time (s) a ``start_schedule`` call waits for the driver's service before it is tried again.
 START_RETRY_S = 1.0
 START_SERVICE = "/tension_driver/start_schedule"
+#: The driver's ``/diagnostics`` status that carries the setpoint and the schedule state.
+DRIVER_ACTUATOR = "tension_driver: actuator"
 
 
 class DemoInterrupted(TdcmError):
@@ -81,11 +83,14 @@ def _watch(port: Any, progress: Progress) -> None:
         progress.tip_x = float(message.pose.position.x)
         progress.count("tip_pose")
 
-    def on_state(message: Any) -> None:
-        values = {kv.key: kv.value for kv in message.values}
-        progress.setpoint = values.get("setpoint", progress.setpoint)
-        progress.schedule = values.get("schedule", progress.schedule)
-        progress.schedule_done = progress.schedule_done or values.get("schedule_done") == "true"
+    def on_diagnostics(message: Any) -> None:
+        for status in message.status:
+            if status.name == DRIVER_ACTUATOR:
+                values = {kv.key: kv.value for kv in status.values}
+                progress.setpoint = values.get("setpoint", progress.setpoint)
+                progress.schedule = values.get("schedule", progress.schedule)
+                progress.schedule_done = (progress.schedule_done
+                                          or values.get("schedule_done") == "true")
 
     def on_markers(message: Any) -> None:
         progress.count("markers")
@@ -93,8 +98,8 @@ def _watch(port: Any, progress: Progress) -> None:
     qos = QoS(depth=10)
     port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", on_tension, qos)
     port.create_subscription("tip_pose", "geometry_msgs/msg/PoseStamped", on_tip, qos)
-    port.create_subscription("device_state", "diagnostic_msgs/msg/DiagnosticStatus", on_state,
-                             qos)
+    port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
+                             on_diagnostics, qos)
     port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", on_markers, qos)
 
 

@@ -25,8 +25,16 @@ from tdcm_ros.device import PLANT_SPECS, PlantConfig, fault_names
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs, grouped
-from tdcm_ros.runtime.diagnostics import OK, Diagnostics, Status
+from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
+    NodeLogic,
+    NodePort,
+    QoS,
+    Status,
+    declare_specs,
+    grouped,
+)
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -134,7 +142,7 @@ class DeviceTwinNode(NodeLogic):
     def check(self) -> Status:
         """The twin's state for ``/diagnostics`` (always OK: it is a simulation)."""
         state = self._state()
-        return Status(OK, f"serving {state['port']}", state)
+        return Status(DiagnosticLevel.OK, f"serving {state['port']}", state)
 
     def close(self) -> None:
         """Stop the twin (the pty closes, the link is removed); logs the final device state."""

@@ -11,8 +11,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from tdcm_ros.device import DriverStatus, Fault, LinkState, Mode, fault_names
-from tdcm_ros.runtime.diagnostics import ERROR, OK, STALE, WARN, Status
+from tdcm_ros.runtime import DiagnosticLevel, Status
 
+OK, WARN, ERROR, STALE = (DiagnosticLevel.OK, DiagnosticLevel.WARN, DiagnosticLevel.ERROR,
+                          DiagnosticLevel.STALE)
 #: Faults of the load cell; the others (OVER_TENSION, WATCHDOG, ESTOP) released the actuator.
 CELL_FAULTS = Fault.SENSOR | Fault.CALIBRATION
 LINK_COUNTERS = ("reconnects", "rejected_lines", "nacks", "version_mismatches",
@@ -46,7 +48,7 @@ def load_cell(status: DriverStatus | None) -> Status:
               "cell": banner.cell if banner else ""}
     if status.link is not LinkState.CONNECTED:
         return Status(STALE, f"no readings: link {status.link.value}", values)
-    if status.level == STALE:
+    if int(status.level) == STALE:
         return Status(STALE, status.message, values)
     if latest is None:
         return Status(STALE, "connected, no readings yet", values)

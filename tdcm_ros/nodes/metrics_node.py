@@ -48,8 +48,16 @@ from tdcm_ros.metrics import (
 )
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import FIELD_SPECS, PRESETS, preset
-from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs, grouped
-from tdcm_ros.runtime.diagnostics import OK, WARN, Diagnostics, Status
+from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
+    NodeLogic,
+    NodePort,
+    QoS,
+    Status,
+    declare_specs,
+    grouped,
+)
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -237,7 +245,8 @@ class MetricsNode(NodeLogic):
         message = "; ".join(problems) or self.running.problem or "ok"
         values = {**dict(sorted(self.counts.items())),
                   "registration": reg.method if reg else "none"}
-        return Status(WARN if problems else OK, message, values)
+        level = DiagnosticLevel.WARN if problems else DiagnosticLevel.OK
+        return Status(level, message, values)
 
 def main() -> int:
     """``ros2 run tdcm_ros metrics_node`` / ``metrics_node`` console script."""

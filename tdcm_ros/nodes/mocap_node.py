@@ -49,14 +49,16 @@ from tdcm_ros.mocap import (
 )
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
     NodeLogic,
     NodePort,
     QoS,
+    Status,
     declare_specs,
     grouped,
     resolve_topic,
 )
-from tdcm_ros.runtime.diagnostics import OK, WARN, Diagnostics, Status
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -337,7 +339,8 @@ class MocapNode(NodeLogic):
                   "source": self.source_name, "state": self.state,
                   "registration": self.registration.method,
                   "registration_residual_m": f"{self.registration.residual_m:.6g}"}
-        level = WARN if (recent or (waiting and self.source_name != "csv")) else OK
+        warn = recent or (waiting and self.source_name != "csv")
+        level = DiagnosticLevel.WARN if warn else DiagnosticLevel.OK
         return Status(level, (self.last_problem if recent else "") or self.state, values)
 
 def main() -> int:

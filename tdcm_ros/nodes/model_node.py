@@ -42,14 +42,16 @@ from tdcm_ros.model import (
 )
 from tdcm_ros.nodes.shape_messages import midline_messages
 from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
     NodeLogic,
     NodePort,
     QoS,
+    Status,
     declare_specs,
     grouped,
     read_specs,
 )
-from tdcm_ros.runtime.diagnostics import OK, WARN, Diagnostics, Status
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -219,8 +221,8 @@ class ModelNode(NodeLogic):
                   if k.startswith(("dropped", "coalesced"))}
         values["dropped_in_window"] = recent
         if recent:
-            return Status(WARN, self.last_problem, values)
-        return Status(OK, "ok", values)
+            return Status(DiagnosticLevel.WARN, self.last_problem, values)
+        return Status(DiagnosticLevel.OK, "ok", values)
 
     def check_solver(self) -> Status:
         """WARN while a solve failed within the window (it recovers), else OK; solves and
@@ -231,8 +233,8 @@ class ModelNode(NodeLogic):
                   if k.startswith(("model", "solved"))}
         values["failed_in_window"] = recent
         if recent:
-            return Status(WARN, self.last_failure, values)
-        return Status(OK, "ok", values)
+            return Status(DiagnosticLevel.WARN, self.last_failure, values)
+        return Status(DiagnosticLevel.OK, "ok", values)
 
 def main() -> int:
     """``ros2 run tdcm_ros model_node`` / ``model_node`` console script."""

@@ -55,18 +55,21 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.driver_diagnostics import actuator, load_cell, serial_link
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
+    Diagnostics,
     NodeLogic,
     NodePort,
     QoS,
+    Status,
     declare_specs,
     grouped,
     read_specs,
+    summary,
 )
-from tdcm_ros.runtime.diagnostics import STATUS_TYPE, Diagnostics, Status, summary
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
 TRIGGER = "std_srvs/srv/Trigger"
+STATUS_TYPE = "diagnostic_msgs/msg/DiagnosticStatus"
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
 #: parameters that bound the force on the tendon: fixed at run time unless safety.limits_writable
 SAFETY_LIMITS = ("tension_max", "setpoint_rate")
@@ -336,8 +339,9 @@ class TensionDriverNode(NodeLogic):
 
     def publish_state(self) -> None:
         """Publish ``device_state`` (deprecated): the components' statuses rolled into one."""
-        self.state.publish(from_dict(STATUS_TYPE, summary(
-            self.diagnostics.statuses(), self.port.node_name, str(self.port.get_parameter("port")))))
+        rolled = summary(self.diagnostics.statuses(), self.port.node_name,
+                         str(self.port.get_parameter("port")))
+        self.state.publish(from_dict(STATUS_TYPE, rolled))
 
     def close(self) -> None:
         """Release the tendon and close the port."""

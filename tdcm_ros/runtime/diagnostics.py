@@ -10,15 +10,24 @@ problems that are events (a dropped input, a clamped setpoint) count over a slid
 
 from __future__ import annotations
 
+import enum
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.port import NodePort, QoS
 
-OK, WARN, ERROR, STALE = 0, 1, 2, 3  #: DiagnosticStatus levels
+
+class DiagnosticLevel(enum.IntEnum):
+    """``diagnostic_msgs/DiagnosticStatus`` levels."""
+
+    OK = 0
+    WARN = 1
+    ERROR = 2
+    STALE = 3
+
+
 TOPIC = "/diagnostics"
 ARRAY_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
 STATUS_TYPE = "diagnostic_msgs/msg/DiagnosticStatus"
@@ -28,9 +37,9 @@ WINDOW_UPDATES = 5
 
 @dataclass(frozen=True)
 class Status:
-    """What a check found: level (``OK`` .. ``STALE``), message and key/values."""
+    """What a check found: level, message and key/values."""
 
-    level: int
+    level: DiagnosticLevel
     message: str
     values: Mapping[str, object] = field(default_factory=dict)
 
@@ -54,7 +63,7 @@ def status_dict(node_name: str, check: Check, status: Status) -> dict[str, Any]:
 def summary(statuses: list[dict[str, Any]], name: str, hardware_id: str) -> dict[str, Any]:
     """One status over several (as diagnostic_aggregator rolls up): the worst level, the
     messages at that level, every key/value."""
-    worst = max((int(s["level"]) for s in statuses), default=STALE)
+    worst = max((int(s["level"]) for s in statuses), default=int(DiagnosticLevel.STALE))
     message = "; ".join(s["message"] for s in statuses if int(s["level"]) == worst)
     values = {kv["key"]: kv["value"] for s in statuses for kv in s["values"]}
     return {"level": worst, "name": name, "message": message, "hardware_id": hardware_id,
@@ -79,7 +88,10 @@ class Diagnostics:
         return [status_dict(self.port.node_name, check, check.run()) for check in self.checks]
 
     def publish(self) -> None:
-        """Publish one ``DiagnosticArray`` with every component's status."""
+        """Publish one ``DiagnosticArray`` with every component's status (rosbags is imported
+        here, not with the runtime face)."""
+        from tdcm_ros.bagio import from_dict
+
         stamp = self.port.now_ns()
         self._publisher.publish(from_dict(ARRAY_TYPE, {
             "header": {"stamp": {"sec": stamp // 10**9, "nanosec": stamp % 10**9}},

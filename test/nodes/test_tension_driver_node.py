@@ -372,7 +372,8 @@ def test_commands_are_trigger_services_that_answer_why(runtime, spawn, probe, tw
         assert served.get(f"/tension_driver/{command}") == "std_srvs/srv/Trigger", served
     stopped = probe.call("estop")
     assert stopped.success and "ESTOP latched" in stopped.message, stopped
-    assert core.mode is Mode.RELEASE and core.faults & Fault.ESTOP
+    probe.until(lambda: core.mode is Mode.RELEASE and bool(core.faults & Fault.ESTOP), 2.0,
+                "the device released with ESTOP latched")  # E was sent before the answer
     refused = probe.call("start_schedule")
     assert not refused.success, refused
     assert "refused: disarmed (e-stop)" in refused.message, refused

@@ -6,10 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from tdcm_ros.runtime.diagnostics import (
-    ERROR,
-    OK,
-    STALE,
-    WARN,
+    DiagnosticLevel,
     Diagnostics,
     EventWindow,
     Status,
@@ -17,6 +14,8 @@ from tdcm_ros.runtime.diagnostics import (
 )
 from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.port import NodeLogic, NodePort
+
+OK, WARN, ERROR, STALE = list(DiagnosticLevel)
 
 
 def test_an_event_window_counts_only_recent_events() -> None:
