@@ -19,6 +19,11 @@ from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 from tdcm_ros.yamlio import load_yaml
 
 DEFAULT_TYPE = "std_srvs/srv/Trigger"
+REFUSED_EXIT = 1
+"""Exit status of a call answered ``success: false`` (or not answered)."""
+EXIT_MEANINGS = {"service call": {
+    REFUSED_EXIT: "the service answered success: false, or no server answered in --timeout"}}
+"""What ``service call`` means by an exit status (its ``--help`` epilog)."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -87,4 +92,4 @@ def run_call(args: argparse.Namespace) -> int:
     answer = to_dict(response)
     print("\nresponse:")
     print(yaml.safe_dump(answer, sort_keys=False, width=1 << 16).rstrip())
-    return 1 if answer.get("success") is False else 0
+    return REFUSED_EXIT if answer.get("success") is False else 0
