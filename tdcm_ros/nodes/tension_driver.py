@@ -4,10 +4,11 @@ Wraps :class:`tdcm_ros.device.driver.TensionDriver` (handshake, heartbeats, setp
 clamp, reconnect with backoff, stale detection). A timer (``step_period_s``) steps the driver and
 publishes every telemetry frame as ``tension`` (``geometry_msgs/msg/WrenchStamped``,
 ``wrench.force.z`` = measured tension in N, frame ``frame_id``; stamp = host receive time, frames
-read together keep their device-clock spacing). ``device_state``
-(``diagnostic_msgs/msg/DiagnosticStatus``, every ``state_period_s``) carries link, mode, faults,
-setpoints and the schedule state (key ``schedule_done``); ``/diagnostics`` the same status plus
-counters every ``diagnostics_period_s``.
+read together keep their device-clock spacing). ``/diagnostics`` (every ``diagnostics_period_s``)
+carries one status per component (:mod:`tdcm_ros.nodes.driver_diagnostics`): ``serial link``,
+``load cell`` and ``actuator`` (mode, faults, setpoints, armed, the schedule state and
+``schedule_done``). ``device_state`` (``diagnostic_msgs/msg/DiagnosticStatus``, every
+``state_period_s``) is deprecated: those statuses rolled into one.
 
 Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
 warning, ramped at ``setpoint_rate``; cancels a running schedule) and ``estop``
@@ -21,8 +22,8 @@ says whether they were carried out and why not: ``~/start_schedule`` ((re)start 
 
 After a link loss, a device reboot or freeze, and an e-stop the driver is disarmed (see
 :mod:`tdcm_ros.device.driver`): the device is held released at a target of 0 N, setpoints and
-schedules are refused, until ``clear_faults``; after it a new setpoint is needed. ``device_state``
-and ``/diagnostics`` report ``armed`` and ``disarm_reason``.
+schedules are refused, until ``clear_faults``; after it a new setpoint is needed. The actuator's
+status reports ``armed`` and ``disarm_reason``.
 
 The force limits :data:`SAFETY_LIMITS` are read-only at run time unless the node is started with
 ``safety.limits_writable: true`` (itself read-only).
@@ -84,7 +85,8 @@ FIXED_SPECS = by_name(
          default=False, kind="bool"),
     Spec("step_period_s", "s", "driver step period; telemetry is 50 Hz", 0.005, low=0.001,
          high=0.02),
-    Spec("state_period_s", "s", "device_state period", 0.1, low=0.01, high=10.0),
+    Spec("state_period_s", "s", "device_state period (deprecated topic)", 0.1, low=0.01,
+         high=10.0),
     Spec("diagnostics_period_s", "s", "/diagnostics period", 0.5, low=0.05, high=60.0))
 #: Parameters of the node a client may change at run time, besides the driver and schedule.
 TUNABLE_SPECS = by_name(
