@@ -1,17 +1,19 @@
 """One message model for every carrier: the rosbags Jazzy typestore plus ``msg_defs/``.
 
 ``serialize``/``deserialize`` move CDR bytes; ``type_hash`` gives the REP-2016 RIHS01 hash
-that rmw_zenoh puts in its key expressions.
+that rmw_zenoh puts in its key expressions (``service_type_hash`` for ``pkg/srv/Name``).
 """
 
 from tdcm_ros.bagio.convert import from_dict, to_dict
 from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio.services import normalize_service_type
 from tdcm_ros.bagio.typestore import (
     deserialize,
     message_definition,
     msg_class,
     normalize_type_name,
     serialize,
+    service_type_hash,
     type_hash,
     type_name_of,
     typestore,
@@ -23,8 +25,10 @@ __all__ = [
     "from_dict",
     "message_definition",
     "msg_class",
+    "normalize_service_type",
     "normalize_type_name",
     "serialize",
+    "service_type_hash",
     "to_dict",
     "type_hash",
     "type_name_of",

@@ -1,4 +1,5 @@
-"""The one message model: the ``rosbags`` Jazzy typestore plus the ``.msg`` files of ``msg_defs/``.
+"""The one message model: the ``rosbags`` Jazzy typestore plus the ``.msg`` files of ``msg_defs/``
+and the service types of :mod:`tdcm_ros.bagio.services`.
 
 Every carrier (bags, the zenoh runtime, the rclpy adapter) moves the CDR bytes produced here.
 ``msg_defs`` is searched, in order, in the directories of ``TDCM_MSG_DEFS`` (``os.pathsep``
@@ -13,9 +14,11 @@ from pathlib import Path
 from typing import Any
 
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys.base import Nodetype
 from rosbags.typesys.store import Typestore
 
 from tdcm_ros.bagio.errors import BagError
+from tdcm_ros.bagio.services import all_service_types, normalize_service_type
 from tdcm_ros.resources import resource_dirs
 
 STORE = Stores.ROS2_JAZZY
@@ -46,6 +49,7 @@ def typestore() -> Typestore:
             types.update(get_types_from_msg(path.read_text(encoding="utf-8"), name))
         except Exception as error:  # rosbags raises several parser error types
             raise BagError(f"cannot parse message definition {path}: {error}") from error
+    types.update(all_service_types())
     store.register(types)
     return store
 
@@ -101,3 +105,41 @@ def type_hash(type_name: str) -> str:
 def message_definition(type_name: str) -> str:
     """The concatenated ``.msg`` definition text (as stored in bags) of ``type_name``."""
     return typestore().generate_msgdef(normalize_type_name(type_name))[0]
+
+
+def _as_rosidl(desc: Any) -> Any:
+    """A field description with ``char`` as rosidl maps it (``uint8``) for hashing."""
+    kind, rest = desc
+    if kind == Nodetype.BASE:
+        return (kind, ("uint8", rest[1]) if rest[0] == "char" else rest)
+    if kind in (Nodetype.ARRAY, Nodetype.SEQUENCE):
+        return (kind, (_as_rosidl(rest[0]), rest[1]))
+    return desc
+
+
+@cache
+def service_type_hash(name: str) -> str:
+    """RIHS01 hash of service type ``pkg/srv/Name``.
+
+    Hashed in a store of its own: rosbags keeps ``char`` (in ``ServiceEventInfo.client_gid``)
+    as its own type where rosidl's type description has ``uint8``, so the Jazzy store's hash of
+    the event differs from ROS's.
+    """
+    name = normalize_service_type(name)
+    source = typestore()
+    store = get_typestore(Stores.EMPTY)
+    pending, seen = [name], set()
+    types = {}
+    while pending:
+        current = pending.pop()
+        if current in seen:
+            continue
+        seen.add(current)
+        consts, fields = source.fielddefs[current]
+        types[current] = (consts, [(n, _as_rosidl(d)) for n, d in fields])
+        for _, desc in fields:
+            inner = desc[1][0] if desc[0] in (Nodetype.ARRAY, Nodetype.SEQUENCE) else desc
+            if inner[0] == Nodetype.NAME:
+                pending.append(inner[1])
+    store.register(types)
+    return str(store.hash_rihs01(name))

@@ -32,6 +32,7 @@ COMMANDS: dict[str, str] = {
     "record": "tdcm_ros.cli.record",
     "bag": "tdcm_ros.cli.bag",
     "param": "tdcm_ros.cli.param",
+    "service": "tdcm_ros.cli.service",
     "bench": "tdcm_ros.cli.bench",
     "figures": "tdcm_ros.cli.figures",
     "evaluate": "tdcm_ros.cli.evaluate",

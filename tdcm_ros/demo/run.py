@@ -1,12 +1,12 @@
 """Run a demo plan: the live graph (embedded zenoh or rclpy), the bag, then evaluation and calibration.
 
 The demo process joins the graph itself (a node named ``_tdcm_demo`` on the same runtime) to print
-progress, to start the driver's schedule (``start_schedule``) once the bag holds every evaluated
-topic (so the first level is recorded whatever the runtime's discovery time), and to see the
-driver report ``schedule_done`` on ``device_state``. Children inherit the
-environment (``ROS_DOMAIN_ID``, ``ROS_AUTOMATIC_DISCOVERY_RANGE``, the zenoh endpoint). Ctrl-C
-stops the graph cleanly (the bag is closed and keeps everything received) and skips the
-evaluation.
+progress, to start the driver's schedule (its ``start_schedule`` service) once the bag holds
+every evaluated topic (so the first level is recorded whatever the runtime's discovery time), and
+to see the driver report ``schedule_done`` on ``/diagnostics`` (``tension_driver: actuator``).
+Children inherit the environment (``ROS_DOMAIN_ID``, ``ROS_AUTOMATIC_DISCOVERY_RANGE``, the zenoh
+endpoint). Ctrl-C stops the graph cleanly (the bag is closed and keeps everything received) and
+skips the evaluation.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from tdcm_ros.bagio import BagError, from_dict
+from tdcm_ros.bagio import BagError
 from tdcm_ros.demo.plan import EVALUATED_TOPICS, NODE_ORDER, DemoPlan
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.runtime import NodeGraph, RuntimePortError, resolve_topic
@@ -34,10 +34,11 @@ START_MARGIN_S = 60.0
 SETTLE_S = 0.5
 #: Longest wait (s) for the bag to hold every evaluated topic before the schedule starts.
 READY_TIMEOUT_S = 60.0
-#: Time (s) between ``start_schedule`` messages while the driver still reports no schedule.
+#: Time (s) a ``start_schedule`` call waits for the driver's service before it is tried again.
 START_RETRY_S = 1.0
-#: Schedule states (``device_state`` key ``schedule``) before a start request was taken.
-_NOT_STARTED = ("", "idle")
+START_SERVICE = "/tension_driver/start_schedule"
+#: The driver's ``/diagnostics`` status that carries the setpoint and the schedule state.
+DRIVER_ACTUATOR = "tension_driver: actuator"
 
 
 class DemoInterrupted(TdcmError):
@@ -82,11 +83,14 @@ def _watch(port: Any, progress: Progress) -> None:
         progress.tip_x = float(message.pose.position.x)
         progress.count("tip_pose")
 
-    def on_state(message: Any) -> None:
-        values = {kv.key: kv.value for kv in message.values}
-        progress.setpoint = values.get("setpoint", progress.setpoint)
-        progress.schedule = values.get("schedule", progress.schedule)
-        progress.schedule_done = progress.schedule_done or values.get("schedule_done") == "true"
+    def on_diagnostics(message: Any) -> None:
+        for status in message.status:
+            if status.name == DRIVER_ACTUATOR:
+                values = {kv.key: kv.value for kv in status.values}
+                progress.setpoint = values.get("setpoint", progress.setpoint)
+                progress.schedule = values.get("schedule", progress.schedule)
+                progress.schedule_done = (progress.schedule_done
+                                          or values.get("schedule_done") == "true")
 
     def on_markers(message: Any) -> None:
         progress.count("markers")
@@ -94,9 +98,23 @@ def _watch(port: Any, progress: Progress) -> None:
     qos = QoS(depth=10)
     port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", on_tension, qos)
     port.create_subscription("tip_pose", "geometry_msgs/msg/PoseStamped", on_tip, qos)
-    port.create_subscription("device_state", "diagnostic_msgs/msg/DiagnosticStatus", on_state,
-                             qos)
+    port.create_subscription("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray",
+                             on_diagnostics, qos)
     port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", on_markers, qos)
+
+
+def start_schedule(context: Any) -> bool:
+    """Call the driver's ``start_schedule``; False if no driver answered yet. A refusal ends
+    the demo with the driver's reason."""
+    try:
+        answer = context.call_service(START_SERVICE, "std_srvs/srv/Trigger",
+                                      timeout=START_RETRY_S)
+    except RuntimePortError as error:
+        log.info("start_schedule not answered yet: %s", error)
+        return False
+    if not answer.success:
+        raise RuntimePortError(f"the driver refused to start the schedule: {answer.message}")
+    return True
 
 
 def _graph_alive(graph: NodeGraph) -> None:
@@ -160,7 +178,6 @@ def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
         context = open_context(runtime)
         port = context.create_port("_tdcm_demo")
         _watch(port, progress)
-        start = port.create_publisher("start_schedule", "std_msgs/msg/Empty")
         overrides = plan.node_overrides()
         for name in NODE_ORDER:
             if stop.is_set():
@@ -177,12 +194,10 @@ def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
         started = time.monotonic()
         say(f"the bag holds {', '.join(EVALUATED_TOPICS)}; starting the schedule")
         deadline = started + plan.schedule.duration + START_MARGIN_S
-        next_line = next_start = started
+        next_line = started
+        requested = False
         while not progress.schedule_done:
-            now = time.monotonic()
-            if progress.schedule in _NOT_STARTED and now >= next_start:
-                start.publish(from_dict("std_msgs/msg/Empty", {}))
-                next_start = now + START_RETRY_S
+            requested = requested or start_schedule(context)
             loop.turn(deadline, lambda: f"the schedule did not finish within "
                                         f"{plan.schedule.duration:g} s + {START_MARGIN_S:g} s "
                                         f"(last state {progress.schedule or 'none'}); see {logs}")

@@ -254,6 +254,11 @@ class TensionDriver:
         return self._armed
 
     @property
+    def disarm_reason(self) -> str:
+        """Why the driver was disarmed last (``""`` while never disarmed)."""
+        return self._disarm_reason
+
+    @property
     def schedule_running(self) -> bool:
         """True while a schedule is being followed."""
         return self._schedule is not None
@@ -493,7 +498,7 @@ class TensionDriver:
             level, text = Level.ERROR, f"device fault {fault_names(latest.faults)}; tendon released"
         elif not self._armed:
             level, text = Level.WARN, (f"disarmed ({self._disarm_reason}): tendon held released; "
-                                       f"publish clear_faults to arm, then a new setpoint")
+                                       f"call clear_faults to arm, then a new setpoint")
         elif latest is not None:
             mode = "tensioning" if latest.mode is Mode.TENSION else "released"
             level, text = Level.OK, (f"{mode}: tension {latest.tension:.3f} N, setpoint "

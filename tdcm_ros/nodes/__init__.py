@@ -10,7 +10,8 @@ imports them, so this face exports nothing.
 - :mod:`.mocap_node` -- motion-capture markers (CSV replay, live, simulated);
 - :mod:`.metrics_node` -- running Table I metrics;
 - :mod:`.talker` -- a minimal example node;
-- :mod:`.shape_messages` -- the ROS messages of a solved shape.
+- :mod:`.shape_messages` -- the ROS messages of a solved shape;
+- :mod:`.driver_diagnostics` -- the tension device's components on ``/diagnostics``.
 """
 
 __all__: list[str] = []

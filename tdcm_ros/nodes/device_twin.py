@@ -25,7 +25,16 @@ from tdcm_ros.device import PLANT_SPECS, PlantConfig, fault_names
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs, grouped
+from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
+    NodeLogic,
+    NodePort,
+    QoS,
+    Status,
+    declare_specs,
+    grouped,
+)
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -105,13 +114,12 @@ class DeviceTwinNode(NodeLogic):
         diag_period = float(own["diagnostics_period_s"])
         self.truth = port.create_publisher("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
                                            QoS(depth=100))
-        self.diagnostics = port.create_publisher("/diagnostics",
-                                                 "diagnostic_msgs/msg/DiagnosticArray", QoS(depth=10))
         self.server = PtyTwin(DeviceTwin(plant), speed=speed, link=link,
                               line_delay=line_delay).start()
         self.samples = 0
         port.create_timer(period, self.publish_truth)
-        port.create_timer(diag_period, self.report)
+        self.diagnostics = Diagnostics(port, diag_period)
+        self.diagnostics.add("device twin", "tdcm_twin", self.check)
         port.logger.info("device twin on %s -> %s (scene %r, speed %g)", self.server.port,
                          self.server.pty_path, scene or "none", speed)
 
@@ -131,14 +139,10 @@ class DeviceTwinNode(NodeLogic):
                 "setpoint": f"{twin.core.setpoint_mn / 1000:.3f}",
                 "tension_true": f"{twin.plant.tension:.3f}", "samples": str(self.samples)}
 
-    def report(self) -> None:
-        """Publish the twin's state on ``/diagnostics`` (always OK: it is a simulation)."""
+    def check(self) -> Status:
+        """The twin's state for ``/diagnostics`` (always OK: it is a simulation)."""
         state = self._state()
-        status = {"level": 0, "name": f"{self.port.node_name}: device twin",
-                  "message": f"serving {state['port']}", "hardware_id": "tdcm_twin",
-                  "values": [{"key": k, "value": v} for k, v in state.items()]}
-        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
-            "header": header(self.port.now_ns(), ""), "status": [status]}))
+        return Status(DiagnosticLevel.OK, f"serving {state['port']}", state)
 
     def close(self) -> None:
         """Stop the twin (the pty closes, the link is removed); logs the final device state."""

@@ -48,8 +48,16 @@ from tdcm_ros.metrics import (
 )
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import FIELD_SPECS, PRESETS, preset
-from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime import NodeLogic, NodePort, QoS, declare_specs, grouped
+from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
+    NodeLogic,
+    NodePort,
+    QoS,
+    Status,
+    declare_specs,
+    grouped,
+)
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -118,8 +126,6 @@ class MetricsNode(NodeLogic):
                                            QoS(depth=1, durability="transient_local"))
         self.values = {name: port.create_publisher(f"metrics/{name}", "std_msgs/msg/Float64",
                                                    qos) for name in TABLE_TOPICS}
-        self.diagnostics = port.create_publisher("/diagnostics",
-                                                 "diagnostic_msgs/msg/DiagnosticArray", qos)
         port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", self._on_tension,
                                  QoS(depth=1000))
         port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", self._on_markers,
@@ -131,7 +137,8 @@ class MetricsNode(NodeLogic):
         self.last_ns: dict[str, int] = {}
         self.index = {label: i for i, label in enumerate(self.options.layout.labels)}
         port.create_timer(update_s, self.update)
-        port.create_timer(diag_s, self.report)
+        self.diagnostics = Diagnostics(port, diag_s)
+        self.diagnostics.add("inputs", "tdcm_metrics", self.check_inputs)
 
     def _options(self) -> EvaluateOptions:
         """Evaluation options from the (read-only) parameters; bad values raise InputError."""
@@ -223,8 +230,9 @@ class MetricsNode(NodeLogic):
             if value is not None:
                 pub.publish(from_dict("std_msgs/msg/Float64", {"data": float(value)}))
 
-    def report(self) -> None:
-        """``/diagnostics``: staleness, registration and counters."""
+    def check_inputs(self) -> Status:
+        """WARN while tension or markers are stale or no registration is known, else OK:
+        staleness, registration and counters."""
         now = self.port.now_ns()
         stale_s = float(self.port.get_parameter("stale_s"))
         problems = [f"no {name} for more than {stale_s:g} s"
@@ -235,14 +243,10 @@ class MetricsNode(NodeLogic):
             problems.append("no registration yet (waiting for /tf_static or a zero-tension and "
                             "a bent step)")
         message = "; ".join(problems) or self.running.problem or "ok"
-        values = {**{k: str(v) for k, v in sorted(self.counts.items())},
+        values = {**dict(sorted(self.counts.items())),
                   "registration": reg.method if reg else "none"}
-        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
-            "header": header(now, ""), "status": [{
-                "level": 1 if problems else 0, "name": f"{self.port.node_name}: inputs",
-                "message": message, "hardware_id": "tdcm_metrics",
-                "values": [{"key": k, "value": v} for k, v in values.items()]}]}))
-
+        level = DiagnosticLevel.WARN if problems else DiagnosticLevel.OK
+        return Status(level, message, values)
 
 def main() -> int:
     """``ros2 run tdcm_ros metrics_node`` / ``metrics_node`` console script."""

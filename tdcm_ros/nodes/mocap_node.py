@@ -5,8 +5,9 @@ Publishes ``markers`` (``mocap4r2_msgs/msg/Markers``, the MOCAP4ROS2 Vicon drive
 ``frame_id`` (``mocap``), positions in m; marker_name = label (``m1``...), marker_index = the
 label's index. Occluded markers (NaN or exactly zero) and unlabelled ones are left out and
 counted. The static transform ``mocap`` -> ``tdcm_base`` goes to ``/tf_static``
-(``tf2_msgs/msg/TFMessage``, transient local) once at start. ``/diagnostics`` carries the
-counters and the source state.
+(``tf2_msgs/msg/TFMessage``, transient local) once at start. ``/diagnostics``
+(``mocap_node: <source> source``) carries the counters and the source state; WARN while a source
+error or rejected axis message happened within the last 5 periods, or a live source waits.
 
 ``source`` (read-only):
 
@@ -48,9 +49,12 @@ from tdcm_ros.mocap import (
 )
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
     NodeLogic,
     NodePort,
     QoS,
+    Status,
     declare_specs,
     grouped,
     resolve_topic,
@@ -148,13 +152,13 @@ class MocapNode(NodeLogic):
         self.poses_pub = port.create_publisher("markers_poses", "geometry_msgs/msg/PoseArray", qos)
         self.tf_pub = port.create_publisher("/tf_static", "tf2_msgs/msg/TFMessage",
                                             QoS(depth=1, durability="transient_local"))
-        self.diagnostics = port.create_publisher("/diagnostics",
-                                                 "diagnostic_msgs/msg/DiagnosticArray", qos)
         start = {"csv": self._start_csv, "relabel": self._start_relabel, "sim": self._start_sim}
         self.registration = start[self.source_name]()
         self.labeller = self._labeller()
         self._publish_tf()
-        port.create_timer(float(get("diagnostics_period_s")), self.report)
+        self.diagnostics = Diagnostics(port, float(get("diagnostics_period_s")))
+        self.problems = self.diagnostics.window()
+        self.diagnostics.add(f"{self.source_name} source", "tdcm_mocap", self.check_source)
 
     # -- registration and labelling ---------------------------------------------------------
 
@@ -325,21 +329,19 @@ class MocapNode(NodeLogic):
             "transform": {"translation": {"x": t[0], "y": t[1], "z": t[2]},
                           "rotation": {"x": q[0], "y": q[1], "z": q[2], "w": q[3]}}}]}))
 
-    def report(self) -> None:
-        """Publish counters, the source state and the registration on ``/diagnostics``."""
+    def check_source(self) -> Status:
+        """WARN while source errors or rejected axis messages happened within the window, or
+        while a live source still waits for input; counters, source state and registration."""
         waiting = self.state.startswith("waiting") or "no sim/tension_true" in self.state
-        problems = self.counts["source_errors"] + self.counts["axis_rejected"]
-        level = 1 if (problems or (waiting and self.source_name != "csv")) else 0
-        values = {**{k: str(v) for k, v in sorted(self.counts.items())},
+        recent = self.problems.recent(self.counts["source_errors"] + self.counts["axis_rejected"],
+                                      self.port.now_ns())
+        values = {**dict(sorted(self.counts.items())),
                   "source": self.source_name, "state": self.state,
                   "registration": self.registration.method,
                   "registration_residual_m": f"{self.registration.residual_m:.6g}"}
-        status = {"level": level, "name": f"{self.port.node_name}: {self.source_name} source",
-                  "message": self.last_problem or self.state, "hardware_id": "tdcm_mocap",
-                  "values": [{"key": k, "value": v} for k, v in values.items()]}
-        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
-            "header": header(self.port.now_ns(), ""), "status": [status]}))
-
+        warn = recent or (waiting and self.source_name != "csv")
+        level = DiagnosticLevel.WARN if warn else DiagnosticLevel.OK
+        return Status(level, (self.last_problem if recent else "") or self.state, values)
 
 def main() -> int:
     """``ros2 run tdcm_ros mocap_node`` / ``mocap_node`` console script."""

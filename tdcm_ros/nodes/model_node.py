@@ -5,7 +5,9 @@ in N, in a frame whose z axis runs along the tendon toward the actuator; or
 ``std_msgs/msg/Float64`` in N, by the ``input.tension_type`` parameter). Publishes, stamped
 with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (nav_msgs/Path),
 ``midline_poses`` (PoseArray), ``tip_pose`` (PoseStamped), ``predicted_markers`` (PoseArray),
-``body_markers`` (visualization_msgs/MarkerArray) and ``/diagnostics``.
+``body_markers`` (visualization_msgs/MarkerArray) and ``/diagnostics`` (``model_node: input``:
+dropped and coalesced inputs; ``model_node: solver``: solves and failures; each WARN while a
+problem happened within the last 5 diagnostics periods, OK again after).
 
 TF (``tf2_msgs/msg/TFMessage``, see :mod:`tdcm_ros.nodes.tf_messages`): on ``/tf_static``
 (transient local, depth 1, as tf2's StaticTransformBroadcaster) ``frame_id -> tf.tendon_frame_id``,
@@ -31,7 +33,6 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError, PhysicsError
 from tdcm_ros.model import (
     FIELD_SPECS,
@@ -45,12 +46,15 @@ from tdcm_ros.model import (
     solve,
     warm_up,
 )
-from tdcm_ros.nodes.shape_messages import header, midline_messages
+from tdcm_ros.nodes.shape_messages import midline_messages
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
 from tdcm_ros.runtime import (
+    DiagnosticLevel,
+    Diagnostics,
     NodeLogic,
     NodePort,
     QoS,
+    Status,
     declare_specs,
     grouped,
     read_specs,
@@ -145,8 +149,6 @@ class ModelNode(NodeLogic):
                                ("tip_pose", "geometry_msgs/msg/PoseStamped"),
                                ("predicted_markers", "geometry_msgs/msg/PoseArray"),
                                ("body_markers", "visualization_msgs/msg/MarkerArray"))}
-        self.diagnostics = port.create_publisher("/diagnostics",
-                                                 "diagnostic_msgs/msg/DiagnosticArray", qos)
         self.tf_static = port.create_publisher("/tf_static", TF_TYPE,
                                                QoS(depth=1, durability="transient_local"))
         self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
@@ -156,10 +158,13 @@ class ModelNode(NodeLogic):
         self.pending: tuple[float, int] | None = None
         self.previous: SolveResult | None = None
         self.counts: Counter[str] = Counter()
-        self.problems_reported = 0
         self.last_problem = ""
+        self.last_failure = ""
         port.create_timer(period, self.process)
-        port.create_timer(diag_period, self.report)
+        self.diagnostics = Diagnostics(port, diag_period)
+        self.dropped, self.failed = self.diagnostics.window(), self.diagnostics.window()
+        self.diagnostics.add("input", "tdcm_model", self.check_input)
+        self.diagnostics.add("solver", "tdcm_model", self.check_solver)
 
     def _config(self, changes: Mapping[str, Any]) -> tuple[Design, SolverSettings]:
         """Design and settings from the current parameters with ``changes`` applied."""
@@ -241,7 +246,7 @@ class ModelNode(NodeLogic):
                            warm_start=self.previous)
         except (PhysicsError, InputError) as error:
             self.counts[f"model_{error.kind}"] += 1
-            self.last_problem = f"tension {tension:g} N: {error}"
+            self.last_failure = f"tension {tension:g} N: {error}"
             return
         self.previous = result
         self.counts["solved"] += 1
@@ -261,21 +266,29 @@ class ModelNode(NodeLogic):
                                 station_prefix=str(self.tf_names["tf.station_prefix"]),
                                 stations=int(self.tf_names["tf.stations"])))
 
-    def report(self) -> None:
-        """Publish the cumulative counters on ``/diagnostics``; the level is WARN, with the last
-        problem as message, only if an input was dropped or failed since the previous report."""
-        problems = sum(v for k, v in self.counts.items() if k.startswith(("dropped", "model")))
-        recent = problems > self.problems_reported
-        self.problems_reported = problems
-        status = {
-            "level": 1 if recent else 0,  # DiagnosticStatus WARN, OK
-            "name": f"{self.port.node_name}: tension input",
-            "message": self.last_problem if recent else "ok", "hardware_id": "tdcm_model",
-            "values": [{"key": k, "value": str(v)} for k, v in sorted(self.counts.items())],
-        }
-        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
-            "header": header(self.port.now_ns(), ""), "status": [status]}))
+    def check_input(self) -> Status:
+        """WARN while a tension was dropped within the window (it recovers), else OK; the
+        cumulative counts of dropped and coalesced inputs."""
+        total = sum(v for k, v in self.counts.items() if k.startswith("dropped"))
+        recent = self.dropped.recent(total, self.port.now_ns())
+        values = {k: v for k, v in sorted(self.counts.items())
+                  if k.startswith(("dropped", "coalesced"))}
+        values["dropped_in_window"] = recent
+        if recent:
+            return Status(DiagnosticLevel.WARN, self.last_problem, values)
+        return Status(DiagnosticLevel.OK, "ok", values)
 
+    def check_solver(self) -> Status:
+        """WARN while a solve failed within the window (it recovers), else OK; solves and
+        failures by kind."""
+        total = sum(v for k, v in self.counts.items() if k.startswith("model"))
+        recent = self.failed.recent(total, self.port.now_ns())
+        values = {k: v for k, v in sorted(self.counts.items())
+                  if k.startswith(("model", "solved"))}
+        values["failed_in_window"] = recent
+        if recent:
+            return Status(DiagnosticLevel.WARN, self.last_failure, values)
+        return Status(DiagnosticLevel.OK, "ok", values)
 
 def main() -> int:
     """``ros2 run tdcm_ros model_node`` / ``model_node`` console script."""

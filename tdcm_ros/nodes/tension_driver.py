@@ -4,22 +4,26 @@ Wraps :class:`tdcm_ros.device.driver.TensionDriver` (handshake, heartbeats, setp
 clamp, reconnect with backoff, stale detection). A timer (``step_period_s``) steps the driver and
 publishes every telemetry frame as ``tension`` (``geometry_msgs/msg/WrenchStamped``,
 ``wrench.force.z`` = measured tension in N, frame ``frame_id``; stamp = host receive time, frames
-read together keep their device-clock spacing). ``device_state``
-(``diagnostic_msgs/msg/DiagnosticStatus``, every ``state_period_s``) carries link, mode, faults,
-setpoints and the schedule state (key ``schedule_done``); ``/diagnostics`` the same status plus
-counters every ``diagnostics_period_s``.
+read together keep their device-clock spacing). ``/diagnostics`` (every ``diagnostics_period_s``)
+carries one status per component (:mod:`tdcm_ros.nodes.driver_diagnostics`): ``serial link``,
+``load cell`` and ``actuator`` (mode, faults, setpoints, armed, the schedule state and
+``schedule_done``). ``device_state`` (``diagnostic_msgs/msg/DiagnosticStatus``, every
+``state_period_s``) is deprecated: those statuses rolled into one.
 
 Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
-warning, ramped at ``setpoint_rate``; cancels a running schedule), ``estop``
-(``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable),
-``clear_faults`` (``std_msgs/msg/Empty``: clear latched faults, arm, and re-enable if
-``enabled``), ``start_schedule`` (``std_msgs/msg/Empty``: (re)start the ``schedule.*``
-staircase). On shutdown the node releases the tendon and closes the port.
+warning, ramped at ``setpoint_rate``; cancels a running schedule) and ``estop``
+(``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable; a topic so any
+node can fire it without waiting). Commands are ``std_srvs/srv/Trigger`` services whose response
+says whether they were carried out and why not: ``~/start_schedule`` ((re)start the
+``schedule.*`` staircase; refused while disarmed or with a latched fault), ``~/clear_faults``
+(clear latched faults, arm, re-enable if ``enabled``; refused while the link is down),
+``~/release`` (slacken the tendon, cancel the schedule, until ``clear_faults``) and ``~/estop``
+(as the topic). On shutdown the node releases the tendon and closes the port.
 
 After a link loss, a device reboot or freeze, and an e-stop the driver is disarmed (see
 :mod:`tdcm_ros.device.driver`): the device is held released at a target of 0 N, setpoints and
-schedules are refused, until ``clear_faults``; after it a new setpoint is needed. ``device_state``
-and ``/diagnostics`` report ``armed`` and ``disarm_reason``.
+schedules are refused, until ``clear_faults``; after it a new setpoint is needed. The actuator's
+status reports ``armed`` and ``disarm_reason``.
 
 The force limits :data:`SAFETY_LIMITS` are read-only at run time unless the node is started with
 ``safety.limits_writable: true`` (itself read-only).
@@ -31,7 +35,7 @@ import math
 import sys
 import time
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -41,7 +45,6 @@ from tdcm_ros.device import (
     SCHEDULE_SPECS,
     DriverConfig,
     DriverStatus,
-    Level,
     LinkState,
     ProtocolVersionError,
     StepSchedule,
@@ -50,18 +53,24 @@ from tdcm_ros.device import (
     fault_names,
 )
 from tdcm_ros.errors import InputError
+from tdcm_ros.nodes.driver_diagnostics import actuator, load_cell, serial_link
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
+    Diagnostics,
     NodeLogic,
     NodePort,
     QoS,
+    Status,
     declare_specs,
     grouped,
     read_specs,
+    summary,
 )
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
+TRIGGER = "std_srvs/srv/Trigger"
+STATUS_TYPE = "diagnostic_msgs/msg/DiagnosticStatus"
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
 #: parameters that bound the force on the tendon: fixed at run time unless safety.limits_writable
 SAFETY_LIMITS = ("tension_max", "setpoint_rate")
@@ -76,7 +85,8 @@ FIXED_SPECS = by_name(
          default=False, kind="bool"),
     Spec("step_period_s", "s", "driver step period; telemetry is 50 Hz", 0.005, low=0.001,
          high=0.02),
-    Spec("state_period_s", "s", "device_state period", 0.1, low=0.01, high=10.0),
+    Spec("state_period_s", "s", "device_state period (deprecated topic)", 0.1, low=0.01,
+         high=10.0),
     Spec("diagnostics_period_s", "s", "/diagnostics period", 0.5, low=0.05, high=60.0))
 #: Parameters of the node a client may change at run time, besides the driver and schedule.
 TUNABLE_SPECS = by_name(
@@ -118,7 +128,6 @@ class TensionDriverNode(NodeLogic):
 
         self.counts: Counter[str] = Counter()
         self.last_warning = ""
-        self.clamped_since_report = False
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
         self.driver = TensionDriver(config, clock=time.monotonic, warn=self._warn)
@@ -127,20 +136,23 @@ class TensionDriverNode(NodeLogic):
 
         self.tension = port.create_publisher("tension", "geometry_msgs/msg/WrenchStamped",
                                              QoS(depth=100))
-        self.state = port.create_publisher("device_state", "diagnostic_msgs/msg/DiagnosticStatus",
-                                           QoS(depth=10))
-        self.diagnostics = port.create_publisher("/diagnostics",
-                                                 "diagnostic_msgs/msg/DiagnosticArray", QoS(depth=10))
+        self.state = port.create_publisher("device_state", STATUS_TYPE, QoS(depth=10))
+        self.diagnostics = Diagnostics(port, diag_period)
+        self.clamps = self.diagnostics.window()
+        hardware = url
+        self.diagnostics.add("serial link", hardware,
+                             lambda: serial_link(self.status, self.counts))
+        self.diagnostics.add("load cell", hardware, lambda: load_cell(self.status))
+        self.diagnostics.add("actuator", hardware, self._check_actuator)
         port.create_subscription("tension_setpoint", "std_msgs/msg/Float64", self._on_setpoint,
                                  QoS(depth=10))
         port.create_subscription("estop", "std_msgs/msg/Empty", self._on_estop, QoS(depth=10))
-        port.create_subscription("clear_faults", "std_msgs/msg/Empty", self._on_clear,
-                                 QoS(depth=10))
-        port.create_subscription("start_schedule", "std_msgs/msg/Empty",
-                                 lambda _: self._start_schedule(), QoS(depth=10))
+        for name, command in (("start_schedule", self.start_schedule),
+                              ("clear_faults", self.clear_faults), ("release", self.release),
+                              ("estop", self.estop)):
+            port.create_service(f"~/{name}", TRIGGER, _answering(command))
         port.create_timer(step_period, self.step)
         port.create_timer(state_period, self.publish_state)
-        port.create_timer(diag_period, self.report)
         port.logger.info("driving the tension device on %s (tension_max %g N)", url,
                          config.tension_max)
 
@@ -199,7 +211,6 @@ class TensionDriverNode(NodeLogic):
         applied = self.driver.set_setpoint(newtons)
         if applied != newtons and self.driver.armed:
             self.counts["clamped_setpoints"] += 1
-            self.clamped_since_report = True
 
     def _on_setpoint(self, message: Any) -> None:
         newtons = float(message.data)
@@ -207,45 +218,75 @@ class TensionDriverNode(NodeLogic):
             self.counts["rejected_setpoints"] += 1
             self._warn(f"tension_setpoint = {newtons!r} N is not finite; ignored")
             return
-        if self.schedule_state in ("waiting", "running"):
-            self.schedule_state = "cancelled"
+        self._cancel_schedule()
         if not self.driver.armed:
             self.counts["rejected_setpoints"] += 1
         self._request(newtons)
 
     def _on_estop(self, _message: Any) -> None:
-        self.counts["estops"] += 1
-        self.driver.estop()
+        self.estop()
+
+    def _cancel_schedule(self) -> None:
         if self.schedule_state in ("waiting", "running"):
             self.schedule_state = "cancelled"
 
-    def _on_clear(self, _message: Any) -> None:
+    # --- commands (std_srvs/srv/Trigger services): (carried out, why / what) ------------------
+    def estop(self) -> tuple[bool, str]:
+        """Release at once (device e-stop, ESTOP latched), disarm, cancel the schedule."""
+        self.counts["estops"] += 1
+        self.driver.estop()
+        self._cancel_schedule()
+        return True, "e-stop sent: tendon released, ESTOP latched; call clear_faults to arm again"
+
+    def release(self) -> tuple[bool, str]:
+        """Slacken the tendon (mode R) and cancel the schedule; ``clear_faults`` holds again."""
+        self.driver.release()
+        self._cancel_schedule()
+        return True, "released: tendon slack; call clear_faults to hold tension again"
+
+    def clear_faults(self) -> tuple[bool, str]:
         """The operator's arm command: clear faults, arm, re-enable if ``enabled``."""
+        link = self.status.link if self.status else LinkState.DISCONNECTED
         if not self.driver.clear_faults():
-            return
+            return False, f"refused: link {link.value}; clear_faults needs the device connected"
         if bool(self.port.get_parameter("enabled")):
             self.driver.enable()
-        self.port.logger.info("faults cleared and armed on request (target %g N)",
-                              self.status.target if self.status else 0.0)
+        target = self.status.target if self.status else 0.0
+        self.port.logger.info("faults cleared and armed on request (target %g N)", target)
+        return True, (f"faults cleared and armed at target {target:g} N (the device keeps a "
+                      f"fault while still over its trip); a new setpoint is needed for tension")
 
-    def _start_schedule(self) -> None:
-        if self.status is not None and self.status.link is LinkState.CONNECTED:
-            self._run_schedule()
-        else:
+    def start_schedule(self) -> tuple[bool, str]:
+        """(Re)start the ``schedule.*`` staircase, or wait for the link; refused while disarmed
+        or with a fault latched, naming it."""
+        status = self.status
+        latest = status.telemetry if status else None
+        if not self.driver.armed:
+            reason = self.driver.disarm_reason
+            self.port.logger.warning("start_schedule refused: disarmed (%s)", reason)
+            return False, (f"refused: disarmed ({reason}); the tendon stays released; call "
+                           f"clear_faults first")
+        if latest is not None and latest.faults:
+            return False, (f"refused: fault latched ({fault_names(latest.faults)}, tension "
+                           f"{latest.tension:.1f} N, tension_max {self.driver.tension_max:g} N); "
+                           f"call clear_faults first")
+        if status is None or status.link is not LinkState.CONNECTED:
             self.schedule_state = "waiting"
+            return True, "waiting for the device link; the schedule starts once connected"
+        return self._run_schedule()
 
-    def _run_schedule(self) -> None:
+    def _run_schedule(self) -> tuple[bool, str]:
         for level in self.schedule.levels:
             if level > self.driver.tension_max:
                 self.counts["clamped_setpoints"] += 1
-                self.clamped_since_report = True
         if not self.driver.run_schedule(self.schedule):
             self.schedule_state = "cancelled"
-            return
+            return False, f"refused: {self.last_warning}"
         self.schedule_state = "running"
-        self.port.logger.info("schedule started: %s N, %g s each, %d trial(s)",
-                              list(self.schedule.levels), self.schedule.hold,
-                              self.schedule.trials)
+        text = (f"schedule started: {list(self.schedule.levels)} N, {self.schedule.hold:g} s "
+                f"each, {self.schedule.trials} trial(s)")
+        self.port.logger.info("%s", text)
+        return True, text
 
     # --- the step ---------------------------------------------------------------------------
     def step(self) -> None:
@@ -292,68 +333,30 @@ class TensionDriverNode(NodeLogic):
         self.counts["telemetry_frames"] += len(frames)
 
     # --- state and diagnostics ----------------------------------------------------------------
-    def _status_dict(self, name: str, extra: Mapping[str, str]) -> dict[str, Any]:
-        status = self.status
-        if status is None:
-            return {"level": int(Level.STALE), "name": name, "message": "not stepped yet",
-                    "hardware_id": str(self.port.get_parameter("port")), "values": []}
-        latest, banner = status.telemetry, status.banner
-        values = {
-            "link": status.link.value,
-            "mode": latest.mode.name.lower() if latest else "",
-            "faults": fault_names(latest.faults) if latest else "",
-            "tension": f"{latest.tension:.3f}" if latest else "",
-            "pulse_us": str(latest.pulse_us) if latest else "",
-            "raw_counts": str(latest.raw) if latest else "",
-            "device_time": f"{latest.time:.3f}" if latest else "",
-            "target": f"{status.target:.3f}",
-            "setpoint": f"{status.setpoint:.3f}",
-            "tension_max": f"{self.driver.tension_max:g}",
-            "enabled": str(status.enabled).lower(),
-            "armed": str(status.armed).lower(),
-            "disarm_reason": status.disarm_reason,
-            "schedule": self.schedule_state,
-            "schedule_done": str(self.schedule_state == "done").lower(),
-            "firmware": banner.firmware if banner else "",
-            "cell": banner.cell if banner else "",
-            **extra,
-        }
-        hardware = f"{self.port.get_parameter('port')}"
-        return {"level": int(status.level), "name": name, "message": status.message,
-                "hardware_id": hardware,
-                "values": [{"key": k, "value": v} for k, v in values.items()]}
+    def _check_actuator(self) -> Status:
+        clamped = self.clamps.recent(self.counts["clamped_setpoints"], self.port.now_ns())
+        return actuator(self.status, tension_max=self.driver.tension_max,
+                        schedule_state=self.schedule_state, counts=self.counts,
+                        last_warning=self.last_warning, clamped_recently=clamped)
 
     def publish_state(self) -> None:
-        """Publish ``device_state``."""
-        self.state.publish(from_dict("diagnostic_msgs/msg/DiagnosticStatus",
-                                     self._status_dict(self.port.node_name, {})))
-
-    def report(self) -> None:
-        """Publish ``/diagnostics``: link, staleness, faults and counters (WARN after a clamp)."""
-        status = self.status
-        counters = {
-            "reconnects": status.reconnects if status else 0,
-            "rejected_lines": status.rejected_lines if status else 0,
-            "nacks": status.nacks if status else 0,
-            "disarms": status.disarms if status else 0,
-            **{key: self.counts[key] for key in ("clamped_setpoints", "rejected_setpoints",
-                                                 "estops", "version_mismatches",
-                                                 "telemetry_frames")},
-        }
-        extra = {k: str(v) for k, v in counters.items()}
-        extra["last_warning"] = self.last_warning
-        entry = self._status_dict(f"{self.port.node_name}: tension device", extra)
-        if self.clamped_since_report and entry["level"] < Level.WARN:
-            entry["level"] = int(Level.WARN)
-            entry["message"] += f"; setpoint clamped to [0, {self.driver.tension_max:g}] N"
-        self.clamped_since_report = False
-        self.diagnostics.publish(from_dict("diagnostic_msgs/msg/DiagnosticArray", {
-            "header": header(self.port.now_ns(), ""), "status": [entry]}))
+        """Publish ``device_state`` (deprecated): the components' statuses rolled into one."""
+        rolled = summary(self.diagnostics.statuses(), self.port.node_name,
+                         str(self.port.get_parameter("port")))
+        self.state.publish(from_dict(STATUS_TYPE, rolled))
 
     def close(self) -> None:
         """Release the tendon and close the port."""
         self.driver.close()
         self.port.logger.info("tendon released, port closed")
+
+
+def _answering(command: Callable[[], tuple[bool, str]]) -> Callable[[Any], Any]:
+    """A ``std_srvs/srv/Trigger`` handler running ``command``."""
+    def handle(_request: Any) -> Any:
+        success, message = command()
+        return from_dict(f"{TRIGGER}_Response", {"success": success, "message": message})
+    return handle
 
 
 def _non_empty(name: str) -> Any:

@@ -10,6 +10,13 @@ import their transport, :mod:`tdcm_ros.runtime.zenoh_runtime`, :mod:`tdcm_ros.ru
 (rclpy).
 """
 
+from tdcm_ros.runtime.diagnostics import (
+    DiagnosticLevel,
+    Diagnostics,
+    EventWindow,
+    Status,
+    summary,
+)
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.graph import NodeGraph
 from tdcm_ros.runtime.launcher import launch
@@ -36,6 +43,9 @@ __all__ = [
     "DEFAULT_NODE_SET",
     "DEFAULT_QOS",
     "NODES",
+    "DiagnosticLevel",
+    "Diagnostics",
+    "EventWindow",
     "NodeGraph",
     "NodeLogic",
     "NodePort",
@@ -45,6 +55,7 @@ __all__ = [
     "QoS",
     "RuntimePortError",
     "SetResult",
+    "Status",
     "Timer",
     "declare_specs",
     "grouped",
@@ -52,4 +63,5 @@ __all__ = [
     "node_target",
     "read_specs",
     "resolve_topic",
+    "summary",
 ]

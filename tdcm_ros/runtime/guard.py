@@ -1,6 +1,6 @@
 """Callback isolation shared by both runtimes: a failing callback never ends a node's loop.
 
-Every callback a node registers through its port (subscriptions, timers) runs inside
+Every callback a node registers through its port (subscriptions, timers, services) runs inside
 :meth:`CallbackGuard.wrap`. An exception is logged with its traceback, counted per callback, and
 reported on ``/diagnostics`` (``diagnostic_msgs/DiagnosticArray``, one status named
 ``<node>: callbacks``, level ERROR, values ``<callback>: <count>`` and the last error), at most

@@ -10,6 +10,7 @@ when the clock is moved with :meth:`MemoryPort.advance`::
     node = Talker(port)
     port.advance(1.0)                      # ten ticks
     port.messages("chatter")
+    port.call("~/reset")                   # a service the node serves, as the node names it
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from collections import defaultdict
 from collections.abc import Callable
 from typing import Any
 
-from tdcm_ros.bagio import deserialize, serialize
+from tdcm_ros.bagio import deserialize, from_dict, normalize_service_type, serialize
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.names import fully_qualified_node_name
@@ -78,6 +79,7 @@ class MemoryPort:
         self.publishers: dict[str, MemoryPublisher] = {}
         self.subscriptions: dict[str, tuple[str, Callable[[Any], None], QoS]] = {}
         self.timers: list[MemoryTimer] = []
+        self.services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
@@ -105,6 +107,23 @@ class MemoryPort:
                             qos: QoS = DEFAULT_QOS) -> None:
         """Subscribe; :meth:`deliver` hands ``callback`` the messages."""
         self.subscriptions[topic] = (type_name, callback, qos)
+
+    def create_service(self, name: str, type_name: str,
+                       handler: Callable[[Any], Any]) -> None:
+        """Serve ``type_name`` on ``name``; :meth:`call` hands ``handler`` the requests."""
+        self.services[name] = (normalize_service_type(type_name), handler)
+
+    def call(self, name: str, request: Any = None) -> Any:
+        """Call the service ``name`` (an empty request by default), with a CDR round trip of
+        the request and of the response, as a transport would carry them."""
+        if name not in self.services:
+            raise RuntimePortError(f"no service {name!r}; served: {sorted(self.services)}")
+        type_name, handler = self.services[name]
+        request_type, response_type = f"{type_name}_Request", f"{type_name}_Response"
+        if request is None:
+            request = from_dict(request_type, {})
+        response = handler(deserialize(serialize(request, request_type), request_type))
+        return deserialize(serialize(response, response_type), response_type)
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> MemoryTimer:
         """Call ``callback`` every ``period`` s of the port's clock (see :meth:`advance`)."""

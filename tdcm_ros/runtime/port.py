@@ -13,6 +13,8 @@ zenoh. The same class runs on the zenoh runtime (no ROS) or the rclpy runtime (R
             self.pub = port.create_publisher("chatter", "std_msgs/msg/String", QoS(depth=10))
             port.create_timer(self.period, self.tick)
 
+Services (``create_service``) answer requests on the node's thread; a command is a
+``std_srvs/srv/Trigger`` whose response says whether it was carried out and why not.
 Messages are rosbags objects (:mod:`tdcm_ros.bagio`); both runtimes carry their CDR bytes.
 """
 
@@ -125,6 +127,13 @@ class NodePort(Protocol):
     def create_subscription(self, topic: str, type_name: str, callback: Callable[[Any], None],
                             qos: QoS = DEFAULT_QOS) -> None:
         """Subscribe; ``callback`` receives the deserialised rosbags message."""
+
+    def create_service(self, name: str, type_name: str,
+                       handler: Callable[[Any], Any]) -> None:
+        """Serve ``type_name`` (``pkg/srv/Name``) on ``name`` (``~/x``: under the node's name);
+        ``handler`` gets the deserialised request and returns the response message. It runs on
+        the node's callback thread like every callback; if it raises, the error is logged and
+        the caller gets no response."""
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> Timer:
         """Call ``callback`` every ``period`` seconds."""

@@ -22,7 +22,14 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-from tdcm_ros.bagio import BagError, deserialize, normalize_type_name, serialize
+from tdcm_ros.bagio import (
+    BagError,
+    deserialize,
+    from_dict,
+    normalize_service_type,
+    normalize_type_name,
+    serialize,
+)
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import wire
 from tdcm_ros.runtime.errors import RuntimePortError
@@ -42,6 +49,8 @@ from tdcm_ros.yamlio import load_yaml
 
 #: Seconds a parameter client waits for a node's parameter services.
 PARAM_TIMEOUT_S = 5.0
+#: Default time (s) a service client waits for its server and the answer.
+SERVICE_TIMEOUT_S = 5.0
 _NO_GID = bytes(wire.GID_SIZE)
 #: rclpy's own parameter that puts the node clock on ``/clock``.
 SIM_TIME = "use_sim_time"
@@ -56,6 +65,30 @@ def message_class(type_name: str) -> Any:
         raise RuntimePortError(
             f"message type {type_name} is not importable for rclpy ({error}); build and source "
             f"its interface package (see README, 'On a ROS 2 machine')") from error
+
+
+def service_class(type_name: str) -> Any:
+    """The rclpy service class of ``pkg/srv/Name``; ``RuntimePortError`` if not installed."""
+    package, _, name = normalize_service_type(type_name).partition("/srv/")
+    try:
+        return getattr(importlib.import_module(f"{package}.srv"), name)
+    except (ImportError, AttributeError) as error:
+        raise RuntimePortError(f"service type {type_name} is not importable for rclpy ({error}); "
+                               f"install its interface package") from error
+
+
+def to_rosbags(native: Any, type_name: str) -> Any:
+    """A rosidl message as the rosbags message of ``type_name`` (through its CDR bytes)."""
+    from rclpy.serialization import serialize_message
+
+    return deserialize(serialize_message(native), type_name)
+
+
+def to_native(message: Any, type_name: str, native_class: Any) -> Any:
+    """A rosbags message as an instance of rosidl class ``native_class`` (through CDR)."""
+    from rclpy.serialization import deserialize_message
+
+    return deserialize_message(serialize(message, type_name), native_class)
 
 
 def _flag_values(args: Sequence[str], flags: tuple[str, ...]) -> list[str]:
@@ -270,6 +303,25 @@ class RclpyNodePort:
         holder.append(self.node.create_subscription(message_class(name), topic, on_message,
                                                     qos_profile(qos), raw=True))
 
+    def create_service(self, name: str, type_name: str,
+                       handler: Callable[[Any], Any]) -> None:
+        """An rclpy service; requests and responses cross to rosbags through their CDR bytes.
+        A failing handler is logged and answered with a default response."""
+        service = normalize_service_type(type_name)
+        native = service_class(service)
+
+        def answer(request: Any) -> Any:
+            return to_native(handler(to_rosbags(request, f"{service}_Request")),
+                             f"{service}_Response", native.Response)
+
+        guarded = self.guard.wrap(f"service {self.node.resolve_service_name(name)}", answer)
+
+        def on_request(request: Any, response: Any) -> Any:
+            answered = guarded(request)
+            return response if answered is None else answered
+
+        self.node.create_service(native, name, on_request)
+
     def create_timer(self, period: float, callback: Callable[[], None]) -> Any:
         """rclpy timer of ``period`` s."""
         if not period > 0:
@@ -317,6 +369,8 @@ class RclpyContext:
         self.cli_params = _flag_values(args, ("-p", "--param"))
         self._stop = threading.Event()
         self._nodes: list[Any] = []
+        self._client_node: Any = None
+        self._clients: dict[tuple[str, str], Any] = {}
 
     def create_port(self, name: str, namespace: str = "/",
                     overrides: Mapping[str, Any] | None = None) -> RclpyNodePort:
@@ -370,6 +424,41 @@ class RclpyContext:
     def request_stop(self) -> None:
         """Make :meth:`spin` return (safe from signal handlers and other threads)."""
         self._stop.set()
+
+    def call_service(self, name: str, type_name: str, request: Any = None,
+                     timeout: float = SERVICE_TIMEOUT_S) -> Any:
+        """Call service ``name`` with an rclpy client (``request`` default: empty); the
+        response as a rosbags message. ``RuntimePortError`` if the service does not appear or
+        answer within ``timeout`` s. Spins this context while waiting (not inside a callback)."""
+        service = normalize_service_type(type_name)
+        native = service_class(service)
+        key = (name, service)
+        if key not in self._clients:
+            if self._client_node is None:
+                self._client_node = self.create_node(f"_tdcm_client_{id(self):x}")
+            self._clients[key] = self._client_node.create_client(native, name)
+        client = self._clients[key]
+        end = time.monotonic() + timeout
+        while not client.service_is_ready():
+            if time.monotonic() > end:
+                raise RuntimePortError(f"service {name} ({service}) has no server after "
+                                       f"{timeout:g} s; is its node running on ROS domain "
+                                       f"{self.domain_id}?")
+            self.spin_for(0.05)
+        if request is None:
+            request = from_dict(f"{service}_Request", {})
+        future = client.call_async(to_native(request, f"{service}_Request", native.Request))
+        response = self.spin_until_future(future, max(0.1, end - time.monotonic()))
+        return to_rosbags(response, f"{service}_Response")
+
+    def service_names(self, timeout: float = 1.0) -> list[tuple[str, str]]:
+        """``(name, type)`` of every service in the graph, sorted (after ``timeout`` s of
+        discovery)."""
+        if self._client_node is None:
+            self._client_node = self.create_node(f"_tdcm_client_{id(self):x}")
+        self.spin_for(timeout)
+        return sorted((name, kind) for name, kinds in
+                      self._client_node.get_service_names_and_types() for kind in kinds)
 
     def close(self) -> None:
         """Destroy every node, then shut the context down."""

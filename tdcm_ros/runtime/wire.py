@@ -9,6 +9,11 @@ Sources (ros2/rmw_zenoh, ``docs/design.md`` and ``rmw_zenoh_cpp/src/detail/``):
 - QoS ``<rel>:<dur>:<hist>,<depth>:<deadline s>,<ns>:<lifespan s>,<ns>:<liveliness>,<s>,<ns>``,
   each component empty when equal to rmw_zenoh's default (``qos.cpp``: reliable, volatile,
   keep-last, depth 42, infinite durations, automatic liveliness); values are ``rmw/types.h`` enums;
+- services (``rmw_service_data.cpp``, ``rmw_client_data.cpp``): the server declares a queryable
+  (complete) on the service's key, whose type chunk is ``pkg::srv::dds_::Name_`` and hash the
+  service type's RIHS01, and an ``SS`` token; a client queries that key with the CDR request and
+  an attachment (its sequence number, time, GID); the reply carries the CDR response and an
+  attachment with the request's sequence number and the client's GID;
 - attachment (since Jazzy 0.2.4, rmw_zenoh#605): zenoh-ext serialisation of
   ``(int64 sequence_number, int64 source_timestamp_ns, uint8[16] gid)`` = 8 + 8 + LEB128 length
   (``0x10``) + 16 bytes, integers little endian.
@@ -34,6 +39,9 @@ RMW_ZENOH_DEFAULT_DEPTH = 42
 _RELIABILITY = {"reliable": 1, "best_effort": 2}
 _DURABILITY = {"transient_local": 1, "volatile": 2}
 _ATTACHMENT = struct.Struct("<qqB16s")
+#: QoS of service servers and clients (``rmw_qos_profile_services_default``: reliable,
+#: volatile, keep-last 10), as their tokens carry it.
+SERVICE_QOS = QoS(depth=10)
 GID_SIZE = 16
 
 
@@ -100,7 +108,9 @@ def node_token(node: NodeIdentity) -> str:
 
 def endpoint_token(node: NodeIdentity, entity_id: int, kind: str, topic: str, type_name: str,
                    type_hash: str, qos: QoS) -> str:
-    """Liveliness token of a publisher (``MP``) or subscription (``MS``)."""
+    """Liveliness token of a publisher (``MP``), subscription (``MS``), service server (``SS``)
+    or client (``SC``); a service's ``type_name`` is ``pkg/srv/Name`` (its chunk
+    ``pkg::srv::dds_::Name_``, the response type's DDS name without ``Response_``)."""
     return (f"{node.prefix(entity_id, kind)}/{mangle(topic)}/{dds_type_name(type_name)}/"
             f"{type_hash}/{qos_chunk(qos)}")
 

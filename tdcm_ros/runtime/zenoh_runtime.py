@@ -8,6 +8,8 @@ control) whose settings stand, with the role's mode and endpoints set on top of 
 ``ROS_DOMAIN_ID`` selects the domain (default 0). Callbacks of every node run one at a time on the
 thread that calls :meth:`ZenohContext.spin`.
 
+Services are rmw_zenoh's (:mod:`tdcm_ros.runtime.wire`): a queryable and an ``SS`` token per
+server, queries with rmw_zenoh's attachment from :meth:`ZenohContext.call_service`.
 Parameters are served on ``@tdcm/<domain>/params/<mangled node fqn>/<get|set|list>`` (JSON);
 :func:`call_parameters` is the client ``tdcm param`` uses.
 """
@@ -35,8 +37,11 @@ import zenoh.ext
 from tdcm_ros.bagio import (
     BagError,
     deserialize,
+    from_dict,
+    normalize_service_type,
     normalize_type_name,
     serialize,
+    service_type_hash,
     type_hash,
 )
 from tdcm_ros.errors import InputError
@@ -74,6 +79,10 @@ PARAM_TIMEOUT_S = 5.0
 HEARTBEAT_PERIOD_S = 0.5
 """Sporadic heartbeat of a reliable transient-local publisher (s): rmw_zenoh's
 ``SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`` (``rmw_publisher_data.cpp``)."""
+#: Longest time (s) a service handler may take on the executor before the query fails.
+SERVICE_HANDLER_TIMEOUT_S = 5.0
+#: Default time (s) a client waits for a server to appear and answer.
+SERVICE_TIMEOUT_S = 5.0
 
 
 def _reliability(qos: QoS) -> zenoh.Reliability:
@@ -300,6 +309,94 @@ class _Subscription:
         self._sub.undeclare()
 
 
+class _Service:
+    """A service server in rmw_zenoh's format: a queryable on the service key and an ``SS``
+    token; ``answer(request CDR)`` runs on the executor and gives the response CDR or None."""
+
+    def __init__(self, context: ZenohContext, identity: wire.NodeIdentity, name: str,
+                 type_name: str, answer: Callable[[bytes], bytes | None]) -> None:
+        self.name, self.type_name = name, type_name
+        self._answer, self._executor = answer, context.executor
+        rihs = service_type_hash(type_name)
+        self.key = wire.topic_key(identity.domain_id, name, type_name, rihs)
+        token = wire.endpoint_token(identity, context.next_id(), wire.SERVICE, name, type_name,
+                                    rihs, wire.SERVICE_QOS)
+        self._queryable = context.session.declare_queryable(self.key, self._on_query,
+                                                            complete=True)
+        self._token = context.session.liveliness().declare_token(token)
+
+    def _on_query(self, query: zenoh.Query) -> None:
+        try:
+            if query.attachment is None:
+                raise RuntimePortError("request without rmw_zenoh's attachment")
+            request = wire.decode_attachment(query.attachment.to_bytes())
+            payload = query.payload.to_bytes() if query.payload is not None else b""
+            response = self._executor.call(lambda: self._answer(payload),
+                                           SERVICE_HANDLER_TIMEOUT_S)
+        except RuntimePortError as error:
+            query.reply_err(f"{self.name}: {error}")
+            return
+        if response is None:
+            query.reply_err(f"{self.name}: the handler failed; see the node's log")
+            return
+        query.reply(self.key, response, attachment=wire.encode_attachment(
+            request.sequence_number, time.time_ns(), request.gid))
+
+    def close(self) -> None:
+        self._token.undeclare()
+        self._queryable.undeclare()
+
+
+class _Client:
+    """A service client in rmw_zenoh's format: an ``SC`` token, sequence numbers from 1."""
+
+    def __init__(self, context: ZenohContext, identity: wire.NodeIdentity, name: str,
+                 type_name: str) -> None:
+        self.name, self.type_name = name, type_name
+        self._context = context
+        rihs = service_type_hash(type_name)
+        self.key = wire.topic_key(identity.domain_id, name, type_name, rihs)
+        token = wire.endpoint_token(identity, context.next_id(), wire.CLIENT, name, type_name,
+                                    rihs, wire.SERVICE_QOS)
+        self._gid = wire.gid_of(token)
+        self._seq = itertools.count(1)
+        self._token = context.session.liveliness().declare_token(token)
+
+    def _server_up(self) -> bool:
+        return any(t.kind == wire.SERVICE and t.topic == self.name and t.type_name == self.type_name
+                   for t in graph_tokens(self._context.session, self._context.domain_id, 0.5))
+
+    def call(self, request: bytes, timeout: float) -> bytes:
+        """Wait up to ``timeout`` s for a server, send ``request`` (CDR), return the response."""
+        end = time.monotonic() + timeout
+        while not self._server_up():
+            if time.monotonic() > end:
+                raise RuntimePortError(
+                    f"service {self.name} ({self.type_name}) has no server after {timeout:g} s; "
+                    f"is its node running on domain {self._context.domain_id}?")
+            time.sleep(0.05)
+        seq = next(self._seq)
+        attachment = wire.encode_attachment(seq, time.time_ns(), self._gid)
+        errors = []
+        for reply in self._context.session.get(
+                self.key, payload=request, attachment=attachment,
+                target=zenoh.QueryTarget.ALL_COMPLETE, consolidation=zenoh.ConsolidationMode.NONE,
+                timeout=max(0.1, end - time.monotonic())):
+            if reply.ok is None:
+                errors.append(reply.err.payload.to_string() if reply.err is not None else "?")
+                continue
+            if reply.ok.attachment is not None:
+                answer = wire.decode_attachment(reply.ok.attachment.to_bytes())
+                if answer.sequence_number != seq or answer.gid != self._gid:
+                    continue  # not the answer to this request
+            return bytes(reply.ok.payload.to_bytes())
+        raise RuntimePortError(f"service {self.name} did not answer within {timeout:g} s"
+                               + (f": {'; '.join(errors)}" if errors else ""))
+
+    def close(self) -> None:
+        self._token.undeclare()
+
+
 class ZenohNodePort:
     """:class:`tdcm_ros.runtime.port.NodePort` on a zenoh session."""
 
@@ -314,7 +411,7 @@ class ZenohNodePort:
         node_id = context.next_id()
         self.identity = wire.NodeIdentity(context.domain_id, context.zid, node_id,
                                           self.namespace, name)
-        self._entities: list[_Publisher | _Subscription] = []
+        self._entities: list[_Publisher | _Subscription | _Service | _Client] = []
         self.guard = CallbackGuard(self.fqn, self.logger, self.create_publisher, self.now_ns)
         self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
         self._queryable = context.session.declare_queryable(
@@ -423,6 +520,26 @@ class ZenohNodePort:
                                             self.guard.wrap(f"subscription {resolved}", callback),
                                             qos, any_type=type_name is None))
 
+    def create_service(self, name: str, type_name: str,
+                       handler: Callable[[Any], Any]) -> None:
+        """Serve ``type_name`` on the resolved ``name`` (queryable and ``SS`` token)."""
+        resolved = resolve_topic(name, self.namespace, self.node_name)
+        service = normalize_service_type(type_name)
+        request_type, response_type = f"{service}_Request", f"{service}_Response"
+
+        def answer(data: bytes) -> bytes:
+            return serialize(handler(deserialize(data, request_type)), response_type)
+
+        self._entities.append(_Service(self._context, self.identity, resolved, service,
+                                       self.guard.wrap(f"service {resolved}", answer)))
+
+    def create_client(self, name: str, type_name: str) -> _Client:
+        """A client of service ``name`` (resolved like a topic) of ``type_name``."""
+        resolved = resolve_topic(name, self.namespace, self.node_name)
+        client = _Client(self._context, self.identity, resolved, normalize_service_type(type_name))
+        self._entities.append(client)
+        return client
+
     def create_timer(self, period: float, callback: Callable[[], None]) -> _Timer:
         """Call ``callback`` every ``period`` s on the executor thread."""
         if not period > 0:
@@ -461,6 +578,7 @@ class ZenohContext:
         self.executor = _Executor()
         self._ids = itertools.count()
         self._ports: list[ZenohNodePort] = []
+        self._clients: dict[tuple[str, str], _Client] = {}
 
     def next_id(self) -> int:
         """Next node/entity id (one counter per context, as in rmw_zenoh)."""
@@ -476,6 +594,36 @@ class ZenohContext:
     def spin(self) -> None:
         """Run callbacks until :meth:`request_stop`."""
         self.executor.spin()
+
+    def call_service(self, name: str, type_name: str, request: Any = None,
+                     timeout: float = SERVICE_TIMEOUT_S) -> Any:
+        """Call service ``name`` (absolute) of ``type_name`` with ``request`` (default: an empty
+        request); the decoded response. ``RuntimePortError`` if no server answers within
+        ``timeout`` s. Blocks the calling thread (not for use inside a callback)."""
+        service = normalize_service_type(type_name)
+        key = (resolve_topic(name), service)
+        if key not in self._clients:
+            if not self._ports:
+                self.create_port(f"_tdcm_client_{os.getpid()}")
+            self._clients[key] = self._ports[0].create_client(*key)
+        if request is None:
+            request = from_dict(f"{service}_Request", {})
+        data = self._clients[key].call(serialize(request, f"{service}_Request"), timeout)
+        return deserialize(data, f"{service}_Response")
+
+    def service_names(self, timeout: float = 1.0) -> list[tuple[str, str]]:
+        """``(name, type)`` of every service with a server on the domain, sorted: the tokens
+        seen by liveliness queries repeated for ``timeout`` s (one query can come back before
+        every token reached the router)."""
+        found: set[tuple[str, str]] = set()
+        end = time.monotonic() + timeout
+        while True:
+            found.update((t.topic, t.type_name) for t in graph_tokens(
+                self.session, self.domain_id, max(0.1, min(0.5, end - time.monotonic())))
+                if t.kind == wire.SERVICE)
+            if time.monotonic() >= end:
+                return sorted(found)
+            time.sleep(0.1)
 
     def spin_for(self, seconds: float) -> None:
         """Run callbacks for ``seconds`` s."""

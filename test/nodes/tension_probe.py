@@ -1,4 +1,5 @@
-"""Test-side port for the tension nodes: publishes commands, collects what the nodes publish."""
+"""Test-side port for the tension nodes: publishes setpoints and e-stops, calls the driver's
+command services, collects what the nodes publish."""
 
 from __future__ import annotations
 
@@ -10,10 +11,14 @@ from typing import Any
 import yaml
 
 from tdcm_ros.bagio import from_dict
+from tdcm_ros.runtime.diagnostics import summary
 
 REPO = Path(__file__).resolve().parents[2]
 DRIVER = "tdcm_ros.nodes.tension_driver:TensionDriverNode"
 TWIN = "tdcm_ros.nodes.device_twin:DeviceTwinNode"
+#: The driver's hardware components on ``/diagnostics``.
+DRIVER_COMPONENTS = ("tension_driver: serial link", "tension_driver: load cell",
+                     "tension_driver: actuator")
 
 
 def stamp_ns(message: Any) -> int:
@@ -46,7 +51,7 @@ def driver_params(path: Path, **changes: Any) -> str:
 
 
 class Probe:
-    """Publishes setpoints/e-stops; records ``tension``, ``device_state``, ``/diagnostics``,
+    """Publishes setpoints/e-stops, calls command services; records ``tension``, ``device_state``, ``/diagnostics``,
     ``sim/tension_true`` and ``midline``."""
 
     def __init__(self, ctx: Any) -> None:
@@ -55,6 +60,7 @@ class Probe:
         self.tension: list[Any] = []
         self.states: list[Any] = []
         self.diagnostics: list[Any] = []
+        self.components: list[dict[str, Any]] = []
         self.truth: list[Any] = []
         self.midlines: list[Any] = []
         port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", self.tension.append)
@@ -67,10 +73,18 @@ class Probe:
         port.create_subscription("midline", "nav_msgs/msg/Path", self.midlines.append)
         self._setpoint = port.create_publisher("tension_setpoint", "std_msgs/msg/Float64")
         self._estop = port.create_publisher("estop", "std_msgs/msg/Empty")
-        self._clear = port.create_publisher("clear_faults", "std_msgs/msg/Empty")
 
     def _on_diagnostics(self, array: Any) -> None:
-        self.diagnostics.extend(s for s in array.status if "tension device" in s.name)
+        """Keep the driver's component statuses of each array rolled into one, as
+        ``device_state`` and diagnostic_aggregator roll them up."""
+        parts = [{"level": level(s), "message": s.message,
+                  "values": [{"key": kv.key, "value": kv.value} for kv in s.values]}
+                 for s in array.status if s.name in DRIVER_COMPONENTS]
+        if parts:
+            self.components.append({s.name: s for s in array.status
+                                    if s.name in DRIVER_COMPONENTS})
+            self.diagnostics.append(from_dict("diagnostic_msgs/msg/DiagnosticStatus",
+                                              summary(parts, "tension_driver", "")))
 
     def setpoint(self, newtons: float) -> None:
         self._setpoint.publish(from_dict("std_msgs/msg/Float64", {"data": newtons}))
@@ -78,8 +92,22 @@ class Probe:
     def estop(self) -> None:
         self._estop.publish(from_dict("std_msgs/msg/Empty", {}))
 
+    def call(self, command: str, timeout: float = 10.0) -> Any:
+        """Call the driver's ``std_srvs/srv/Trigger`` service ``command``; its response."""
+        return self.ctx.call_service(f"/tension_driver/{command}", "std_srvs/srv/Trigger",
+                                     timeout=timeout)
+
     def clear_faults(self) -> None:
-        self._clear.publish(from_dict("std_msgs/msg/Empty", {}))
+        self.call("clear_faults")
+
+    def component(self, name: str) -> Any:
+        """The newest ``/diagnostics`` status of driver component ``name`` (None before)."""
+        return self.components[-1].get(f"tension_driver: {name}") if self.components else None
+
+    def component_level(self, name: str) -> int:
+        """Its level (-1 before the first)."""
+        status = self.component(name)
+        return -1 if status is None else level(status)
 
     def state(self) -> dict[str, str]:
         """Values of the newest ``device_state`` (empty before the first)."""

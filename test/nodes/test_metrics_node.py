@@ -104,7 +104,7 @@ def test_node_publishes_errors_and_the_running_table(recording: Recording) -> No
     assert table["n_steps"] == 6 and table["n_trials"] == 2
     assert table["rmse_m"] < 2e-5
     assert port.published["metrics/rmse_m"][-1].data == pytest.approx(table["rmse_m"])
-    node.report()
+    node.diagnostics.publish()
     status = port.published["/diagnostics"][-1].status[0]
     assert status.level == 0 and status.message == "ok"
     values = {kv.key: kv.value for kv in status.values}
@@ -125,7 +125,7 @@ def test_stale_inputs_and_no_registration_warn() -> None:
     port = metrics_port({"registration.source": "tf_static", "stale_s": 0.5})
     node = MetricsNode(port)
     port.clock_ns = 10**10
-    node.report()
+    node.diagnostics.publish()
     status = port.published["/diagnostics"][-1].status[0]
     assert status.level == 1
     assert "no tension for more than 0.5 s" in status.message

@@ -107,7 +107,7 @@ def test_sim_source_samples_the_scene_world_at_its_rate_with_its_delay(monkeypat
         assert [m.marker_name for m in message.markers] == list(LABELS[:expected])
         assert np.allclose(xyz(message)[:, 0], 1e-3 * tension)
     port.advance(1.0)
-    node.report()
+    node.diagnostics.publish()
     values = counters(port)
     assert values["state"] == "simulating" and values["registration"] == "scene"
     hidden = sum(3 - len(m.markers) for m in port.messages("markers"))
@@ -192,7 +192,7 @@ def test_registration_estimated_from_recordings_is_published_on_tf_static(tmp_pa
     assert np.allclose([t.x, t.y, t.z], truth.translation, atol=1e-9)
     got = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
     assert np.allclose(got, truth.rotation, atol=1e-9)
-    node.report()
+    node.diagnostics.publish()
     assert counters(port)["registration"] == "estimated"
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -19,7 +20,7 @@ from typing import Any
 
 import pytest
 from runtime_helpers import stop
-from tension_probe import DRIVER, Probe, driver_params, level, stamp_ns, values
+from tension_probe import DRIVER, REPO, Probe, driver_params, level, stamp_ns, values
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.plant import PlantConfig
@@ -352,3 +353,97 @@ def test_a_bad_parameter_file_exits_with_status_2(runtime, spawn, tmp_path) -> N
     assert node.wait(30) == 2
     assert node.stderr is not None
     assert "tension_max = 30.0 is out of range" in node.stderr.read().decode()
+
+
+COMMANDS = ("start_schedule", "clear_faults", "release", "estop")
+
+
+def test_commands_are_trigger_services_that_answer_why(runtime, spawn, probe, twin,
+                                                      tmp_path) -> None:
+    """Each command is a ``std_srvs/srv/Trigger`` service whose response says whether it was
+    carried out and why not; after an e-stop (a fault) the tendon stays released and the
+    schedule is refused until ``clear_faults``; ``release`` slackens and cancels the schedule."""
+    start_driver(spawn, tmp_path, twin, **{"schedule.levels": [0.0, 3.0],
+                                           "schedule.hold_s": 1.0, "schedule.trials": 5})
+    probe.connected()
+    core = twin.twin.core
+    served = dict(probe.ctx.service_names(2.0))
+    for command in COMMANDS:
+        assert served.get(f"/tension_driver/{command}") == "std_srvs/srv/Trigger", served
+    stopped = probe.call("estop")
+    assert stopped.success and "ESTOP latched" in stopped.message, stopped
+    probe.until(lambda: core.mode is Mode.RELEASE and bool(core.faults & Fault.ESTOP), 2.0,
+                "the device released with ESTOP latched")  # E was sent before the answer
+    refused = probe.call("start_schedule")
+    assert not refused.success, refused
+    assert "refused: disarmed (e-stop)" in refused.message, refused
+    assert "call clear_faults first" in refused.message, refused
+    time.sleep(0.5)
+    assert core.mode is Mode.RELEASE and core.setpoint_mn == 0  # nothing started
+    cleared = probe.call("clear_faults")
+    assert cleared.success and "armed at target 0 N" in cleared.message, cleared
+    probe.until(lambda: core.mode is Mode.TENSION, 10.0, "holding 0 N after clear_faults")
+    started = probe.call("start_schedule")
+    assert started.success and "schedule started: [0.0, 3.0] N" in started.message, started
+    probe.until(lambda: probe.state().get("schedule") == "running"
+                and probe.state().get("target") == "3.000", 10.0, "the schedule at 3 N")
+    released = probe.call("release")
+    assert released.success and "clear_faults" in released.message, released
+    probe.until(lambda: core.mode is Mode.RELEASE and probe.state().get("schedule")
+                == "cancelled", 10.0, "released, schedule cancelled")
+
+
+def test_service_cli_lists_and_calls_the_driver_commands(runtime, spawn, probe, twin,
+                                                         tmp_path) -> None:
+    """``tdcm service list -t`` shows the commands; ``tdcm service call`` prints the response
+    and exits 1 when the command was refused, 0 when carried out."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+
+    def tdcm(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "service", *args,
+                               "--runtime", runtime], check=False, capture_output=True,
+                              text=True, timeout=60, cwd=REPO)
+
+    listing = tdcm("list", "-t", "--timeout", "2")
+    assert listing.returncode == 0, listing.stderr
+    for command in COMMANDS:
+        assert f"/tension_driver/{command} [std_srvs/srv/Trigger]" in listing.stdout
+    estop = tdcm("call", "/tension_driver/estop", "std_srvs/srv/Trigger", "--timeout", "20")
+    assert estop.returncode == 0, estop.stderr
+    assert "success: true" in estop.stdout and "ESTOP latched" in estop.stdout
+    refused = tdcm("call", "/tension_driver/start_schedule", "--timeout", "20")
+    assert refused.returncode == 1, refused.stderr
+    assert "success: false" in refused.stdout and "call clear_faults first" in refused.stdout
+    missing = tdcm("call", "/tension_driver/no_such_command", "--timeout", "1")
+    assert missing.returncode != 0 and "no server" in missing.stderr, missing.stderr
+
+
+def test_diagnostics_report_each_component_and_recover(runtime, spawn, probe, twin,
+                                                       tmp_path) -> None:
+    """/diagnostics carries one status per hardware component (serial link, load cell,
+    actuator; hardware_id the port) whose level follows the component: an e-stop makes the
+    actuator ERROR until clear_faults, silence makes the load cell STALE until readings flow,
+    a clamped setpoint warns for the window only."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    names = ("serial link", "load cell", "actuator")
+    probe.until(lambda: all(probe.component_level(n) == 0 for n in names), 10.0,
+                "every component OK")
+    assert sorted(probe.components[-1]) == sorted(f"tension_driver: {n}" for n in names)
+    assert {s.hardware_id for s in probe.components[-1].values()} == {twin.port}
+    assert probe.call("estop").success
+    probe.until(lambda: probe.component_level("actuator") == 2, 10.0, "actuator ERROR")
+    assert "ESTOP" in probe.component("actuator").message
+    assert probe.component_level("serial link") == 0 and probe.component_level("load cell") == 0
+    probe.until(lambda: probe.component_level("actuator") == 0, 10.0, "actuator OK again",
+                action=probe.clear_faults)
+    probe.setpoint(30.0)  # above tension_max 20 N: clamped
+    probe.until(lambda: probe.component_level("actuator") == 1, 10.0, "actuator WARN")
+    assert "setpoint clamped to [0, 20] N" in probe.component("actuator").message
+    probe.until(lambda: probe.component_level("actuator") == 0, 10.0,
+                "actuator OK once the clamp left the window")
+    with twin.frozen():
+        probe.until(lambda: probe.component_level("load cell") == 3, 10.0, "load cell STALE")
+        assert "no telemetry for" in probe.component("load cell").message
+    probe.until(lambda: probe.component_level("load cell") == 0, 20.0, "load cell OK again")

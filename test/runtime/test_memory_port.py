@@ -64,3 +64,31 @@ def test_delivering_to_a_topic_nobody_subscribed_names_the_subscriptions() -> No
 def test_a_timer_period_must_be_positive() -> None:
     with pytest.raises(InputError, match="timer period = 0 s must be > 0"):
         MemoryPort().create_timer(0, lambda: None)
+
+
+class Counter(NodeLogic):
+    """Serves ``~/reset`` (std_srvs/srv/Trigger): refuses until ``armed``, then counts."""
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        self.armed, self.resets = False, 0
+        port.create_service("~/reset", "std_srvs/srv/Trigger", self.reset)
+
+    def reset(self, _request: object) -> object:
+        if not self.armed:
+            return from_dict("std_srvs/srv/Trigger_Response",
+                             {"success": False, "message": "refused: not armed"})
+        self.resets += 1
+        return from_dict("std_srvs/srv/Trigger_Response",
+                         {"success": True, "message": f"reset {self.resets}"})
+
+
+def test_services_answer_through_a_cdr_round_trip() -> None:
+    port = MemoryPort()
+    node = Counter(port)
+    refused = port.call("~/reset")
+    assert (refused.success, refused.message) == (False, "refused: not armed")
+    node.armed = True
+    assert port.call("~/reset").message == "reset 1"
+    with pytest.raises(RuntimePortError, match=r"no service 'reset'; served: \['~/reset'\]"):
+        port.call("reset")

@@ -162,6 +162,46 @@ def test_acl_denies_observer_commands_and_allows_operator(
     assert [m.data for m in setpoints if m.data != 2.0] == []
 
 
+def test_acl_denies_observer_command_services_but_estop(
+        secrets: dict[str, Path], tls_port: int, spawn: Spawn,
+        probes: Callable[[Path, str], ZenohContext]) -> None:
+    """The shipped ACL: an observer's call of the driver's clear_faults never reaches it (no
+    answer), its estop call does; the operator's clear_faults does."""
+    import threading
+
+    endpoint = f"tls/127.0.0.1:{tls_port}"
+    spawn("tdcm_ros.runtime.router", "--listen", endpoint, "--config", str(secrets["router"]))
+    wait_for(lambda: listening(tls_port), 15.0, "the TLS router")
+    driver = probes(secrets["operator"], endpoint)
+    port = driver.create_port("tension_driver")
+    calls: list[str] = []
+
+    def serve(name: str) -> None:
+        def handle(_request: Any) -> Any:
+            calls.append(name)
+            return from_dict("std_srvs/srv/Trigger_Response", {"success": True, "message": name})
+        port.create_service(f"~/{name}", "std_srvs/srv/Trigger", handle)
+
+    serve("clear_faults")
+    serve("estop")
+    spinner = threading.Thread(target=driver.spin, daemon=True)
+    spinner.start()
+    try:
+        observer = probes(secrets["observer"], endpoint)
+        operator = probes(secrets["operator"], endpoint)
+        assert observer.call_service("/tension_driver/estop", "std_srvs/srv/Trigger",
+                                     timeout=15.0).message == "estop"
+        with pytest.raises(RuntimePortError, match="did not answer"):
+            observer.call_service("/tension_driver/clear_faults", "std_srvs/srv/Trigger",
+                                  timeout=3.0)
+        assert operator.call_service("/tension_driver/clear_faults", "std_srvs/srv/Trigger",
+                                     timeout=15.0).message == "clear_faults"
+        assert calls == ["estop", "clear_faults"]
+    finally:
+        driver.request_stop()
+        spinner.join(5.0)
+
+
 @pytest.mark.parametrize("endpoint", ["tcp/0.0.0.0:7447", "tcp/[::]:7447",
                                       "tls/192.168.1.20:7447", "tcp/robot.lan:7447"])
 def test_router_beyond_loopback_without_auth_is_exposed(endpoint: str,
