@@ -24,8 +24,10 @@ cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s jo
 from __future__ import annotations
 
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, fields
 from functools import cached_property, lru_cache
+from itertools import pairwise
 from typing import Any, TypeVar
 
 import numpy as np
@@ -311,11 +313,12 @@ class GridParts:
 
     @classmethod
     def of(cls, members: Members, routing: str, kind: str, cells_per_notch: int,
-           cells_per_tube: int, quad_order: int) -> GridParts:
-        """Lay out and integrate every member's cells (``members`` already checked)."""
+           cells_per_tube: int, quad_order: int, workers: int = 1) -> GridParts:
+        """Lay out and integrate every member's cells (``members`` already checked) with
+        ``workers`` threads."""
         table = cell_table(prototypes(members, routing, kind, cells_per_notch, cells_per_tube),
                            routing)
-        fc, fq, strain = _prototype_integrals(table.prototypes, quad_order)
+        fc, fq, strain = _prototype_integrals(table.prototypes, quad_order, workers)
         return cls(members=members, table=table, proto_fc=fc, proto_fq=fq,
                    proto_strain=strain, gauss_u=_gauss(quad_order)[0],
                    gauss_w=_gauss(quad_order)[1])
@@ -366,9 +369,11 @@ class GridParts:
             notch_right_node=table.notch_right_node[rows, :notches])
 
 
-def _prototype_integrals(table: Prototypes, quad_order: int) -> tuple[Array, Array, Array]:
+def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
+                         ) -> tuple[Array, Array, Array]:
     """:class:`GridParts`' ``proto_fc``, ``proto_fq``, ``proto_strain`` of every prototype cell
-    of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row."""
+    of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row;
+    ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
     gauss_u, gauss_w = _gauss(quad_order)
     members = table.members
     cell = np.stack([table.is_notch, table.chord, table.u_a, table.u_b, table.a, table.length,
@@ -383,9 +388,20 @@ def _prototype_integrals(table: Prototypes, quad_order: int) -> tuple[Array, Arr
     fc = np.zeros((count + 1, 8))
     fq = np.zeros((count + 1, 8, quad_order))
     strain = np.zeros((count + 1, 2, PEAK_SAMPLES))
-    build.cell_integrals(table.member, cell, design, custom_row, custom_h1, gauss_u, gauss_w,
-                         _integration_matrix(quad_order), probe, fc[:count], fq[:count],
-                         strain[:count])
+    matrix = _integration_matrix(quad_order)
+
+    def integrate(part: slice) -> None:
+        build.cell_integrals(table.member[part], cell[part], design, custom_row[part],
+                             custom_h1, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
+                             strain[part])
+
+    ends = np.linspace(0, count, workers + 1).astype(int)
+    parts = [slice(int(a), int(b)) for a, b in pairwise(ends)]
+    if workers == 1:
+        integrate(parts[0])
+    else:
+        with ThreadPoolExecutor(workers) as pool:
+            list(pool.map(integrate, parts))
     return fc, fq, strain
 
 
@@ -471,9 +487,12 @@ def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStac
     return grid_parts(designs, settings).stack(np.arange(len(designs)))
 
 
-def grid_parts(designs: Sequence[Design], settings: SolverSettings) -> GridParts:
-    """The :class:`GridParts` of ``designs`` under ``settings``' grid (at least one design)."""
+def grid_parts(designs: Sequence[Design], settings: SolverSettings, workers: int = 1
+               ) -> GridParts:
+    """The :class:`GridParts` of ``designs`` under ``settings``' grid (at least one design),
+    integrated by ``workers`` threads (the same values for any count)."""
     if len(designs) == 0:
         raise out_of_range("number of designs", 0, "[1, inf)", error=InvalidDesignError)
     return GridParts.of(Members.of(designs), settings.routing, settings.grid,
-                        settings.cells_per_notch, settings.cells_per_tube, settings.quad_order)
+                        settings.cells_per_notch, settings.cells_per_tube, settings.quad_order,
+                        workers)

@@ -219,6 +219,19 @@ def _weights_and_chords(chord: bool, scale: float, gauss_w: Array, matrix: Array
             out[A0_T + term, q] = partial if chord else 0.0
 
 
+def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
+    """``out[m, f, j, :] = source[index[m, j], fields[f], :]``: prototype cells' values
+    (source (P, F, Q)) laid out per member (out (M, len(fields), W, Q)), field-major as
+    :mod:`tdcm_ros.model.kernel` reads them."""
+    for m in range(index.shape[0]):
+        for f in range(fields.shape[0]):
+            field = fields[f]
+            for j in range(index.shape[1]):
+                p = index[m, j]
+                for q in range(out.shape[3]):
+                    out[m, f, j, q] = source[p, field, q]
+
+
 KERNELS = ("disc_strip_moment", "notch_compliance", "geometry", "point", "points",
-           "_weights_and_chords", "cell_integrals")
+           "_weights_and_chords", "cell_integrals", "gather")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""
