@@ -17,8 +17,11 @@ For each cell the grid stores:
   ``A0``; they are zero where the tendon follows the body.
 
 Grids depend only on the design and the discretisation settings and are cached. Where the
-cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s job;
-:func:`build_grids` builds many designs' grids at once into a :class:`GridStack`.
+cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s job; the
+integrals of each segment kind's cells are computed once per design by the compiled
+:func:`tdcm_ros.model.grid_kernel.cell_integrals` (:class:`GridParts`) and copied along the
+body. :func:`build_grids` builds many designs' grids at once into a :class:`GridStack`;
+:func:`build_grid` is the same build with one member.
 """
 
 from __future__ import annotations
@@ -219,13 +222,6 @@ class CellRows:
     seg_length: Array
     a: Array
     length: Array
-
-    @classmethod
-    def of(cls, table: Prototypes) -> CellRows:
-        """One row per prototype cell of ``table``."""
-        return cls(members=table.members, member=table.member, is_notch=table.is_notch,
-                   seg_start=table.seg_start, seg_length=table.seg_length, a=table.a,
-                   length=table.length)
 
     def local_sigma(self, u: Array) -> Array:
         """Arc length from each row's segment start (m) at ``u``."""
