@@ -12,7 +12,8 @@ Workloads (default solver settings, whose tip error against a converged referenc
 
 Both are also timed with two worker threads (``workers=2``). Every workload is timed in
 ``--rounds`` interleaved rounds (best of ``--repeat`` each): medians, spreads and the
-per-round ratio of two workers to one are printed. ``--baseline`` times another checkout
+per-round ratio of two workers to one are printed; one-worker workloads also per CPU second
+of the process (``time.process_time``), which other jobs on shared cores disturb less. ``--baseline`` times another checkout
 (e.g. main) on the warm design-space and the many-design cases in the same run: it and this
 checkout alternate in fresh processes for ``--rounds`` rounds and the per-round ratios are
 printed.
@@ -30,7 +31,7 @@ import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from time import perf_counter
+from time import perf_counter, process_time
 from typing import Any
 
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
@@ -49,17 +50,19 @@ def paper_like(count: int, rng: Any) -> list[Any]:
             for _ in range(count)]
 
 
-def best_time(run: Callable[[], object], repeat: int, cold: bool) -> float:
-    """Best wall time (s) of ``run()`` over ``repeat`` calls; ``cold`` clears the grid cache."""
+def best_time(run: Callable[[], object], repeat: int, cold: bool, clock: Callable[[], float]
+              = perf_counter) -> float:
+    """Best time (s, wall unless ``clock`` says otherwise) of ``run()`` over ``repeat`` calls;
+    ``cold`` clears the grid cache."""
     from tdcm_ros.model.grid import _build_grid
 
     times = []
     for _ in range(repeat):
         if cold:
             _build_grid.cache_clear()
-        started = perf_counter()
+        started = clock()
         run()
-        times.append(perf_counter() - started)
+        times.append(clock() - started)
     return min(times)
 
 
@@ -113,6 +116,9 @@ def throughputs(args: argparse.Namespace, names: list[str], rounds: int
         for name in names:
             count, call, cold = work[name]
             out[name].append(count / best_time(call, args.repeat, cold))
+            if "2" not in name:  # CPU time of one thread: less sensitive to the other jobs
+                out.setdefault(f"{name} cpu", []).append(
+                    count / best_time(call, args.repeat, cold, process_time))
     return out
 
 
@@ -125,6 +131,7 @@ def run(args: argparse.Namespace) -> None:
 
     if args.throughput_only:
         measured = throughputs(args, ["space", "many"], 1)
+        print(measured["space cpu"][0], measured["many cpu"][0])
         print(measured["space"][0], measured["many"][0])
         return
     reference = SolverSettings(cells_per_notch=128, cells_per_tube=16, quad_order=12, tol=1e-14)
@@ -163,11 +170,14 @@ def run(args: argparse.Namespace) -> None:
     print(f"solves/s, median (min-max) of {args.rounds} interleaved rounds, each best of "
           f"{args.repeat}")
     print(f"design space {args.designs} designs x {args.tensions} tensions = {count} solves")
-    print(f"  grids built  : {spread(measured['space'])}")
+    print(f"  grids built  : {spread(measured['space'])} (per CPU second: "
+          f"{spread(measured['space cpu'])})")
     print(f"  two workers  : {spread(measured['space2'])}; per round "
           f"{ratio_spread(per_round('space2', 'space'))} one worker (target >= 1.8x)")
-    print(f"  incl. grids  : {spread(measured['cold'])}")
-    print(f"many designs {args.many} x 1 tension, incl. grids: {spread(measured['many'])}")
+    print(f"  incl. grids  : {spread(measured['cold'])} (per CPU second: "
+          f"{spread(measured['cold cpu'])})")
+    print(f"many designs {args.many} x 1 tension, incl. grids: {spread(measured['many'])} "
+          f"(per CPU second: {spread(measured['many cpu'])})")
     print(f"  two workers  : {spread(measured['many2'])}; per round "
           f"{ratio_spread(per_round('many2', 'many'))} one worker")
     print(f"single solve() loop          : {single_n / single_time:10.0f} solves/s")
@@ -176,23 +186,24 @@ def run(args: argparse.Namespace) -> None:
           f"median {np.median(converged) * 1e6:.3f} um (target <= 1 um)")
 
 
-def throughput_in(checkout: Path, args: argparse.Namespace) -> tuple[float, float]:
-    """Design-space (grids built) and many-design throughputs (solves/s) in a fresh process
-    importing ``tdcm_ros`` from ``checkout``."""
+def throughput_in(checkout: Path, args: argparse.Namespace
+                  ) -> tuple[float, float, float, float]:
+    """Design-space (grids built) and many-design throughputs (solves/s), then the same per
+    CPU second, in a fresh process importing ``tdcm_ros`` from ``checkout``."""
     env = {**os.environ, "PYTHONPATH": str(checkout)}
     command = [sys.executable, __file__, "--throughput-only", "--designs", str(args.designs),
                "--tensions", str(args.tensions), "--many", str(args.many), "--repeat",
                str(args.repeat)]
     out = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
-    space, many = out.stdout.split()[-2:]
-    return float(space), float(many)
+    space_cpu, many_cpu, space, many = (float(v) for v in out.stdout.split()[-4:])
+    return space, many, space_cpu, many_cpu
 
 
 def compare(args: argparse.Namespace) -> None:
     """Alternate the baseline checkout and this one; print throughputs and their ratios."""
     here = Path(__file__).resolve().parents[1]
-    base: list[tuple[float, float]] = []
-    mine: list[tuple[float, float]] = []
+    base: list[tuple[float, float, float, float]] = []
+    mine: list[tuple[float, float, float, float]] = []
     for _ in range(args.rounds):
         base.append(throughput_in(args.baseline, args))
         mine.append(throughput_in(here, args))
@@ -202,10 +213,13 @@ def compare(args: argparse.Namespace) -> None:
             ((f"design space {args.designs} x {args.tensions}, grids built", "250,000"),
              (f"many designs {args.many} x 1, grids included", "100,000"))):
         b, m = [r[k] for r in base], [r[k] for r in mine]
+        b_cpu, m_cpu = [r[k + 2] for r in base], [r[k + 2] for r in mine]
         print(f"  {label} (target >= {target} solves/s)")
-        print(f"    baseline {args.baseline}: {spread(b)}")
-        print(f"    this checkout: {spread(m)}")
-        print(f"    speed-up per round: {ratio_spread([y / x for x, y in zip(b, m, strict=True)])}")
+        print(f"    baseline {args.baseline}: {spread(b)}; per CPU second {spread(b_cpu)}")
+        print(f"    this checkout: {spread(m)}; per CPU second {spread(m_cpu)}")
+        print(f"    speed-up per round: {ratio_spread([y / x for x, y in zip(b, m, strict=True)])}"
+              f"; per CPU second "
+              f"{ratio_spread([y / x for x, y in zip(b_cpu, m_cpu, strict=True)])}")
 
 
 def main() -> None:
