@@ -13,14 +13,15 @@ Workloads (default solver settings, whose tip error against a converged referenc
 Both are also timed with two worker threads (``workers=2``). Every workload is timed in
 ``--rounds`` interleaved rounds (best of ``--repeat`` each): medians, spreads and the
 per-round ratio of two workers to one are printed; one-worker workloads also per CPU second
-of the process (``time.process_time``), which other jobs on shared cores disturb less. ``--baseline`` times another checkout
-(e.g. main) on the warm design-space and the many-design cases in the same run: it and this
-checkout alternate in fresh processes for ``--rounds`` rounds and the per-round ratios are
-printed.
+of the process (``time.process_time``), which other jobs on shared cores disturb less.
+``--baseline`` times another checkout (e.g. main) on the warm design-space and the
+many-design cases in the same run: it and this checkout alternate in fresh processes for
+``--rounds`` rounds and the per-round ratios are printed. ``--breakdown`` prints only the CPU
+time of the many-design case's steps.
 
 Tip error: the batch against single solves at the same settings (should be ~1e-17 m), and
 against converged single solves (128 cells per notch, 16 per tube, 12-point quadrature,
-tol 1e-14 m) on a sample of points. Timings are best-of-``repeat`` wall times.
+tol 1e-14 m) on a sample of points. Timings are best of ``repeat``.
 """
 
 from __future__ import annotations
@@ -199,6 +200,47 @@ def throughput_in(checkout: Path, args: argparse.Namespace
     return space, many, space_cpu, many_cpu
 
 
+def breakdown(args: argparse.Namespace) -> None:
+    """CPU time (best of ``repeat``) of the steps of the many-design case, and of the grid
+    kernel per compliance evaluation point."""
+    import numpy as np
+
+    from tdcm_ros.model import SolverSettings
+    from tdcm_ros.model.batch import _Stack, solve_batch
+    from tdcm_ros.model.grid import _prototype_integrals, grid_parts
+    from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members, cell_table, prototypes
+
+    settings = SolverSettings()
+    rng = np.random.default_rng(2024)
+    paper_like(args.designs, rng)
+    many = paper_like(args.many, rng)
+    many_t = rng.uniform(0.0, 20.0, args.many)
+    members = Members.of(many)
+    layout = (settings.routing, settings.grid, settings.cells_per_notch,
+              settings.cells_per_tube)
+    proto = prototypes(members, *layout)
+    parts = grid_parts(many, settings)
+    steps: list[tuple[str, Callable[[], object]]] = [
+        ("solve_batch, all of it", lambda: solve_batch(many, many_t, settings=settings)),
+        ("Members.of (collect, check rigidity)", lambda: Members.of(many)),
+        ("prototypes + cell_table (layout)",
+         lambda: cell_table(prototypes(members, *layout), settings.routing)),
+        ("grid kernel (cell_integrals)", lambda: _prototype_integrals(proto, settings.quad_order)),
+        ("kernel arrays + strain per group (gathers)", lambda: _Stack.split(parts, settings))]
+    print(f"many designs {args.many} x 1: CPU time (process_time), best of {args.repeat}")
+    kernel_ms = 0.0
+    for label, call in steps:
+        call()
+        ms = best_time(call, args.repeat, False, process_time) * 1e3
+        kernel_ms = ms if label.startswith("grid kernel") else kernel_ms
+        print(f"  {label:<44} {ms:7.1f} ms")
+    q = settings.quad_order
+    points = int(np.sum(proto.is_notch)) * (q + q * q + PEAK_SAMPLES + 2)
+    print(f"  grid kernel: {points / args.many:.0f} notch compliance points per design, "
+          f"{kernel_ms * 1e6 / points:.1f} ns each (tube cells included in the time), "
+          f"{kernel_ms * 1e3 / args.many:.1f} us per design")
+
+
 def compare(args: argparse.Namespace) -> None:
     """Alternate the baseline checkout and this one; print throughputs and their ratios."""
     here = Path(__file__).resolve().parents[1]
@@ -232,9 +274,14 @@ def main() -> None:
     parser.add_argument("--sample", type=int, default=24, help="points checked at the reference")
     parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. /work/main")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--breakdown", action="store_true",
+                        help="only the CPU-time breakdown of the many-design case")
     parser.add_argument("--throughput-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     os.environ.update({name: "1" for name in THREAD_VARIABLES})
+    if args.breakdown:
+        breakdown(args)
+        return
     if args.baseline is not None:
         compare(args)
     run(args)

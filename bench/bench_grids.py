@@ -5,7 +5,8 @@ every design's prototype cells) against one ``build_grid`` per design, in the sa
 Run: ``python bench/bench_grids.py [--designs 2000] [--repeat 3] [--baseline CHECKOUT]
 [--rounds 3]``. Designs are paper-like (``w_n``, ``w_d`` drawn around the paper's), every one
 different, so no cache helps; the grid cache is cleared before each single-design pass.
-Single-threaded. ``--baseline`` times ``build_grids`` of another checkout (e.g. main) in the
+Single-threaded; times are CPU time of the process (``time.process_time``), which other jobs
+on shared cores disturb far less than wall time. ``--baseline`` times ``build_grids`` of another checkout (e.g. main) in the
 same run: it and this checkout alternate in fresh processes for ``--rounds`` rounds and the
 per-round ratios are printed (median and range).
 """
@@ -41,9 +42,9 @@ def stacked_rates(designs: list, repeat: int) -> list[float]:
         build_grids(designs, settings)
         times = []
         for _ in range(repeat):
-            start = time.perf_counter()
+            start = time.process_time()
             build_grids(designs, settings)
-            times.append(time.perf_counter() - start)
+            times.append(time.process_time() - start)
         rates.append(len(designs) / min(times))
     return rates
 
@@ -59,7 +60,7 @@ def compare(args: argparse.Namespace) -> None:
                  "--repeat", str(args.repeat)], env={**os.environ, "PYTHONPATH": str(checkout)},
                 capture_output=True, text=True, check=True)
             rates.append([float(v) for v in out.stdout.split()[-len(CASES):]])
-    print(f"build_grids, grids/s, {args.rounds} alternating rounds (fresh processes), "
+    print(f"build_grids, grids per CPU second, {args.rounds} alternating rounds (fresh processes), "
           f"median (min-max); baseline {args.baseline}")
     for k, (label, _) in enumerate(CASES):
         base = [r[k] for r in runs[args.baseline]]
@@ -92,17 +93,17 @@ def main() -> None:
         stacked, single = [], []
         stack = build_grids(designs, settings)
         for _ in range(args.repeat):
-            start = time.perf_counter()
+            start = time.process_time()
             stack = build_grids(designs, settings)
-            stacked.append(time.perf_counter() - start)
+            stacked.append(time.process_time() - start)
             _build_grid.cache_clear()
-            start = time.perf_counter()
+            start = time.process_time()
             for design in designs:
                 build_grid(design, settings)
-            single.append(time.perf_counter() - start)
+            single.append(time.process_time() - start)
         fast, slow = min(stacked), min(single)
         print(f"{label:<28} cells/design {stack.n_cells.mean():6.1f}  build_grids "
-              f"{args.designs / fast:9.0f} grids/s ({fast / args.designs * 1e6:6.1f} us)  "
+              f"{args.designs / fast:9.0f} grids per CPU s ({fast / args.designs * 1e6:6.1f} us)  "
               f"build_grid loop {args.designs / slow:7.0f} grids/s  ratio {slow / fast:5.1f}x")
 
 
