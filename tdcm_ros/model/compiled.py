@@ -30,6 +30,9 @@ PLAIN = types.SimpleNamespace(**{name: quiet_fp(getattr(kernel, name))
                                  for name in kernel.KERNELS})
 """The plain-Python build: NumPy scalar arithmetic in it would warn where the compiled
 build is silent, so each entry point runs under :func:`~tdcm_ros.model.quiet.quiet_fp`."""
+GRID_PLAIN = types.SimpleNamespace(**{name: quiet_fp(getattr(grid_kernel, name))
+                                      for name in grid_kernel.KERNELS})
+"""The plain-Python build of :mod:`grid_kernel`, guarded the same way."""
 _CHOICES = {"0": False, "1": True, "": None}
 _state: dict[str, Any] = {"wanted": None, "chosen": False, "build": None, "grid_build": None}
 
@@ -66,10 +69,10 @@ def kernels() -> types.SimpleNamespace:
     return build
 
 
-def grid_kernels() -> types.SimpleNamespace | types.ModuleType:
+def grid_kernels() -> types.SimpleNamespace:
     """The functions of :mod:`grid_kernel` in the build :func:`kernels` selected."""
-    if kernels() is kernel:
-        return grid_kernel
+    if kernels() is PLAIN:
+        return GRID_PLAIN
     build = _state["grid_build"]
     if build is None:
         import numba

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -58,9 +62,10 @@ def test_plain_and_compiled_builds_agree_to_1e_15(routing, monkeypatch):
     for key in ("wanted", "chosen", "build"):
         monkeypatch.setitem(compiled._state, key, compiled._state[key])
     compiled.use_compiled(False)
+    assert compiled.grid_kernels() is compiled.GRID_PLAIN
     plain = parts_arrays(grid_parts(designs(), cfg))
     compiled.use_compiled(True)
-    assert compiled.grid_kernels() is not grid_kernel
+    assert compiled.grid_kernels() is not compiled.GRID_PLAIN
     fast = parts_arrays(grid_parts(designs(), cfg))
     for a, b in zip(plain, fast, strict=True):
         scale = np.max(np.abs(a), axis=0, keepdims=True)
@@ -74,3 +79,16 @@ def test_threads_give_the_same_bits():
     two = parts_arrays(grid_parts(many, SolverSettings(), workers=3))
     for a, b in zip(one, two, strict=True):
         assert a.tobytes() == b.tobytes()
+
+
+def test_plain_build_never_imports_numba():
+    code = ("import sys, numpy as np\n"
+            "from tdcm_ros.model import preset, solve\n"
+            "from tdcm_ros.model.batch import solve_batch\n"
+            "d = preset('paper-experiment')\n"
+            "solve(d, 10.0); solve_batch([d, d.with_overrides(N=3)], np.array([5.0, 9.0]))\n"
+            "print('numba' in sys.modules)\n")
+    env = {**os.environ, "TDCM_JIT": "0"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.split()[-1] == "False"
