@@ -206,11 +206,18 @@ def breakdown(args: argparse.Namespace) -> None:
     import numpy as np
 
     from tdcm_ros.model import SolverSettings
-    from tdcm_ros.model.batch import _Stack, solve_batch
+    from tdcm_ros.model.batch import CHUNK, _KernelArrays, _Stack, solve_batch
     from tdcm_ros.model.grid import _prototype_integrals, grid_parts
     from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members, cell_table, prototypes
 
     settings = SolverSettings()
+
+    def gathers(parts: Any) -> None:
+        """Every chunk's kernel arrays, each dropped after use as in ``solve_batch``."""
+        for _, stack in _Stack.split(parts, settings):
+            for k in range(0, stack.rows.size, CHUNK):
+                _KernelArrays.of(parts, stack.rows[k:k + CHUNK])
+
     rng = np.random.default_rng(2024)
     paper_like(args.designs, rng)
     many = paper_like(args.many, rng)
@@ -226,7 +233,7 @@ def breakdown(args: argparse.Namespace) -> None:
         ("prototypes + cell_table (layout)",
          lambda: cell_table(prototypes(members, *layout), settings.routing)),
         ("grid kernel (cell_integrals)", lambda: _prototype_integrals(proto, settings.quad_order)),
-        ("kernel arrays + strain per group (gathers)", lambda: _Stack.split(parts, settings))]
+        ("kernel arrays + strain per chunk (gathers)", lambda: gathers(parts))]
     print(f"many designs {args.many} x 1: CPU time (process_time), best of {args.repeat}")
     kernel_ms = 0.0
     for label, call in steps:

@@ -20,11 +20,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tdcm_ros.model import grid_kernel
 from tdcm_ros.model.cells import Cells
 from tdcm_ros.model.compiled import grid_kernels, kernels
 from tdcm_ros.model.design import Design
@@ -86,43 +87,76 @@ class BatchResult:
 
 
 @dataclass(frozen=True, eq=False)
-class _Stack:
-    """Designs of one cell count: their :class:`Cells` (one row per design) and, per design,
-    its notch cells ``notch_cells`` (-1: padding) and the strain coefficients
+class _KernelArrays:
+    """What the compiled iteration reads for some designs: their :class:`Cells`, and per
+    design its notch cells ``notch_cells`` (-1: padding) and the strain coefficients
     ``strain0``/``strain1`` (designs, notch cells, samples) giving the bending strain at
     ``PEAK_SAMPLES`` points of every notch cell as ``|m_a S0 + m_b S1|``."""
 
-    designs: tuple[Design, ...]
-    settings: SolverSettings
     cells: Cells
     notch_cells: NDArray[np.int64]
     strain0: Array
     strain1: Array
 
     @classmethod
+    def of(cls, parts: GridParts, rows: NDArray[np.int64]) -> _KernelArrays:
+        """Gathered from the prototype cells of designs ``rows`` of ``parts``."""
+        return cls(Cells.of_parts(parts, rows), *_strain_coefficients(parts, rows))
+
+
+@dataclass(frozen=True, eq=False)
+class _Stack:
+    """Designs ``rows`` of ``parts``, all of one cell count; per design its tendon offset
+    ``r_c`` (m) and largest compliance where the tendon follows the body
+    ``constrained_peak_c`` (1/(N m^2)), for the screening before iterating. The kernel
+    arrays are gathered per chunk of members (:meth:`arrays`), or once for the whole stack
+    when it has at most ``CHUNK`` designs (a design-space sweep)."""
+
+    parts: GridParts
+    rows: NDArray[np.int64]
+    settings: SolverSettings
+    r_c: Array
+    constrained_peak_c: Array
+    _whole: dict[str, _KernelArrays] = field(default_factory=dict)
+
+    @classmethod
     def split(cls, parts: GridParts, settings: SolverSettings
               ) -> list[tuple[NDArray[np.int64], _Stack]]:
         """``(rows of parts, stack)`` for every cell count of ``parts``."""
         counts = parts.table.count
+        proto = parts.table.prototypes
+        peak = np.zeros(counts.size)
+        np.maximum.at(peak, proto.member[~proto.chord],
+                      parts.proto_fc[:-1, grid_kernel.PEAK_C][~proto.chord])
         out = []
         for count in np.unique(counts):
             rows = np.flatnonzero(counts == count)
-            notch_cells, strain0, strain1 = _strain_coefficients(parts, rows)
-            out.append((rows, cls(designs=tuple(parts.members.designs[r] for r in rows),
-                                  settings=settings, cells=Cells.of_parts(parts, rows),
-                                  notch_cells=notch_cells, strain0=strain0,
-                                  strain1=strain1)))
+            out.append((rows, cls(parts=parts, rows=rows, settings=settings,
+                                  r_c=parts.members.R_c[rows],
+                                  constrained_peak_c=peak[rows])))
         return out
+
+    def arrays(self, local: NDArray[np.int64]) -> tuple[_KernelArrays, NDArray[np.int64]]:
+        """The kernel arrays holding designs ``local`` (rows of this stack), and each one's
+        row in them."""
+        if self.rows.size <= CHUNK:
+            whole = self._whole.get("all")
+            if whole is None:
+                whole = self._whole.setdefault("all", _KernelArrays.of(self.parts, self.rows))
+            return whole, local
+        distinct, inverse = np.unique(local, return_inverse=True)
+        return _KernelArrays.of(self.parts, self.rows[distinct]), inverse.astype(np.int64)
 
     def grid(self, row: int) -> Grid:
         """The :class:`Grid` of design ``row`` (built on demand, for an error message)."""
-        return build_grid(self.designs[row], self.settings)
+        return build_grid(self.parts.members.designs[self.rows[row]], self.settings)
 
     def strain(self, rows: NDArray[np.int64], x: Array) -> Array:
         """Largest notch bending strain of members of design ``rows`` from their cell end
         moments ``x = [m_a, m_b]`` (N m)."""
+        arrays, at = self.arrays(rows)
         out = np.empty(rows.size)
-        kernels().peak_strains(rows, self.notch_cells, self.strain0, self.strain1,
+        kernels().peak_strains(at, arrays.notch_cells, arrays.strain0, arrays.strain1,
                                np.ascontiguousarray(x), out)
         return out
 
@@ -300,7 +334,7 @@ def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
         except TensionRangeError as error:
             out.fail(np.array([m]), error)
     # limits.check_tendon_singularity, evaluated in the same order of operations.
-    r_c, peak = stack.cells.r_c[rows], stack.cells.constrained_peak_c[rows]
+    r_c, peak = stack.r_c[rows], stack.constrained_peak_c[rows]
     singular = ~bad & (r_c**2 * tension * peak >= 1.0) & (r_c * (r_c * tension) * peak >= 1.0)
     for m, row in zip(members[singular], rows[singular]):
         try:
@@ -327,21 +361,22 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
     """
     mode = settings.acceleration
     budget = 1 if mode == "anderson" else settings.max_iter
-    cells = st.cells
+    arrays, at = st.arrays(rows)
+    cells = arrays.cells
     n = cells.n_cells
     tension = out.tensions[members]
     x = np.empty((members.size, 2 * n))
-    x[...] = (cells.r_c[rows] * tension)[:, None]
+    x[...] = (st.r_c[rows] * tension)[:, None]
     p = np.empty((members.size, n + 1), np.complex128)
     theta = np.empty((members.size, n + 1))
     tangent = np.empty((members.size, n + 1), np.complex128)
     info = np.empty((members.size, 3 + budget))
     strain = np.empty(members.size)
     kernels().iterate_strained(
-        cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension, x, p, theta,
+        cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, at, tension, x, p, theta,
         tangent, settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
-        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, st.notch_cells,
-        st.strain0, st.strain1, strain)
+        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, arrays.notch_cells,
+        arrays.strain0, arrays.strain1, strain)
     done = info[:, 1] == CONVERGED
     out.pending.extend((int(members[i]), st, int(rows[i])) for i in np.flatnonzero(~done))
     out.iterations[members[done]] = info[done, 0].astype(np.int64)
