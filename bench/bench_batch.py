@@ -1,7 +1,7 @@
 """Batch solver throughput on one core for paper-like designs, and its tip error.
 
-Run: ``python bench/bench_batch.py [--designs 40] [--tensions 250] [--repeat 5]
-[--baseline /work/main] [--rounds 3]``.
+Run: ``python bench/bench_batch.py [--designs 40] [--tensions 250] [--many 2000]
+[--repeat 5] [--baseline /work/main] [--rounds 3]``.
 
 Workloads (default solver settings, whose tip error against a converged reference is printed):
 
@@ -10,14 +10,18 @@ Workloads (default solver settings, whose tip error against a converged referenc
   the design grid exists) and cold (grid building included);
 - many designs: one tension per design, grid building included (the worst case).
 
-The design-space case is also timed with two worker threads (``workers=2``; the ratio to one
-is printed). ``--baseline`` times another checkout (e.g. main's NumPy batch) on the warm
-design-space case in the same run: it and this checkout alternate in fresh processes for
-``--rounds`` rounds and the ratio of their median throughputs is printed.
+Both are also timed with two worker threads (``workers=2``). Every workload is timed in
+``--rounds`` interleaved rounds (best of ``--repeat`` each): medians, spreads and the
+per-round ratio of two workers to one are printed; one-worker workloads also per CPU second
+of the process (``time.process_time``), which other jobs on shared cores disturb less.
+``--baseline`` times another checkout (e.g. main) on the warm design-space and the
+many-design cases in the same run: it and this checkout alternate in fresh processes for
+``--rounds`` rounds and the per-round ratios are printed. ``--breakdown`` prints only the CPU
+time of the many-design case's steps.
 
 Tip error: the batch against single solves at the same settings (should be ~1e-17 m), and
 against converged single solves (128 cells per notch, 16 per tube, 12-point quadrature,
-tol 1e-14 m) on a sample of points. Timings are best-of-``repeat`` wall times.
+tol 1e-14 m) on a sample of points. Timings are best of ``repeat``.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from time import perf_counter
+from time import perf_counter, process_time
 from typing import Any
 
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
@@ -47,18 +51,76 @@ def paper_like(count: int, rng: Any) -> list[Any]:
             for _ in range(count)]
 
 
-def best_time(run: Callable[[], object], repeat: int, cold: bool) -> float:
-    """Best wall time (s) of ``run()`` over ``repeat`` calls; ``cold`` clears the grid cache."""
+def best_time(run: Callable[[], object], repeat: int, cold: bool, clock: Callable[[], float]
+              = perf_counter) -> float:
+    """Best time (s, wall unless ``clock`` says otherwise) of ``run()`` over ``repeat`` calls;
+    ``cold`` clears the grid cache."""
     from tdcm_ros.model.grid import _build_grid
 
     times = []
     for _ in range(repeat):
         if cold:
             _build_grid.cache_clear()
-        started = perf_counter()
+        started = clock()
         run()
-        times.append(perf_counter() - started)
+        times.append(clock() - started)
     return min(times)
+
+
+def spread(values: list[float]) -> str:
+    """``median (min-max)`` of ``values``."""
+    ordered = sorted(values)
+    return f"{ordered[len(ordered) // 2]:.0f} ({ordered[0]:.0f}-{ordered[-1]:.0f})"
+
+
+def ratio_spread(values: list[float]) -> str:
+    """``median (min-max)`` of ratios."""
+    ordered = sorted(values)
+    return f"{ordered[len(ordered) // 2]:.2f}x ({ordered[0]:.2f}-{ordered[-1]:.2f})"
+
+
+def workloads(args: argparse.Namespace) -> dict[str, tuple[int, Callable[[], object], bool]]:
+    """Name -> (solves, run, cold) of every timed workload (imports NumPy)."""
+    import numpy as np
+
+    from tdcm_ros.model import SolverSettings
+    from tdcm_ros.model.batch import solve_batch
+
+    settings = SolverSettings()
+    rng = np.random.default_rng(2024)
+    designs = paper_like(args.designs, rng)
+    tensions = np.broadcast_to(np.linspace(0.0, 20.0, args.tensions),
+                               (args.designs, args.tensions))
+    many = paper_like(args.many, rng)
+    many_t = rng.uniform(0.0, 20.0, args.many)
+    return {
+        "space": (tensions.size, lambda: solve_batch(designs, tensions, settings=settings),
+                  False),
+        "space2": (tensions.size,
+                   lambda: solve_batch(designs, tensions, settings=settings, workers=2), False),
+        "cold": (tensions.size, lambda: solve_batch(designs, tensions, settings=settings),
+                 True),
+        "many": (args.many, lambda: solve_batch(many, many_t, settings=settings), True),
+        "many2": (args.many, lambda: solve_batch(many, many_t, settings=settings, workers=2),
+                  True),
+    }
+
+
+def throughputs(args: argparse.Namespace, names: list[str], rounds: int
+                ) -> dict[str, list[float]]:
+    """Solves/s of workloads ``names`` (best of ``repeat`` each), interleaved for ``rounds``."""
+    work = workloads(args)
+    for name in names:
+        work[name][1]()  # compile and warm up
+    out: dict[str, list[float]] = {name: [] for name in names}
+    for _ in range(rounds):
+        for name in names:
+            count, call, cold = work[name]
+            out[name].append(count / best_time(call, args.repeat, cold))
+            if "2" not in name:  # CPU time of one thread: less sensitive to the other jobs
+                out.setdefault(f"{name} cpu", []).append(
+                    count / best_time(call, args.repeat, cold, process_time))
+    return out
 
 
 def run(args: argparse.Namespace) -> None:
@@ -68,6 +130,11 @@ def run(args: argparse.Namespace) -> None:
     from tdcm_ros.model import SolverSettings, solve
     from tdcm_ros.model.batch import solve_batch
 
+    if args.throughput_only:
+        measured = throughputs(args, ["space", "many"], 1)
+        print(measured["space cpu"][0], measured["many cpu"][0])
+        print(measured["space"][0], measured["many"][0])
+        return
     reference = SolverSettings(cells_per_notch=128, cells_per_tube=16, quad_order=12, tol=1e-14)
     settings = SolverSettings()
     rng = np.random.default_rng(2024)
@@ -76,19 +143,8 @@ def run(args: argparse.Namespace) -> None:
                                (args.designs, args.tensions))
     count = tensions.size
     result = solve_batch(designs, tensions, settings=settings)
-    warm = best_time(lambda: solve_batch(designs, tensions, settings=settings), args.repeat,
-                     cold=False)
-    if args.throughput_only:
-        print(count / warm)
-        return
-    solve_batch(designs, tensions, settings=settings, workers=2)
-    two = best_time(lambda: solve_batch(designs, tensions, settings=settings, workers=2),
-                    args.repeat, cold=False)
-    cold = best_time(lambda: solve_batch(designs, tensions, settings=settings), args.repeat,
-                     cold=True)
-    many = paper_like(args.many, rng)
-    many_t = rng.uniform(0.0, 20.0, args.many)
-    many_time = best_time(lambda: solve_batch(many, many_t, settings=settings), 2, cold=True)
+    names = ["space", "space2", "cold", "many", "many2"]
+    measured = throughputs(args, names, args.rounds)
     single_n = 200
     pairs = [(designs[i % args.designs], float(tensions[0, (7 * i) % args.tensions]))
              for i in range(single_n)]
@@ -104,49 +160,115 @@ def run(args: argparse.Namespace) -> None:
                                       .tip_position - result.tip_position[i, k]))
                  for i, k in picks]
 
+    def per_round(two: str, one: str) -> list[float]:
+        return [b / a for a, b in zip(measured[one], measured[two], strict=True)]
+
     print(f"settings: cells_per_notch={settings.cells_per_notch}, quad_order="
           f"{settings.quad_order}, tol={settings.tol:g} m; "
           f"{', '.join(THREAD_VARIABLES)} = {os.environ['OMP_NUM_THREADS']}")
     print(f"statuses: {dict(zip(*np.unique(result.status, return_counts=True)))}; "
           f"fallback to single solve: {int(result.fallback.sum())}")
+    print(f"solves/s, median (min-max) of {args.rounds} interleaved rounds, each best of "
+          f"{args.repeat}")
     print(f"design space {args.designs} designs x {args.tensions} tensions = {count} solves")
-    print(f"  grids built  : {count / warm:10.0f} solves/s  ({warm * 1e3:.1f} ms)")
-    print(f"  two workers  : {count / two:10.0f} solves/s  ({two * 1e3:.1f} ms), "
-          f"{warm / two:.2f}x one worker (target >= 1.8x)")
-    print(f"  incl. grids  : {count / cold:10.0f} solves/s  ({cold * 1e3:.1f} ms)")
-    print(f"many designs {args.many} x 1 tension, incl. grids: {args.many / many_time:10.0f} "
-          f"solves/s ({many_time * 1e3:.1f} ms)")
+    print(f"  grids built  : {spread(measured['space'])} (per CPU second: "
+          f"{spread(measured['space cpu'])})")
+    print(f"  two workers  : {spread(measured['space2'])}; per round "
+          f"{ratio_spread(per_round('space2', 'space'))} one worker (target >= 1.8x)")
+    print(f"  incl. grids  : {spread(measured['cold'])} (per CPU second: "
+          f"{spread(measured['cold cpu'])})")
+    print(f"many designs {args.many} x 1 tension, incl. grids: {spread(measured['many'])} "
+          f"(per CPU second: {spread(measured['many cpu'])})")
+    print(f"  two workers  : {spread(measured['many2'])}; per round "
+          f"{ratio_spread(per_round('many2', 'many'))} one worker")
     print(f"single solve() loop          : {single_n / single_time:10.0f} solves/s")
     print(f"tip error vs single solve, same settings ({len(picks)} points): {same:.2e} m")
     print(f"tip error vs converged reference: max {max(converged) * 1e6:.3f} um, "
           f"median {np.median(converged) * 1e6:.3f} um (target <= 1 um)")
 
 
-def throughput_in(checkout: Path, args: argparse.Namespace) -> float:
-    """Warm design-space throughput (solves/s) in a fresh process importing ``tdcm_ros`` from
-    ``checkout``."""
+def throughput_in(checkout: Path, args: argparse.Namespace
+                  ) -> tuple[float, float, float, float]:
+    """Design-space (grids built) and many-design throughputs (solves/s), then the same per
+    CPU second, in a fresh process importing ``tdcm_ros`` from ``checkout``."""
     env = {**os.environ, "PYTHONPATH": str(checkout)}
     command = [sys.executable, __file__, "--throughput-only", "--designs", str(args.designs),
-               "--tensions", str(args.tensions), "--repeat", str(args.repeat)]
+               "--tensions", str(args.tensions), "--many", str(args.many), "--repeat",
+               str(args.repeat)]
     out = subprocess.run(command, env=env, capture_output=True, text=True, check=True)
-    return float(out.stdout.split()[-1])
+    space_cpu, many_cpu, space, many = (float(v) for v in out.stdout.split()[-4:])
+    return space, many, space_cpu, many_cpu
+
+
+def breakdown(args: argparse.Namespace) -> None:
+    """CPU time (best of ``repeat``) of the steps of the many-design case, and of the grid
+    kernel per compliance evaluation point."""
+    import numpy as np
+
+    from tdcm_ros.model import SolverSettings
+    from tdcm_ros.model.batch import CHUNK, _KernelArrays, _Stack, solve_batch
+    from tdcm_ros.model.grid import _prototype_integrals, grid_parts
+    from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members, cell_table, prototypes
+
+    settings = SolverSettings()
+
+    def gathers(parts: Any) -> None:
+        """Every chunk's kernel arrays, each dropped after use as in ``solve_batch``."""
+        for _, stack in _Stack.split(parts, settings):
+            for k in range(0, stack.rows.size, CHUNK):
+                _KernelArrays.of(parts, stack.rows[k:k + CHUNK])
+
+    rng = np.random.default_rng(2024)
+    paper_like(args.designs, rng)
+    many = paper_like(args.many, rng)
+    many_t = rng.uniform(0.0, 20.0, args.many)
+    members = Members.of(many)
+    layout = (settings.routing, settings.grid, settings.cells_per_notch,
+              settings.cells_per_tube)
+    proto = prototypes(members, *layout)
+    parts = grid_parts(many, settings)
+    steps: list[tuple[str, Callable[[], object]]] = [
+        ("solve_batch, all of it", lambda: solve_batch(many, many_t, settings=settings)),
+        ("Members.of (collect, check rigidity)", lambda: Members.of(many)),
+        ("prototypes + cell_table (layout)",
+         lambda: cell_table(prototypes(members, *layout), settings.routing)),
+        ("grid kernel (cell_integrals)", lambda: _prototype_integrals(proto, settings.quad_order)),
+        ("kernel arrays + strain per chunk (gathers)", lambda: gathers(parts))]
+    print(f"many designs {args.many} x 1: CPU time (process_time), best of {args.repeat}")
+    kernel_ms = 0.0
+    for label, call in steps:
+        call()
+        ms = best_time(call, args.repeat, False, process_time) * 1e3
+        kernel_ms = ms if label.startswith("grid kernel") else kernel_ms
+        print(f"  {label:<44} {ms:7.1f} ms")
+    q = settings.quad_order
+    points = int(np.sum(proto.is_notch)) * (q + q * q + PEAK_SAMPLES + 2)
+    print(f"  grid kernel: {points / args.many:.0f} notch compliance points per design, "
+          f"{kernel_ms * 1e6 / points:.1f} ns each (tube cells included in the time), "
+          f"{kernel_ms * 1e3 / args.many:.1f} us per design")
 
 
 def compare(args: argparse.Namespace) -> None:
-    """Alternate the baseline checkout and this one; print throughputs and their ratio."""
+    """Alternate the baseline checkout and this one; print throughputs and their ratios."""
     here = Path(__file__).resolve().parents[1]
-    base, mine = [], []
+    base: list[tuple[float, float, float, float]] = []
+    mine: list[tuple[float, float, float, float]] = []
     for _ in range(args.rounds):
         base.append(throughput_in(args.baseline, args))
         mine.append(throughput_in(here, args))
-    b, m = sorted(base)[len(base) // 2], sorted(mine)[len(mine) // 2]
-    print(f"same-run comparison, {args.designs} x {args.tensions}, grids built, one core, "
-          f"{args.rounds} alternating rounds")
-    print(f"  baseline {args.baseline}: {b:10.0f} solves/s (rounds: "
-          + ", ".join(f"{t:.0f}" for t in base) + ")")
-    print(f"  this checkout      : {m:10.0f} solves/s (rounds: "
-          + ", ".join(f"{t:.0f}" for t in mine) + ")")
-    print(f"  speed-up           : {m / b:10.1f}x  (target >= 250,000 solves/s)")
+    print(f"same-run comparison, one core, {args.rounds} alternating rounds (fresh processes), "
+          "solves/s median (min-max)")
+    for k, (label, target) in enumerate(
+            ((f"design space {args.designs} x {args.tensions}, grids built", "250,000"),
+             (f"many designs {args.many} x 1, grids included", "100,000"))):
+        b, m = [r[k] for r in base], [r[k] for r in mine]
+        b_cpu, m_cpu = [r[k + 2] for r in base], [r[k + 2] for r in mine]
+        print(f"  {label} (target >= {target} solves/s)")
+        print(f"    baseline {args.baseline}: {spread(b)}; per CPU second {spread(b_cpu)}")
+        print(f"    this checkout: {spread(m)}; per CPU second {spread(m_cpu)}")
+        print(f"    speed-up per round: {ratio_spread([y / x for x, y in zip(b, m, strict=True)])}"
+              f"; per CPU second "
+              f"{ratio_spread([y / x for x, y in zip(b_cpu, m_cpu, strict=True)])}")
 
 
 def main() -> None:
@@ -159,9 +281,14 @@ def main() -> None:
     parser.add_argument("--sample", type=int, default=24, help="points checked at the reference")
     parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. /work/main")
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--breakdown", action="store_true",
+                        help="only the CPU-time breakdown of the many-design case")
     parser.add_argument("--throughput-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     os.environ.update({name: "1" for name in THREAD_VARIABLES})
+    if args.breakdown:
+        breakdown(args)
+        return
     if args.baseline is not None:
         compare(args)
     run(args)

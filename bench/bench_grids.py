@@ -1,16 +1,24 @@
-"""Grid building for many different designs: ``build_grids`` (numpy over the member axis)
-against one ``build_grid`` per design, in the same run (issue 15, item 3).
+"""Grid building for many different designs: ``build_grids`` (one compiled kernel call over
+every design's prototype cells) against one ``build_grid`` per design, in the same run
+(issue 15, item 3).
 
-Run: ``python bench/bench_grids.py [--designs 2000] [--repeat 3]``. Designs are paper-like
-(``w_n``, ``w_d`` drawn around the paper's), every one different, so no cache helps; the
-grid cache is cleared before each single-design pass. Single-threaded.
+Run: ``python bench/bench_grids.py [--designs 2000] [--repeat 3] [--baseline CHECKOUT]
+[--rounds 3]``. Designs are paper-like (``w_n``, ``w_d`` drawn around the paper's), every one
+different, so no cache helps; the grid cache is cleared before each single-design pass.
+Single-threaded; times are CPU time of the process (``time.process_time``), which other jobs
+on shared cores disturb far less than wall time. ``--baseline`` times ``build_grids`` of another checkout (e.g. main) in the
+same run: it and this checkout alternate in fresh processes for ``--rounds`` rounds and the
+per-round ratios are printed (median and range).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
@@ -21,35 +29,81 @@ from tdcm_ros.model import SolverSettings, preset
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.grid import _build_grid, build_grid, build_grids
 
+CASES = (("default (adaptive), paper", SolverSettings()),
+         ("default (adaptive), free", SolverSettings(routing="free")),
+         ("uniform cpn=4 cpt=1 q=4", SolverSettings(grid="uniform", cells_per_notch=4,
+                                                    cells_per_tube=1, quad_order=4)))
+
+
+def stacked_rates(designs: list, repeat: int) -> list[float]:
+    """``build_grids`` grids/s of every case (best of ``repeat``; the first call warms up)."""
+    rates = []
+    for _, settings in CASES:
+        build_grids(designs, settings)
+        times = []
+        for _ in range(repeat):
+            start = time.process_time()
+            build_grids(designs, settings)
+            times.append(time.process_time() - start)
+        rates.append(len(designs) / min(times))
+    return rates
+
+
+def compare(args: argparse.Namespace) -> None:
+    """Alternate the baseline checkout and this one in fresh processes; print the ratios."""
+    here = Path(__file__).resolve().parents[1]
+    runs: dict[Path, list[list[float]]] = {args.baseline: [], here: []}
+    for _ in range(args.rounds):
+        for checkout, rates in runs.items():
+            out = subprocess.run(
+                [sys.executable, __file__, "--rates-only", "--designs", str(args.designs),
+                 "--repeat", str(args.repeat)], env={**os.environ, "PYTHONPATH": str(checkout)},
+                capture_output=True, text=True, check=True)
+            rates.append([float(v) for v in out.stdout.split()[-len(CASES):]])
+    print(f"build_grids, grids per CPU second, {args.rounds} alternating rounds (fresh processes), "
+          f"median (min-max); baseline {args.baseline}")
+    for k, (label, _) in enumerate(CASES):
+        base = [r[k] for r in runs[args.baseline]]
+        mine = [r[k] for r in runs[here]]
+        ratios = sorted(m / b for m, b in zip(mine, base, strict=True))
+        print(f"  {label:<28} baseline {np.median(base):8.0f} ({min(base):.0f}-{max(base):.0f})"
+              f"  this {np.median(mine):8.0f} ({min(mine):.0f}-{max(mine):.0f})  ratio "
+              f"{ratios[len(ratios) // 2]:.2f}x ({ratios[0]:.2f}-{ratios[-1]:.2f})")
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--designs", type=int, default=2000)
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. main")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rates-only", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     rng = np.random.default_rng(0)
     base = preset("paper-experiment")
     designs = [base.with_overrides(w_n=float(rng.uniform(1.0, 2.5)) * MM,
                                    w_d=float(rng.uniform(1.2, 2.0)) * MM)
                for _ in range(args.designs)]
-    for label, settings in (("default (adaptive), paper", SolverSettings()),
-                            ("default (adaptive), free", SolverSettings(routing="free")),
-                            ("uniform cpn=4 cpt=1 q=4", SolverSettings(
-                                grid="uniform", cells_per_notch=4, cells_per_tube=1,
-                                quad_order=4))):
+    if args.rates_only:
+        print(*stacked_rates(designs, args.repeat))
+        return
+    if args.baseline is not None:
+        compare(args)
+    for label, settings in CASES:
         stacked, single = [], []
+        stack = build_grids(designs, settings)
         for _ in range(args.repeat):
-            start = time.perf_counter()
+            start = time.process_time()
             stack = build_grids(designs, settings)
-            stacked.append(time.perf_counter() - start)
+            stacked.append(time.process_time() - start)
             _build_grid.cache_clear()
-            start = time.perf_counter()
+            start = time.process_time()
             for design in designs:
                 build_grid(design, settings)
-            single.append(time.perf_counter() - start)
+            single.append(time.process_time() - start)
         fast, slow = min(stacked), min(single)
         print(f"{label:<28} cells/design {stack.n_cells.mean():6.1f}  build_grids "
-              f"{args.designs / fast:9.0f} grids/s ({fast / args.designs * 1e6:6.1f} us)  "
+              f"{args.designs / fast:9.0f} grids per CPU s ({fast / args.designs * 1e6:6.1f} us)  "
               f"build_grid loop {args.designs / slow:7.0f} grids/s  ratio {slow / fast:5.1f}x")
 
 

@@ -1,6 +1,6 @@
 """Vectorised Algorithm 1: many designs and tensions in one call, same answers as ``solve``.
 
-Every design's grid is built at once (:func:`~tdcm_ros.model.grid.build_grids`, vectorised;
+Every design's grid is built at once (:func:`~tdcm_ros.model.grid.grid_parts`, compiled;
 a :class:`~tdcm_ros.model.grid.Grid` object is built only for a member whose limit check
 needs its error message); designs of one cell count are stacked as
 :class:`~tdcm_ros.model.cells.Cells` (a leading member axis) and every member
@@ -20,13 +20,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tdcm_ros.model import grid_kernel
 from tdcm_ros.model.cells import Cells
-from tdcm_ros.model.compiled import kernels
+from tdcm_ros.model.compiled import grid_kernels, kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import (
     InvalidDesignError,
@@ -34,14 +35,7 @@ from tdcm_ros.model.errors import (
     ModelError,
     TensionRangeError,
 )
-from tdcm_ros.model.grid import (
-    PEAK_SAMPLES,
-    CellRows,
-    Grid,
-    GridStack,
-    build_grid,
-    build_grids,
-)
+from tdcm_ros.model.grid import PEAK_SAMPLES, Grid, GridParts, build_grid, grid_parts
 from tdcm_ros.model.grid_layout import Members
 from tdcm_ros.model.kernel import CONVERGED
 from tdcm_ros.model.kinematics import PlanarShape
@@ -93,51 +87,76 @@ class BatchResult:
 
 
 @dataclass(frozen=True, eq=False)
-class _Stack:
-    """Designs of one cell count: their :class:`Cells` (one row per design) and, per design,
-    its notch cells ``notch_cells`` (-1: padding) and the strain coefficients
+class _KernelArrays:
+    """What the compiled iteration reads for some designs: their :class:`Cells`, and per
+    design its notch cells ``notch_cells`` (-1: padding) and the strain coefficients
     ``strain0``/``strain1`` (designs, notch cells, samples) giving the bending strain at
     ``PEAK_SAMPLES`` points of every notch cell as ``|m_a S0 + m_b S1|``."""
 
-    designs: tuple[Design, ...]
-    settings: SolverSettings
     cells: Cells
     notch_cells: NDArray[np.int64]
     strain0: Array
     strain1: Array
 
     @classmethod
-    def split(cls, grids: GridStack, settings: SolverSettings) -> list[tuple[NDArray[np.int64],
-                                                                              _Stack]]:
-        """``(rows of grids, stack)`` for every cell count of ``grids``, trimmed to it."""
-        cells = Cells.of_stack(grids)
-        notch_cells, strain0, strain1 = _strain_coefficients(grids)
+    def of(cls, parts: GridParts, rows: NDArray[np.int64]) -> _KernelArrays:
+        """Gathered from the prototype cells of designs ``rows`` of ``parts``."""
+        return cls(Cells.of_parts(parts, rows), *_strain_coefficients(parts, rows))
+
+
+@dataclass(frozen=True, eq=False)
+class _Stack:
+    """Designs ``rows`` of ``parts``, all of one cell count; per design its tendon offset
+    ``r_c`` (m) and largest compliance where the tendon follows the body
+    ``constrained_peak_c`` (1/(N m^2)), for the screening before iterating. The kernel
+    arrays are gathered per chunk of members (:meth:`arrays`), or once for the whole stack
+    when it has at most ``CHUNK`` designs (a design-space sweep)."""
+
+    parts: GridParts
+    rows: NDArray[np.int64]
+    settings: SolverSettings
+    r_c: Array
+    constrained_peak_c: Array
+    _whole: dict[str, _KernelArrays] = field(default_factory=dict)
+
+    @classmethod
+    def split(cls, parts: GridParts, settings: SolverSettings
+              ) -> list[tuple[NDArray[np.int64], _Stack]]:
+        """``(rows of parts, stack)`` for every cell count of ``parts``."""
+        counts = parts.table.count
+        proto = parts.table.prototypes
+        peak = np.zeros(counts.size)
+        np.maximum.at(peak, proto.member[~proto.chord],
+                      parts.proto_fc[:-1, grid_kernel.PEAK_C][~proto.chord])
         out = []
-        for count in np.unique(grids.n_cells):
-            rows = np.flatnonzero(grids.n_cells == count)
-            notches = int(max(grids.designs[r].N for r in rows))
-            width = int(np.max(np.sum(notch_cells[rows] >= 0, axis=1)))
-            part = Cells(fc=np.ascontiguousarray(cells.fc[rows, :, :count]),
-                         fq=np.ascontiguousarray(cells.fq[rows, :, :count]),
-                         ic=np.ascontiguousarray(cells.ic[rows, :, :count]),
-                         notch=np.ascontiguousarray(cells.notch[rows, :, :notches]),
-                         scal=cells.scal[rows])
-            out.append((rows, cls(designs=tuple(grids.designs[r] for r in rows),
-                                  settings=settings, cells=part,
-                                  notch_cells=np.ascontiguousarray(notch_cells[rows, :width]),
-                                  strain0=np.ascontiguousarray(strain0[rows, :width]),
-                                  strain1=np.ascontiguousarray(strain1[rows, :width]))))
+        for count in np.unique(counts):
+            rows = np.flatnonzero(counts == count)
+            out.append((rows, cls(parts=parts, rows=rows, settings=settings,
+                                  r_c=parts.members.R_c[rows],
+                                  constrained_peak_c=peak[rows])))
         return out
+
+    def arrays(self, local: NDArray[np.int64]) -> tuple[_KernelArrays, NDArray[np.int64]]:
+        """The kernel arrays holding designs ``local`` (rows of this stack), and each one's
+        row in them."""
+        if self.rows.size <= CHUNK:
+            whole = self._whole.get("all")
+            if whole is None:
+                whole = self._whole.setdefault("all", _KernelArrays.of(self.parts, self.rows))
+            return whole, local
+        distinct, inverse = np.unique(local, return_inverse=True)
+        return _KernelArrays.of(self.parts, self.rows[distinct]), inverse.astype(np.int64)
 
     def grid(self, row: int) -> Grid:
         """The :class:`Grid` of design ``row`` (built on demand, for an error message)."""
-        return build_grid(self.designs[row], self.settings)
+        return build_grid(self.parts.members.designs[self.rows[row]], self.settings)
 
     def strain(self, rows: NDArray[np.int64], x: Array) -> Array:
         """Largest notch bending strain of members of design ``rows`` from their cell end
         moments ``x = [m_a, m_b]`` (N m)."""
+        arrays, at = self.arrays(rows)
         out = np.empty(rows.size)
-        kernels().peak_strains(rows, self.notch_cells, self.strain0, self.strain1,
+        kernels().peak_strains(at, arrays.notch_cells, arrays.strain0, arrays.strain1,
                                np.ascontiguousarray(x), out)
         return out
 
@@ -148,8 +167,8 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
 
     A 1-D ``tensions`` pairs design ``i`` with tension ``i``; a 2-D one gives each design a
     row of tensions (a design-space grid). Results have the shape of ``tensions``.
-    ``workers`` threads iterate chunks of members at once (the compiled kernel releases the
-    GIL); the answers do not depend on it.
+    ``workers`` threads build the grids and iterate chunks of members at once (the compiled
+    kernels release the GIL); the answers do not depend on it.
     """
     designs = list(designs)
     for i, design in enumerate(designs):
@@ -178,10 +197,10 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
             f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
     out = _Outcome(t_all.reshape(len(designs), -1))
-    valid, grids = _grids(out, designs, settings)
+    valid, parts = _grids(out, designs, settings, workers)
     chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
-    if grids is not None:
-        for rows, stack in _Stack.split(grids, settings):
+    if parts is not None:
+        for rows, stack in _Stack.split(parts, settings):
             chunks += _screen_group(out, valid[rows].tolist(), stack, settings)
     if workers == 1 or len(chunks) == 1:
         for members, stack, rows in chunks:
@@ -252,13 +271,14 @@ class _Outcome:
             iterations=self.iterations.reshape(shape), fallback=self.fallback.reshape(shape))
 
 
-def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings
-           ) -> tuple[NDArray[np.int64], GridStack | None]:
-    """The designs whose grids build, and their grids built at once; the others' members are
-    marked invalid (each design is checked alone only if the whole set is refused)."""
+def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings, workers: int
+           ) -> tuple[NDArray[np.int64], GridParts | None]:
+    """The designs whose grids build, and their grids built at once by ``workers`` threads;
+    the others' members are marked invalid (each design is checked alone only if the whole
+    set is refused)."""
     valid = np.arange(len(designs))
     try:
-        return valid, build_grids(designs, settings) if designs else None
+        return valid, grid_parts(designs, settings, workers) if designs else None
     except InvalidDesignError:
         pass
     kept = []
@@ -270,40 +290,32 @@ def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings
             continue
         kept.append(d)
     valid = np.array(kept, np.int64)
-    return valid, build_grids([designs[d] for d in kept], settings) if kept else None
+    return valid, grid_parts([designs[d] for d in kept], settings, workers) if kept else None
 
 
-def _strain_coefficients(grids: GridStack) -> tuple[NDArray[np.int64], Array, Array]:
-    """Per design: its notch cells (padded with -1) and ``S0``, ``S1`` (designs, notch cells,
-    samples): strain ``|m_a S0 + m_b S1|`` at ``PEAK_SAMPLES`` points of every notch cell,
-    ``S = (1 - xi | xi) * c * min(h1, R_outer)``. Every notch of a design has the same cells
-    in its own coordinates, so the samples are computed on the first notch and copied."""
-    member, cell = np.nonzero(grids.is_notch & (grids.notch_index == 0))
-    members = Members.of(grids.designs)
-    length = grids.s_nodes[member, cell + 1] - grids.s_nodes[member, cell]
-    seg_start = grids.seg_start[member, cell]
-    rows = CellRows(members=members, member=member, is_notch=np.ones(member.size, bool),
-                    seg_start=seg_start, seg_length=grids.seg_length[member, cell],
-                    a=grids.s_nodes[member, cell], length=length)
-    u_a, u_b = grids.u_a[member, cell], grids.u_b[member, cell]
-    u = u_a[:, None] + (u_b - u_a)[:, None] * np.linspace(0.0, 1.0, PEAK_SAMPLES)[None, :]
-    xi = (rows.local_sigma(u) - (rows.a - seg_start)[:, None]) / length[:, None]
-    weight = rows.compliance(u) * np.minimum(members.h1(member, u),
-                                             members.R_outer[member][:, None])
-    designs = len(grids.designs)
-    per_notch = np.bincount(member, minlength=designs)
-    every, cells = np.nonzero(grids.is_notch)
-    count = np.bincount(every, minlength=designs)
-    slot = np.arange(every.size) - np.repeat(np.cumsum(count) - count, count)
-    source = (np.cumsum(per_notch) - per_notch)[every] + slot % per_notch[every]
+def _strain_coefficients(parts: GridParts, rows: NDArray[np.int64]
+                         ) -> tuple[NDArray[np.int64], Array, Array]:
+    """For designs ``rows``: their notch cells (padded with -1) and ``S0``, ``S1`` (designs,
+    notch cells, samples): strain ``|m_a S0 + m_b S1|`` at ``PEAK_SAMPLES`` points of every
+    notch cell (``(1 - xi | xi) c min(h1, R_outer)``, the grid kernel's coefficients of the
+    cell's prototype)."""
+    cell, proto, valid = parts.cells_of(rows)
+    notch = valid & parts.table.is_notch[cell]
+    member, cells = np.nonzero(notch)
+    count = np.sum(notch, axis=1)
+    slot = np.arange(member.size) - np.repeat(np.cumsum(count) - count, count)
     width = int(count.max(initial=0))
-    notch_cells = np.full((designs, width), -1, np.int64)
-    notch_cells[every, slot] = cells
-    s0 = np.zeros((designs, width, PEAK_SAMPLES))
-    s1 = np.zeros((designs, width, PEAK_SAMPLES))
-    s0[every, slot] = ((1.0 - xi) * weight)[source]
-    s1[every, slot] = (xi * weight)[source]
-    return notch_cells, s0, s1
+    notch_cells = np.full((rows.size, width), -1, np.int64)
+    notch_cells[member, slot] = cells
+    source = np.full((rows.size, width), parts.proto_fc.shape[0] - 1, np.int64)
+    source[member, slot] = proto[member, cells]
+    build = grid_kernels()
+    out = []
+    for k in range(2):
+        coefficients = np.empty((rows.size, 1, width, PEAK_SAMPLES))
+        build.gather(source, np.array([k]), parts.proto_strain, coefficients)
+        out.append(coefficients[:, 0])
+    return notch_cells, out[0], out[1]
 
 
 def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
@@ -322,7 +334,7 @@ def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
         except TensionRangeError as error:
             out.fail(np.array([m]), error)
     # limits.check_tendon_singularity, evaluated in the same order of operations.
-    r_c, peak = stack.cells.r_c[rows], stack.cells.constrained_peak_c[rows]
+    r_c, peak = stack.r_c[rows], stack.constrained_peak_c[rows]
     singular = ~bad & (r_c**2 * tension * peak >= 1.0) & (r_c * (r_c * tension) * peak >= 1.0)
     for m, row in zip(members[singular], rows[singular]):
         try:
@@ -349,21 +361,22 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
     """
     mode = settings.acceleration
     budget = 1 if mode == "anderson" else settings.max_iter
-    cells = st.cells
+    arrays, at = st.arrays(rows)
+    cells = arrays.cells
     n = cells.n_cells
     tension = out.tensions[members]
     x = np.empty((members.size, 2 * n))
-    x[...] = (cells.r_c[rows] * tension)[:, None]
+    x[...] = (st.r_c[rows] * tension)[:, None]
     p = np.empty((members.size, n + 1), np.complex128)
     theta = np.empty((members.size, n + 1))
     tangent = np.empty((members.size, n + 1), np.complex128)
     info = np.empty((members.size, 3 + budget))
     strain = np.empty(members.size)
     kernels().iterate_strained(
-        cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension, x, p, theta,
+        cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, at, tension, x, p, theta,
         tangent, settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
-        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, st.notch_cells,
-        st.strain0, st.strain1, strain)
+        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, arrays.notch_cells,
+        arrays.strain0, arrays.strain1, strain)
     done = info[:, 1] == CONVERGED
     out.pending.extend((int(members[i]), st, int(rows[i])) for i in np.flatnonzero(~done))
     out.iterations[members[done]] = info[done, 0].astype(np.int64)

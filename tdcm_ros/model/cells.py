@@ -18,7 +18,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.grid import CellArrays, Grid, GridStack
+from tdcm_ros.model import grid_kernel
+from tdcm_ros.model.compiled import grid_kernels
+from tdcm_ros.model.grid import CellArrays, Grid, GridParts, GridStack
 
 Array = NDArray[np.float64]
 Ints = NDArray[np.int64]
@@ -70,6 +72,32 @@ class Cells:
              np.array([d.R_outer for d in stack.designs]),
              np.array([d.length for d in stack.designs]),
              np.max(peak, axis=1, initial=0.0)], axis=1))
+
+    @classmethod
+    def of_parts(cls, parts: GridParts, rows: Ints) -> Cells:
+        """Members = designs ``rows`` of ``parts``, laid out straight from their prototype
+        cells (the same values as :meth:`of_stack` of ``parts.stack(rows)``, without the
+        stack's other arrays)."""
+        cell, proto, valid = parts.cells_of(rows)
+        table, members = parts.table, parts.members
+        build = grid_kernels()
+        fc = np.empty((rows.size, 4, cell.shape[1], 1))
+        build.gather(proto, _FC_FIELDS, parts.proto_fc[..., None], fc)
+        fq = np.empty((rows.size, 5, cell.shape[1], parts.gauss_u.size))
+        build.gather(proto, _FQ_FIELDS, parts.proto_fq, fq)
+        tip = table.count[rows][:, None]
+        constrained = np.where(valid, table.constrained[cell], True)
+        ic = np.stack([np.where(valid, table.chord_start_node[cell], tip),
+                       np.where(valid, table.chord_end_node[cell], tip),
+                       constrained], axis=1).astype(np.int64)
+        notches = int(members.N[rows].max())
+        peak = np.where(constrained, parts.proto_fc[proto, grid_kernel.PEAK_C], 0.0)
+        scal = np.stack([members.R_c[rows], members.R_outer[rows], members.length[rows],
+                         np.max(peak, axis=1, initial=0.0)], axis=1)
+        return cls(fc=fc[..., 0], fq=fq, ic=ic,
+                   notch=np.stack([table.notch_left_node[rows, :notches],
+                                   table.notch_right_node[rows, :notches]], axis=1),
+                   scal=scal)
 
     def take(self, rows: Ints) -> Cells:
         """The members ``rows`` (repeats allowed)."""
@@ -175,6 +203,11 @@ class Cells:
     def constrained_peak_c(self) -> Array:
         """Largest compliance (1/(N m^2)) where the tendon follows the body, per member."""
         return self.scal[:, 3]
+
+
+_FC_FIELDS = np.array([grid_kernel.C0, grid_kernel.C1, grid_kernel.C0_T, grid_kernel.C1_T])
+_FQ_FIELDS = np.array([grid_kernel.A0, grid_kernel.A1, grid_kernel.W_Q, grid_kernel.A0_T,
+                       grid_kernel.A1_T])
 
 
 @lru_cache(maxsize=512)

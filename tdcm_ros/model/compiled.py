@@ -21,7 +21,7 @@ from contextlib import contextmanager
 from typing import Any
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model import kernel
+from tdcm_ros.model import grid_kernel, kernel
 from tdcm_ros.model.errors import InvalidSettingsError
 from tdcm_ros.model.quiet import quiet_fp
 
@@ -30,8 +30,11 @@ PLAIN = types.SimpleNamespace(**{name: quiet_fp(getattr(kernel, name))
                                  for name in kernel.KERNELS})
 """The plain-Python build: NumPy scalar arithmetic in it would warn where the compiled
 build is silent, so each entry point runs under :func:`~tdcm_ros.model.quiet.quiet_fp`."""
+GRID_PLAIN = types.SimpleNamespace(**{name: quiet_fp(getattr(grid_kernel, name))
+                                      for name in grid_kernel.KERNELS})
+"""The plain-Python build of :mod:`grid_kernel`, guarded the same way."""
 _CHOICES = {"0": False, "1": True, "": None}
-_state: dict[str, Any] = {"wanted": None, "chosen": False, "build": None}
+_state: dict[str, Any] = {"wanted": None, "chosen": False, "build": None, "grid_build": None}
 
 
 def use_compiled(flag: bool | None) -> None:
@@ -66,6 +69,18 @@ def kernels() -> types.SimpleNamespace:
     return build
 
 
+def grid_kernels() -> types.SimpleNamespace:
+    """The functions of :mod:`grid_kernel` in the build :func:`kernels` selected."""
+    if kernels() is PLAIN:
+        return GRID_PLAIN
+    build = _state["grid_build"]
+    if build is None:
+        import numba
+
+        build = _state["grid_build"] = _compile(numba, grid_kernel)
+    return build
+
+
 def is_compiled() -> bool:
     """Whether the selected build is numba's."""
     return kernels() is not PLAIN
@@ -90,13 +105,13 @@ def _select() -> types.SimpleNamespace:
     return _compile(numba)
 
 
-def _compile(numba: Any) -> types.SimpleNamespace:
-    """Each kernel function jitted, its calls to the others resolved to their jitted versions
-    (the plain functions keep theirs)."""
-    namespace = dict(vars(kernel))
+def _compile(numba: Any, module: types.ModuleType = kernel) -> types.SimpleNamespace:
+    """Each kernel function of ``module`` (its ``KERNELS``) jitted, its calls to the others
+    resolved to their jitted versions (the plain functions keep theirs)."""
+    namespace = dict(vars(module))
     compiled = {}
-    for name in kernel.KERNELS:
-        plain = getattr(kernel, name)
+    for name in module.KERNELS:
+        plain = getattr(module, name)
         clone = types.FunctionType(plain.__code__, namespace, name, plain.__defaults__,
                                    plain.__closure__)
         clone.__qualname__ = plain.__qualname__

@@ -13,27 +13,34 @@ For each cell the grid stores:
   cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it;
 - on cells the tendon crosses as a chord, ``A0_T``, ``A1_T``, ``C0_T``, ``C1_T``: the same per
   newton of tension for the chord moment's non-linear part (``m'' = -T c m``, see
-  :func:`_chord_terms`). A kernel that uses them takes ``A0 + T A0_T`` etc. in place of
+  :func:`tdcm_ros.model.grid_kernel.cell_integrals`). A kernel that uses them takes ``A0 + T A0_T`` etc. in place of
   ``A0``; they are zero where the tendon follows the body.
 
 Grids depend only on the design and the discretisation settings and are cached. Where the
-cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s job;
-:func:`build_grids` builds many designs' grids at once into a :class:`GridStack`.
+cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s job; the
+integrals of each segment kind's cells are computed once per design by the compiled
+:func:`tdcm_ros.model.grid_kernel.cell_integrals` (:class:`GridParts`) and copied along the
+body. :func:`build_grids` builds many designs' grids at once into a :class:`GridStack`;
+:func:`build_grid` is the same build with one member.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field, fields
 from functools import cached_property, lru_cache
-from typing import TypeVar
+from itertools import pairwise
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.compiled import grid_kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.grid_kernel import CIRCULAR, CUSTOM, RECTANGULAR
 from tdcm_ros.model.grid_layout import (
     PEAK_SAMPLES,
     CellTable,
@@ -216,13 +223,6 @@ class CellRows:
     a: Array
     length: Array
 
-    @classmethod
-    def of(cls, table: Prototypes) -> CellRows:
-        """One row per prototype cell of ``table``."""
-        return cls(members=table.members, member=table.member, is_notch=table.is_notch,
-                   seg_start=table.seg_start, seg_length=table.seg_length, a=table.a,
-                   length=table.length)
-
     def local_sigma(self, u: Array) -> Array:
         """Arc length from each row's segment start (m) at ``u``."""
         out = per_row(self.seg_length, u) * u
@@ -272,7 +272,8 @@ def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Ar
 
 
 def build_grid(design: Design, settings: SolverSettings) -> Grid:
-    """The (cached) grid for ``design`` under ``settings``' routing and discretisation."""
+    """The (cached) grid for ``design`` under ``settings``' routing and discretisation: the
+    many-design build (:func:`build_grids`) with one member."""
     return _build_grid(design, settings.routing, settings.grid, settings.cells_per_notch,
                        settings.cells_per_tube, settings.quad_order)
 
@@ -281,83 +282,150 @@ def build_grid(design: Design, settings: SolverSettings) -> Grid:
 @quiet_fp
 def _build_grid(design: Design, routing: str, kind: str, cells_per_notch: int,
                 cells_per_tube: int, quad_order: int) -> Grid:
-    proto = prototypes(Members.of([design]), routing, kind, cells_per_notch, cells_per_tube)
-    table = cell_table(proto, routing)
-    cells = _cell_integrals(table, quad_order)
-    constrained = table.constrained
-    return Grid(design=design, s_nodes=np.append(table.a, design.length),
-                is_notch=table.is_notch, notch_index=table.notch_index,
-                seg_start=table.seg_start, seg_length=table.seg_length, u_a=table.u_a,
-                u_b=table.u_b, constrained=constrained,
-                chord_cells=np.flatnonzero(~constrained),
-                chord_start_node=table.chord_start_node, chord_end_node=table.chord_end_node,
-                notch_left_node=table.notch_left_node[0],
-                notch_right_node=table.notch_right_node[0], **cells)
+    parts = GridParts.of(Members.of([design]), routing, kind, cells_per_notch,
+                         cells_per_tube, quad_order)
+    return parts.stack(np.zeros(1, np.int64)).grid(0)
 
 
-def _cell_integrals(table: CellTable, quad_order: int) -> dict[str, Array]:
-    """Every per-cell integral of the module docstring for all cells of ``table``: computed
-    once per prototype cell, in its segment's coordinates, and copied to its cells."""
-    proto = _prototype_integrals(table.prototypes, quad_order)
-    cells = {name: values[table.prototype] for name, values in proto.items()
-             if name not in ("gauss_u", "gauss_w")}
-    for name in ("s_q", "peak_s"):
-        cells[name] = per_row(table.seg_start, cells[name]) + cells[name]
-    return {**cells, "gauss_u": proto["gauss_u"], "gauss_w": proto["gauss_w"]}
+@dataclass(frozen=True, eq=False)
+class GridParts:
+    """Many designs' cells before they are laid out member by member: where every cell goes
+    (``table``, :mod:`tdcm_ros.model.grid_layout`) and the integrals of every prototype cell
+    (:func:`tdcm_ros.model.grid_kernel.cell_integrals`), SI units.
 
-
-def _prototype_integrals(table: Prototypes, quad_order: int) -> dict[str, Array]:
-    """The integrals of every prototype cell; ``s_q``, ``peak_s`` from its segment's start."""
-    gauss_x, gauss_wt = np.polynomial.legendre.leggauss(quad_order)
-    gauss_u = 0.5 * (gauss_x + 1.0)
-    gauss_w = 0.5 * gauss_wt
-    rows = CellRows.of(table)
-    u_a, u_b = table.u_a, table.u_b
-    span = (u_b - u_a)[:, None]
-    uq = u_a[:, None] + span * gauss_u[None, :]
-    length = table.length
-    w_q = _exact_length(span * gauss_w[None, :] * rows.jacobian(uq), length)
-    s_q = rows.local_sigma(uq)
-    xi_q = (s_q - table.a[:, None]) / length[:, None]
-    c_q = rows.compliance(uq)
-    a0, a1 = _nested(rows, gauss_u, gauss_w, u_a[:, None], uq)
-    probe_u = u_a[:, None] + span * np.linspace(0.0, 1.0, PEAK_SAMPLES)[None, :]
-    probe_c = rows.compliance(probe_u)
-    arg = np.argmax(probe_c, axis=1)
-    every = np.arange(u_a.size)
-    chord = _chord_terms(table.chord, quad_order, w_q / gauss_w, w_q, xi_q, c_q, a0, a1)
-    return {"gauss_u": gauss_u, "gauss_w": gauss_w, "s_q": s_q, "w_q": w_q, "xi_q": xi_q,
-            "c_q": c_q, "C0": np.sum(w_q * (1.0 - xi_q) * c_q, axis=1),
-            "C1": np.sum(w_q * xi_q * c_q, axis=1), "A0": a0, "A1": a1, **chord,
-            "c_start": rows.compliance(u_a), "c_end": rows.compliance(u_b),
-            "peak_c": probe_c[every, arg],
-            "peak_s": rows.local_sigma(probe_u[every, arg])}
-
-
-def _chord_terms(chord: NDArray[np.bool_], quad_order: int, ds_du: Array, w_q: Array,
-                 xi_q: Array, c_q: Array, a0: Array, a1: Array) -> dict[str, Array]:
-    """``A0_T``, ``A1_T`` (at the Gauss points) and ``C0_T``, ``C1_T`` (per cell) of chord cells.
-
-    On a chord the moment obeys ``m'' = -T c m`` (the tendon's pull on a curving body), so it is
-    not linear: ``m = m_a (1 - xi) + m_b xi + T (m_a G0 + m_b G1)`` to first order in
-    ``T c h^2``, with ``G0'' = -c (1 - xi)``, ``G1'' = -c xi`` and ``G = 0`` at both cell ends,
-    i.e. ``G0(s) = xi int_a^b A0 ds - int_a^s A0 ds``. The extra bend is ``T (m_a C0_T + m_b
-    C1_T)`` with ``C0_T = int c G0 ds``, and ``A0_T(s) = int_a^s c G0`` at the Gauss points
-    (rad/(N^2 m)); zero where the tendon follows the body. Partial integrals use the Gauss
-    points' spectral integration matrix. ``ds_du`` (m) is each Gauss point's ds per unit of
-    the cell's own reference coordinate.
+    ``proto_fc`` (P + 1, 8) and ``proto_fq`` (P + 1, 8, Q) hold the kernel's per-cell and
+    per-Gauss-point outputs (columns and rows named in :mod:`tdcm_ros.model.grid_kernel`),
+    ``proto_strain`` (P + 1, 2, ``PEAK_SAMPLES``) its strain coefficients; their last row is
+    zero, the integrals of a padding cell.
     """
+
+    members: Members
+    table: CellTable
+    proto_fc: Array
+    proto_fq: Array
+    proto_strain: Array
+    gauss_u: Array
+    gauss_w: Array
+
+    @classmethod
+    def of(cls, members: Members, routing: str, kind: str, cells_per_notch: int,
+           cells_per_tube: int, quad_order: int, workers: int = 1) -> GridParts:
+        """Lay out and integrate every member's cells (``members`` already checked) with
+        ``workers`` threads."""
+        table = cell_table(prototypes(members, routing, kind, cells_per_notch, cells_per_tube),
+                           routing)
+        fc, fq, strain = _prototype_integrals(table.prototypes, quad_order, workers)
+        return cls(members=members, table=table, proto_fc=fc, proto_fq=fq,
+                   proto_strain=strain, gauss_u=_gauss(quad_order)[0],
+                   gauss_w=_gauss(quad_order)[1])
+
+    def cells_of(self, rows: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
+        """For members ``rows``, padded to the most cells among them (m, W): each slot's cell
+        of ``table`` (0 in padding), its prototype cell (the zero row P in padding) and
+        whether it is a cell (not padding)."""
+        table = self.table
+        count = table.count[rows]
+        slot = np.arange(int(count.max()))
+        valid = slot[None, :] < count[:, None]
+        cell = np.where(valid, table.first[rows][:, None] + slot[None, :], 0)
+        pad = self.proto_fc.shape[0] - 1
+        return cell, np.where(valid, table.prototype[cell], pad), valid
+
+    def stack(self, rows: IntArray) -> GridStack:
+        """The :class:`GridStack` of members ``rows``."""
+        table, members = self.table, self.members
+        cell, proto, valid = self.cells_of(rows)
+        count = table.count[rows]
+        tip = members.length[rows][:, None]
+        tip_node = count[:, None]
+
+        def laid(values: NDArray[Scalar], pad: float | bool | Array | IntArray
+                 ) -> NDArray[Scalar]:
+            return np.where(valid, values[cell], pad).astype(values.dtype, copy=False)
+
+        seg_start = laid(table.seg_start, tip)
+        fq = {name: self.proto_fq[proto, k] for k, name in enumerate(
+            ("s_q", "w_q", "xi_q", "c_q", "A0", "A1", "A0_T", "A1_T"))}
+        fc = {name: self.proto_fc[proto, k] for k, name in enumerate(
+            ("C0", "C1", "C0_T", "C1_T", "c_start", "c_end", "peak_c", "peak_s"))}
+        fq["s_q"] += seg_start[..., None]
+        fc["peak_s"] += seg_start
+        notches = int(members.N[rows].max())
+        return GridStack(
+            designs=tuple(members.designs[r] for r in rows), n_cells=count,
+            s_nodes=np.concatenate([laid(table.a, tip), tip], axis=1),
+            is_notch=laid(table.is_notch, False), notch_index=laid(table.notch_index, -1),
+            seg_start=seg_start, seg_length=laid(table.seg_length, 0.0),
+            u_a=laid(table.u_a, 0.0), u_b=laid(table.u_b, 0.0),
+            constrained=laid(table.constrained, True),
+            chord_start_node=laid(table.chord_start_node, tip_node),
+            chord_end_node=laid(table.chord_end_node, tip_node),
+            gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc,
+            notch_left_node=table.notch_left_node[rows, :notches],
+            notch_right_node=table.notch_right_node[rows, :notches])
+
+
+def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
+                         ) -> tuple[Array, Array, Array]:
+    """:class:`GridParts`' ``proto_fc``, ``proto_fq``, ``proto_strain`` of every prototype cell
+    of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row;
+    ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
+    gauss_u, gauss_w = _gauss(quad_order)
+    members = table.members
+    cell = np.stack([table.is_notch, table.chord, table.u_a, table.u_b, table.a, table.length,
+                     table.seg_length], axis=1).astype(float)
+    kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
+    design = np.stack([kinds[members.profile_of], members.w_n, members.w_d, members.R_outer,
+                       members.r_inner, members.E, members.tube_moment], axis=1)
+    build = grid_kernels()
+    probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
+    custom_row, custom_h1 = _custom_h1(table, build, cell, design, gauss_u, probe)
+    count = table.u_a.size
+    fc = np.zeros((count + 1, 8))
+    fq = np.zeros((count + 1, 8, quad_order))
+    strain = np.zeros((count + 1, 2, PEAK_SAMPLES))
     matrix = _integration_matrix(quad_order)
 
-    def partial(values: Array) -> Array:
-        return np.sum((values * ds_du)[:, None, :] * matrix[None, :, :], axis=-1)
+    def integrate(part: slice) -> None:
+        build.cell_integrals(table.member[part], cell[part], design, custom_row[part],
+                             custom_h1, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
+                             strain[part])
 
-    out = {}
-    for name, a in (("0", a0), ("1", a1)):
-        g = xi_q * np.sum(w_q * a, axis=1, keepdims=True) - partial(a)
-        out[f"A{name}_T"] = np.where(chord[:, None], partial(c_q * g), 0.0)
-        out[f"C{name}_T"] = np.where(chord, np.sum(w_q * c_q * g, axis=1), 0.0)
-    return out
+    ends = np.linspace(0, count, workers + 1).astype(int)
+    parts = [slice(int(a), int(b)) for a, b in pairwise(ends)]
+    if workers == 1:
+        integrate(parts[0])
+    else:
+        with ThreadPoolExecutor(workers) as pool:
+            list(pool.map(integrate, parts))
+    return fc, fq, strain
+
+
+_PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR}
+
+
+def _custom_h1(table: Prototypes, build: Any, cell: Array, design: Array,
+               gauss_u: Array, probe: Array) -> tuple[IntArray, Array]:
+    """For prototype cells in notches of user profiles: a row of ``custom_h1`` each (-1 for
+    the others) holding ``h1`` (m) at every evaluation point of
+    :func:`tdcm_ros.model.grid_kernel.points`."""
+    custom = (design[table.member, 0] == CUSTOM) & table.is_notch
+    rows = np.full(table.u_a.size, -1, np.int64)
+    chosen = np.flatnonzero(custom)
+    size = gauss_u.size * (gauss_u.size + 1) + probe.size + 2
+    u = np.empty((chosen.size, size))
+    if chosen.size:
+        rows[chosen] = np.arange(chosen.size)
+        build.points(np.ascontiguousarray(cell[chosen]), gauss_u, probe, u)
+        u = table.members.h1(table.member[chosen], u)
+    return rows, np.ascontiguousarray(u, dtype=float)
+
+
+@lru_cache(maxsize=32)
+def _gauss(quad_order: int) -> tuple[Array, Array]:
+    """Gauss-Legendre points and weights of order ``quad_order`` on [0, 1]."""
+    gauss_x, gauss_wt = np.polynomial.legendre.leggauss(quad_order)
+    return 0.5 * (gauss_x + 1.0), 0.5 * gauss_wt
 
 
 @lru_cache(maxsize=32)
@@ -396,43 +464,31 @@ class GridStack(CellArrays):
         """Cell lengths (m), shape (M, C); 0 in the padding."""
         return np.diff(self.s_nodes, axis=-1)
 
+    def grid(self, m: int) -> Grid:
+        """Member ``m`` as a :class:`Grid` (its arrays are views of the stack's, unpadded)."""
+        n = int(self.n_cells[m])
+        design = self.designs[m]
+        shared = ("s_nodes", "gauss_u", "gauss_w", "notch_left_node", "notch_right_node")
+        per_cell = {f.name: getattr(self, f.name)[m, :n] for f in fields(CellArrays)
+                    if f.name not in shared}
+        per_cell.update(s_nodes=self.s_nodes[m, :n + 1], gauss_u=self.gauss_u,
+                        gauss_w=self.gauss_w, notch_left_node=self.notch_left_node[m, :design.N],
+                        notch_right_node=self.notch_right_node[m, :design.N])
+        return Grid(design=design, chord_cells=np.flatnonzero(~per_cell["constrained"]),
+                    **per_cell)
+
 
 def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStack:
-    """Grids of many designs at once (numpy over the member axis); see :class:`GridStack`."""
+    """Grids of many designs at once (:class:`GridParts`); see :class:`GridStack`."""
+    return grid_parts(designs, settings).stack(np.arange(len(designs)))
+
+
+def grid_parts(designs: Sequence[Design], settings: SolverSettings, workers: int = 1
+               ) -> GridParts:
+    """The :class:`GridParts` of ``designs`` under ``settings``' grid (at least one design),
+    integrated by ``workers`` threads (the same values for any count)."""
     if len(designs) == 0:
         raise out_of_range("number of designs", 0, "[1, inf)", error=InvalidDesignError)
-    members = Members.of(designs)
-    table = cell_table(prototypes(members, settings.routing, settings.grid,
-                                  settings.cells_per_notch, settings.cells_per_tube),
-                       settings.routing)
-    cells = _cell_integrals(table, settings.quad_order)
-    count = table.count
-    width = int(count.max())
-    slot = np.arange(table.member.size) - table.first[table.member]
-    at = (table.member, slot)
-    tip = np.broadcast_to(members.length[:, None], (count.size, width))
-
-    def spread(values: NDArray[Scalar], pad: float | bool,
-               like: Array | IntArray | None = None) -> NDArray[Scalar]:
-        out = np.full((count.size, width) + values.shape[1:], pad, dtype=values.dtype)
-        if like is not None:
-            out[...] = like.reshape(like.shape + (1,) * (values.ndim - 1))
-        out[at] = values
-        return out
-
-    s_nodes = np.concatenate([spread(table.a, 0.0, tip), members.length[:, None]], axis=1)
-    tip_node = np.broadcast_to(count[:, None], (count.size, width))
-    return GridStack(
-        designs=members.designs, n_cells=count, s_nodes=s_nodes,
-        is_notch=spread(table.is_notch, False), notch_index=spread(table.notch_index, -1),
-        seg_start=spread(table.seg_start, 0.0, tip), seg_length=spread(table.seg_length, 0.0),
-        u_a=spread(table.u_a, 0.0), u_b=spread(table.u_b, 0.0),
-        constrained=spread(table.constrained, True),
-        chord_start_node=spread(table.chord_start_node, 0, tip_node),
-        chord_end_node=spread(table.chord_end_node, 0, tip_node),
-        gauss_u=cells["gauss_u"], gauss_w=cells["gauss_w"],
-        s_q=spread(cells["s_q"], 0.0, tip), peak_s=spread(cells["peak_s"], 0.0, tip),
-        **{name: spread(cells[name], 0.0) for name in
-           ("w_q", "xi_q", "c_q", "C0", "C1", "A0", "A1", "A0_T", "A1_T", "C0_T", "C1_T",
-            "c_start", "c_end", "peak_c")},
-        notch_left_node=table.notch_left_node, notch_right_node=table.notch_right_node)
+    return GridParts.of(Members.of(designs), settings.routing, settings.grid,
+                        settings.cells_per_notch, settings.cells_per_tube, settings.quad_order,
+                        workers)

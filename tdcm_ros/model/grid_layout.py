@@ -55,6 +55,7 @@ class Members:
     w_d: Array
     R_outer: Array
     r_inner: Array
+    R_c: Array
     E: Array
     tube_moment: Array
     length: Array
@@ -84,7 +85,7 @@ class Members:
         r_outer, r_inner = column("R_outer"), column("r_inner")
         members = cls(designs=designs, profiles=tuple(profiles), profile_of=profile_of, N=n,
                       w_base=w_base, w_tip=w_tip, w_n=w_n, w_t=w_t, w_d=column("w_d"),
-                      R_outer=r_outer, r_inner=r_inner, E=column("E"),
+                      R_outer=r_outer, r_inner=r_inner, R_c=column("R_c"), E=column("E"),
                       tube_moment=np.pi / 4.0 * (r_outer**4 - r_inner**4),
                       length=w_base + n * w_n + (n - 1) * w_t + w_tip)
         for design in designs:

@@ -199,3 +199,20 @@ def test_stacked_designs_equal_designs_solved_alone():
                                    atol=1e-12)
         np.testing.assert_allclose(together.max_bending_strain[i], alone.max_bending_strain[0],
                                    rtol=1e-12, atol=0)
+
+
+def test_a_layout_group_larger_than_a_chunk_gathers_per_chunk_with_the_same_answers():
+    # 300 designs of one cell count (only E differs): more than CHUNK designs, so each chunk
+    # gathers its own designs' kernel arrays; every member must still equal its single solve.
+    from tdcm_ros.model.batch import CHUNK
+
+    base = preset("paper-experiment")
+    designs = [base.with_overrides(E=base.E * (1.0 + 0.002 * k)) for k in range(CHUNK + 44)]
+    tensions = np.linspace(1.0, 20.0, len(designs))[::-1].copy()
+    result = solve_batch(designs, tensions)
+    assert np.all(result.ok)
+    for k in range(0, len(designs), 23):
+        single = solve(designs[k], float(tensions[k]))
+        assert np.max(np.abs(single.tip_position - result.tip_position[k])) <= 1e-12
+    alone = solve_batch(designs[-3:], tensions[-3:])
+    np.testing.assert_array_equal(alone.max_bending_strain, result.max_bending_strain[-3:])

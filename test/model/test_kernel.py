@@ -203,14 +203,14 @@ def test_one_shot_picks_the_plain_build_only_inside_and_only_if_unchosen(monkeyp
 @pytest.mark.parametrize("build", ["plain", "compiled"])
 def test_iterate_strained_adds_the_peak_strain_of_converged_members_only(build):
     from tdcm_ros.model.batch import _strain_coefficients
-    from tdcm_ros.model.grid import build_grids
+    from tdcm_ros.model.grid import grid_parts
 
     code = kernel if build == "plain" else compiled.kernels()
     base = preset("paper-experiment")
     designs = [base.with_overrides(N=n, w_n=w) for n, w in ((2, 1e-3), (5, 2e-3), (8, 1.5e-3))]
-    grids = build_grids(designs, SolverSettings())
-    cells = Cells.of_stack(grids)
-    notch_cells, s0, s1 = _strain_coefficients(grids)
+    parts = grid_parts(designs, SolverSettings())
+    cells = Cells.of_stack(parts.stack(np.arange(3)))
+    notch_cells, s0, s1 = _strain_coefficients(parts, np.arange(3))
     rows = np.array([0, 1, 2, 2], np.int64)
     tension = np.array([15.0, 3.0, 9.0, 20.0])
     n = cells.n_cells

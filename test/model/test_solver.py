@@ -85,13 +85,17 @@ def test_default_setting_within_one_micron_of_converged_reference(name):
 def linear_chord_moments(monkeypatch):
     """Grids without their chord terms: the moment taken linear in every cell, chords too."""
     from tdcm_ros.model import grid as grid_module
+    from tdcm_ros.model import grid_kernel
 
-    chord_terms = grid_module._chord_terms
+    integrals = grid_module._prototype_integrals
 
     def zero(*args):
-        return {name: np.zeros_like(values) for name, values in chord_terms(*args).items()}
+        fc, fq, strain = integrals(*args)
+        fc[:, [grid_kernel.C0_T, grid_kernel.C1_T]] = 0.0
+        fq[:, [grid_kernel.A0_T, grid_kernel.A1_T]] = 0.0
+        return fc, fq, strain
 
-    monkeypatch.setattr(grid_module, "_chord_terms", zero)
+    monkeypatch.setattr(grid_module, "_prototype_integrals", zero)
     grid_module._build_grid.cache_clear()
     yield
     grid_module._build_grid.cache_clear()

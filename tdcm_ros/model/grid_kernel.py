@@ -1,0 +1,237 @@
+"""The compliance integrals of grid cells, one loop over cells for one design or many.
+
+Plain Python on NumPy arrays and scalars, in the subset numba compiles:
+:mod:`tdcm_ros.model.compiled` runs these functions as they are (``TDCM_JIT=0``) or compiled,
+as it does :mod:`tdcm_ros.model.kernel`. :func:`tdcm_ros.model.grid.build_grid` (one design)
+and :func:`~tdcm_ros.model.grid.build_grids` (many) both call :func:`cell_integrals` on the
+prototype cells of :mod:`tdcm_ros.model.grid_layout`; the module docstring of
+:mod:`tdcm_ros.model.grid` says what each integral is.
+
+Per prototype cell ``i`` (inputs, SI units): ``member[i]``; ``cell[i, :]`` =
+``(is_notch, chord, u_a, u_b, a, length, seg_length)`` (``a`` from the segment start, m).
+Per member ``m``: ``design[m, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E,
+tube moment)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR` and :data:`CUSTOM`
+(``h1`` read from ``custom_h1[custom_row[i]]`` at the points of :func:`points`, ``sigma``
+linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
+(``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally
+spaced probes and its two ends, in that order (:func:`points`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+Ints = NDArray[np.int64]
+
+CIRCULAR = 0
+RECTANGULAR = 1
+CUSTOM = 2
+"""Profile kinds of ``design[:, 0]``."""
+
+IS_NOTCH, CHORD, U_A, U_B, START, LENGTH, SEG_LENGTH = range(7)
+"""Columns of ``cell``."""
+KIND, W_N, W_D, R_OUTER, R_INNER, E, TUBE_MOMENT = range(7)
+"""Columns of ``design``."""
+C0, C1, C0_T, C1_T, C_START, C_END, PEAK_C, PEAK_S = range(8)
+"""Columns of the per-cell output ``fc``."""
+S_Q, W_Q, XI_Q, C_Q, A0, A1, A0_T, A1_T = range(8)
+"""Rows of the per-Gauss-point output ``fq`` (cells, 8, Q)."""
+
+SERIES_BELOW = 0.05
+"""Below this ``h/R`` the disc-strip moment is its series (as :mod:`tdcm_ros.model.section`)."""
+
+
+def disc_strip_moment(h: float, radius: float) -> float:
+    """``J(h) = int_0^h y^2 sqrt(radius^2 - y^2) dy``, ``h`` clipped to [0, radius] (m^4); the
+    scalar form of :func:`tdcm_ros.model.section.disc_strip_moment` (same formulas; at
+    ``h >= radius`` its closed form's value ``radius^4 pi / 16`` without calling libm)."""
+    if radius <= 0.0:
+        return 0.0
+    r2 = radius * radius
+    r4 = r2 * r2
+    if h >= radius:
+        return (r4 / 8.0) * (0.5 * math.pi)
+    hc = max(h, 0.0)
+    t = hc / radius
+    if t < SERIES_BELOW:
+        t2 = t * t
+        series = ((((-5.0 / 1408.0) * t2 + (-1.0 / 144.0)) * t2 + (-1.0 / 56.0)) * t2
+                  + (-1.0 / 10.0)) * t2 + 1.0 / 3.0
+        return r4 * (t2 * t) * series
+    root = math.sqrt(max(r2 - hc * hc, 0.0))
+    return (hc / 8.0) * (2.0 * hc * hc - r2) * root + (r4 / 8.0) * math.asin(t)
+
+
+def notch_compliance(h1: float, r_outer: float, r_inner: float, e: float) -> float:
+    """``1/(E I)`` (1/(N m^2)) of eq. 12's notched section at half-width ``h1`` (m)."""
+    inertia = 4.0 * (disc_strip_moment(h1, r_outer)
+                     - disc_strip_moment(min(h1, r_inner), r_inner))
+    return 1.0 / (e * inertia)
+
+
+def geometry(kind: float, w_n: float, w_d: float, u: float,
+             custom: float) -> tuple[float, float, float]:
+    """``(sigma, d sigma/du, h1)`` (m) at ``u`` in a notch of profile ``kind``; ``custom`` is
+    ``h1`` of a :data:`CUSTOM` profile there (ignored otherwise)."""
+    if kind == CIRCULAR:
+        angle = math.pi * u
+        sine = math.sin(angle)
+        return (0.5 * w_n * (1.0 - math.cos(angle)), 0.5 * w_n * math.pi * sine,
+                0.5 * (w_n + w_d) - 0.5 * w_n * sine)
+    if kind == RECTANGULAR:
+        return w_n * u, w_n, 0.5 * w_d
+    return w_n * u, w_n, custom
+
+
+def point(notch: bool, d: Array, seg_length: float, u: float, custom: float
+          ) -> tuple[float, float, float]:
+    """``(sigma, ds/du, 1/(E I))`` at ``u`` in a cell's segment (m, m, 1/(N m^2)) of a member
+    with ``design`` row ``d``."""
+    if not notch:
+        return seg_length * u, seg_length, 1.0 / (d[E] * d[TUBE_MOMENT])
+    sigma, jac, h1 = geometry(d[KIND], d[W_N], d[W_D], u, custom)
+    return sigma, jac, notch_compliance(h1, d[R_OUTER], d[R_INNER], d[E])
+
+
+def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
+    """Reference coordinates ``u`` of every evaluation point of each cell (cells, P): Gauss
+    points, nested points, probes, ends (module docstring)."""
+    q_count = gauss_u.shape[0]
+    for i in range(cell.shape[0]):
+        u_a = cell[i, U_A]
+        span = cell[i, U_B] - u_a
+        for q in range(q_count):
+            u_q = u_a + span * gauss_u[q]
+            out[i, q] = u_q
+            inner = u_q - u_a
+            for k in range(q_count):
+                out[i, q_count + q * q_count + k] = u_a + inner * gauss_u[k]
+        first = q_count + q_count * q_count
+        for k in range(probe.shape[0]):
+            out[i, first + k] = u_a + span * probe[k]
+        out[i, first + probe.shape[0]] = u_a
+        out[i, first + probe.shape[0] + 1] = cell[i, U_B]
+
+
+def cell_integrals(member: Ints, cell: Array, design: Array, custom_row: Ints,
+                   custom_h1: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
+                   probe: Array, fc: Array, fq: Array, strain: Array) -> None:
+    """Every integral of each cell (module docstring) into ``fc`` (cells, 8) and ``fq``
+    (cells, 8, Q); ``strain`` (cells, 2, probes) gets the bending-strain coefficients
+    ``(1 - xi, xi) c min(h1, R_outer)`` at the probes of notch cells (0 elsewhere).
+    ``matrix`` (Q, Q) is the Gauss points' partial-integration matrix on [0, 1]."""
+    q_count = gauss_u.shape[0]
+    first = q_count + q_count * q_count
+    no_custom = np.zeros(first + probe.shape[0] + 2)
+    for i in range(cell.shape[0]):
+        d = design[member[i]]
+        c = cell[i]
+        custom = custom_h1[custom_row[i]] if custom_row[i] >= 0 else no_custom
+        notch = c[IS_NOTCH] != 0.0
+        seg_length = c[SEG_LENGTH]
+        u_a = c[U_A]
+        span = c[U_B] - u_a
+        start = c[START]
+        length = c[LENGTH]
+        out = fq[i]
+        total = 0.0
+        for q in range(q_count):
+            u_q = u_a + span * gauss_u[q]
+            sigma, jac, c_q = point(notch, d, seg_length, u_q, custom[q])
+            out[W_Q, q] = span * gauss_w[q] * jac
+            total += out[W_Q, q]
+            out[S_Q, q] = sigma
+            out[XI_Q, q] = (sigma - start) / length
+            out[C_Q, q] = c_q
+            inner = u_q - u_a
+            a0 = 0.0
+            a1 = 0.0
+            for k in range(q_count):
+                s_k, jac_k, c_k = point(notch, d, seg_length, u_a + inner * gauss_u[k],
+                                        custom[q_count + q * q_count + k])
+                ds = inner * gauss_w[k] * jac_k
+                xi = (s_k - start) / length
+                a0 += ds * (1.0 - xi) * c_k
+                a1 += ds * xi * c_k
+            out[A0, q] = a0
+            out[A1, q] = a1
+        _weights_and_chords(c[CHORD] != 0.0, length / total if total > 0.0 else 0.0,
+                            gauss_w, matrix, out, fc[i])
+        peak = -1.0
+        for k in range(probe.shape[0]):
+            s_k, _, c_k = point(notch, d, seg_length, u_a + span * probe[k], custom[first + k])
+            if c_k > peak:
+                peak = c_k
+                fc[i, PEAK_C] = c_k
+                fc[i, PEAK_S] = s_k
+            weight = 0.0
+            if notch:
+                weight = c_k * min(geometry(d[KIND], d[W_N], d[W_D], u_a + span * probe[k],
+                                            custom[first + k])[2], d[R_OUTER])
+            xi = (s_k - start) / length
+            strain[i, 0, k] = (1.0 - xi) * weight
+            strain[i, 1, k] = xi * weight
+        ends = first + probe.shape[0]
+        fc[i, C_START] = point(notch, d, seg_length, u_a, custom[ends])[2]
+        fc[i, C_END] = point(notch, d, seg_length, c[U_B], custom[ends + 1])[2]
+
+
+def _weights_and_chords(chord: bool, scale: float, gauss_w: Array, matrix: Array,
+                        out: Array, fc: Array) -> None:
+    """Scale one cell's ds weights ``out[W_Q]`` by ``scale`` (so they sum to its length), then
+    its ``C0``, ``C1`` and chord terms (``tdcm_ros.model.grid``: ``m'' = -T c m`` on a chord,
+    ``G0 = xi int_a^b A0 ds - int_a^s A0 ds``, ``C0_T = int c G0 ds``, ``A0_T(s) = int_a^s c G0``
+    by the partial-integration ``matrix``; zero where the tendon follows the body)."""
+    q_count = gauss_w.shape[0]
+    ds_du = np.empty(q_count)
+    cg = np.empty(q_count)
+    c0 = 0.0
+    c1 = 0.0
+    for q in range(q_count):
+        out[W_Q, q] *= scale
+        ds_du[q] = out[W_Q, q] / gauss_w[q]
+        w_c = out[W_Q, q] * out[C_Q, q]
+        c0 += w_c * (1.0 - out[XI_Q, q])
+        c1 += w_c * out[XI_Q, q]
+    fc[C0] = c0
+    fc[C1] = c1
+    for term in range(2):
+        a_row = A0 + term
+        whole = 0.0
+        for q in range(q_count):
+            whole += out[W_Q, q] * out[a_row, q]
+        c_t = 0.0
+        for q in range(q_count):
+            partial = 0.0
+            for k in range(q_count):
+                partial += out[a_row, k] * ds_du[k] * matrix[q, k]
+            cg[q] = out[C_Q, q] * (out[XI_Q, q] * whole - partial)
+            c_t += out[W_Q, q] * cg[q]
+        fc[C0_T + term] = c_t if chord else 0.0
+        for q in range(q_count):
+            partial = 0.0
+            for k in range(q_count):
+                partial += cg[k] * ds_du[k] * matrix[q, k]
+            out[A0_T + term, q] = partial if chord else 0.0
+
+
+def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
+    """``out[m, f, j, :] = source[index[m, j], fields[f], :]``: prototype cells' values
+    (source (P, F, Q)) laid out per member (out (M, len(fields), W, Q)), field-major as
+    :mod:`tdcm_ros.model.kernel` reads them."""
+    for m in range(index.shape[0]):
+        for f in range(fields.shape[0]):
+            field = fields[f]
+            for j in range(index.shape[1]):
+                p = index[m, j]
+                for q in range(out.shape[3]):
+                    out[m, f, j, q] = source[p, field, q]
+
+
+KERNELS = ("disc_strip_moment", "notch_compliance", "geometry", "point", "points",
+           "_weights_and_chords", "cell_integrals", "gather")
+"""The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

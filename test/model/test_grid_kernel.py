@@ -1,0 +1,94 @@
+"""The grid kernel: its scalar eq. 12 against the section module, and its builds agreeing."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tdcm_ros.model import CustomProfile, SolverSettings, compiled, grid_kernel, preset
+from tdcm_ros.model.design import MM
+from tdcm_ros.model.grid import grid_parts
+from tdcm_ros.model.section import disc_strip_moment, notched_moment
+
+E = 1.7e9
+EPS = float(np.finfo(float).eps)
+
+
+def strip_tolerance(h: float, radius: float) -> float:
+    """Rounding bound (m^4) of the closed form of J(h, radius): a few ulp of its two terms,
+    each ~h radius^3 / 8, which cancel to ~h^3 radius / 3 (section's docstring)."""
+    h = min(h, radius)
+    return 4.0 * EPS * (h * radius**3 / 8.0 + h**3 * radius / 3.0)
+
+
+@settings(max_examples=300, deadline=None)
+@given(r_outer=st.floats(0.5, 5.0), inner_ratio=st.floats(0.0, 0.95),
+       h_ratio=st.one_of(st.floats(0.0, 1.2), st.floats(0.0, 0.06)))
+def test_notch_compliance_equals_the_section_modules_eq_12(r_outer, inner_ratio, h_ratio):
+    # Both sides of the series switch (h/R < 0.05), the h1 = r_inner clip and h1 >= R_outer;
+    # same formulas, different rounding (R^4 as (R^2)^2), so equal to their rounding bound.
+    r_outer *= MM
+    r_inner = inner_ratio * r_outer
+    h1 = max(h_ratio * r_outer, 1e-3 * r_outer)
+    for h, radius in ((h1, r_outer), (min(h1, r_inner), r_inner)):
+        assert abs(grid_kernel.disc_strip_moment(h, radius) - disc_strip_moment(h, radius)) <= \
+            strip_tolerance(h, radius)
+    inertia = float(notched_moment(h1, r_outer, r_inner))
+    bound = 4.0 * (strip_tolerance(h1, r_outer) + strip_tolerance(min(h1, r_inner), r_inner))
+    got = 1.0 / (E * grid_kernel.notch_compliance(h1, r_outer, r_inner, E))
+    assert abs(got - inertia) <= bound + 2.0 * EPS * inertia
+
+
+def designs() -> list:
+    base = preset("paper-experiment")
+    return [base, base.with_overrides(N=3, w_n=2.5 * MM, w_d=1.0 * MM),
+            base.with_overrides(N=1, profile="rectangular", w_base=0.0),
+            base.with_overrides(N=4, profile=CustomProfile(lambda s: 0.6 * MM + 0.2 * s))]
+
+
+def parts_arrays(parts):
+    return (parts.proto_fc, parts.proto_fq, parts.proto_strain)
+
+
+@pytest.mark.parametrize("routing", ["paper", "free"])
+def test_plain_and_compiled_builds_agree_to_1e_15(routing, monkeypatch):
+    cfg = SolverSettings(routing=routing)
+    for key in ("wanted", "chosen", "build"):
+        monkeypatch.setitem(compiled._state, key, compiled._state[key])
+    compiled.use_compiled(False)
+    assert compiled.grid_kernels() is compiled.GRID_PLAIN
+    plain = parts_arrays(grid_parts(designs(), cfg))
+    compiled.use_compiled(True)
+    assert compiled.grid_kernels() is not compiled.GRID_PLAIN
+    fast = parts_arrays(grid_parts(designs(), cfg))
+    for a, b in zip(plain, fast, strict=True):
+        scale = np.max(np.abs(a), axis=0, keepdims=True)
+        assert np.all(np.abs(a - b) <= 1e-15 * scale)
+
+
+def test_threads_give_the_same_bits():
+    many = [preset("paper-experiment").with_overrides(w_n=w * MM)
+            for w in np.linspace(1.0, 2.5, 9)] + designs()
+    one = parts_arrays(grid_parts(many, SolverSettings()))
+    two = parts_arrays(grid_parts(many, SolverSettings(), workers=3))
+    for a, b in zip(one, two, strict=True):
+        assert a.tobytes() == b.tobytes()
+
+
+def test_plain_build_never_imports_numba():
+    code = ("import sys, numpy as np\n"
+            "from tdcm_ros.model import preset, solve\n"
+            "from tdcm_ros.model.batch import solve_batch\n"
+            "d = preset('paper-experiment')\n"
+            "solve(d, 10.0); solve_batch([d, d.with_overrides(N=3)], np.array([5.0, 9.0]))\n"
+            "print('numba' in sys.modules)\n")
+    env = {**os.environ, "TDCM_JIT": "0"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.split()[-1] == "False"
