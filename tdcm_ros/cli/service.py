@@ -28,8 +28,14 @@ EXIT_MEANINGS = {"service call": {
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``service`` with its verbs."""
-    parser = subparsers.add_parser("service", help="list or call services (e.g. the driver's "
-                                                   "commands)")
+    parser = subparsers.add_parser(
+        "service", help="list or call services (e.g. the driver's commands)",
+        description="List the services of the live graph or call one, as `ros2 service` does "
+                    "(zenoh or rclpy). The driver's commands are std_srvs/srv/Trigger services: "
+                    "the response says whether the command was carried out and, if not, why.",
+        epilog="examples:\n"
+               "  tdcm service list -t\n"
+               "  tdcm service call /tension_driver/clear_faults")
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--runtime", choices=RUNTIMES,
                         default=os.environ.get(RUNTIME_ENV) or "zenoh",

@@ -117,9 +117,12 @@ def _compile(numba: Any, module: types.ModuleType = kernel) -> types.SimpleNames
         clone.__qualname__ = plain.__qualname__
         clone.__module__ = plain.__module__
         clone.__doc__ = plain.__doc__
+        # error_model="numpy": a float divided by zero is inf or nan, as in the plain build
+        # (NumPy scalars), which the solver then reports as a non-finite iterate; numba's
+        # default would raise ZeroDivisionError out of a hostile design's grid build.
         try:
-            jitted = numba.njit(cache=True, nogil=True)(clone)
+            jitted = numba.njit(cache=True, nogil=True, error_model="numpy")(clone)
         except RuntimeError:  # no writable cache location: compile every process instead
-            jitted = numba.njit(cache=False, nogil=True)(clone)
+            jitted = numba.njit(cache=False, nogil=True, error_model="numpy")(clone)
         namespace[name] = compiled[name] = jitted
     return types.SimpleNamespace(**compiled)

@@ -127,7 +127,7 @@ def test_compiles_uncached_when_no_cache_location_is_writable():
 
     class FakeNumba:
         @staticmethod
-        def njit(cache, nogil):
+        def njit(cache, nogil, error_model):
             calls.append(cache)
             if cache:
                 raise RuntimeError("cannot cache function: no locator available")
