@@ -5,6 +5,7 @@ Typical use::
     from tdcm_ros.model import preset, solve
     result = solve(preset("paper-experiment"), 20.0)
     result.tip_position  # m, frame tdcm_base
+    solve_inverse(preset("paper-experiment"), tip_angle=0.3).tension_n  # N
 
 Separate entry points, kept out of this face because they pull scipy:
 :mod:`tdcm_ros.model.baselines` (the other models, by name) and :mod:`tdcm_ros.model.accuracy`
@@ -35,6 +36,14 @@ from tdcm_ros.model.errors import (
     TendonSingularityError,
     TensionRangeError,
 )
+from tdcm_ros.model.inverse import (
+    DEFAULT_TENSION_MAX_N,
+    InvalidTargetError,
+    InverseResult,
+    Sensitivity,
+    UnreachableTargetError,
+    solve_inverse,
+)
 from tdcm_ros.model.limits import check_tension
 from tdcm_ros.model.loading import (
     Capstan,
@@ -59,6 +68,7 @@ from tdcm_ros.model.surface import offset_points, surface_points
 __all__ = [
     "DEFAULT_ALLOWABLE_STRAIN",
     "DEFAULT_SETTINGS",
+    "DEFAULT_TENSION_MAX_N",
     "FIELD_SPECS",
     "MARKER_SPECS",
     "PRESETS",
@@ -74,6 +84,8 @@ __all__ = [
     "InvalidDesignError",
     "InvalidLoadingError",
     "InvalidSettingsError",
+    "InvalidTargetError",
+    "InverseResult",
     "Loading",
     "MarkerLayout",
     "ModelError",
@@ -82,11 +94,13 @@ __all__ = [
     "NotchContact",
     "Progress",
     "RectangularProfile",
+    "Sensitivity",
     "SolveResult",
     "SolverSettings",
     "TendonSingularityError",
     "TensionProfile",
     "TensionRangeError",
+    "UnreachableTargetError",
     "check_tension",
     "design_curves",
     "offset_points",
@@ -95,6 +109,7 @@ __all__ = [
     "preset",
     "report_progress",
     "solve",
+    "solve_inverse",
     "surface_points",
     "sweep",
     "use_compiled",

@@ -1,0 +1,373 @@
+"""The inverse model: the tendon tension (N) that puts the tip at a target.
+
+A target is a tip deflection (m, distance from the +z axis), a tip angle (rad, from +z toward
++x) or a tip point ``(x, z)`` in ``tdcm_base`` (m). The tension is sought within bounds
+``[tension_min, tension_max]`` (N; default ``[0, DEFAULT_TENSION_MAX_N]``), each trial a
+forward :func:`~tdcm_ros.model.solver.solve` warm-started from the previous one.
+
+- Deflection and angle: a root of ``tip(T) - target`` bracketed by the bounds, found with
+  Brent's method (``scipy.optimize.brentq``, imported only here). Both grow monotonically
+  with the tension while the tip angle stays below about 2.3 rad (a circular arc's deflection
+  peaks there); the reachable range is the tip at the bounds. Past that peak (bounds far above
+  the default) a target only reached on the curled branch is reported unreachable.
+- Point: least squares over the tension (the closest tip point on the tension's path),
+  Gauss-Newton with the secant of the last two solves as the Jacobian; the result carries the
+  residual (m). A point whose closest tip lies at a bound, farther than ``tol``, is unreachable.
+
+Physical limits: the tendon singularity and notch closure grow with the tension. If the solve
+at ``tension_max`` meets one, the upper end of the reachable range is the largest tension that
+solves (bisected to ``LIMIT_RTOL``), and an unreachable target's error names that limit.
+
+Sensitivity ``d(tip)/dT``: a finite difference of two warm-started solves at ``T +- h`` with
+``h = SENSITIVITY_STEP * (upper - lower)``, central inside the bounds, one-sided at them. Its
+error is the truncation ``h**2 |tip'''| / 6`` (one-sided: ``h |tip''| / 2``) plus the solves'
+noise ``~ tol_solve / h``; ``bench/bench_inverse.py`` measures it against a tight reference.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.model.design import Design
+from tdcm_ros.model.errors import ModelError, ModelLimitError
+from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
+
+Array = NDArray[np.float64]
+
+#: Default upper tension bound (N): over twice the paper's 0-20 N experiment, so the bench's
+#: whole setpoint range is covered, while every preset stays far from its tendon singularity
+#: and notch closure and below 1 rad of tip angle (deflection still monotone).
+DEFAULT_TENSION_MAX_N = 50.0
+#: Default tolerance on the target: m for a deflection or point, rad for an angle.
+DEFAULT_TOL = 1e-9
+#: Finite-difference step of the sensitivity, as a fraction of the tension bounds' span.
+SENSITIVITY_STEP = 1e-3
+#: Relative tolerance (of the bounds' span) on the limit tension when ``tension_max`` is past one.
+LIMIT_RTOL = 1e-9
+#: Largest number of Gauss-Newton steps for a point target.
+MAX_POINT_STEPS = 40
+
+TARGET_KINDS = ("tip_deflection", "tip_angle", "tip_point")
+
+
+class InvalidTargetError(ModelError, InputError):
+    """A target or tension bound is missing, not finite, or outside its allowed range."""
+
+    kind = "invalid_target"
+
+
+class UnreachableTargetError(ModelLimitError):
+    """The target lies outside what the tip reaches within the tension bounds.
+
+    ``reachable`` is the tip (the target's kind and unit) at the lower and upper end of the
+    reachable tension range ``tension_range`` (N); ``limit`` names the physical limit that ends
+    the range below ``tension_max``, if one does.
+    """
+
+    kind = "unreachable_target"
+
+    def __init__(self, message: str, *, target: Any, reachable: tuple[Any, Any],
+                 tension_range: tuple[float, float], limit: str | None = None) -> None:
+        super().__init__(message)
+        self.target = target
+        self.reachable = reachable
+        self.tension_range = tension_range
+        self.limit = limit
+
+
+@dataclass(frozen=True)
+class Sensitivity:
+    """``d(tip)/dT`` at the returned tension: of the tip point ``(x, z)`` (m/N), the tip angle
+    (rad/N) and the tip deflection (m/N), by ``method`` (``central``, ``forward`` or
+    ``backward`` finite difference of warm-started solves) with step ``step_n`` (N)."""
+
+    tip_point_m_per_n: tuple[float, float]
+    tip_angle_rad_per_n: float
+    tip_deflection_m_per_n: float
+    method: str
+    step_n: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields."""
+        return {"tip_point_m_per_n": list(self.tip_point_m_per_n),
+                "tip_angle_rad_per_n": self.tip_angle_rad_per_n,
+                "tip_deflection_m_per_n": self.tip_deflection_m_per_n,
+                "method": self.method, "step_n": self.step_n}
+
+
+@dataclass(frozen=True)
+class InverseResult:
+    """The tension for a target and what it achieves.
+
+    ``tension_n`` (N) is the answer; ``result`` its forward solve (so ``result.tip_position``
+    is the achieved tip); ``residual`` the distance from the achieved tip to the target (m for a
+    deflection or point, rad for an angle); ``forward_solves`` how many solves the call made,
+    the sensitivity's included.
+    """
+
+    target_kind: str
+    target: Any
+    tension_n: float
+    result: SolveResult = field(repr=False)
+    residual: float
+    sensitivity: Sensitivity
+    forward_solves: int
+    tension_bounds: tuple[float, float]
+
+    @property
+    def tip_point_m(self) -> tuple[float, float]:
+        """Achieved tip ``(x, z)`` (m, ``tdcm_base``)."""
+        return _point(self.result)
+
+    def summary(self) -> dict[str, Any]:
+        """The JSON-ready summary used by ``tdcm inverse --json`` (SI units)."""
+        return {
+            "target": {"kind": self.target_kind,
+                       "value": list(self.target) if self.target_kind == "tip_point"
+                       else self.target},
+            "tension_n": self.tension_n,
+            "tip_point_m": list(self.tip_point_m),
+            "tip_angle_rad": self.result.tip_angle_rad,
+            "tip_deflection_m": self.result.tip_deflection_m,
+            "residual": self.residual,
+            "residual_unit": "rad" if self.target_kind == "tip_angle" else "m",
+            "sensitivity": self.sensitivity.to_dict(),
+            "forward_solves": self.forward_solves,
+            "tension_bounds_n": list(self.tension_bounds),
+        }
+
+
+def _point(result: SolveResult) -> tuple[float, float]:
+    """Tip ``(x, z)`` (m) of a solve."""
+    return float(result.positions[-1, 0]), float(result.positions[-1, 2])
+
+
+class _Forward:
+    """Forward solves of one design, each warm-started from the nearest earlier one; counted."""
+
+    def __init__(self, design: Design, settings: SolverSettings,
+                 warm_start: SolveResult | None) -> None:
+        self.design = design
+        self.settings = settings
+        self.solved: dict[float, SolveResult] = {}
+        self.warm = warm_start
+        self.count = 0
+
+    def __call__(self, tension: float) -> SolveResult:
+        if tension in self.solved:
+            return self.solved[tension]
+        warm = min(self.solved.values(), key=lambda r: abs(r.tension_n - tension),
+                   default=self.warm)
+        self.count += 1
+        result = solve(self.design, tension, settings=self.settings, warm_start=warm)
+        self.solved[tension] = result
+        return result
+
+
+def solve_inverse(design: Design, *, tip_deflection: float | None = None,
+                  tip_angle: float | None = None,
+                  tip_point: tuple[float, float] | None = None,
+                  tension_min: float = 0.0, tension_max: float = DEFAULT_TENSION_MAX_N,
+                  settings: SolverSettings = DEFAULT_SETTINGS,
+                  warm_start: SolveResult | None = None,
+                  tol: float = DEFAULT_TOL) -> InverseResult:
+    """The tension (N) in ``[tension_min, tension_max]`` that puts the tip of ``design`` at
+    exactly one target: ``tip_deflection`` (m), ``tip_angle`` (rad) or ``tip_point`` ``(x, z)``
+    (m, least squares). ``tol`` is the tolerance on the target (m, or rad for an angle);
+    ``warm_start`` seeds the first forward solve (a result of the same design and settings).
+
+    Raises :class:`InvalidTargetError` for a bad target, bounds or ``tol``;
+    :class:`UnreachableTargetError` (naming the reachable range) when the target is out of
+    reach; a forward solve's own errors pass through.
+    """
+    kind, target = _check_target(tip_deflection, tip_angle, tip_point)
+    lower, upper = _check_bounds(tension_min, tension_max)
+    if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0.0):
+        raise InvalidTargetError(f"tol = {tol!r} is out of range; allowed: (0, inf) m or rad",
+                                 parameter="tol", value=tol, allowed="(0, inf)")
+    forward = _Forward(design, settings, warm_start)
+    top, limit = _reachable_top(forward, lower, upper)
+    if kind == "tip_point":
+        tension, residual = _point_tension(forward, target, lower, top, limit, tol)
+    else:
+        measure = _MEASURES[kind]
+        tension = _scalar_tension(forward, measure, kind, target, lower, top, limit, tol)
+        residual = abs(measure(forward(tension)) - target)
+    sensitivity = _sensitivity(forward, tension, lower, top)
+    return InverseResult(kind, target, tension, forward(tension), residual, sensitivity,
+                         forward.count, (lower, upper))
+
+
+_MEASURES: dict[str, Callable[[SolveResult], float]] = {
+    "tip_deflection": lambda r: r.tip_deflection_m,
+    "tip_angle": lambda r: r.tip_angle_rad,
+}
+_UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m"}
+
+
+def _check_target(tip_deflection: float | None, tip_angle: float | None,
+                  tip_point: tuple[float, float] | None) -> tuple[str, Any]:
+    """The one target given, checked: ``(kind, value)``."""
+    given = {name: value for name, value in zip(
+        TARGET_KINDS, (tip_deflection, tip_angle, tip_point), strict=True) if value is not None}
+    if len(given) != 1:
+        raise InvalidTargetError(
+            f"give exactly one target, got {sorted(given) or 'none'}; allowed: one of "
+            f"{', '.join(TARGET_KINDS)}", parameter="target", value=sorted(given),
+            allowed=" | ".join(TARGET_KINDS))
+    (kind, value), = given.items()
+    if kind == "tip_point":
+        values = np.asarray(value, dtype=float) if _is_pair(value) else None
+        if values is None or not np.all(np.isfinite(values)):
+            raise InvalidTargetError(
+                f"tip_point = {value!r} is out of range; allowed: two finite numbers (x, z) m",
+                parameter="tip_point", value=value, allowed="(x, z), finite, m")
+        return kind, (float(values[0]), float(values[1]))
+    number = _real(value)
+    low = 0.0 if kind == "tip_deflection" else -math.inf
+    if number is None or not math.isfinite(number) or number < low:
+        allowed = "[0, inf) m, finite" if kind == "tip_deflection" else "finite rad"
+        raise InvalidTargetError(f"{kind} = {value!r} is out of range; allowed: {allowed}",
+                                 parameter=kind, value=value, allowed=allowed)
+    return kind, number
+
+
+def _is_pair(value: Any) -> bool:
+    """Whether ``value`` is a sequence of exactly two real numbers."""
+    try:
+        return len(value) == 2 and all(_real(v) is not None for v in value)
+    except TypeError:
+        return False
+
+
+def _real(value: Any) -> float | None:
+    """``value`` as a float if it is a real number (not a bool), else None."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        return None
+    return float(value)
+
+
+def _check_bounds(tension_min: Any, tension_max: Any) -> tuple[float, float]:
+    """The tension bounds (N), finite with ``0 <= tension_min < tension_max``."""
+    low, high = _real(tension_min), _real(tension_max)
+    if low is None or not math.isfinite(low) or low < 0.0:
+        raise InvalidTargetError(
+            f"tension_min = {tension_min!r} N is out of range; allowed: finite, >= 0 N",
+            parameter="tension_min", value=tension_min, allowed="[0, tension_max) N")
+    if high is None or not math.isfinite(high) or high <= low:
+        raise InvalidTargetError(
+            f"tension_max = {tension_max!r} N is out of range; allowed: finite, > tension_min "
+            f"= {low:g} N", parameter="tension_max", value=tension_max,
+            allowed=f"({low:g}, inf) N")
+    return low, high
+
+
+def _reachable_top(forward: _Forward, lower: float, upper: float) -> tuple[float, str | None]:
+    """The largest tension (N) of the bounds that solves, and the limit that sets it (None if
+    ``upper`` solves). Solves at both bounds; bisects the limit only if ``upper`` meets one."""
+    forward(lower)
+    try:
+        forward(upper)
+        return upper, None
+    except ModelLimitError as error:
+        limit = error.kind
+    good, bad = lower, upper
+    while bad - good > LIMIT_RTOL * (upper - lower):
+        middle = 0.5 * (good + bad)
+        try:
+            forward(middle)
+            good = middle
+        except ModelLimitError as error:
+            bad, limit = middle, error.kind
+    return good, limit
+
+
+def _unreachable(kind: str, target: Any, shown: tuple[str, str], lower: float, top: float,
+                 limit: str | None, reachable: tuple[Any, Any]) -> UnreachableTargetError:
+    """The error for a target out of reach, naming the reachable range."""
+    unit = _UNITS[kind]
+    end = f" (upper end set by {limit.replace('_', ' ')} at {top:.6g} N)" if limit else ""
+    shown_target = (f"({target[0]:.9g}, {target[1]:.9g})" if kind == "tip_point"
+                    else f"{target:.9g}")
+    return UnreachableTargetError(
+        f"{kind} = {shown_target} {unit} is unreachable: within tension [{lower:g}, {top:.6g}] N "
+        f"the {kind.replace('_', ' ')} spans {shown[0]} to {shown[1]} {unit}{end}",
+        target=target, reachable=reachable, tension_range=(lower, top), limit=limit)
+
+
+def _scalar_tension(forward: _Forward, measure: Callable[[SolveResult], float], kind: str,
+                    target: float, lower: float, top: float, limit: str | None,
+                    tol: float) -> float:
+    """Brent's root of ``measure(T) - target`` on ``[lower, top]`` (N)."""
+    at_low, at_top = measure(forward(lower)), measure(forward(top))
+    if not min(at_low, at_top) - tol <= target <= max(at_low, at_top) + tol:
+        raise _unreachable(kind, target, (f"{at_low:.9g}", f"{at_top:.9g}"), lower, top, limit,
+                           (at_low, at_top))
+    if abs(at_low - target) <= tol:
+        return lower
+    if abs(at_top - target) <= tol:
+        return top
+    from scipy.optimize import brentq  # lazily: `tdcm solve` never loads scipy
+
+    slope = abs(at_top - at_low) / (top - lower)
+    tension = brentq(lambda t: measure(forward(t)) - target, lower, top,
+                     xtol=0.01 * tol / slope, rtol=4.0 * np.finfo(float).eps, maxiter=100)
+    return float(tension)
+
+
+def _point_tension(forward: _Forward, target: tuple[float, float], lower: float, top: float,
+                   limit: str | None, tol: float) -> tuple[float, float]:
+    """Least-squares tension (N) on ``[lower, top]`` for a tip point and its residual (m):
+    Gauss-Newton with the secant of the last two solves as the Jacobian, clipped to the
+    bounds."""
+    aim = np.array(target)
+    previous = (lower, np.array(_point(forward(lower))))
+    current = (top, np.array(_point(forward(top))))
+    if np.linalg.norm(previous[1] - aim) < np.linalg.norm(current[1] - aim):
+        previous, current = current, previous
+    wanted = current[0]
+    for _ in range(MAX_POINT_STEPS):
+        jacobian = (current[1] - previous[1]) / (current[0] - previous[0])
+        gain = float(jacobian @ jacobian)
+        if gain == 0.0:
+            break
+        wanted = current[0] - float(jacobian @ (current[1] - aim)) / gain
+        tension = min(max(wanted, lower), top)
+        if abs(tension - current[0]) * math.sqrt(gain) <= 1e-3 * tol:
+            break
+        previous, current = current, (tension, np.array(_point(forward(tension))))
+    tension, tip = current
+    residual = float(np.linalg.norm(tip - aim))
+    at_bound = tension in (lower, top)
+    if at_bound and residual > tol and not lower < wanted < top:
+        ends = (_point(forward(lower)), _point(forward(top)))
+        raise _unreachable("tip_point", target, tuple(  # type: ignore[arg-type]
+            f"({x:.9g}, {z:.9g})" for x, z in ends), lower, top, limit, ends)
+    return tension, residual
+
+
+def _sensitivity(forward: _Forward, tension: float, lower: float, top: float) -> Sensitivity:
+    """``d(tip)/dT`` at ``tension`` (N) from two warm-started solves ``h`` apart."""
+    step = SENSITIVITY_STEP * (top - lower)
+    below, above = tension - step, tension + step
+    if below >= 0.0 and above <= top:
+        method, low, high = "central", forward(below), forward(above)
+    elif above <= top:
+        method, low, high = "forward", forward(tension), forward(above)
+    else:
+        method, low, high = "backward", forward(below), forward(tension)
+    span = high.tension_n - low.tension_n
+    d_point = (np.array(_point(high)) - np.array(_point(low))) / span
+    return Sensitivity(
+        (float(d_point[0]), float(d_point[1])),
+        (high.tip_angle_rad - low.tip_angle_rad) / span,
+        (high.tip_deflection_m - low.tip_deflection_m) / span, method, step)
