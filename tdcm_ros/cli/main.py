@@ -27,6 +27,7 @@ from tdcm_ros.errors import InputError, PhysicsError, TdcmError
 COMMANDS: dict[str, str] = {
     "demo": "tdcm_ros.cli.demo",
     "solve": "tdcm_ros.cli.solve",
+    "inverse": "tdcm_ros.cli.inverse",
     "up": "tdcm_ros.cli.up",
     "topic": "tdcm_ros.cli.topic",
     "record": "tdcm_ros.cli.record",

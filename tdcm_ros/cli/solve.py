@@ -7,22 +7,9 @@ import json
 import sys
 from typing import Any
 
-from tdcm_ros.errors import InputError, TdcmError
-from tdcm_ros.model import (
-    PRESETS,
-    PROFILE_NAMES,
-    SOLVER_SPECS,
-    Design,
-    SolverSettings,
-    TensionRangeError,
-    one_shot,
-    parse_field,
-    preset,
-    solve,
-)
-from tdcm_ros.spec import spelled_as
-
-DEFAULT_DESIGN = "paper-experiment"
+from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
+from tdcm_ros.errors import TdcmError
+from tdcm_ros.model import TensionRangeError, one_shot, solve
 
 
 def register(subparsers: Any) -> None:
@@ -34,44 +21,12 @@ def register(subparsers: Any) -> None:
                "  tdcm solve --tension 20\n"
                "  tdcm solve --design fig2-wn-1.9 --tension 20 --json\n"
                "  tdcm solve --tension 12 --set E=1.2e9 --plot shape.png")
-    parser.add_argument("--design", metavar="NAME",
-                        help=f"design preset: {', '.join(PRESETS)} (default: {DEFAULT_DESIGN}); "
-                             "the same as --set design.preset=NAME")
     parser.add_argument("--tension", required=True, type=str, help="tendon tension (N)")
-    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                        help="override a design field in SI units, e.g. --set E=1.2e9 (or "
-                             "design.E=1.2e9, as evaluate takes it)")
-    parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
-    for name in ("routing", "loads"):  # choices and defaults from the settings' specs
-        spec = SOLVER_SPECS[name]
-        parser.add_argument(f"--{name}", choices=spec.choices, default=spec.default,
-                            help=spec.description)
+    add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.add_argument("--plot", metavar="FILE", help="draw midline and curvature to a .png, "
                         ".pdf or .svg file in an existing folder")
     parser.set_defaults(handler=run)
-
-
-def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
-    """The preset's name (``--design`` or ``--set design.preset``, once) and the design: that
-    preset with the ``--set`` fields (``NAME`` or ``design.NAME``) over it."""
-    values: dict[str, Any] = {}
-    for pair in pairs:
-        name, sep, text = pair.partition("=")
-        name = name.strip().removeprefix("design.")
-        if not sep or not name:
-            raise InputError(f"--set {pair!r} is not NAME=VALUE", parameter="--set", value=pair,
-                             allowed="NAME=VALUE with a design field name")
-        if name != "preset":
-            values[name] = parse_field(name, text.strip())
-        elif named is not None:
-            raise InputError(f"--design {named!r} and --set {pair.strip()!r} both name the "
-                             "design; allowed: one of them", parameter="--design", value=named,
-                             allowed="--design NAME or --set design.preset=NAME, not both")
-        else:
-            named = text.strip()
-    design = preset(named or DEFAULT_DESIGN).with_overrides(**values)
-    return spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN, design
 
 
 def _tension(text: str) -> float:
@@ -87,10 +42,7 @@ def _tension(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     """Solve and report; typed errors become exit status 2 (input) or 3 (physics)."""
     try:
-        name, design = _design(args.design, args.set)
-        if args.profile:
-            design = design.with_overrides(profile=args.profile)
-        settings = SolverSettings(routing=args.routing, loads=args.loads)
+        name, design, settings = design_and_settings(args)
         if args.plot:
             from tdcm_ros.figures import plot_file
 

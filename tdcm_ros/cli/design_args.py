@@ -1,0 +1,68 @@
+"""The design and solver options shared by the commands that solve one design (``solve``,
+``inverse``): ``--design``, ``--set``, ``--profile``, ``--routing`` and ``--loads``."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from tdcm_ros.errors import InputError
+from tdcm_ros.model import (
+    PRESETS,
+    PROFILE_NAMES,
+    SOLVER_SPECS,
+    Design,
+    SolverSettings,
+    parse_field,
+    preset,
+)
+from tdcm_ros.spec import spelled_as
+
+DEFAULT_DESIGN = "paper-experiment"
+
+
+def add_design_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the design preset, its field overrides, the notch profile and the solver's routing
+    and load form to ``parser``."""
+    parser.add_argument("--design", metavar="NAME",
+                        help=f"design preset: {', '.join(PRESETS)} (default: {DEFAULT_DESIGN}); "
+                             "the same as --set design.preset=NAME")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a design field in SI units, e.g. --set E=1.2e9 (or "
+                             "design.E=1.2e9, as evaluate takes it)")
+    parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
+    for name in ("routing", "loads"):  # choices and defaults from the settings' specs
+        spec = SOLVER_SPECS[name]
+        parser.add_argument(f"--{name}", choices=spec.choices, default=spec.default,
+                            help=spec.description)
+
+
+def design_and_settings(args: argparse.Namespace) -> tuple[str, Design, SolverSettings]:
+    """The preset's name, the design and the solver settings that the options of
+    :func:`add_design_arguments` give."""
+    name, design = _design(args.design, args.set)
+    if args.profile:
+        design = design.with_overrides(profile=args.profile)
+    return name, design, SolverSettings(routing=args.routing, loads=args.loads)
+
+
+def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
+    """The preset's name (``--design`` or ``--set design.preset``, once) and the design: that
+    preset with the ``--set`` fields (``NAME`` or ``design.NAME``) over it."""
+    values: dict[str, Any] = {}
+    for pair in pairs:
+        name, sep, text = pair.partition("=")
+        name = name.strip().removeprefix("design.")
+        if not sep or not name:
+            raise InputError(f"--set {pair!r} is not NAME=VALUE", parameter="--set", value=pair,
+                             allowed="NAME=VALUE with a design field name")
+        if name != "preset":
+            values[name] = parse_field(name, text.strip())
+        elif named is not None:
+            raise InputError(f"--design {named!r} and --set {pair.strip()!r} both name the "
+                             "design; allowed: one of them", parameter="--design", value=named,
+                             allowed="--design NAME or --set design.preset=NAME, not both")
+        else:
+            named = text.strip()
+    design = preset(named or DEFAULT_DESIGN).with_overrides(**values)
+    return spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN, design

@@ -1,0 +1,106 @@
+"""``tdcm inverse``: the tendon tension that puts the tip at a target, as a summary or JSON."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Any
+
+from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
+from tdcm_ros.errors import TdcmError
+from tdcm_ros.model import (
+    DEFAULT_TENSION_MAX_N,
+    InvalidTargetError,
+    InverseResult,
+    solve_inverse,
+)
+
+EXIT_MEANINGS = {"inverse": {3: "the target is out of reach within the tension bounds, or a "
+                                "physical limit of the model"}}
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``inverse`` subcommand."""
+    parser = subparsers.add_parser(
+        "inverse", help="tendon tension that puts the tip at a target",
+        description="The tension (N) within [--tension-min, --tension-max] that puts the tip "
+                    "at a deflection (m), an angle (rad) or a point (x, z in tdcm_base, m; "
+                    "least squares), with the achieved tip, the residual and d(tip)/dT.",
+        epilog="examples:\n"
+               "  tdcm inverse --tip-angle 0.3\n"
+               "  tdcm inverse --design fig2-wn-1.9 --tip-deflection 0.005 --json\n"
+               "  tdcm inverse --tip-point=0.006,0.0525 --set E=1.2e9 --tension-max 22")
+    target = parser.add_mutually_exclusive_group(required=True)
+    target.add_argument("--tip-deflection", metavar="M",
+                        help="tip distance from the undeformed axis (m)")
+    target.add_argument("--tip-angle", metavar="RAD", help="tip angle from +z toward +x (rad)")
+    target.add_argument("--tip-point", metavar="X,Z", help="tip point in tdcm_base (m); write a negative X as "
+                        "--tip-point=-0.001,0.05")
+    parser.add_argument("--tension-min", default="0", metavar="N",
+                        help="lower tension bound (N, default 0)")
+    parser.add_argument("--tension-max", default=str(DEFAULT_TENSION_MAX_N), metavar="N",
+                        help=f"upper tension bound (N, default {DEFAULT_TENSION_MAX_N:g})")
+    add_design_arguments(parser)
+    parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    parser.set_defaults(handler=run)
+
+
+def _number(option: str, text: str, allowed: str) -> float:
+    """``text`` of ``option`` as a float; the model checks its range."""
+    try:
+        return float(text)
+    except ValueError:
+        raise InvalidTargetError(f"{option} = {text!r} is not a number; allowed: {allowed}",
+                                 parameter=option, value=text, allowed=allowed) from None
+
+
+def _target(args: argparse.Namespace) -> dict[str, Any]:
+    """The target keyword of :func:`~tdcm_ros.model.solve_inverse` the options name."""
+    if args.tip_deflection is not None:
+        return {"tip_deflection": _number("--tip-deflection", args.tip_deflection, "[0, inf) m")}
+    if args.tip_angle is not None:
+        return {"tip_angle": _number("--tip-angle", args.tip_angle, "a finite number, rad")}
+    parts = args.tip_point.split(",")
+    if len(parts) != 2:
+        raise InvalidTargetError(f"--tip-point = {args.tip_point!r} is not X,Z; allowed: two "
+                                 "numbers (m) separated by a comma", parameter="--tip-point",
+                                 value=args.tip_point, allowed="X,Z (m)")
+    return {"tip_point": tuple(_number("--tip-point", p, "X,Z (m)") for p in parts)}
+
+
+def run(args: argparse.Namespace) -> int:
+    """Find the tension and report; typed errors become exit status 2 (input) or 3 (out of
+    reach, physics)."""
+    try:
+        name, design, settings = design_and_settings(args)
+        found = solve_inverse(
+            design, **_target(args), settings=settings,
+            tension_min=_number("--tension-min", args.tension_min, "[0, tension-max) N"),
+            tension_max=_number("--tension-max", args.tension_max, "(tension-min, inf) N"))
+    except TdcmError as error:
+        if args.json:
+            print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))
+        print(f"tdcm inverse: {error}", file=sys.stderr)
+        return error.exit_code
+    if args.json:
+        print(json.dumps(found.summary()))
+    else:
+        _print(name, found)
+    return 0
+
+
+def _print(name: str, found: InverseResult) -> None:
+    """The human summary (mm, rad, N)."""
+    x, z = (v * 1e3 for v in found.tip_point_m)
+    result, sens = found.result, found.sensitivity
+    unit = "rad" if found.target_kind == "tip_angle" else "m"
+    print(f"design {name}: {found.target_kind.replace('_', ' ')} {found.target} {unit} -> "
+          f"tension {found.tension_n:.9g} N")
+    print(f"achieved tip (x, z) = ({x:.6f}, {z:.6f}) mm, angle {result.tip_angle_rad:.9f} rad, "
+          f"deflection {result.tip_deflection_m * 1e3:.6f} mm; residual {found.residual:.3g} "
+          f"{unit}")
+    dx, dz = (v * 1e3 for v in sens.tip_point_m_per_n)
+    print(f"d(tip)/dT: (x, z) ({dx:.6g}, {dz:.6g}) mm/N, angle {sens.tip_angle_rad_per_n:.6g} "
+          f"rad/N ({sens.method} difference, step {sens.step_n:g} N); "
+          f"{found.forward_solves} forward solves")

@@ -1,0 +1,76 @@
+"""The ``tdcm inverse`` contract, run as a user runs it (a subprocess): JSON keys, the round trip
+to ``tdcm solve``, the human summary and the exit statuses."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from tdcm_ros.model import preset, solve
+
+KEYS = {"target", "tension_n", "tip_point_m", "tip_angle_rad", "tip_deflection_m", "residual",
+        "residual_unit", "sensitivity", "forward_solves", "tension_bounds_n"}
+
+
+def tdcm(*args):
+    return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", *args],
+                          capture_output=True, text=True, timeout=120, check=False)
+
+
+def test_json_tension_round_trips_through_tdcm_solve():
+    proc = tdcm("inverse", "--design", "fig2-wn-1.9", "--tip-angle", "0.25", "--json")
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)
+    assert KEYS <= set(data) and data["target"] == {"kind": "tip_angle", "value": 0.25}
+    assert data["tip_angle_rad"] == pytest.approx(0.25, abs=1e-9)
+    again = tdcm("solve", "--design", "fig2-wn-1.9", "--tension", repr(data["tension_n"]),
+                 "--json")
+    tip = json.loads(again.stdout)["tip_position_m"]
+    assert [tip[0], tip[2]] == pytest.approx(data["tip_point_m"], abs=1e-9)
+    assert data["sensitivity"]["tip_angle_rad_per_n"] > 0.0
+
+
+def test_tip_point_with_overrides_reports_the_least_squares_residual():
+    expected = solve(preset("paper-experiment").with_overrides(E=1.2e9), 12.0).tip_position
+    point = f"{float(expected[0]) + 1e-4!r},{float(expected[2])!r}"
+    proc = tdcm("inverse", "--tip-point", point, "--set", "E=1.2e9", "--json")
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)
+    assert data["residual_unit"] == "m" and 0.0 < data["residual"] < 1e-4
+    assert data["tension_n"] == pytest.approx(12.0, abs=0.5)
+
+
+def test_human_summary_names_tension_tip_and_sensitivity():
+    proc = tdcm("inverse", "--tip-deflection", "0.005")
+    assert proc.returncode == 0, proc.stderr
+    assert "tension 15.24" in proc.stdout and "d(tip)/dT" in proc.stdout
+    assert "forward solves" in proc.stdout
+
+
+@pytest.mark.parametrize(("args", "status", "kind"), [
+    (["--tip-deflection", "0.05"], 3, "unreachable_target"),
+    (["--tip-angle", "-0.2"], 3, "unreachable_target"),
+    (["--tip-angle", "4", "--tension-max", "400"], 3, "unreachable_target"),
+    (["--tip-deflection", "-0.001"], 2, "invalid_target"),
+    (["--tip-deflection", "abc"], 2, "invalid_target"),
+    (["--tip-point", "0.01"], 2, "invalid_target"),
+    (["--tip-angle", "0.1", "--tension-max", "-1"], 2, "invalid_target"),
+    (["--tip-angle", "0.1", "--set", "w_n=-1"], 2, "invalid_design"),
+])
+def test_errors_exit_with_the_cli_convention(args, status, kind):
+    proc = tdcm("inverse", *args, "--json")
+    assert proc.returncode == status, proc.stderr
+    assert json.loads(proc.stdout)["error"]["kind"] == kind
+    assert proc.stderr.startswith("tdcm inverse: ")
+
+
+def test_unreachable_names_the_range_and_the_limit():
+    proc = tdcm("inverse", "--tip-angle", "4", "--tension-max", "400")
+    assert proc.returncode == 3
+    assert "spans 0 to 3.43" in proc.stderr and "tendon singularity" in proc.stderr
+
+
+def test_exactly_one_target_is_usage():
+    assert tdcm("inverse").returncode == 2
+    assert tdcm("inverse", "--tip-angle", "0.1", "--tip-deflection", "0.001").returncode == 2
