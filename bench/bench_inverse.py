@@ -13,6 +13,8 @@ issue's target row) and over all presets:
   one solve of the same design in the same run and their ratio;
 - the sensitivity's relative error against a reference: Richardson-extrapolated central
   differences of solves at ``tol = 1e-14`` with steps 0.02 and 0.01 N;
+- off the path: tip points 1 mm across the tip's path from the tip at each tension (the
+  closest tip is still that one): forward solves, time, ``|T* - T|`` and the residual's error;
 - why Brent: the solves (bounds included, sensitivity not) that ``brentq``, ``toms748`` and
   ``ridder`` need for the deflection and angle targets, under the tolerances the model uses.
 
@@ -97,6 +99,26 @@ def measure(name: str, kind: str, tensions: np.ndarray) -> dict[str, float]:
             else np.nan}
 
 
+def measure_off_path(name: str, tensions: np.ndarray, offset: float = 1e-3) -> dict[str, float]:
+    """Figures of point targets ``offset`` (m) across the tip's path at ``tensions`` (N)."""
+    design = preset(name)
+    rows = []
+    for tension in tensions:
+        tip = solve(design, float(tension)).tip_position[[0, 2]]
+        along = (solve(design, float(tension) + 1e-3).tip_position
+                 - solve(design, float(tension) - 1e-3).tip_position)[[0, 2]]
+        aim = tip + offset * np.array([along[1], -along[0]]) / np.hypot(*along)
+        start = time.perf_counter()
+        found = solve_inverse(design, tip_point=(float(aim[0]), float(aim[1])))
+        elapsed = time.perf_counter() - start
+        rows.append((abs(found.tension_n - tension), abs(found.residual - offset),
+                     found.forward_solves, elapsed))
+    table = np.array(rows)
+    return {"tension_err_n": table[:, 0].max(), "residual_err_m": table[:, 1].max(),
+            "solves_mean": table[:, 2].mean(), "solves_max": table[:, 2].max(),
+            "call_s": float(np.median(table[:, 3]))}
+
+
 def finder_solves(finder: str, design, kind: str, target: float) -> int:
     """Distinct warm-started solves ``scipy.optimize.<finder>`` needs for a scalar target on
     ``[0, 50]`` N with the model's tolerances (xtol = 0.01 tol / mean slope, tol = 1e-9)."""
@@ -150,6 +172,12 @@ def main() -> None:
         every["call_s"] = float(np.median([f["call_s"] for f in figures.values()]))
         every["sens_rel_err"] = paper["sens_rel_err"]
         _row(kind, f"all {len(PRESETS)} presets", every, float(np.median(ratios)), sens=False)
+    for name in ("paper-experiment", *(n for n in PRESETS if n != "paper-experiment")):
+        f = measure_off_path(name, tensions[name])
+        print(f"tip_point 1 mm off the path, {name:16s}: |T*-T| {f['tension_err_n']:.2e} N, "
+              f"|residual - 1 mm| {f['residual_err_m']:.2e} m, solves {f['solves_mean']:.2f} / "
+              f"{int(f['solves_max'])}, {f['call_s'] * 1e6:.1f} us per call "
+              f"({f['call_s'] / solve_s[name]:.1f} x solve)")
     compare_finders(tensions)
 
 

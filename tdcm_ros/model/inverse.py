@@ -10,9 +10,11 @@ forward :func:`~tdcm_ros.model.solver.solve` warm-started from the previous one.
   with the tension while the tip angle stays below about 2.3 rad (a circular arc's deflection
   peaks there); the reachable range is the tip at the bounds. Past that peak (bounds far above
   the default) a target only reached on the curled branch is reported unreachable.
-- Point: least squares over the tension (the closest tip point on the tension's path),
-  Gauss-Newton with the secant of the last two solves as the Jacobian; the result carries the
-  residual (m). A point whose closest tip lies at a bound, farther than ``tol``, is unreachable.
+- Point: least squares over the tension (the closest tip point on the tension's path): each
+  step minimises the distance to the target along a quadratic through three solves near the
+  best (Newton with the path's curvature), until the tip would move less than ``tol / 10``;
+  the result carries the residual (m). A point
+  whose closest tip lies at a bound, farther than ``tol``, is unreachable.
 
 Physical limits: the tendon singularity and notch closure grow with the tension. If the solve
 at ``tension_max`` meets one, the upper end of the reachable range is the largest tension that
@@ -26,6 +28,7 @@ noise ``~ tol_solve / h``; ``bench/bench_inverse.py`` measures it against a tigh
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -37,7 +40,7 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import InputError
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import ModelError, ModelLimitError
-from tdcm_ros.model.result import SolveResult
+from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
 
@@ -53,8 +56,10 @@ DEFAULT_TOL = 1e-9
 SENSITIVITY_STEP = 1e-3
 #: Relative tolerance (of the bounds' span) on the limit tension when ``tension_max`` is past one.
 LIMIT_RTOL = 1e-9
-#: Largest number of Gauss-Newton steps for a point target.
+#: Largest number of model steps (solves) for a point target beyond the first three.
 MAX_POINT_STEPS = 40
+#: Largest number of safeguarded Newton steps per root of the point target's cubic.
+CUBIC_STEPS = 200
 
 TARGET_KINDS = ("tip_deflection", "tip_angle", "tip_point")
 
@@ -326,33 +331,138 @@ def _scalar_tension(forward: _Forward, measure: Callable[[SolveResult], float], 
 
 def _point_tension(forward: _Forward, target: tuple[float, float], lower: float, top: float,
                    limit: str | None, tol: float) -> tuple[float, float]:
-    """Least-squares tension (N) on ``[lower, top]`` for a tip point and its residual (m):
-    Gauss-Newton with the secant of the last two solves as the Jacobian, clipped to the
-    bounds."""
-    aim = np.array(target)
-    previous = (lower, np.array(_point(forward(lower))))
-    current = (top, np.array(_point(forward(top))))
-    if np.linalg.norm(previous[1] - aim) < np.linalg.norm(current[1] - aim):
-        previous, current = current, previous
-    wanted = current[0]
+    """Least-squares tension (N) on ``[lower, top]`` for a tip point and its residual (m).
+
+    The tip's path is modelled by the quadratic through the best solved tension so far, its
+    nearest solved neighbour and the nearest one at least ``SENSITIVITY_STEP`` of the span
+    away, so the curvature is not drawn from solves closer than their noise (first: the
+    bounds and their middle); the next tension minimises the model's distance to the target
+    over the bounds (the real roots of a cubic). This is Newton on the distance with the
+    path's curvature included, so it converges fast also when the target is off the path,
+    where Gauss-Newton crawls.
+    """
+    tips = {t: _point(forward(t)) for t in (lower, 0.5 * (lower + top), top)}
+
+    def miss(tension: float) -> float:
+        x, z = tips[tension]
+        return math.hypot(x - target[0], z - target[1])
+
+    baseline = SENSITIVITY_STEP * (top - lower)
     for _ in range(MAX_POINT_STEPS):
-        jacobian = (current[1] - previous[1]) / (current[0] - previous[0])
-        gain = float(jacobian @ jacobian)
-        if gain == 0.0:
+        best = min(tips, key=miss)
+        others = sorted((t for t in tips if t != best), key=lambda t: abs(t - best))
+        far = next(t for t in others if abs(t - best) >= baseline)  # the bounds are that far
+        near = (others[0], far if far != others[0] else others[1])
+        path = _Quadratic.through(best, tips[best], *((t, tips[t]) for t in near))
+        step = path.closest_step(target, lower - best, top - best)
+        if abs(step) * math.hypot(*path.slope) <= 0.1 * tol or best + step in tips:
             break
-        wanted = current[0] - float(jacobian @ (current[1] - aim)) / gain
-        tension = min(max(wanted, lower), top)
-        if abs(tension - current[0]) * math.sqrt(gain) <= 1e-3 * tol:
-            break
-        previous, current = current, (tension, np.array(_point(forward(tension))))
-    tension, tip = current
-    residual = float(np.linalg.norm(tip - aim))
-    at_bound = tension in (lower, top)
-    if at_bound and residual > tol and not lower < wanted < top:
-        ends = (_point(forward(lower)), _point(forward(top)))
+        tips[best + step] = _point(forward(best + step))
+    else:
+        raise ConvergenceError(
+            f"tip_point = {target}: the least-squares tension did not settle in "
+            f"{MAX_POINT_STEPS} solves")
+    tension = min(tips, key=miss)
+    residual = miss(tension)
+    if tension in (lower, top) and residual > tol:
+        ends = (tips[lower], tips[top])
         raise _unreachable("tip_point", target, tuple(  # type: ignore[arg-type]
             f"({x:.9g}, {z:.9g})" for x, z in ends), lower, top, limit, ends)
     return tension, residual
+
+
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class _Quadratic:
+    """The tip path ``q(s) = at + slope s + bend s^2`` (m, per coordinate ``(x, z)``) in
+    ``s = T - center`` (N)."""
+
+    at: Point
+    slope: Point
+    bend: Point
+
+    @classmethod
+    def through(cls, center: float, tip: Point, first: tuple[float, Point],
+                second: tuple[float, Point]) -> _Quadratic:
+        """The quadratic through ``(center, tip)`` and two more ``(tension, tip)`` pairs
+        (Newton's divided differences)."""
+        (t1, p1), (t2, p2) = first, second
+        s1, s2 = t1 - center, t2 - center
+        slope, bend = [], []
+        for k in range(2):
+            d1, d2 = (p1[k] - tip[k]) / s1, (p2[k] - tip[k]) / s2
+            curve = (d2 - d1) / (s2 - s1)
+            bend.append(curve)
+            slope.append(d1 - curve * s1)
+        return cls(tip, (slope[0], slope[1]), (bend[0], bend[1]))
+
+    def miss(self, s: float, aim: Point) -> float:
+        """Distance (m) from ``q(s)`` to ``aim``."""
+        return math.hypot(*(self.at[k] + (self.slope[k] + self.bend[k] * s) * s - aim[k]
+                            for k in range(2)))
+
+    def closest_step(self, aim: Point, low: float, high: float) -> float:
+        """The ``s`` in ``[low, high]`` minimising :meth:`miss`: a bound or a real root of
+        ``d/ds |q - aim|^2 / 2 = (d + b s + c s^2) . (b + 2 c s)``."""
+        d = [self.at[k] - aim[k] for k in range(2)]
+        b, c = self.slope, self.bend
+
+        def dot(u: Any, v: Any) -> float:
+            return float(u[0] * v[0] + u[1] * v[1])
+
+        cubic = (2.0 * dot(c, c), 3.0 * dot(b, c), dot(b, b) + 2.0 * dot(d, c), dot(d, b))
+        return min([low, high, *_cubic_roots(cubic, low, high)], key=lambda s: self.miss(s, aim))
+
+
+def _cubic_roots(cubic: tuple[float, float, float, float], low: float,
+                 high: float) -> list[float]:
+    """Real roots in ``(low, high)`` of ``a s^3 + b s^2 + c s + d`` (``cubic = (a, b, c, d)``):
+    the cubic's turning points cut the interval into monotone pieces; each piece whose ends
+    differ in sign holds one root, found by Newton kept inside the piece's bracket (bisection
+    when a step would leave it)."""
+    a, b, c, d = cubic
+
+    def value(s: float) -> float:
+        return ((a * s + b) * s + c) * s + d
+
+    def slope(s: float) -> float:
+        return (3.0 * a * s + 2.0 * b) * s + c
+
+    cuts = [low, high]
+    if a != 0.0:
+        disc = b * b - 3.0 * a * c  # turning points: roots of 3 a s^2 + 2 b s + c
+        if disc > 0.0:  # in the form that does not cancel
+            q = -(b + math.copysign(math.sqrt(disc), b))
+            cuts += [q / (3.0 * a), c / q] if q != 0.0 else [0.0]
+    elif b != 0.0:
+        cuts.append(-c / (2.0 * b))
+    cuts = sorted(s for s in cuts if low <= s <= high)
+    roots = [s for s in cuts if low < s < high and value(s) == 0.0]  # a root at a turning point
+    for left, right in itertools.pairwise(cuts):
+        f_left = value(left)
+        if f_left * value(right) >= 0.0:
+            continue
+        s = 0.5 * (left + right)
+        for _ in range(CUBIC_STEPS):
+            f = value(s)
+            if f == 0.0:
+                break
+            if (f < 0.0) == (f_left < 0.0):
+                left = s
+            else:
+                right = s
+            gradient = slope(s)
+            newton = s - f / gradient if gradient != 0.0 else left - 1.0
+            step_to = newton if left < newton < right else 0.5 * (left + right)
+            if abs(step_to - s) <= 1e-15 * (1.0 + abs(s)):
+                s = step_to
+                break
+            s = step_to
+        if low < s < high:
+            roots.append(s)
+    return roots
 
 
 def _sensitivity(forward: _Forward, tension: float, lower: float, top: float) -> Sensitivity:

@@ -1,6 +1,7 @@
 """The inverse model (:func:`tdcm_ros.model.solve_inverse`): round trips through ``solve``,
 unreachable targets naming their range, physical limits bounding it, and bad input."""
 
+import functools
 import math
 
 import numpy as np
@@ -120,6 +121,32 @@ def test_a_point_off_the_path_is_met_in_least_squares():
     assert found.residual == pytest.approx(offset, rel=1e-3)
 
 
+@functools.cache
+def tip_path(name):
+    """Tensions (N) every 25 mN over the default bounds and the tip ``(x, z)`` (m) at each."""
+    tensions = np.linspace(0.0, DEFAULT_TENSION_MAX_N, 2001)
+    design = preset(name)
+    return tensions, np.array([solve(design, t).tip_position[[0, 2]] for t in tensions])
+
+
+@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(name=st.sampled_from(["paper-experiment", "fig3-wd-1.2", "fig2-wn-1"]),
+       x=st.floats(-0.01, 0.04), z=st.floats(0.02, 0.06))
+def test_any_point_gets_the_closest_tip_on_the_path_or_is_beyond_its_ends(name, x, z):
+    tensions, tips = tip_path(name)
+    distance = np.hypot(tips[:, 0] - x, tips[:, 1] - z)
+    closest = int(np.argmin(distance))
+    try:
+        found = solve_inverse(preset(name), tip_point=(x, z))
+    except UnreachableTargetError as error:
+        assert closest in (0, tensions.size - 1)  # the scan's closest tip is at an end too
+        assert error.reachable == (tuple(tips[0]), tuple(tips[-1]))
+        return
+    assert found.residual <= distance[closest] + 1e-12  # no worse than a 25 mN scan
+    assert abs(found.tension_n - tensions[closest]) <= 0.025 + 1e-9
+    assert found.forward_solves <= 16
+
+
 def test_warm_start_gives_the_same_answer():
     first = solve_inverse(PAPER, tip_angle=0.3)
     again = solve_inverse(PAPER, tip_angle=0.31, warm_start=first.result)
@@ -160,3 +187,24 @@ def test_summary_is_json_ready():
     assert data["residual"] == found.residual and data["residual_unit"] == "m"
     assert data["sensitivity"]["method"] == "central"
     assert data["target"] == {"kind": "tip_point", "value": [0.005, 0.0527]}
+
+
+@settings(max_examples=300, deadline=None)
+@given(coefficients=st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4),
+       scales=st.lists(st.integers(-12, 0), min_size=4, max_size=4),
+       ends=st.lists(st.floats(-5.0, 5.0), min_size=2, max_size=2, unique=True))
+def test_the_point_steps_cubic_roots_match_numpy(coefficients, scales, ends):
+    from tdcm_ros.model.inverse import _cubic_roots
+
+    cubic = tuple(c * 10.0**e for c, e in zip(coefficients, scales, strict=True))
+    low, high = sorted(ends)
+    found = _cubic_roots(cubic, low, high)
+    for root in found:  # each is a root: the cubic changes sign within rounding around it
+        assert low < root < high
+        value = np.polyval(cubic, root)
+        size = sum(abs(c) * max(1.0, abs(root)) ** (3 - k) for k, c in enumerate(cubic))
+        assert abs(value) <= 1e-12 * size
+    grid = np.linspace(low, high, 20001)
+    values = np.polyval(cubic, grid)
+    for k in np.flatnonzero(values[:-1] * values[1:] < 0.0):  # every sign change has its root
+        assert any(grid[k] - 1e-12 <= f <= grid[k + 1] + 1e-12 for f in found)
