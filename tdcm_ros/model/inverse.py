@@ -3,7 +3,7 @@
 A target is a tip deflection (m, distance from the +z axis), a tip angle (rad, from +z toward
 +x) or a tip point ``(x, z)`` in ``tdcm_base`` (m). The tension is sought within bounds
 ``[tension_min, tension_max]`` (N; default ``[0, DEFAULT_TENSION_MAX_N]``), each trial a
-forward :func:`~tdcm_ros.model.solver.solve` warm-started from the previous one.
+forward :func:`~tdcm_ros.model.solver.solve` warm-started from the nearest earlier one.
 
 - Deflection and angle: a root of ``tip(T) - target`` bracketed by the bounds, found with
   Brent's method (``scipy.optimize.brentq``, imported only here). Both grow monotonically
@@ -13,17 +13,20 @@ forward :func:`~tdcm_ros.model.solver.solve` warm-started from the previous one.
 - Point: least squares over the tension (the closest tip point on the tension's path): each
   step minimises the distance to the target along a quadratic through three solves near the
   best (Newton with the path's curvature), until the tip would move less than ``tol / 10``;
-  the result carries the residual (m). A point
-  whose closest tip lies at a bound, farther than ``tol``, is unreachable.
+  the result carries the residual (m). A point whose closest tip lies at a bound, farther
+  than ``tol``, is unreachable.
 
 Physical limits: the tendon singularity and notch closure grow with the tension. If the solve
 at ``tension_max`` meets one, the upper end of the reachable range is the largest tension that
-solves (bisected to ``LIMIT_RTOL``), and an unreachable target's error names that limit.
+solves (bisected to ``LIMIT_RTOL``, ~40 more solves), and an unreachable target's error
+names that limit. A ``tension_min`` past a limit raises that limit's own error.
 
 Sensitivity ``d(tip)/dT``: a finite difference of two warm-started solves at ``T +- h`` with
 ``h = SENSITIVITY_STEP * (upper - lower)``, central inside the bounds, one-sided at them. Its
 error is the truncation ``h**2 |tip'''| / 6`` (one-sided: ``h |tip''| / 2``) plus the solves'
-noise ``~ tol_solve / h``; ``bench/bench_inverse.py`` measures it against a tight reference.
+noise ``~ tol_solve / h``; ``bench/bench_inverse.py`` measures it against a tight reference
+(3.6e-8 relative on paper-experiment). The implicit-function derivative would need the fixed
+point's Jacobian, which the solver does not expose.
 """
 
 from __future__ import annotations
@@ -196,16 +199,17 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
     """
     kind, target = _check_target(tip_deflection, tip_angle, tip_point)
     lower, upper = _check_bounds(tension_min, tension_max)
-    if not (isinstance(tol, (int, float)) and math.isfinite(tol) and tol > 0.0):
+    tolerance = _real(tol)
+    if tolerance is None or not math.isfinite(tolerance) or tolerance <= 0.0:
         raise InvalidTargetError(f"tol = {tol!r} is out of range; allowed: (0, inf) m or rad",
                                  parameter="tol", value=tol, allowed="(0, inf)")
     forward = _Forward(design, settings, warm_start)
     top, limit = _reachable_top(forward, lower, upper)
     if kind == "tip_point":
-        tension, residual = _point_tension(forward, target, lower, top, limit, tol)
+        tension, residual = _point_tension(forward, target, lower, top, limit, tolerance)
     else:
         measure = _MEASURES[kind]
-        tension = _scalar_tension(forward, measure, kind, target, lower, top, limit, tol)
+        tension = _scalar_tension(forward, measure, kind, target, lower, top, limit, tolerance)
         residual = abs(measure(forward(tension)) - target)
     sensitivity = _sensitivity(forward, tension, lower, top)
     return InverseResult(kind, target, tension, forward(tension), residual, sensitivity,

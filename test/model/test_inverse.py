@@ -169,6 +169,7 @@ def test_warm_start_gives_the_same_answer():
     ({"tip_angle": 0.1, "tension_max": 0.0}, "tension_max"),
     ({"tip_angle": 0.1, "tension_max": math.inf}, "tension_max"),
     ({"tip_angle": 0.1, "tol": 0.0}, "tol"),
+    ({"tip_angle": 0.1, "tol": True}, "tol"),
 ])
 def test_bad_targets_and_bounds_are_input_errors_naming_the_parameter(kwargs, parameter):
     with pytest.raises(InvalidTargetError) as caught:
