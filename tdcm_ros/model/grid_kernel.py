@@ -2,7 +2,8 @@
 
 Plain Python on NumPy arrays and scalars, in the subset numba compiles:
 :mod:`tdcm_ros.model.compiled` runs these functions as they are (``TDCM_JIT=0``) or compiled,
-as it does :mod:`tdcm_ros.model.kernel`. :func:`tdcm_ros.model.grid.build_grid` (one design)
+as it does :mod:`tdcm_ros.model.kernel` (NumPy's error model in both builds: a float divided
+by zero is inf or nan). :func:`tdcm_ros.model.grid.build_grid` (one design)
 and :func:`~tdcm_ros.model.grid.build_grids` (many) both call :func:`cell_integrals` on the
 prototype cells of :mod:`tdcm_ros.model.grid_layout`; the module docstring of
 :mod:`tdcm_ros.model.grid` says what each integral is.

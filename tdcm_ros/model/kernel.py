@@ -2,7 +2,8 @@
 
 Every function here is plain Python on NumPy arrays and scalars, in the subset of Python that
 numba compiles: :mod:`tdcm_ros.model.compiled` runs these same functions either as they are
-or compiled (lazily, on first use). A single solve is one member; a batch stacks many.
+or compiled (lazily, on first use), with NumPy's error model in both builds (a float divided
+by zero is inf or nan). A single solve is one member; a batch stacks many.
 
 Member arrays (SI units; ``M`` members, ``n`` cells, ``Q`` quadrature points, ``K`` notches):
 
