@@ -51,6 +51,7 @@ from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
 from tdcm_ros.runtime import (
     DiagnosticLevel,
     Diagnostics,
+    EventWindow,
     NodeLogic,
     NodePort,
     QoS,
@@ -269,25 +270,26 @@ class ModelNode(NodeLogic):
     def check_input(self) -> Status:
         """WARN while a tension was dropped within the window (it recovers), else OK; the
         cumulative counts of dropped and coalesced inputs."""
-        total = sum(v for k, v in self.counts.items() if k.startswith("dropped"))
-        recent = self.dropped.recent(total, self.port.now_ns())
-        values = {k: v for k, v in sorted(self.counts.items())
-                  if k.startswith(("dropped", "coalesced"))}
-        values["dropped_in_window"] = recent
-        if recent:
-            return Status(DiagnosticLevel.WARN, self.last_problem, values)
-        return Status(DiagnosticLevel.OK, "ok", values)
+        return self._windowed(self.dropped, "dropped", ("dropped", "coalesced"),
+                              "dropped_in_window", self.last_problem)
 
     def check_solver(self) -> Status:
         """WARN while a solve failed within the window (it recovers), else OK; solves and
         failures by kind."""
-        total = sum(v for k, v in self.counts.items() if k.startswith("model"))
-        recent = self.failed.recent(total, self.port.now_ns())
-        values = {k: v for k, v in sorted(self.counts.items())
-                  if k.startswith(("model", "solved"))}
-        values["failed_in_window"] = recent
+        return self._windowed(self.failed, "model", ("model", "solved"), "failed_in_window",
+                              self.last_failure)
+
+    def _windowed(self, window: EventWindow, problems: str, shown: tuple[str, ...],
+                  in_window: str, last: str) -> Status:
+        """WARN with ``last`` while the counters named ``problems*`` grew within ``window``,
+        else OK; values: the counters named ``shown*`` and, as ``in_window``, how many
+        problems the window holds."""
+        total = sum(v for k, v in self.counts.items() if k.startswith(problems))
+        recent = window.recent(total, self.port.now_ns())
+        values = {k: v for k, v in sorted(self.counts.items()) if k.startswith(shown)}
+        values[in_window] = recent
         if recent:
-            return Status(DiagnosticLevel.WARN, self.last_failure, values)
+            return Status(DiagnosticLevel.WARN, last, values)
         return Status(DiagnosticLevel.OK, "ok", values)
 
 def main() -> int:
