@@ -76,10 +76,11 @@ def service_class(type_name: str) -> Any:
 
 
 def to_rosbags(native: Any, type_name: str) -> Any:
-    """A rosidl message as the rosbags message of ``type_name`` (through its CDR bytes)."""
+    """A rosidl message as the rosbags message of ``type_name`` (through its CDR bytes; rclpy
+    may pad them past the message)."""
     from rclpy.serialization import serialize_message
 
-    return deserialize(serialize_message(native), type_name)
+    return deserialize(serialize_message(native), type_name, exact=False)
 
 
 def to_native(message: Any, type_name: str, native_class: Any) -> Any:
