@@ -12,13 +12,14 @@ import argparse
 import json
 import os
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.param_client import ParameterClient
-from tdcm_ros.runtime.param_services import type_name as parameter_type_name
 from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 from tdcm_ros.yamlio import load_yaml
+
+if TYPE_CHECKING:  # the client imports the message model; help must not
+    from tdcm_ros.runtime.param_client import ParameterClient
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -72,6 +73,7 @@ R = TypeVar("R")
 
 def _with_client(args: argparse.Namespace, use: Callable[[ParameterClient], R]) -> R:
     """``use`` a parameter client of ``args.node`` on a context of ``args.runtime``."""
+    from tdcm_ros.runtime.param_client import ParameterClient
     from tdcm_ros.runtime.run_node import open_context, resolve_runtime
 
     context = open_context(resolve_runtime(args.runtime))
@@ -113,6 +115,8 @@ def run_list(args: argparse.Namespace) -> int:
 
 def run_describe(args: argparse.Namespace) -> int:
     """Print each parameter's type, description and constraints, as ``ros2 param describe``."""
+    from tdcm_ros.runtime.param_services import type_name as parameter_type_name
+
     for desc in _with_client(args, lambda client: client.describe(args.names)):
         print(f"Parameter name: {desc.name}\n  Type: {parameter_type_name(desc.type)}")
         if desc.description:

@@ -42,7 +42,6 @@ _TYPES = {"bool": 1, "int": 2, "float": 3, "str": 4, "list": 5, "list[bool]": 6,
 _FIELDS = {1: "bool_value", 2: "integer_value", 3: "double_value", 4: "string_value",
            5: "byte_array_value", 6: "bool_array_value", 7: "integer_array_value",
            8: "double_array_value", 9: "string_array_value"}
-NOT_SET = 0
 #: ``ParameterType`` codes as ``ros2 param describe`` names them.
 TYPE_NAMES = ("not set", "boolean", "integer", "double", "string", "byte array",
               "boolean array", "integer array", "double array", "string array")
@@ -82,7 +81,7 @@ def to_value(value: ParamValue, spec: ParamSpec[Any] | None = None) -> Any:
 
 
 def from_value(message: Any) -> ParamValue:
-    """The plain Python value of a ``ParameterValue``; ``InputError`` for ``NOT_SET`` or an
+    """The plain Python value of a ``ParameterValue``; ``InputError`` for ``NOT_SET`` (0) or an
     unknown type code."""
     code = int(message.type)
     if code not in _FIELDS:
