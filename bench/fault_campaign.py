@@ -12,8 +12,10 @@ Classes:
   ``clear_faults``, or a setpoint is accepted while disarmed.
 - ``limits``: raising ``tension_max`` or ``setpoint_rate`` of a running tension_driver through
   the parameter interface. Failure: the change is accepted.
-- ``param_queries``: random JSON bodies (null, numbers, lists, nested objects, wrong types) sent
-  to model_node's parameter queryables. Failure: no reply within 5 s, or the node dies.
+- ``param_queries``: random bytes, JSON bodies, and well-formed CDR requests with hostile contents
+  (unknown type codes, non-finite and extreme numbers, undeclared and read-only names) sent with
+  rmw_zenoh's attachment to model_node's six rcl_interfaces parameter services. Failure: no reply
+  within 5 s, or the node dies.
 - ``callbacks``: random bytes published as CDR on model_node's ``tension`` key. Failure: the node
   dies or stops answering a valid tension with a midline.
 - ``yaml``: alias bombs, deep nesting, duplicate keys, huge and random text as scenes and
@@ -183,7 +185,7 @@ def campaign_reconnect(tries: int, rng: random.Random, tmp: Path) -> Failures:
 def campaign_limits(tries: int, rng: random.Random, tmp: Path) -> Failures:
     """Raise the driver's force limits through its parameter interface: always refused."""
     from tdcm_ros.device.twin import DeviceTwin, PtyTwin
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext, call_parameters
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
 
     twin = PtyTwin(DeviceTwin(), link=str(tmp / "limits_port")).start()
     params = tmp / "driver.yaml"
@@ -198,9 +200,7 @@ def campaign_limits(tries: int, rng: random.Random, tmp: Path) -> Failures:
                 for attempt in range(tries):
                     name = ("tension_max", "setpoint_rate")[attempt % 2]
                     value = rng.uniform(21.0, 1000.0)
-                    answer = _ask(context, "/tension_driver", "set",
-                                  {"name": name, "value": value}, call_parameters)
-                    if answer.get("successful"):
+                    if _set_when_up(context, "/tension_driver", name, value):
                         failures.append(f"{name} = {value:.1f} accepted")
             finally:
                 context.close()
@@ -209,16 +209,17 @@ def campaign_limits(tries: int, rng: random.Random, tmp: Path) -> Failures:
     return failures
 
 
-def _ask(context: Any, node: str, op: str, request: dict[str, Any],
-         call: Callable[..., dict[str, Any]], timeout: float = 30.0) -> dict[str, Any]:
-    """``call`` until the node answers (it may still be starting)."""
+def _set_when_up(context: Any, node: str, name: str, value: Any, timeout: float = 30.0) -> bool:
+    """Whether ``node`` accepted ``name = value`` (asked until it answers; it may be starting)."""
+    from tdcm_ros.runtime.param_client import ParameterClient
+
     end = time.monotonic() + timeout
     while True:
         try:
-            return call(context.session, 0, node, op, request, timeout=2.0)
-        except TdcmError as error:
+            return ParameterClient(context, node, timeout=2.0).set(name, value).successful
+        except TdcmError:
             if time.monotonic() > end:
-                return {"error": str(error)}
+                return False
 
 
 # --- runtime ------------------------------------------------------------------------------------
@@ -278,21 +279,57 @@ def midline_answers(context: Any, timeout: float = 20.0) -> bool:
     return False
 
 
+def hostile_parameter_value(rng: random.Random) -> dict[str, Any]:
+    """A ``ParameterValue`` (as a dict) with any type code and extreme field values."""
+    return {"type": rng.randrange(256),
+            "integer_value": rng.choice([0, -1, 2**63 - 1, -2**63]),
+            "double_value": rng.choice([math.nan, math.inf, -0.0, 1e308, 5e-324]),
+            "string_value": "".join(chr(rng.randrange(32, 0x2FFF)) for _ in range(rng.randrange(40))),
+            "bool_array_value": [rng.random() < 0.5 for _ in range(rng.randrange(4))],
+            "double_array_value": [rng.choice([math.nan, 1.0, -1e308]) for _ in range(rng.randrange(4))]}
+
+
+def hostile_parameter_request(rng: random.Random, type_name: str) -> bytes:
+    """Random bytes, a JSON body, or a well-formed CDR request of ``type_name`` with hostile
+    names and values."""
+    from tdcm_ros.bagio import from_dict, serialize
+
+    pick = rng.randrange(3)
+    if pick == 0:
+        return rng.randbytes(rng.randrange(64))
+    if pick == 1:
+        return json.dumps(hostile_json(rng))[:2000].encode()
+    names = [rng.choice(["design.E", "frame_id", "solver.tol", "use_sim_time", "nope", ""])
+             for _ in range(rng.randrange(4))]
+    fields: dict[str, Any] = {"names": names}
+    if type_name.endswith("/ListParameters"):
+        fields = {"prefixes": names, "depth": rng.choice([0, 1, 2, 2**64 - 1])}
+    elif "/SetParameters" in type_name:
+        fields = {"parameters": [{"name": n, "value": hostile_parameter_value(rng)} for n in names]}
+    return serialize(from_dict(f"{type_name}_Request", fields))
+
+
 def campaign_param_queries(tries: int, rng: random.Random, tmp: Path) -> Failures:
-    """Random JSON bodies to model_node's parameter queryables; each answered, the node alive."""
-    from tdcm_ros.runtime.zenoh_runtime import param_key
+    """Hostile requests to model_node's parameter services; each answered, the node alive."""
+    from tdcm_ros.bagio import service_type_hash
+    from tdcm_ros.runtime import wire
+    from tdcm_ros.runtime.param_services import SERVICES
 
     failures: Failures = []
+    gid = bytes(range(16))
     with model_graph() as context:
         if not midline_answers(context, 30.0):
             return ["model_node never answered before the campaign"]
-        for _ in range(tries):
-            op = rng.choice(["get", "set", "list", "describe"])
-            body = json.dumps(hostile_json(rng))[:2000]
-            replies = context.session.get(param_key(0, "/model_node", op), payload=body,
-                                          timeout=5.0)
-            if next((r.ok for r in replies if r.ok is not None), None) is None:
-                failures.append(f"{op} {body[:60]!r}: no reply within 5 s")
+        for seq in range(1, tries + 1):
+            service, type_name = rng.choice(sorted(SERVICES.items()))
+            body = hostile_parameter_request(rng, type_name)
+            key = wire.topic_key(0, f"/model_node/{service}", type_name,
+                                 service_type_hash(type_name))
+            replies = list(context.session.get(
+                key, payload=body, timeout=5.0,
+                attachment=wire.encode_attachment(seq, time.time_ns(), gid)))
+            if not replies:
+                failures.append(f"{service} {body[:40]!r}: no reply within 5 s")
         if not midline_answers(context):
             failures.append("model_node stopped answering after the queries")
     return failures

@@ -34,6 +34,7 @@ ENTRY_POINTS = frozenset(f"tdcm_ros.{name}" for name in (  # besides scripts (py
     "bagio.reader", "bagio.writer",  # mcap
     "metrics.api", "metrics.calibration", "metrics.synthetic", "metrics.synthetic_bag",  # bags
     "runtime.zenoh_runtime", "runtime.zenoh_config", "runtime.rclpy_runtime",  # transports
+    "runtime.param_client", "runtime.param_services",  # rcl_interfaces messages (rosbags)
     "runtime.wire", "device.constants",  # used as namespaces: wire.parse_token, c.TRIP_MN
 ))
 BUDGETS = {unit: frozenset() for layer in LAYERS for unit in layer} | {

@@ -23,6 +23,17 @@ SERVICE_DEFINITIONS: dict[str, str] = {
     "std_srvs/srv/Trigger": "---\n"
                             "bool success    # the command was carried out\n"
                             "string message  # why not, or what was done\n",
+    # The six parameter services every ROS node serves (rcl_interfaces, Jazzy), comments cut.
+    "rcl_interfaces/srv/DescribeParameters": "string[] names\n---\n"
+                                             "ParameterDescriptor[] descriptors\n",
+    "rcl_interfaces/srv/GetParameterTypes": "string[] names\n---\nuint8[] types\n",
+    "rcl_interfaces/srv/GetParameters": "string[] names\n---\nParameterValue[] values\n",
+    "rcl_interfaces/srv/ListParameters": "uint64 DEPTH_RECURSIVE=0\nstring[] prefixes\n"
+                                         "uint64 depth\n---\nListParametersResult result\n",
+    "rcl_interfaces/srv/SetParameters": "Parameter[] parameters\n---\n"
+                                        "SetParametersResult[] results\n",
+    "rcl_interfaces/srv/SetParametersAtomically": "Parameter[] parameters\n---\n"
+                                                  "SetParametersResult result\n",
 }
 EVENT_INFO = "service_msgs/msg/ServiceEventInfo"
 _PLACEHOLDER = ("structure_needs_at_least_one_member", (Nodetype.BASE, ("uint8", 0)))
@@ -34,7 +45,7 @@ def normalize_service_type(type_name: str) -> str:
     name = "/".join([parts[0], "srv", parts[1]] if len(parts) == 2 else parts)
     if name not in SERVICE_DEFINITIONS:
         raise BagError(f"unknown service type {type_name!r}; known: "
-                       f"{', '.join(sorted(SERVICE_DEFINITIONS))}")
+                       f"{', '.join(SERVICE_DEFINITIONS)}")
     return name
 
 

@@ -88,11 +88,19 @@ def serialize(message: Any, type_name: str | None = None) -> bytes:
         raise BagError(f"cannot serialise {type(message).__name__} as {name}: {error}") from error
 
 
-def deserialize(data: bytes | memoryview, type_name: str) -> Any:
-    """The rosbags message decoded from CDR ``data`` of type ``type_name``."""
+def deserialize(data: bytes | memoryview, type_name: str, *, exact: bool = True) -> Any:
+    """The rosbags message decoded from CDR ``data`` of type ``type_name``.
+
+    ``exact=False`` ignores bytes after the message: rclpy's ``serialize_message`` on
+    rmw_fastrtps returns a buffer padded past the message with uninitialised bytes.
+    """
     name = normalize_type_name(type_name)
     try:
-        return typestore().deserialize_cdr(data, name)
+        if exact or len(data) < 4:
+            return typestore().deserialize_cdr(data, name)
+        msgdef = typestore().get_msgdef(name)
+        decode = msgdef.deserialize_cdr_le if data[1] else msgdef.deserialize_cdr_be
+        return decode(data[4:], 0, msgdef.cls, typestore())[0]
     except Exception as error:  # truncated or mistyped payloads raise several error types
         raise BagError(f"cannot deserialise {len(data)} bytes as {name}: {error}") from error
 

@@ -1,9 +1,9 @@
-"""``tdcm param get|set|list NODE ...``: parameters of running nodes, on either runtime;
-``tdcm param specs NODE``: a node's parameters from their specs, without running it.
+"""``tdcm param get|set|list|describe|dump NODE ...``: parameters of running nodes, on either
+runtime; ``tdcm param specs NODE``: a node's parameters from their specs, without running it.
 
-On zenoh it uses the embedded runtime's parameter queryables; on rclpy the node's
-rcl_interfaces parameter services (what ``ros2 param`` uses). ``--runtime`` defaults to
-``TDCM_RUNTIME`` if set, else zenoh.
+Both runtimes go through the node's six ``rcl_interfaces`` parameter services, what ``ros2 param``
+uses (:class:`tdcm_ros.runtime.param_client.ParameterClient` over the context's
+``call_service``). ``--runtime`` defaults to ``TDCM_RUNTIME`` if set, else zenoh.
 """
 
 from __future__ import annotations
@@ -11,11 +11,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
-from typing import Any
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 from tdcm_ros.yamlio import load_yaml
+
+if TYPE_CHECKING:  # the client imports the message model; help must not
+    from tdcm_ros.runtime.param_client import ParameterClient
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -28,6 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                "  tdcm param list /model_node\n"
                "  tdcm param get /model_node design.preset\n"
                "  tdcm param set /model_node design.E 1.2e+9\n"
+               "  tdcm param describe /model_node design.E\n"
+               "  tdcm param dump /model_node > model_node.yaml\n"
                "  tdcm param specs model_node               # offline: units, defaults, ranges")
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--runtime", choices=RUNTIMES,
@@ -47,51 +53,99 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     listing = verbs.add_parser("list", parents=[common], help="list parameters with values")
     listing.add_argument("node")
     listing.set_defaults(handler=run_list)
+    describe = verbs.add_parser("describe", parents=[common],
+                                help="print type, description and constraints of parameters")
+    describe.add_argument("node")
+    describe.add_argument("names", nargs="+", metavar="name")
+    describe.set_defaults(handler=run_describe)
+    dump = verbs.add_parser("dump", parents=[common],
+                            help="print every parameter as ROS 2 parameter YAML (ros__parameters)")
+    dump.add_argument("node")
+    dump.set_defaults(handler=run_dump)
     specs = verbs.add_parser("specs", help="print a node's parameters from their specs (offline): "
                                            "name, unit, default, allowed values, meaning")
     specs.add_argument("node")
     specs.set_defaults(handler=run_specs)
 
 
-def _call(args: argparse.Namespace, op: str, request: dict[str, Any]) -> dict[str, Any]:
+R = TypeVar("R")
+
+
+def _with_client(args: argparse.Namespace, use: Callable[[ParameterClient], R]) -> R:
+    """``use`` a parameter client of ``args.node`` on a context of ``args.runtime``."""
+    from tdcm_ros.runtime.param_client import ParameterClient
     from tdcm_ros.runtime.run_node import open_context, resolve_runtime
 
-    runtime = resolve_runtime(args.runtime)
-    context = open_context(runtime)
-    node = "/" + args.node.strip("/")
+    context = open_context(resolve_runtime(args.runtime))
     try:
-        if runtime == "rclpy":
-            from tdcm_ros.runtime.rclpy_runtime import call_parameters as call_rclpy
-
-            return call_rclpy(context, node, op, request)
-        from tdcm_ros.runtime.zenoh_runtime import call_parameters
-
-        return call_parameters(context.session, context.domain_id, node, op, request)
+        return use(ParameterClient(context, args.node))
     finally:
         context.close()
 
 
 def run_get(args: argparse.Namespace) -> int:
     """Print the value."""
-    print(json.dumps(_call(args, "get", {"name": args.name})["value"]))
+    print(json.dumps(_with_client(args, lambda client: client.get(args.name))))
     return 0
 
 
 def run_set(args: argparse.Namespace) -> int:
     """Set the value; a rejection is an input error carrying the node's reason."""
     value = load_yaml(args.value, args.name)
-    answer = _call(args, "set", {"name": args.name, "value": value})
-    if not answer["successful"]:
-        raise InputError(f"rejected: {answer['reason']}", parameter=args.name, value=value)
+    result = _with_client(args, lambda client: client.set(args.name, value))
+    if not result.successful:
+        raise InputError(f"rejected: {result.reason}", parameter=args.name, value=value)
     print("Set parameter successful")
     return 0
 
 
+def _listing(client: ParameterClient) -> tuple[dict[str, Any], list[Any]]:
+    names = client.names()
+    return client.get_values(names), client.describe(names)
+
+
 def run_list(args: argparse.Namespace) -> int:
     """Print ``name: value  # description`` lines."""
-    for name, info in sorted(_call(args, "list", {})["parameters"].items()):
-        note = f"  # {info['description']}" if info["description"] else ""
-        print(f"  {name}: {json.dumps(info['value'])}{note}")
+    values, descriptors = _with_client(args, _listing)
+    for desc in descriptors:
+        note = f"  # {desc.description}" if desc.description else ""
+        print(f"  {desc.name}: {json.dumps(values[desc.name])}{note}")
+    return 0
+
+
+def run_describe(args: argparse.Namespace) -> int:
+    """Print each parameter's type, description and constraints, as ``ros2 param describe``."""
+    from tdcm_ros.runtime.param_services import type_name as parameter_type_name
+
+    for desc in _with_client(args, lambda client: client.describe(args.names)):
+        print(f"Parameter name: {desc.name}\n  Type: {parameter_type_name(desc.type)}")
+        if desc.description:
+            print(f"  Description: {desc.description}")
+        print("  Constraints:")
+        if desc.read_only:
+            print("    Read only: true")
+        for bounds in [*desc.floating_point_range, *desc.integer_range]:
+            print(f"    Min value: {bounds.from_value}\n    Max value: {bounds.to_value}")
+    return 0
+
+
+def _yaml_value(value: Any) -> str:
+    """YAML flow text of a value; floats keep a dot (``1.0e-05``), so every YAML reader,
+    1.1 or 1.2, reads them as floats."""
+    if isinstance(value, list):
+        return "[" + ", ".join(_yaml_value(v) for v in value) + "]"
+    if isinstance(value, float):
+        text = repr(value)
+        return text if "." in text else text.replace("e", ".0e", 1)
+    return json.dumps(value)
+
+
+def run_dump(args: argparse.Namespace) -> int:
+    """Print the node's values as a parameter file (``tdcm up --params`` and ROS read it)."""
+    values, _ = _with_client(args, _listing)
+    print(f"{'/' + args.node.strip('/')}:\n  ros__parameters:")
+    for name, value in values.items():
+        print(f"    {name}: {_yaml_value(value)}")
     return 0
 
 

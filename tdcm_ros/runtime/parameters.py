@@ -31,7 +31,9 @@ class SetResult:
     reason: str = ""
 
 
-def _kind(value: Any) -> str:
+def kind_of(value: Any) -> str:
+    """``bool``, ``int``, ``float``, ``str``, ``list[<element>]`` or ``list`` (empty) of a value;
+    ``InputError`` for anything else."""
     if isinstance(value, bool):
         return "bool"
     if isinstance(value, int):
@@ -41,7 +43,7 @@ def _kind(value: Any) -> str:
     if isinstance(value, str):
         return "str"
     if isinstance(value, list | tuple):
-        kinds = {_kind(v) for v in value}
+        kinds = {kind_of(v) for v in value}
         if kinds <= {"int", "float"} and "float" in kinds:
             return "list[float]"
         if len(kinds) == 1:
@@ -66,11 +68,11 @@ class ParamSpec(Generic[P]):
     @property
     def kind(self) -> str:
         """``bool``, ``int``, ``float``, ``str`` or ``list[...]``."""
-        return _kind(self.default)
+        return kind_of(self.default)
 
     def coerce(self, value: Any) -> P:
         """The value converted to this parameter's type and checked; raises ``InputError``."""
-        kind, given = self.kind, _kind(value)
+        kind, given = self.kind, kind_of(value)
         compatible = (given == kind or (kind, given) in _WIDENING
                       or (kind.startswith("list") and given == "list"))
         if not compatible:

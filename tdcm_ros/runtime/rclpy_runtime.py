@@ -31,7 +31,7 @@ from tdcm_ros.bagio import (
     serialize,
 )
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime import wire
+from tdcm_ros.runtime import param_services, wire
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.guard import CallbackGuard
 from tdcm_ros.runtime.parameters import (
@@ -47,8 +47,6 @@ from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
 from tdcm_ros.runtime.wire import RawSample
 from tdcm_ros.yamlio import load_yaml
 
-#: Seconds a parameter client waits for a node's parameter services.
-PARAM_TIMEOUT_S = 5.0
 #: Default time (s) a service client waits for its server and the answer.
 SERVICE_TIMEOUT_S = 5.0
 _NO_GID = bytes(wire.GID_SIZE)
@@ -78,10 +76,11 @@ def service_class(type_name: str) -> Any:
 
 
 def to_rosbags(native: Any, type_name: str) -> Any:
-    """A rosidl message as the rosbags message of ``type_name`` (through its CDR bytes)."""
+    """A rosidl message as the rosbags message of ``type_name`` (through its CDR bytes; rclpy
+    may pad them past the message)."""
     from rclpy.serialization import serialize_message
 
-    return deserialize(serialize_message(native), type_name)
+    return deserialize(serialize_message(native), type_name, exact=False)
 
 
 def to_native(message: Any, type_name: str, native_class: Any) -> Any:
@@ -133,20 +132,12 @@ def qos_profile(qos: QoS) -> Any:
 
 
 def descriptor(spec: ParamSpec) -> Any:
-    """``ParameterDescriptor`` with the spec's type, description, read-only flag and range."""
-    from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
-    from rclpy.parameter import Parameter
+    """rclpy's ``ParameterDescriptor`` of a spec: the one the embedded runtime serves
+    (:func:`tdcm_ros.runtime.param_services.descriptor`), crossed through its CDR bytes."""
+    from rcl_interfaces.msg import ParameterDescriptor
 
-    desc = ParameterDescriptor(name=spec.name, description=spec.description,
-                               read_only=spec.read_only,
-                               type=Parameter.Type.from_parameter_value(spec.default).value)
-    if spec.range is not None and spec.kind in ("float", "list[float]"):
-        desc.floating_point_range = [FloatingPointRange(
-            from_value=float(spec.range[0]), to_value=float(spec.range[1]), step=0.0)]
-    elif spec.range is not None and spec.kind in ("int", "list[int]"):
-        desc.integer_range = [IntegerRange(
-            from_value=int(spec.range[0]), to_value=int(spec.range[1]), step=0)]
-    return desc
+    return to_native(param_services.descriptor(spec), "rcl_interfaces/msg/ParameterDescriptor",
+                     ParameterDescriptor)
 
 
 class _Publisher:
@@ -468,68 +459,3 @@ class RclpyContext:
         self._nodes.clear()
         self.context.try_shutdown()
 
-
-def call_parameters(context: RclpyContext, node_fqn: str, op: str, request: dict[str, Any],
-                    timeout: float = PARAM_TIMEOUT_S) -> dict[str, Any]:
-    """A parameter request through the node's rcl_interfaces services (what ``ros2 param`` uses).
-
-    Answers in the zenoh client's shapes: ``get`` ``{"value"}``, ``set`` ``{"successful",
-    "reason"}``, ``list`` ``{"parameters": {name: {"value", "description", "range",
-    "read_only"}}}``. ``RuntimePortError`` if the node's services do not appear within ``timeout``.
-    """
-    from rclpy.parameter_client import AsyncParameterClient
-
-    client = AsyncParameterClient(context.create_node(f"_tdcm_param_{id(context):x}"), node_fqn)
-    end = time.monotonic() + timeout
-    while not client.services_are_ready():
-        if time.monotonic() > end:
-            raise RuntimePortError(f"node {node_fqn} has no parameter services after {timeout:g} "
-                                   f"s; is it running on ROS domain {context.domain_id}?")
-        context.spin_for(0.1)
-    if op == "get":
-        return {"value": _get(context, client, node_fqn, str(request.get("name")), timeout)}
-    if op == "set":
-        return _set(context, client, str(request.get("name")), request.get("value"), timeout)
-    if op == "list":
-        return {"parameters": _list(context, client, timeout)}
-    raise InputError(f"unknown parameter operation {op!r}; allowed: get, set, list",
-                     parameter="op", value=op, allowed="get, set, list")
-
-
-def _get(context: RclpyContext, client: Any, node_fqn: str, name: str, timeout: float) -> Any:
-    from rcl_interfaces.msg import ParameterType
-    from rclpy.parameter import parameter_value_to_python
-
-    value = context.spin_until_future(client.get_parameters([name]), timeout).values[0]
-    if value.type == ParameterType.PARAMETER_NOT_SET:
-        raise InputError(f"{node_fqn}: parameter {name!r} is not declared", parameter=name)
-    return plain_value(parameter_value_to_python(value))
-
-
-def _set(context: RclpyContext, client: Any, name: str, value: Any,
-         timeout: float) -> dict[str, Any]:
-    from rclpy.parameter import Parameter
-
-    try:
-        parameter = Parameter(name, value=value)
-    except TypeError as error:
-        raise InputError(f"{name} = {value!r} is not a ROS parameter value: {error}",
-                         parameter=name, value=value) from error
-    result = context.spin_until_future(client.set_parameters([parameter]), timeout).results[0]
-    return {"successful": bool(result.successful), "reason": str(result.reason)}
-
-
-def _list(context: RclpyContext, client: Any, timeout: float) -> dict[str, dict[str, Any]]:
-    from rclpy.parameter import parameter_value_to_python
-
-    names = list(context.spin_until_future(client.list_parameters(), timeout).result.names)
-    values = context.spin_until_future(client.get_parameters(names), timeout).values
-    descriptors = context.spin_until_future(client.describe_parameters(names),
-                                            timeout).descriptors
-    listing = {}
-    for name, value, desc in zip(names, values, descriptors, strict=True):
-        ranges = [*desc.floating_point_range, *desc.integer_range]
-        listing[name] = {"value": plain_value(parameter_value_to_python(value)),
-                         "description": desc.description, "read_only": bool(desc.read_only),
-                         "range": [ranges[0].from_value, ranges[0].to_value] if ranges else None}
-    return listing

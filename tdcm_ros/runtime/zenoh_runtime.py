@@ -10,15 +10,15 @@ thread that calls :meth:`ZenohContext.spin`.
 
 Services are rmw_zenoh's (:mod:`tdcm_ros.runtime.wire`): a queryable and an ``SS`` token per
 server, queries with rmw_zenoh's attachment from :meth:`ZenohContext.call_service`.
-Parameters are served on ``@tdcm/<domain>/params/<mangled node fqn>/<get|set|list>`` (JSON);
-:func:`call_parameters` is the client ``tdcm param`` uses.
+Every node serves the six ``rcl_interfaces`` parameter services and publishes
+``/parameter_events`` as an rclpy node does (:mod:`tdcm_ros.runtime.param_services`), so
+``ros2 param`` and ``tdcm param`` (:mod:`tdcm_ros.runtime.param_client`) reach it.
 """
 
 from __future__ import annotations
 
 import heapq
 import itertools
-import json
 import logging
 import os
 import queue
@@ -53,6 +53,13 @@ from tdcm_ros.runtime.names import (
     normalize_namespace,
     resolve_topic,
 )
+from tdcm_ros.runtime.param_services import (
+    PARAMETER_EVENT_TYPE,
+    PARAMETER_EVENTS_QOS,
+    PARAMETER_EVENTS_TOPIC,
+    PARAMETER_SERVICES_QOS,
+    ParameterServices,
+)
 from tdcm_ros.runtime.parameters import (
     P,
     ParameterStore,
@@ -74,8 +81,6 @@ from tdcm_ros.runtime.wire import RawSample
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
 CONFIG_ENV = "TDCM_ZENOH_CONFIG"
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
-PARAM_SPACE = "@tdcm"
-PARAM_TIMEOUT_S = 5.0
 HEARTBEAT_PERIOD_S = 0.5
 """Sporadic heartbeat of a reliable transient-local publisher (s): rmw_zenoh's
 ``SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`` (``rmw_publisher_data.cpp``)."""
@@ -122,11 +127,6 @@ def open_session(*, mode: str = "peer", router_endpoint: str | None = None) -> z
     except zenoh.ZError as error:
         raise RuntimePortError(f"cannot open zenoh session ({mode}, "
                                f"{router_endpoint or endpoint()}): {error}") from error
-
-
-def param_key(domain: int, node_fqn: str, op: str) -> str:
-    """Key of the parameter queryable of node ``/ns/name`` for ``op`` (get, set, list)."""
-    return f"{PARAM_SPACE}/{domain}/params/{wire.mangle(node_fqn)}/{op}"
 
 
 @dataclass(order=True)
@@ -314,13 +314,14 @@ class _Service:
     token; ``answer(request CDR)`` runs on the executor and gives the response CDR or None."""
 
     def __init__(self, context: ZenohContext, identity: wire.NodeIdentity, name: str,
-                 type_name: str, answer: Callable[[bytes], bytes | None]) -> None:
+                 type_name: str, answer: Callable[[bytes], bytes | None],
+                 qos: QoS = wire.SERVICE_QOS) -> None:
         self.name, self.type_name = name, type_name
         self._answer, self._executor = answer, context.executor
         rihs = service_type_hash(type_name)
         self.key = wire.topic_key(identity.domain_id, name, type_name, rihs)
         token = wire.endpoint_token(identity, context.next_id(), wire.SERVICE, name, type_name,
-                                    rihs, wire.SERVICE_QOS)
+                                    rihs, qos)
         self._queryable = context.session.declare_queryable(self.key, self._on_query,
                                                             complete=True)
         self._token = context.session.liveliness().declare_token(token)
@@ -337,7 +338,8 @@ class _Service:
             query.reply_err(f"{self.name}: {error}")
             return
         if response is None:
-            query.reply_err(f"{self.name}: the handler failed; see the node's log")
+            query.reply_err(f"{self.name}: no response: the request was undecodable or the "
+                            f"handler failed; see the node's log")
             return
         query.reply(self.key, response, attachment=wire.encode_attachment(
             request.sequence_number, time.time_ns(), request.gid))
@@ -414,9 +416,13 @@ class ZenohNodePort:
         self._entities: list[_Publisher | _Subscription | _Service | _Client] = []
         self.guard = CallbackGuard(self.fqn, self.logger, self.create_publisher, self.now_ns)
         self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
-        self._queryable = context.session.declare_queryable(
-            param_key(context.domain_id, self.fqn, "*"), self._on_param_query)
-        self._clock_ns = 0
+        self._clock_ns, self.use_sim_time = 0, False
+        self._parameter_services = ParameterServices(
+            self._params, self.fqn, self.logger, self.now_ns,
+            self.create_publisher(PARAMETER_EVENTS_TOPIC, PARAMETER_EVENT_TYPE,
+                                  PARAMETER_EVENTS_QOS).publish)
+        for service, (service_type, handler) in self._parameter_services.handlers().items():
+            self._serve(f"~/{service}", service_type, handler, PARAMETER_SERVICES_QOS)
         self.use_sim_time = self.declare_parameter(
             "use_sim_time", False, read_only=True,
             description=f"take the time from {CLOCK_TOPIC} ({CLOCK_TYPE}) instead of the system "
@@ -429,9 +435,12 @@ class ZenohNodePort:
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
                           read_only: bool = False) -> P:
-        """Declare a parameter; returns the YAML override or the default, validated."""
-        return self._params.declare(ParamSpec(name, default, description, range, validator,
-                                              read_only))
+        """Declare a parameter; returns the YAML override or the default, validated, and
+        announces it on ``/parameter_events`` as a new parameter."""
+        value = self._params.declare(ParamSpec(name, default, description, range, validator,
+                                               read_only))
+        self._parameter_services.publish(new=[name])
+        return value
 
     def get_parameter(self, name: str) -> ParamValue:
         """Current value of a declared parameter."""
@@ -440,52 +449,6 @@ class ZenohNodePort:
     def add_on_set_parameters(self, callback: SetCallback) -> None:
         """Add a check run on each runtime change; raising ``InputError`` rejects it."""
         self._params.add_on_set(callback)
-
-    def _param_request(self, op: str, request: Any) -> dict[str, Any]:
-        if not isinstance(request, dict) or not isinstance(request.get("name", ""), str):
-            raise InputError(f"parameter request {request!r} is invalid; allowed: a JSON object "
-                             f"with a string 'name'", parameter="request", value=request,
-                             allowed="JSON object")
-        if op == "list":
-            specs = self._params.specs
-            return {"parameters": {n: {"value": v, "description": specs[n].description,
-                                       "range": specs[n].range, "read_only": specs[n].read_only}
-                                   for n, v in self._params.values().items()}}
-        if op == "get":
-            return {"value": self._params.get(str(request.get("name")))}
-        if op == "set":
-            name = str(request.get("name"))
-            result = self._params.set({name: request.get("value")})
-            if result.successful:
-                self.logger.info("parameter %s set to %r", name, self._params.get(name))
-            else:
-                self.logger.warning("parameter change rejected: %s", result.reason)
-            return {"successful": result.successful, "reason": result.reason}
-        raise InputError(f"unknown parameter operation {op!r}; allowed: get, set, list")
-
-    def _on_param_query(self, query: zenoh.Query) -> None:
-        op = str(query.key_expr).rsplit("/", 1)[-1]
-        try:
-            request = json.loads(query.payload.to_bytes() or b"{}") if query.payload else {}
-            reply = self._context.executor.call(lambda: self._param_answer(op, request),
-                                                PARAM_TIMEOUT_S)
-        except (RuntimePortError, ValueError) as error:
-            reply = {"error": str(error)}
-        query.reply(query.key_expr, json.dumps(reply))
-
-    def _param_answer(self, op: str, request: Any) -> dict[str, Any]:
-        """The reply to a parameter request, errors included (executor thread).
-
-        No exception leaves: one raised across threads would keep the zenoh query alive in a
-        reference cycle, and its reply would wait for the query's timeout.
-        """
-        try:
-            return self._param_request(op, request)
-        except InputError as error:
-            return {"error": str(error)}
-        except Exception as error:  # noqa: BLE001 - a hostile query must not end the node
-            self.guard.failed(f"parameter query {op}", error)
-            return {"error": f"{type(error).__name__}: {error}"}
 
     # endpoints
     def create_publisher(self, topic: str, type_name: str, qos: QoS = DEFAULT_QOS) -> _Publisher:
@@ -523,15 +486,27 @@ class ZenohNodePort:
     def create_service(self, name: str, type_name: str,
                        handler: Callable[[Any], Any]) -> None:
         """Serve ``type_name`` on the resolved ``name`` (queryable and ``SS`` token)."""
+        self._serve(name, type_name, handler, wire.SERVICE_QOS)
+
+    def _serve(self, name: str, type_name: str, handler: Callable[[Any], Any], qos: QoS) -> None:
+        """:meth:`create_service` with the ``qos`` its token announces."""
         resolved = resolve_topic(name, self.namespace, self.node_name)
         service = normalize_service_type(type_name)
         request_type, response_type = f"{service}_Request", f"{service}_Response"
 
-        def answer(data: bytes) -> bytes:
-            return serialize(handler(deserialize(data, request_type)), response_type)
+        guarded = self.guard.wrap(f"service {resolved}",
+                                  lambda request: serialize(handler(request), response_type))
 
-        self._entities.append(_Service(self._context, self.identity, resolved, service,
-                                       self.guard.wrap(f"service {resolved}", answer)))
+        def answer(data: bytes) -> bytes | None:
+            try:  # a request that is no CDR of its type is the caller's fault, not a node bug
+                request = deserialize(data, request_type)
+            except BagError as error:
+                self.logger.warning("service %s: request dropped: %s", resolved, error)
+                return None
+            return guarded(request)
+
+        self._entities.append(_Service(self._context, self.identity, resolved, service, answer,
+                                       qos))
 
     def create_client(self, name: str, type_name: str) -> _Client:
         """A client of service ``name`` (resolved like a topic) of ``type_name``."""
@@ -556,11 +531,10 @@ class ZenohNodePort:
         return self._clock_ns if self.use_sim_time else time.time_ns()
 
     def close(self) -> None:
-        """Undeclare every endpoint, the parameter queryable and the node token."""
+        """Undeclare every endpoint (parameter services included) and the node token."""
         for entity in self._entities:
             entity.close()
         self._entities.clear()
-        self._queryable.undeclare()
         self._token.undeclare()
 
 
@@ -654,16 +628,3 @@ def graph_tokens(session: zenoh.Session, domain: int, timeout: float = 1.0) -> I
         except (RuntimePortError, ValueError):
             continue
 
-
-def call_parameters(session: zenoh.Session, domain: int, node_fqn: str, op: str,
-                    request: dict[str, Any], timeout: float = PARAM_TIMEOUT_S) -> dict[str, Any]:
-    """Send a parameter request to a node; raises ``RuntimePortError`` if none answers."""
-    key = param_key(domain, node_fqn, op)
-    for reply in session.get(key, payload=json.dumps(request), timeout=timeout):
-        if reply.ok is not None:
-            answer: dict[str, Any] = json.loads(reply.ok.payload.to_bytes())
-            if "error" in answer:
-                raise InputError(f"{node_fqn}: {answer['error']}", parameter=request.get("name"))
-            return answer
-    raise RuntimePortError(f"node {node_fqn} did not answer on {key} within {timeout} s; "
-                           f"is it running on domain {domain}?")

@@ -82,3 +82,13 @@ def test_from_dict_fills_defaults_and_rejects_unknown_fields() -> None:
 def test_deserialize_garbage_raises_bag_error() -> None:
     with pytest.raises(BagError, match="cannot deserialise"):
         deserialize(b"\x00\x01\x00\x00\x01", "geometry_msgs/msg/WrenchStamped")
+
+
+def test_bytes_past_the_message_are_refused_unless_not_exact() -> None:
+    """rclpy's serialize_message (rmw_fastrtps) pads past the message; only that path is lenient."""
+    data = serialize(from_dict("std_msgs/msg/String", {"data": "hi"})) + b"\x60\x06\x0a\x75\xf9\x7f"
+    with pytest.raises(BagError, match="size mismatch"):
+        deserialize(data, "std_msgs/msg/String")
+    assert deserialize(data, "std_msgs/msg/String", exact=False).data == "hi"
+    with pytest.raises(BagError):
+        deserialize(data[:9], "std_msgs/msg/String", exact=False)

@@ -4,13 +4,14 @@ them into their conftest.py; ``pythonpath`` in setup.cfg puts this folder on the
 ``runtime`` runs a test twice: on the embedded zenoh runtime (a router on a private loopback
 port) and on rclpy (a private ``ROS_DOMAIN_ID``, discovery on this host only). Nodes started with
 ``spawn`` pick the runtime up from ``TDCM_RUNTIME``; ``context`` is the test's own peer on that
-runtime (a zenoh context, or plain rclpy nodes); ``params`` is a parameter client (the zenoh
-one, or rclpy's ``AsyncParameterClient``). The rclpy half is marked ``rclpy``; where rclpy is not
+runtime (a zenoh context, or plain rclpy nodes); ``params`` is a client of a node's
+rcl_interfaces parameter services (the package's, or rclpy's ``AsyncParameterClient``). The rclpy half is marked ``rclpy``; where rclpy is not
 importable it is skipped, unless ``TDCM_REQUIRE_RCLPY=1`` (CI's ROS step), where that fails.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 import subprocess
@@ -134,25 +135,26 @@ def context(request: pytest.FixtureRequest) -> Iterator[Any]:
     ctx.close()
 
 
-class ZenohParameterClient:
-    """The embedded runtime's parameter client, in the same shape as the rclpy one."""
+class ServiceParameterClient:
+    """The package's client of the rcl_interfaces parameter services (what ``tdcm param``
+    uses), in the same shape as the rclpy one."""
 
-    def __init__(self, ctx: Any, node_fqn: str) -> None:
-        self.ctx, self.node_fqn = ctx, node_fqn
+    def __init__(self, ctx: Any, node_fqn: str, timeout: float = 15.0) -> None:
+        from tdcm_ros.runtime.param_client import ParameterClient
 
-    def _call(self, op: str, request: dict[str, Any]) -> dict[str, Any]:
-        from tdcm_ros.runtime.zenoh_runtime import call_parameters
-
-        return call_parameters(self.ctx.session, self.ctx.domain_id, self.node_fqn, op, request)
+        self.client = ParameterClient(ctx, node_fqn, timeout)
 
     def get(self, name: str) -> Any:
-        return self._call("get", {"name": name})["value"]
+        return self.client.get(name)
 
     def set(self, name: str, value: Any) -> dict[str, Any]:
-        return self._call("set", {"name": name, "value": value})
+        return dataclasses.asdict(self.client.set(name, value))
 
     def names(self) -> list[str]:
-        return sorted(self._call("list", {})["parameters"])
+        return self.client.names()
+
+    def describe(self, name: str) -> Any:
+        return self.client.describe([name])[0]
 
 
 @pytest.fixture
@@ -163,6 +165,6 @@ def params(context: Any) -> Callable[[str], Any]:
     def client(node_fqn: str) -> Any:
         if isinstance(context, PlainRclpyContext):
             return PlainParameterClient(context, node_fqn)
-        return ZenohParameterClient(context, node_fqn)
+        return ServiceParameterClient(context, node_fqn)
 
     return client

@@ -51,8 +51,9 @@ def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
     from tdcm_ros.runtime.zenoh_runtime import graph_tokens
 
     def publishers() -> list[tuple[str, str, str]]:
+        """Publisher tokens but those every ROS node has (``/parameter_events``, ``/rosout``)."""
         return [(t.topic, t.type_name, t.node_name) for t in graph_tokens(context.session, 0)
-                if t.kind == "MP"]
+                if t.kind == "MP" and t.topic not in ("/parameter_events", "/rosout")]
 
     wait_for(lambda: publishers() == [("/tension", "geometry_msgs/msg/WrenchStamped",
                                        "_tdcm_topic")], 10.0, "the publisher's liveliness token")
@@ -97,6 +98,26 @@ def test_tdcm_param_lists_gets_and_sets(runtime: str, graph_env: dict[str, str],
     assert tdcm_param(graph_env, "get", "talker", "period").stdout.strip() == "0.2"
     missing = tdcm_param(graph_env, "get", "nobody", "period", "--runtime", runtime)
     assert missing.returncode != 0 and "nobody" in missing.stderr
+
+
+def test_tdcm_param_describes_and_dumps(runtime: str, graph_env: dict[str, str], spawn: Spawn,
+                                        tmp_path: Path) -> None:
+    """``describe`` shows the spec's type and range from the node's descriptor; ``dump`` prints
+    a parameter file the package's reader takes back."""
+    from tdcm_ros.runtime.params import node_parameters
+
+    spawn("tdcm_ros.runtime.run_node", TALKER)
+    deadline = time.monotonic() + 30
+    while (described := tdcm_param(graph_env, "describe", "talker", "period")).returncode != 0:
+        assert time.monotonic() < deadline, described.stderr
+    assert described.stdout.splitlines()[:2] == ["Parameter name: period", "  Type: double"]
+    assert "    Min value: 0.001\n    Max value: 60.0" in described.stdout
+    assert tdcm_param(graph_env, "set", "talker", "prefix", "dumped").returncode == 0
+    dump = tdcm_param(graph_env, "dump", "talker")
+    assert dump.returncode == 0 and dump.stdout.startswith("/talker:\n  ros__parameters:\n")
+    (tmp_path / "dump.yaml").write_text(dump.stdout)
+    values = node_parameters(tmp_path / "dump.yaml", "/talker")
+    assert (values["period"], values["prefix"], values["use_sim_time"]) == (0.5, "dumped", False)
 
 
 def test_tdcm_param_set_reads_exponent_floats(runtime: str, graph_env: dict[str, str],

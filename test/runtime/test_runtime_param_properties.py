@@ -1,8 +1,9 @@
 """Parameter requests with random and hostile content never break a node's parameters.
 
-On zenoh the request is any JSON value sent to the node's queryable (answered in-process through
-the same handler); on rclpy any value rclpy can carry, through ``Node.set_parameters`` (what the
-parameter services call). Either way: an answer, never an exception; a value outside the spec is
+On zenoh the request is any ``rcl_interfaces`` parameter-service request (any names, any
+``ParameterValue``: every type code, every field), crossed through CDR and answered in-process by the
+handlers the node's services call; on rclpy any value rclpy can carry, through
+``Node.set_parameters`` (what rclpy's parameter services call). Either way: an answer, never an exception; a value outside the spec is
 never committed; every current value still passes its own spec.
 """
 
@@ -61,18 +62,43 @@ def assert_consistent(get: Any) -> None:
     assert get("gain") <= get("period") * 100
 
 
+PARAMETER_VALUES = st.fixed_dictionaries({
+    "type": st.integers(0, 255), "bool_value": st.booleans(),
+    "integer_value": st.integers(-2**63, 2**63 - 1), "double_value": st.floats(),
+    "string_value": st.text(max_size=20),
+    "bool_array_value": st.lists(st.booleans(), max_size=4),
+    "integer_array_value": st.lists(st.integers(-2**63, 2**63 - 1), max_size=4),
+    "double_array_value": st.lists(st.floats(), max_size=4),
+    "string_array_value": st.lists(st.text(max_size=5), max_size=4)})
+
+
 def test_zenoh_parameter_requests_of_any_shape(context: Any) -> None:
+    from tdcm_ros.bagio import deserialize, from_dict, serialize
+    from tdcm_ros.runtime.param_services import SERVICES
+
     port = context.create_port("props")
     declare(port)
+    handlers = port._parameter_services.handlers()
+
+    def request(service: str, fields: dict[str, Any]) -> Any:
+        name = f"{SERVICES[service]}_Request"
+        return deserialize(serialize(from_dict(name, fields)), name)
 
     @SETTINGS
-    @given(op=st.sampled_from(["get", "set", "list", "bogus"]), request=JSON, name=NAMES,
-           value=JSON)
-    def check(op: str, request: Any, name: str, value: Any) -> None:
-        for body in (request, {"name": name, "value": value}):
-            answer = port._param_answer(op, body)
-            assert isinstance(answer, dict) and answer
-            assert_consistent(port.get_parameter)
+    @given(service=st.sampled_from(sorted(SERVICES)), names=st.lists(NAMES, max_size=3),
+           values=st.lists(PARAMETER_VALUES, max_size=3), depth=st.integers(0, 2**64 - 1))
+    def check(service: str, names: list[str], values: list[dict[str, Any]], depth: int) -> None:
+        fields: dict[str, Any] = {"names": names}
+        if service == "list_parameters":
+            fields = {"prefixes": names, "depth": depth}
+        elif service.startswith("set_parameters"):
+            fields = {"parameters": [{"name": n, "value": v}
+                                     for n, v in zip(names, values, strict=False)]}
+        type_name, handler = handlers[service]
+        answer = handler(request(service, fields))
+        assert answer.__msgtype__ == f"{type_name}_Response"
+        serialize(answer)
+        assert_consistent(port.get_parameter)
 
     check()
 
