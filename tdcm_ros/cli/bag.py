@@ -10,14 +10,14 @@ does: ``--rate``, ``--start-offset``, ``--loop``, ``--topics``, ``--remap OLD:=N
 from __future__ import annotations
 
 import argparse
-import os
 import signal
 import sys
 from types import FrameType
 from typing import Any
 
 from tdcm_ros.cli.main import INTERRUPTED_EXIT
-from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
+from tdcm_ros.cli.runtime_option import add_runtime_option
+from tdcm_ros.runtime.run_node import resolve_runtime
 
 DEFAULT_CLOCK_HZ = 40.0
 """``--clock`` without a value: ``ros2 bag play --clock``'s default rate (Hz)."""
@@ -64,10 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                       help="wait S seconds between creating the publishers and the first "
                            "message (lets subscribers discover them; useful on rclpy)")
     play.add_argument("--quiet", action="store_true", help="no progress line")
-    play.add_argument("--runtime", choices=RUNTIMES,
-                      default=os.environ.get(RUNTIME_ENV) or "zenoh",
-                      help=f"graph to play into (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
-                           f"if importable)")
+    add_runtime_option(play, "the graph to play into")
     play.set_defaults(handler=run_play)
 
 

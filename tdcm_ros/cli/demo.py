@@ -17,8 +17,8 @@ import time
 from pathlib import Path
 
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
+from tdcm_ros.cli.runtime_option import add_runtime_option
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -54,11 +54,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              "topics, tdcm_ros.demo.plan.RECORDED_TOPICS)")
     parser.add_argument("--endpoint", default=None,
                         help="zenoh router endpoint (default: a private router on a free port)")
-    parser.add_argument("--runtime", choices=RUNTIMES,
-                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
-                        help=f"runtime of the graph (default: {RUNTIME_ENV}, else zenoh; auto: "
-                             f"rclpy if importable); rclpy uses ROS_DOMAIN_ID and "
-                             f"ROS_AUTOMATIC_DISCOVERY_RANGE from the environment")
+    add_runtime_option(parser, "the graph", "; rclpy uses ROS_DOMAIN_ID and "
+                       "ROS_AUTOMATIC_DISCOVERY_RANGE from the environment")
     add_quiet_argument(parser)
     parser.set_defaults(handler=run)
 

@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeVar
 
+from tdcm_ros.cli.runtime_option import add_runtime_option
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 from tdcm_ros.yamlio import load_yaml
 
 if TYPE_CHECKING:  # the client imports the message model; help must not
@@ -36,10 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                "  tdcm param dump /model_node > model_node.yaml\n"
                "  tdcm param specs model_node               # offline: units, defaults, ranges")
     common = argparse.ArgumentParser(add_help=False)
-    common.add_argument("--runtime", choices=RUNTIMES,
-                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
-                        help=f"runtime of the node (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
-                             f"if importable)")
+    add_runtime_option(common, "the node")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     get = verbs.add_parser("get", parents=[common], help="print a parameter value")
     get.add_argument("node")

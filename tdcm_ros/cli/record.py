@@ -8,14 +8,14 @@
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import signal
 import sys
 from types import FrameType
 
+from tdcm_ros.cli.runtime_option import add_runtime_option
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES, resolve_runtime
+from tdcm_ros.runtime.run_node import resolve_runtime
 
 EMPTY_BAG_EXIT = 1
 """Exit status of a recording that wrote no message (the empty bag is kept)."""
@@ -39,10 +39,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--flush-period", type=float, default=0.1,
                         help="longest time (s) a received message waits before it is written "
                              "to the file (bounds the loss on SIGKILL)")
-    parser.add_argument("--runtime", choices=RUNTIMES,
-                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
-                        help=f"graph to record (default: {RUNTIME_ENV}, else zenoh; auto: rclpy "
-                             f"if importable)")
+    add_runtime_option(parser, "the graph to record")
     parser.set_defaults(handler=run_record)
 
 

@@ -9,13 +9,12 @@ printed) or nothing answered within ``--timeout`` (the error on stderr).
 from __future__ import annotations
 
 import argparse
-import os
 from typing import Any
 
 import yaml
 
+from tdcm_ros.cli.runtime_option import add_runtime_option
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.run_node import RUNTIME_ENV, RUNTIMES
 from tdcm_ros.yamlio import load_yaml
 
 DEFAULT_TYPE = "std_srvs/srv/Trigger"
@@ -37,10 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                "  tdcm service list -t\n"
                "  tdcm service call /tension_driver/clear_faults")
     common = argparse.ArgumentParser(add_help=False)
-    common.add_argument("--runtime", choices=RUNTIMES,
-                        default=os.environ.get(RUNTIME_ENV) or "zenoh",
-                        help=f"runtime of the graph (default: {RUNTIME_ENV}, else zenoh; auto: "
-                             f"rclpy if importable)")
+    add_runtime_option(common, "the graph")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     listing = verbs.add_parser("list", parents=[common], help="services with a server")
     listing.add_argument("-t", "--show-types", action="store_true", help="show service types")
