@@ -13,6 +13,7 @@ server, queries with rmw_zenoh's attachment from :meth:`ZenohContext.call_servic
 Every node serves the six ``rcl_interfaces`` parameter services and publishes
 ``/parameter_events`` as an rclpy node does (:mod:`tdcm_ros.runtime.param_services`), so
 ``ros2 param`` and ``tdcm param`` (:mod:`tdcm_ros.runtime.param_client`) reach it.
+Each node's logger also goes to ``/rosout`` (:mod:`tdcm_ros.runtime.rosout`), as a ROS node's.
 """
 
 from __future__ import annotations
@@ -76,6 +77,7 @@ from tdcm_ros.runtime.port import (
     NodePort,
     QoS,
 )
+from tdcm_ros.runtime.rosout import ROSOUT_QOS, ROSOUT_TOPIC, RosoutHandler
 from tdcm_ros.runtime.wire import RawSample
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
@@ -423,6 +425,9 @@ class ZenohNodePort:
                                   PARAMETER_EVENTS_QOS).publish)
         for service, (service_type, handler) in self._parameter_services.handlers().items():
             self._serve(f"~/{service}", service_type, handler, PARAMETER_SERVICES_QOS)
+        self._rosout = RosoutHandler(self.fqn, self.create_publisher(
+            ROSOUT_TOPIC, "rcl_interfaces/msg/Log", ROSOUT_QOS))
+        self.logger.addHandler(self._rosout)
         self.use_sim_time = self.declare_parameter(
             "use_sim_time", False, read_only=True,
             description=f"take the time from {CLOCK_TOPIC} ({CLOCK_TYPE}) instead of the system "
@@ -531,7 +536,9 @@ class ZenohNodePort:
         return self._clock_ns if self.use_sim_time else time.time_ns()
 
     def close(self) -> None:
-        """Undeclare every endpoint (parameter services included) and the node token."""
+        """Detach the ``/rosout`` handler; undeclare every endpoint (parameter services
+        included) and the node token."""
+        self.logger.removeHandler(self._rosout)
         for entity in self._entities:
             entity.close()
         self._entities.clear()
