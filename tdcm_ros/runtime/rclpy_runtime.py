@@ -17,6 +17,7 @@ functions and classes, so the module imports where ROS is absent.
 from __future__ import annotations
 
 import importlib
+import os
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -101,9 +102,17 @@ def plain_value(value: Any) -> Any:
 
 
 class _Logger:
-    """%-style facade over an rclpy logger."""
+    """%-style facade over an rclpy logger. rclpy stamps a record (on the console and in the
+    ``/rosout`` message) with the first calling frame outside its own files; this file joins
+    that list (``rcutils_logger._internal_callers``, kept open for wrappers like this one) so
+    the call site is the node's, not this facade's."""
 
     def __init__(self, logger: Any) -> None:
+        from rclpy.impl import rcutils_logger
+
+        here = os.path.realpath(__file__)
+        if here not in rcutils_logger._internal_callers:
+            rcutils_logger._internal_callers.append(here)
         self._logger = logger
 
     def debug(self, msg: str, *args: object) -> None:
