@@ -53,7 +53,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 ADMIN_SPACE = "@ros2_lv"
 #: rmw_zenoh's QoS defaults (``qos.cpp``) as ``rmw/types.h`` enum values.
-DEFAULT_RELIABILITY, DEFAULT_DURABILITY, DEFAULT_HISTORY, DEFAULT_DEPTH = 1, 2, 1, 42
+DEFAULT_RELIABILITY, DEFAULT_DURABILITY, DEFAULT_DEPTH = 1, 2, 42  # history: keep-last (1) always
 RELIABILITY = {"reliable": 1, "best_effort": 2}
 DURABILITY = {"transient_local": 1, "volatile": 2}
 #: ``rmw_qos_profile_services_default`` (reliable, volatile, keep last 10).
@@ -122,7 +122,7 @@ def qos_chunk(reliability: str = "reliable", durability: str = "volatile", depth
     rel = RELIABILITY[reliability]
     dur = DURABILITY[durability]
     return (f"{'' if rel == DEFAULT_RELIABILITY else rel}:"
-            f"{'' if dur == DURABILITY['volatile'] else dur}:"
+            f"{'' if dur == DEFAULT_DURABILITY else dur}:"
             f",{'' if depth == DEFAULT_DEPTH else depth}:,:,:,,")
 
 
