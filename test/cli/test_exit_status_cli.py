@@ -5,12 +5,12 @@ table, not after it."""
 from __future__ import annotations
 
 import os
-import pty
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from pty_helpers import run_on_terminal
 
 from tdcm_ros.cli.main import EXIT_STATUSES
 from tdcm_ros.metrics.synthetic import simulate
@@ -29,19 +29,10 @@ def tdcm(*args: str) -> subprocess.CompletedProcess[str]:
 
 def on_terminal(*args: str) -> tuple[int, str]:
     """Exit status and what a terminal shows (stdout and stderr on one pty, as a user sees)."""
-    master, slave = pty.openpty()
-    child = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *args], stdin=subprocess.DEVNULL,
-                             stdout=slave, stderr=slave, env=ENV, cwd=REPO)
-    os.close(slave)
-    chunks: list[bytes] = []
-    try:
-        while data := os.read(master, 65536):
-            chunks.append(data)
-    except OSError:  # EIO: the child closed the terminal
-        pass
-    finally:
-        os.close(master)
-    return child.wait(timeout=120), b"".join(chunks).decode().replace("\r\n", "\n")
+    status, _, screen = run_on_terminal([sys.executable, "-m", "tdcm_ros", *args], env=ENV,
+                                        cwd=REPO, stdout_on_terminal=True, timeout=120,
+                                        columns=None)
+    return status, screen.replace("\r\n", "\n")
 
 
 def one_line(text: str) -> str:

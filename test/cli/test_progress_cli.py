@@ -4,18 +4,14 @@ a pipe; stdout (``--json``) stays clean either way. Run as child processes with 
 
 from __future__ import annotations
 
-import fcntl
 import json
 import os
-import pty
-import struct
 import subprocess
 import sys
-import termios
-import threading
 from pathlib import Path
 
 import pytest
+from pty_helpers import run_on_terminal
 
 import tdcm_ros
 from tdcm_ros.metrics.synthetic import simulate
@@ -37,30 +33,7 @@ def run_tdcm(*args: str, cwd: Path, tty: bool = True) -> tuple[int, str, str]:
         done = subprocess.run(command, capture_output=True, text=True, env=env, cwd=cwd,
                               timeout=300, check=False)
         return done.returncode, done.stdout, done.stderr
-    leader, follower = pty.openpty()
-    # A terminal 100 columns wide (a fresh pty is 0 x 0, where tqdm draws an empty bar).
-    fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
-    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=follower, env=env, cwd=cwd,
-                             text=True)
-    os.close(follower)
-    chunks: list[bytes] = []
-
-    def drain() -> None:
-        while True:
-            try:
-                data = os.read(leader, 4096)
-            except OSError:  # EIO: the child closed the terminal
-                return
-            if not data:
-                return
-            chunks.append(data)
-
-    reader = threading.Thread(target=drain)
-    reader.start()
-    out, _ = child.communicate(timeout=300)
-    reader.join(timeout=30)
-    os.close(leader)
-    return child.returncode, out, b"".join(chunks).decode(errors="replace")
+    return run_on_terminal(command, env=env, cwd=cwd)
 
 
 @pytest.fixture(scope="module")

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from runtime_helpers import spin_until
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
@@ -49,13 +50,6 @@ def xyzw(transform: Any) -> np.ndarray:
     q = transform.transform.rotation
     return np.array([q.x, q.y, q.z, q.w])
 
-
-def spin_until(ctx: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        ctx.spin_for(0.1)
 
 
 def test_a_peer_receives_the_tendon_frame_and_the_models_tip(runtime, context, spawn,

@@ -11,6 +11,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from runtime_helpers import spin_until
+
 from tdcm_ros.bagio import from_dict, serialize
 from tdcm_ros.bagio.writer import BagWriter, OfferedQos
 from tdcm_ros.runtime.port import QoS
@@ -99,14 +101,6 @@ class RawPeer:
         self.context.spin_for(0.3)
         return int(process.returncode)
 
-
-def spin_until(context: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-    """Spin ``context`` until ``predicate()``; AssertionError naming ``what`` after ``timeout`` s."""
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        context.spin_for(0.05)
 
 
 def interrupt(process: subprocess.Popen[bytes], timeout: float = 20.0) -> tuple[int, str]:

@@ -23,6 +23,7 @@ from player_peers import (
     sample_messages,
     write_bag,
 )
+from pty_helpers import run_on_terminal
 
 from tdcm_ros.bagio import deserialize
 from tdcm_ros.runtime.port import CLOCK_QOS, CLOCK_TOPIC, CLOCK_TYPE, QoS
@@ -150,26 +151,12 @@ def test_clock_carries_the_bag_time(runtime: str, context: Any, spawn: Spawn,
 
 def _stderr_on_a_terminal(env: dict[str, str], *argv: str) -> str:
     """Run ``tdcm bag play`` with stderr on a pseudo-terminal; what it wrote there."""
-    import os
-    import pty
     import sys
 
-    leader, follower = pty.openpty()
-    child = subprocess.Popen([sys.executable, "-m", *PLAY, *argv], env=env, cwd=REPO,
-                             stdout=subprocess.DEVNULL, stderr=follower)
-    os.close(follower)
-    chunks = []
-    while True:
-        try:
-            chunk = os.read(leader, 4096)
-        except OSError:         # EIO: the child closed the terminal
-            break
-        if not chunk:
-            break
-        chunks.append(chunk)
-    os.close(leader)
-    assert child.wait(60) == 0
-    return b"".join(chunks).decode()
+    status, _, terminal = run_on_terminal([sys.executable, "-m", *PLAY, *argv], env=env, cwd=REPO,
+                                          timeout=60, columns=None)
+    assert status == 0
+    return terminal
 
 
 def test_a_progress_line_on_a_terminal_unless_quiet(router: Any, zenoh_env: dict[str, str],

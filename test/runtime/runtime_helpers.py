@@ -7,6 +7,7 @@ import socket
 import subprocess
 import time
 from collections.abc import Callable
+from typing import Any
 
 
 def free_port() -> int:
@@ -37,3 +38,13 @@ def stop(process: subprocess.Popen[bytes], timeout: float = 10.0) -> int:
     if process.poll() is None:
         process.send_signal(signal.SIGINT)
     return process.wait(timeout)
+
+
+def spin_until(context: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
+    """Spin ``context`` (anything with ``spin_for(s)``) until ``predicate()``; AssertionError
+    naming ``what`` after ``timeout`` s."""
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        context.spin_for(0.05)

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import stop, wait_for
+from runtime_helpers import spin_until, stop, wait_for
 
 from tdcm_ros.bagio import from_dict, to_dict
 from tdcm_ros.runtime.port import QoS
@@ -20,13 +20,6 @@ from tdcm_ros.runtime.port import QoS
 Spawn = Callable[..., subprocess.Popen[bytes]]
 TALKER = "tdcm_ros.nodes.talker:Talker"
 
-
-def spin_until(ctx: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        ctx.spin_for(0.05)
 
 
 def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
