@@ -14,15 +14,17 @@ import itertools
 import math
 import statistics
 import sys
-import threading
 import time
 from collections.abc import Collection
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.yamlio import load_yaml
+
+if TYPE_CHECKING:
+    from tdcm_ros.runtime.zenoh_runtime import GraphWatch
 
 TOOL_NODE = "_tdcm_topic"
 EXIT_MEANINGS = {f"topic {verb}": {InputError.exit_code: "also: the type given is not the one "
@@ -83,56 +85,12 @@ def _context() -> Any:
     return ZenohContext()
 
 
-class GraphWatch:
-    """The publishers and subscriptions of the domain from rmw_zenoh liveliness tokens: a
-    liveliness subscriber with history collects the present ones and those that show up while
-    it runs (a one-shot liveliness query right after the session opens can come back empty)."""
-
-    def __init__(self, context: Any) -> None:
-        from tdcm_ros.runtime import wire
-
-        self._alive: set[str] = set()
-        self._lock = threading.Lock()
-        self._subscriber = context.session.liveliness().declare_subscriber(
-            f"{wire.ADMIN_SPACE}/{context.domain_id}/**", self._seen, history=True)
-
-    def _seen(self, sample: Any) -> None:
-        """Zenoh thread: a token appeared or went away."""
-        import zenoh
-
-        key = str(sample.key_expr)
-        with self._lock:
-            if sample.kind == zenoh.SampleKind.DELETE:
-                self._alive.discard(key)
-            else:
-                self._alive.add(key)
-
-    def topics(self, kinds: Collection[str] = ("MP", "MS"),
-               ignore_zid: str = "") -> dict[str, set[str]]:
-        """Topic -> message types of the endpoints of ``kinds`` (publishers ``MP``,
-        subscriptions ``MS``), leaving out those of the session ``ignore_zid``."""
-        from tdcm_ros.runtime import RuntimePortError, wire
-
-        with self._lock:
-            keys = sorted(self._alive)
-        topics: dict[str, set[str]] = {}
-        for key in keys:
-            try:
-                token = wire.parse_token(key)
-            except (RuntimePortError, ValueError):
-                continue
-            if token.kind in kinds and token.zid != ignore_zid:
-                topics.setdefault(token.topic, set()).add(token.type_name)
-        return topics
-
-    def close(self) -> None:
-        """Stop collecting."""
-        self._subscriber.undeclare()
-
-
 def graph_topics(timeout: float) -> dict[str, set[str]]:
     """Topic -> message types of the publishers and subscriptions seen within ``timeout`` s."""
+    from tdcm_ros.runtime.zenoh_runtime import GraphWatch
+
     context = _context()
+
     try:
         watch = GraphWatch(context)
         time.sleep(timeout)
@@ -201,6 +159,8 @@ def run_echo(args: argparse.Namespace) -> int:
         if limit and received >= limit:
             context.request_stop()
 
+    from tdcm_ros.runtime.zenoh_runtime import GraphWatch
+
     try:
         watch = GraphWatch(context)
         port.create_raw_subscription(args.topic, args.type, show)
@@ -236,6 +196,8 @@ def run_pub(args: argparse.Namespace) -> int:
     message = from_dict(args.type, values if values is not None else {})
     times = 1 if args.once else args.times
     context = _context()
+    from tdcm_ros.runtime.zenoh_runtime import GraphWatch
+
     try:
         watch = GraphWatch(context)
         publisher = context.create_port(TOOL_NODE).create_publisher(args.topic, args.type)

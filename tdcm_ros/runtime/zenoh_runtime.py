@@ -26,7 +26,7 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass, field
@@ -594,17 +594,14 @@ class ZenohContext:
 
     def service_names(self, timeout: float = 1.0) -> list[tuple[str, str]]:
         """``(name, type)`` of every service with a server on the domain, sorted: the tokens
-        seen by liveliness queries repeated for ``timeout`` s (one query can come back before
-        every token reached the router)."""
-        found: set[tuple[str, str]] = set()
-        end = time.monotonic() + timeout
-        while True:
-            found.update((t.topic, t.type_name) for t in graph_tokens(
-                self.session, self.domain_id, max(0.1, min(0.5, end - time.monotonic())))
-                if t.kind == wire.SERVICE)
-            if time.monotonic() >= end:
-                return sorted(found)
-            time.sleep(0.1)
+        a :class:`GraphWatch` sees within ``timeout`` s."""
+        watch = GraphWatch(self)
+        try:
+            time.sleep(timeout)
+            services = watch.topics(kinds=(wire.SERVICE,))
+        finally:
+            watch.close()
+        return sorted((name, kind) for name, kinds in services.items() for kind in kinds)
 
     def spin_for(self, seconds: float) -> None:
         """Run callbacks for ``seconds`` s."""
@@ -623,6 +620,47 @@ class ZenohContext:
             port.close()
         self._ports.clear()
         self.session.close()
+
+
+class GraphWatch:
+    """The endpoints of a context's domain from rmw_zenoh liveliness tokens: a liveliness
+    subscriber with history collects the present ones and those that show up while it runs (a
+    one-shot liveliness query right after the session opens can come back empty)."""
+
+    def __init__(self, context: ZenohContext) -> None:
+        self._alive: set[str] = set()
+        self._lock = threading.Lock()
+        self._subscriber = context.session.liveliness().declare_subscriber(
+            f"{wire.ADMIN_SPACE}/{context.domain_id}/**", self._seen, history=True)
+
+    def _seen(self, sample: zenoh.Sample) -> None:
+        """Zenoh thread: a token appeared or went away."""
+        key = str(sample.key_expr)
+        with self._lock:
+            if sample.kind == zenoh.SampleKind.DELETE:
+                self._alive.discard(key)
+            else:
+                self._alive.add(key)
+
+    def topics(self, kinds: Collection[str] = (wire.PUBLISHER, wire.SUBSCRIPTION),
+               ignore_zid: str = "") -> dict[str, set[str]]:
+        """Topic (or service) name -> types of the endpoints of ``kinds`` (``MP``, ``MS``,
+        ``SS``, ``SC``), leaving out those of the session ``ignore_zid``."""
+        with self._lock:
+            keys = sorted(self._alive)
+        topics: dict[str, set[str]] = {}
+        for key in keys:
+            try:
+                token = wire.parse_token(key)
+            except (RuntimePortError, ValueError):
+                continue
+            if token.kind in kinds and token.zid != ignore_zid:
+                topics.setdefault(token.topic, set()).add(token.type_name)
+        return topics
+
+    def close(self) -> None:
+        """Stop collecting."""
+        self._subscriber.undeclare()
 
 
 def graph_tokens(session: zenoh.Session, domain: int, timeout: float = 1.0) -> Iterator[wire.TokenInfo]:
