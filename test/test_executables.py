@@ -53,6 +53,8 @@ def test_colcon_install_has_ros_names_in_lib_tdcm_ros(tmp_path: Path) -> None:
                           text=True,
                           env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"}, timeout=60)
     assert done.returncode == 0 and "--runtime" in done.stdout, done.stderr
+    assert done.stdout.startswith("usage: model_node "), done.stdout  # its own name, not tdcm_node
+    assert "Run the model_node node." in done.stdout
 
 
 def test_every_console_script_target_exists() -> None:

@@ -15,6 +15,7 @@ import os
 import signal
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
@@ -111,9 +112,10 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     return 0
 
 
-def build_parser(prog: str = "tdcm_node", *, with_target: bool = True) -> argparse.ArgumentParser:
+def build_parser(prog: str = "tdcm_node", *, with_target: bool = True,
+                 description: str = "Run a tdcm_ros node.") -> argparse.ArgumentParser:
     """Arguments shared by ``tdcm_node`` and the per-node executables."""
-    parser = argparse.ArgumentParser(prog=prog, description="Run a tdcm_ros node.")
+    parser = argparse.ArgumentParser(prog=prog, description=description)
     if with_target:
         parser.add_argument("node", help="node class as package.module:Class")
     parser.add_argument("--name", help="node name (default: the class's default_name)")
@@ -132,7 +134,11 @@ def main_for(node_class: type[NodeLogic] | None, argv: Sequence[str] | None = No
     if "--ros-args" in args_in:
         cut = args_in.index("--ros-args")
         args_in, ros_args = args_in[:cut], args_in[cut:]
-    parser = build_parser(with_target=node_class is None)
+    if node_class is None:
+        parser = build_parser()
+    else:
+        parser = build_parser(executable_name(), with_target=False,
+                              description=f"Run the {node_class.default_name} node.")
     args = parser.parse_args(args_in)
     configure_logging(args.log_level)
     try:
@@ -142,6 +148,11 @@ def main_for(node_class: type[NodeLogic] | None, argv: Sequence[str] | None = No
     except TdcmError as error:
         print(f"{parser.prog}: {error}", file=sys.stderr)
         return error.exit_code
+
+
+def executable_name() -> str:
+    """The name this process was started as (``tdcm_model_node``, ``model_node``, ...)."""
+    return Path(sys.argv[0]).stem or "tdcm_node"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
