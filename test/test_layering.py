@@ -21,7 +21,7 @@ LAYERS = (  # from the ground up; units in one layer do not import each other
     frozenset({"spec", "yamlio", "resources"}),
     frozenset({"model"}),
     frozenset({"device", "mocap", "bagio", "figures", "plotting"}),
-    frozenset({"metrics", "scenes"}),
+    frozenset({"metrics", "scenes", "control"}),
     frozenset({"runtime"}),
     frozenset({"nodes", "recording"}),
     frozenset({"demo"}),
@@ -39,6 +39,7 @@ ENTRY_POINTS = frozenset(f"tdcm_ros.{name}" for name in (  # besides scripts (py
 ))
 BUDGETS = {unit: frozenset() for layer in LAYERS for unit in layer} | {
     "mocap": frozenset({"scipy"}), "metrics": frozenset({"scipy"}), "scenes": frozenset({"scipy"}),
+    "control": frozenset({"scipy"}),
     "bagio": frozenset({"rosbags"}), "recording": frozenset({"rosbags", "mcap"}),
     "demo": frozenset({"scipy", "rosbags", "mcap"}),
 }
