@@ -47,7 +47,7 @@ from tdcm_ros.metrics import (
     StepSettings,
 )
 from tdcm_ros.mocap import Registration
-from tdcm_ros.model import FIELD_SPECS, PRESETS, preset
+from tdcm_ros.model import FIELD_SPECS, PRESETS, Design, preset
 from tdcm_ros.runtime import (
     DiagnosticLevel,
     Diagnostics,
@@ -89,6 +89,38 @@ TUNABLE_SPECS = by_name(Spec("stale_s", "s", "inputs older than this are stale; 
 
 def _stamp_s(message: Any) -> float:
     return int(message.header.stamp.sec) + int(message.header.stamp.nanosec) * 1e-9
+
+
+def declare_design_and_layout(port: NodePort) -> tuple[Design, MarkerLayout]:
+    """The design (``design.preset`` then ``design.*``) and the marker layout (``markers.*``)
+    as read-only parameters; bad values raise InputError."""
+    base = preset(str(declare_specs(port, PRESET_SPECS, read_only=True)["design.preset"]))
+    design = base.with_overrides(**declare_specs(
+        port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
+    given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}
+    fields = declare_specs(port, given, prefix="markers.", read_only=True)
+    # a ROS parameter has a value: the default offset is the surface's, of the values above
+    fields.update(declare_specs(
+        port, {"radial_offset": LAYOUT_SPECS["radial_offset"]}, prefix="markers.",
+        defaults={"radial_offset": design.R_outer + fields["ball_radius"]}, read_only=True))
+    return design, MarkerLayout(**fields)
+
+
+def marker_rows(message: Any, index: dict[str, int]) -> tuple[np.ndarray, int]:
+    """Marker points (k, 3) m of a ``mocap4r2_msgs/msg/Markers`` in the order of ``index``
+    (label -> row; NaN rows not seen) and how many markers were ignored (unknown label or
+    not finite)."""
+    rows = np.full((len(index), 3), np.nan)
+    ignored = 0
+    for marker in message.markers:
+        i = index.get(marker.marker_name)
+        p = marker.translation
+        if i is None or not all(math.isfinite(v) for v in (p.x, p.y, p.z)):
+            ignored += 1
+            continue
+        rows[i] = (p.x, p.y, p.z)
+    return rows, ignored
+
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
@@ -143,16 +175,7 @@ class MetricsNode(NodeLogic):
     def _options(self) -> EvaluateOptions:
         """Evaluation options from the (read-only) parameters; bad values raise InputError."""
         port = self.port
-        base = preset(str(declare_specs(port, PRESET_SPECS, read_only=True)["design.preset"]))
-        design = base.with_overrides(**declare_specs(
-            port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
-        given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}
-        fields = declare_specs(port, given, prefix="markers.", read_only=True)
-        # a ROS parameter has a value: the default offset is the surface's, of the values above
-        fields.update(declare_specs(
-            port, {"radial_offset": LAYOUT_SPECS["radial_offset"]}, prefix="markers.",
-            defaults={"radial_offset": design.R_outer + fields["ball_radius"]}, read_only=True))
-        layout = MarkerLayout(**fields)
+        design, layout = declare_design_and_layout(port)
         steps = StepSettings(**declare_specs(port, STEP_SPECS, prefix="steps.", read_only=True))
         return EvaluateOptions(design=design, steps=steps, layout=layout,
                                **declare_specs(port, OPTION_SPECS, read_only=True))
@@ -169,14 +192,9 @@ class MetricsNode(NodeLogic):
     def _on_markers(self, message: Any) -> None:
         self.counts["marker_frames"] += 1
         self.last_ns["markers"] = self.port.now_ns()
-        rows = np.full((len(self.index), 3), np.nan)
-        for marker in message.markers:
-            i = self.index.get(marker.marker_name)
-            p = marker.translation
-            if i is None or not all(math.isfinite(v) for v in (p.x, p.y, p.z)):
-                self.counts["markers_ignored"] += 1
-                continue
-            rows[i] = (p.x, p.y, p.z)
+        rows, ignored = marker_rows(message, self.index)
+        if ignored:
+            self.counts["markers_ignored"] += ignored
         stamp = _stamp_s(message)
         self.running.add_markers(stamp, rows)
         errors = self.running.sample_errors(stamp, rows)
