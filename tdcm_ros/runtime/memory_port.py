@@ -32,7 +32,7 @@ from tdcm_ros.runtime.parameters import (
     SetCallback,
     Validator,
 )
-from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
+from tdcm_ros.runtime.port import DEFAULT_QOS, SERVICE_TIMEOUT_S, NodePort, QoS
 
 
 class MemoryPublisher:
@@ -64,6 +64,16 @@ class MemoryTimer:
         self.cancelled = True
 
 
+def _answer(type_name: str, handler: Callable[[Any], Any], request: Any) -> Any:
+    """``handler``'s response to ``request`` (an empty one if ``None``) of service
+    ``type_name``, both through a CDR round trip as a transport would carry them."""
+    request_type, response_type = f"{type_name}_Request", f"{type_name}_Response"
+    if request is None:
+        request = from_dict(request_type, {})
+    response = handler(deserialize(serialize(request, request_type), request_type))
+    return deserialize(serialize(response, response_type), response_type)
+
+
 class MemoryPort:
     """NodePort of one node: parameters from ``overrides``, a clock at ``start_ns`` (ns since
     the UNIX epoch), published messages and their send times (ns) per topic."""
@@ -80,6 +90,7 @@ class MemoryPort:
         self.subscriptions: dict[str, tuple[str, Callable[[Any], None], QoS]] = {}
         self.timers: list[MemoryTimer] = []
         self.services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
+        self.remote_services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
@@ -118,12 +129,23 @@ class MemoryPort:
         the request and of the response, as a transport would carry them."""
         if name not in self.services:
             raise RuntimePortError(f"no service {name!r}; served: {sorted(self.services)}")
-        type_name, handler = self.services[name]
-        request_type, response_type = f"{type_name}_Request", f"{type_name}_Response"
-        if request is None:
-            request = from_dict(request_type, {})
-        response = handler(deserialize(serialize(request, request_type), request_type))
-        return deserialize(serialize(response, response_type), response_type)
+        return _answer(*self.services[name], request)
+
+    def add_remote_service(self, name: str, type_name: str,
+                           handler: Callable[[Any], Any]) -> None:
+        """Stand in for another node's service ``name``: :meth:`call_service` hands
+        ``handler`` the node's requests."""
+        self.remote_services[name] = (normalize_service_type(type_name), handler)
+
+    def call_service(self, name: str, type_name: str, request: Any = None,
+                     timeout: float = SERVICE_TIMEOUT_S) -> Any:
+        """The node calls another node's service: the handler given to
+        :meth:`add_remote_service`, with CDR round trips; ``RuntimePortError`` if there is
+        none (as a runtime after ``timeout`` s without a server)."""
+        service = normalize_service_type(type_name)
+        if self.remote_services.get(name, ("", None))[0] != service:
+            raise RuntimePortError(f"service {name} ({service}) has no server")
+        return _answer(*self.remote_services[name], request)
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> MemoryTimer:
         """Call ``callback`` every ``period`` s of the port's clock (see :meth:`advance`)."""

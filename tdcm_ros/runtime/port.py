@@ -54,6 +54,8 @@ class QoS:
 
 
 DEFAULT_QOS = QoS()
+#: Default time (s) a service call waits for a server and its answer.
+SERVICE_TIMEOUT_S = 5.0
 #: Where a node with ``use_sim_time`` takes its time from, as in ROS 2.
 CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
@@ -134,6 +136,14 @@ class NodePort(Protocol):
         ``handler`` gets the deserialised request and returns the response message. It runs on
         the node's callback thread like every callback; if it raises, the error is logged and
         the caller gets no response."""
+
+    def call_service(self, name: str, type_name: str, request: Any = None,
+                     timeout: float = SERVICE_TIMEOUT_S) -> Any:
+        """Call service ``name`` (resolved like a topic) of ``type_name`` with ``request``
+        (default: an empty request); the response, or ``RuntimePortError`` if no server
+        answers within ``timeout`` s. Blocks the calling thread: call it from a thread of the
+        node's own, never from a callback (on rclpy the callbacks' thread delivers the
+        answer)."""
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> Timer:
         """Call ``callback`` every ``period`` seconds."""

@@ -44,12 +44,10 @@ from tdcm_ros.runtime.parameters import (
     Validator,
 )
 from tdcm_ros.runtime.params import node_parameters
-from tdcm_ros.runtime.port import DEFAULT_QOS, NodePort, QoS
+from tdcm_ros.runtime.port import DEFAULT_QOS, SERVICE_TIMEOUT_S, NodePort, QoS
 from tdcm_ros.runtime.wire import RawSample
 from tdcm_ros.yamlio import load_yaml
 
-#: Default time (s) a service client waits for its server and the answer.
-SERVICE_TIMEOUT_S = 5.0
 _NO_GID = bytes(wire.GID_SIZE)
 #: rclpy's own parameter that puts the node clock on ``/clock``.
 SIM_TIME = "use_sim_time"
@@ -183,6 +181,8 @@ class RclpyNodePort:
         self.logger = _Logger(node.get_logger())
         self._overrides = dict(overrides or {})
         self._params = ParameterStore()
+        self._clients: dict[tuple[str, str], Any] = {}
+        self._clients_lock = threading.Lock()
         self.guard = CallbackGuard(node.get_fully_qualified_name(), self.logger,
                                    self.create_publisher, self.now_ns)
         node.add_pre_set_parameters_callback(self._widen)
@@ -321,6 +321,35 @@ class RclpyNodePort:
             return response if answered is None else answered
 
         self.node.create_service(native, name, on_request)
+
+    def call_service(self, name: str, type_name: str, request: Any = None,
+                     timeout: float = SERVICE_TIMEOUT_S) -> Any:
+        """Call service ``name`` with an rclpy client of this node (``request`` default:
+        empty); the response as a rosbags message. ``RuntimePortError`` if the service does not
+        appear or answer within ``timeout`` s. Waits on the calling thread while the context's
+        executor (spinning elsewhere) delivers the answer: never call it from a callback."""
+        service = normalize_service_type(type_name)
+        native = service_class(service)
+        with self._clients_lock:
+            if (name, service) not in self._clients:
+                self._clients[(name, service)] = self.node.create_client(native, name)
+            client = self._clients[(name, service)]
+        end = time.monotonic() + timeout
+        while not client.service_is_ready():
+            if time.monotonic() > end:
+                raise RuntimePortError(f"service {name} ({service}) has no server after "
+                                       f"{timeout:g} s")
+            time.sleep(0.05)
+        if request is None:
+            request = from_dict(f"{service}_Request", {})
+        answered = threading.Event()
+        future = client.call_async(to_native(request, f"{service}_Request", native.Request))
+        future.add_done_callback(lambda _: answered.set())
+        if not answered.wait(max(0.1, end - time.monotonic())):
+            client.remove_pending_request(future)
+            raise RuntimePortError(f"service {name} ({service}) did not answer within "
+                                   f"{timeout:g} s")
+        return to_rosbags(future.result(), f"{service}_Response")
 
     def create_timer(self, period: float, callback: Callable[[], None]) -> Any:
         """rclpy timer of ``period`` s."""

@@ -74,6 +74,7 @@ from tdcm_ros.runtime.port import (
     CLOCK_TOPIC,
     CLOCK_TYPE,
     DEFAULT_QOS,
+    SERVICE_TIMEOUT_S,
     NodePort,
     QoS,
 )
@@ -88,8 +89,6 @@ HEARTBEAT_PERIOD_S = 0.5
 ``SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`` (``rmw_publisher_data.cpp``)."""
 #: Longest time (s) a service handler may take on the executor before the query fails.
 SERVICE_HANDLER_TIMEOUT_S = 5.0
-#: Default time (s) a client waits for a server to appear and answer.
-SERVICE_TIMEOUT_S = 5.0
 
 
 def _reliability(qos: QoS) -> zenoh.Reliability:
@@ -416,6 +415,8 @@ class ZenohNodePort:
         self.identity = wire.NodeIdentity(context.domain_id, context.zid, node_id,
                                           self.namespace, name)
         self._entities: list[_Publisher | _Subscription | _Service | _Client] = []
+        self._clients: dict[tuple[str, str], _Client] = {}
+        self._clients_lock = threading.Lock()
         self.guard = CallbackGuard(self.fqn, self.logger, self.create_publisher, self.now_ns)
         self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
         self._clock_ns, self.use_sim_time = 0, False
@@ -520,6 +521,22 @@ class ZenohNodePort:
         self._entities.append(client)
         return client
 
+    def call_service(self, name: str, type_name: str, request: Any = None,
+                     timeout: float = SERVICE_TIMEOUT_S) -> Any:
+        """Call service ``name`` (resolved like a topic) of ``type_name`` with ``request``
+        (default: an empty request); the decoded response. ``RuntimePortError`` if no server
+        answers within ``timeout`` s. Blocks the calling thread (any thread but a callback's
+        is fine: the answer comes on zenoh's threads)."""
+        service = normalize_service_type(type_name)
+        with self._clients_lock:
+            if (name, service) not in self._clients:
+                self._clients[(name, service)] = self.create_client(name, service)
+            client = self._clients[(name, service)]
+        if request is None:
+            request = from_dict(f"{service}_Request", {})
+        data = client.call(serialize(request, f"{service}_Request"), timeout)
+        return deserialize(data, f"{service}_Response")
+
     def create_timer(self, period: float, callback: Callable[[], None]) -> _Timer:
         """Call ``callback`` every ``period`` s on the executor thread."""
         if not period > 0:
@@ -559,7 +576,6 @@ class ZenohContext:
         self.executor = _Executor()
         self._ids = itertools.count()
         self._ports: list[ZenohNodePort] = []
-        self._clients: dict[tuple[str, str], _Client] = {}
 
     def next_id(self) -> int:
         """Next node/entity id (one counter per context, as in rmw_zenoh)."""
@@ -581,16 +597,9 @@ class ZenohContext:
         """Call service ``name`` (absolute) of ``type_name`` with ``request`` (default: an empty
         request); the decoded response. ``RuntimePortError`` if no server answers within
         ``timeout`` s. Blocks the calling thread (not for use inside a callback)."""
-        service = normalize_service_type(type_name)
-        key = (resolve_topic(name), service)
-        if key not in self._clients:
-            if not self._ports:
-                self.create_port(f"_tdcm_client_{os.getpid()}")
-            self._clients[key] = self._ports[0].create_client(*key)
-        if request is None:
-            request = from_dict(f"{service}_Request", {})
-        data = self._clients[key].call(serialize(request, f"{service}_Request"), timeout)
-        return deserialize(data, f"{service}_Response")
+        if not self._ports:
+            self.create_port(f"_tdcm_client_{os.getpid()}")
+        return self._ports[0].call_service(resolve_topic(name), type_name, request, timeout)
 
     def service_names(self, timeout: float = 1.0) -> list[tuple[str, str]]:
         """``(name, type)`` of every service with a server on the domain, sorted: the tokens
