@@ -21,6 +21,7 @@ NODES = {
     "mocap_node": "tdcm_ros.nodes.mocap_node:main",
     "tension_driver": "tdcm_ros.nodes.tension_driver:main",
     "device_twin": "tdcm_ros.nodes.device_twin:main",
+    "shape_controller": "tdcm_ros.nodes.shape_controller:main",
 }
 #: Console scripts every install gets: prefixed, so a pip install puts no generic name on PATH.
 SCRIPTS = {

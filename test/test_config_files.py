@@ -13,6 +13,7 @@ from tdcm_ros.nodes import (
     metrics_node,
     mocap_node,
     model_node,
+    shape_controller,
     tension_driver,
 )
 from tdcm_ros.runtime.params import read_param_file
@@ -24,7 +25,7 @@ CONFIG = Path(__file__).resolve().parents[1] / "config"
 NODES: dict[str, dict[str, Spec]] = {
     "model_node": model_node.PARAMETERS, "metrics_node": metrics_node.PARAMETERS,
     "mocap_node": mocap_node.PARAMETERS, "tension_driver": tension_driver.PARAMETERS,
-    "device_twin": device_twin.PARAMETERS}
+    "device_twin": device_twin.PARAMETERS, "shape_controller": shape_controller.PARAMETERS}
 
 
 def check_parameter_file(path: Path) -> int:

@@ -11,7 +11,8 @@ from pathlib import Path
 
 from setup_info import REPO, console_scripts
 
-NODES = ("model_node", "metrics_node", "mocap_node", "tension_driver", "device_twin")
+NODES = ("model_node", "metrics_node", "mocap_node", "tension_driver", "device_twin",
+         "shape_controller")
 
 
 def _entry_points(egg_info: Path) -> dict[str, str]:

@@ -9,6 +9,7 @@ imports them, so this face exports nothing.
 - :mod:`.device_twin` -- a simulated device behind a pty;
 - :mod:`.mocap_node` -- motion-capture markers (CSV replay, live, simulated);
 - :mod:`.metrics_node` -- running Table I metrics;
+- :mod:`.shape_controller` -- a tip target in, the driver's setpoints out (feedback from mocap);
 - :mod:`.talker` -- a minimal example node;
 - :mod:`.shape_messages` -- the ROS messages of a solved shape;
 - :mod:`.driver_diagnostics` -- the tension device's components on ``/diagnostics``.

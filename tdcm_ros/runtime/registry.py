@@ -11,6 +11,7 @@ NODES: dict[str, str] = {
     "mocap_node": "tdcm_ros.nodes.mocap_node:MocapNode",
     "tension_driver": "tdcm_ros.nodes.tension_driver:TensionDriverNode",
     "device_twin": "tdcm_ros.nodes.device_twin:DeviceTwinNode",
+    "shape_controller": "tdcm_ros.nodes.shape_controller:ShapeControllerNode",
 }
 
 DEFAULT_NODE_SET: tuple[str, ...] = ("model_node",)
