@@ -103,12 +103,14 @@ def test_launch_files_find_configs_with_find_package_share_and_pass_valid_parame
         metrics_node,
         mocap_node,
         model_node,
+        shape_controller,
         tension_driver,
     )
 
     specs = {"model_node": model_node.PARAMETERS, "metrics_node": metrics_node.PARAMETERS,
              "mocap_node": mocap_node.PARAMETERS, "tension_driver": tension_driver.PARAMETERS,
-             "device_twin": device_twin.PARAMETERS}
+             "device_twin": device_twin.PARAMETERS,
+             "shape_controller": shape_controller.PARAMETERS}
     tree = ast.parse(path.read_text())
     imported = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
     assert "ament_index_python.packages" not in imported, "use FindPackageShare"

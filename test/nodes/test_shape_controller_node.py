@@ -9,7 +9,6 @@ on transient-local ``/tf_static``). The logic in detail: test_shape_controller_l
 from __future__ import annotations
 
 import math
-import subprocess
 import time
 from collections.abc import Callable
 from pathlib import Path

@@ -1,0 +1,30 @@
+"""ROS 2 launch: the shape controller beside a running bench (``bench.launch.py`` or ``tdcm up``).
+
+``ros2 launch tdcm_ros controller.launch.py [mode:=feedforward|feedback] [namespace:=/tdcm]``
+
+It commands the ``tension_driver`` of the same namespace (``tension_setpoint``,
+``roll_setpoint``) within that driver's limits, once a target arrives on ``target_point`` or
+``target_angle``; ``mode`` can also be changed at run time (``tdcm param set``).
+"""
+
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
+from launch_ros.actions import Node
+from launch_ros.substitutions import FindPackageShare
+
+from launch import LaunchDescription
+
+
+def generate_launch_description() -> LaunchDescription:
+    """shape_controller with the package's config and the chosen mode."""
+    params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
+                                   "shape_controller.yaml"])
+    return LaunchDescription([
+        DeclareLaunchArgument("mode", default_value="feedback",
+                              choices=["feedforward", "feedback"],
+                              description="feedforward, or feedback from motion capture"),
+        DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
+        Node(package="tdcm_ros", executable="shape_controller", name="shape_controller",
+             namespace=LaunchConfiguration("namespace"), output="screen",
+             parameters=[params, {"mode": LaunchConfiguration("mode")}]),
+    ])
