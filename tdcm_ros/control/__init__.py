@@ -17,6 +17,7 @@ from tdcm_ros.control.estimator import GainEstimator, GainSettings, ModelTip
 from tdcm_ros.control.frames import TransformBuffer
 from tdcm_ros.control.limits import DRIVER_LIMIT_NAMES, DriverLimits, clamp, slew
 from tdcm_ros.control.measured import marker_to_tip, measured_tip
+from tdcm_ros.control.simulation import TrackingRun, simulate_tracking
 from tdcm_ros.control.target import (
     AXIS_EPS_M,
     PlaneTarget,
@@ -42,6 +43,7 @@ __all__ = [
     "Resolved",
     "ShapeController",
     "TargetRefusedError",
+    "TrackingRun",
     "TransformBuffer",
     "angle_target",
     "check_roll",
@@ -51,5 +53,6 @@ __all__ = [
     "measured_tip",
     "point_target",
     "rotate_z",
+    "simulate_tracking",
     "slew",
 ]
