@@ -55,8 +55,9 @@ PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML
 VENV_RECIPE_VERSION=2
 # What `ros2 run tdcm_ros <exe>` starts: the nodes' ROS names (colcon only, see setup.py) and the
 # prefixed names a pip install puts on PATH.
-EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin tdcm_node
-             tdcm_model_node tdcm_metrics_node tdcm_mocap_node tdcm_tension_driver tdcm_device_twin)
+EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin shape_controller tdcm_node
+             tdcm_model_node tdcm_metrics_node tdcm_mocap_node tdcm_tension_driver tdcm_device_twin
+             tdcm_shape_controller)
 
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
