@@ -31,6 +31,7 @@ import math
 import sys
 import threading
 from collections import Counter
+from collections.abc import Callable
 from typing import Any
 
 from tdcm_ros.bagio import from_dict
@@ -255,7 +256,7 @@ class ShapeControllerNode(NodeLogic):
     def _current_roll(self) -> float:
         return self.command[1] if self.command is not None else self.roll_rad
 
-    def _set_target(self, what: str, make: Any) -> None:
+    def _set_target(self, what: str, make: Callable[[DriverLimits], PlaneTarget]) -> None:
         limits = self.limits.limits
         if limits is None:
             self.counts["targets_refused"] += 1
@@ -263,8 +264,7 @@ class ShapeControllerNode(NodeLogic):
             self.port.logger.warning("%s", self.refusal)
             return
         try:
-            plane: PlaneTarget = make(limits)
-            resolved = self.core.resolve(plane, limits)
+            resolved = self.core.resolve(make(limits), limits)
         except TdcmError as error:
             self._refuse(what, error)
             return
@@ -305,8 +305,12 @@ class ShapeControllerNode(NodeLogic):
         now = self.port.now_ns()
         dt_s = (now - self.last_ns.get("observed", now)) * 1e-9
         adapt = str(self.port.get_parameter("mode")) == "feedback"
-        observation = self.core.observe(self.tension_n, self.roll_rad,
-                                        registration.to_base(rows), dt_s, adapt=adapt)
+        try:
+            observation = self.core.observe(self.tension_n, self.roll_rad,
+                                            registration.to_base(rows), dt_s, adapt=adapt)
+        except TdcmError as error:  # a tension past a model limit: no prediction for it
+            self.counts[f"model_{error.kind}"] += 1
+            return
         self.last_ns["observed"] = now
         header = {"stamp": {"sec": int(message.header.stamp.sec),
                             "nanosec": int(message.header.stamp.nanosec)},
@@ -319,10 +323,10 @@ class ShapeControllerNode(NodeLogic):
             self._publish_point(self.measured_tip, header, observation.measured)
             target = self.core.target
             if target is not None:
-                error = (m - t for m, t in zip(observation.measured, target.tip_base,
-                                               strict=True))
+                offset = (m - t for m, t in zip(observation.measured, target.tip_base,
+                                                strict=True))
                 self.tracking_error.publish(from_dict("geometry_msgs/msg/Vector3Stamped", {
-                    "header": header, "vector": dict(zip("xyz", error, strict=True))}))
+                    "header": header, "vector": dict(zip("xyz", offset, strict=True))}))
         estimator = self.core.estimator
         self.gain.publish(from_dict("std_msgs/msg/Float64", {"data": estimator.gain}))
         self.gain_std.publish(from_dict("std_msgs/msg/Float64", {"data": estimator.std}))

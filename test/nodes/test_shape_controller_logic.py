@@ -257,3 +257,17 @@ def test_mode_is_writable_at_run_time_and_checked(bench) -> None:
     refused = b.port.store.set({"mode": "open-loop"})
     assert not refused.successful and "mode" in refused.reason
     assert not b.port.store.set({"design.E": 1e9}).successful  # read-only
+
+
+def test_a_tension_past_the_model_limits_is_counted_not_fatal(bench) -> None:
+    rng = np.random.default_rng(5)
+    b = bench()
+    b.target(model_tip(8.0, 0.0))
+    b.port.advance(0.1)
+    b.tension(1e4)                       # a glitch past the tendon singularity
+    b.markers(8.0, 0.0, 1.0, rng)
+    assert b.node.counts["model_tendon_singularity"] == 1
+    assert b.port.messages("controller/measured_tip") == []
+    b.tension(8.0)
+    b.markers(8.0, 0.0, 1.0, rng)
+    assert len(b.port.messages("controller/measured_tip")) == 1
