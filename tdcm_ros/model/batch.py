@@ -14,6 +14,10 @@ the kernel's notch gaps) are checked per member.
 
 Nothing is raised for a member: each gets a status (``STATUSES``) and a message. Numbers are
 returned only for ``ok`` members; the others hold NaN.
+
+:func:`prepare_batch` builds the grids once and :meth:`BatchGrids.solve` solves them (or a
+subset) at any tensions, as often as needed: a search over designs solves in rounds without
+rebuilding grids (the grid build is most of a one-tension batch's cost).
 """
 
 from __future__ import annotations
@@ -168,8 +172,16 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
     A 1-D ``tensions`` pairs design ``i`` with tension ``i``; a 2-D one gives each design a
     row of tensions (a design-space grid). Results have the shape of ``tensions``.
     ``workers`` threads build the grids and iterate chunks of members at once (the compiled
-    kernels release the GIL); the answers do not depend on it.
+    kernels release the GIL); the answers do not depend on it. The same as
+    ``prepare_batch(designs, ...).solve(tensions)``.
     """
+    return prepare_batch(designs, settings=settings, workers=workers).solve(tensions)
+
+
+def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAULT_SETTINGS,
+                  workers: int = 1) -> BatchGrids:
+    """Build the grids of ``designs`` once, for :meth:`BatchGrids.solve` to solve them at any
+    tensions, as often as needed (a search that solves the same designs in rounds)."""
     designs = list(designs)
     for i, design in enumerate(designs):
         if not isinstance(design, Design):
@@ -180,36 +192,83 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
         raise InvalidSettingsError(f"settings = {settings!r} is not a SolverSettings",
                                    parameter="settings", value=settings,
                                    allowed="tdcm_ros.model.SolverSettings")
-    try:
-        t_all = np.array(tensions, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise TensionRangeError(f"tensions = {tensions!r} are not numbers; allowed: [0, inf) N",
-                                parameter="tensions", value=tensions,
-                                allowed="array of numbers in [0, inf) N") from exc
-    if t_all.ndim == 0 or t_all.shape[0] != len(designs):
-        raise TensionRangeError(
-            f"tensions of shape {t_all.shape} do not match {len(designs)} designs; allowed: "
-            "shape (len(designs), ...)", parameter="tensions", value=t_all.shape,
-            allowed=f"shape ({len(designs)}, ...)")
     if isinstance(workers, bool) or not isinstance(workers, int) or \
             not 1 <= workers <= MAX_WORKERS:
         raise InvalidSettingsError(
             f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
-    out = _Outcome(t_all.reshape(len(designs), -1))
-    valid, parts = _grids(out, designs, settings, workers)
-    chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
-    if parts is not None:
-        for rows, stack in _Stack.split(parts, settings):
-            chunks += _screen_group(out, valid[rows].tolist(), stack, settings)
-    if workers == 1 or len(chunks) == 1:
-        for members, stack, rows in chunks:
-            _iterate(out, members, stack, rows, settings)
-    else:
-        with ThreadPoolExecutor(workers) as pool:
-            list(pool.map(lambda c: _iterate(out, c[0], c[1], c[2], settings), chunks))
-    out.run_fallbacks(designs, settings)
-    return out.result(t_all.shape)
+    valid, parts, invalid = _grids(designs, settings, workers)
+    stacks = [] if parts is None else [(valid[rows], stack)
+                                       for rows, stack in _Stack.split(parts, settings)]
+    return BatchGrids(tuple(designs), settings, workers, invalid, stacks)
+
+
+@dataclass(frozen=True, eq=False)
+class BatchGrids:
+    """Grids of ``designs`` built once by :func:`prepare_batch`; ``invalid`` maps a design
+    whose grid cannot be built to its error, ``stacks`` holds the others as ``(design
+    indices, stack)`` per cell count."""
+
+    designs: tuple[Design, ...]
+    settings: SolverSettings
+    workers: int
+    invalid: dict[int, InvalidDesignError]
+    stacks: list[tuple[NDArray[np.int64], _Stack]]
+
+    def solve(self, tensions: ArrayLike, *, subset: ArrayLike | None = None) -> BatchResult:
+        """Solve the designs (or the distinct design indices ``subset``, in its order) at
+        ``tensions`` (N) of shape ``(number of designs solved, ...)``, as :func:`solve_batch`;
+        the answers do not depend on which other designs are solved with them."""
+        chosen = self._subset(subset)
+        try:
+            t_all = np.array(tensions, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise TensionRangeError(
+                f"tensions = {tensions!r} are not numbers; allowed: [0, inf) N",
+                parameter="tensions", value=tensions,
+                allowed="array of numbers in [0, inf) N") from exc
+        if t_all.ndim == 0 or t_all.shape[0] != chosen.size:
+            raise TensionRangeError(
+                f"tensions of shape {t_all.shape} do not match {chosen.size} designs; allowed: "
+                "shape (len(designs), ...)", parameter="tensions", value=t_all.shape,
+                allowed=f"shape ({chosen.size}, ...)")
+        out = _Outcome(t_all.reshape(chosen.size, -1))
+        k = out.per_design
+        position = np.full(len(self.designs), -1, np.int64)
+        position[chosen] = np.arange(chosen.size)
+        for d, error in self.invalid.items():
+            if position[d] >= 0:
+                out.fail(position[d] * k + np.arange(k), error)
+        chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
+        for design_ids, stack in self.stacks:
+            local = np.flatnonzero(position[design_ids] >= 0)
+            if local.size:
+                chunks += _screen_group(out, position[design_ids[local]], local, stack,
+                                        self.settings)
+        if self.workers == 1 or len(chunks) == 1:
+            for members, stack, rows in chunks:
+                _iterate(out, members, stack, rows, self.settings)
+        else:
+            with ThreadPoolExecutor(self.workers) as pool:
+                list(pool.map(lambda c: _iterate(out, c[0], c[1], c[2], self.settings),
+                              chunks))
+        out.run_fallbacks([self.designs[d] for d in chosen], self.settings)
+        return out.result(t_all.shape)
+
+    def _subset(self, subset: ArrayLike | None) -> NDArray[np.int64]:
+        """``subset`` checked: distinct indices of designs (all designs when ``None``)."""
+        count = len(self.designs)
+        if subset is None:
+            return np.arange(count)
+        chosen = np.asarray(subset)
+        if chosen.ndim != 1 or (chosen.size and not np.issubdtype(chosen.dtype, np.integer)) \
+                or np.any((chosen < 0) | (chosen >= count)) or \
+                np.unique(chosen).size != chosen.size:
+            raise InvalidSettingsError(
+                f"subset = {subset!r} is out of range; allowed: distinct integers in "
+                f"[0, {count})", parameter="subset", value=subset,
+                allowed=f"distinct integers in [0, {count})")
+        return chosen.astype(np.int64)
 
 
 class _Outcome:
@@ -271,26 +330,26 @@ class _Outcome:
             iterations=self.iterations.reshape(shape), fallback=self.fallback.reshape(shape))
 
 
-def _grids(out: _Outcome, designs: list[Design], settings: SolverSettings, workers: int
-           ) -> tuple[NDArray[np.int64], GridParts | None]:
-    """The designs whose grids build, and their grids built at once by ``workers`` threads;
-    the others' members are marked invalid (each design is checked alone only if the whole
-    set is refused)."""
+def _grids(designs: list[Design], settings: SolverSettings, workers: int
+           ) -> tuple[NDArray[np.int64], GridParts | None, dict[int, InvalidDesignError]]:
+    """The designs whose grids build, their grids built at once by ``workers`` threads, and
+    the others' errors (each design is checked alone only if the whole set is refused)."""
     valid = np.arange(len(designs))
     try:
-        return valid, grid_parts(designs, settings, workers) if designs else None
+        return valid, grid_parts(designs, settings, workers) if designs else None, {}
     except InvalidDesignError:
         pass
-    kept = []
+    kept, invalid = [], {}
     for d, design in enumerate(designs):
         try:
             Members.of([design])
         except InvalidDesignError as error:
-            out.fail(d * out.per_design + np.arange(out.per_design), error)
+            invalid[d] = error
             continue
         kept.append(d)
     valid = np.array(kept, np.int64)
-    return valid, grid_parts([designs[d] for d in kept], settings, workers) if kept else None
+    parts = grid_parts([designs[d] for d in kept], settings, workers) if kept else None
+    return valid, parts, invalid
 
 
 def _strain_coefficients(parts: GridParts, rows: NDArray[np.int64]
@@ -318,14 +377,15 @@ def _strain_coefficients(parts: GridParts, rows: NDArray[np.int64]
     return notch_cells, out[0], out[1]
 
 
-def _screen_group(out: _Outcome, design_ids: list[int], stack: _Stack,
-                  settings: SolverSettings
+def _screen_group(out: _Outcome, design_ids: NDArray[np.int64], local: NDArray[np.int64],
+                  stack: _Stack, settings: SolverSettings
                   ) -> list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]]:
-    """Screen one layout group, queue it for the single solve (literal loads) or return its
-    chunks ``(members, stack, design rows)`` to iterate (closed loads)."""
+    """Screen rows ``local`` of one layout group (design ``design_ids[i]`` of ``out`` is row
+    ``local[i]``), queue them for the single solve (literal loads) or return their chunks
+    ``(members, stack, design rows)`` to iterate (closed loads)."""
     k = out.per_design
-    rows = np.repeat(np.arange(len(design_ids)), k)
-    members = (np.asarray(design_ids)[:, None] * k + np.arange(k)[None, :]).ravel()
+    rows = np.repeat(local, k)
+    members = (design_ids[:, None] * k + np.arange(k)[None, :]).ravel()
     tension = out.tensions[members]
     bad = ~(np.isfinite(tension) & (tension >= 0.0))
     for m in members[bad]:

@@ -216,3 +216,28 @@ def test_a_layout_group_larger_than_a_chunk_gathers_per_chunk_with_the_same_answ
         assert np.max(np.abs(single.tip_position - result.tip_position[k])) <= 1e-12
     alone = solve_batch(designs[-3:], tensions[-3:])
     np.testing.assert_array_equal(alone.max_bending_strain, result.max_bending_strain[-3:])
+
+
+def test_prepared_grids_solve_any_subset_as_solve_batch_does():
+    # A search solves the same designs in rounds: grids built once, any distinct subset in any
+    # order, an invalid design marked in every round that includes it.
+    designs = random_designs(seed=13, count=9)
+    designs[4] = designs[4].with_overrides(profile=CustomProfile(lambda s: -1.0 + 0.0 * s))
+    prepared = batch.prepare_batch(designs)
+    tensions = np.random.default_rng(2).uniform(0.0, 30.0, (9, 3))
+    whole = solve_batch(designs, tensions)
+    subset = np.array([8, 4, 0, 5])
+    part = prepared.solve(tensions[subset], subset=subset)
+    np.testing.assert_array_equal(part.status, whole.status[subset])
+    np.testing.assert_array_equal(part.tip_position, whole.tip_position[subset])
+    np.testing.assert_array_equal(part.max_bending_strain, whole.max_bending_strain[subset])
+    assert list(part.status[1]) == ["invalid"] * 3
+    again = prepared.solve(tensions[:, 0])
+    np.testing.assert_array_equal(again.tip_position, whole.tip_position[:, 0])
+
+
+@pytest.mark.parametrize("subset", [[0, 0], [-1], [3], [0.5], [[0]]])
+def test_bad_subsets_raise_typed_errors(subset):
+    prepared = batch.prepare_batch([preset("paper-experiment")] * 3)
+    with pytest.raises(batch.InvalidSettingsError, match="subset"):
+        prepared.solve(np.ones(len(subset)), subset=subset)
