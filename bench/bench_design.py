@@ -1,0 +1,112 @@
+"""Inverse-design benchmark (issue 18, item 5): ``search_designs`` over 100,000 candidates, 0-20 N.
+
+Run: ``python bench/bench_design.py [--samples 100000] [--rounds 3] [--ladders 2,4,8]
+[--check 20] [--profile]``.
+
+The search: ``paper-experiment`` with ``w_n`` in [0.5, 3] mm, ``w_d`` in [0.6, 2.2] mm, ``N`` in
+3..12 and ``w_t`` in [1, 6] mm freed, Sobol' samples, budget 0-20 N, allowable strain 6 %,
+targets a tip angle of 0.45 rad and a tip deflection of 12 mm. Printed per target and ladder:
+CPU seconds of the process (``process_time``, steadier than wall on the shared 2-core machine)
+and wall seconds per run (median and range of ``--rounds``), against the target of 10 s on one
+core, with candidates per CPU second, solves per candidate, refinement rounds and counts.
+
+``--check K``: ``K`` Pareto and other ``meets`` designs of the default ladder's run, their
+tension against ``solve_inverse`` (same target, bounds 0-20 N, default ``tol``), relative
+difference (largest), and a re-solve with ``solve`` at the reported tension (tip within ``tol``
+of the target). ``--profile``: where one run's time goes (cProfile, cumulative, top entries;
+profiling inflates the Python-heavy parts). Warm: kernels compiled and loaded before timing.
+Single-threaded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import os
+import pstats
+import statistics
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np
+
+from tdcm_ros.model import preset, solve, solve_inverse, warm_up
+from tdcm_ros.model.inverse_design import DEFAULT_LADDER, search_designs
+
+MM = 1e-3
+FREE = {"w_n": (0.5 * MM, 3.0 * MM), "w_d": (0.6 * MM, 2.2 * MM), "N": (3, 12),
+        "w_t": (1.0 * MM, 6.0 * MM)}
+TARGETS = {"tip_angle": 0.45, "tip_deflection": 0.012}
+TARGET_SECONDS = 10.0
+
+
+def run(kind: str, samples: int, ladder: int):
+    """One search; (search, CPU s, wall s)."""
+    cpu, wall = time.process_time(), time.perf_counter()
+    found = search_designs(preset("paper-experiment"), FREE, samples=samples, ladder=ladder,
+                           tension_max=20.0, **{kind: TARGETS[kind]})
+    return found, time.process_time() - cpu, time.perf_counter() - wall
+
+
+def check(found, kind: str, count: int) -> None:
+    """Tensions of ``count`` designs against ``solve_inverse``, and a re-solve at each."""
+    meets = np.flatnonzero(found.outcome == "meets")
+    picks = list(found.pareto[:count])
+    picks += [int(i) for i in meets[:: max(1, meets.size // max(1, count - len(picks)))]]
+    worst_rel, worst_miss = 0.0, 0.0
+    for i in picks[:count]:
+        design = found.design(int(i))
+        reference = solve_inverse(design, tension_max=20.0, **{kind: found.target})
+        worst_rel = max(worst_rel, abs(found.tension_n[i] - reference.tension_n)
+                        / reference.tension_n)
+        again = solve(design, float(found.tension_n[i]))
+        tip = again.tip_deflection_m if kind == "tip_deflection" else again.tip_angle_rad
+        worst_miss = max(worst_miss, abs(tip - found.target))
+        assert tip == found.tip_value[i], (i, tip, found.tip_value[i])
+    print(f"  check of {min(count, len(picks))} designs: tension vs solve_inverse, largest "
+          f"relative difference {worst_rel:.2e}; re-solve at the reported tension: tip "
+          f"bit-identical, largest |tip - target| {worst_miss:.2e} {found.unit} "
+          f"(tol {found.tol:g})")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--samples", type=int, default=100_000)
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--ladders", default=f"{DEFAULT_LADDER}",
+                        help="comma-separated ladder sizes to time (default: the default's)")
+    parser.add_argument("--check", type=int, default=20)
+    parser.add_argument("--profile", action="store_true")
+    args = parser.parse_args()
+    warm_up()
+    search_designs(preset("paper-experiment"), FREE, tip_angle=0.3, samples=300)  # warm
+    print(f"{args.samples} candidates, free {', '.join(FREE)}, budget 0-20 N, one core; "
+          f"target {TARGET_SECONDS:g} CPU s")
+    for kind, value in TARGETS.items():
+        for ladder in (int(x) for x in args.ladders.split(",")):
+            cpu, wall = [], []
+            for _ in range(args.rounds):
+                found, c, w = run(kind, args.samples, ladder)
+                cpu.append(c)
+                wall.append(w)
+            mid = statistics.median(cpu)
+            print(f"{kind} = {value:g} {found.unit}, ladder {ladder}: CPU "
+                  f"{mid:.2f} s (runs {min(cpu):.2f}-{max(cpu):.2f}), wall "
+                  f"{statistics.median(wall):.2f} s ({min(wall):.2f}-{max(wall):.2f}); "
+                  f"{args.samples / mid:,.0f} candidates per CPU s; {mid / TARGET_SECONDS:.2f}x"
+                  f" the target; {found.solves / args.samples:.2f} solves per candidate, "
+                  f"{found.rounds} rounds; {found.counts()}; Pareto {found.pareto.size}")
+            if ladder == DEFAULT_LADDER and args.check:
+                check(found, kind, args.check)
+    if args.profile:
+        profiler = cProfile.Profile()
+        profiler.enable()
+        run("tip_angle", args.samples, DEFAULT_LADDER)
+        profiler.disable()
+        pstats.Stats(profiler).sort_stats("cumulative").print_stats(25)
+
+
+if __name__ == "__main__":
+    main()
