@@ -28,6 +28,7 @@ COMMANDS: dict[str, str] = {
     "demo": "tdcm_ros.cli.demo",
     "solve": "tdcm_ros.cli.solve",
     "inverse": "tdcm_ros.cli.inverse",
+    "design": "tdcm_ros.cli.design",
     "up": "tdcm_ros.cli.up",
     "topic": "tdcm_ros.cli.topic",
     "record": "tdcm_ros.cli.record",

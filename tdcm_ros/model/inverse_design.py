@@ -18,7 +18,10 @@ Tension for the target, per design (the tip and the strain grow with the tension
 2. rounds of one batch solve per bracketed design at an estimate (inverse quadratic
    interpolation through the bracket and the last point replaced, kept inside the bracket;
    extrapolation from below, or bisection, when the upper end is a limit with no tip), until
-   the tip is within ``tol`` of the target (m or rad, as ``solve_inverse``'s ``tol``).
+   the tip is within ``tol`` of the target (m or rad, as ``solve_inverse``'s ``tol``);
+3. for a design that meets the target but leaves the limits below the budget's top, the same
+   rounds find where it leaves them: the peak strain within ``STRAIN_RTOL`` below the
+   allowable, or a closure or singularity bracketed to ``LIMIT_XTOL`` of the budget.
 
 The reported tension is the last solve's: its tip, strain and status are those of ``solve`` at
 that tension. It differs from ``solve_inverse``'s by at most about ``2 tol / (dtip/dT)`` (both
@@ -29,14 +32,15 @@ budget's top, inside every limit, falls short), ``strain`` (the target needs mor
 allowable strain), ``limit`` (a singularity, closure or non-convergence comes first), ``invalid``
 (the sampled fields are not a valid design). The Pareto set is that of the ``meets`` designs on
 (reach: larger is better, peak strain at the target, tension needed: smaller is better). The
-reach is the largest tip at a tension of the ladder (or the target's) that is inside every
-limit: a lower bound of what the design reaches within the budget, within one rung of it.
+reach is the largest tip of any solve of the design inside every limit: the tip at the
+budget's top, or where step 3 found the limit (for a ``meets`` design; for the others, at the
+highest rung inside the limits).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -74,13 +78,17 @@ DEFAULT_SAMPLES = 100_000
 DEFAULT_TENSION_MAX_N = 20.0
 """The bench's tension range (0-20 N), the budget of issue 18's target."""
 DEFAULT_LADDER = 4
-"""Rungs of the tension ladder: bench/bench_design.py measured 4 the fastest of 2-12 (the
-grid build, not the rungs, dominates a rung's cost; fewer rungs cost refinement rounds)."""
+"""Rungs of the tension ladder. bench/bench_design.py: 2 rungs ran ~10 % faster and 8 ~25 %
+slower (each design's grid, built once, costs more than a rung); 4 keeps rungs a quarter of
+the budget apart, so a deflection that rises past the target and falls again between rungs
+(past ~2.3 rad of tip angle) is less likely to be missed."""
 MAX_LADDER = 1000
 MAX_ROUNDS = 60
 """Refinement rounds at most (bisection to a limit needs ~35)."""
 LIMIT_XTOL = 1e-10
 """A bracket closed to this fraction of the budget at a limit ends the design's search."""
+STRAIN_RTOL = 1e-9
+"""A design's reach ends where its peak strain is within this fraction below the allowable."""
 BATCH_DESIGNS = 8192
 """Designs searched together: bounds memory; each batch is one progress step."""
 
@@ -105,8 +113,8 @@ class DesignSearch:
     ``tension_n`` (N) is the tension that puts the tip on the target, ``tip_value`` the tip
     there (m or rad), ``peak_strain`` the peak notch strain there (NaN where the target is not
     reached: ``short``, ``limit``, ``invalid``, some ``strain``). ``reach`` (m or rad) and
-    ``reach_tension_n`` (N): the largest tip within limits at a ladder (or the target's)
-    tension. ``pareto``: indices of the Pareto set, by tension needed. ``solves``: members
+    ``reach_tension_n`` (N): the largest tip of the design's solves inside every limit, and
+    the tension of that solve (see the module's docstring). ``pareto``: indices of the Pareto set, by tension needed. ``solves``: members
     solved; ``rounds``: most refinement rounds of any batch.
     """
 
@@ -294,16 +302,29 @@ class _Problem:
         rungs = self.budget * np.arange(1, self.ladder + 1) / self.ladder
         result = grids.solve(np.broadcast_to(rungs, (len(designs), self.ladder)))
         found.solves += result.status.size
-        bracket = self._ladder(result, rungs, ids, found)
-        found.rounds = max(found.rounds, self._refine(grids, bracket, ids, found))
+        feasible = (result.status == "ok") & (result.max_bending_strain <= self.strain_limit)
+        prefix = np.cumprod(feasible, axis=1).astype(bool)
+        target = _Rounds(grids, ids, self.budget, self.measure,
+                         lambda q: np.abs(q - self.target) <= self.tol)
+        rounds = target.run(self._ladder(result, rungs, prefix, ids, found), self.target,
+                            lambda where, t, r, q, hit: self._met(where, t, r, q, hit, found))
+        for where, message in target.left:
+            found.outcome[where], found.message[where] = "limit", message
+        boundary = _Rounds(grids, ids, self.budget, lambda r: r.max_bending_strain,
+                           lambda q: (q >= (1.0 - STRAIN_RTOL) * self.strain_limit)
+                           & (q <= self.strain_limit))
+        rounds += boundary.run(self._boundary(result, rungs, prefix, ids, found),
+                               self.strain_limit,
+                               lambda where, t, r, q, hit: self._inside(where, t, r, found))
+        found.rounds = max(found.rounds, rounds)
+        found.solves += target.solves + boundary.solves
 
-    def _ladder(self, result: BatchResult, rungs: Array, ids: NDArray[np.int64],
-                found: _Found) -> _Bracket:
-        """Classify by the ladder; the bracket of each design the refinement continues."""
+    def _ladder(self, result: BatchResult, rungs: Array, prefix: NDArray[np.bool_],
+                ids: NDArray[np.int64], found: _Found) -> _Bracket:
+        """Classify by the ladder (``prefix``: rungs below the first outside a limit); the
+        bracket of each design the refinement continues."""
         tip = self.measure(result)
         solved = result.status == "ok"
-        feasible = solved & (result.max_bending_strain <= self.strain_limit)
-        prefix = np.cumprod(feasible, axis=1).astype(bool)
         within = np.where(prefix, tip, 0.0)  # a deflection falls again past ~2.3 rad: the max
         top = np.argmax(within, axis=1)
         rows = np.arange(ids.size)
@@ -312,7 +333,7 @@ class _Problem:
         stop = ~solved | (tip >= self.target)
         stops = stop.any(axis=1)
         first = np.where(stops, np.argmax(stop, axis=1), self.ladder)
-        over_below = (~feasible & solved & (np.arange(self.ladder) < first[:, None])).any(axis=1)
+        over_below = (~prefix & solved & (np.arange(self.ladder) < first[:, None])).any(axis=1)
         found.outcome[ids[~stops]] = "short"
         over = stops & over_below
         found.outcome[ids[over]] = "strain"
@@ -329,41 +350,86 @@ class _Problem:
             c_t=np.where(below >= 0, padded_t[np.maximum(below, 0)], np.nan),
             c_m=np.where(below >= 0, padded_m[go, np.maximum(below, 0)], np.nan))
 
-    def _refine(self, grids: BatchGrids, bracket: _Bracket, ids: NDArray[np.int64],
-                found: _Found) -> int:
-        """Rounds of one solve per bracketed design until its tip is within ``tol`` of the
-        target; the number of rounds."""
-        xtol = LIMIT_XTOL * self.budget
-        b = bracket
-        rounds = 0
+    def _met(self, where: NDArray[np.int64], tension: Array, result: BatchResult, tip: Array,
+             hit: NDArray[np.bool_], found: _Found) -> None:
+        """Record the designs ``where`` whose tip ``hit`` the target at ``tension``."""
+        where, tension, tip = where[hit], tension[hit], tip[hit]
+        strain = result.max_bending_strain[hit]
+        found.tension[where], found.tip[where], found.strain[where] = tension, tip, strain
+        inside = strain <= self.strain_limit
+        found.outcome[where] = np.where(inside, "meets", "strain")
+        better = inside & (tip > found.reach[where])
+        found.reach[where[better]] = tip[better]
+        found.reach_tension[where[better]] = tension[better]
+
+    def _boundary(self, result: BatchResult, rungs: Array, prefix: NDArray[np.bool_],
+                  ids: NDArray[np.int64], found: _Found) -> _Bracket:
+        """Brackets of the strain, closure or singularity limit of each design that meets
+        the target but not every rung: from its highest point inside the limits (the rung
+        below or the target's tension) to the first rung outside them."""
+        count = prefix.sum(axis=1)
+        go = np.flatnonzero((found.outcome[ids] == "meets") & (count < self.ladder))
+        f = count[go]
+        strain = result.max_bending_strain
+        below_t = np.where(f >= 1, rungs[np.maximum(f - 1, 0)], 0.0)
+        below_s = np.where(f >= 1, strain[go, np.maximum(f - 1, 0)], 0.0)
+        at_target = found.tension[ids[go]] > below_t
+        nan = np.full(go.size, np.nan)
+        return _Bracket(
+            rows=go, a_t=np.where(at_target, found.tension[ids[go]], below_t),
+            a_m=np.where(at_target, found.strain[ids[go]], below_s), b_t=rungs[f],
+            b_m=np.where(result.status[go, f] == "ok", strain[go, f], np.nan),
+            b_message=result.message[go, f], c_t=nan, c_m=nan)
+
+    def _inside(self, where: NDArray[np.int64], tension: Array, result: BatchResult,
+                found: _Found) -> None:
+        """Raise the reach of the designs ``where`` by their solves at ``tension`` that are
+        inside every limit."""
+        tip = self.measure(result)
+        inside = (result.status == "ok") & (result.max_bending_strain <= self.strain_limit)
+        better = inside & (tip > found.reach[where])
+        found.reach[where[better]] = tip[better]
+        found.reach_tension[where[better]] = tension[better]
+
+
+Record = Callable[[NDArray[np.int64], Array, BatchResult, Array, NDArray[np.bool_]], None]
+
+
+class _Rounds:
+    """Rounds of one batch solve per bracketed design (``ids``: sample of each batch row) at
+    :meth:`_Bracket.estimate`, until ``quantity`` of the solve satisfies ``hit``; a bracket
+    closed at a limit (``LIMIT_XTOL`` of the budget) or still open after ``MAX_ROUNDS`` ends
+    that design's search, listed in ``left`` with the reason."""
+
+    def __init__(self, grids: BatchGrids, ids: NDArray[np.int64], budget: float,
+                 quantity: Callable[[BatchResult], Array],
+                 hit: Callable[[Array], NDArray[np.bool_]]) -> None:
+        self.grids, self.ids, self.budget = grids, ids, budget
+        self.quantity, self.hit = quantity, hit
+        self.left: list[tuple[NDArray[np.int64], Any]] = []
+        self.solves = 0
+
+    def run(self, bracket: _Bracket, level: float, record: Record) -> int:
+        """Refine ``bracket`` toward ``quantity = level``; ``record(samples, tensions, result,
+        quantity, hit)`` sees every round's solves. Returns the rounds run."""
+        b, rounds = bracket, 0
         while b.rows.size and rounds < MAX_ROUNDS:
             rounds += 1
-            estimate = b.estimate(self.target)
-            result = grids.solve(estimate, subset=b.rows)
-            found.solves += b.rows.size
-            tip = self.measure(result)
+            estimate = b.estimate(level)
+            result = self.grids.solve(estimate, subset=b.rows)
+            self.solves += b.rows.size
             solved = result.status == "ok"
-            hit = solved & (np.abs(tip - self.target) <= self.tol)
-            where = ids[b.rows[hit]]
-            strain = result.max_bending_strain[hit]
-            found.tension[where], found.tip[where], found.strain[where] = \
-                estimate[hit], tip[hit], strain
-            found.outcome[where] = np.where(strain <= self.strain_limit, "meets", "strain")
-            better = (strain <= self.strain_limit) & (tip[hit] > found.reach[where])
-            found.reach[where[better]] = tip[hit][better]
-            found.reach_tension[where[better]] = estimate[hit][better]
-            b = b.update(estimate, np.where(solved, tip, np.nan), result.message, self.target)
-            b = b.drop(hit)
-            closed = b.b_t - b.a_t <= xtol
+            value = np.where(solved, self.quantity(result), np.nan)
+            hit = solved & self.hit(value)
+            record(self.ids[b.rows], estimate, result, value, hit)
+            b = b.update(estimate, value, result.message, level).drop(hit)
+            closed = b.b_t - b.a_t <= LIMIT_XTOL * self.budget
             if closed.any():
-                where = ids[b.rows[closed]]
-                found.outcome[where] = "limit"
-                found.message[where] = b.b_message[closed]
+                self.left.append((self.ids[b.rows[closed]], b.b_message[closed]))
                 b = b.drop(closed)
         if b.rows.size:
-            where = ids[b.rows]
-            found.outcome[where] = "limit"
-            found.message[where] = f"the tip did not settle within {MAX_ROUNDS} rounds"
+            self.left.append((self.ids[b.rows],
+                              f"the search did not settle within {MAX_ROUNDS} rounds"))
         return rounds
 
 
