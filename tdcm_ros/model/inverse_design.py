@@ -501,9 +501,12 @@ def _closest(search: DesignSearch) -> str:
     valid = np.flatnonzero(search.outcome != "invalid")
     if valid.size == 0:
         return f"{head}; no sampled combination is a valid design: {search.message[0]}"
+    if counts["strain"]:
+        head += (f"; {counts['strain']} reach it only past the allowable strain "
+                 f"{search.allowable_strain:g}")
     best = int(valid[np.argmax(search.reach[valid])])
     return (f"{head}; the closest reaches {search.reach[best]:.6g} {search.unit} at "
-            f"{search.reach_tension_n[best]:.6g} N: {_fields(search, best)}")
+            f"{search.reach_tension_n[best]:.6g} N inside the limits: {_fields(search, best)}")
 
 
 def _fields(search: DesignSearch, index: int) -> str:

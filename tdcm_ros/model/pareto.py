@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tdcm_ros.errors import InputError
+
 BLOCK = 256
 """Candidates compared at once (a ``BLOCK x front`` comparison per step)."""
 
@@ -20,9 +22,12 @@ def non_dominated(objectives: ArrayLike) -> NDArray[np.int64]:
     """
     points = np.asarray(objectives, dtype=float)
     if points.ndim != 2:
-        raise ValueError(f"objectives must be 2-D (points x objectives), got {points.shape}")
+        raise InputError(f"objectives of shape {points.shape} are not 2-D; allowed: (points, "
+                         "objectives)", parameter="objectives", value=points.shape,
+                         allowed="2-D (points, objectives)")
     if not np.all(np.isfinite(points)):
-        raise ValueError("objectives must be finite")
+        raise InputError("objectives are not all finite; allowed: finite numbers",
+                         parameter="objectives", value="NaN or inf", allowed="finite numbers")
     order = np.lexsort(points.T[::-1])
     ordered = points[order]
     front = np.empty((0, points.shape[1]))
