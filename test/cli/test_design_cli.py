@@ -102,3 +102,23 @@ def test_bad_input_exits_2_naming_the_parameter(args, names):
     assert proc.returncode == 2, proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
     assert names in proc.stderr
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_progress_bar_on_a_terminal_and_stdout_stays_json(quiet, tmp_path):
+    import os
+    from pathlib import Path
+
+    from pty_helpers import run_on_terminal
+
+    import tdcm_ros
+
+    root = Path(tdcm_ros.__file__).resolve().parents[1]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        p for p in (str(root), os.environ.get("PYTHONPATH")) if p)}
+    status, out, err = run_on_terminal(
+        [sys.executable, "-m", "tdcm_ros", "design", *SEARCH, "--json",
+         *(["-q"] if quiet else [])], env=env, cwd=tmp_path)
+    assert status == 0, err
+    assert json.loads(out)["samples"] == 300
+    assert ("design search:" in err) is not quiet, err
