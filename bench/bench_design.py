@@ -33,7 +33,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 
 from tdcm_ros.model import preset, solve, solve_inverse, warm_up
-from tdcm_ros.model.inverse_design import DEFAULT_LADDER, search_designs
+from tdcm_ros.model.inverse_design import DEFAULT_DESIGN_LADDER, search_designs
 
 MM = 1e-3
 FREE = {"w_n": (0.5 * MM, 3.0 * MM), "w_d": (0.6 * MM, 2.2 * MM), "N": (3, 12),
@@ -75,7 +75,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--samples", type=int, default=100_000)
     parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--ladders", default=f"{DEFAULT_LADDER}",
+    parser.add_argument("--ladders", default=f"{DEFAULT_DESIGN_LADDER}",
                         help="comma-separated ladder sizes to time (default: the default's)")
     parser.add_argument("--check", type=int, default=20)
     parser.add_argument("--profile", action="store_true")
@@ -98,12 +98,12 @@ def main() -> None:
                   f"{args.samples / mid:,.0f} candidates per CPU s; {mid / TARGET_SECONDS:.2f}x"
                   f" the target; {found.solves / args.samples:.2f} solves per candidate, "
                   f"{found.rounds} rounds; {found.counts()}; Pareto {found.pareto.size}")
-            if ladder == DEFAULT_LADDER and args.check:
+            if ladder == DEFAULT_DESIGN_LADDER and args.check:
                 check(found, kind, args.check)
     if args.profile:
         profiler = cProfile.Profile()
         profiler.enable()
-        run("tip_angle", args.samples, DEFAULT_LADDER)
+        run("tip_angle", args.samples, DEFAULT_DESIGN_LADDER)
         profiler.disable()
         pstats.Stats(profiler).sort_stats("cumulative").print_stats(25)
 

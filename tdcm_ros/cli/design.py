@@ -13,8 +13,19 @@ from typing import Any
 from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
 from tdcm_ros.errors import InputError, TdcmError
-from tdcm_ros.model import DEFAULT_ALLOWABLE_STRAIN, InvalidTargetError
-from tdcm_ros.model.inverse import DEFAULT_TOL
+from tdcm_ros.model import (
+    DEFAULT_ALLOWABLE_STRAIN,
+    DEFAULT_DESIGN_LADDER,
+    DEFAULT_DESIGN_SAMPLES,
+    DEFAULT_TENSION_BUDGET_N,
+    DEFAULT_TOL,
+    FREE_FIELDS,
+    SAMPLINGS,
+    DesignSearch,
+    InvalidTargetError,
+    NoDesignMeetsTargetError,
+    search_designs,
+)
 
 EXIT_MEANINGS = {"design": {3: "no candidate reaches the target within the budget inside the "
                                "limits (the message names the closest)"}}
@@ -26,13 +37,6 @@ FILES = ("design.json", "pareto.csv", "pareto.png")
 
 def register(subparsers: Any) -> None:
     """Add the ``design`` subcommand."""
-    from tdcm_ros.model.design_sampling import FREE_FIELDS, SAMPLINGS
-    from tdcm_ros.model.inverse_design import (
-        DEFAULT_LADDER,
-        DEFAULT_SAMPLES,
-        DEFAULT_TENSION_MAX_N,
-    )
-
     parser = subparsers.add_parser(
         "design", help="inverse design: designs that reach a tip target within a tension budget",
         description="Sample designs (the base design with --free fields varied) and find for "
@@ -54,18 +58,18 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--free", action="append", default=[], metavar="NAME=MIN:MAX",
                         help=f"a field to vary over [MIN, MAX] (SI units; N integers): "
                              f"{', '.join(FREE_FIELDS)}; repeat for more")
-    parser.add_argument("--tension-max", default=str(DEFAULT_TENSION_MAX_N), metavar="N",
-                        help=f"tension budget 0..N (default {DEFAULT_TENSION_MAX_N:g} N)")
+    parser.add_argument("--tension-max", default=str(DEFAULT_TENSION_BUDGET_N), metavar="N",
+                        help=f"tension budget 0..N (default {DEFAULT_TENSION_BUDGET_N:g} N)")
     parser.add_argument("--allowable-strain", default=str(DEFAULT_ALLOWABLE_STRAIN),
                         metavar="S", help="largest peak notch bending strain (default "
                                           f"{DEFAULT_ALLOWABLE_STRAIN:g})")
-    parser.add_argument("--samples", default=str(DEFAULT_SAMPLES), metavar="K",
-                        help=f"candidate designs (default {DEFAULT_SAMPLES})")
+    parser.add_argument("--samples", default=str(DEFAULT_DESIGN_SAMPLES), metavar="K",
+                        help=f"candidate designs (default {DEFAULT_DESIGN_SAMPLES})")
     parser.add_argument("--sampling", choices=SAMPLINGS, default=SAMPLINGS[0],
                         help="scrambled Sobol' (default) or Latin hypercube")
     parser.add_argument("--seed", default="0", help="sampling seed (default 0)")
-    parser.add_argument("--ladder", default=str(DEFAULT_LADDER), metavar="K",
-                        help=f"tension rungs before refining (default {DEFAULT_LADDER})")
+    parser.add_argument("--ladder", default=str(DEFAULT_DESIGN_LADDER), metavar="K",
+                        help=f"tension rungs before refining (default {DEFAULT_DESIGN_LADDER})")
     parser.add_argument("--tol", default=str(DEFAULT_TOL),
                         help=f"tolerance on the target, m or rad (default {DEFAULT_TOL:g})")
     parser.add_argument("--top", default=str(DEFAULT_TOP), metavar="K",
@@ -109,8 +113,6 @@ def _free(pairs: list[str]) -> dict[str, tuple[float, float]]:
 
 def run(args: argparse.Namespace) -> int:
     """Search and report; typed errors become exit status 2 (input) or 3 (no design)."""
-    from tdcm_ros.model.inverse_design import NoDesignMeetsTargetError, search_designs
-
     started = perf_counter()
     name = ""
     try:
@@ -157,7 +159,7 @@ def _target(option: str, text: str) -> float:
                                  parameter=option, value=text, allowed="(0, inf)") from None
 
 
-def _write(search: Any, name: str, out: Path, *, plot: bool) -> list[Path]:
+def _write(search: DesignSearch, name: str, out: Path, *, plot: bool) -> list[Path]:
     """``design.json`` (the summary), ``pareto.csv`` and (``plot``) ``pareto.png`` in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     paths = [out / "design.json", out / "pareto.csv"]
@@ -171,13 +173,13 @@ def _write(search: Any, name: str, out: Path, *, plot: bool) -> list[Path]:
         for row in rows:
             writer.writerow([row["free"][c] if c in row["free"] else row[c] for c in columns])
     if plot:
-        from tdcm_ros.design_plot import plot_search
+        from tdcm_ros.plotting import plot_search
 
         paths.append(plot_search(search, out / "pareto.png"))
     return paths
 
 
-def _print(name: str, search: Any, seconds: float, top: int) -> None:
+def _print(name: str, search: DesignSearch, seconds: float, top: int) -> None:
     """The human summary: counts, then the Pareto set by tension needed (mm, %, N, rad)."""
     scale, unit = (1e3, "mm") if search.unit == "m" else (1.0, "rad")
     counts = ", ".join(f"{v} {k}" for k, v in search.counts().items() if v)

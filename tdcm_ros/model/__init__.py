@@ -20,6 +20,7 @@ from tdcm_ros.model.design import (
     parse_field,
     preset,
 )
+from tdcm_ros.model.design_sampling import FREE_FIELDS, SAMPLINGS
 from tdcm_ros.model.design_space import (
     DEFAULT_ALLOWABLE_STRAIN,
     STATUSES,
@@ -38,11 +39,20 @@ from tdcm_ros.model.errors import (
 )
 from tdcm_ros.model.inverse import (
     DEFAULT_TENSION_MAX_N,
+    DEFAULT_TOL,
     InvalidTargetError,
     InverseResult,
     Sensitivity,
     UnreachableTargetError,
     solve_inverse,
+)
+from tdcm_ros.model.inverse_design import (
+    DEFAULT_DESIGN_LADDER,
+    DEFAULT_DESIGN_SAMPLES,
+    DEFAULT_TENSION_BUDGET_N,
+    DesignSearch,
+    NoDesignMeetsTargetError,
+    search_designs,
 )
 from tdcm_ros.model.limits import check_tension
 from tdcm_ros.model.loading import (
@@ -67,12 +77,18 @@ from tdcm_ros.model.surface import offset_points, surface_points
 
 __all__ = [
     "DEFAULT_ALLOWABLE_STRAIN",
+    "DEFAULT_DESIGN_LADDER",
+    "DEFAULT_DESIGN_SAMPLES",
     "DEFAULT_SETTINGS",
+    "DEFAULT_TENSION_BUDGET_N",
     "DEFAULT_TENSION_MAX_N",
+    "DEFAULT_TOL",
     "FIELD_SPECS",
+    "FREE_FIELDS",
     "MARKER_SPECS",
     "PRESETS",
     "PROFILE_NAMES",
+    "SAMPLINGS",
     "SOLVER_SPECS",
     "STATUSES",
     "Capstan",
@@ -80,6 +96,7 @@ __all__ = [
     "ConvergenceError",
     "CustomProfile",
     "Design",
+    "DesignSearch",
     "DesignSpace",
     "InvalidDesignError",
     "InvalidLoadingError",
@@ -90,6 +107,7 @@ __all__ = [
     "MarkerLayout",
     "ModelError",
     "ModelLimitError",
+    "NoDesignMeetsTargetError",
     "NotchClosureError",
     "NotchContact",
     "Progress",
@@ -108,6 +126,7 @@ __all__ = [
     "parse_field",
     "preset",
     "report_progress",
+    "search_designs",
     "solve",
     "solve_inverse",
     "surface_points",

@@ -74,10 +74,10 @@ Array = NDArray[np.float64]
 TARGET_KINDS = ("tip_deflection", "tip_angle")
 UNITS = {"tip_deflection": "m", "tip_angle": "rad"}
 OUTCOMES = ("meets", "short", "strain", "limit", "invalid")
-DEFAULT_SAMPLES = 100_000
-DEFAULT_TENSION_MAX_N = 20.0
+DEFAULT_DESIGN_SAMPLES = 100_000
+DEFAULT_TENSION_BUDGET_N = 20.0
 """The bench's tension range (0-20 N), the budget of issue 18's target."""
-DEFAULT_LADDER = 4
+DEFAULT_DESIGN_LADDER = 4
 """Rungs of the tension ladder. bench/bench_design.py: 2 rungs ran ~10 % faster and 8 ~25 %
 slower (each design's grid, built once, costs more than a rung); 4 keeps rungs a quarter of
 the budget apart, so a deflection that rises past the target and falls again between rungs
@@ -179,10 +179,10 @@ class DesignSearch:
 
 def search_designs(base: Design, free: Mapping[str, Any], *,
                    tip_deflection: float | None = None, tip_angle: float | None = None,
-                   tension_max: float = DEFAULT_TENSION_MAX_N,
+                   tension_max: float = DEFAULT_TENSION_BUDGET_N,
                    allowable_strain: float = DEFAULT_ALLOWABLE_STRAIN,
-                   samples: int = DEFAULT_SAMPLES, sampling: str = "sobol", seed: int = 0,
-                   ladder: int = DEFAULT_LADDER, tol: float = DEFAULT_TOL,
+                   samples: int = DEFAULT_DESIGN_SAMPLES, sampling: str = "sobol", seed: int = 0,
+                   ladder: int = DEFAULT_DESIGN_LADDER, tol: float = DEFAULT_TOL,
                    settings: SolverSettings = DEFAULT_SETTINGS,
                    progress: Progress | None = None) -> DesignSearch:
     """Sample ``samples`` designs (``base`` with the fields of ``free`` = ``{name: (low,
