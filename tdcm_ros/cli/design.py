@@ -10,7 +10,12 @@ from pathlib import Path
 from time import perf_counter
 from typing import Any
 
-from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
+from tdcm_ros.cli.design_args import (
+    add_design_arguments,
+    add_tip_targets,
+    design_and_settings,
+    target_number,
+)
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.model import (
@@ -22,7 +27,6 @@ from tdcm_ros.model import (
     FREE_FIELDS,
     SAMPLINGS,
     DesignSearch,
-    InvalidTargetError,
     NoDesignMeetsTargetError,
     search_designs,
 )
@@ -51,10 +55,7 @@ def register(subparsers: Any) -> None:
                "--samples 20000 --json\n"
                "  tdcm design --design fig2-wn-1.9 --tip-angle 0.3 --free w_n=1e-3:2.5e-3 "
                "--free L=0.04:0.06 --out design_out")
-    target = parser.add_mutually_exclusive_group(required=True)
-    target.add_argument("--tip-deflection", metavar="M",
-                        help="tip distance from the undeformed axis (m)")
-    target.add_argument("--tip-angle", metavar="RAD", help="tip angle from +z toward +x (rad)")
+    add_tip_targets(parser.add_mutually_exclusive_group(required=True))
     parser.add_argument("--free", action="append", default=[], metavar="NAME=MIN:MAX",
                         help=f"a field to vary over [MIN, MAX] (SI units; N integers): "
                              f"{', '.join(FREE_FIELDS)}; repeat for more")
@@ -117,9 +118,10 @@ def run(args: argparse.Namespace) -> int:
     name = ""
     try:
         name, design, settings = design_and_settings(args)
-        target = ({"tip_deflection": _target("--tip-deflection", args.tip_deflection)}
-                  if args.tip_deflection is not None
-                  else {"tip_angle": _target("--tip-angle", args.tip_angle)})
+        target = ({"tip_deflection": target_number("--tip-deflection", args.tip_deflection,
+                                                   "(0, inf) m")}
+                  if args.tip_deflection is not None else
+                  {"tip_angle": target_number("--tip-angle", args.tip_angle, "(0, inf) rad")})
         top = _number("--top", args.top, int)
         if top < 0:
             raise InputError(f"--top = {top} is out of range; allowed: an integer >= 0",
@@ -148,15 +150,6 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print(name, search, summary["time_s"], top)
     return 0
-
-
-def _target(option: str, text: str) -> float:
-    """The target's value (the model checks its range)."""
-    try:
-        return float(text)
-    except ValueError:
-        raise InvalidTargetError(f"{option} = {text!r} is not a number; allowed: (0, inf)",
-                                 parameter=option, value=text, allowed="(0, inf)") from None
 
 
 def _write(search: DesignSearch, name: str, out: Path, *, plot: bool) -> list[Path]:

@@ -1,5 +1,6 @@
 """The design and solver options shared by the commands that solve one design (``solve``,
-``inverse``): ``--design``, ``--set``, ``--profile``, ``--routing`` and ``--loads``."""
+``inverse``, ``design``): ``--design``, ``--set``, ``--profile``, ``--routing`` and ``--loads``;
+and the tip targets of ``inverse`` and ``design`` (``--tip-deflection``, ``--tip-angle``)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from tdcm_ros.model import (
     PROFILE_NAMES,
     SOLVER_SPECS,
     Design,
+    InvalidTargetError,
     SolverSettings,
     parse_field,
     preset,
@@ -66,3 +68,20 @@ def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
             named = text.strip()
     design = preset(named or DEFAULT_DESIGN).with_overrides(**values)
     return spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN, design
+
+
+def add_tip_targets(group: argparse._MutuallyExclusiveGroup) -> None:
+    """Add ``--tip-deflection M`` and ``--tip-angle RAD`` to a target ``group``."""
+    group.add_argument("--tip-deflection", metavar="M",
+                       help="tip distance from the undeformed axis (m)")
+    group.add_argument("--tip-angle", metavar="RAD", help="tip angle from +z toward +x (rad)")
+
+
+def target_number(option: str, text: str, allowed: str) -> float:
+    """``text`` of ``option`` (a target or a tension bound) as a float; the model checks its
+    range."""
+    try:
+        return float(text)
+    except ValueError:
+        raise InvalidTargetError(f"{option} = {text!r} is not a number; allowed: {allowed}",
+                                 parameter=option, value=text, allowed=allowed) from None

@@ -7,7 +7,12 @@ import json
 import sys
 from typing import Any
 
-from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
+from tdcm_ros.cli.design_args import (
+    add_design_arguments,
+    add_tip_targets,
+    design_and_settings,
+    target_number,
+)
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.model import (
     DEFAULT_TENSION_MAX_N,
@@ -32,9 +37,7 @@ def register(subparsers: Any) -> None:
                "  tdcm inverse --design fig2-wn-1.9 --tip-deflection 0.005 --json\n"
                "  tdcm inverse --tip-point=0.006,0.0525 --set E=1.2e9 --tension-max 22")
     target = parser.add_mutually_exclusive_group(required=True)
-    target.add_argument("--tip-deflection", metavar="M",
-                        help="tip distance from the undeformed axis (m)")
-    target.add_argument("--tip-angle", metavar="RAD", help="tip angle from +z toward +x (rad)")
+    add_tip_targets(target)
     target.add_argument("--tip-point", metavar="X,Z", help="tip point in tdcm_base (m); write a negative X as "
                         "--tip-point=-0.001,0.05")
     parser.add_argument("--tension-min", default="0", metavar="N",
@@ -46,27 +49,18 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def _number(option: str, text: str, allowed: str) -> float:
-    """``text`` of ``option`` as a float; the model checks its range."""
-    try:
-        return float(text)
-    except ValueError:
-        raise InvalidTargetError(f"{option} = {text!r} is not a number; allowed: {allowed}",
-                                 parameter=option, value=text, allowed=allowed) from None
-
-
 def _target(args: argparse.Namespace) -> dict[str, Any]:
     """The target keyword of :func:`~tdcm_ros.model.solve_inverse` the options name."""
     if args.tip_deflection is not None:
-        return {"tip_deflection": _number("--tip-deflection", args.tip_deflection, "[0, inf) m")}
+        return {"tip_deflection": target_number("--tip-deflection", args.tip_deflection, "[0, inf) m")}
     if args.tip_angle is not None:
-        return {"tip_angle": _number("--tip-angle", args.tip_angle, "a finite number, rad")}
+        return {"tip_angle": target_number("--tip-angle", args.tip_angle, "a finite number, rad")}
     parts = args.tip_point.split(",")
     if len(parts) != 2:
         raise InvalidTargetError(f"--tip-point = {args.tip_point!r} is not X,Z; allowed: two "
                                  "numbers (m) separated by a comma", parameter="--tip-point",
                                  value=args.tip_point, allowed="X,Z (m)")
-    return {"tip_point": tuple(_number("--tip-point", p, "X,Z (m)") for p in parts)}
+    return {"tip_point": tuple(target_number("--tip-point", p, "X,Z (m)") for p in parts)}
 
 
 def run(args: argparse.Namespace) -> int:
@@ -76,8 +70,8 @@ def run(args: argparse.Namespace) -> int:
         name, design, settings = design_and_settings(args)
         found = solve_inverse(
             design, **_target(args), settings=settings,
-            tension_min=_number("--tension-min", args.tension_min, "[0, tension-max) N"),
-            tension_max=_number("--tension-max", args.tension_max, "(tension-min, inf) N"))
+            tension_min=target_number("--tension-min", args.tension_min, "[0, tension-max) N"),
+            tension_max=target_number("--tension-max", args.tension_max, "(tension-min, inf) N"))
     except TdcmError as error:
         if args.json:
             print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))

@@ -223,17 +223,24 @@ _MEASURES: dict[str, Callable[[SolveResult], float]] = {
 _UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m"}
 
 
-def _check_target(tip_deflection: float | None, tip_angle: float | None,
-                  tip_point: tuple[float, float] | None) -> tuple[str, Any]:
-    """The one target given, checked: ``(kind, value)``."""
-    given = {name: value for name, value in zip(
-        TARGET_KINDS, (tip_deflection, tip_angle, tip_point), strict=True) if value is not None}
+def one_target(targets: dict[str, Any]) -> tuple[str, Any]:
+    """The one target of ``targets`` (kind -> value, ``None`` where not given) that is given,
+    as ``(kind, value)``; :class:`InvalidTargetError` unless exactly one is."""
+    given = {name: value for name, value in targets.items() if value is not None}
     if len(given) != 1:
         raise InvalidTargetError(
             f"give exactly one target, got {sorted(given) or 'none'}; allowed: one of "
-            f"{', '.join(TARGET_KINDS)}", parameter="target", value=sorted(given),
-            allowed=" | ".join(TARGET_KINDS))
+            f"{', '.join(targets)}", parameter="target", value=sorted(given),
+            allowed=" | ".join(targets))
     (kind, value), = given.items()
+    return kind, value
+
+
+def _check_target(tip_deflection: float | None, tip_angle: float | None,
+                  tip_point: tuple[float, float] | None) -> tuple[str, Any]:
+    """The one target given, checked: ``(kind, value)``."""
+    kind, value = one_target(dict(zip(TARGET_KINDS, (tip_deflection, tip_angle, tip_point),
+                                      strict=True)))
     if kind == "tip_point":
         values = np.asarray(value, dtype=float) if _is_pair(value) else None
         if values is None or not np.all(np.isfinite(values)):

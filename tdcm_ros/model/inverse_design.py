@@ -63,7 +63,7 @@ from tdcm_ros.model.errors import (
     InvalidSettingsError,
     ModelLimitError,
 )
-from tdcm_ros.model.inverse import DEFAULT_TOL, InvalidTargetError
+from tdcm_ros.model.inverse import DEFAULT_TOL, InvalidTargetError, one_target
 from tdcm_ros.model.pareto import non_dominated
 from tdcm_ros.model.progress import Progress, report_progress
 from tdcm_ros.model.settings import SolverSettings
@@ -232,14 +232,7 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
 
 def _target(tip_deflection: float | None, tip_angle: float | None) -> tuple[str, float]:
     """The one target given, ``(kind, value)``, finite and > 0."""
-    given = {k: v for k, v in zip(TARGET_KINDS, (tip_deflection, tip_angle), strict=True)
-             if v is not None}
-    if len(given) != 1:
-        raise InvalidTargetError(
-            f"give exactly one target, got {sorted(given) or 'none'}; allowed: one of "
-            f"{', '.join(TARGET_KINDS)}", parameter="target", value=sorted(given),
-            allowed=" | ".join(TARGET_KINDS))
-    (kind, value), = given.items()
+    kind, value = one_target(dict(zip(TARGET_KINDS, (tip_deflection, tip_angle), strict=True)))
     return kind, _positive(kind, value, UNITS[kind], InvalidTargetError)
 
 
