@@ -199,8 +199,8 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
         raise InvalidDesignError(f"base = {base!r} is not a Design", parameter="base",
                                  value=base, allowed="tdcm_ros.model.Design")
     kind, target = _target(tip_deflection, tip_angle)
-    budget = _positive("tension_max", tension_max, "N", InvalidTargetError)
-    tolerance = _positive("tol", tol, UNITS[kind], InvalidTargetError)
+    budget = _positive("tension_max", tension_max, "N")
+    tolerance = _positive("tol", tol, UNITS[kind])
     strain_limit = _allowable(allowable_strain)
     if isinstance(ladder, bool) or not isinstance(ladder, int) or not 1 <= ladder <= MAX_LADDER:
         raise out_of_range("ladder", ladder, f"an integer in [1, {MAX_LADDER}]",
@@ -233,14 +233,14 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
 def _target(tip_deflection: float | None, tip_angle: float | None) -> tuple[str, float]:
     """The one target given, ``(kind, value)``, finite and > 0."""
     kind, value = one_target(dict(zip(TARGET_KINDS, (tip_deflection, tip_angle), strict=True)))
-    return kind, _positive(kind, value, UNITS[kind], InvalidTargetError)
+    return kind, _positive(kind, value, UNITS[kind])
 
 
-def _positive(name: str, value: Any, unit: str, error: type[InvalidTargetError]) -> float:
-    """``value`` as a float, finite and > 0."""
+def _positive(name: str, value: Any, unit: str) -> float:
+    """``value`` as a float, finite and > 0, or :class:`InvalidTargetError`."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)) \
             or not (math.isfinite(value) and value > 0.0):
-        raise out_of_range(name, value, f"(0, inf) {unit}, finite", error=error)
+        raise out_of_range(name, value, f"(0, inf) {unit}, finite", error=InvalidTargetError)
     return float(value)
 
 
