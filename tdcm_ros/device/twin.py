@@ -43,7 +43,8 @@ class DeviceTwin:
 
     The EEPROM starts with a calibration matching the plant's load cell unless ``storage``
     (an ``EEPROM_RECORD_SIZE`` byte buffer) is given. At every load-cell sample ``truth`` gets
-    ``(simulated time s, true tendon tension N)`` (the newest ``TRUTH_KEPT`` are kept).
+    ``(simulated time s, true tendon tension N)`` and ``roll_truth`` ``(simulated time s, true
+    roll servo angle rad)`` (the newest ``TRUTH_KEPT`` of each are kept).
 
     Failures: :meth:`reboot` (a reset: fresh firmware state, boot banner, EEPROM kept) and
     :attr:`hung` (the firmware's loop stalls while time and the bench go on; see :meth:`advance`);
@@ -58,6 +59,7 @@ class DeviceTwin:
             pack_calibration(cfg.tare_counts, cfg.scale_mcpn))
         self.output = bytearray()
         self.truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_KEPT)
+        self.roll_truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_KEPT)
         self.cell = cell
         self.core = TensionCore(self.storage, cell=cell, send=self.output.extend)
         self.now_ms = 0
@@ -100,18 +102,19 @@ class DeviceTwin:
     def advance(self, seconds: float) -> None:
         """Run the bench and the firmware for ``seconds`` of simulated time (1 ms steps).
 
-        While :attr:`hung` the firmware neither samples, ticks nor sends: the actuator holds its
-        last pulse. Once it is cleared, the buffered host bytes are read first."""
+        While :attr:`hung` the firmware neither samples, ticks nor sends: the actuator and the roll
+        servo hold their last pulses. Once it is cleared, the buffered host bytes are read first."""
         if not self.hung and self._held:
             self.receive(b"")
         period_ms = self.plant.config.sample_period * 1000
         for _ in range(round(seconds * 1000)):
             self.now_ms += 1
-            self.plant.step(self.core.pulse_us, 0.001)
+            self.plant.step(self.core.pulse_us, 0.001, self.core.roll_pulse_us)
             due = self.now_ms >= self._next_sample_ms
             if due:
                 self._next_sample_ms += period_ms
                 self.truth.append((self.time, self.plant.tension))
+                self.roll_truth.append((self.time, self.plant.roll))
             if self.hung:
                 self._stalled = True
                 continue
@@ -130,6 +133,12 @@ class DeviceTwin:
         """Ground-truth samples ``(simulated time s, tension N)`` since the last call."""
         samples = list(self.truth)
         self.truth.clear()
+        return samples
+
+    def take_roll_truth(self) -> list[tuple[float, float]]:
+        """Ground-truth roll samples ``(simulated time s, roll rad)`` since the last call."""
+        samples = list(self.roll_truth)
+        self.roll_truth.clear()
         return samples
 
 
@@ -274,6 +283,13 @@ class PtyTwin:
         with self._lock:
             samples = self.twin.take_truth()
         return [(self.host_time_ns(t), tension) for t, tension in samples]
+
+    def take_roll_truth(self) -> list[tuple[int, float]]:
+        """Ground-truth roll samples since the last call as ``(host time ns since the epoch,
+        rad)``, taken like :meth:`take_truth`."""
+        with self._lock:
+            samples = self.twin.take_roll_truth()
+        return [(self.host_time_ns(t), roll) for t, roll in samples]
 
     def host_time_ns(self, sim_time: float) -> int:
         """Host time (ns since the epoch) at which the threaded twin reaches ``sim_time`` s."""
