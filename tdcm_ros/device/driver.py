@@ -274,8 +274,8 @@ class TensionDriver:
 
     def set_roll(self, radians: float) -> float | None:
         """Request a roll (rad), clamped to ``[-roll_max, roll_max]`` with a warning; slewed at
-        ``roll_rate``. Returns the roll target now held: the clamped value, or while disarmed
-        (the request refused with a warning) the previous one (None: no target)."""
+        ``roll_rate``. Returns the roll target now held (the clamped value), or None when refused
+        with a warning: while disarmed or with a trip fault latched (the roll holds)."""
         limit = self.config.roll_max
         if not math.isfinite(radians):
             raise out_of_range("roll", radians, "a finite number", unit="rad",
@@ -285,11 +285,12 @@ class TensionDriver:
             self._warn(f"roll = {radians:g} rad is out of range [{-limit:g}, {limit:g}] rad; "
                        f"clamped to {clamped:g} rad")
         if self._refused_while_disarmed(f"roll = {radians:g} rad", what_stays="the roll holds"):
-            return self._roll_target
+            return None
         if self._roll_faults():
+            self._roll_target = self._roll_setpoint = None
             self._warn(f"roll = {radians:g} rad refused: device fault "
                        f"{fault_names(self._roll_faults())}; the roll holds until clear_faults")
-            return self._roll_target
+            return None
         if self._roll_setpoint is None:
             self._roll_setpoint = self.roll_position
             self._last_roll_ramp = self._clock()
