@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_driver_unit import FakePort
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.driver import DriverConfig, LinkState, StepResult, TensionDriver
@@ -169,25 +170,6 @@ def test_roll_is_forgotten_on_a_device_reboot(bench: Bench) -> None:
     bench.run(0.5)
     assert not bench.driver.armed
     assert bench.joints[-1].position == 0.0 and bench.twin.core.roll_engaged is False
-
-
-class FakePort:
-    """Replies with whatever is queued in ``incoming``; records what the driver writes."""
-
-    def __init__(self, replies: bytes) -> None:
-        self.incoming = bytearray(replies)
-        self.written = bytearray()
-
-    def read(self) -> bytes:
-        data = bytes(self.incoming)
-        self.incoming.clear()
-        return data
-
-    def write(self, data: bytes) -> None:
-        self.written.extend(data)
-
-    def close(self) -> None:
-        pass
 
 
 BANNER = encode(Banner("0.1.0", "FAKE", 0.02, 0.5, 22.0, 25.0))
