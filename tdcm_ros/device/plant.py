@@ -13,7 +13,8 @@ standard deviation drawn from a generator seeded with ``seed``. :attr:`Plant.ten
 tendon tension, which bias, drift and noise do not touch.
 
 The roll servo (a hobby servo without position feedback) turns toward the angle its pulse
-commands, ``(pulse - ROLL_PULSE_CENTER_US) / ROLL_US_PER_RAD`` rad, at most ``roll_speed`` rad/s;
+commands, ``(pulse - ROLL_PULSE_CENTER_US) / ROLL_US_PER_RAD`` rad, at most ``roll_speed`` rad/s
+(an argument of :class:`Plant`, not a :class:`PlantConfig` field: scenes own those);
 :attr:`Plant.roll` is its true angle (rad).
 """
 
@@ -56,8 +57,6 @@ class PlantConfig:
         "dead zone: the actuator stops this short of its command"))
     bias: float = spec_field(0.0, unit="N", description="load-cell offset")
     drift: float = spec_field(0.0, unit="N/s", description="load-cell linear drift")
-    roll_speed: float = spec_field(8.7, unit="rad/s", low=0.0, low_open=True, description=(
-        "roll servo speed limit (a hobby servo: 0.12 s per 60 deg)"))
 
     def __post_init__(self) -> None:
         check_fields(self, PLANT_SPECS, error=DeviceInputError)
@@ -73,6 +72,8 @@ class PlantConfig:
         return round(self.counts_per_newton * 1000)
 
 
+ROLL_SPEED = 8.7  #: rad/s, default roll servo speed limit (a hobby servo: 0.12 s per 60 deg)
+
 #: Specs of the plant parameters, by field name.
 PLANT_SPECS = specs_of(PlantConfig)
 
@@ -80,8 +81,12 @@ PLANT_SPECS = specs_of(PlantConfig)
 class Plant:
     """State of the simulated bench; :meth:`step` advances it by ``dt`` s."""
 
-    def __init__(self, config: PlantConfig) -> None:
+    def __init__(self, config: PlantConfig, *, roll_speed: float = ROLL_SPEED) -> None:
+        if not (math.isfinite(roll_speed) and roll_speed > 0):
+            raise out_of_range("roll_speed", roll_speed, "(0, inf)", unit="rad/s",
+                               error=DeviceInputError)
         self.config = config
+        self.roll_speed = roll_speed  #: rad/s, roll servo speed limit
         self.position = 0.0
         self.roll = 0.0  #: rad, true angle of the roll servo
         self.time = 0.0  #: s the plant has run
@@ -101,7 +106,7 @@ class Plant:
     def step(self, pulse_us: int, dt: float, roll_pulse_us: int = c.ROLL_PULSE_CENTER_US) -> None:
         """Move the actuator and the roll servo toward their pulses' positions for ``dt`` s."""
         cfg = self.config
-        turn = cfg.roll_speed * dt
+        turn = self.roll_speed * dt
         self.roll += min(max(self.roll_target(roll_pulse_us) - self.roll, -turn), turn)
         target = self.target(pulse_us)
         substeps = max(1, math.ceil(dt / cfg.lag))  # explicit Euler stays stable for h <= lag

@@ -31,7 +31,7 @@ from typing import Self
 
 from tdcm_ros.device.core import TensionCore, pack_calibration
 from tdcm_ros.device.errors import DeviceInputError
-from tdcm_ros.device.plant import Plant, PlantConfig
+from tdcm_ros.device.plant import ROLL_SPEED, Plant, PlantConfig
 from tdcm_ros.errors import out_of_range
 
 TRUTH_KEPT = 4096  #: ground-truth samples kept until taken (older ones are dropped)
@@ -42,7 +42,7 @@ class DeviceTwin:
     """Firmware core + plant in simulated time; ``output`` collects the bytes it sends.
 
     The EEPROM starts with a calibration matching the plant's load cell unless ``storage``
-    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given. At every load-cell sample ``truth`` gets
+    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given; ``roll_speed`` (rad/s) is the roll servo's. At every load-cell sample ``truth`` gets
     ``(simulated time s, true tendon tension N)`` and ``roll_truth`` ``(simulated time s, true
     roll servo angle rad)`` (the newest ``TRUTH_KEPT`` of each are kept).
 
@@ -52,8 +52,9 @@ class DeviceTwin:
     """
 
     def __init__(self, plant: PlantConfig | None = None, *, cell: str = "TWIN",
-                 storage: bytearray | None = None, rx_buffer: int = RX_BUFFER) -> None:
-        self.plant = Plant(plant or PlantConfig())
+                 storage: bytearray | None = None, rx_buffer: int = RX_BUFFER,
+                 roll_speed: float = ROLL_SPEED) -> None:
+        self.plant = Plant(plant or PlantConfig(), roll_speed=roll_speed)
         cfg = self.plant.config
         self.storage = storage if storage is not None else bytearray(
             pack_calibration(cfg.tare_counts, cfg.scale_mcpn))
@@ -341,6 +342,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--print-port", action="store_true", help="print the port path on stdout")
     parser.add_argument("--link", help="also expose the pty as this symlink")
     parser.add_argument("--speed", type=float, default=1.0, help="simulated / real time")
+    parser.add_argument("--roll-speed", type=float, default=ROLL_SPEED,
+                        help="roll servo speed limit (rad/s)")
     for field in fields(PlantConfig):
         parser.add_argument(f"--{field.name.replace('_', '-')}", type=type(field.default),
                             default=field.default, help=f"plant {field.name} (SI)")
@@ -351,7 +354,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry: serve until SIGINT/SIGTERM."""
     args = _parser().parse_args(argv)
     plant = PlantConfig(**{f.name: getattr(args, f.name) for f in fields(PlantConfig)})
-    server = PtyTwin(DeviceTwin(plant), speed=args.speed, link=args.link)
+    server = PtyTwin(DeviceTwin(plant, roll_speed=args.roll_speed), speed=args.speed,
+                     link=args.link)
     done = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: done.set())

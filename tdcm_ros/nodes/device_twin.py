@@ -24,6 +24,7 @@ from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import PLANT_SPECS, PlantConfig, fault_names
+from tdcm_ros.device.plant import ROLL_SPEED
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
@@ -48,6 +49,7 @@ TWIN_SPECS = by_name(
     Spec("link", description="symlink to the pty (empty: <tmp>/tdcm_twin_<pid>)", default="",
          kind="str"),
     Spec("speed", description="simulated time / real time", default=1.0, low=0.01, high=100.0),
+    Spec("roll_speed", "rad/s", "roll servo speed limit", ROLL_SPEED, low=0.01, high=100.0),
     Spec("frame_id", description="frame of sim/tension_true", default="tdcm_tendon", kind="str"),
     Spec("publish_period_s", "s", "how often the samples are published; every load-cell sample "
          "is published", 0.01, low=0.001, high=1.0),
@@ -119,8 +121,8 @@ class DeviceTwinNode(NodeLogic):
                                            QoS(depth=100))
         self.roll_truth = port.create_publisher("sim/joint_states_true", JOINT_STATE,
                                                 QoS(depth=100))
-        self.server = PtyTwin(DeviceTwin(plant), speed=speed, link=link,
-                              line_delay=line_delay).start()
+        twin = DeviceTwin(plant, roll_speed=float(own["roll_speed"]))
+        self.server = PtyTwin(twin, speed=speed, link=link, line_delay=line_delay).start()
         self.samples = 0
         port.create_timer(period, self.publish_truth)
         self.diagnostics = Diagnostics(port, diag_period)

@@ -21,7 +21,7 @@ from tdcm_ros.device.twin import DeviceTwin
        st.floats(0.5, 20.0), st.floats(1e-4, 0.02))
 def test_plant_roll_is_rate_limited_toward_the_pulse_angle(pulses: list[int], speed: float,
                                                             dt: float) -> None:
-    plant = Plant(PlantConfig(roll_speed=speed))
+    plant = Plant(PlantConfig(), roll_speed=speed)
     for pulse in pulses:
         target = Plant.roll_target(pulse)
         for _ in range(50):
@@ -39,9 +39,10 @@ def test_roll_target_of_the_pulse_ends() -> None:
     assert Plant.roll_target(c.ROLL_PULSE_MIN_US) == pytest.approx(-math.pi / 2, abs=2e-3)
 
 
-def test_roll_speed_must_be_positive() -> None:
-    with pytest.raises(DeviceInputError, match="roll_speed"):
-        PlantConfig(roll_speed=0.0)
+@pytest.mark.parametrize("speed", [0.0, -1.0, math.inf, math.nan])
+def test_roll_speed_must_be_positive_and_finite(speed: float) -> None:
+    with pytest.raises(DeviceInputError, match=r"roll_speed = .* rad/s"):
+        Plant(PlantConfig(), roll_speed=speed)
 
 
 def test_twin_turns_the_servo_at_the_device_slew_and_samples_it() -> None:

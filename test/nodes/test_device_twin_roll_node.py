@@ -27,7 +27,7 @@ def test_twin_node_publishes_the_true_roll(runtime, spawn, context, tmp_path: Pa
     link = tmp_path / "twin_link"
     params = tmp_path / "twin.yaml"
     params.write_text(yaml.safe_dump({"device_twin": {"ros__parameters": {
-        "link": str(link), "plant": {"roll_speed": 4.0}}}}))
+        "link": str(link), "roll_speed": 4.0}}}))
     node = spawn("tdcm_ros.runtime.run_node", TWIN, "--params", str(params))
     wait_for(lambda: link.is_symlink(), 30.0, "the twin's link")
     driver = TensionDriver(DriverConfig(port=str(link), roll_rate=1.5), clock=time.monotonic)
