@@ -26,7 +26,7 @@ from tdcm_ros.device.errors import (
     PortError,
     ProtocolVersionError,
 )
-from tdcm_ros.device.plant import PLANT_SPECS, PlantConfig
+from tdcm_ros.device.plant import PLANT_SPECS, ROLL_SPEED, PlantConfig
 from tdcm_ros.device.protocol import (
     Fault,
     Heartbeat,
@@ -44,6 +44,7 @@ from tdcm_ros.device.schedule import SCHEDULE_SPECS, StepSchedule
 __all__ = [
     "DRIVER_SPECS",
     "PLANT_SPECS",
+    "ROLL_SPEED",
     "SCHEDULE_SPECS",
     "DeviceError",
     "DriverConfig",

@@ -23,8 +23,7 @@ from collections.abc import Callable
 from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.device import PLANT_SPECS, PlantConfig, fault_names
-from tdcm_ros.device.plant import ROLL_SPEED
+from tdcm_ros.device import PLANT_SPECS, ROLL_SPEED, PlantConfig, fault_names
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
