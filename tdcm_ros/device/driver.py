@@ -17,10 +17,11 @@ automatically: call :meth:`TensionDriver.clear_faults`.
 
 Roll: :meth:`TensionDriver.set_roll` clamps a roll target to ``[-roll_max, roll_max]`` (with a
 warning) and the driver slews the roll it sends (``R``) at ``roll_rate`` rad/s from the roll the
-device reports. Nothing is sent for the roll before a first request, so the servo stays where it
-is; a trip fault on the device (it stops the servo and refuses ``R`` until ``C``) drops the
-target and refuses new ones, like a disarm. The device's roll comes back in ``J`` frames after every ``T`` once it has accepted an ``R``;
-before that (two ``T`` in a row) it holds its boot position 0 rad. :attr:`StepResult.joints` holds
+device reports (a request waits until that is known). Nothing is sent for the roll before a first
+request, so the servo stays where it is; a trip fault on the device (it stops the servo and
+refuses ``R`` until ``C``) drops the target and refuses new ones, like a disarm. The device's roll
+comes back in ``J`` frames after every ``T`` once it has accepted an ``R``; before that (two ``T``
+in a row) it holds its boot position 0 rad. :attr:`StepResult.joints` holds
 one :class:`~tdcm_ros.device.protocol.RollState` per telemetry tick: the ``J`` frame, or the boot
 position; none while it is not yet known which (the first ``T`` after a banner).
 
@@ -291,20 +292,12 @@ class TensionDriver:
             self._warn(f"roll = {radians:g} rad refused: device fault "
                        f"{fault_names(self._roll_faults())}; the roll holds until clear_faults")
             return None
-        if self._roll_setpoint is None:
-            self._roll_setpoint = self.roll_position
-            self._last_roll_ramp = self._clock()
         self._roll_target = clamped
         return clamped
 
     def _roll_faults(self) -> Fault:
         """The latched faults that stop the device's roll servo (it refuses R until C)."""
         return self._latest.faults & TRIP_FAULTS if self._latest is not None else Fault(0)
-
-    @property
-    def roll_position(self) -> float:
-        """The device's roll now (rad): its latest ``J`` frame, else its boot position 0."""
-        return self._roll.position if self._roll is not None else 0.0
 
     def _refused_while_disarmed(self, what: str, *,
                                 what_stays: str = "the tendon stays released") -> bool:
@@ -530,7 +523,7 @@ class TensionDriver:
     def _forget_roll(self) -> None:
         """After a banner or a reboot the device's roll is not known until its next frames."""
         self._roll, self._roll_engaged, self._t_without_j = None, None, False
-        self._sent_roll = None
+        self._roll_setpoint = self._sent_roll = None
 
     def _on_banner(self, banner: Banner, now: float) -> None:
         """Complete the handshake; a banner nobody asked for while connected is a reboot, unless
@@ -580,10 +573,12 @@ class TensionDriver:
         """Move the roll setpoint toward the target at ``roll_rate``; send it when it changed."""
         step = self.config.roll_rate * (now - self._last_roll_ramp)
         self._last_roll_ramp = now
-        target, setpoint = self._roll_target, self._roll_setpoint
         if self._roll_faults():
             self._roll_target = self._roll_setpoint = None  # the device holds; so do we
-        if target is None or setpoint is None or not self._armed or self._roll_faults():
+        if self._roll_setpoint is None and self._roll is not None:
+            self._roll_setpoint = self._roll.position  # slew from where the device is
+        target, setpoint = self._roll_target, self._roll_setpoint
+        if target is None or setpoint is None or not self._armed:
             return
         limit = self.config.roll_max  # a lowered roll_max applies to the held target too
         target = self._roll_target = min(max(target, -limit), limit)

@@ -195,8 +195,9 @@ def test_a_t_and_its_j_in_different_steps_give_one_sample_each_tick() -> None:
                             (tick(1.04) + encode(RollState(1.04, 0.5, 0.5, 1818)),
                              (RollState(1.04, 0.5, 0.5, 1818),))]:
         port.incoming.extend(chunk)
-        assert driver.step().joints == expected
-    assert driver.roll_position == 0.5
+        result = driver.step()
+        assert result.joints == expected
+    assert result.status.roll == RollState(1.04, 0.5, 0.5, 1818)
 
 
 def test_two_ts_in_a_row_mean_the_boot_position() -> None:
@@ -218,3 +219,27 @@ def test_a_trip_fault_on_the_device_drops_the_roll_target_and_refuses_new_ones()
     assert "roll = -0.5 rad refused: device fault SENSOR; the roll holds" in warnings[-1]
     sent = [decode(line) for line in bytes(port.written).splitlines()]
     assert not any(isinstance(m, SetRoll) and m.radians < 0 for m in sent)
+
+
+def test_a_roll_request_waits_for_the_device_roll_and_slews_from_it() -> None:
+    """Connected to a device already rolled to 0.8 rad, a request for 1.0 rad starts there."""
+    now = [100.0]
+    port = FakePort(BANNER + tick(1.0))
+    driver = TensionDriver(DriverConfig(port="fake", roll_rate=1.0), clock=lambda: now[0],
+                           open_port=lambda url: port)
+    driver.step()
+    assert driver.set_roll(1.0) == 1.0
+    for _ in range(5):
+        now[0] += 0.02
+        driver.step()
+    assert not any(isinstance(m, SetRoll) for m in port.sent())  # the device's roll unknown
+    port.incoming.extend(encode(RollState(1.0, 0.8, 0.8, 2009)) + tick(1.02))
+    rolls: list[float] = []
+    for _ in range(20):
+        now[0] += 0.02
+        driver.step()
+        rolls = [m.radians for m in port.sent() if isinstance(m, SetRoll)]
+    assert rolls[0] == pytest.approx(0.8, abs=0.021)  # one 20 ms step of 1 rad/s from 0.8
+    assert rolls[-1] == pytest.approx(1.0) and rolls == sorted(rolls)
+    sends = len(rolls) - 1  # at most 2 steps (40 ms) apart: never a jump
+    assert all(b - a <= 0.04 + 1e-9 for a, b in itertools.pairwise(rolls)) and sends >= 4
