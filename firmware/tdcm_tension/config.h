@@ -39,6 +39,15 @@ constexpr int32_t CAL_LOAD_MAX_MN = 100000;
 constexpr int32_t DEFAULT_TARE = 0;
 constexpr int32_t DEFAULT_SCALE_MCPN = 1000000;
 
+// Roll servo (hobby servo, direct drive): 1500 us = 0 rad, 637 us/rad (2000 us over pi rad, so
+// 500..2500 us spans -pi/2..pi/2); _MRAD milliradians.
+constexpr int32_t ROLL_MAX_MRAD = 1571;            // |roll| the R command accepts (pi/2, rounded up)
+constexpr int32_t ROLL_SLEW_MRAD_PER_TICK = 40;    // roll slew limit per control tick (2 rad/s)
+constexpr int32_t ROLL_PULSE_CENTER_US = 1500;     // pulse at 0 rad (the boot position)
+constexpr int32_t ROLL_US_PER_RAD = 637;
+constexpr int32_t ROLL_PULSE_MIN_US = 500;
+constexpr int32_t ROLL_PULSE_MAX_US = 2500;
+
 constexpr int32_t EEPROM_MAGIC = 0x7D01;
 constexpr int32_t EEPROM_RECORD_SIZE = 11;  // magic u16, tare i32, scale i32, crc8 (LE)
 

@@ -17,7 +17,7 @@ int hex_value(char c) {
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
-// Parse "(-)?(0|[1-9][0-9]{0,2})\.[0-9]{3}" into millinewtons; false on bad syntax
+// Parse "(-)?(0|[1-9][0-9]{0,2})\.[0-9]{3}" into thousandths (mN, mrad); false on bad syntax
 // (negative zero included).
 bool parse_mn(const char* s, uint8_t n, int32_t& out) {
   uint8_t i = 0;
@@ -90,7 +90,7 @@ Reject decode_command(const char* line, uint8_t len, Command& out, char& letter)
     version = version * 10 + (v[i] - '0');
   }
   if (version != PROTOCOL_VERSION) return R_VER;
-  if (count < 2 || size[1] != 1 || strchr("SMHZKECI", body[start[1]]) == nullptr) return R_TYPE;
+  if (count < 2 || size[1] != 1 || strchr("SMHZKECIR", body[start[1]]) == nullptr) return R_TYPE;
   char type = body[start[1]];
   letter = type;
   for (uint8_t f = 2; f < count; ++f) {
@@ -100,6 +100,7 @@ Reject decode_command(const char* line, uint8_t len, Command& out, char& letter)
   out.type = type;
   out.mode = 0;
   out.mn = 0;
+  out.mrad = 0;
   if (strchr("HZECI", type) != nullptr) return fields == 0 ? R_NONE : R_FIELDS;
   if (fields != 1) return R_FIELDS;
   const char* a = body + start[2];
@@ -107,6 +108,10 @@ Reject decode_command(const char* line, uint8_t len, Command& out, char& letter)
     if (size[2] != 1 || (a[0] != 'R' && a[0] != 'T')) return R_FIELDS;
     out.mode = a[0];
     return R_NONE;
+  }
+  if (type == 'R') {
+    if (!parse_mn(a, size[2], out.mrad)) return R_FIELDS;
+    return (out.mrad < -ROLL_MAX_MRAD || out.mrad > ROLL_MAX_MRAD) ? R_RANGE : R_NONE;
   }
   if (!parse_mn(a, size[2], out.mn)) return R_FIELDS;
   int32_t low = type == 'S' ? 0 : CAL_LOAD_MIN_MN;

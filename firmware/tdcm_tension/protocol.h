@@ -1,4 +1,4 @@
-// Protocol v1 of the tension device (see firmware/PROTOCOL.md): framing, strict command
+// Protocol v1 (with the roll servo extension) of the tension device (see firmware/PROTOCOL.md): framing, strict command
 // decoding and reply encoding. Plain C++11, no Arduino headers; mirrors
 // tdcm_ros/device/protocol.py decision for decision.
 #ifndef TDCM_PROTOCOL_H
@@ -19,9 +19,10 @@ enum Reject : uint8_t {
 const char* reject_name(Reject reason);
 
 struct Command {
-  char type;      // one of S M H Z K E C I
+  char type;      // one of S M H Z K E C I R
   char mode;      // 'R' or 'T' for M
   int32_t mn;     // millinewtons for S and K
+  int32_t mrad;   // milliradians for R
 };
 
 // Decode one frame ('$' .. checksum, no '\n'). Returns R_NONE and fills `out`, or the reason;
@@ -52,7 +53,7 @@ class Writer {
   void add_char(char value);
   void add_int(int32_t value);
   void add_uint(uint32_t value);
-  void add_mn(int32_t millinewtons);   // "-12.345"
+  void add_mn(int32_t millinewtons);   // "-12.345" (also milliradians: "-1.571")
   void add_hex2(uint8_t value);
   void finish();
   const char* text() const { return buffer_; }

@@ -1,8 +1,9 @@
-// tdcm_tension: Arduino UNO tendon-tension controller (protocol v1, see ../PROTOCOL.md).
+// tdcm_tension: Arduino UNO tendon-tension controller (protocol v1 with roll, see ../PROTOCOL.md).
 //
 // Wiring: load cell on an HX711 (DOUT -> D3, SCK -> D2) or an analog amplifier (out -> A0),
 // chosen with TDCM_LOAD_CELL below (or -DTDCM_LOAD_CELL=... from the Makefile); the linear
-// actuator's servo signal on D9 (Timer1 OC1A, 0.5 us resolution, 50 Hz frame).
+// actuator's servo signal on D9 (Timer1 OC1A, 0.5 us resolution, 50 Hz frame); the roll servo's
+// signal on D10 (Timer1 OC1B, same frame).
 // All protocol and control logic lives in tension_core.cpp / protocol.cpp (plain C++).
 #include <EEPROM.h>
 
@@ -17,7 +18,8 @@
 const uint8_t PIN_HX711_DOUT = 3;
 const uint8_t PIN_HX711_SCK = 2;
 const uint8_t PIN_ANALOG = A0;
-const uint8_t PIN_SERVO = 9;  // OC1A
+const uint8_t PIN_SERVO = 9;   // OC1A
+const uint8_t PIN_ROLL = 10;   // OC1B
 const uint16_t ANALOG_PERIOD_MS = 5;
 
 class EepromStorage : public tdcm::Storage {
@@ -43,16 +45,22 @@ tdcm::TensionCore core(storage, sink, "HX711");
 tdcm::TensionCore core(storage, sink, "ANALOG");
 #endif
 
-// Servo pulse on D9 with Timer1: fast PWM mode 14, TOP = ICR1, prescaler 8 (0.5 us ticks).
+// Servo pulses on D9 and D10 with Timer1: fast PWM mode 14, TOP = ICR1, prescaler 8 (0.5 us
+// ticks). The roll servo starts at 0 rad, the boot position of the core.
 void servo_begin() {
   pinMode(PIN_SERVO, OUTPUT);
-  TCCR1A = _BV(COM1A1) | _BV(WGM11);
+  pinMode(PIN_ROLL, OUTPUT);
+  TCCR1A = _BV(COM1A1) | _BV(COM1B1) | _BV(WGM11);
   TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS11);
   ICR1 = 40000;  // 20 ms frame
   OCR1A = tdcm::PULSE_RELEASE_US * 2;
+  OCR1B = tdcm::ROLL_PULSE_CENTER_US * 2;
 }
 
-void servo_write(uint16_t pulse_us) { OCR1A = pulse_us * 2; }
+void servo_write(uint16_t pulse_us, uint16_t roll_pulse_us) {
+  OCR1A = pulse_us * 2;
+  OCR1B = roll_pulse_us * 2;
+}
 
 #if TDCM_LOAD_CELL == TDCM_CELL_HX711
 // One conversion if the HX711 has one ready (DOUT low): 24 bits, then 1 pulse = gain 128 ch A.
@@ -97,5 +105,5 @@ void loop() {
   int32_t counts;
   if (read_cell(counts)) core.sample(counts, now);
   core.tick(now);
-  servo_write(core.pulse_us());
+  servo_write(core.pulse_us(), core.roll_pulse_us());
 }

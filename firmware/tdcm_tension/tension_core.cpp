@@ -133,6 +133,11 @@ void TensionCore::execute(const Command& command) {
         release();
       }
       break;
+    case 'R':
+      if (faults_ & TRIP_FAULTS) return nack(letter, R_FAULT);
+      roll_target_mrad_ = command.mrad;
+      roll_engaged_ = true;
+      break;
     case 'E':
       release();
       faults_ |= F_ESTOP;
@@ -170,8 +175,12 @@ void TensionCore::tick(uint32_t now_ms) {
   if ((uint32_t)(now_ms - sample_ms_) > (uint32_t)SENSOR_TIMEOUT_MS) faults_ |= F_SENSOR;
   if (tension_mn_ > TRIP_MN) faults_ |= F_OVER_TENSION;
   if (mode_ == 'T' && (uint32_t)(now_ms - last_rx_ms_) >= (uint32_t)WATCHDOG_MS) faults_ |= F_WATCHDOG;
-  if (faults_ & TRIP_FAULTS) release();
+  if (faults_ & TRIP_FAULTS) {
+    release();
+    roll_target_mrad_ = roll_mrad_;  // the roll servo holds where it is
+  }
   if (mode_ == 'T') control();
+  roll();
   emit();
 }
 
@@ -187,6 +196,16 @@ void TensionCore::control() {
   pulse_us_ = limited;
 }
 
+void TensionCore::roll() {
+  roll_mrad_ += clamp(roll_target_mrad_ - roll_mrad_, -ROLL_SLEW_MRAD_PER_TICK,
+                      ROLL_SLEW_MRAD_PER_TICK);
+}
+
+uint16_t TensionCore::roll_pulse_us() const {
+  return (uint16_t)clamp(ROLL_PULSE_CENTER_US + roll_mrad_ * ROLL_US_PER_RAD / 1000,
+                         ROLL_PULSE_MIN_US, ROLL_PULSE_MAX_US);
+}
+
 void TensionCore::emit() {
   writer_.start('T');
   writer_.add_uint(last_control_ms_);
@@ -195,6 +214,14 @@ void TensionCore::emit() {
   writer_.add_int(pulse_us_);
   writer_.add_char(mode_);
   writer_.add_hex2(faults_);
+  writer_.finish();
+  sink_.send(writer_.text(), writer_.size());
+  if (!roll_engaged_) return;
+  writer_.start('J');
+  writer_.add_uint(last_control_ms_);
+  writer_.add_mn(roll_target_mrad_);
+  writer_.add_mn(roll_mrad_);
+  writer_.add_int(roll_pulse_us());
   writer_.finish();
   sink_.send(writer_.text(), writer_.size());
 }

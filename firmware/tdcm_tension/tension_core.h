@@ -1,4 +1,4 @@
-// Tension device core: protocol handling and the PI tension loop. Plain C++11, no Arduino
+// Tension device core: protocol handling, the PI tension loop and the roll servo slew. Plain C++11, no Arduino
 // headers; the sketch and the host harness (firmware/host/sim_main.cpp) both drive it.
 // Python twin: tdcm_ros/device/core.py (same integer arithmetic, same decisions).
 #ifndef TDCM_TENSION_CORE_H
@@ -42,6 +42,7 @@ class TensionCore {
   void sample(int32_t raw, uint32_t now_ms);  // a fresh load-cell reading (counts)
   void tick(uint32_t now_ms);                 // call often; controls every period
   uint16_t pulse_us() const { return (uint16_t)pulse_us_; }
+  uint16_t roll_pulse_us() const;             // roll servo pulse for the current roll
 
  private:
   void banner();
@@ -50,6 +51,7 @@ class TensionCore {
   void nack(char letter, Reject reason);
   void execute(const Command& command);
   void control();
+  void roll();
   void emit();
 
   Storage& storage_;
@@ -65,6 +67,9 @@ class TensionCore {
   int32_t integral_mus_ = 0;
   int32_t raw_ = 0;
   int32_t tension_mn_ = 0;
+  int32_t roll_target_mrad_ = 0;  // where the roll servo is going
+  int32_t roll_mrad_ = 0;         // where its pulse points now (slew-limited)
+  bool roll_engaged_ = false;     // an R was accepted since boot: J frames follow every T
   int32_t tare_ = DEFAULT_TARE;
   int32_t scale_mcpn_ = DEFAULT_SCALE_MCPN;
   uint32_t sample_ms_ = 0;

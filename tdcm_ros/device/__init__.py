@@ -26,12 +26,14 @@ from tdcm_ros.device.errors import (
     PortError,
     ProtocolVersionError,
 )
-from tdcm_ros.device.plant import PLANT_SPECS, PlantConfig
+from tdcm_ros.device.plant import PLANT_SPECS, ROLL_SPEED, PlantConfig
 from tdcm_ros.device.protocol import (
     Fault,
     Heartbeat,
     Mode,
+    RollState,
     SetMode,
+    SetRoll,
     SetSetpoint,
     Telemetry,
     decode,
@@ -42,6 +44,7 @@ from tdcm_ros.device.schedule import SCHEDULE_SPECS, StepSchedule
 __all__ = [
     "DRIVER_SPECS",
     "PLANT_SPECS",
+    "ROLL_SPEED",
     "SCHEDULE_SPECS",
     "DeviceError",
     "DriverConfig",
@@ -55,7 +58,9 @@ __all__ = [
     "PlantConfig",
     "PortError",
     "ProtocolVersionError",
+    "RollState",
     "SetMode",
+    "SetRoll",
     "SetSetpoint",
     "StepSchedule",
     "Telemetry",

@@ -4,8 +4,8 @@ This is the one Python place for them; the firmware's twin of this file is
 ``firmware/tdcm_tension/config.h`` and ``test_constants_match`` in
 ``test/firmware/test_firmware_core.py`` checks that the
 two agree. Names carry their unit: ``_MS`` milliseconds, ``_MN`` millinewtons, ``_US``
-microseconds of servo pulse. The control loop works in these integer units on both sides so the
-twin and the firmware compute bit-identical results.
+microseconds of servo pulse, ``_MRAD`` milliradians. The control loop works in these integer units
+on both sides so the twin and the firmware compute bit-identical results.
 """
 
 from __future__ import annotations
@@ -38,6 +38,13 @@ CAL_LOAD_MIN_MN = 100         #: known load accepted by the calibrate command
 CAL_LOAD_MAX_MN = 100000
 DEFAULT_TARE = 0              #: used when the EEPROM record is invalid (CAL fault set)
 DEFAULT_SCALE_MCPN = 1_000_000
+
+ROLL_MAX_MRAD = 1571          #: |roll| the R command accepts, in mrad (pi/2 rounded up)
+ROLL_SLEW_MRAD_PER_TICK = 40  #: roll slew limit per control tick, in mrad (2 rad/s)
+ROLL_PULSE_CENTER_US = 1500   #: roll servo pulse at 0 rad (the boot position)
+ROLL_US_PER_RAD = 637         #: roll servo gain: 2000 us over pi rad (500..2500 us = -pi/2..pi/2)
+ROLL_PULSE_MIN_US = 500       #: roll servo pulse clamp, low end
+ROLL_PULSE_MAX_US = 2500      #: roll servo pulse clamp, high end
 
 EEPROM_MAGIC = 0x7D01         #: first two bytes of the calibration record
 EEPROM_RECORD_SIZE = 11       #: magic u16 + tare i32 + scale i32 + crc8, little endian

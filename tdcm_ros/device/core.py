@@ -8,6 +8,8 @@ Control (every ``CONTROL_PERIOD_MS``): tension = (raw - tare) * 1e6 / scale [mN]
 stale load cell, over-tension and host silence latch faults and release; in mode T a PI law
 ``pulse = PULSE_RELEASE + KP*e + I`` is clamped to the pulse range and slew-limited, and the
 integral is frozen while the output is limited in the direction of the error (anti-windup).
+The roll servo's position slews toward its target by at most ``ROLL_SLEW_MRAD_PER_TICK`` per
+tick; a trip fault stops it where it is (target = position) and R is refused until C.
 """
 
 from __future__ import annotations
@@ -31,7 +33,9 @@ from tdcm_ros.device.protocol import (
     Mode,
     Nack,
     Reject,
+    RollState,
     SetMode,
+    SetRoll,
     SetSetpoint,
     Tare,
     Telemetry,
@@ -100,6 +104,9 @@ class TensionCore:
         self.integral_mus = 0
         self.raw = 0
         self.tension_mn = 0
+        self.roll_target_mrad = 0   #: where the roll servo is going
+        self.roll_mrad = 0          #: where its pulse points now (slew-limited)
+        self.roll_engaged = False   #: an R was accepted since boot: J frames follow every T
         self.have_sample = False
         self.sample_ms = 0
         self.last_rx_ms = 0
@@ -167,6 +174,11 @@ class TensionCore:
                     self.integral_mus = 0
             case SetMode(mode=Mode.RELEASE):
                 self._release()
+            case SetRoll(radians=r):
+                if self.faults & TRIP_FAULTS:
+                    return self._refuse("R", Reject.FAULT)
+                self.roll_target_mrad = round(r * 1000)
+                self.roll_engaged = True
             case EStop():
                 self._release()
                 self.faults |= Fault.ESTOP
@@ -207,11 +219,24 @@ class TensionCore:
             self.faults |= Fault.WATCHDOG
         if self.faults & TRIP_FAULTS:
             self._release()
+            self.roll_target_mrad = self.roll_mrad  # the roll servo holds where it is
         if self.mode is Mode.TENSION:
             self._control()
-        self.send(encode(Telemetry(time=(now_ms & 0xFFFFFFFF) / 1000, raw=self.raw,
-                                   tension=self.tension_mn / 1000, pulse_us=self.pulse_us,
-                                   mode=self.mode, faults=self.faults)))
+        self.roll_mrad += clamp(self.roll_target_mrad - self.roll_mrad,
+                                -c.ROLL_SLEW_MRAD_PER_TICK, c.ROLL_SLEW_MRAD_PER_TICK)
+        stamp = (now_ms & 0xFFFFFFFF) / 1000
+        self.send(encode(Telemetry(time=stamp, raw=self.raw, tension=self.tension_mn / 1000,
+                                   pulse_us=self.pulse_us, mode=self.mode, faults=self.faults)))
+        if self.roll_engaged:
+            self.send(encode(RollState(time=stamp, target=self.roll_target_mrad / 1000,
+                                       position=self.roll_mrad / 1000,
+                                       pulse_us=self.roll_pulse_us)))
+
+    @property
+    def roll_pulse_us(self) -> int:
+        """The roll servo's pulse for the current roll, in us."""
+        return clamp(c.ROLL_PULSE_CENTER_US + cdiv(self.roll_mrad * c.ROLL_US_PER_RAD, 1000),
+                     c.ROLL_PULSE_MIN_US, c.ROLL_PULSE_MAX_US)
 
     def _control(self) -> None:
         error = self.setpoint_mn - self.tension_mn
@@ -227,4 +252,4 @@ class TensionCore:
 
 
 _LETTER: dict[type, str] = {SetSetpoint: "S", SetMode: "M", Tare: "Z", Calibrate: "K",
-                            EStop: "E", ClearFaults: "C"}
+                            EStop: "E", ClearFaults: "C", SetRoll: "R"}

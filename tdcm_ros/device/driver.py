@@ -15,8 +15,19 @@ the port and retry after an exponential backoff (``backoff_initial`` doubling to
 ``backoff_max``). Device faults (watchdog, over-tension, e-stop, sensor) are never cleared
 automatically: call :meth:`TensionDriver.clear_faults`.
 
+Roll: :meth:`TensionDriver.set_roll` clamps a roll target to ``[-roll_max, roll_max]`` (with a
+warning) and the driver slews the roll it sends (``R``) at ``roll_rate`` rad/s from the roll the
+device reports (a request waits until that is known). Nothing is sent for the roll before a first
+request, so the servo stays where it is; a trip fault on the device (it stops the servo and
+refuses ``R`` until ``C``) drops the target and refuses new ones, like a disarm. The device's roll
+comes back in ``J`` frames after every ``T`` once it has accepted an ``R``; before that (two ``T``
+in a row) it holds its boot position 0 rad. :attr:`StepResult.joints` holds
+one :class:`~tdcm_ros.device.protocol.RollState` per telemetry tick: the ``J`` frame, or the boot
+position; none while it is not yet known which (the first ``T`` after a banner).
+
 Arming: the driver starts armed. It disarms -- target and setpoint 0 N, schedule cancelled, mode
-R sent, setpoints and schedules refused -- on an e-stop and on every event after which the device's
+R sent, setpoints, schedules and roll targets refused, the roll left where the device holds it --
+on an e-stop and on every event after which the device's
 state is unknown: the link lost while connected (port error, ``link_timeout``, a version
 mismatch), a device reboot (a banner nobody asked for once telemetry has flowed, or the device
 clock running backwards)
@@ -35,6 +46,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from tdcm_ros.device import constants as c
+from tdcm_ros.device.core import TRIP_FAULTS
 from tdcm_ros.device.errors import (
     DeviceInputError,
     FrameError,
@@ -43,6 +55,7 @@ from tdcm_ros.device.errors import (
 )
 from tdcm_ros.device.protocol import (
     DEVICE_TYPES,
+    Ack,
     Banner,
     ClearFaults,
     Command,
@@ -54,7 +67,9 @@ from tdcm_ros.device.protocol import (
     Mode,
     Nack,
     Reject,
+    RollState,
     SetMode,
+    SetRoll,
     SetSetpoint,
     Telemetry,
     encode,
@@ -113,6 +128,11 @@ class DriverConfig:
                                         description="first reconnect delay")
     backoff_max: float = spec_field(8.0, unit="s", low=0.01, high=600.0,
                                     description="largest reconnect delay")
+    roll_max: float = spec_field(math.pi / 2, unit="rad", low=0.0, high=c.ROLL_MAX_MRAD / 1000,
+                                 description="largest |roll| target")
+    roll_rate: float = spec_field(
+        1.0, unit="rad/s", low=0.01, high=c.ROLL_SLEW_MRAD_PER_TICK / c.CONTROL_PERIOD_MS,
+        description="roll slew rate (the device's own limit is 2 rad/s)")
 
     def __post_init__(self) -> None:
         check_fields(self, DRIVER_SPECS, error=DeviceInputError)
@@ -143,6 +163,9 @@ class DriverStatus:
     rejected_lines: int           #: malformed lines from the device
     nacks: int                    #: commands the device refused
     disarms: int                  #: times the driver disarmed since start
+    roll: RollState | None = None        #: latest roll of the device (None: not known yet)
+    roll_target: float | None = None     #: rad, requested roll after clamping (None: none)
+    roll_setpoint: float | None = None   #: rad, roll last slewed toward the target
 
 
 @dataclass(frozen=True)
@@ -151,6 +174,7 @@ class StepResult:
 
     telemetry: tuple[Telemetry, ...]
     status: DriverStatus
+    joints: tuple[RollState, ...] = ()  #: the roll at each telemetry tick known this step
 
 
 def fault_names(faults: Fault) -> str:
@@ -198,6 +222,14 @@ class TensionDriver:
         self._sent_setpoint: float | None = None
         self._schedule: StepSchedule | None = None
         self._schedule_start = 0.0
+        self._roll: RollState | None = None     # the latest J frame or boot position
+        self._roll_engaged: bool | None = None  # the device sends J frames (None: not known)
+        self._t_without_j = False               # the last frame was a T, no J after it yet
+        self._joints: list[RollState] = []      # roll samples of the current step
+        self._roll_target: float | None = None
+        self._roll_setpoint: float | None = None
+        self._sent_roll: float | None = None
+        self._last_roll_send = self._last_roll_ramp = clock()
         now = clock()
         self._since = now  # start of the current link phase
         self._last_rx = self._last_heartbeat = self._last_setpoint = self._last_mode = now
@@ -241,11 +273,38 @@ class TensionDriver:
         self._schedule_start = self._clock()
         return True
 
-    def _refused_while_disarmed(self, what: str) -> bool:
+    def set_roll(self, radians: float) -> float | None:
+        """Request a roll (rad), clamped to ``[-roll_max, roll_max]`` with a warning; slewed at
+        ``roll_rate``. Returns the roll target now held (the clamped value), or None when refused
+        with a warning: while disarmed or with a trip fault latched (the roll holds)."""
+        limit = self.config.roll_max
+        if not math.isfinite(radians):
+            raise out_of_range("roll", radians, "a finite number", unit="rad",
+                               error=DeviceInputError)
+        clamped = min(max(radians, -limit), limit)
+        if clamped != radians:
+            self._warn(f"roll = {radians:g} rad is out of range [{-limit:g}, {limit:g}] rad; "
+                       f"clamped to {clamped:g} rad")
+        if self._refused_while_disarmed(f"roll = {radians:g} rad", what_stays="the roll holds"):
+            return None
+        if self._roll_faults():
+            self._roll_target = self._roll_setpoint = None
+            self._warn(f"roll = {radians:g} rad refused: device fault "
+                       f"{fault_names(self._roll_faults())}; the roll holds until clear_faults")
+            return None
+        self._roll_target = clamped
+        return clamped
+
+    def _roll_faults(self) -> Fault:
+        """The latched faults that stop the device's roll servo (it refuses R until C)."""
+        return self._latest.faults & TRIP_FAULTS if self._latest is not None else Fault(0)
+
+    def _refused_while_disarmed(self, what: str, *,
+                                what_stays: str = "the tendon stays released") -> bool:
         if self._armed:
             return False
-        self._warn(f"{what} refused: disarmed ({self._disarm_reason}); the tendon stays released "
-                   f"until clear_faults, then needs a new setpoint")
+        self._warn(f"{what} refused: disarmed ({self._disarm_reason}); {what_stays} until "
+                   f"clear_faults, then needs a new setpoint")
         return True
 
     @property
@@ -302,6 +361,7 @@ class TensionDriver:
         self._schedule = None
         self._target = self._setpoint = 0.0
         self._sent_setpoint = None
+        self._roll_target = self._roll_setpoint = self._sent_roll = None  # the roll holds
         self._warn(f"disarmed: {reason}; tendon held released until clear_faults")
         if send_release and self._transport is not None:
             try:
@@ -320,6 +380,7 @@ class TensionDriver:
         """Do everything due now; raises :class:`ProtocolVersionError` on a version mismatch."""
         now = self._clock()
         received: list[Telemetry] = []
+        self._joints = []
         if self._link is LinkState.DISCONNECTED and now >= self._next_attempt:
             self._connect(now)
         if self._transport is not None:
@@ -327,7 +388,7 @@ class TensionDriver:
                 self._service(now, received)
             except PortError as error:
                 self._drop(str(error))
-        return StepResult(tuple(received), self._status(now))
+        return StepResult(tuple(received), self._status(now), tuple(self._joints))
 
     def _connect(self, now: float) -> None:
         try:
@@ -422,6 +483,12 @@ class TensionDriver:
         if isinstance(message, Telemetry):
             received.append(message)
             self._on_telemetry(message, now)
+            self._roll_tick(message)
+        elif isinstance(message, RollState):
+            self._roll, self._roll_engaged, self._t_without_j = message, True, False
+            self._joints.append(message)
+        elif isinstance(message, Ack) and message.command == "R":
+            self._roll_engaged = True  # J frames follow from the next tick on
         elif isinstance(message, Banner):
             self._on_banner(message, now)
         elif isinstance(message, Nack):
@@ -437,10 +504,26 @@ class TensionDriver:
                 and previous.time - frame.time < CLOCK_WRAP / 2:
             self._warn(f"device rebooted: its clock went back from {previous.time:.3f} s to "
                        f"{frame.time:.3f} s")
+            self._forget_roll()
             if self._armed:
                 self._disarm("device rebooted")
         elif silent and self._armed:
             self._disarm(f"device silent for {silence:.2f} s (frozen?)")
+
+    def _roll_tick(self, frame: Telemetry) -> None:
+        """A ``T`` frame: a ``J`` follows it if the device's roll is engaged; two ``T`` in a row
+        show it is not, so it holds its boot position 0 rad."""
+        if self._roll_engaged is None and self._t_without_j:
+            self._roll_engaged = False
+        self._t_without_j = True
+        if self._roll_engaged is False:
+            self._roll = RollState(frame.time, 0.0, 0.0, c.ROLL_PULSE_CENTER_US)
+            self._joints.append(self._roll)
+
+    def _forget_roll(self) -> None:
+        """After a banner or a reboot the device's roll is not known until its next frames."""
+        self._roll, self._roll_engaged, self._t_without_j = None, None, False
+        self._roll_setpoint = self._sent_roll = None
 
     def _on_banner(self, banner: Banner, now: float) -> None:
         """Complete the handshake; a banner nobody asked for while connected is a reboot, unless
@@ -453,6 +536,7 @@ class TensionDriver:
             self._latest = None  # the old frames' clock is not the new boot's
             if self._armed:
                 self._disarm("device rebooted")
+        self._forget_roll()
         self._banner, self._link = banner, LinkState.CONNECTED
         self._last_rx = self._last_ramp = now
         self._backoff = self.config.backoff_initial
@@ -473,6 +557,7 @@ class TensionDriver:
         if self._sent_setpoint != self._setpoint and now - self._last_setpoint >= SETPOINT_PERIOD:
             self._last_setpoint, self._sent_setpoint = now, self._setpoint
             self._send(SetSetpoint(self._setpoint))
+        self._slew_roll(now)
         latest = self._latest
         if latest is None or now - self._last_mode < MODE_RETRY:
             return
@@ -483,6 +568,25 @@ class TensionDriver:
         elif not holding and latest.mode is Mode.TENSION:
             self._last_mode = now
             self._send(SetMode(Mode.RELEASE))
+
+    def _slew_roll(self, now: float) -> None:
+        """Move the roll setpoint toward the target at ``roll_rate``; send it when it changed."""
+        step = self.config.roll_rate * (now - self._last_roll_ramp)
+        self._last_roll_ramp = now
+        if self._roll_faults():
+            self._roll_target = self._roll_setpoint = None  # the device holds; so do we
+        if self._roll_setpoint is None and self._roll is not None:
+            self._roll_setpoint = self._roll.position  # slew from where the device is
+        target, setpoint = self._roll_target, self._roll_setpoint
+        if target is None or setpoint is None or not self._armed:
+            return
+        limit = self.config.roll_max  # a lowered roll_max applies to the held target too
+        target = self._roll_target = min(max(target, -limit), limit)
+        setpoint += max(-step, min(step, target - setpoint))
+        self._roll_setpoint = setpoint
+        if self._sent_roll != setpoint and now - self._last_roll_send >= SETPOINT_PERIOD:
+            self._last_roll_send, self._sent_roll = now, setpoint
+            self._send(SetRoll(setpoint))
 
     # --- status ------------------------------------------------------------------------------
     def _status(self, now: float) -> DriverStatus:
@@ -510,4 +614,5 @@ class TensionDriver:
                             disarm_reason=self._disarm_reason, telemetry=latest,
                             banner=self._banner, reconnects=self._reconnects,
                             rejected_lines=self._rejected, nacks=self._nacks,
-                            disarms=self._disarms)
+                            disarms=self._disarms, roll=self._roll,
+                            roll_target=self._roll_target, roll_setpoint=self._roll_setpoint)

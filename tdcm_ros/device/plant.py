@@ -1,4 +1,4 @@
-"""The bench the twin simulates: linear actuator, tendon and load cell.
+"""The bench the twin simulates: linear actuator, tendon, load cell and roll servo.
 
 The actuator maps the servo pulse linearly onto ``stroke`` metres of travel between
 ``PULSE_MIN_US`` and ``PULSE_MAX_US``; its position follows the command through a first-order
@@ -11,6 +11,11 @@ of ``quantum`` counts, every ``sample_period`` s, where ``t`` is the plant's run
 ``bias`` an offset (N) and ``drift`` a linear drift (N/s); the noise is Gaussian with ``noise`` N
 standard deviation drawn from a generator seeded with ``seed``. :attr:`Plant.tension` is the true
 tendon tension, which bias, drift and noise do not touch.
+
+The roll servo (a hobby servo without position feedback) turns toward the angle its pulse
+commands, ``(pulse - ROLL_PULSE_CENTER_US) / ROLL_US_PER_RAD`` rad, at most ``roll_speed`` rad/s
+(an argument of :class:`Plant`, not a :class:`PlantConfig` field: scenes own those);
+:attr:`Plant.roll` is its true angle (rad).
 """
 
 from __future__ import annotations
@@ -67,6 +72,8 @@ class PlantConfig:
         return round(self.counts_per_newton * 1000)
 
 
+ROLL_SPEED = 8.7  #: rad/s, default roll servo speed limit (a hobby servo: 0.12 s per 60 deg)
+
 #: Specs of the plant parameters, by field name.
 PLANT_SPECS = specs_of(PlantConfig)
 
@@ -74,9 +81,14 @@ PLANT_SPECS = specs_of(PlantConfig)
 class Plant:
     """State of the simulated bench; :meth:`step` advances it by ``dt`` s."""
 
-    def __init__(self, config: PlantConfig) -> None:
+    def __init__(self, config: PlantConfig, *, roll_speed: float = ROLL_SPEED) -> None:
+        if not (math.isfinite(roll_speed) and roll_speed > 0):
+            raise out_of_range("roll_speed", roll_speed, "(0, inf)", unit="rad/s",
+                               error=DeviceInputError)
         self.config = config
+        self.roll_speed = roll_speed  #: rad/s, roll servo speed limit
         self.position = 0.0
+        self.roll = 0.0  #: rad, true angle of the roll servo
         self.time = 0.0  #: s the plant has run
         self._random = random.Random(config.seed)
 
@@ -86,9 +98,16 @@ class Plant:
         fraction = min(max((pulse_us - c.PULSE_MIN_US) / span, 0.0), 1.0)
         return fraction * self.config.stroke
 
-    def step(self, pulse_us: int, dt: float) -> None:
-        """Move the actuator toward the pulse's position for ``dt`` s."""
+    @staticmethod
+    def roll_target(roll_pulse_us: int) -> float:
+        """Roll angle commanded by a roll servo pulse, in rad."""
+        return (roll_pulse_us - c.ROLL_PULSE_CENTER_US) / c.ROLL_US_PER_RAD
+
+    def step(self, pulse_us: int, dt: float, roll_pulse_us: int = c.ROLL_PULSE_CENTER_US) -> None:
+        """Move the actuator and the roll servo toward their pulses' positions for ``dt`` s."""
         cfg = self.config
+        turn = self.roll_speed * dt
+        self.roll += min(max(self.roll_target(roll_pulse_us) - self.roll, -turn), turn)
         target = self.target(pulse_us)
         substeps = max(1, math.ceil(dt / cfg.lag))  # explicit Euler stays stable for h <= lag
         h = dt / substeps

@@ -1,6 +1,6 @@
 """The tension device's serial line protocol: pure encode/decode, no I/O.
 
-Wire format (protocol version 1, 115200 baud 8N1, ASCII)::
+Wire format (protocol version 1 with the roll extension, 115200 baud 8N1, ASCII)::
 
     $<version>,<type>[,<field>...]*<HH>\\n
 
@@ -22,6 +22,7 @@ K     newtons              calibrate: the applied known load, 0.100 .. 100.000 N
 E     -                    e-stop: release at once and latch the ESTOP fault
 C     -                    clear latched faults (not CAL; refused while over the trip)
 I     -                    ask for the banner
+R     radians              roll servo target, -1.571 .. 1.571 rad (refused with a trip fault)
 ====  ===================  ==========================================================
 
 Device -> host:
@@ -34,9 +35,15 @@ B     TDCM, firmware version, load cell, control period ms, watchdog ms, setpoin
 T     time ms (u32), raw counts (i32), tension N, pulse us, mode R|T, faults (2 hex)
 A     command letter -- command accepted (heartbeats are not acknowledged)
 N     command letter or ``?``, reason -- command rejected (see :class:`Reject`)
+J     time ms (u32), roll target rad, roll rad, roll pulse us -- after every T once an R
+      was accepted since boot (before that the servo holds 0 rad, its boot position)
 ====  ===============================================================================
 
-Fault bits: 01 over-tension, 02 watchdog, 04 e-stop, 08 sensor, 10 calibration invalid.
+The roll extension (R, J) is additive: a host that never sends R sees exactly the stream of a
+device without a roll servo, so the version stays 1.
+
+Fault bits (the trip faults 01-08 also stop the roll servo where it is and refuse R until C):
+01 over-tension, 02 watchdog, 04 e-stop, 08 sensor, 10 calibration invalid.
 A decoded line is either a complete frame or a :class:`~tdcm_ros.device.errors.FrameError`
 naming the :class:`Reject` reason; nothing is ever half-applied. :class:`LineDecoder` frames an
 arbitrary byte stream: a ``$`` always starts a new frame, so garbage never hides a valid frame
@@ -46,6 +53,7 @@ that follows it.
 from __future__ import annotations
 
 import enum
+import math
 import re
 from collections import Counter
 from collections.abc import Callable, Iterable
@@ -122,6 +130,13 @@ class Info:
 
 
 @dataclass(frozen=True)
+class SetRoll:
+    """Command R: roll servo target in rad."""
+
+    radians: float
+
+
+@dataclass(frozen=True)
 class Banner:
     """Device B: identity and limits. Times in s, forces in N."""
 
@@ -146,6 +161,17 @@ class Telemetry:
 
 
 @dataclass(frozen=True)
+class RollState:
+    """Device J: the roll servo at one control tick. ``time`` in s (the tick's T frame), ``target``
+    and ``position`` (where the slew-limited pulse points now) in rad, ``pulse_us`` in us."""
+
+    time: float
+    target: float
+    position: float
+    pulse_us: int
+
+
+@dataclass(frozen=True)
 class Ack:
     """Device A: the command with this letter was accepted."""
 
@@ -160,12 +186,13 @@ class Nack:
     reason: Reject
 
 
-Command = SetSetpoint | SetMode | Heartbeat | Tare | Calibrate | EStop | ClearFaults | Info
-DeviceMessage = Banner | Telemetry | Ack | Nack
+Command = (SetSetpoint | SetMode | Heartbeat | Tare | Calibrate | EStop | ClearFaults | Info
+           | SetRoll)
+DeviceMessage = Banner | Telemetry | RollState | Ack | Nack
 Message = Command | DeviceMessage
 
-COMMAND_TYPES = frozenset("SMHZKECI")
-DEVICE_TYPES = frozenset("BTAN")
+COMMAND_TYPES = frozenset("SMHZKECIR")
+DEVICE_TYPES = frozenset("BTANJ")
 _FIELDLESS: dict[str, type] = {"H": Heartbeat, "Z": Tare, "E": EStop, "C": ClearFaults, "I": Info}
 
 # --- field syntax ---------------------------------------------------------------------------
@@ -186,12 +213,12 @@ def checksum(body: bytes) -> int:
     return value
 
 
-def _mn(newtons: float, parameter: str, low_mn: int, high_mn: int) -> int:
-    """Newtons -> integer millinewtons, range-checked for encoding."""
-    mn = round(newtons * 1000.0)
-    if not low_mn <= mn <= high_mn:
+def _mn(newtons: float, parameter: str, low_mn: int, high_mn: int, unit: str = "N") -> int:
+    """Newtons (or radians) -> integer thousandths, range-checked for encoding."""
+    mn = round(newtons * 1000.0) if math.isfinite(newtons) else None
+    if mn is None or not low_mn <= mn <= high_mn:
         raise out_of_range(parameter, newtons, f"[{low_mn / 1000:.3f}, {high_mn / 1000:.3f}]",
-                           unit="N", error=DeviceInputError)
+                           unit=unit, error=DeviceInputError)
     return mn
 
 
@@ -206,6 +233,8 @@ def _fields(message: Message) -> list[str]:
             return ["S", _fmt_mn(_mn(n, "setpoint", 0, c.SETPOINT_MAX_MN))]
         case SetMode(mode=m):
             return ["M", m.value]
+        case SetRoll(radians=r):
+            return ["R", _fmt_mn(_mn(r, "roll", -c.ROLL_MAX_MRAD, c.ROLL_MAX_MRAD, "rad"))]
         case Calibrate(newtons=n):
             return ["K", _fmt_mn(_mn(n, "known_load", c.CAL_LOAD_MIN_MN, c.CAL_LOAD_MAX_MN))]
         case Heartbeat() | Tare() | EStop() | ClearFaults() | Info():
@@ -218,6 +247,9 @@ def _fields(message: Message) -> list[str]:
             return ["T", str(round(message.time * 1000)), str(message.raw),
                     _fmt_mn(round(message.tension * 1000)), str(message.pulse_us),
                     message.mode.value, f"{int(message.faults):02X}"]
+        case RollState():
+            return ["J", str(round(message.time * 1000)), _fmt_mn(round(message.target * 1000)),
+                    _fmt_mn(round(message.position * 1000)), str(message.pulse_us)]
         case Ack(command=letter):
             return ["A", letter]
         case Nack(command=letter, reason=reason):
@@ -244,7 +276,7 @@ def _reject(reason: Reject, detail: str, *, command: str | None = None,
                       command=command, version=version)
 
 
-def _parse_mn(text: str, name: str, low: int, high: int, letter: str) -> int:
+def _parse_mn(text: str, name: str, low: int, high: int, letter: str, unit: str = "N") -> int:
     match = _NEWTONS.fullmatch(text)
     if match is None:
         raise _reject(Reject.FIELDS, f"{name} = {text!r} is not a decimal with 3 decimals",
@@ -255,8 +287,8 @@ def _parse_mn(text: str, name: str, low: int, high: int, letter: str) -> int:
             raise _reject(Reject.FIELDS, f"{name} = {text!r}: negative zero", command=letter)
         mn = -mn
     if not low <= mn <= high:
-        raise _reject(Reject.RANGE, f"{name} = {text} N is out of range; allowed: "
-                      f"[{_fmt_mn(low)}, {_fmt_mn(high)}] N", command=letter)
+        raise _reject(Reject.RANGE, f"{name} = {text} {unit} is out of range; allowed: "
+                      f"[{_fmt_mn(low)}, {_fmt_mn(high)}] {unit}", command=letter)
     return mn
 
 
@@ -283,6 +315,9 @@ def _decode_command(letter: str, f: list[str]) -> Command:
     _expect(f, 1, letter)
     if letter == "S":
         return SetSetpoint(_parse_mn(f[0], "setpoint", 0, c.SETPOINT_MAX_MN, letter) / 1000)
+    if letter == "R":
+        return SetRoll(_parse_mn(f[0], "roll", -c.ROLL_MAX_MRAD, c.ROLL_MAX_MRAD, letter,
+                                 "rad") / 1000)
     if letter == "K":
         return Calibrate(_parse_mn(f[0], "known_load", c.CAL_LOAD_MIN_MN, c.CAL_LOAD_MAX_MN,
                                    letter) / 1000)
@@ -302,6 +337,14 @@ def _decode_device(letter: str, f: list[str]) -> DeviceMessage:
                                            c.TENSION_LIMIT_MN, letter) / 1000,
                          pulse_us=_parse_int(f[3], "pulse_us", 0, 9999, letter),
                          mode=Mode(f[4]), faults=Fault(int(f[5], 16)))
+    if letter == "J":
+        _expect(f, 4, letter)
+        return RollState(time=_parse_int(f[0], "time_ms", 0, 2**32 - 1, letter) / 1000,
+                         target=_parse_mn(f[1], "roll_target", -c.ROLL_MAX_MRAD,
+                                          c.ROLL_MAX_MRAD, letter, "rad") / 1000,
+                         position=_parse_mn(f[2], "roll", -c.ROLL_MAX_MRAD, c.ROLL_MAX_MRAD,
+                                            letter, "rad") / 1000,
+                         pulse_us=_parse_int(f[3], "roll_pulse_us", 0, 9999, letter))
     if letter == "B":
         _expect(f, 7, letter)
         if f[0] != "TDCM" or _WORD.fullmatch(f[1]) is None or _WORD.fullmatch(f[2]) is None:

@@ -31,7 +31,7 @@ from typing import Self
 
 from tdcm_ros.device.core import TensionCore, pack_calibration
 from tdcm_ros.device.errors import DeviceInputError
-from tdcm_ros.device.plant import Plant, PlantConfig
+from tdcm_ros.device.plant import ROLL_SPEED, Plant, PlantConfig
 from tdcm_ros.errors import out_of_range
 
 TRUTH_KEPT = 4096  #: ground-truth samples kept until taken (older ones are dropped)
@@ -42,8 +42,9 @@ class DeviceTwin:
     """Firmware core + plant in simulated time; ``output`` collects the bytes it sends.
 
     The EEPROM starts with a calibration matching the plant's load cell unless ``storage``
-    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given. At every load-cell sample ``truth`` gets
-    ``(simulated time s, true tendon tension N)`` (the newest ``TRUTH_KEPT`` are kept).
+    (an ``EEPROM_RECORD_SIZE`` byte buffer) is given; ``roll_speed`` (rad/s) is the roll servo's. At every load-cell sample ``truth`` gets
+    ``(simulated time s, true tendon tension N)`` and ``roll_truth`` ``(simulated time s, true
+    roll servo angle rad)`` (the newest ``TRUTH_KEPT`` of each are kept).
 
     Failures: :meth:`reboot` (a reset: fresh firmware state, boot banner, EEPROM kept) and
     :attr:`hung` (the firmware's loop stalls while time and the bench go on; see :meth:`advance`);
@@ -51,13 +52,15 @@ class DeviceTwin:
     """
 
     def __init__(self, plant: PlantConfig | None = None, *, cell: str = "TWIN",
-                 storage: bytearray | None = None, rx_buffer: int = RX_BUFFER) -> None:
-        self.plant = Plant(plant or PlantConfig())
+                 storage: bytearray | None = None, rx_buffer: int = RX_BUFFER,
+                 roll_speed: float = ROLL_SPEED) -> None:
+        self.plant = Plant(plant or PlantConfig(), roll_speed=roll_speed)
         cfg = self.plant.config
         self.storage = storage if storage is not None else bytearray(
             pack_calibration(cfg.tare_counts, cfg.scale_mcpn))
         self.output = bytearray()
         self.truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_KEPT)
+        self.roll_truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_KEPT)
         self.cell = cell
         self.core = TensionCore(self.storage, cell=cell, send=self.output.extend)
         self.now_ms = 0
@@ -100,18 +103,19 @@ class DeviceTwin:
     def advance(self, seconds: float) -> None:
         """Run the bench and the firmware for ``seconds`` of simulated time (1 ms steps).
 
-        While :attr:`hung` the firmware neither samples, ticks nor sends: the actuator holds its
-        last pulse. Once it is cleared, the buffered host bytes are read first."""
+        While :attr:`hung` the firmware neither samples, ticks nor sends: the actuator and the roll
+        servo hold their last pulses. Once it is cleared, the buffered host bytes are read first."""
         if not self.hung and self._held:
             self.receive(b"")
         period_ms = self.plant.config.sample_period * 1000
         for _ in range(round(seconds * 1000)):
             self.now_ms += 1
-            self.plant.step(self.core.pulse_us, 0.001)
+            self.plant.step(self.core.pulse_us, 0.001, self.core.roll_pulse_us)
             due = self.now_ms >= self._next_sample_ms
             if due:
                 self._next_sample_ms += period_ms
                 self.truth.append((self.time, self.plant.tension))
+                self.roll_truth.append((self.time, self.plant.roll))
             if self.hung:
                 self._stalled = True
                 continue
@@ -130,6 +134,12 @@ class DeviceTwin:
         """Ground-truth samples ``(simulated time s, tension N)`` since the last call."""
         samples = list(self.truth)
         self.truth.clear()
+        return samples
+
+    def take_roll_truth(self) -> list[tuple[float, float]]:
+        """Ground-truth roll samples ``(simulated time s, roll rad)`` since the last call."""
+        samples = list(self.roll_truth)
+        self.roll_truth.clear()
         return samples
 
 
@@ -275,6 +285,13 @@ class PtyTwin:
             samples = self.twin.take_truth()
         return [(self.host_time_ns(t), tension) for t, tension in samples]
 
+    def take_roll_truth(self) -> list[tuple[int, float]]:
+        """Ground-truth roll samples since the last call as ``(host time ns since the epoch,
+        rad)``, taken like :meth:`take_truth`."""
+        with self._lock:
+            samples = self.twin.take_roll_truth()
+        return [(self.host_time_ns(t), roll) for t, roll in samples]
+
     def host_time_ns(self, sim_time: float) -> int:
         """Host time (ns since the epoch) at which the threaded twin reaches ``sim_time`` s."""
         return self._start_epoch_ns + round((sim_time - self._start_sim) / self.speed * 1e9)
@@ -325,6 +342,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--print-port", action="store_true", help="print the port path on stdout")
     parser.add_argument("--link", help="also expose the pty as this symlink")
     parser.add_argument("--speed", type=float, default=1.0, help="simulated / real time")
+    parser.add_argument("--roll-speed", type=float, default=ROLL_SPEED,
+                        help="roll servo speed limit (rad/s)")
     for field in fields(PlantConfig):
         parser.add_argument(f"--{field.name.replace('_', '-')}", type=type(field.default),
                             default=field.default, help=f"plant {field.name} (SI)")
@@ -335,7 +354,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry: serve until SIGINT/SIGTERM."""
     args = _parser().parse_args(argv)
     plant = PlantConfig(**{f.name: getattr(args, f.name) for f in fields(PlantConfig)})
-    server = PtyTwin(DeviceTwin(plant), speed=args.speed, link=args.link)
+    server = PtyTwin(DeviceTwin(plant, roll_speed=args.roll_speed), speed=args.speed,
+                     link=args.link)
     done = threading.Event()
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: done.set())

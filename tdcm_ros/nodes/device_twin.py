@@ -9,7 +9,9 @@ scene's ``latency`` effect delays every line the device sends by its ``tension``
 
 Publishes ``sim/tension_true`` (``geometry_msgs/msg/WrenchStamped``): the true tendon tension
 (N, ``wrench.force.z``, frame ``frame_id``) at every load-cell sample, stamped with the host time
-of the sample; and ``/diagnostics`` (port, simulated time, device mode, faults).
+of the sample; ``sim/joint_states_true`` (``sensor_msgs/msg/JointState``, name ``["roll"]``): the
+simulated roll servo's true angle (rad) at the same samples and stamps; and ``/diagnostics``
+(port, simulated time, device mode, faults, roll).
 """
 
 from __future__ import annotations
@@ -21,9 +23,10 @@ from collections.abc import Callable
 from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.device import PLANT_SPECS, PlantConfig, fault_names
+from tdcm_ros.device import PLANT_SPECS, ROLL_SPEED, PlantConfig, fault_names
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
+from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
     DiagnosticLevel,
@@ -45,6 +48,7 @@ TWIN_SPECS = by_name(
     Spec("link", description="symlink to the pty (empty: <tmp>/tdcm_twin_<pid>)", default="",
          kind="str"),
     Spec("speed", description="simulated time / real time", default=1.0, low=0.01, high=100.0),
+    Spec("roll_speed", "rad/s", "roll servo speed limit", ROLL_SPEED, low=0.01, high=100.0),
     Spec("frame_id", description="frame of sim/tension_true", default="tdcm_tendon", kind="str"),
     Spec("publish_period_s", "s", "how often the samples are published; every load-cell sample "
          "is published", 0.01, low=0.001, high=1.0),
@@ -114,8 +118,10 @@ class DeviceTwinNode(NodeLogic):
         diag_period = float(own["diagnostics_period_s"])
         self.truth = port.create_publisher("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
                                            QoS(depth=100))
-        self.server = PtyTwin(DeviceTwin(plant), speed=speed, link=link,
-                              line_delay=line_delay).start()
+        self.roll_truth = port.create_publisher("sim/joint_states_true", JOINT_STATE,
+                                                QoS(depth=100))
+        twin = DeviceTwin(plant, roll_speed=float(own["roll_speed"]))
+        self.server = PtyTwin(twin, speed=speed, link=link, line_delay=line_delay).start()
         self.samples = 0
         port.create_timer(period, self.publish_truth)
         self.diagnostics = Diagnostics(port, diag_period)
@@ -130,6 +136,8 @@ class DeviceTwinNode(NodeLogic):
                 "header": header(stamp_ns, self.frame_id),
                 "wrench": {"force": {"z": tension}}}))
             self.samples += 1
+        for stamp_ns, roll in self.server.take_roll_truth():
+            self.roll_truth.publish(joint_state(stamp_ns, roll))
 
     def _state(self) -> dict[str, str]:
         twin = self.server.twin
@@ -137,7 +145,9 @@ class DeviceTwinNode(NodeLogic):
                 "sim_time": f"{twin.time:.3f}", "mode": twin.core.mode.name.lower(),
                 "faults": fault_names(twin.core.faults),
                 "setpoint": f"{twin.core.setpoint_mn / 1000:.3f}",
-                "tension_true": f"{twin.plant.tension:.3f}", "samples": str(self.samples)}
+                "tension_true": f"{twin.plant.tension:.3f}", "samples": str(self.samples),
+                "roll_target": f"{twin.core.roll_target_mrad / 1000:.3f}",
+                "roll_true": f"{twin.plant.roll:.4f}"}
 
     def check(self) -> Status:
         """The twin's state for ``/diagnostics`` (always OK: it is a simulation)."""

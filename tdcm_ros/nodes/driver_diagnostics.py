@@ -2,7 +2,7 @@
 
 ``serial link`` (link state, firmware, link counters), ``load cell`` (fresh readings, SENSOR and
 CAL faults) and ``actuator`` (mode, latched OVER/WATCHDOG/ESTOP faults, armed, setpoints, the
-schedule). Each reports the component as it is now (:mod:`tdcm_ros.runtime.diagnostics`), so a
+schedule, the roll servo). Each reports the component as it is now (:mod:`tdcm_ros.runtime.diagnostics`), so a
 level recovers with the component: the link reconnects, readings flow again, faults are cleared.
 """
 
@@ -58,10 +58,25 @@ def load_cell(status: DriverStatus | None) -> Status:
     return Status(OK, f"tension {latest.tension:.3f} N", values)
 
 
+def _roll_values(status: DriverStatus, roll_max: float) -> dict[str, str]:
+    """The roll servo's fields (rad): where it is, its device target, the host's target and
+    slewed setpoint (empty: none), and the limit."""
+    roll = status.roll
+
+    def rad(value: float | None) -> str:
+        return "" if value is None else f"{value:.3f}"
+
+    return {"roll": rad(roll.position if roll else None),
+            "roll_device_target": rad(roll.target if roll else None),
+            "roll_target": rad(status.roll_target), "roll_setpoint": rad(status.roll_setpoint),
+            "roll_pulse_us": str(roll.pulse_us) if roll else "", "roll_max": f"{roll_max:g}"}
+
+
 def actuator(status: DriverStatus | None, *, tension_max: float, schedule_state: str,
-             counts: Mapping[str, int], last_warning: str, clamped_recently: int) -> Status:
-    """ERROR with an OVER, WATCHDOG or ESTOP fault latched (the device released), WARN while
-    disarmed or after a setpoint was clamped within the window, else OK."""
+             counts: Mapping[str, int], last_warning: str, clamped_recently: int,
+             roll_max: float) -> Status:
+    """ERROR with an OVER, WATCHDOG or ESTOP fault latched (the device released, the roll
+    held), WARN while disarmed or after a setpoint was clamped within the window, else OK."""
     if status is None:
         return Status(STALE, "not stepped yet")
     latest = status.telemetry
@@ -75,11 +90,12 @@ def actuator(status: DriverStatus | None, *, tension_max: float, schedule_state:
         "schedule": schedule_state, "schedule_done": str(schedule_state == "done").lower(),
         "disarms": status.disarms,
         **{key: counts.get(key, 0) for key in ("clamped_setpoints", "rejected_setpoints",
-                                                "estops")},
+                                                "estops", "clamped_rolls", "rejected_rolls")},
+        **_roll_values(status, roll_max),
         "last_warning": last_warning}
     if latest is not None and latest.faults & ~CELL_FAULTS:
-        return Status(ERROR, f"device fault {fault_names(latest.faults)}; tendon released",
-                      values)
+        return Status(ERROR, f"device fault {fault_names(latest.faults)}; tendon released, "
+                             f"roll held", values)
     if not status.armed:
         return Status(WARN, f"disarmed ({status.disarm_reason}): tendon held released; call "
                             f"clear_faults to arm, then a new setpoint", values)

@@ -7,11 +7,17 @@ publishes every telemetry frame as ``tension`` (``geometry_msgs/msg/WrenchStampe
 read together keep their device-clock spacing). ``/diagnostics`` (every ``diagnostics_period_s``)
 carries one status per component (:mod:`tdcm_ros.nodes.driver_diagnostics`): ``serial link``,
 ``load cell`` and ``actuator`` (mode, faults, setpoints, armed, the schedule state and
-``schedule_done``). ``device_state`` (``diagnostic_msgs/msg/DiagnosticStatus``, every
+``schedule_done``, the roll). ``joint_states`` (``sensor_msgs/msg/JointState``, name ``["roll"]``)
+carries the roll servo's position (rad, from the device's telemetry: where its slew-limited pulse
+points; 0 rad, its boot position, until a roll is commanded) once per telemetry frame, stamped like
+``tension``. ``device_state`` (``diagnostic_msgs/msg/DiagnosticStatus``, every
 ``state_period_s``) is deprecated: those statuses rolled into one.
 
 Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
-warning, ramped at ``setpoint_rate``; cancels a running schedule) and ``estop``
+warning, ramped at ``setpoint_rate``; cancels a running schedule), ``roll_setpoint``
+(``std_msgs/msg/Float64``, rad: clamped to ``[-roll_max, roll_max]`` with a warning, slewed at
+``roll_rate``; refused while disarmed or with a trip fault latched, the servo holding where it is)
+and ``estop``
 (``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable; a topic so any
 node can fire it without waiting). Commands are ``std_srvs/srv/Trigger`` services whose response
 says whether they were carried out and why not: ``~/start_schedule`` ((re)start the
@@ -25,7 +31,7 @@ After a link loss, a device reboot or freeze, and an e-stop the driver is disarm
 schedules are refused, until ``clear_faults``; after it a new setpoint is needed. The actuator's
 status reports ``armed`` and ``disarm_reason``.
 
-The force limits :data:`SAFETY_LIMITS` are read-only at run time unless the node is started with
+The force and roll limits :data:`SAFETY_LIMITS` are read-only at run time unless the node is started with
 ``safety.limits_writable: true`` (itself read-only).
 """
 
@@ -47,6 +53,7 @@ from tdcm_ros.device import (
     DriverStatus,
     LinkState,
     ProtocolVersionError,
+    RollState,
     StepSchedule,
     Telemetry,
     TensionDriver,
@@ -54,6 +61,7 @@ from tdcm_ros.device import (
 )
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.driver_diagnostics import actuator, load_cell, serial_link
+from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
     Diagnostics,
@@ -72,8 +80,8 @@ from tdcm_ros.spec import Spec, by_name
 TRIGGER = "std_srvs/srv/Trigger"
 STATUS_TYPE = "diagnostic_msgs/msg/DiagnosticStatus"
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
-#: parameters that bound the force on the tendon: fixed at run time unless safety.limits_writable
-SAFETY_LIMITS = ("tension_max", "setpoint_rate")
+#: parameters that bound the force on the tendon and the roll: fixed at run time unless safety.limits_writable
+SAFETY_LIMITS = ("tension_max", "setpoint_rate", "roll_max", "roll_rate")
 LIMITS_WRITABLE = "safety.limits_writable"
 #: DriverConfig fields fixed at start (the link); the others change at run time.
 LINK_FIELDS = ("port", "baudrate")
@@ -136,6 +144,7 @@ class TensionDriverNode(NodeLogic):
 
         self.tension = port.create_publisher("tension", "geometry_msgs/msg/WrenchStamped",
                                              QoS(depth=100))
+        self.joints = port.create_publisher("joint_states", JOINT_STATE, QoS(depth=100))
         self.state = port.create_publisher("device_state", STATUS_TYPE, QoS(depth=10))
         self.diagnostics = Diagnostics(port, diag_period)
         self.clamps = self.diagnostics.window()
@@ -145,6 +154,8 @@ class TensionDriverNode(NodeLogic):
         self.diagnostics.add("load cell", hardware, lambda: load_cell(self.status))
         self.diagnostics.add("actuator", hardware, self._check_actuator)
         port.create_subscription("tension_setpoint", "std_msgs/msg/Float64", self._on_setpoint,
+                                 QoS(depth=10))
+        port.create_subscription("roll_setpoint", "std_msgs/msg/Float64", self._on_roll,
                                  QoS(depth=10))
         port.create_subscription("estop", "std_msgs/msg/Empty", self._on_estop, QoS(depth=10))
         for name, command in (("start_schedule", self.start_schedule),
@@ -182,6 +193,7 @@ class TensionDriverNode(NodeLogic):
         if (status is not None and not self.driver.schedule_running
                 and status.target > self.driver.tension_max):
             self._request(status.target)  # re-clamp a held setpoint to the lower maximum
+        # a held roll target is re-clamped to a lower roll_max by the driver's next step
         if "enabled" in changes:
             if changes["enabled"]:
                 self.driver.enable()
@@ -222,6 +234,18 @@ class TensionDriverNode(NodeLogic):
         if not self.driver.armed:
             self.counts["rejected_setpoints"] += 1
         self._request(newtons)
+
+    def _on_roll(self, message: Any) -> None:
+        radians = float(message.data)
+        if not math.isfinite(radians):
+            self.counts["rejected_rolls"] += 1
+            self._warn(f"roll_setpoint = {radians!r} rad is not finite; ignored")
+            return
+        held = self.driver.set_roll(radians)
+        if held is None:
+            self.counts["rejected_rolls"] += 1
+        elif held != radians:
+            self.counts["clamped_rolls"] += 1
 
     def _on_estop(self, _message: Any) -> None:
         self.estop()
@@ -304,8 +328,8 @@ class TensionDriverNode(NodeLogic):
         if previous is not None and previous.armed and not result.status.armed \
                 and self.schedule_state in ("waiting", "running"):
             self.schedule_state = "cancelled"
-        if result.telemetry:
-            self._publish_tension(result.telemetry)
+        if result.telemetry or result.joints:
+            self._publish_frames(result.telemetry, result.joints)
         connected = result.status.link is LinkState.CONNECTED
         if self.schedule_state == "waiting" and connected:
             self._run_schedule()
@@ -321,21 +345,28 @@ class TensionDriverNode(NodeLogic):
         elif status.link is LinkState.DISCONNECTED:
             self.port.logger.warning("link down: %s", status.message)
 
-    def _publish_tension(self, frames: tuple[Telemetry, ...]) -> None:
+    def _publish_frames(self, frames: tuple[Telemetry, ...], joints: tuple[RollState, ...]
+                        ) -> None:
+        """``tension`` for every telemetry frame, ``joint_states`` for every roll sample; stamp
+        = now minus the device-clock age relative to the newest frame read in this step."""
         now = self.port.now_ns()
-        newest = frames[-1].time
+        newest = max([frame.time for frame in frames] + [joint.time for joint in joints])
         frame_id = str(self.port.get_parameter("frame_id"))
         for frame in frames:
             stamp = now - max(0, round((newest - frame.time) * 1e9))
             self.tension.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
                 "header": header(stamp, frame_id),
                 "wrench": {"force": {"z": frame.tension}}}))
+        for joint in joints:
+            self.joints.publish(joint_state(now - max(0, round((newest - joint.time) * 1e9)),
+                                            joint.position))
         self.counts["telemetry_frames"] += len(frames)
 
     # --- state and diagnostics ----------------------------------------------------------------
     def _check_actuator(self) -> Status:
         clamped = self.clamps.recent(self.counts["clamped_setpoints"], self.port.now_ns())
         return actuator(self.status, tension_max=self.driver.tension_max,
+                        roll_max=self.driver.config.roll_max,
                         schedule_state=self.schedule_state, counts=self.counts,
                         last_warning=self.last_warning, clamped_recently=clamped)
 

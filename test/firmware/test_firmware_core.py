@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from tdcm_ros.device import constants
-from tdcm_ros.device.protocol import Mode, SetMode, SetSetpoint, encode
+from tdcm_ros.device.protocol import Mode, SetMode, SetRoll, SetSetpoint, encode
 from tdcm_ros.device.transcript import (
     load,
     mismatches,
@@ -46,13 +46,14 @@ def test_transcript_on_firmware_core(harness: Path, path: Path) -> None:
     assert mismatches(steps, run_harness(harness, to_script(steps))) == []
 
 
-def _random_script(seed: int) -> str:
+def _random_script(seed: int, extra: tuple[bytes, ...] = ()) -> str:
     rng = random.Random(seed)
     lines = ["eeprom 8000 1000000" if rng.random() < 0.8 else "", "boot"]
     pieces = [encode(SetSetpoint(rng.randint(0, 22000) / 1000)), encode(SetMode(Mode.TENSION)),
               b"$1,H*79\n", b"$1,E*58\n", b"$1,C*5E\n", b"$1,Z*47\n", b"$1,K,1.000*55\n",
               b"$1,M,R*2E\n", b"$1,I*54\n"]
     pieces += [pieces[1], pieces[1], b"$1,C*5E\n", b"$1,C*5E\n", b"$1,H*79\n", b"$1,H*79\n"]
+    pieces += list(extra)
     for _ in range(150):
         roll = rng.random()
         if roll < 0.35:
@@ -78,6 +79,17 @@ def test_random_sessions_agree_with_python_core(harness: Path, seed: int) -> Non
     script = _random_script(seed)
     firmware, python = run_harness(harness, script), run_core(script)
     assert firmware.count("\n") > 10
+    assert firmware == python
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_random_roll_sessions_agree_with_python_core(harness: Path, seed: int) -> None:
+    rng = random.Random(1000 + seed)
+    rolls = tuple(encode(SetRoll(rng.randint(-constants.ROLL_MAX_MRAD, constants.ROLL_MAX_MRAD)
+                                 / 1000)) for _ in range(6))
+    script = _random_script(1000 + seed, rolls + (b"$1,R,1.572*4C\n", b"$1,R,-0.000*60\n"))
+    firmware, python = run_harness(harness, script), run_core(script)
+    assert ",R" in firmware  # R was decoded (accepted, or refused FAULT/RANGE/FIELDS)
     assert firmware == python
 
 

@@ -1,5 +1,6 @@
 """The UNO build of the firmware, run in simavr with its UART driven through a small libsimavr
-bridge (firmware/host/simavr_uart.c): banner, NACK, e-stop and the 50 Hz telemetry on the AVR."""
+bridge (firmware/host/simavr_uart.c): banner, NACK, e-stop, the 50 Hz telemetry and the roll
+servo on the AVR."""
 
 from __future__ import annotations
 
@@ -20,7 +21,9 @@ from tdcm_ros.device.protocol import (
     Mode,
     Nack,
     Reject,
+    RollState,
     SetMode,
+    SetRoll,
     Telemetry,
     encode,
 )
@@ -66,3 +69,25 @@ def test_firmware_talks_protocol_in_simavr(simulator: tuple[Path, Path]) -> None
     assert all(round((b.time - a.time) * 1000) == 20 for a, b in itertools.pairwise(telemetry))
     assert telemetry[-1].faults == Fault.CALIBRATION | Fault.ESTOP
     assert telemetry[-1].pulse_us == 1000
+
+
+def test_roll_servo_in_simavr(simulator: tuple[Path, Path]) -> None:
+    """On the AVR too: R is accepted despite the CAL fault of the blank EEPROM, J frames follow
+    every T from then on, slewing 40 mrad per tick; after an e-stop R is refused FAULT."""
+    bridge, elf = simulator
+    script = "".join(f"{ms} {data.hex()}\n" for ms, data in [
+        (300, encode(SetRoll(0.3))), (500, encode(EStop())), (520, encode(SetRoll(-0.3)))])
+    done = subprocess.run([str(bridge), str(elf), "0.8"], input=script, capture_output=True,
+                          text=True, timeout=120, check=True)
+    messages = LineDecoder().feed(done.stdout.encode())
+    replies = [m for m in messages if isinstance(m, Ack | Nack)]
+    assert replies == [Ack("R"), Ack("E"), Nack("R", Reject.FAULT)]
+    first = messages.index(Ack("R"))
+    assert not any(isinstance(m, RollState) for m in messages[:first])
+    after = messages[first + 1:]
+    kinds = [type(m) for m in after if isinstance(m, Telemetry | RollState)]
+    assert kinds[:10] == [Telemetry, RollState] * 5
+    rolls = [m for m in after if isinstance(m, RollState)]
+    assert [round(r.position * 1000) for r in rolls[:8]] == [40, 80, 120, 160, 200, 240, 280, 300]
+    assert rolls[7].pulse_us == 1500 + 300 * 637 // 1000
+    assert len(rolls) >= 20 and rolls[-1].position == rolls[-1].target  # held after the e-stop
