@@ -71,6 +71,15 @@ from tdcm_ros.model.profiles import (
 )
 from tdcm_ros.model.progress import Progress, report_progress, within
 from tdcm_ros.model.result import ConvergenceError, SolveResult
+from tdcm_ros.model.roll import (
+    InvalidRollError,
+    check_roll,
+    depends_on_roll,
+    roll_loading,
+    roll_points,
+    roll_poses,
+    roll_quaternions,
+)
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
@@ -100,6 +109,7 @@ __all__ = [
     "DesignSpace",
     "InvalidDesignError",
     "InvalidLoadingError",
+    "InvalidRollError",
     "InvalidSettingsError",
     "InvalidTargetError",
     "InverseResult",
@@ -119,13 +129,19 @@ __all__ = [
     "TensionProfile",
     "TensionRangeError",
     "UnreachableTargetError",
+    "check_roll",
     "check_tension",
+    "depends_on_roll",
     "design_curves",
     "offset_points",
     "one_shot",
     "parse_field",
     "preset",
     "report_progress",
+    "roll_loading",
+    "roll_points",
+    "roll_poses",
+    "roll_quaternions",
     "search_designs",
     "solve",
     "solve_inverse",

@@ -1,0 +1,95 @@
+"""Roll: the whole manipulator, and so its bending plane, turned about the base +z axis.
+
+Frame ``tdcm_base`` (REP 103, SI units): the planar model bends in the x-z plane toward +x. A
+roll ``phi`` (rad, right-handed about +z) turns every point of the solved shape rigidly, so a
+planar point ``(x, 0, z)`` becomes ``(x cos phi, x sin phi, z)`` and every body frame ``q``
+becomes ``q_z(phi) q``. ``phi = 0`` returns the inputs unchanged, bit for bit.
+
+Loads fixed in ``tdcm_base`` (a scene's gravity, a tip load) do not roll with the body: the
+planar model takes their component in the rolled bending plane (:func:`roll_loading`); the
+component normal to it would bend the body out of the plane, which the planar model cannot
+represent, and is left out.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from tdcm_ros.errors import InputError, out_of_range
+from tdcm_ros.model.errors import ModelError
+from tdcm_ros.model.loading import Loading
+
+Array = NDArray[np.float64]
+
+
+class InvalidRollError(ModelError, InputError):
+    """The roll angle is not a finite real number."""
+
+    kind = "invalid_roll"
+
+
+def check_roll(roll: Any, parameter: str = "roll") -> float:
+    """``roll`` (rad) as a float, or :class:`InvalidRollError` naming ``parameter``: any finite
+    real number (``bool``, strings and arrays are refused)."""
+    if isinstance(roll, (bool, np.bool_)) or not isinstance(roll, numbers.Real) \
+            or not math.isfinite(float(roll)):
+        raise out_of_range(parameter, roll, "a finite real number (-inf, inf)", unit="rad",
+                           error=InvalidRollError)
+    return float(roll)
+
+
+def roll_points(points: ArrayLike, roll: float) -> Array:
+    """Points (..., 3) m turned by ``roll`` (rad) about +z; unchanged at ``roll = 0``."""
+    phi = check_roll(roll)
+    p = np.asarray(points, dtype=float)
+    if phi == 0.0:
+        return p
+    c, s = math.cos(phi), math.sin(phi)
+    x, y = p[..., 0], p[..., 1]
+    return np.stack([c * x - s * y, s * x + c * y, p[..., 2]], axis=-1)
+
+
+def roll_quaternions(quaternions: ArrayLike, roll: float) -> Array:
+    """Orientations (..., 4) ``(x, y, z, w)`` turned by ``roll`` (rad) about +z: the product
+    ``q_z(roll) q``; unchanged at ``roll = 0``."""
+    phi = check_roll(roll)
+    q = np.asarray(quaternions, dtype=float)
+    if phi == 0.0:
+        return q
+    c, s = math.cos(0.5 * phi), math.sin(0.5 * phi)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.stack([c * x - s * y, c * y + s * x, c * z + s * w, c * w - s * z], axis=-1)
+
+
+def roll_poses(positions: ArrayLike, quaternions: ArrayLike, roll: float
+               ) -> tuple[Array, Array]:
+    """Poses (positions (k, 3) m, quaternions (k, 4) xyzw) turned by ``roll`` (rad) about +z."""
+    return roll_points(positions, roll), roll_quaternions(quaternions, roll)
+
+
+def depends_on_roll(loading: Loading | None) -> bool:
+    """True when ``loading`` has a base-frame load whose in-plane part changes with the roll
+    (a tip force or body force with an x component, or a tip moment)."""
+    return loading is not None and (loading.tip_force[0] != 0.0 or loading.tip_moment != 0.0
+                                    or loading.body_force_density[0] != 0.0)
+
+
+def roll_loading(loading: Loading | None, roll: float) -> Loading | None:
+    """The planar loading of a body rolled by ``roll`` (rad) under ``loading``'s base-frame
+    loads: their part in the rolled bending plane. A force ``(F_x, F_z)`` keeps
+    ``(F_x cos roll, F_z)``, a moment about +y keeps ``M cos roll``; the rest acts out of the
+    plane and is dropped. ``loading`` itself when nothing depends on the roll."""
+    phi = check_roll(roll)
+    if phi == 0.0 or loading is None or not depends_on_roll(loading):
+        return loading
+    c = math.cos(phi)
+    force_x, force_z = loading.tip_force
+    density_x, density_z = loading.body_force_density
+    return replace(loading, tip_force=(force_x * c, force_z), tip_moment=loading.tip_moment * c,
+                   body_force_density=(density_x * c, density_z))
