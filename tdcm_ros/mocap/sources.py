@@ -97,8 +97,9 @@ class MarkerFrame(Protocol):
 class MarkerWorld(Protocol):
     """The part of a scene world the simulation source uses."""
 
-    def markers(self, stamp_s: float, true_tension: float) -> MarkerFrame:
-        """Markers of the simulated bench at ``stamp_s`` (s) under ``true_tension`` (N)."""
+    def markers(self, stamp_s: float, true_tension: float, roll: float = 0.0) -> MarkerFrame:
+        """Markers of the simulated bench at ``stamp_s`` (s) under ``true_tension`` (N), the
+        body rolled by ``roll`` (rad) about the base +z axis."""
 
 
 def no_delay() -> float:
@@ -118,9 +119,10 @@ class SimSource:
         self.frame_number = 0
         self._queue: deque[tuple[int, RawFrame]] = deque()
 
-    def sample(self, now_ns: int, true_tension: float) -> None:
-        """Ask the world for the markers at ``now_ns`` under ``true_tension`` (N); queue them."""
-        frame = self.world.markers(now_ns / 1e9, true_tension)
+    def sample(self, now_ns: int, true_tension: float, roll: float = 0.0) -> None:
+        """Ask the world for the markers at ``now_ns`` under ``true_tension`` (N) and body roll
+        ``roll`` (rad); queue them."""
+        frame = self.world.markers(now_ns / 1e9, true_tension, roll)
         labels = tuple(str(label) for label in frame.labels)
         positions = np.asarray(frame.positions, dtype=float)
         if positions.shape != (len(labels), 3):

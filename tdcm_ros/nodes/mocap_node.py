@@ -17,7 +17,10 @@ error or rejected axis message happened within the last 5 periods, or a live sou
 - ``relabel``: subscribe ``relabel.input_topic`` (a live driver's Markers; positions times
   ``relabel.input_scale`` give m), relabel and republish with the input's stamp and frame number;
 - ``sim``: a scene's world (``sim.scene``): on a timer at the scene's mocap rate, markers for
-  the latest ``sim/tension_true`` (0 N until one arrives), published ``world.delay_s("markers")``
+  the latest ``sim/tension_true`` (0 N until one arrives) and the latest true roll, joint
+  ``sim.roll_joint`` of ``sim/joint_states_true`` (``sensor_msgs/msg/JointState``, rad; 0 until
+  one arrives; messages without that joint are ignored, non-finite rolls dropped and counted):
+  the markers roll with the body about tdcm_base's z axis. Published ``world.delay_s("markers")``
   (drawn per frame) after their stamp; the registration comes from the scene (``world.mocap_to_base``).
 """
 
@@ -47,6 +50,7 @@ from tdcm_ros.mocap import (
     read_nexus_csv,
     straight_axis,
 )
+from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
     DiagnosticLevel,
@@ -86,6 +90,8 @@ MOCAP_SPECS = by_name(
     Spec("relabel.input_scale", description="m per input position unit (0.001 if the driver "
          "sends mm)", default=1.0, low=1e-6, high=1e3),
     Spec("sim.scene", description="scene name or YAML path (sim)", default="ideal", kind="str"),
+    Spec("sim.roll_joint", description="joint of sim/joint_states_true the body rolls by (sim)",
+         default="roll", kind="str"),
     Spec("labelling.mode", description="name or arc_length", default="name", kind="str",
          choices=LABELLING_MODES),
     Spec("labelling.labels", description="published labels, base to tip",
@@ -270,8 +276,12 @@ class MocapNode(NodeLogic):
         world = scene.world()
         self.sim = SimSource(world, delay=lambda: world.delay_s("markers"))
         self.true_tension: float | None = None
+        self.true_roll = 0.0
+        self.roll_joint = str(self.port.get_parameter("sim.roll_joint"))
         self.port.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
                                       self._on_true_tension, QoS(depth=10))
+        self.port.create_subscription("sim/joint_states_true", "sensor_msgs/msg/JointState",
+                                      self._on_true_joint_states, QoS(depth=10))
         self.port.create_timer(1.0 / float(scene.mocap_rate_hz), self._sim_tick)
         self.drain_timer: Any = None
         self.state = f"simulating scene {scene.name!r}; no sim/tension_true yet (0 N)"
@@ -288,9 +298,18 @@ class MocapNode(NodeLogic):
             self.state = "simulating"
         self.true_tension = tension
 
+    def _on_true_joint_states(self, message: Any) -> None:
+        roll = joint_position(message, self.roll_joint)
+        if roll is None:
+            return
+        if not math.isfinite(roll):
+            self.counts["dropped_non_finite_roll"] += 1
+            return
+        self.true_roll = roll
+
     def _sim_tick(self) -> None:
         try:
-            self.sim.sample(self.port.now_ns(), self.true_tension or 0.0)
+            self.sim.sample(self.port.now_ns(), self.true_tension or 0.0, self.true_roll)
         except InputError as error:
             self.counts["source_errors"] += 1
             self.last_problem = str(error)

@@ -5,7 +5,13 @@ Built from a :class:`~tdcm_ros.scenes.compiled.CompiledScene` (``Scene.world()``
 it walks the bundle's per-stage effects and nothing else. Stateful and seeded: friction
 history, dropout bursts and every random draw depend only on the scene's seed and the sequence
 of calls. Shapes are warm-started from the previous solve and, unless a mechanics effect keeps
-a history (friction) that makes the shape depend on the path, cached by tension.
+a history (friction) that makes the shape depend on the path, cached by tension (and roll).
+
+Roll (:mod:`tdcm_ros.model.roll`): the body turns about the base +z axis by the true roll
+(rad), its markers with it (they are glued to it). The scene's loads stay fixed in
+``tdcm_base``: the planar solve takes their part in the rolled bending plane
+(:func:`~tdcm_ros.model.roll_loading`), so a horizontal gravity bends the body less as it rolls
+away from the x-z plane and not at all at +-pi/2; the out-of-plane part is not modelled.
 """
 
 from __future__ import annotations
@@ -20,7 +26,17 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model import Loading, SolveResult, check_tension, solve, surface_points
+from tdcm_ros.model import (
+    Loading,
+    SolveResult,
+    check_roll,
+    check_tension,
+    depends_on_roll,
+    roll_loading,
+    roll_points,
+    solve,
+    surface_points,
+)
 from tdcm_ros.scenes.compiled import CompiledScene
 from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS
 from tdcm_ros.scenes.errors import InvalidSceneError
@@ -45,8 +61,9 @@ class World:
     def __init__(self, compiled: CompiledScene) -> None:
         self.compiled = compiled
         self.bench = compiled.bench
-        self._cache: OrderedDict[float, SolveResult] = OrderedDict()
-        self._last: SolveResult | None = None
+        self._cache: OrderedDict[tuple[float, float], SolveResult] = OrderedDict()
+        self._last: tuple[tuple[float, float], SolveResult] | None = None
+        self._rolls = depends_on_roll(compiled.loading)
         self.solves = 0  #: solver calls made (cache hits excluded)
         self.solve_time_s = 0.0  #: wall time in those calls (s)
         self.true_mocap_to_base: Pose = self.bench.mocap_pose
@@ -85,28 +102,33 @@ class World:
     def _stateful(self) -> bool:
         return bool(self.compiled.histories)
 
-    def solve(self, true_tension: float) -> SolveResult:
-        """The true body's shape at base tension ``true_tension`` (N), frame tdcm_base.
+    def solve(self, true_tension: float, roll: float = 0.0) -> SolveResult:
+        """The true body's planar shape at base tension ``true_tension`` (N), in its bending
+        plane rolled by ``roll`` (rad): frame tdcm_base at roll 0 (turn it with
+        :func:`~tdcm_ros.model.roll_points`). The roll matters only through the loads' part in
+        that plane (module docstring).
 
         Raises the model's typed errors at a physical limit or on non-convergence; only a
         converged result advances the mechanics effects' histories.
         """
         tension = check_tension(true_tension)
-        cached = self._lookup(tension)
+        phi = check_roll(roll)
+        key = (tension, math.cos(phi) if self._rolls else 1.0)  # the in-plane loads' factor
+        cached = self._lookup(key)
         if cached is not None:
             return cached
         started = perf_counter()
         try:
             result = solve(self.bench.true_design, tension, warm_start=self._warm_start(tension),
-                           loading=self.loading)
+                           loading=roll_loading(self.loading, phi))
         finally:
             self.solves += 1
             self.solve_time_s += perf_counter() - started
         for history in self.compiled.histories:
             history.advance(result)
-        self._last = result
+        self._last = (key, result)
         if not self._stateful:
-            self._cache[tension] = result
+            self._cache[key] = result
             if len(self._cache) > CACHE_SIZE:
                 self._cache.popitem(last=False)
         return result
@@ -114,37 +136,41 @@ class World:
     def _warm_start(self, tension: float) -> SolveResult | None:
         """The previous shape, unless the tension ratio makes its rescaling meaningless (the
         solver scales a warm start by ``tension / previous``; from ~0 N that overflows)."""
-        last = self._last
-        if last is None or not WARM_RATIO[0] <= tension / max(last.tension_n, 1e-300) \
-                <= WARM_RATIO[1]:
+        if self._last is None:
+            return None
+        last = self._last[1]
+        if not WARM_RATIO[0] <= tension / max(last.tension_n, 1e-300) <= WARM_RATIO[1]:
             return None
         return last
 
-    def _lookup(self, tension: float) -> SolveResult | None:
-        if self._stateful:  # history matters: only the same tension again is the same state
+    def _lookup(self, key: tuple[float, float]) -> SolveResult | None:
+        """The shape solved for ``(tension, in-plane load factor)``, if kept."""
+        if self._stateful:  # history matters: only the same state again is the same shape
             last = self._last
-            return last if last is not None and last.tension_n == tension else None
-        hit = self._cache.get(tension)
+            return last[1] if last is not None and last[0] == key else None
+        hit = self._cache.get(key)
         if hit is not None:
-            self._cache.move_to_end(tension)
+            self._cache.move_to_end(key)
         return hit
 
-    def body_markers(self, result: SolveResult) -> Array:
-        """True marker centres (k, 3) m in tdcm_base on the shape ``result``."""
+    def body_markers(self, result: SolveResult, roll: float = 0.0) -> Array:
+        """True marker centres (k, 3) m in tdcm_base on the planar shape ``result`` turned by
+        ``roll`` (rad) about the base +z axis."""
         bench = self.bench
         s = np.asarray(bench.marker_arc_lengths, dtype=float)
         radius, side = bench.marker_radius, bench.marker_side_rad
         for effect in self.sensing:
             s, radius, side = effect.placement(s, radius, side)
         points, _ = surface_points(result, s, radius, side)
-        return points
+        return roll_points(points, roll)
 
-    def markers(self, stamp_s: float, true_tension: float) -> MarkerFrame:
-        """The motion-capture frame at ``stamp_s`` (s) for base tension ``true_tension`` (N):
-        marker positions (k, 3) m in ``mocap``, NaN rows not visible."""
+    def markers(self, stamp_s: float, true_tension: float, roll: float = 0.0) -> MarkerFrame:
+        """The motion-capture frame at ``stamp_s`` (s) for base tension ``true_tension`` (N)
+        and body roll ``roll`` (rad about the base +z axis): marker positions (k, 3) m in
+        ``mocap``, NaN rows not visible."""
         if not math.isfinite(stamp_s):
             raise out_of_range("stamp_s", stamp_s, "a finite time", unit="s")
-        body = self.body_markers(self.solve(true_tension))
+        body = self.body_markers(self.solve(true_tension, roll), roll)
         positions = self._rotation.apply(body) + self.true_mocap_to_base[0]
         for effect in self.sensing:
             positions = effect.observe(positions, stamp_s)

@@ -103,9 +103,11 @@ class FakeWorld:
 
     def __init__(self):
         self.calls: list[tuple[float, float]] = []
+        self.rolls: list[float] = []
 
-    def markers(self, stamp_s: float, true_tension: float) -> FakeFrame:
+    def markers(self, stamp_s: float, true_tension: float, roll: float = 0.0) -> FakeFrame:
         self.calls.append((stamp_s, true_tension))
+        self.rolls.append(roll)
         p = np.array([[1e-3 * true_tension, 0.0, s] for s in ARCS])
         if int(stamp_s) % 2:
             p[2] = np.nan
@@ -130,8 +132,16 @@ def test_sim_source_samples_the_world_and_delays_frames():
         SimSource(world, delay=lambda: -1.0).sample(0, 0.0)
 
     class Broken(FakeWorld):
-        def markers(self, stamp_s, true_tension):
+        def markers(self, stamp_s, true_tension, roll=0.0):
             return FakeFrame(LABELS, np.zeros((2, 3)))
 
     with pytest.raises(SourceError, match="shape"):
         SimSource(Broken()).sample(0, 0.0)
+
+
+def test_sim_source_hands_the_true_roll_to_the_world():
+    world = FakeWorld()
+    source = SimSource(world)
+    source.sample(1_000_000_000, 5.0)
+    source.sample(2_000_000_000, 5.0, 0.4)
+    assert world.rolls == [0.0, 0.4]

@@ -55,7 +55,7 @@ class DoubleWorld:
     def __init__(self):
         self.calls: list[tuple[float, float]] = []
 
-    def markers(self, stamp_s, true_tension):
+    def markers(self, stamp_s, true_tension, roll=0.0):
         self.calls.append((stamp_s, true_tension))
         p = np.array([[1e-3 * true_tension, 0.0, s] for s in ARCS])
         if true_tension > 8.0:
@@ -235,6 +235,40 @@ def test_sim_source_with_the_real_ideal_scene_publishes_the_model_markers():
     for message in messages:
         assert [m.marker_name for m in message.markers] == list(LABELS)
         assert np.allclose(registration.to_base(xyz(message)), expected, rtol=0, atol=1e-12)
+
+
+def joint_states(names, positions):
+    return from_dict("sensor_msgs/msg/JointState", {"name": names, "position": positions})
+
+
+def test_sim_markers_roll_with_the_true_roll_about_the_base_z_axis():
+    from tdcm_ros.mocap.registration import Registration
+    from tdcm_ros.model import solve, surface_points
+    from tdcm_ros.scenes import load_scene
+
+    scene = load_scene("ideal")
+    port = mocap_port({"source": "sim", "sim.scene": "ideal"})
+    node = MocapNode(port)
+    port.deliver("sim/tension_true", wrench(15.0))
+    roll = 0.7
+    port.deliver("sim/joint_states_true", joint_states(["roll"], [roll]))
+    port.deliver("sim/joint_states_true", joint_states(["other"], [2.0]))        # ignored
+    port.deliver("sim/joint_states_true", joint_states(["other", "roll"], [1.0, math.nan]))
+    port.advance(0.1)
+    tf = port.messages("/tf_static")[0].transforms[0].transform
+    registration = Registration((tf.translation.x, tf.translation.y, tf.translation.z),
+                                (tf.rotation.x, tf.rotation.y, tf.rotation.z, tf.rotation.w))
+    flat, _ = surface_points(solve(scene.true_design, 15.0), np.array(ARCS),
+                             scene.marker_radius, scene.marker_side_rad)
+    about_z = np.array([[math.cos(roll), -math.sin(roll), 0.0],
+                        [math.sin(roll), math.cos(roll), 0.0], [0.0, 0.0, 1.0]])
+    messages = port.messages("markers")
+    assert messages
+    for message in messages:
+        assert np.allclose(registration.to_base(xyz(message)), flat @ about_z.T, rtol=0,
+                           atol=1e-12)
+    node.diagnostics.publish()
+    assert counters(port)["dropped_non_finite_roll"] == "1"
 
 
 def test_shipped_config_file_starts_the_node():
