@@ -9,6 +9,15 @@ with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (na
 dropped and coalesced inputs; ``model_node: solver``: solves and failures; each WARN while a
 problem happened within the last 5 diagnostics periods, OK again after).
 
+Roll: subscribes ``joint_states`` (``sensor_msgs/msg/JointState``) and reads the joint named by
+``roll.joint`` (default ``roll``, rad about the base +z axis): every output above and the TF
+below is the planar shape turned by the roll (:mod:`tdcm_ros.model.roll`). Each tension is paired
+with the latest roll stamped at or before the tension's stamp (the oldest one held if all are
+newer; 0 until one arrives; an unstamped JointState takes the node's clock). A JointState
+without that joint (or without its position) is ignored; a non-finite roll is dropped and
+counted on the input diagnostics like a bad tension. A roll alone does not trigger a solve:
+the outputs follow the tension stream, as the driver publishes both per telemetry frame.
+
 TF (``tf2_msgs/msg/TFMessage``, see :mod:`tdcm_ros.nodes.tf_messages`): on ``/tf_static``
 (transient local, depth 1, as tf2's StaticTransformBroadcaster) ``frame_id -> tf.tendon_frame_id``,
 the frame ``tension`` is stamped in, sent at start and again when ``frame_id`` or the design
@@ -26,7 +35,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
@@ -46,6 +55,7 @@ from tdcm_ros.model import (
     solve,
     warm_up,
 )
+from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import midline_messages
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
 from tdcm_ros.runtime import (
@@ -64,12 +74,16 @@ from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
+#: Rolls (stamp, rad) kept to pair with tensions: over a second at the driver's telemetry rate.
+ROLL_HISTORY = 2048
 #: Parameters fixed at start, besides the design and solver groups.
 FIXED_SPECS = by_name(
     Spec("input.tension_type", description="message type on `tension`", default=TENSION_TYPES[0],
          kind="str", choices=TENSION_TYPES),
     Spec("design.preset", description="design preset the fields start from",
          default="paper-experiment", kind="str", choices=tuple(PRESETS)),
+    Spec("roll.joint", description="joint of `joint_states` the body rolls by (rad about "
+         "the base +z axis)", default="roll", kind="str"),
     Spec("process_period_s", "s", "solver timer period", 0.001, low=1e-4, high=1.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
 #: Parameters a client may change at run time, besides the design and solver groups.
@@ -133,6 +147,7 @@ class ModelNode(NodeLogic):
         self.tf_names = declare_specs(port, TF_SPECS, read_only=True)
         _check_frame_names(self.tf_names)
         self.tension_type = str(fixed["input.tension_type"])
+        self.roll_joint = str(fixed["roll.joint"])
         base = preset(str(fixed["design.preset"]))
         declare_specs(port, FIELD_SPECS, prefix="design.", defaults=base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
@@ -156,6 +171,9 @@ class ModelNode(NodeLogic):
         self._publish_tendon_tf(str(port.get_parameter("frame_id")))
         # A deep queue so every input is seen (and counted); the callback only stores the newest.
         port.create_subscription("tension", self.tension_type, self._on_tension, QoS(depth=100))
+        port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
+                                 self._on_joint_states, QoS(depth=100))
+        self.rolls: deque[tuple[int, float]] = deque(maxlen=ROLL_HISTORY)
         self.pending: tuple[float, int] | None = None
         self.previous: SolveResult | None = None
         self.counts: Counter[str] = Counter()
@@ -201,8 +219,7 @@ class ModelNode(NodeLogic):
         stamp_ns: int | None
         if self.tension_type == TENSION_TYPES[0]:
             tension = float(message.wrench.force.z)
-            stamp_ns = int(message.header.stamp.sec) * 1_000_000_000 + int(
-                message.header.stamp.nanosec)
+            stamp_ns = _stamp_ns(message)
         else:
             tension, stamp_ns = float(message.data), None
         now = self.port.now_ns()
@@ -214,6 +231,26 @@ class ModelNode(NodeLogic):
         if self.pending is not None:
             self.counts["coalesced"] += 1
         self.pending = (tension, now if stamp_ns is None else stamp_ns)
+
+    def _on_joint_states(self, message: Any) -> None:
+        """Keep the roll (rad) of a JointState naming ``roll.joint``, with its stamp (ns; an
+        unset stamp takes the node's clock); a non-finite roll is dropped and counted."""
+        roll = joint_position(message, self.roll_joint)
+        if roll is None:
+            return
+        if not math.isfinite(roll):
+            self.counts["dropped_roll_non_finite"] += 1
+            self.last_problem = f"dropped roll {roll!r} rad of joint {self.roll_joint!r}: non_finite"
+            return
+        self.rolls.append((_stamp_ns(message) or self.port.now_ns(), roll))
+
+    def roll_at(self, stamp_ns: int) -> float:
+        """The roll (rad) at ``stamp_ns`` (ns): the latest kept one stamped at or before it,
+        else the oldest kept one, else 0."""
+        for stamp, roll in reversed(self.rolls):
+            if stamp <= stamp_ns:
+                return roll
+        return self.rolls[0][1] if self.rolls else 0.0
 
     def _reject_reason(self, tension: float, stamp_ns: int | None, now_ns: int) -> str:
         """Why a tension (N) stamped ``stamp_ns`` (ns; None: a type without a header) is
@@ -255,17 +292,19 @@ class ModelNode(NodeLogic):
         radius = (self.design.R_outer + float(self.port.get_parameter("markers.radius"))
                   if placement == "surface" else 0.0)
         frame_id = str(self.port.get_parameter("frame_id"))
+        roll = self.roll_at(stamp_ns)
         for topic, message in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),
                 marker_s=np.asarray(self.port.get_parameter("markers.arc_lengths"), dtype=float),
                 marker_radius=radius,
-                marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg")))):
+                marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
+                roll=roll):
             self.publishers[topic].publish(message)  # midline first: sent before the rest is built
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=str(self.tf_names["tf.station_prefix"]),
-                                stations=int(self.tf_names["tf.stations"])))
+                                stations=int(self.tf_names["tf.stations"]), roll=roll))
 
     def check_input(self) -> Status:
         """WARN while a tension was dropped within the window (it recovers), else OK; the
@@ -291,6 +330,11 @@ class ModelNode(NodeLogic):
         if recent:
             return Status(DiagnosticLevel.WARN, last, values)
         return Status(DiagnosticLevel.OK, "ok", values)
+
+def _stamp_ns(message: Any) -> int:
+    """A message's header stamp (ns since the epoch; 0 when never set)."""
+    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
+
 
 def main() -> int:
     """``ros2 run tdcm_ros model_node`` / ``model_node`` console script."""

@@ -1,7 +1,8 @@
 """Build the model node's ROS messages (rosbags objects) from a :class:`SolveResult`.
 
 All poses are in the frame given as ``frame_id`` (``tdcm_base`` by default, see README Frames),
-positions in m, orientations as quaternions of the body frame (z axis = midline tangent).
+positions in m, orientations as quaternions of the body frame (z axis = midline tangent), the
+planar shape turned by the roll (rad) about the base +z axis (:mod:`tdcm_ros.model.roll`).
 Messages are built from the typestore classes directly (not through ``from_dict``), one
 ``pose_at`` call per result: the model node does this for every input (see bench_latency.py).
 """
@@ -17,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.bagio import from_dict, msg_class
-from tdcm_ros.model import SolveResult, offset_points
+from tdcm_ros.model import SolveResult, offset_points, roll_points, roll_poses
 
 Array = NDArray[np.float64]
 
@@ -63,14 +64,16 @@ def _marker(hdr: Any, ns: str, marker_id: int, marker_type: int,
 
 
 def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, samples: int,
-                     marker_s: Array, marker_radius: float, marker_side_rad: float
-                     ) -> Iterator[tuple[str, Any]]:
+                     marker_s: Array, marker_radius: float, marker_side_rad: float,
+                     roll: float = 0.0) -> Iterator[tuple[str, Any]]:
     """``(topic, message)`` for ``midline``, ``midline_poses``, ``tip_pose``,
     ``predicted_markers`` and ``body_markers``, in that order, each built when the previous one
-    has been taken (so ``midline`` can be sent before the rest exist). The messages share
-    sub-objects (header, poses): serialise them, do not modify them."""
+    has been taken (so ``midline`` can be sent before the rest exist), the shape rolled by
+    ``roll`` (rad). The messages share sub-objects (header, poses): serialise them, do not
+    modify them."""
     s = np.linspace(0.0, result.design.length, samples)
-    positions, quats = result.pose_at(np.concatenate([s, np.asarray(marker_s, dtype=float)]))
+    planar, planar_quats = result.pose_at(np.concatenate([s, np.asarray(marker_s, dtype=float)]))
+    positions, quats = roll_poses(planar, planar_quats, roll)
     hdr = _header_msg(stamp_ns, frame_id)
     pose_stamped = msg_class("geometry_msgs/msg/PoseStamped")
     pose_array = msg_class("geometry_msgs/msg/PoseArray")
@@ -78,10 +81,12 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     yield "midline", msg_class("nav_msgs/msg/Path")(
         header=hdr, poses=[pose_stamped(header=hdr, pose=pose) for pose in poses])
     yield "midline_poses", pose_array(header=hdr, poses=poses)
-    tip = _poses(result.tip_position[None, :], result.tip_quaternion[None, :])[0]
+    tip = _poses(*roll_poses(result.tip_position[None, :], result.tip_quaternion[None, :],
+                             roll))[0]
     yield "tip_pose", pose_stamped(header=hdr, pose=tip)
-    markers = _poses(offset_points(positions[samples:], quats[samples:], marker_radius,
-                                   marker_side_rad), quats[samples:])
+    on_planar = offset_points(planar[samples:], planar_quats[samples:], marker_radius,
+                              marker_side_rad)
+    markers = _poses(roll_points(on_planar, roll), quats[samples:])
     yield "predicted_markers", pose_array(header=hdr, poses=markers)
     body = _marker(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
                    (0.85, 0.85, 0.9, 0.8), [p.position for p in poses])

@@ -5,9 +5,13 @@ The tree under ``base`` (``tdcm_base`` by default, REP 103, SI units; see README
 - ``base -> tendon`` (static): where the tendon leaves the base, ``R_c`` (m) from the midline on
   +x, its z axis along the tendon toward the actuator (``-z`` of the base), x kept: a rotation by
   pi about x. ``tension`` (``wrench.force.z``) is stamped in this frame.
-- ``base -> tip`` (dynamic): the midline's tip pose of the latest solve, z along the tangent.
+- ``base -> tip`` (dynamic): the midline's tip pose of the latest solve, z along the tangent,
+  turned by the roll about the base +z axis (:mod:`tdcm_ros.model.roll`).
 - ``base -> <station_prefix><k>`` (dynamic, optional): midline poses at ``s = k L / n``,
-  ``k = 1 .. n``.
+  ``k = 1 .. n``, rolled alike.
+
+The tendon frame stays where it is at roll 0: it is static, and the tension's direction in it
+(along the base's -z) does not change with the roll; only its origin would turn with the body.
 """
 
 from __future__ import annotations
@@ -18,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.bagio import msg_class
-from tdcm_ros.model import Design, SolveResult
+from tdcm_ros.model import Design, SolveResult, roll_poses
 
 Array = NDArray[np.float64]
 TF_TYPE = "tf2_msgs/msg/TFMessage"
@@ -56,12 +60,13 @@ def station_lengths(length: float, stations: int) -> Array:
 
 
 def body_tf(result: SolveResult, *, stamp_ns: int, parent: str, tip: str,
-            station_prefix: str, stations: int) -> Any:
-    """``parent -> tip`` and, for ``stations > 0``, ``parent -> <station_prefix><k>``."""
+            station_prefix: str, stations: int, roll: float = 0.0) -> Any:
+    """``parent -> tip`` and, for ``stations > 0``, ``parent -> <station_prefix><k>``, the
+    shape rolled by ``roll`` (rad) about the base +z axis."""
     children = [tip]
     positions, quaternions = result.tip_position[None, :], result.tip_quaternion[None, :]
     if stations > 0:
         at, turn = result.pose_at(station_lengths(result.design.length, stations))
         children += [f"{station_prefix}{k}" for k in range(1, stations + 1)]
         positions, quaternions = np.vstack([positions, at]), np.vstack([quaternions, turn])
-    return _transforms(stamp_ns, parent, children, positions, quaternions)
+    return _transforms(stamp_ns, parent, children, *roll_poses(positions, quaternions, roll))
