@@ -73,6 +73,7 @@ from tdcm_ros.model.progress import Progress, report_progress, within
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.roll import (
     InvalidRollError,
+    RollHistory,
     check_roll,
     depends_on_roll,
     roll_loading,
@@ -122,6 +123,7 @@ __all__ = [
     "NotchContact",
     "Progress",
     "RectangularProfile",
+    "RollHistory",
     "Sensitivity",
     "SolveResult",
     "SolverSettings",

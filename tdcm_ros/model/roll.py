@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import math
 import numbers
+from bisect import bisect_right
+from collections import deque
 from dataclasses import replace
 from typing import Any
 
@@ -93,3 +95,36 @@ def roll_loading(loading: Loading | None, roll: float) -> Loading | None:
     density_x, density_z = loading.body_force_density
     return replace(loading, tip_force=(force_x * c, force_z), tip_moment=loading.tip_moment * c,
                    body_force_density=(density_x * c, density_z))
+
+
+class RollHistory:
+    """Recent rolls (rad) by stamp, to pair each sample of another stream (a tension, a marker
+    frame) with the roll at its time: the latest roll stamped at or before it, else the oldest
+    kept (all are newer), else 0 (none yet). Stamps in any one unit (ns, s), fed in order;
+    an out-of-order roll replaces nothing and is ignored. Keeps the last ``size``."""
+
+    def __init__(self, size: int = 2048) -> None:
+        if isinstance(size, bool) or not isinstance(size, int) or size < 1:
+            raise out_of_range("size", size, "an integer >= 1")
+        self._stamps: deque[float] = deque(maxlen=size)
+        self._rolls: deque[float] = deque(maxlen=size)
+
+    def __len__(self) -> int:
+        return len(self._rolls)
+
+    def add(self, stamp: float, roll: float, parameter: str = "roll") -> bool:
+        """Keep ``roll`` (rad; :class:`InvalidRollError` naming ``parameter`` unless finite) at
+        ``stamp``; False (not kept) when ``stamp`` is older than the latest kept one."""
+        phi = check_roll(roll, parameter)
+        if self._stamps and stamp < self._stamps[-1]:
+            return False
+        self._stamps.append(stamp)
+        self._rolls.append(phi)
+        return True
+
+    def at(self, stamp: float) -> float:
+        """The roll (rad) at ``stamp`` (see the class docstring)."""
+        if not self._rolls:
+            return 0.0
+        index = bisect_right(self._stamps, stamp)
+        return self._rolls[index - 1] if index else self._rolls[0]

@@ -14,8 +14,8 @@ Roll: subscribes ``joint_states`` (``sensor_msgs/msg/JointState``) and reads the
 below is the planar shape turned by the roll (:mod:`tdcm_ros.model.roll`). Each tension is paired
 with the latest roll stamped at or before the tension's stamp (the oldest one held if all are
 newer; 0 until one arrives; an unstamped JointState takes the node's clock). A JointState
-without that joint (or without its position) is ignored; a non-finite roll is dropped and
-counted on the input diagnostics like a bad tension. A roll alone does not trigger a solve:
+without that joint (or without its position) is ignored; a non-finite roll, or one stamped
+before the latest kept, is dropped and counted on the input diagnostics like a bad tension. A roll alone does not trigger a solve:
 the outputs follow the tension stream, as the driver publishes both per telemetry frame.
 
 TF (``tf2_msgs/msg/TFMessage``, see :mod:`tdcm_ros.nodes.tf_messages`): on ``/tf_static``
@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 import sys
-from collections import Counter, deque
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
@@ -49,6 +49,8 @@ from tdcm_ros.model import (
     PRESETS,
     SOLVER_SPECS,
     Design,
+    InvalidRollError,
+    RollHistory,
     SolveResult,
     SolverSettings,
     preset,
@@ -74,7 +76,7 @@ from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
-#: Rolls (stamp, rad) kept to pair with tensions: over a second at the driver's telemetry rate.
+#: Rolls kept to pair with tensions: over a second at the driver's telemetry rate.
 ROLL_HISTORY = 2048
 #: Parameters fixed at start, besides the design and solver groups.
 FIXED_SPECS = by_name(
@@ -173,7 +175,7 @@ class ModelNode(NodeLogic):
         port.create_subscription("tension", self.tension_type, self._on_tension, QoS(depth=100))
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
                                  self._on_joint_states, QoS(depth=100))
-        self.rolls: deque[tuple[int, float]] = deque(maxlen=ROLL_HISTORY)
+        self.rolls = RollHistory(ROLL_HISTORY)
         self.pending: tuple[float, int] | None = None
         self.previous: SolveResult | None = None
         self.counts: Counter[str] = Counter()
@@ -238,19 +240,15 @@ class ModelNode(NodeLogic):
         roll = joint_position(message, self.roll_joint)
         if roll is None:
             return
-        if not math.isfinite(roll):
-            self.counts["dropped_roll_non_finite"] += 1
-            self.last_problem = f"dropped roll {roll!r} rad of joint {self.roll_joint!r}: non_finite"
-            return
-        self.rolls.append((_stamp_ns(message) or self.port.now_ns(), roll))
-
-    def roll_at(self, stamp_ns: int) -> float:
-        """The roll (rad) at ``stamp_ns`` (ns): the latest kept one stamped at or before it,
-        else the oldest kept one, else 0."""
-        for stamp, roll in reversed(self.rolls):
-            if stamp <= stamp_ns:
-                return roll
-        return self.rolls[0][1] if self.rolls else 0.0
+        reason = ""
+        try:
+            if not self.rolls.add(_stamp_ns(message) or self.port.now_ns(), roll):
+                reason = "out_of_order"
+        except InvalidRollError:
+            reason = "non_finite"
+        if reason:
+            self.counts[f"dropped_roll_{reason}"] += 1
+            self.last_problem = f"dropped roll {roll!r} rad of joint {self.roll_joint!r}: {reason}"
 
     def _reject_reason(self, tension: float, stamp_ns: int | None, now_ns: int) -> str:
         """Why a tension (N) stamped ``stamp_ns`` (ns; None: a type without a header) is
@@ -292,7 +290,7 @@ class ModelNode(NodeLogic):
         radius = (self.design.R_outer + float(self.port.get_parameter("markers.radius"))
                   if placement == "surface" else 0.0)
         frame_id = str(self.port.get_parameter("frame_id"))
-        roll = self.roll_at(stamp_ns)
+        roll = self.rolls.at(stamp_ns)
         for topic, message in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),

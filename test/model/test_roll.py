@@ -15,6 +15,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.model import (
     InvalidRollError,
     Loading,
+    RollHistory,
     check_roll,
     depends_on_roll,
     offset_points,
@@ -154,3 +155,20 @@ def test_loads_along_the_roll_axis_do_not_depend_on_it():
     assert depends_on_roll(sideways) and roll_loading(sideways, 0.0) is sideways
     assert roll_loading(sideways, math.pi / 2).body_force_density[0] == pytest.approx(0.0,
                                                                                       abs=1e-9)
+
+
+def test_roll_history_pairs_a_stamp_with_the_roll_current_then() -> None:
+    history = RollHistory(size=3)
+    assert history.at(5.0) == 0.0                       # none yet
+    for stamp, roll in ((1.0, 0.1), (2.0, 0.2), (2.0, 0.25), (3.0, 0.3)):
+        assert history.add(stamp, roll)
+    assert len(history) == 3                            # (1.0, 0.1) fell out
+    assert history.at(2.0) == 0.25 and history.at(2.9) == 0.25
+    assert history.at(3.0) == 0.3 and history.at(1e9) == 0.3
+    assert history.at(0.0) == 0.2                       # older than all: the oldest kept
+    assert not history.add(2.5, 0.9) and history.at(2.6) == 0.25  # out of order: ignored
+    with pytest.raises(InvalidRollError, match="joint_states"):
+        history.add(4.0, math.nan, "joint_states")
+    assert history.at(5.0) == 0.3
+    with pytest.raises(InputError, match="size"):
+        RollHistory(size=0)

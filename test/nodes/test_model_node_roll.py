@@ -109,7 +109,7 @@ def test_a_tension_takes_the_roll_at_its_stamp_and_bad_rolls_are_counted() -> No
     port = MemoryPort(name="model_node")
     node = ModelNode(port)
     now = port.clock_ns
-    assert node.roll_at(now) == 0.0                               # none yet
+    assert node.rolls.at(now) == 0.0                               # none yet
     port.deliver("joint_states", joint_states(["roll"], [0.2], now - 30_000_000))
     port.deliver("joint_states", joint_states(["roll"], [0.3], now - 10_000_000))
     port.deliver("joint_states", joint_states(["roll"], [0.4], now + 10_000_000))
@@ -117,10 +117,11 @@ def test_a_tension_takes_the_roll_at_its_stamp_and_bad_rolls_are_counted() -> No
     port.deliver("joint_states", joint_states(["roll"], [], now - 5_000_000))      # no position
     port.deliver("joint_states", joint_states(["roll"], [math.nan], now - 5_000_000))
     port.deliver("joint_states", joint_states(["roll"], [math.inf], now - 5_000_000))
-    assert node.roll_at(now - 20_000_000) == 0.2
-    assert node.roll_at(now) == 0.3
-    assert node.roll_at(now + 10_000_000) == 0.4
-    assert node.roll_at(now - 40_000_000) == 0.2                  # older than all: the oldest
+    port.deliver("joint_states", joint_states(["roll"], [0.9], now - 20_000_000))  # out of order
+    assert node.rolls.at(now - 20_000_000) == 0.2
+    assert node.rolls.at(now) == 0.3
+    assert node.rolls.at(now + 10_000_000) == 0.4
+    assert node.rolls.at(now - 40_000_000) == 0.2                  # older than all: the oldest
     port.deliver("tension", wrench(10.0, now))
     node.process()
     expected = rolled(solve(PAPER, 10.0).tip_position[None, :], 0.3)
@@ -129,6 +130,7 @@ def test_a_tension_takes_the_roll_at_its_stamp_and_bad_rolls_are_counted() -> No
     status = port.messages("/diagnostics")[-1].status[0]
     values = {v.key: v.value for v in status.values}
     assert values["dropped_roll_non_finite"] == "2" and status.level == 1
+    assert values["dropped_roll_out_of_order"] == "1"
     assert "roll" in status.message
 
 
@@ -137,8 +139,10 @@ def test_an_unstamped_joint_state_takes_the_node_clock_and_roll_joint_is_a_param
     node = ModelNode(port)
     port.deliver("joint_states", joint_states(["roll"], [1.0], 0))       # another joint
     port.deliver("joint_states", joint_states(["base_roll"], [-0.5], 0))
-    assert node.roll_at(port.clock_ns) == -0.5 and len(node.rolls) == 1
-    assert node.rolls[0][0] == port.clock_ns
+    assert node.rolls.at(port.clock_ns) == -0.5 and len(node.rolls) == 1
+    port.deliver("joint_states", joint_states(["base_roll"], [0.5], port.clock_ns - 1))
+    assert node.rolls.at(port.clock_ns) == -0.5    # older than the clock the unstamped one took
+    assert node.counts["dropped_roll_out_of_order"] == 1
 
 
 def test_a_peer_sees_the_rolled_tip_on_tf(runtime, context, spawn) -> None:
