@@ -8,6 +8,11 @@ from the buffer. Trials and phases are assigned over all finished steps at each 
 offline evaluation does: a zero hold after a rise is the trial's unloading until the next rise
 makes it the start of the next trial (the running Table I then counts it as loading). The buffer keeps at most
 ``max_buffer_s`` of data (older samples are dropped when no step finishes, e.g. a long ramp).
+
+Roll (issue 18): the per-frame errors (:meth:`RunningEvaluation.sample_errors`) compare with
+the model rolled by the roll current at the frame's stamp (:meth:`RunningEvaluation.add_roll`,
+:class:`~tdcm_ros.model.RollHistory`). Table I (the steps, as offline) scores the planar model:
+it assumes the body at roll 0.
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.steps import assign_phases, assign_trials, detect_steps
 from tdcm_ros.metrics.table import TableMetrics
 from tdcm_ros.mocap import Registration
+from tdcm_ros.model import RollHistory, roll_points
 
 Array = NDArray[np.float64]
 
@@ -52,6 +58,7 @@ class RunningEvaluation:
         self._x: list[float] = []
         self._frame_t: list[float] = []
         self._frames: list[Array] = []
+        self.rolls = RollHistory()
         self.measured: list[MeasuredStep] = []
         self._dips: list[float] = []
         self._low_since_step = np.inf
@@ -72,6 +79,11 @@ class RunningEvaluation:
         self._t.append(float(stamp_s))
         self._x.append(float(tension_n))
 
+    def add_roll(self, stamp_s: float, roll_rad: float) -> bool:
+        """One roll sample (s; rad about the base +z axis); False when out of order (ignored).
+        Raises :class:`~tdcm_ros.model.InvalidRollError` unless the roll is finite."""
+        return self.rolls.add(float(stamp_s), roll_rad)
+
     def add_markers(self, stamp_s: float, positions: ArrayLike) -> None:
         """One marker frame (s; (k, 3) m in the markers' frame, NaN rows not visible)."""
         self._frame_t.append(float(stamp_s))
@@ -87,13 +99,15 @@ class RunningEvaluation:
 
     def sample_errors(self, stamp_s: float, positions: ArrayLike) -> Array | None:
         """Measured minus predicted marker points (k, 3) m in ``tdcm_base`` for one frame, the
-        model at the aligned tension (:class:`MarkerTable`); ``None`` without a registration
-        (given or estimated yet) or an aligned tension."""
+        model at the aligned tension (:class:`MarkerTable`) rolled by the roll at the frame's
+        stamp (0 without any); ``None`` without a registration (given or estimated yet) or an
+        aligned tension."""
         tension = self.tension_at(stamp_s)
         if tension is None or self.used_registration is None:
             return None
         measured = self.used_registration.to_base(np.asarray(positions, dtype=float))
-        return measured - self.table.markers(max(tension, 0.0))
+        predicted = roll_points(self.table.markers(max(tension, 0.0)), self.rolls.at(stamp_s))
+        return measured - predicted
 
     def update(self) -> list[StepRecord]:
         """Finish the steps that ended; returns their records (Table I updated)."""

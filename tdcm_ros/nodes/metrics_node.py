@@ -1,8 +1,11 @@
 """``metrics_node``: live Table I metrics of the model against motion capture.
 
 Subscribes ``tension`` (geometry_msgs/msg/WrenchStamped, ``wrench.force.z`` in N), ``markers``
-(mocap4r2_msgs/msg/Markers, frame ``mocap``, labels ``markers.labels``) and ``/tf_static``
-(tf2_msgs/msg/TFMessage, transient local: the ``mocap`` -> ``tdcm_base`` transform).
+(mocap4r2_msgs/msg/Markers, frame ``mocap``, labels ``markers.labels``), ``/tf_static``
+(tf2_msgs/msg/TFMessage, transient local: the ``mocap`` -> ``tdcm_base`` transform) and
+``joint_states`` (sensor_msgs/msg/JointState: the roll, joint ``roll.joint``, rad; 0 until one
+arrives). The per-frame errors compare at the roll current at the frame's stamp; Table I assumes
+roll 0 (see :mod:`tdcm_ros.metrics.streaming`).
 
 Publishes (frame ``tdcm_base``, SI units):
 
@@ -47,7 +50,8 @@ from tdcm_ros.metrics import (
     StepSettings,
 )
 from tdcm_ros.mocap import Registration
-from tdcm_ros.model import FIELD_SPECS, PRESETS, Design, preset
+from tdcm_ros.model import FIELD_SPECS, PRESETS, Design, InvalidRollError, preset
+from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.runtime import (
     DiagnosticLevel,
     Diagnostics,
@@ -78,6 +82,8 @@ FIXED_SPECS = by_name(
          (0.0, 0.0, 0.0), kind="vector"),
     Spec("registration.rotation", "", "tdcm_base orientation in mocap (x, y, z, w)",
          (0.0, 0.0, 0.0, 1.0), kind="vector", size=4),
+    Spec("roll.joint", description="joint of `joint_states` the body rolls by (rad about "
+         "the base +z axis)", default="roll", kind="str"),
     Spec("update_period_s", "s", "period of step detection", 0.5, low=0.01, high=60.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0),
     Spec("max_buffer_s", "s", "longest buffered stretch without a step", 120.0, low=1.0,
@@ -140,6 +146,7 @@ class MetricsNode(NodeLogic):
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
         declare_specs(port, TUNABLE_SPECS)
         self.source = str(fixed["registration.source"])
+        self.roll_joint = str(fixed["roll.joint"])
         translation, rotation = fixed["registration.translation"], fixed["registration.rotation"]
         update_s = float(fixed["update_period_s"])
         diag_s = float(fixed["diagnostics_period_s"])
@@ -162,6 +169,8 @@ class MetricsNode(NodeLogic):
                                  QoS(depth=1000))
         port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", self._on_markers,
                                  QoS(depth=100))
+        port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
+                                 self._on_joint_states, QoS(depth=1000))
         if self.source in ("auto", "tf_static"):
             port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
                                      QoS(depth=10, durability="transient_local"))
@@ -188,6 +197,17 @@ class MetricsNode(NodeLogic):
         self.counts["tension"] += 1
         self.last_ns["tension"] = self.port.now_ns()
         self.running.add_tension(_stamp_s(message), value)
+
+    def _on_joint_states(self, message: Any) -> None:
+        roll = joint_position(message, self.roll_joint)
+        if roll is None:
+            return
+        try:
+            kept = self.running.add_roll(_stamp_s(message) or self.port.now_ns() * 1e-9, roll)
+        except InvalidRollError:
+            self.counts["roll_non_finite"] += 1
+            return
+        self.counts["roll" if kept else "roll_out_of_order"] += 1
 
     def _on_markers(self, message: Any) -> None:
         self.counts["marker_frames"] += 1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -14,7 +15,7 @@ from tdcm_ros.metrics.evaluation import evaluate_series
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.synthetic import Recording, simulate
-from tdcm_ros.model import MarkerLayout, preset
+from tdcm_ros.model import MarkerLayout, preset, roll_points
 from tdcm_ros.nodes.metrics_node import MetricsNode
 from tdcm_ros.runtime.memory_port import MemoryPort
 
@@ -165,3 +166,38 @@ def test_node_maps_other_labels_and_midline_markers() -> None:
     feed(port, node, rec)
     table = json.loads(port.published["metrics/table"][-1].data)
     assert table["n_steps"] == 3 and table["rmse_m"] < 2e-5
+
+
+def _rolled(rec: Recording, roll: float) -> Recording:
+    """``rec`` with the body rolled by ``roll`` (rad) about tdcm_base z: markers turned in base."""
+    base = rec.registration.to_base(rec.markers.positions.reshape(-1, 3))
+    turned = rec.registration.to_mocap(roll_points(base, roll))
+    markers = replace(rec.markers, positions=turned.reshape(rec.markers.positions.shape))
+    return replace(rec, markers=markers)
+
+
+@pytest.mark.parametrize("roll_sent", [True, False])
+def test_marker_errors_compare_at_the_measured_roll(recording: Recording, roll_sent: bool
+                                                    ) -> None:
+    """The body rolled by 0.8 rad: with the roll on joint_states the per-frame errors stay at
+    the noise level; without it (the model at roll 0) they are millimetres."""
+    roll = 0.8
+    rec = _rolled(recording, roll)
+    port = metrics_port({"registration.source": "parameter",
+                         "registration.translation": list(rec.registration.translation),
+                         "registration.rotation": list(rec.registration.quaternion)})
+    node = MetricsNode(port)
+    if roll_sent:
+        port.deliver("joint_states", from_dict("sensor_msgs/msg/JointState", {
+            "header": _hdr(0.0, ""), "name": ["roll"], "position": [roll]}))
+        port.deliver("joint_states", from_dict("sensor_msgs/msg/JointState", {
+            "header": _hdr(0.5, ""), "name": ["roll"], "position": [float("nan")]}))
+    feed(port, node, rec)
+    sizes = [np.linalg.norm([m.translation.x, m.translation.y, m.translation.z])
+             for msg in port.published["metrics/marker_errors"] for m in msg.markers]
+    assert len(sizes) > 0.9 * rec.markers.stamps_s.size
+    if roll_sent:
+        assert np.median(sizes) < 3e-4
+        assert node.counts["roll"] == 1 and node.counts["roll_non_finite"] == 1
+    else:
+        assert np.median(sizes) > 2e-3
