@@ -53,8 +53,7 @@ def roll_points(points: ArrayLike, roll: float) -> Array:
     if phi == 0.0:
         return p
     c, s = math.cos(phi), math.sin(phi)
-    x, y = p[..., 0], p[..., 1]
-    return np.stack([c * x - s * y, s * x + c * y, p[..., 2]], axis=-1)
+    return p @ np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # rows: p R_z^T
 
 
 def roll_quaternions(quaternions: ArrayLike, roll: float) -> Array:
@@ -65,8 +64,9 @@ def roll_quaternions(quaternions: ArrayLike, roll: float) -> Array:
     if phi == 0.0:
         return q
     c, s = math.cos(0.5 * phi), math.sin(0.5 * phi)
-    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return np.stack([c * x - s * y, c * y + s * x, c * z + s * w, c * w - s * z], axis=-1)
+    # (x, y, z, w) -> (c x - s y, c y + s x, c z + s w, c w - s z), as rows: q M^T
+    return q @ np.array([[c, s, 0.0, 0.0], [-s, c, 0.0, 0.0], [0.0, 0.0, c, -s],
+                         [0.0, 0.0, s, c]])
 
 
 def roll_poses(positions: ArrayLike, quaternions: ArrayLike, roll: float

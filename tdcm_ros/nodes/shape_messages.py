@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.bagio import from_dict, msg_class
-from tdcm_ros.model import SolveResult, offset_points, roll_points, roll_poses
+from tdcm_ros.model import SolveResult, offset_points, roll_poses
 
 Array = NDArray[np.float64]
 
@@ -73,7 +73,11 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     modify them."""
     s = np.linspace(0.0, result.design.length, samples)
     planar, planar_quats = result.pose_at(np.concatenate([s, np.asarray(marker_s, dtype=float)]))
-    positions, quats = roll_poses(planar, planar_quats, roll)
+    planar[samples:] = offset_points(planar[samples:], planar_quats[samples:], marker_radius,
+                                     marker_side_rad)
+    # midline, markers and tip turned in one call: rows [0, samples), [samples, -1), -1
+    positions, quats = roll_poses(np.vstack([planar, result.tip_position]),
+                                  np.vstack([planar_quats, result.tip_quaternion]), roll)
     hdr = _header_msg(stamp_ns, frame_id)
     pose_stamped = msg_class("geometry_msgs/msg/PoseStamped")
     pose_array = msg_class("geometry_msgs/msg/PoseArray")
@@ -81,12 +85,9 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     yield "midline", msg_class("nav_msgs/msg/Path")(
         header=hdr, poses=[pose_stamped(header=hdr, pose=pose) for pose in poses])
     yield "midline_poses", pose_array(header=hdr, poses=poses)
-    tip = _poses(*roll_poses(result.tip_position[None, :], result.tip_quaternion[None, :],
-                             roll))[0]
+    tip = _poses(positions[-1:], quats[-1:])[0]
     yield "tip_pose", pose_stamped(header=hdr, pose=tip)
-    on_planar = offset_points(planar[samples:], planar_quats[samples:], marker_radius,
-                              marker_side_rad)
-    markers = _poses(roll_points(on_planar, roll), quats[samples:])
+    markers = _poses(positions[samples:-1], quats[samples:-1])
     yield "predicted_markers", pose_array(header=hdr, poses=markers)
     body = _marker(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
                    (0.85, 0.85, 0.9, 0.8), [p.position for p in poses])
