@@ -51,7 +51,7 @@ from tdcm_ros.mocap import (
     straight_axis,
 )
 from tdcm_ros.nodes.joint_states import joint_position
-from tdcm_ros.nodes.shape_messages import header
+from tdcm_ros.nodes.shape_messages import header, stamp_ns_of
 from tdcm_ros.runtime import (
     DiagnosticLevel,
     Diagnostics,
@@ -129,10 +129,6 @@ MOCAP_SPECS = by_name(
 
 #: Every parameter of the node by full name (parameter files are checked against it).
 PARAMETERS = grouped(MOCAP_SPECS)
-
-
-def _stamp_ns(message: Any) -> int:
-    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
 
 
 class MocapNode(NodeLogic):
@@ -266,7 +262,7 @@ class MocapNode(NodeLogic):
         positions = np.array([[m.translation.x, m.translation.y, m.translation.z]
                               for m in message.markers], dtype=float).reshape(-1, 3)
         names = tuple(str(m.marker_name) for m in message.markers)
-        self._publish(RawFrame(_stamp_ns(message) or self.port.now_ns(),
+        self._publish(RawFrame(stamp_ns_of(message) or self.port.now_ns(),
                                int(message.frame_number), names, positions * self.input_scale))
 
     def _start_sim(self) -> Registration:

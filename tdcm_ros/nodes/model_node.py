@@ -58,7 +58,7 @@ from tdcm_ros.model import (
     warm_up,
 )
 from tdcm_ros.nodes.joint_states import joint_position
-from tdcm_ros.nodes.shape_messages import midline_messages
+from tdcm_ros.nodes.shape_messages import midline_messages, stamp_ns_of
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
 from tdcm_ros.runtime import (
     DiagnosticLevel,
@@ -221,7 +221,7 @@ class ModelNode(NodeLogic):
         stamp_ns: int | None
         if self.tension_type == TENSION_TYPES[0]:
             tension = float(message.wrench.force.z)
-            stamp_ns = _stamp_ns(message)
+            stamp_ns = stamp_ns_of(message)
         else:
             tension, stamp_ns = float(message.data), None
         now = self.port.now_ns()
@@ -242,7 +242,7 @@ class ModelNode(NodeLogic):
             return
         reason = ""
         try:
-            if not self.rolls.add(_stamp_ns(message) or self.port.now_ns(), roll):
+            if not self.rolls.add(stamp_ns_of(message) or self.port.now_ns(), roll):
                 reason = "out_of_order"
         except InvalidRollError:
             reason = "non_finite"
@@ -328,11 +328,6 @@ class ModelNode(NodeLogic):
         if recent:
             return Status(DiagnosticLevel.WARN, last, values)
         return Status(DiagnosticLevel.OK, "ok", values)
-
-def _stamp_ns(message: Any) -> int:
-    """A message's header stamp (ns since the epoch; 0 when never set)."""
-    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
-
 
 def main() -> int:
     """``ros2 run tdcm_ros model_node`` / ``model_node`` console script."""

@@ -29,6 +29,11 @@ def header(stamp_ns: int, frame_id: str) -> dict[str, Any]:
             "frame_id": frame_id}
 
 
+def stamp_ns_of(message: Any) -> int:
+    """The header stamp of ``message`` (ns since the epoch; 0 when never set)."""
+    return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
+
+
 def _header_msg(stamp_ns: int, frame_id: str) -> Any:
     sec, nanosec = divmod(stamp_ns, 1_000_000_000)
     return msg_class("std_msgs/msg/Header")(
