@@ -1,5 +1,5 @@
 """mocap_node in its own process, on the embedded runtime and on rclpy (see conftest.py): CSV
-replay, live relabelling and bad configuration.
+replay, live relabelling, bad configuration and the sim source rolling with the true roll.
 
 The node's logic in detail (sim source, arc-length labelling, every configuration error) is
 tested in-process in test/mocap/test_mocap_node_logic.py.
@@ -199,3 +199,50 @@ def test_bad_configuration_exits_with_one_line(runtime, spawn, tmp_path, values,
     wait_for(lambda: node.poll() is not None, 20.0, "the node to exit")
     stderr = node.stderr.read().decode()
     assert node.returncode == 2 and phrase in stderr and "Traceback" not in stderr
+
+
+def test_sim_markers_roll_with_the_true_roll(runtime, context, spawn, tmp_path):
+    """Source sim on both runtimes: with sim/joint_states_true at 0.5 rad the markers, mapped
+    to tdcm_base through the published registration, are the scene's planar markers at the
+    true tension turned by 0.5 rad about tdcm_base z."""
+    import math
+
+    from tdcm_ros.mocap.registration import Registration
+    from tdcm_ros.model import solve, surface_points
+    from tdcm_ros.runtime.port import QoS
+    from tdcm_ros.scenes import load_scene
+
+    params = params_file(tmp_path, "mocap_node", {"source": "sim", "sim": {"scene": "ideal"}})
+    spawn("tdcm_ros.runtime.run_node", MOCAP, "--params", params)
+    probe = Probe(context)
+    tension = probe.port.create_publisher("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
+                                          QoS(depth=10))
+    rolls = probe.port.create_publisher("sim/joint_states_true", "sensor_msgs/msg/JointState",
+                                        QoS(depth=10))
+    scene = load_scene("ideal")
+    arcs = np.asarray(scene.marker_arc_lengths)
+    flat, _ = surface_points(solve(scene.true_design, 12.0), arcs, scene.marker_radius,
+                             scene.marker_side_rad)
+    roll = 0.5
+    c, s = math.cos(roll), math.sin(roll)
+    expected = flat @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
+    probe.join_tf_static()
+    probe.spin_until(lambda: bool(probe.tf), 20.0, "the registration on /tf_static")
+    t = probe.tf[-1].transforms[0].transform
+    registration = Registration((t.translation.x, t.translation.y, t.translation.z),
+                                (t.rotation.x, t.rotation.y, t.rotation.z, t.rotation.w))
+
+    def rolled_seen() -> bool:
+        tension.publish(from_dict("geometry_msgs/msg/WrenchStamped",
+                                  {"wrench": {"force": {"z": 12.0}}}))
+        rolls.publish(from_dict("sensor_msgs/msg/JointState",
+                                {"name": ["roll"], "position": [roll]}))
+        if not probe.markers or len(probe.markers[-1].markers) != len(arcs):
+            return False
+        seen = registration.to_base(np.array([xyz(m) for m in probe.markers[-1].markers]))
+        return bool(np.max(np.abs(seen - expected)) <= 1e-12)
+
+    probe.spin_until(rolled_seen, 30.0, "markers rolled by 0.5 rad")
+    seen = registration.to_base(np.array([xyz(m) for m in probe.markers[-1].markers]))
+    flat_seen = np.max(np.abs(seen - flat))
+    assert flat_seen > 1e-3, flat_seen          # the roll moved them by millimetres
