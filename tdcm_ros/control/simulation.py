@@ -18,7 +18,7 @@ from tdcm_ros.control.controller import ShapeController
 from tdcm_ros.control.estimator import GainSettings
 from tdcm_ros.control.limits import DriverLimits, slew
 from tdcm_ros.control.target import point_target, rotate_z
-from tdcm_ros.model import Design, MarkerLayout, solve, surface_points
+from tdcm_ros.model import Design, MarkerLayout, roll_points, solve, surface_points
 
 Array = NDArray[np.float64]
 
@@ -76,7 +76,7 @@ def simulate_tracking(design: Design, targets: Sequence[tuple[float, float, floa
             roll = slew(roll, goal[1], limits.roll_rate, dt_s)
             result = solve(world, tension)
             planar = surface_points(result, layout.s, radius, layout.side_rad)[0]
-            markers = np.array([rotate_z(tuple(p), roll) for p in planar])
+            markers = roll_points(planar, roll)
             controller.observe(tension + rng.normal(0.0, tension_noise_n), roll,
                                markers + rng.normal(0.0, marker_noise_m, markers.shape), dt_s,
                                adapt=mode == "feedback")

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from tdcm_ros.control.errors import TargetRefusedError
 from tdcm_ros.errors import out_of_range
+from tdcm_ros.model import roll_points
 
 #: Distance from the z axis (m) below which a point target keeps the current roll.
 AXIS_EPS_M = 1e-12
@@ -64,10 +65,10 @@ def angle_target(angle: float, current_roll: float) -> PlaneTarget:
 
 
 def rotate_z(point: tuple[float, float, float], roll_rad: float) -> tuple[float, float, float]:
-    """``point`` (m) rotated by ``roll_rad`` about the base +z axis."""
-    c, s = math.cos(roll_rad), math.sin(roll_rad)
-    x, y, z = point
-    return (c * x - s * y, s * x + c * y, z)
+    """``point`` (m) rotated by ``roll_rad`` about the base +z axis: the model's
+    :func:`~tdcm_ros.model.roll_points` for one point, as a tuple of floats."""
+    x, y, z = (float(value) for value in roll_points(point, roll_rad))
+    return (x, y, z)
 
 
 def in_plane(point: tuple[float, float, float], roll_rad: float) -> tuple[float, float]:
