@@ -32,6 +32,7 @@ from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param, as_mapping, parse_params, parse_value
 from tdcm_ros.scenes.schema import SECTIONS, TOP_KEYS
 from tdcm_ros.scenes.stages import Metered
+from tdcm_ros.scenes.trajectory import CircleTrajectory, parse_trajectory
 from tdcm_ros.scenes.world import World
 
 Array = NDArray[np.float64]
@@ -60,6 +61,7 @@ class Scene:
     effects: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
     source: Path | None = None
     marker_radial_offset: float | None = None
+    trajectory: CircleTrajectory | None = None  #: a tip path to follow; None: a staircase scene
 
     @property
     def marker_radius(self) -> float:
@@ -138,6 +140,7 @@ class Scene:
                               "quaternion_xyzw": quaternion.tolist()},
             "effects": {n: {k: list(v) if isinstance(v, tuple) else v for k, v in p.items()}
                         for n, p in self.effects.items()},
+            "trajectory": None if self.trajectory is None else self.trajectory.to_dict(),
         }
 
 
@@ -153,7 +156,7 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
                                     value=value, allowed="a string")
     seed = parse_value("seed", SEED, data.get("seed", 0))
     sections = {key: parse_params(key, specs, data.get(key))
-                for key, specs in SECTIONS.items() if key != "design"}
+                for key, specs in SECTIONS.items() if key not in ("design", "trajectory")}
     design = _design(data.get("design"))
     material = sections["material"]
     true_e = design.E if material["E"] is None else material["E"]
@@ -173,7 +176,9 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
         marker_labels=markers["labels"], marker_arc_lengths=markers["arc_lengths_m"],
         marker_ball_radius=markers["ball_radius_m"], marker_side_deg=markers["side_deg"],
         mocap_pose=(np.asarray(frame["translation_m"], dtype=float), quaternion),
-        source=source, marker_radial_offset=markers["radial_offset_m"])
+        source=source, marker_radial_offset=markers["radial_offset_m"],
+        trajectory=parse_trajectory(as_mapping("trajectory", data["trajectory"]))
+        if "trajectory" in data else None)
     raw_effects = as_mapping("effects", data.get("effects"))
     check_names(raw_effects)
     context = scene.context()

@@ -16,6 +16,7 @@ from tdcm_ros.device import SCHEDULE_SPECS
 from tdcm_ros.device.constants import SETPOINT_MAX_MN
 from tdcm_ros.model import FIELD_SPECS, MARKER_SPECS
 from tdcm_ros.scenes.params import Param
+from tdcm_ros.scenes.trajectory import TRAJECTORY
 
 NYLON12_DENSITY = 1010.0  # kg/m^3, Formlabs Nylon 12 powder, printed part
 
@@ -30,6 +31,7 @@ TOP_KEYS: dict[str, str] = {
     "markers": "nominal marker placement (the estimator's and, without marker_offset, the world's)",
     "mocap_frame": "true pose of tdcm_base in the mocap frame",
     "effects": "mapping effect name -> parameters (empty mapping: defaults); only these run",
+    "trajectory": "optional: a circle of tip targets the demo follows (tdcm demo tracks it)",
 }
 
 DESIGN = (
@@ -80,6 +82,7 @@ MOCAP_FRAME = (
 SECTIONS: dict[str, tuple[Param, ...]] = {
     "design": DESIGN, "material": MATERIAL, "schedule": SCHEDULE, "sensors": SENSORS,
     "markers": MARKERS, "mocap_frame": MOCAP_FRAME,
+    "trajectory": TRAJECTORY,  # optional: parsed only when the file has it
 }
 
 
