@@ -1,0 +1,116 @@
+"""Plots of a tracking run (needs matplotlib, the ``plot`` extra), in mm and s.
+
+- ``tracking_paths.png``: the target, measured and predicted tip paths seen from above (x-y of
+  ``tdcm_base``) and in the bending plane's coordinates (r = hypot(x, y) against z), the
+  measured tip coloured by phase.
+- ``tracking_error.png``: ``|measured - target|`` over time with the phases and their settle
+  spans marked, and, when recorded, the controller's stiffness correction with its standard
+  deviation.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tdcm_ros.demo.tracking_report import PhaseError, TrackingRecord, lap_of, points_at
+from tdcm_ros.figures import output_folder
+from tdcm_ros.metrics.plots import FONT_SIZE, _pyplot
+from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD, CircleTrajectory
+
+MM = 1e3
+"""Metres to millimetres (plots are in mm)."""
+PHASE_COLOURS = {FEEDFORWARD: "#d95f02", FEEDBACK: "#1b9e77"}
+
+
+def _modes(record: TrackingRecord, circle: CircleTrajectory) -> np.ndarray:
+    laps = lap_of(record, record.measured.log_s)
+    return np.array([circle.mode_of_lap(int(lap)) if lap > 0 else "" for lap in laps])
+
+
+def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory) -> Any:
+    """Two panels: x-y (top view) and r-z of the target, measured and predicted tips."""
+    fig, (top, side) = plt.subplots(1, 2, figsize=(11.5, 5.2))
+    target = record.targets.points * MM
+    modes = _modes(record, circle)
+    measured = record.measured.points * MM
+    predicted = record.predicted.points * MM
+    lapping = np.array([lap > 0 for lap in lap_of(record, record.predicted.log_s)], dtype=bool)
+    for ax, column in ((top, lambda p: (p[:, 0], p[:, 1])),
+                       (side, lambda p: (np.hypot(p[:, 0], p[:, 1]), p[:, 2]))):
+        for mode in (FEEDFORWARD, FEEDBACK):
+            pick = modes == mode
+            ax.plot(*column(measured[pick]), ".", ms=2.0, color=PHASE_COLOURS[mode],
+                    label=f"measured tip, {mode}")
+        ax.plot(*column(predicted[lapping]), "-", lw=0.6, color="0.45",
+                label="predicted tip (model at the measured tension and roll)")
+        ax.plot(*column(target), "-", lw=1.4, color="k", label="target")
+        ax.grid(True, alpha=0.3)
+        ax.tick_params(labelsize=FONT_SIZE)
+    top.set_aspect("equal")
+    top.set_xlabel("x in tdcm_base (mm)", fontsize=FONT_SIZE)
+    top.set_ylabel("y in tdcm_base (mm)", fontsize=FONT_SIZE)
+    top.set_title("seen from above (roll turns the bending plane)", fontsize=FONT_SIZE + 1)
+    side.set_xlabel("r = distance from the base z axis (mm)", fontsize=FONT_SIZE)
+    side.set_ylabel("z in tdcm_base (mm)", fontsize=FONT_SIZE)
+    side.set_title("in the bending plane (the bend sets r and z)", fontsize=FONT_SIZE + 1)
+    side.legend(loc="best", fontsize=FONT_SIZE - 1, markerscale=4)
+    fig.tight_layout()
+    return fig
+
+
+def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
+                 circle: CircleTrajectory) -> Any:
+    """The tip's distance from its target over time, and the controller's estimate."""
+    gain = record.gain
+    rows = 2 if gain is not None else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(10.0, 3.6 * rows), sharex=True, squeeze=False)
+    ax = axes[0][0]
+    measured = record.measured
+    distance = np.linalg.norm(measured.points - points_at(record.targets, measured.stamps_s),
+                              axis=1)
+    ax.plot(measured.stamps_s, distance * MM, "-", lw=0.6, color="0.3",
+            label="|measured - target|")
+    for error in errors:
+        colour = PHASE_COLOURS[error.mode]
+        ax.axvspan(error.start_s, error.start_s + circle.settle, color=colour, alpha=0.08, lw=0)
+        ax.axvspan(error.window_s[0], error.window_s[1], color=colour, alpha=0.22, lw=0,
+                   label=f"{error.mode}: RMSE {error.rmse_m * MM:.3f} mm, max "
+                         f"{error.max_m * MM:.3f} mm")
+    ax.set_ylabel("tip error (mm)", fontsize=FONT_SIZE)
+    ax.set_title("tracking error (light: settle time left out; dark: evaluated)",
+                 fontsize=FONT_SIZE + 1)
+    ax.legend(loc="upper right", fontsize=FONT_SIZE - 1)
+    if gain is not None:
+        gax = axes[1][0]
+        times = gain[0]
+        gax.plot(times, gain[1], "-", color="#7570b3", label="controller/gain")
+        if record.gain_std is not None and len(record.gain_std[1]) == len(gain[1]):
+            spread = record.gain_std[1]
+            gax.fill_between(times, gain[1] - spread, gain[1] + spread, color="#7570b3",
+                             alpha=0.2, lw=0, label="± controller/gain_std")
+        gax.set_ylabel("stiffness correction (-)", fontsize=FONT_SIZE)
+        gax.legend(loc="best", fontsize=FONT_SIZE - 1)
+    for row in axes:
+        row[0].grid(True, alpha=0.3)
+        row[0].tick_params(labelsize=FONT_SIZE)
+    axes[-1][0].set_xlabel("time from the first target (s)", fontsize=FONT_SIZE)
+    fig.tight_layout()
+    return fig
+
+
+def write_tracking_plots(record: TrackingRecord, errors: list[PhaseError],
+                         circle: CircleTrajectory, directory: str | Path) -> list[Path]:
+    """Write ``tracking_paths.png`` and ``tracking_error.png`` into ``directory`` (created if
+    missing; its parent must exist)."""
+    plt = _pyplot(Path(directory), "--out")
+    out = output_folder("--out", directory)
+    paths = []
+    for name, fig in (("tracking_paths.png", paths_figure(plt, record, circle)),
+                      ("tracking_error.png", error_figure(plt, record, errors, circle))):
+        fig.savefig(out / name, dpi=120)
+        plt.close(fig)
+        paths.append(out / name)
+    return paths
