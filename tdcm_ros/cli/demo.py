@@ -6,6 +6,10 @@ private zenoh router (``--runtime zenoh``, the default unless ``TDCM_RUNTIME`` s
 as rclpy nodes in the environment's ROS domain (``--runtime rclpy``). After the schedule (default: the scene's, the paper's 3 trials of
 0 -> 20 N in 4 N steps) the bag is evaluated (Table I metrics, per-step table, plots) and the
 model's E is calibrated on it, with the metrics after calibration.
+
+A scene with a ``trajectory`` section (``--scene tracking``) runs the shape controller instead
+of the schedule: the demo publishes the circle's tip targets, feed-forward laps then feedback
+laps, and reports the tracking error of each phase from the bag (no calibration).
 """
 
 from __future__ import annotations
@@ -33,7 +37,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog="examples:\n"
                "  tdcm demo                                 # the paper's 3 x (0 -> 20 N)\n"
                "  tdcm demo --scene friction-hysteresis --out /tmp/demo --trials 1\n"
-               "  tdcm demo --runtime rclpy --no-calibrate\n\n"
+               "  tdcm demo --runtime rclpy --no-calibrate\n"
+               "  tdcm demo --scene tracking                # follow a circle of tip targets\n\n"
                "scenes: tdcm scene list; each scene YAML documents its bench.")
     parser.add_argument("--scene", default="paper-experiment",
                         help="shipped scene name or scene YAML path (default paper-experiment)")
@@ -78,10 +83,20 @@ def _check_new(bag: Path, option: str) -> None:
                          value=str(bag), allowed="a new path")
 
 
+def _check_tracking_options(args: argparse.Namespace) -> None:
+    """A tracking scene's timing is its trajectory section: the staircase options do not apply."""
+    for option, given in (("--trials", args.trials is not None), ("--hold", args.hold is not None),
+                          ("--set", bool(args.set))):
+        if given:
+            raise InputError(f"{option} applies to a scene's tension schedule; a scene with a "
+                             "trajectory section runs its laps (set them in the scene file's "
+                             "trajectory section)", parameter=option,
+                             allowed="no value for a tracking scene")
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the demo; returns the exit status."""
     from tdcm_ros.demo import (
-        RECORDED_TOPICS,
         make_plan,
         record_live,
         report,
@@ -97,25 +112,42 @@ def run(args: argparse.Namespace) -> int:
     started = time.monotonic()
     scene = load_scene(args.scene)
     out = _out_dir(args.out, scene.name)
-    topics = RECORDED_TOPICS if args.record is None else tuple(
+    topics = None if args.record is None else tuple(
         t.strip() for t in args.record.split(",") if t.strip())
+    if scene.trajectory is not None:
+        _check_tracking_options(args)
     plan = make_plan(scene, args.scene, out, trials=args.trials, hold_s=args.hold,
                      bag=Path(args.bag) if args.bag else None, recorded_topics=topics)
     _check_new(plan.bag, "--bag" if args.bag else "--out")
-    options = options_from_sets(args.set, base=scene_options(plan))  # checked before the run
+    options = (options_from_sets(args.set, base=scene_options(plan))  # checked before the run
+               if plan.targets is None else None)
     out.mkdir(parents=True, exist_ok=True)
     endpoint = args.endpoint or _free_endpoint()
     os.environ[ENDPOINT_ENV] = endpoint
     levels = ", ".join(f"{v:g}" for v in plan.schedule.levels)
     print(f"tdcm demo: scene {scene.name!r} ({scene.description})")
-    print(f"  schedule: {plan.schedule.trials} trial(s) of [{levels}] N, {plan.schedule.hold:g} s "
-          f"per level ({plan.schedule.duration:g} s); effects: "
-          f"{', '.join(scene.effect_names()) or 'none'}")
+    effects = ', '.join(scene.effect_names()) or 'none'
+    if plan.targets is None:
+        print(f"  schedule: {plan.schedule.trials} trial(s) of [{levels}] N, "
+              f"{plan.schedule.hold:g} s per level ({plan.schedule.duration:g} s); effects: "
+              f"{effects}")
+    else:
+        circle = plan.targets.circle
+        print(f"  trajectory: circle of radius {circle.radius * 1e3:g} mm about "
+              f"({circle.centre[0] * 1e3:g}, {circle.centre[1] * 1e3:g}) mm, {circle.period:g} s "
+              f"per lap, {circle.feedforward_laps} feed-forward then {circle.feedback_laps} "
+              f"feedback lap(s) ({circle.duration:g} s); effects: {effects}")
     graph = (f"router {endpoint}" if runtime == "zenoh" else
              f"rclpy, ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}")
     print(f"  output: {plan.out}   runtime: {graph}")
     record_live(plan, endpoint=endpoint, runtime=runtime)
-    with ProgressBars.of(args) as bars:
-        report(plan, options, calibrate=not args.no_calibrate, progress=bars)
+    if options is None:
+        from tdcm_ros.demo.tracking_report import tracking_report
+
+        assert plan.targets is not None
+        tracking_report(plan.bag, plan.targets.circle, plan.out, scene.name)
+    else:
+        with ProgressBars.of(args) as bars:
+            report(plan, options, calibrate=not args.no_calibrate, progress=bars)
     print(f"tdcm demo: done in {time.monotonic() - started:.1f} s; outputs in {plan.out}")
     return 0

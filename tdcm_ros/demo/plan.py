@@ -1,4 +1,8 @@
-"""What the demo starts, in which order, with which parameters, all derived from one scene."""
+"""What the demo starts, in which order, with which parameters, all derived from one scene.
+
+A scene with a ``trajectory`` section is a tracking run: the shape controller takes the
+tension driver's setpoints, the demo publishes the circle's targets (``plan.targets``) and the
+report reads the tracking topics; any other scene runs the driver's staircase schedule."""
 
 from __future__ import annotations
 
@@ -8,6 +12,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from tdcm_ros.demo.tracking_report import REPORTED_TOPICS
+from tdcm_ros.demo.trajectory import TipTrajectory, tip_trajectory
 from tdcm_ros.device import StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics import settings_for_hold
@@ -24,6 +30,18 @@ RECORDED_TOPICS: tuple[str, ...] = (
     "midline", "device_state", "/diagnostics")
 #: Topics the evaluation after the run reads.
 EVALUATED_TOPICS: tuple[str, ...] = ("tension", "markers", "/tf_static")
+#: A tracking run's nodes in start order: the shape controller instead of the metrics node.
+TRACKING_NODE_ORDER: tuple[str, ...] = ("model_node", "mocap_node", "shape_controller",
+                                        "device_twin", "tension_driver")
+#: What a tracking run records: the bench, the targets and everything the controller says.
+TRACKING_TOPICS: tuple[str, ...] = (
+    "tension", "sim/tension_true", "joint_states", "sim/joint_states_true", "markers",
+    "/tf_static", "tension_setpoint", "roll_setpoint", *REPORTED_TOPICS,
+    "controller/target_tip", "controller/tracking_error", "tip_pose", "/diagnostics")
+#: Topics a tracking run waits for in the bag before the first target: the bench and the
+#: controller's measured tip (it is up and sees the markers).
+TRACKING_READY_TOPICS: tuple[str, ...] = ("tension", "markers", "/tf_static",
+                                          "controller/measured_tip")
 
 
 @dataclass(frozen=True)
@@ -36,6 +54,17 @@ class DemoPlan:
     out: Path
     bag: Path                            #: the rosbag2 folder the recorder writes
     recorded_topics: tuple[str, ...] = RECORDED_TOPICS
+    targets: TipTrajectory | None = None  #: a tracking run's targets; None: the schedule
+
+    @property
+    def node_order(self) -> tuple[str, ...]:
+        """The nodes this run starts, in order."""
+        return NODE_ORDER if self.targets is None else TRACKING_NODE_ORDER
+
+    @property
+    def ready_topics(self) -> tuple[str, ...]:
+        """Topics the bag must hold before the schedule or the first target starts."""
+        return EVALUATED_TOPICS if self.targets is None else TRACKING_READY_TOPICS
 
     @property
     def link(self) -> str:
@@ -54,7 +83,7 @@ class DemoPlan:
         live = {"steps.settle_s": steps.settle_s, "steps.min_hold_s": steps.min_hold_s}
         if scene.marker_radial_offset is not None:
             live["markers.radial_offset"] = scene.marker_radial_offset
-        return {
+        nodes: dict[str, dict[str, Any]] = {
             # The bag's /tf_static carries only the registration the evaluation reads.
             "model_node": {**design, **markers, "markers.radius": scene.marker_ball_radius,
                            "tf.tendon": False},
@@ -69,14 +98,21 @@ class DemoPlan:
                                "schedule.hold_s": float(self.schedule.hold),
                                "schedule.trials": int(self.schedule.trials),
                                "schedule.autostart": False},  # the demo starts it
+            "shape_controller": {**design, **markers, "markers.radius": scene.marker_ball_radius,
+                                 "markers.labels": list(scene.marker_labels),
+                                 "mode": "feedforward", "driver": "tension_driver"},
         }
+        return {name: nodes[name] for name in self.node_order}
 
 
 def make_plan(scene: Scene, scene_ref: str, out: Path, *, trials: int | None = None,
               hold_s: float | None = None, bag: Path | None = None,
-              recorded_topics: tuple[str, ...] = RECORDED_TOPICS) -> DemoPlan:
+              recorded_topics: tuple[str, ...] | None = None) -> DemoPlan:
     """The plan for ``scene``: outputs in ``out`` (the bag in ``bag``, default ``out/bag``), the
-    schedule's trials and hold time optionally shortened, ``recorded_topics`` in the bag."""
+    schedule's trials and hold time optionally shortened, ``recorded_topics`` in the bag
+    (default :data:`RECORDED_TOPICS`, for a tracking scene :data:`TRACKING_TOPICS`). A tracking
+    scene's targets must be reachable by the model within the driver's ``tension_max`` (the
+    schedule's top level), else the model's ``UnreachableTargetError``."""
     schedule = scene.schedule
     if trials is not None or hold_s is not None:
         schedule = replace(schedule, trials=schedule.trials if trials is None else trials,
@@ -85,10 +121,17 @@ def make_plan(scene: Scene, scene_ref: str, out: Path, *, trials: int | None = N
         raise InputError(f"schedule levels {schedule.levels!r} never tension the tendon; "
                          "allowed: at least one level > 0 N", parameter="schedule.levels",
                          value=list(schedule.levels), allowed="a level > 0 N")
-    missing = [t for t in EVALUATED_TOPICS if t not in recorded_topics]
+    targets = None
+    read = EVALUATED_TOPICS
+    if scene.trajectory is not None:
+        targets = tip_trajectory(scene.trajectory, scene.design, tension_max=max(schedule.levels))
+        read = (*REPORTED_TOPICS, *TRACKING_READY_TOPICS)
+    if recorded_topics is None:
+        recorded_topics = RECORDED_TOPICS if targets is None else TRACKING_TOPICS
+    missing = [t for t in read if t not in recorded_topics]
     if missing:
         raise InputError(f"recorded topics {list(recorded_topics)} lack {missing}, which the "
-                         f"evaluation reads; allowed: any list including {list(EVALUATED_TOPICS)}",
+                         f"report reads; allowed: any list including {list(read)}",
                          parameter="--record", value=list(recorded_topics),
-                         allowed=f"includes {', '.join(EVALUATED_TOPICS)}")
-    return DemoPlan(scene, scene_ref, schedule, out, bag or out / "bag", recorded_topics)
+                         allowed=f"includes {', '.join(read)}")
+    return DemoPlan(scene, scene_ref, schedule, out, bag or out / "bag", recorded_topics, targets)

@@ -4,6 +4,8 @@ The demo process joins the graph itself (a node named ``_tdcm_demo`` on the same
 progress, to start the driver's schedule (its ``start_schedule`` service) once the bag holds
 every evaluated topic (so the first level is recorded whatever the runtime's discovery time), and
 to see the driver report ``schedule_done`` on ``/diagnostics`` (``tension_driver: actuator``).
+A tracking plan instead publishes its targets and switches the controller's mode
+(:mod:`tdcm_ros.demo.follow`) once the bag holds the bench and the controller's measured tip.
 Children inherit the environment (``ROS_DOMAIN_ID``, ``ROS_AUTOMATIC_DISCOVERY_RANGE``, the zenoh
 endpoint). Ctrl-C stops the graph cleanly (the bag is closed and keeps everything received) and
 skips the evaluation.
@@ -23,7 +25,7 @@ from types import FrameType
 from typing import Any
 
 from tdcm_ros.bagio import BagError
-from tdcm_ros.demo.plan import EVALUATED_TOPICS, NODE_ORDER, DemoPlan
+from tdcm_ros.demo.plan import DemoPlan
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.runtime import NodeGraph, RuntimePortError, resolve_topic
 
@@ -142,21 +144,41 @@ class _Loop:
     def __init__(self, graph: NodeGraph, context: Any, stop: threading.Event) -> None:
         self.graph, self.context, self.stop = graph, context, stop
 
-    def turn(self, deadline: float, late: Callable[[], str]) -> None:
-        """Spin 0.1 s; ``late()`` is the error message once ``deadline`` (monotonic s) passed."""
+    def turn(self, deadline: float, late: Callable[[], str], seconds: float = 0.1) -> None:
+        """Spin ``seconds``; ``late()`` is the error message once ``deadline`` (monotonic s)
+        passed."""
         if self.stop.is_set():
             raise DemoInterrupted("demo interrupted; the bag so far is closed and readable")
         _graph_alive(self.graph)
         if time.monotonic() > deadline:
             raise RuntimePortError(late())
-        self.context.spin_for(0.1)
+        self.context.spin_for(seconds)
+
+
+def _run_schedule(plan: DemoPlan, context: Any, loop: _Loop, progress: Progress,
+                  say: Callable[[str], None], progress_period: float) -> None:
+    """Start the driver's schedule and wait until it reports ``schedule_done``."""
+    started = time.monotonic()
+    deadline = started + plan.schedule.duration + START_MARGIN_S
+    next_line = started
+    requested = False
+    while not progress.schedule_done:
+        requested = requested or start_schedule(context)
+        loop.turn(deadline, lambda: f"the schedule did not finish within "
+                                    f"{plan.schedule.duration:g} s + {START_MARGIN_S:g} s "
+                                    f"(last state {progress.schedule or 'none'}); see "
+                                    f"{loop.graph.log_dir}")
+        if time.monotonic() >= next_line:
+            say(progress.line(time.monotonic() - started))
+            next_line += progress_period
 
 
 def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
                 say: Callable[[str], None] = print, progress_period: float = 2.0) -> Progress:
     """Run the graph on ``runtime`` (``zenoh``: with a router on ``endpoint`` unless one answers
-    there; ``rclpy``) until the driver's schedule is done; the bag is closed on return.
-    ``progress_period`` is the time between progress lines (s)."""
+    there; ``rclpy``) until the driver's schedule is done, or a tracking plan's last target is
+    published; the bag is closed on return. ``progress_period`` is the time between progress
+    lines (s)."""
     from tdcm_ros.runtime.run_node import open_context
 
     stop = threading.Event()
@@ -179,36 +201,35 @@ def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
         port = context.create_port("_tdcm_demo")
         _watch(port, progress)
         overrides = plan.node_overrides()
-        for name in NODE_ORDER:
+        for name in plan.node_order:
             if stop.is_set():
                 break
             graph.start_node(name, overrides=overrides[name],
                              ready_path=plan.link if name == "device_twin" else None)
         say(f"graph up on {runtime}: {'router, ' if graph.router else ''}recorder, "
-            f"{', '.join(NODE_ORDER)} (logs in {logs})")
+            f"{', '.join(plan.node_order)} (logs in {logs})")
         loop = _Loop(graph, context, stop)
         ready_by = time.monotonic() + READY_TIMEOUT_S
-        while not bag_holds(plan.bag, EVALUATED_TOPICS):
-            loop.turn(ready_by, lambda: f"the recorder wrote no {', '.join(EVALUATED_TOPICS)} "
+        ready = plan.ready_topics
+        while not bag_holds(plan.bag, ready):
+            loop.turn(ready_by, lambda: f"the recorder wrote no {', '.join(ready)} "
                                         f"within {READY_TIMEOUT_S:g} s; see {logs}")
         started = time.monotonic()
-        say(f"the bag holds {', '.join(EVALUATED_TOPICS)}; starting the schedule")
-        deadline = started + plan.schedule.duration + START_MARGIN_S
-        next_line = started
-        requested = False
-        while not progress.schedule_done:
-            requested = requested or start_schedule(context)
-            loop.turn(deadline, lambda: f"the schedule did not finish within "
-                                        f"{plan.schedule.duration:g} s + {START_MARGIN_S:g} s "
-                                        f"(last state {progress.schedule or 'none'}); see {logs}")
-            if time.monotonic() >= next_line:
-                say(progress.line(time.monotonic() - started))
-                next_line += progress_period
+        if plan.targets is None:
+            say(f"the bag holds {', '.join(ready)}; starting the schedule")
+            _run_schedule(plan, context, loop, progress, say, progress_period)
+        else:
+            from tdcm_ros.demo.follow import follow
+
+            say(f"the bag holds {', '.join(ready)}; following the trajectory")
+            follow(plan.targets, context, port, loop.turn, say=say,
+                   progress_period=progress_period, margin_s=START_MARGIN_S)
         context.spin_for(SETTLE_S)
         status = graph.stop(recorder)
         if status not in (0, 130, -signal.SIGINT):
             raise RuntimePortError(f"the recorder exited with {status}; see {logs}/recorder.log")
-        say(f"schedule done after {time.monotonic() - started:.1f} s; bag closed: {plan.bag}")
+        say(f"{'schedule' if plan.targets is None else 'trajectory'} done after "
+            f"{time.monotonic() - started:.1f} s; bag closed: {plan.bag}")
         return progress
     finally:
         if context is not None:
