@@ -145,7 +145,8 @@ def run(args: argparse.Namespace) -> int:
         from tdcm_ros.demo.tracking_report import tracking_report
 
         assert plan.targets is not None
-        tracking_report(plan.bag, plan.targets.circle, plan.out, scene.name)
+        tracking_report(plan.bag, plan.targets.circle, plan.out, scene.name,
+                        world_gain=scene.design.E / scene.true_design.E)
     else:
         with ProgressBars.of(args) as bars:
             report(plan, options, calibrate=not args.no_calibrate, progress=bars)

@@ -4,8 +4,8 @@
   ``tdcm_base``) and in the bending plane's coordinates (r = hypot(x, y) against z), the
   measured tip coloured by phase.
 - ``tracking_error.png``: ``|measured - target|`` over time with the phases and their settle
-  spans marked, and, when recorded, the controller's stiffness correction with its standard
-  deviation.
+  spans marked, and, when recorded, the controller's stiffness correction ``g`` with its
+  standard deviation.
 """
 
 from __future__ import annotations
@@ -62,8 +62,9 @@ def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory) -> 
 
 
 def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
-                 circle: CircleTrajectory) -> Any:
-    """The tip's distance from its target over time, and the controller's estimate."""
+                 circle: CircleTrajectory, world_gain: float | None = None) -> Any:
+    """The tip's distance from its target over time (the approach's larger error off the
+    scale), and the controller's estimate with the scene's ``world_gain`` if given."""
     gain = record.gain
     rows = 2 if gain is not None else 1
     fig, axes = plt.subplots(rows, 1, figsize=(10.0, 3.6 * rows), sharex=True, squeeze=False)
@@ -79,8 +80,11 @@ def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
         ax.axvspan(error.window_s[0], error.window_s[1], color=colour, alpha=0.22, lw=0,
                    label=f"{error.mode}: RMSE {error.rmse_m * MM:.3f} mm, max "
                          f"{error.max_m * MM:.3f} mm")
+    if errors:
+        ax.set_ylim(0.0, 1.6 * max(e.max_m for e in errors) * MM)
     ax.set_ylabel("tip error (mm)", fontsize=FONT_SIZE)
-    ax.set_title("tracking error (light: settle time left out; dark: evaluated)",
+    ax.set_title("tracking error (light: settle time left out; dark: evaluated; the approach "
+                 "from 0 N is off the scale)",
                  fontsize=FONT_SIZE + 1)
     ax.legend(loc="upper right", fontsize=FONT_SIZE - 1)
     if gain is not None:
@@ -91,7 +95,10 @@ def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
             spread = record.gain_std[1]
             gax.fill_between(times, gain[1] - spread, gain[1] + spread, color="#7570b3",
                              alpha=0.2, lw=0, label="± controller/gain_std")
-        gax.set_ylabel("stiffness correction (-)", fontsize=FONT_SIZE)
+        if world_gain is not None:
+            gax.axhline(world_gain, color="k", ls="--", lw=1.0,
+                        label=f"the scene's E_model / E_world = {world_gain:.4f}")
+        gax.set_ylabel("g = E_model / E_world (-)", fontsize=FONT_SIZE)
         gax.legend(loc="best", fontsize=FONT_SIZE - 1)
     for row in axes:
         row[0].grid(True, alpha=0.3)
@@ -102,14 +109,16 @@ def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
 
 
 def write_tracking_plots(record: TrackingRecord, errors: list[PhaseError],
-                         circle: CircleTrajectory, directory: str | Path) -> list[Path]:
+                         circle: CircleTrajectory, directory: str | Path, *,
+                         world_gain: float | None = None) -> list[Path]:
     """Write ``tracking_paths.png`` and ``tracking_error.png`` into ``directory`` (created if
-    missing; its parent must exist)."""
+    missing; its parent must exist); ``world_gain`` as in :func:`error_figure`."""
     plt = _pyplot(Path(directory), "--out")
     out = output_folder("--out", directory)
     paths = []
     for name, fig in (("tracking_paths.png", paths_figure(plt, record, circle)),
-                      ("tracking_error.png", error_figure(plt, record, errors, circle))):
+                      ("tracking_error.png", error_figure(plt, record, errors, circle,
+                                                          world_gain))):
         fig.savefig(out / name, dpi=120)
         plt.close(fig)
         paths.append(out / name)

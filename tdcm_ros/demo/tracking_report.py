@@ -226,10 +226,11 @@ def format_phases(errors: list[PhaseError]) -> str:
     return "\n".join(lines)
 
 
-def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: str) -> dict[
-        str, Any]:
+def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: str, *,
+                    world_gain: float | None = None) -> dict[str, Any]:
     """Read ``bag``, print the phases' errors, write ``out/plots/tracking_*.png`` and
-    ``out/metrics.json``; returns what was written to the JSON."""
+    ``out/metrics.json``; returns what was written to the JSON. ``world_gain`` is the scene's
+    ``E_model / E_world`` (what the controller's ``gain`` estimates), shown beside it."""
     from tdcm_ros.demo.tracking_plots import write_tracking_plots
 
     record = read_tracking(bag)
@@ -237,7 +238,8 @@ def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: 
     print(f"\n== tracking error of {bag}: |measured - target| of the tip (3D), each phase after "
           f"its first {circle.settle:g} s ==")
     print(format_phases(errors))
-    for path in write_tracking_plots(record, errors, circle, out / "plots"):
+    for path in write_tracking_plots(record, errors, circle, out / "plots",
+                                     world_gain=world_gain):
         print(f"plot written to {path}")
     results: dict[str, Any] = {
         "scene": scene_name, "trajectory": circle.to_dict(),
@@ -246,8 +248,14 @@ def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: 
                     "predicted": len(record.predicted)}}
     if record.gain is not None:
         results["final_gain"] = float(record.gain[1][-1])
+        print(f"controller gain at the end: {results['final_gain']:.4f}"
+              + ("" if record.gain_std is None else f" +- {float(record.gain_std[1][-1]):.4f}")
+              + ("" if world_gain is None else f" (the scene's E_model / E_world: "
+                                               f"{world_gain:.4f})"))
     if record.gain_std is not None:
         results["final_gain_std"] = float(record.gain_std[1][-1])
+    if world_gain is not None:
+        results["world_gain"] = world_gain
     path = out / "metrics.json"
     path.write_text(json.dumps(results, indent=2), encoding="utf-8")
     print(f"metrics written to {path}")

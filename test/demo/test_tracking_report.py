@@ -121,13 +121,15 @@ def test_the_report_writes_what_it_computed_from_the_bag(tmp_path: Path,
                                                         ) -> None:
     pytest.importorskip("matplotlib")
     write_bag(tmp_path / "bag")
-    results = tracking_report(tmp_path / "bag", CIRCLE, tmp_path, "synthetic")
+    results = tracking_report(tmp_path / "bag", CIRCLE, tmp_path, "synthetic", world_gain=1.1)
     written = json.loads((tmp_path / "metrics.json").read_text())
     assert written == json.loads(json.dumps(results))
     assert written["tracking"][FEEDFORWARD]["rmse_m"] == pytest.approx(1.5811e-3, rel=1e-4)
     assert written["final_gain"] == pytest.approx(1.0 + 12.95 / 100)
+    assert written["world_gain"] == 1.1
     out = capsys.readouterr().out
     assert "feedforward" in out and "1.581 mm" in out and "0.100 mm" in out
+    assert "controller gain at the end: 1.1295 (the scene's E_model / E_world: 1.1000)" in out
     for name in ("tracking_paths.png", "tracking_error.png"):
         assert (tmp_path / "plots" / name).stat().st_size > 0
 
