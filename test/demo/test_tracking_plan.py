@@ -26,8 +26,10 @@ from tdcm_ros.demo.plan import (
 from tdcm_ros.demo.tracking_report import LAP_TOPIC, REPORTED_TOPICS, TARGET_TOPIC
 from tdcm_ros.demo.trajectory import tip_trajectory
 from tdcm_ros.errors import InputError
+from tdcm_ros.nodes import shape_controller
 from tdcm_ros.runtime import RuntimePortError
 from tdcm_ros.runtime.param_services import from_value
+from tdcm_ros.runtime.registry import NODES
 from tdcm_ros.scenes import load_scene
 from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD, parse_trajectory
 
@@ -41,6 +43,8 @@ def test_a_tracking_scene_starts_the_controller_and_records_what_the_report_read
     overrides = plan.node_overrides()
     assert list(overrides) == list(TRACKING_NODE_ORDER)
     assert overrides["shape_controller"]["mode"] == FEEDFORWARD
+    assert set(overrides["shape_controller"]) <= set(shape_controller.PARAMETERS)
+    assert set(plan.node_order) <= set(NODES)
     assert overrides["shape_controller"]["design.E"] == pytest.approx(plan.scene.design.E)
     assert overrides["tension_driver"]["port"] == overrides["device_twin"]["link"]
     assert plan.recorded_topics == TRACKING_TOPICS
