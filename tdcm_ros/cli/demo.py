@@ -101,6 +101,7 @@ def run(args: argparse.Namespace) -> int:
         record_live,
         report,
         scene_options,
+        tracking_report,
     )
     from tdcm_ros.metrics import options_from_sets
     from tdcm_ros.runtime.run_node import configure_logging, resolve_runtime
@@ -142,8 +143,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"  output: {plan.out}   runtime: {graph}")
     record_live(plan, endpoint=endpoint, runtime=runtime)
     if options is None:
-        from tdcm_ros.demo.tracking_report import tracking_report
-
         assert plan.targets is not None
         tracking_report(plan.bag, plan.targets.circle, plan.out, scene.name,
                         world_gain=scene.design.E / scene.true_design.E)

@@ -20,8 +20,7 @@ from typing import Any, Protocol
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.demo.tracking_report import LAP_TOPIC, LAP_TYPE, POINT_TYPE, TARGET_TOPIC
 from tdcm_ros.demo.trajectory import TipTrajectory
-from tdcm_ros.nodes.shape_messages import header
-from tdcm_ros.runtime import RuntimePortError
+from tdcm_ros.runtime import QoS, RuntimePortError
 from tdcm_ros.runtime.param_client import ParameterClient
 
 #: The node whose ``mode`` parameter the demo switches.
@@ -53,8 +52,6 @@ class FollowState:
 
 
 def _watch_error(port: Any, state: FollowState) -> None:
-    from tdcm_ros.runtime import QoS
-
     def on_error(message: Any) -> None:
         v = message.vector
         state.error_m = math.sqrt(v.x * v.x + v.y * v.y + v.z * v.z)
@@ -71,7 +68,7 @@ def set_mode(params: ParameterClient, mode: str) -> None:
 
 
 def follow(targets: TipTrajectory, context: Any, port: Any, turn: Turn, *,
-           say: Callable[[str], None], progress_period: float, margin_s: float) -> FollowState:
+           say: Callable[[str], None], progress_period: float, margin_s: float) -> None:
     """Publish every target of ``targets`` in real time, switching modes at lap starts;
     ``turn`` waits between ticks, with a deadline ``margin_s`` past the trajectory's end."""
     circle = targets.circle
@@ -100,12 +97,13 @@ def follow(targets: TipTrajectory, context: Any, port: Any, turn: Turn, *,
             next_line += progress_period
         turn(deadline, lambda: f"the trajectory did not finish within {circle.duration:g} s + "
                                f"{margin_s:g} s", max(1e-3, min(next_tick - now, MAX_SPIN_S)))
-    return state
 
 
 def _publish(port: Any, point_out: Any, lap_out: Any, point: tuple[float, float, float],
              lap: int) -> None:
+    stamp = port.now_ns()
     point_out.publish(from_dict(POINT_TYPE, {
-        "header": header(port.now_ns(), "tdcm_base"),
+        "header": {"stamp": {"sec": stamp // 10**9, "nanosec": stamp % 10**9},
+                   "frame_id": "tdcm_base"},
         "point": {"x": point[0], "y": point[1], "z": point[2]}}))
     lap_out.publish(from_dict(LAP_TYPE, {"data": lap}))

@@ -1,8 +1,11 @@
-"""After the run: evaluate the demo's bag, write plots and JSON, calibrate E, show the metrics after."""
+"""After the run: evaluate the demo's bag, write plots and JSON, calibrate E, show the metrics after
+(a tracking run: :func:`tracking_report`)."""
 
 from __future__ import annotations
 
 import json
+from pathlib import Path
+from typing import Any
 
 from tdcm_ros.demo.plan import DemoPlan
 from tdcm_ros.metrics import (
@@ -12,6 +15,7 @@ from tdcm_ros.metrics import (
     settings_for_hold,
 )
 from tdcm_ros.model import Progress
+from tdcm_ros.scenes import CircleTrajectory
 
 
 def scene_options(plan: DemoPlan) -> EvaluateOptions:
@@ -69,3 +73,41 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
     path = plan.out / "metrics.json"
     path.write_text(json.dumps(results, indent=2), encoding="utf-8")
     print(f"metrics written to {path}")
+
+
+def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: str, *,
+                    world_gain: float | None = None) -> dict[str, Any]:
+    """A tracking run's report (:mod:`tdcm_ros.demo.tracking_report`): read ``bag``, print the
+    phases' errors, write ``out/plots/tracking_*.png`` and ``out/metrics.json``; returns what
+    was written to the JSON. ``world_gain`` is the scene's ``E_model / E_world`` (what the
+    controller's ``gain`` estimates), shown beside it."""
+    from tdcm_ros.demo.tracking_plots import write_tracking_plots
+    from tdcm_ros.demo.tracking_report import format_phases, phase_errors, read_tracking
+
+    record = read_tracking(bag)
+    errors = phase_errors(record, circle)
+    print(f"\n== tracking error of {bag}: |measured - target| of the tip (3D), each phase after "
+          f"its first {circle.settle:g} s ==")
+    print(format_phases(errors))
+    for path in write_tracking_plots(record, errors, circle, out / "plots",
+                                     world_gain=world_gain):
+        print(f"plot written to {path}")
+    results: dict[str, Any] = {
+        "scene": scene_name, "trajectory": circle.to_dict(),
+        "tracking": {e.mode: e.to_json() for e in errors},
+        "samples": {"targets": len(record.targets), "measured": len(record.measured),
+                    "predicted": len(record.predicted)}}
+    if record.gain is not None:
+        results["final_gain"] = float(record.gain[1][-1])
+        print(f"controller gain at the end: {results['final_gain']:.4f}"
+              + ("" if record.gain_std is None else f" +- {float(record.gain_std[1][-1]):.4f}")
+              + ("" if world_gain is None else f" (the scene's E_model / E_world: "
+                                               f"{world_gain:.4f})"))
+    if record.gain_std is not None:
+        results["final_gain_std"] = float(record.gain_std[1][-1])
+    if world_gain is not None:
+        results["world_gain"] = world_gain
+    path = out / "metrics.json"
+    path.write_text(json.dumps(results, indent=2), encoding="utf-8")
+    print(f"metrics written to {path}")
+    return results

@@ -14,7 +14,6 @@ RMSE and maximum of ``|measured - target|`` (m, 3D), and of the predicted tip fo
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,7 +23,7 @@ from numpy.typing import NDArray
 
 from tdcm_ros.bagio import BagError
 from tdcm_ros.bagio.reader import open_bag, require_topic
-from tdcm_ros.scenes.trajectory import MODES, CircleTrajectory
+from tdcm_ros.scenes import MODES, CircleTrajectory
 
 Array = NDArray[np.float64]
 TARGET_TOPIC = "target_point"
@@ -199,6 +198,7 @@ def phase_errors(record: TrackingRecord, circle: CircleTrajectory) -> list[Phase
                            f"{circle.settle:g} s (trajectory.settle_s)",
                            parameter="trajectory.settle_s", value=circle.settle)
         error = measured.points[keep] - target[keep]
+        mean = error.mean(axis=0)
         distance = np.linalg.norm(error, axis=1)
         stamps = measured.stamps_s[keep]
         with_model = keep & np.all(np.isfinite(predicted), axis=1)
@@ -206,7 +206,7 @@ def phase_errors(record: TrackingRecord, circle: CircleTrajectory) -> list[Phase
             mode=mode, laps=mode_laps, start_s=start,
             window_s=(float(stamps.min()), float(stamps.max())), samples=int(keep.sum()),
             rmse_m=_rms(error), max_m=float(distance.max()),
-            mean_m=tuple(float(v) for v in error.mean(axis=0)),  # type: ignore[arg-type]
+            mean_m=(float(mean[0]), float(mean[1]), float(mean[2])),
             predicted_rmse_m=_rms(predicted[with_model] - target[with_model]),
             model_rmse_m=_rms(predicted[with_model] - measured.points[with_model])))
     return errors
@@ -224,39 +224,3 @@ def format_phases(errors: list[PhaseError]) -> str:
                      f"{e.rmse_m * 1e3:6.3f} mm {e.max_m * 1e3:6.3f} mm "
                      f"{e.predicted_rmse_m * 1e3:13.3f} mm {e.model_rmse_m * 1e3:15.3f} mm")
     return "\n".join(lines)
-
-
-def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: str, *,
-                    world_gain: float | None = None) -> dict[str, Any]:
-    """Read ``bag``, print the phases' errors, write ``out/plots/tracking_*.png`` and
-    ``out/metrics.json``; returns what was written to the JSON. ``world_gain`` is the scene's
-    ``E_model / E_world`` (what the controller's ``gain`` estimates), shown beside it."""
-    from tdcm_ros.demo.tracking_plots import write_tracking_plots
-
-    record = read_tracking(bag)
-    errors = phase_errors(record, circle)
-    print(f"\n== tracking error of {bag}: |measured - target| of the tip (3D), each phase after "
-          f"its first {circle.settle:g} s ==")
-    print(format_phases(errors))
-    for path in write_tracking_plots(record, errors, circle, out / "plots",
-                                     world_gain=world_gain):
-        print(f"plot written to {path}")
-    results: dict[str, Any] = {
-        "scene": scene_name, "trajectory": circle.to_dict(),
-        "tracking": {e.mode: e.to_json() for e in errors},
-        "samples": {"targets": len(record.targets), "measured": len(record.measured),
-                    "predicted": len(record.predicted)}}
-    if record.gain is not None:
-        results["final_gain"] = float(record.gain[1][-1])
-        print(f"controller gain at the end: {results['final_gain']:.4f}"
-              + ("" if record.gain_std is None else f" +- {float(record.gain_std[1][-1]):.4f}")
-              + ("" if world_gain is None else f" (the scene's E_model / E_world: "
-                                               f"{world_gain:.4f})"))
-    if record.gain_std is not None:
-        results["final_gain_std"] = float(record.gain_std[1][-1])
-    if world_gain is not None:
-        results["world_gain"] = world_gain
-    path = out / "metrics.json"
-    path.write_text(json.dumps(results, indent=2), encoding="utf-8")
-    print(f"metrics written to {path}")
-    return results

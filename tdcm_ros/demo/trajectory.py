@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.model import Design, solve_inverse
-from tdcm_ros.scenes.trajectory import CircleTrajectory
+from tdcm_ros.scenes import CircleTrajectory
 
 Array = NDArray[np.float64]
 #: Inverse solves in the height table (evenly spaced deflections over the circle's range).

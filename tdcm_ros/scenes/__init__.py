@@ -23,10 +23,17 @@ from tdcm_ros.scenes.params import param_table
 from tdcm_ros.scenes.parts import LoadingPart, PlantPart
 from tdcm_ros.scenes.paths import shipped_scenes
 from tdcm_ros.scenes.scene import Scene
-from tdcm_ros.scenes.trajectory import CircleTrajectory
+from tdcm_ros.scenes.trajectory import (
+    FEEDBACK,
+    FEEDFORWARD,
+    MODES,
+    CircleTrajectory,
+    parse_trajectory,
+)
 from tdcm_ros.scenes.world import MarkerFrame, World
 
-__all__ = ["CONSTRUCTED", "REGISTRY", "SCENE_NAMES", "STAGES", "CircleTrajectory", "CompiledScene",
+__all__ = ["CONSTRUCTED", "FEEDBACK", "FEEDFORWARD", "MODES", "REGISTRY", "SCENE_NAMES", "STAGES",
+           "CircleTrajectory", "CompiledScene",
            "EffectConflictError", "InvalidSceneError", "LoadingPart", "MarkerFrame", "PlantPart",
            "Scene", "SceneError", "World", "explain", "format_table", "load_scene", "param_table",
-           "scene_from_text", "shipped_scenes"]
+           "parse_trajectory", "scene_from_text", "shipped_scenes"]

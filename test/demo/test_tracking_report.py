@@ -12,6 +12,7 @@ import pytest
 
 from tdcm_ros.bagio import BagError, from_dict, serialize
 from tdcm_ros.bagio.writer import BagWriter
+from tdcm_ros.demo import tracking_report
 from tdcm_ros.demo.tracking_report import (
     GAIN_TOPIC,
     LAP_TOPIC,
@@ -20,7 +21,6 @@ from tdcm_ros.demo.tracking_report import (
     TARGET_TOPIC,
     phase_errors,
     read_tracking,
-    tracking_report,
 )
 from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD, parse_trajectory
 
