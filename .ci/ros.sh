@@ -3,7 +3,6 @@
 # wheels for Python 3.11), colcon, and this package built and run from a colcon install space.
 #
 #   bash .ci/ros.sh            # from any directory
-#   bash .ci/ros.sh --prepare  # phases 1 and 2 only (.ci/test.sh runs it beside the other tests)
 #
 # Phases: (1) a separate virtual environment (TDCM_ROS_VENV, default <repo>/.ros/venv; reused when
 # complete), (2) a colcon workspace (TDCM_ROS_WS, default <repo>/.ros/ws) holding tdcm_ros (this
@@ -12,13 +11,6 @@
 # node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy). Prints the time of each phase
 # and the disk used. Any failure exits non-zero.
 set -euo pipefail
-
-PREPARE_ONLY=0
-case "${1:-}" in
-  "") ;;
-  --prepare) PREPARE_ONLY=1 ;;
-  *) echo "usage: bash .ci/ros.sh [--prepare]" >&2; exit 2 ;;
-esac
 
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd -P)"
 cd "$REPO"
@@ -176,11 +168,6 @@ set +u
 # shellcheck disable=SC1091
 source "$WS/install/setup.bash"
 set -u
-
-if [ "$PREPARE_ONLY" = 1 ]; then
-  phase ""
-  exit 0
-fi
 
 # --- 3. the installed executables ---------------------------------------------------------------
 phase "installed executables"
