@@ -63,14 +63,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     def on_signal(signum: int, frame: FrameType | None) -> None:
         stop.set()
 
+    # Before the session opens: the router accepts connections while open_session is still
+    # running, so a client may signal it then; a KeyboardInterrupt there would leave an open
+    # session whose threads keep the process from exiting (seen on eclipse-zenoh 1.5.0 under load).
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, on_signal)
     try:
         warn_if_exposed(session_config(mode="router", router_endpoint=listen), "router")
         session = open_session(mode="router", router_endpoint=listen)
     except TdcmError as error:
         print(f"tdcm_router: {error}", file=sys.stderr)
         return error.exit_code
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, on_signal)
     print(f"tdcm_router: listening on {listen} (zid {session.zid()})", file=sys.stderr,
           flush=True)
     while not stop.wait(0.2):

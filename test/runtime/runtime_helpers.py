@@ -34,10 +34,19 @@ def wait_for(predicate: Callable[[], bool], timeout: float, what: str) -> None:
 
 
 def stop(process: subprocess.Popen[bytes], timeout: float = 10.0) -> int:
-    """SIGINT, then wait; returns the exit status."""
+    """SIGINT, then wait; returns the exit status. A process still running after ``timeout`` s
+    is killed and the failure shows the end of what it wrote (its stderr, when piped), so a
+    hang says where it was."""
     if process.poll() is None:
         process.send_signal(signal.SIGINT)
-    return process.wait(timeout)
+    try:
+        return process.wait(timeout)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        _, err = process.communicate()
+        tail = (err or b"")[-3000:].decode(errors="replace")
+        raise AssertionError(f"{process.args} did not exit within {timeout} s of SIGINT; "
+                             f"killed. Its stderr ends:\n{tail}") from None
 
 
 def spin_until(context: Any, predicate: Callable[[], bool], timeout: float, what: str) -> None:
