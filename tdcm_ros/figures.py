@@ -34,6 +34,7 @@ from tdcm_ros.model import (
     sweep,
     within,
 )
+from tdcm_ros.plot_backend import load_pyplot
 
 MM = 1e-3
 PLOT_FORMATS = ("png", "pdf", "svg")
@@ -103,19 +104,6 @@ FIGURES = (
 )
 
 
-def _pyplot() -> Any:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise InputError("figures need matplotlib: pip install 'tdcm_ros[plot]'",
-                         parameter="matplotlib", value=None,
-                         allowed="matplotlib installed") from exc
-    return plt
-
-
 def write_figures(out_dir: str | Path, *, points: int = 41, dpi: int = 130,
                   progress: Progress | None = None) -> list[Path]:
     """Write ``fig2.png``, ``fig3.png`` and ``feasibility.png`` to ``out_dir``; return paths.
@@ -126,7 +114,7 @@ def write_figures(out_dir: str | Path, *, points: int = 41, dpi: int = 130,
     if isinstance(points, bool) or not isinstance(points, int) or not 3 <= points <= 400:
         raise InputError(f"points = {points!r} is out of range; allowed: integer in [3, 400]",
                          parameter="points", value=points, allowed="integer in [3, 400]")
-    plt = _pyplot()
+    plt = load_pyplot("matplotlib", None, subject="figures need")
     out = output_folder("--out", out_dir)
     tensions = np.linspace(0.0, T_BASE, points)
     paths = [_paper_figure(plt, spec, tensions, points, out / f"{spec.name}.png", dpi, progress)

@@ -7,8 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tdcm_ros.errors import InputError
 from tdcm_ros.model import DesignSearch, SolveResult
+from tdcm_ros.plot_backend import load_pyplot
 
 FONT_SIZE = 10
 """Smallest font of the plot (pt)."""
@@ -55,22 +55,9 @@ def solution_figure(plt: Any, result: SolveResult) -> Any:
     return fig
 
 
-def _pyplot(option: str, path: str | Path) -> Any:
-    """``matplotlib.pyplot`` on the Agg backend, or an :class:`InputError` naming ``--option``."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise InputError(f"--{option} needs matplotlib: pip install 'tdcm_ros[plot]'",
-                         parameter=option, value=str(path), allowed="matplotlib installed") from exc
-    return plt
-
-
 def plot_solution(result: SolveResult, path: str | Path) -> Path:
     """Write :func:`solution_figure` of ``result`` to ``path`` (.png, .pdf or .svg)."""
-    plt = _pyplot("plot", path)
+    plt = load_pyplot("--plot", path)
     out = Path(path)
     fig = solution_figure(plt, result)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -85,7 +72,7 @@ def plot_search(search: DesignSearch, path: str | Path) -> Path:
     the Pareto set coloured by reach."""
     import numpy as np
 
-    plt = _pyplot("out", path)
+    plt = load_pyplot("--out", path)
     meets = np.flatnonzero(search.outcome == "meets")
     shown = meets[:: max(1, -(-meets.size // MAX_SHOWN))]
     front = search.pareto

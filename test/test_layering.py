@@ -18,7 +18,7 @@ HEAVY = frozenset({"scipy", "matplotlib", "zenoh", "rclpy", "mcap", "rosbags", "
 
 LAYERS = (  # from the ground up; units in one layer do not import each other
     frozenset({"__init__", "errors"}),
-    frozenset({"spec", "yamlio", "resources"}),
+    frozenset({"spec", "yamlio", "resources", "plot_backend"}),
     frozenset({"model"}),
     frozenset({"device", "mocap", "bagio", "figures", "plotting"}),
     frozenset({"metrics", "scenes", "control"}),

@@ -17,7 +17,8 @@ import numpy as np
 
 from tdcm_ros.demo.tracking_report import PhaseError, TrackingRecord, lap_of, points_at
 from tdcm_ros.figures import output_folder
-from tdcm_ros.plotting import FONT_SIZE, _pyplot
+from tdcm_ros.plot_backend import load_pyplot
+from tdcm_ros.plotting import FONT_SIZE
 from tdcm_ros.scenes import FEEDBACK, FEEDFORWARD, CircleTrajectory
 
 MM = 1e3
@@ -113,7 +114,7 @@ def write_tracking_plots(record: TrackingRecord, errors: list[PhaseError],
                          world_gain: float | None = None) -> list[Path]:
     """Write ``tracking_paths.png`` and ``tracking_error.png`` into ``directory`` (created if
     missing; its parent must exist); ``world_gain`` as in :func:`error_figure`."""
-    plt = _pyplot("out", directory)
+    plt = load_pyplot("--out", directory)
     out = output_folder("--out", directory)
     paths = []
     for name, fig in (("tracking_paths.png", paths_figure(plt, record, circle)),

@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.errors import InputError
 from tdcm_ros.figures import output_folder
 from tdcm_ros.metrics.evaluation import Evaluation
+from tdcm_ros.plot_backend import load_pyplot
 
 MM = 1e3
 """Metres to millimetres (plots are in mm)."""
@@ -24,19 +24,6 @@ PANEL_SIZE_IN = (3.8, 8.5)
 """Width and height of one trial's panel (inches)."""
 FONT_SIZE = 10
 """Smallest font of the plots (pt): readable at 100 % zoom of a 120 dpi PNG."""
-
-
-def _pyplot(target: Path, option: str) -> Any:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError as exc:
-        raise InputError(f"{option} needs matplotlib: pip install 'tdcm_ros[plot]'",
-                         parameter=option.lstrip("-"), value=str(target),
-                         allowed="matplotlib installed") from exc
-    return plt
 
 
 def marker_offset_m(evaluation: Evaluation) -> float:
@@ -139,7 +126,7 @@ def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = 
     """Write ``shapes.png`` (:func:`shapes_figure`) and ``error_vs_tension.png``
     (:func:`error_figure`) into ``directory`` (created if missing; its parent must exist;
     ``option`` names it in errors)."""
-    plt = _pyplot(Path(directory), option)
+    plt = load_pyplot(option, Path(directory))
     out = output_folder(option, directory)
     paths = []
     for name, make in (("shapes.png", shapes_figure), ("error_vs_tension.png", error_figure)):

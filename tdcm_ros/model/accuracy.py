@@ -38,6 +38,7 @@ from tdcm_ros.model.kinematics import integrate
 from tdcm_ros.model.progress import Progress, report_progress
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
+from tdcm_ros.plot_backend import load_pyplot
 
 Array = NDArray[np.float64]
 
@@ -472,11 +473,7 @@ def _speedup_text(speedup: dict[str, Any]) -> str:
 
 def plot_pareto(report: Report, path: str) -> None:
     """Error vs time (log-log) of every configuration to a PNG; the front is joined."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = load_pyplot("--plot", path)
     fig, ax = plt.subplots(figsize=(9, 6))
     styles = {"algorithm1": ("o", "C0"), "constant-curvature": ("s", "C2"),
               "pseudo-rigid-body": ("D", "C4"), "shooting-segmented": ("^", "C1"),
