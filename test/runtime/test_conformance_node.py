@@ -136,7 +136,10 @@ def test_driver_service_call_and_rosout(peer: RosPeer, spawn: Any, tmp_path: Pat
     request = peer.message(f"{TRIGGER}_Request", structure_needs_at_least_one_member=0)
     first = peer.call(service, TRIGGER, request)
     second = peer.call(service, TRIGGER, request)
-    client = [t for t in peer.tokens() if t.node == RosPeer.NAME and t.kind == "SC"]
+    # One liveliness query is not enough: peer.tokens() returns what arrived within its 1 s
+    # timeout, so under load a reply can be cut short. Poll until the token is seen.
+    client = until("the peer's client token", lambda: [
+        t for t in peer.tokens() if t.node == RosPeer.NAME and t.kind == "SC"])
     assert [t.topic for t in client] == [service]
     for number, reply in enumerate((first, second), start=1):
         assert reply.key == key_expr(0, service, TRIGGER)
