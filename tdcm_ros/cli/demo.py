@@ -137,7 +137,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"  trajectory: circle of radius {circle.radius * 1e3:g} mm about "
               f"({circle.centre[0] * 1e3:g}, {circle.centre[1] * 1e3:g}) mm, {circle.period:g} s "
               f"per lap, {circle.feedforward_laps} feed-forward then {circle.feedback_laps} "
-              f"feedback lap(s) ({circle.duration:g} s); effects: {effects}")
+              f"feedback lap(s)"
+              + (f" then {circle.learned_feedforward_laps} feed-forward with the learned gain"
+                 if circle.learned_feedforward_laps else "")
+              + f" ({circle.duration:g} s); effects: {effects}")
     graph = (f"router {endpoint}" if runtime == "zenoh" else
              f"rclpy, ROS_DOMAIN_ID {os.environ.get('ROS_DOMAIN_ID', '0')}")
     print(f"  output: {plan.out}   runtime: {graph}")

@@ -5,8 +5,9 @@ stamped with the runtime's clock) at the trajectory's rate, each the target at t
 (so a late tick publishes where the target is, not where it was), and beside it the lap on
 ``tracking/lap`` (``std_msgs/msg/Int32``: 0 the approach, then 1, 2, ...) for the report. At
 each lap whose mode differs from the controller's it sets the shape controller's ``mode``
-parameter through its parameter services first; a refusal ends the run with the controller's
-reason.
+parameter through its parameter services first (back to ``feedforward`` for the laps with the
+learned gain: the controller keeps its estimate, frozen); a refusal ends the run with the
+controller's reason.
 """
 
 from __future__ import annotations
@@ -42,13 +43,14 @@ class FollowState:
 
     lap: int = -1
     mode: str = ""
+    phase: str = ""                #: the lap's phase ("" during the approach)
     error_m: float | None = None   #: latest |controller/tracking_error| (m)
 
     def line(self, elapsed: float, laps: int) -> str:
         """One progress line."""
         error = "-" if self.error_m is None else f"{self.error_m * 1e3:6.3f} mm"
         lap = "approach" if self.lap == 0 else f"lap {self.lap}/{laps}"
-        return f"  t = {elapsed:5.1f} s  {lap:10s} {self.mode:11s} tip error {error}"
+        return f"  t = {elapsed:5.1f} s  {lap:10s} {self.phase or self.mode:19s} tip error {error}"
 
 
 def _watch_error(port: Any, state: FollowState) -> None:
@@ -85,11 +87,12 @@ def follow(targets: TipTrajectory, context: Any, port: Any, turn: Turn, *,
         elapsed = now - start
         if now >= next_tick:
             lap = circle.lap_at(elapsed)
-            mode = circle.mode_of_lap(lap)
+            mode, phase = circle.mode_of_lap(lap), circle.phase_of_lap(lap)
             if mode != state.mode:
                 set_mode(params, mode)
-                say(f"  t = {elapsed:5.1f} s  controller mode -> {mode}")
-            state.lap, state.mode = lap, mode
+                say(f"  t = {elapsed:5.1f} s  controller mode -> {mode}"
+                    + (f" ({phase} phase)" if phase else ""))
+            state.lap, state.mode, state.phase = lap, mode, phase
             _publish(port, point_out, lap_out, targets.point(elapsed), lap)
             next_tick += period * max(1, math.ceil((now - next_tick) / period))
         if now >= next_line:

@@ -94,7 +94,7 @@ def tracking_report(bag: Path, circle: CircleTrajectory, out: Path, scene_name: 
         print(f"plot written to {path}")
     results: dict[str, Any] = {
         "scene": scene_name, "trajectory": circle.to_dict(),
-        "tracking": {e.mode: e.to_json() for e in errors},
+        "tracking": {e.phase: e.to_json() for e in errors},
         "samples": {"targets": len(record.targets), "measured": len(record.measured),
                     "predicted": len(record.predicted)}}
     if record.gain is not None:

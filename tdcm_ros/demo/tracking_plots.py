@@ -2,7 +2,7 @@
 
 - ``tracking_paths.png``: the target, measured and predicted tip paths seen from above (x-y of
   ``tdcm_base``) and in the bending plane's coordinates (r = hypot(x, y) against z), the
-  measured tip coloured by phase.
+  measured tip coloured by phase (feed-forward, feedback, feed-forward with the learned gain).
 - ``tracking_error.png``: ``|measured - target|`` over time with the phases and their settle
   spans marked, and, when recorded, the controller's stiffness correction ``g`` with its
   standard deviation.
@@ -19,32 +19,41 @@ from tdcm_ros.demo.tracking_report import PhaseError, TrackingRecord, lap_of, po
 from tdcm_ros.figures import output_folder
 from tdcm_ros.plot_backend import load_pyplot
 from tdcm_ros.plotting import FONT_SIZE
-from tdcm_ros.scenes import FEEDBACK, FEEDFORWARD, CircleTrajectory
+from tdcm_ros.scenes import (
+    FEEDBACK,
+    FEEDFORWARD,
+    FEEDFORWARD_LEARNED,
+    PHASES,
+    CircleTrajectory,
+)
 
 MM = 1e3
 """Metres to millimetres (plots are in mm)."""
-PHASE_COLOURS = {FEEDFORWARD: "#d95f02", FEEDBACK: "#1b9e77"}
+PHASE_COLOURS = {FEEDFORWARD: "#d95f02", FEEDBACK: "#1b9e77", FEEDFORWARD_LEARNED: "#e7298a"}
+PHASE_LABELS = {FEEDFORWARD: "feed-forward", FEEDBACK: "feedback",
+                FEEDFORWARD_LEARNED: "feed-forward, learned gain"}
 
 
-def _modes(record: TrackingRecord, circle: CircleTrajectory) -> np.ndarray:
+def _phases(record: TrackingRecord, circle: CircleTrajectory) -> np.ndarray:
     laps = lap_of(record, record.measured.log_s)
-    return np.array([circle.mode_of_lap(int(lap)) if lap > 0 else "" for lap in laps])
+    return np.array([circle.phase_of_lap(int(lap)) if lap > 0 else "" for lap in laps])
 
 
 def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory) -> Any:
     """Two panels: x-y (top view) and r-z of the target, measured and predicted tips."""
     fig, (top, side) = plt.subplots(1, 2, figsize=(11.5, 5.2))
     target = record.targets.points * MM
-    modes = _modes(record, circle)
+    phases = _phases(record, circle)
     measured = record.measured.points * MM
     predicted = record.predicted.points * MM
     lapping = np.array([lap > 0 for lap in lap_of(record, record.predicted.log_s)], dtype=bool)
     for ax, column in ((top, lambda p: (p[:, 0], p[:, 1])),
                        (side, lambda p: (np.hypot(p[:, 0], p[:, 1]), p[:, 2]))):
-        for mode in (FEEDFORWARD, FEEDBACK):
-            pick = modes == mode
-            ax.plot(*column(measured[pick]), ".", ms=2.0, color=PHASE_COLOURS[mode],
-                    label=f"measured tip, {mode}")
+        for phase in PHASES:
+            pick = phases == phase
+            if pick.any():
+                ax.plot(*column(measured[pick]), ".", ms=2.0, color=PHASE_COLOURS[phase],
+                        label=f"measured tip, {PHASE_LABELS[phase]}")
         ax.plot(*column(predicted[lapping]), "-", lw=0.6, color="0.45",
                 label="predicted tip (model at the measured tension and roll)")
         ax.plot(*column(target), "-", lw=1.4, color="k", label="target")
@@ -76,10 +85,10 @@ def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
     ax.plot(measured.stamps_s, distance * MM, "-", lw=0.6, color="0.3",
             label="|measured - target|")
     for error in errors:
-        colour = PHASE_COLOURS[error.mode]
+        colour = PHASE_COLOURS[error.phase]
         ax.axvspan(error.start_s, error.start_s + circle.settle, color=colour, alpha=0.08, lw=0)
         ax.axvspan(error.window_s[0], error.window_s[1], color=colour, alpha=0.22, lw=0,
-                   label=f"{error.mode}: RMSE {error.rmse_m * MM:.3f} mm, max "
+                   label=f"{PHASE_LABELS[error.phase]}: RMSE {error.rmse_m * MM:.3f} mm, max "
                          f"{error.max_m * MM:.3f} mm")
     if errors:
         ax.set_ylim(0.0, 1.6 * max(e.max_m for e in errors) * MM)

@@ -6,8 +6,9 @@ controller measured from motion capture (``controller/measured_tip``) and the on
 predicted (``controller/predicted_tip``). Each measured tip is compared with the target at its
 stamp (linear interpolation between the published targets: the circle is continuous, so this
 is the target in force at that instant, without the publishing rate's steps). A sample belongs
-to the lap announced last before it was recorded (log times); a phase is the laps of one mode
-(:class:`~tdcm_ros.scenes.CircleTrajectory`), and its first ``settle_s`` are left out (the
+to the lap announced last before it was recorded (log times); a phase is a run of laps
+(:data:`~tdcm_ros.scenes.PHASES`: feed-forward, feedback, feed-forward with the learned gain;
+:class:`~tdcm_ros.scenes.CircleTrajectory`), and its first ``settle_s`` are left out (the
 move off the approach hold, the estimator's convergence after feedback starts). Per phase:
 RMSE and maximum of ``|measured - target|`` (m, 3D), and of the predicted tip for comparison.
 """
@@ -23,7 +24,7 @@ from numpy.typing import NDArray
 
 from tdcm_ros.bagio import BagError
 from tdcm_ros.bagio.reader import open_bag, require_topic
-from tdcm_ros.scenes import MODES, CircleTrajectory
+from tdcm_ros.scenes import PHASE_MODES, PHASES, CircleTrajectory
 
 Array = NDArray[np.float64]
 TARGET_TOPIC = "target_point"
@@ -152,7 +153,7 @@ def lap_of(record: TrackingRecord, log_s: Array) -> NDArray[np.int64]:
 class PhaseError:
     """The tracking error of one phase after its settle time (m, 3D distances)."""
 
-    mode: str
+    phase: str              #: one of :data:`~tdcm_ros.scenes.PHASES`
     laps: tuple[int, ...]
     start_s: float          #: the phase's first announcement (s from the first target)
     window_s: tuple[float, float]  #: evaluated span (s from the first target)
@@ -163,9 +164,15 @@ class PhaseError:
     predicted_rmse_m: float  #: RMSE of predicted - target over the same span
     model_rmse_m: float      #: RMSE of predicted - measured (the model's error)
 
+    @property
+    def mode(self) -> str:
+        """The controller's ``mode`` during the phase."""
+        return PHASE_MODES[self.phase]
+
     def to_json(self) -> dict[str, Any]:
         """JSON-ready (SI units)."""
-        return {"mode": self.mode, "laps": list(self.laps), "start_s": self.start_s,
+        return {"phase": self.phase, "mode": self.mode, "laps": list(self.laps),
+                "start_s": self.start_s,
                 "window_s": list(self.window_s), "samples": self.samples,
                 "rmse_m": self.rmse_m, "max_m": self.max_m, "mean_error_m": list(self.mean_m),
                 "predicted_rmse_m": self.predicted_rmse_m, "model_rmse_m": self.model_rmse_m}
@@ -176,7 +183,8 @@ def _rms(vectors: Array) -> float:
 
 
 def phase_errors(record: TrackingRecord, circle: CircleTrajectory) -> list[PhaseError]:
-    """One :class:`PhaseError` per mode (in :data:`MODES` order) whose laps the bag holds.
+    """One :class:`PhaseError` per phase (in :data:`~tdcm_ros.scenes.PHASES` order) whose
+    laps the bag holds.
 
     Raises BagError if a phase has no measured sample after its settle time."""
     measured = record.measured
@@ -184,17 +192,17 @@ def phase_errors(record: TrackingRecord, circle: CircleTrajectory) -> list[Phase
     laps = lap_of(record, measured.log_s)
     predicted = points_at(record.predicted, measured.stamps_s)  # the model at those instants
     errors = []
-    for mode in MODES:
-        mode_laps = tuple(lap for lap in range(1, circle.laps + 1)
-                          if circle.mode_of_lap(lap) == mode)
-        announced = record.lap_log_s[np.isin(record.lap_index, mode_laps)]
+    for phase in PHASES:
+        phase_laps = tuple(lap for lap in range(1, circle.laps + 1)
+                           if circle.phase_of_lap(lap) == phase)
+        announced = record.lap_log_s[np.isin(record.lap_index, phase_laps)]
         if not len(announced):
             continue
         start = float(announced.min())
-        keep = (np.isin(laps, mode_laps) & (measured.log_s >= start + circle.settle)
+        keep = (np.isin(laps, phase_laps) & (measured.log_s >= start + circle.settle)
                 & np.all(np.isfinite(target), axis=1))
         if not keep.any():
-            raise BagError(f"the {mode} phase has no measured tip after its first "
+            raise BagError(f"the {phase} phase has no measured tip after its first "
                            f"{circle.settle:g} s (trajectory.settle_s)",
                            parameter="trajectory.settle_s", value=circle.settle)
         error = measured.points[keep] - target[keep]
@@ -203,7 +211,7 @@ def phase_errors(record: TrackingRecord, circle: CircleTrajectory) -> list[Phase
         stamps = measured.stamps_s[keep]
         with_model = keep & np.all(np.isfinite(predicted), axis=1)
         errors.append(PhaseError(
-            mode=mode, laps=mode_laps, start_s=start,
+            phase=phase, laps=phase_laps, start_s=start,
             window_s=(float(stamps.min()), float(stamps.max())), samples=int(keep.sum()),
             rmse_m=_rms(error), max_m=float(distance.max()),
             mean_m=(float(mean[0]), float(mean[1]), float(mean[2])),
@@ -214,13 +222,13 @@ def phase_errors(record: TrackingRecord, circle: CircleTrajectory) -> list[Phase
 
 def format_phases(errors: list[PhaseError]) -> str:
     """A table of the phases' errors (mm)."""
-    header = (f"{'phase':12s} {'laps':>6s} {'window (s)':>15s} {'samples':>8s} {'RMSE':>9s} "
+    header = (f"{'phase':19s} {'laps':>6s} {'window (s)':>15s} {'samples':>8s} {'RMSE':>9s} "
               f"{'max':>9s} {'model vs target':>16s} {'model vs measured':>18s}")
     lines = [header]
     for e in errors:
         laps = f"{e.laps[0]}-{e.laps[-1]}" if len(e.laps) > 1 else str(e.laps[0])
         window = f"{e.window_s[0]:.1f}-{e.window_s[1]:.1f}"
-        lines.append(f"{e.mode:12s} {laps:>6s} {window:>15s} {e.samples:8d} "
+        lines.append(f"{e.phase:19s} {laps:>6s} {window:>15s} {e.samples:8d} "
                      f"{e.rmse_m * 1e3:6.3f} mm {e.max_m * 1e3:6.3f} mm "
                      f"{e.predicted_rmse_m * 1e3:13.3f} mm {e.model_rmse_m * 1e3:15.3f} mm")
     return "\n".join(lines)

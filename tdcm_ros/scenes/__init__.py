@@ -26,13 +26,17 @@ from tdcm_ros.scenes.scene import Scene
 from tdcm_ros.scenes.trajectory import (
     FEEDBACK,
     FEEDFORWARD,
+    FEEDFORWARD_LEARNED,
     MODES,
+    PHASE_MODES,
+    PHASES,
     CircleTrajectory,
     parse_trajectory,
 )
 from tdcm_ros.scenes.world import MarkerFrame, World
 
-__all__ = ["CONSTRUCTED", "FEEDBACK", "FEEDFORWARD", "MODES", "REGISTRY", "SCENE_NAMES", "STAGES",
+__all__ = ["CONSTRUCTED", "FEEDBACK", "FEEDFORWARD", "FEEDFORWARD_LEARNED", "MODES", "PHASES",
+           "PHASE_MODES", "REGISTRY", "SCENE_NAMES", "STAGES",
            "CircleTrajectory", "CompiledScene",
            "EffectConflictError", "InvalidSceneError", "LoadingPart", "MarkerFrame", "PlantPart",
            "Scene", "SceneError", "World", "explain", "format_table", "load_scene", "param_table",

@@ -1,5 +1,6 @@
 """A scene's tip trajectory: a circle of tip targets seen from above (the x-y plane of
-``tdcm_base``), followed lap by lap, first feed-forward, then with feedback (SI units).
+``tdcm_base``), followed lap by lap, first feed-forward, then with feedback, then (optionally)
+feed-forward again with the stiffness correction feedback learned (SI units).
 
 The circle is declared by its centre ``(x, y)`` (m) and radius (m) in the x-y plane; the
 height ``z`` of each target is not declared, it is the one the tip reaches at that distance
@@ -8,9 +9,12 @@ through a roll (``atan2(y, x)``) and a bend. The circle must lie in ``x > 0`` (s
 the roll stays inside (-pi/2, pi/2) rad and never flips through the z axis.
 
 Time: ``approach_s`` holding the first target (phase angle 0, the point farthest along +x
-from the centre), then ``feedforward_laps`` laps, then ``feedback_laps`` laps of
-``period_s`` each, counter-clockwise seen from +z. The targets are published at ``rate_hz``.
-The tracking error of each phase is taken after its first ``settle_s``.
+from the centre), then ``feedforward_laps`` laps, then ``feedback_laps`` laps, then
+``learned_feedforward_laps`` laps (default 0) of ``period_s`` each, counter-clockwise seen
+from +z. The targets are published at ``rate_hz``. Each run of laps is a phase
+(:data:`PHASES`); the last one runs the controller in mode ``feedforward`` again, which keeps
+the gain the feedback laps learned (the controller freezes it, it does not reset it). The
+tracking error of each phase is taken after its first ``settle_s``.
 """
 
 from __future__ import annotations
@@ -24,8 +28,15 @@ from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param, parse_params
 
 FEEDFORWARD, FEEDBACK = "feedforward", "feedback"
-#: Phases in the order they run (the controller's ``mode`` values).
+#: The controller's ``mode`` values, in the order their first phases run.
 MODES = (FEEDFORWARD, FEEDBACK)
+#: The phase of feed-forward laps after the feedback laps (controller mode ``feedforward``,
+#: with the gain the feedback laps learned).
+FEEDFORWARD_LEARNED = "feedforward_learned"
+#: Phases in the order they run.
+PHASES = (FEEDFORWARD, FEEDBACK, FEEDFORWARD_LEARNED)
+#: The controller's ``mode`` during each phase.
+PHASE_MODES = {FEEDFORWARD: FEEDFORWARD, FEEDBACK: FEEDBACK, FEEDFORWARD_LEARNED: FEEDFORWARD}
 
 TRAJECTORY = (
     Param("centre_m", "m", "centre (x, y) of the circle of tip targets in tdcm_base",
@@ -39,6 +50,8 @@ TRAJECTORY = (
           low=1, high=1000),
     Param("feedback_laps", "", "laps run in feedback mode (after the feed-forward laps)", 2,
           kind="int", low=1, high=1000),
+    Param("learned_feedforward_laps", "", "laps run in feedforward mode after the feedback laps, "
+          "with the gain they learned (0: none)", 0, kind="int", low=0, high=1000),
     Param("settle_s", "s", "time at the start of each phase left out of its tracking error",
           5.0, low=0.0, high=3600.0),
     Param("rate_hz", "Hz", "rate at which the targets are published", 20.0, low=0.1,
@@ -57,18 +70,30 @@ class CircleTrajectory:
     approach: float
     feedforward_laps: int
     feedback_laps: int
+    learned_feedforward_laps: int
     settle: float
     rate: float
 
     @property
+    def phase_laps(self) -> dict[str, int]:
+        """Laps of each phase, in :data:`PHASES` order (phases without laps included)."""
+        return {FEEDFORWARD: self.feedforward_laps, FEEDBACK: self.feedback_laps,
+                FEEDFORWARD_LEARNED: self.learned_feedforward_laps}
+
+    @property
+    def lap_phases(self) -> tuple[str, ...]:
+        """The phase of laps 1, 2, ... in order (lap 0 is the approach)."""
+        return tuple(phase for phase, laps in self.phase_laps.items() for _ in range(laps))
+
+    @property
     def lap_modes(self) -> tuple[str, ...]:
-        """The mode of laps 1, 2, ... in order (lap 0 is the approach)."""
-        return (FEEDFORWARD,) * self.feedforward_laps + (FEEDBACK,) * self.feedback_laps
+        """The controller mode of laps 1, 2, ... in order (lap 0 is the approach)."""
+        return tuple(PHASE_MODES[phase] for phase in self.lap_phases)
 
     @property
     def laps(self) -> int:
         """Number of laps after the approach."""
-        return self.feedforward_laps + self.feedback_laps
+        return sum(self.phase_laps.values())
 
     @property
     def duration(self) -> float:
@@ -84,6 +109,10 @@ class CircleTrajectory:
     def mode_of_lap(self, lap: int) -> str:
         """The controller mode of ``lap`` (the approach runs feed-forward)."""
         return FEEDFORWARD if lap == 0 else self.lap_modes[lap - 1]
+
+    def phase_of_lap(self, lap: int) -> str:
+        """The phase of ``lap`` (1..laps; the approach, lap 0, belongs to none: ``""``)."""
+        return "" if lap == 0 else self.lap_phases[lap - 1]
 
     def phase_angle(self, t: float) -> float:
         """Angle (rad) around the circle at ``t`` (s), 0 during the approach."""
@@ -107,6 +136,7 @@ class CircleTrajectory:
         return {"centre_m": list(self.centre), "radius_m": self.radius,
                 "period_s": self.period, "approach_s": self.approach,
                 "feedforward_laps": self.feedforward_laps, "feedback_laps": self.feedback_laps,
+                "learned_feedforward_laps": self.learned_feedforward_laps,
                 "settle_s": self.settle, "rate_hz": self.rate}
 
 
@@ -116,7 +146,8 @@ def parse_trajectory(raw: Mapping[str, Any] | None) -> CircleTrajectory:
     trajectory = CircleTrajectory(
         centre=values["centre_m"], radius=values["radius_m"], period=values["period_s"],
         approach=values["approach_s"], feedforward_laps=values["feedforward_laps"],
-        feedback_laps=values["feedback_laps"], settle=values["settle_s"],
+        feedback_laps=values["feedback_laps"],
+        learned_feedforward_laps=values["learned_feedforward_laps"], settle=values["settle_s"],
         rate=values["rate_hz"])
     x = trajectory.centre[0]
     if x <= trajectory.radius:
@@ -126,7 +157,7 @@ def parse_trajectory(raw: Mapping[str, Any] | None) -> CircleTrajectory:
             "(= radius_m: the circle in x > 0, so the roll stays inside (-pi/2, pi/2) rad)",
             parameter="trajectory.centre_m", value=list(trajectory.centre),
             allowed=f"x > {trajectory.radius:g} m")
-    shortest = min(trajectory.feedforward_laps, trajectory.feedback_laps) * trajectory.period
+    shortest = min(laps for laps in trajectory.phase_laps.values() if laps) * trajectory.period
     if trajectory.settle >= shortest:
         raise InvalidSceneError(
             f"trajectory.settle_s = {trajectory.settle:g} s leaves nothing of the shortest "

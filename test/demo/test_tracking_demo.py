@@ -1,7 +1,8 @@
 """``tdcm demo --scene tracking`` end to end on a shortened circle (on zenoh, and on rclpy: marked
 ``rclpy``): the shape controller on the device twin with simulated motion capture, in a world
-whose E is not the model's. Feedback must track better than feed-forward, and metrics.json must
-hold what the bag gives."""
+whose E is not the model's. Feedback must track better than feed-forward, feed-forward with the
+gain feedback learned better than the first feed-forward, and metrics.json must hold what the
+bag gives."""
 
 from __future__ import annotations
 
@@ -19,12 +20,13 @@ from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.demo.tracking_report import REPORTED_TOPICS, phase_errors, read_tracking
 from tdcm_ros.scenes import load_scene
 from tdcm_ros.scenes.paths import shipped_scenes
-from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD
+from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD, FEEDFORWARD_LEARNED
 
 REPO = Path(__file__).resolve().parents[2]
-#: The shipped scene, three 10 s laps (one feed-forward, two feedback) after a 2 s approach.
+#: The shipped scene, four 10 s laps (one feed-forward, two feedback, one feed-forward with the
+#: learned gain) after a 2 s approach.
 SHORT = {"period_s": 10.0, "approach_s": 2.0, "feedforward_laps": 1, "feedback_laps": 2,
-         "settle_s": 4.0}
+         "learned_feedforward_laps": 1, "settle_s": 4.0}
 
 
 def _short_scene(folder: Path) -> Path:
@@ -57,7 +59,7 @@ def test_feedback_tracks_the_circle_better_than_feed_forward(tmp_path: Path,
     assert circle is not None
     results = json.loads((out / "metrics.json").read_text())["tracking"]
     # the numbers written are the ones the bag gives
-    recomputed = {e.mode: e.to_json() for e in phase_errors(read_tracking(out / "bag"), circle)}
+    recomputed = {e.phase: e.to_json() for e in phase_errors(read_tracking(out / "bag"), circle)}
     assert results == json.loads(json.dumps(recomputed))
     feedforward, feedback = results[FEEDFORWARD], results[FEEDBACK]
     assert feedback["samples"] > 100 and feedforward["samples"] > 100
@@ -65,5 +67,10 @@ def test_feedback_tracks_the_circle_better_than_feed_forward(tmp_path: Path,
     # the estimated stiffness takes the feedback laps to the marker noise and the loop's lag
     assert feedback["rmse_m"] < feedforward["rmse_m"]
     assert feedback["rmse_m"] < 0.5e-3 < feedforward["rmse_m"]
+    # back in feed-forward, the controller keeps the gain it learned: the feed-forward improved
+    assert "controller mode -> feedforward (feedforward_learned phase)" in done.stdout
+    learned = results[FEEDFORWARD_LEARNED]
+    assert learned["mode"] == FEEDFORWARD and learned["samples"] > 100
+    assert learned["rmse_m"] < feedforward["rmse_m"]
     for name in ("tracking_paths.png", "tracking_error.png"):
         assert (out / "plots" / name).stat().st_size > 0

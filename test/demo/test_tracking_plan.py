@@ -142,3 +142,24 @@ def test_a_refused_mode_ends_the_run_with_the_controllers_reason() -> None:
     with pytest.raises(RuntimePortError, match="refused mode = 'feedback': no estimate"):
         follow(targets, FakeGraph(refuse=FEEDBACK), FakeGraph(), _sleep, say=lambda line: None,
                progress_period=10.0, margin_s=5.0)
+
+
+def test_follow_switches_back_to_feedforward_for_the_learned_laps() -> None:
+    circle = parse_trajectory({"centre_m": [0.009, 0.0], "radius_m": 0.003, "period_s": 1.0,
+                               "approach_s": 0.3, "feedforward_laps": 1, "feedback_laps": 1,
+                               "learned_feedforward_laps": 1, "settle_s": 0.1,
+                               "rate_hz": 20.0})
+    targets = tip_trajectory(circle, load_scene("tracking").design, tension_max=20.0)
+    graph = FakeGraph()
+    said: list[str] = []
+    started = time.monotonic()
+    follow(targets, graph, graph, _sleep, say=said.append, progress_period=10.0, margin_s=5.0)
+    assert [mode for _, mode in graph.modes] == [FEEDFORWARD, FEEDBACK, FEEDFORWARD]
+    back = graph.modes[2][0] - started
+    assert back == pytest.approx(circle.approach + 2 * circle.period, abs=0.1)
+    laps = [(t, m.data) for topic, t, m in graph.sent if topic == LAP_TOPIC]
+    assert [lap for _, lap in laps] == sorted(lap for _, lap in laps)
+    assert {lap for _, lap in laps} == {0, 1, 2, 3}
+    assert graph.modes[2][0] <= next(t for t, lap in laps if lap == 3)
+    assert any("controller mode -> feedforward (feedforward_learned phase)" in line
+               for line in said)

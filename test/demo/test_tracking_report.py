@@ -22,17 +22,28 @@ from tdcm_ros.demo.tracking_report import (
     phase_errors,
     read_tracking,
 )
-from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD, parse_trajectory
+from tdcm_ros.scenes.trajectory import (
+    FEEDBACK,
+    FEEDFORWARD,
+    FEEDFORWARD_LEARNED,
+    CircleTrajectory,
+    parse_trajectory,
+)
 
 CIRCLE = parse_trajectory({"centre_m": [0.009, 0.0], "radius_m": 0.003, "period_s": 4.0,
                            "approach_s": 1.0, "feedforward_laps": 1, "feedback_laps": 2,
                            "settle_s": 2.0, "rate_hz": 20.0})
+#: The same circle ending with a lap of feed-forward with the learned gain (13-17 s).
+LEARNED = parse_trajectory({**CIRCLE.to_dict(), "learned_feedforward_laps": 1})
 EPOCH_NS = 1_700_000_000 * 10**9
 Z = 0.05
-#: error of the measured tip (m) by mode, inside the settle span and after it (alternating)
-SETTLING = {0: 0.010, 1: 0.005, 2: 0.003, 3: 0.003}
+#: error of the measured tip (m) by lap inside its phase's settle span, and by phase after it
+#: (alternating)
+SETTLING = {0: 0.010, 1: 0.005, 2: 0.003, 3: 0.003, 4: 0.004}
 FF_AFTER = (0.001, 0.002)   # RMSE sqrt((1 + 4) / 2) mm, max 2 mm
 FB_AFTER = (0.0001, 0.0001)
+LEARNED_AFTER = (0.0003, 0.0004)   # RMSE sqrt((0.09 + 0.16) / 2) mm, max 0.4 mm
+AFTER = {FEEDFORWARD: FF_AFTER, FEEDBACK: FB_AFTER, FEEDFORWARD_LEARNED: LEARNED_AFTER}
 PREDICTED_OFFSET = 0.0005
 
 
@@ -57,18 +68,20 @@ def _published_target(ms: int) -> tuple[float, float, float]:
     return float(x), float(y), float(z)
 
 
-def _measured_error(t: float, index: int) -> float:
-    lap = CIRCLE.lap_at(t)
-    mode_start = CIRCLE.approach + (0 if lap <= 1 else CIRCLE.period)
-    if lap == 0 or t < mode_start + CIRCLE.settle:
+def _measured_error(circle: CircleTrajectory, t: float, index: int) -> float:
+    lap = circle.lap_at(t)
+    phase = circle.phase_of_lap(lap)
+    phase_start = circle.approach + (circle.lap_phases.index(phase) * circle.period if lap else 0)
+    if lap == 0 or t < phase_start + circle.settle:
         return SETTLING[lap]
-    return (FF_AFTER if lap == 1 else FB_AFTER)[index % 2]
+    return AFTER[phase][index % 2]
 
 
-def write_bag(path: Path, *, frame: str = "tdcm_base", skip: str = "") -> None:
+def write_bag(path: Path, *, frame: str = "tdcm_base", skip: str = "",
+              circle: CircleTrajectory = CIRCLE) -> None:
     """Targets at 20 Hz with their laps, measured tips at 100 Hz (error along the radial
     direction, sizes above), predicted tips 0.5 mm off the target along z."""
-    end_ms = int(CIRCLE.duration * 1000)
+    end_ms = int(circle.duration * 1000)
     with BagWriter(path) as bag:
         for topic, kind in ((TARGET_TOPIC, "geometry_msgs/msg/PointStamped"),
                             (LAP_TOPIC, "std_msgs/msg/Int32"),
@@ -83,12 +96,12 @@ def write_bag(path: Path, *, frame: str = "tdcm_base", skip: str = "") -> None:
             if ms % 50 == 0 and ms < end_ms:
                 bag.write("/" + TARGET_TOPIC, stamp + 10**6, _point(stamp, _target(t), frame))
                 bag.write("/" + LAP_TOPIC, stamp + 10**6, serialize(from_dict(
-                    "std_msgs/msg/Int32", {"data": CIRCLE.lap_at(t)})))
+                    "std_msgs/msg/Int32", {"data": circle.lap_at(t)})))
                 bag.write("/" + GAIN_TOPIC, stamp + 10**6, serialize(from_dict(
                     "std_msgs/msg/Float64", {"data": 1.0 + t / 100})))
             x, y, z = _published_target(ms)
             radial = math.atan2(y, x)
-            size = _measured_error(t, ms // 10)
+            size = _measured_error(circle, t, ms // 10)
             measured = (x + size * math.cos(radial), y + size * math.sin(radial), z)
             bag.write("/" + MEASURED_TOPIC, stamp + 5 * 10**6, _point(stamp, measured))
             if skip != PREDICTED_TOPIC:
@@ -114,6 +127,46 @@ def test_each_phase_error_is_the_one_built_into_the_bag(tmp_path: Path) -> None:
     assert ff.predicted_rmse_m == pytest.approx(PREDICTED_OFFSET, rel=1e-6)
     # the measured tips sit radially off, the predicted ones along z: perpendicular errors
     assert ff.model_rmse_m == pytest.approx(math.hypot(PREDICTED_OFFSET, ff.rmse_m), rel=1e-6)
+
+
+def test_the_learned_feed_forward_laps_are_a_phase_of_their_own(tmp_path: Path) -> None:
+    write_bag(tmp_path / "bag", circle=LEARNED)
+    errors = {e.phase: e for e in phase_errors(read_tracking(tmp_path / "bag"), LEARNED)}
+    assert list(errors) == [FEEDFORWARD, FEEDBACK, FEEDFORWARD_LEARNED]
+    ff, fb, learned = errors[FEEDFORWARD], errors[FEEDBACK], errors[FEEDFORWARD_LEARNED]
+    assert [e.mode for e in errors.values()] == [FEEDFORWARD, FEEDBACK, FEEDFORWARD]
+    assert (ff.laps, fb.laps, learned.laps) == ((1,), (2, 3), (4,))
+    # the first two phases are as without the learned lap: the feedback phase now ends at 13 s
+    assert ff.rmse_m == pytest.approx(math.sqrt((1 + 4) / 2) * 1e-3, rel=1e-6)
+    assert ff.samples == 200
+    assert fb.rmse_m == pytest.approx(1e-4, rel=1e-6) and fb.max_m == pytest.approx(1e-4, rel=1e-6)
+    assert fb.window_s == pytest.approx((7.0, 12.99)) and fb.samples == 600
+    # the learned lap: its settle span (4 mm) left out, 15.00 s to the last target, 16.95 s
+    assert learned.rmse_m == pytest.approx(math.sqrt((0.09 + 0.16) / 2) * 1e-3, rel=1e-6)
+    assert learned.max_m == pytest.approx(0.4e-3, rel=1e-6)
+    assert learned.start_s == pytest.approx(13.0, abs=2e-3)
+    assert learned.window_s == pytest.approx((15.0, 16.95)) and learned.samples == 196
+    assert learned.mean_m[2] == pytest.approx(0.0, abs=1e-12)   # radial errors: none along z
+    assert learned.predicted_rmse_m == pytest.approx(PREDICTED_OFFSET, rel=1e-6)
+    assert learned.to_json()["phase"] == FEEDFORWARD_LEARNED
+    assert learned.to_json()["mode"] == FEEDFORWARD
+
+
+def test_the_report_writes_the_learned_phase_beside_the_others(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("matplotlib")
+    write_bag(tmp_path / "bag", circle=LEARNED)
+    results = tracking_report(tmp_path / "bag", LEARNED, tmp_path, "synthetic", world_gain=1.1)
+    written = json.loads((tmp_path / "metrics.json").read_text())
+    assert written == json.loads(json.dumps(results))
+    assert list(written["tracking"]) == [FEEDFORWARD, FEEDBACK, FEEDFORWARD_LEARNED]
+    assert written["tracking"][FEEDFORWARD_LEARNED]["rmse_m"] == pytest.approx(0.35355e-3,
+                                                                               rel=1e-4)
+    assert written["trajectory"]["learned_feedforward_laps"] == 1
+    out = capsys.readouterr().out
+    assert "feedforward_learned" in out and "0.354 mm" in out and "0.400 mm" in out
+    for name in ("tracking_paths.png", "tracking_error.png"):
+        assert (tmp_path / "plots" / name).stat().st_size > 0
 
 
 def test_the_report_writes_what_it_computed_from_the_bag(tmp_path: Path,

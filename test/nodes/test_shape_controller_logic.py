@@ -228,6 +228,27 @@ def test_feedback_learns_the_gain_and_tracks_where_feedforward_does_not(bench, m
     assert errors["feedforward"] > 0.3e-3 > errors["feedback"]
 
 
+def test_back_in_feedforward_the_learned_gain_is_kept_frozen_and_commands(bench) -> None:
+    rng = np.random.default_rng(6)
+    b = bench(overrides={"mode": "feedback"})
+    b.target(model_tip(10.0, 0.4))
+    b.follow(4.0, 1.3, rng)
+    estimator = b.node.core.estimator
+    learned, std = estimator.gain, estimator.std
+    assert learned == pytest.approx(1.3, abs=4 * std + 1e-3) and std < 0.03
+    assert b.port.store.set({"mode": "feedforward"}).successful
+    adapted = b.node.counts["adapted"]
+    target = model_tip(7.0, -0.3)        # a new target, reached with the learned gain only
+    b.target(target)
+    b.follow(4.0, 1.3, rng)
+    assert b.node.counts["adapted"] == adapted
+    assert (estimator.gain, estimator.std) == (learned, std)
+    assert b.last("controller/gain").data == learned
+    measured = b.last("controller/measured_tip").point
+    # feed-forward at the prior (g = 1) misses by more than 0.3 mm in this world (above)
+    assert math.dist([measured.x, measured.y, measured.z], target) < 0.3e-3
+
+
 def test_feedback_falls_back_without_markers_and_stops_adapting_when_released(bench) -> None:
     rng = np.random.default_rng(4)
     b = bench(overrides={"measurement_timeout_s": 0.3})

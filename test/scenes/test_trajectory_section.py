@@ -13,6 +13,7 @@ from tdcm_ros.scenes import InvalidSceneError, load_scene, scene_from_text
 from tdcm_ros.scenes.trajectory import (
     FEEDBACK,
     FEEDFORWARD,
+    FEEDFORWARD_LEARNED,
     CircleTrajectory,
     parse_trajectory,
 )
@@ -23,7 +24,8 @@ def test_the_tracking_scene_declares_a_circle_and_a_world_e_not_the_models() -> 
     circle = scene.trajectory
     assert circle is not None
     assert scene.true_design.E != scene.design.E
-    assert circle.lap_modes == (FEEDFORWARD, FEEDBACK, FEEDBACK)
+    assert circle.lap_modes == (FEEDFORWARD, FEEDBACK, FEEDBACK, FEEDFORWARD)
+    assert circle.lap_phases == (FEEDFORWARD, FEEDBACK, FEEDBACK, FEEDFORWARD_LEARNED)
     low, high = circle.deflection_range()
     assert 0.0 < low < high
     assert scene.to_dict()["trajectory"]["radius_m"] == circle.radius
@@ -53,6 +55,18 @@ def test_timing_runs_the_approach_then_the_laps_in_order() -> None:
         [FEEDFORWARD, FEEDFORWARD, FEEDBACK, FEEDBACK]
     assert circle.xy(0.0) == pytest.approx((0.012, 0.002))   # the approach holds angle 0
     assert circle.xy(2.0 + 2.5) == pytest.approx((0.009, 0.005))  # a quarter lap: +y
+    assert circle.learned_feedforward_laps == 0 and circle.lap_phases == circle.lap_modes
+
+
+def test_learned_feed_forward_laps_run_last_in_mode_feedforward() -> None:
+    circle = _circle(learned_feedforward_laps=2)
+    assert circle.laps == 5 and circle.duration == pytest.approx(52.0)
+    assert [circle.lap_at(t) for t in (31.9, 32.0, 42.0, 51.9, 60.0)] == [3, 4, 5, 5, 5]
+    assert [circle.mode_of_lap(lap) for lap in range(6)] == \
+        [FEEDFORWARD, FEEDFORWARD, FEEDBACK, FEEDBACK, FEEDFORWARD, FEEDFORWARD]
+    assert [circle.phase_of_lap(lap) for lap in range(6)] == \
+        ["", FEEDFORWARD, FEEDBACK, FEEDBACK, FEEDFORWARD_LEARNED, FEEDFORWARD_LEARNED]
+    assert parse_trajectory(circle.to_dict()) == circle
 
 
 @given(st.floats(0.0, 40.0))
@@ -73,6 +87,15 @@ def test_every_target_lies_on_the_circle_in_x_above_zero(t: float) -> None:
     ({"feedback_laps": 0}, "trajectory.feedback_laps", "integer in [1, 1000]"),
     ({"feedforward_laps": 1.5}, "trajectory.feedforward_laps", "integer in [1, 1000]"),
     ({"settle_s": 10.0}, "trajectory.settle_s", "[0, 10) s"),
+    ({"learned_feedforward_laps": -1}, "trajectory.learned_feedforward_laps",
+     "integer in [0, 1000]"),
+    ({"learned_feedforward_laps": 0.5}, "trajectory.learned_feedforward_laps",
+     "integer in [0, 1000]"),
+    ({"learned_feedforward_laps": "one"}, "trajectory.learned_feedforward_laps",
+     "integer in [0, 1000]"),
+    # the learned phase is the shortest: settle_s must leave some of it
+    ({"feedforward_laps": 2, "learned_feedforward_laps": 1, "settle_s": 10.0},
+     "trajectory.settle_s", "[0, 10) s"),
     ({"rate_hz": -1.0}, "trajectory.rate_hz", "[0.1, 1000] Hz"),
 ])
 def test_bad_values_name_the_key_and_the_allowed_range(changes: dict[str, object], key: str,
@@ -81,6 +104,12 @@ def test_bad_values_name_the_key_and_the_allowed_range(changes: dict[str, object
         _circle(**changes)  # type: ignore[arg-type]
     assert info.value.parameter == key
     assert key in str(info.value) and allowed in str(info.value)
+
+
+def test_no_learned_laps_leave_the_settle_limit_to_the_other_phases() -> None:
+    # 0 learned laps is no phase: settle_s may take 19.9 s of two 10 s laps of each
+    circle = _circle(feedforward_laps=2, settle_s=19.9)
+    assert circle.learned_feedforward_laps == 0 and circle.settle == 19.9
 
 
 def test_an_unknown_key_lists_the_valid_ones() -> None:
