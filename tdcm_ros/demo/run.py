@@ -26,6 +26,7 @@ from typing import Any
 
 from tdcm_ros.bagio import BagError
 from tdcm_ros.demo.plan import DemoPlan
+from tdcm_ros.device import TRIP_FAULTS, Fault
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.runtime import NodeGraph, RuntimePortError, resolve_topic
 
@@ -39,6 +40,11 @@ READY_TIMEOUT_S = 60.0
 #: Time (s) a ``start_schedule`` call waits for the driver's service before it is tried again.
 START_RETRY_S = 1.0
 START_SERVICE = "/tension_driver/start_schedule"
+CLEAR_SERVICE = "/tension_driver/clear_faults"
+#: Longest wait (s) for the driver's first actuator status, and for a cleared fault to show.
+DRIVER_STATUS_TIMEOUT_S = 15.0
+#: The device faults that release the tendon (CALIBRATION does not).
+TRIP_FAULT_NAMES = frozenset(flag.name for flag in Fault if flag & TRIP_FAULTS and flag.name)
 #: The driver's ``/diagnostics`` status that carries the setpoint and the schedule state.
 DRIVER_ACTUATOR = "tension_driver: actuator"
 
@@ -58,6 +64,8 @@ class Progress:
     setpoint: str = ""
     schedule: str = ""
     schedule_done: bool = False
+    faults: str = ""               #: the driver's latched trip faults, that release the tendon
+    actuator_statuses: int = 0     #: driver actuator statuses seen
     counts: dict[str, int] = field(default_factory=dict)
 
     def count(self, topic: str) -> None:
@@ -93,6 +101,9 @@ def _watch(port: Any, progress: Progress) -> None:
                 progress.schedule = values.get("schedule", progress.schedule)
                 progress.schedule_done = (progress.schedule_done
                                           or values.get("schedule_done") == "true")
+                progress.faults = "|".join(name for name in values.get("faults", "").split("|")
+                                           if name in TRIP_FAULT_NAMES)
+                progress.actuator_statuses += 1
 
     def on_markers(message: Any) -> None:
         progress.count("markers")
@@ -117,6 +128,42 @@ def start_schedule(context: Any) -> bool:
     if not answer.success:
         raise RuntimePortError(f"the driver refused to start the schedule: {answer.message}")
     return True
+
+
+def clear_start_up_fault(context: Any, loop: _Loop, progress: Progress,
+                         say: Callable[[str], None]) -> None:
+    """Before a tracking run's first target: wait for the driver's actuator status; a device
+    fault latched while the graph started (e.g. the watchdog of a starved driver process) is
+    cleared once through ``clear_faults``, said, and must be gone from the statuses within
+    ``DRIVER_STATUS_TIMEOUT_S``."""
+    deadline = time.monotonic() + DRIVER_STATUS_TIMEOUT_S
+    while not progress.actuator_statuses:
+        loop.turn(deadline, lambda: f"no {DRIVER_ACTUATOR!r} status on /diagnostics within "
+                                    f"{DRIVER_STATUS_TIMEOUT_S:g} s")
+    if not progress.faults:
+        return
+    fault = progress.faults
+    answer = context.call_service(CLEAR_SERVICE, "std_srvs/srv/Trigger",
+                                  timeout=DRIVER_STATUS_TIMEOUT_S)
+    if not answer.success:
+        raise RuntimePortError(f"the driver latched device fault {fault} while the graph "
+                               f"started and refused clear_faults: {answer.message}")
+    say(f"the driver latched device fault {fault} while the graph started (no target sent "
+        f"yet); cleared it with clear_faults")
+    deadline = time.monotonic() + DRIVER_STATUS_TIMEOUT_S
+    while progress.faults:  # a status sent before the clear may still arrive after it
+        loop.turn(deadline, lambda: f"device fault {progress.faults} is still latched "
+                                    f"{DRIVER_STATUS_TIMEOUT_S:g} s after clear_faults; the "
+                                    "tendon stays released")
+
+
+def fault_free(progress: Progress) -> None:
+    """Raise if the driver reports a latched device fault: the tendon is then released until
+    an operator clears it, and the run's tracking figures would not mean anything."""
+    if progress.faults:
+        raise RuntimePortError(f"the driver reports device fault {progress.faults} during the "
+                               "run: the tendon is released until clear_faults, so the "
+                               "tracking run stopped (the bag so far is kept)")
 
 
 def _graph_alive(graph: NodeGraph) -> None:
@@ -221,8 +268,14 @@ def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
         else:
             from tdcm_ros.demo.follow import follow
 
+            clear_start_up_fault(context, loop, progress, say)
             say(f"the bag holds {', '.join(ready)}; following the trajectory")
-            follow(plan.targets, context, port, loop.turn, say=say,
+
+            def turn(deadline: float, late: Callable[[], str], seconds: float) -> None:
+                fault_free(progress)
+                loop.turn(deadline, late, seconds)
+
+            follow(plan.targets, context, port, turn, say=say,
                    progress_period=progress_period, margin_s=START_MARGIN_S)
         context.spin_for(SETTLE_S)
         status = graph.stop(recorder)

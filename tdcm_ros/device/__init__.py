@@ -11,6 +11,7 @@ tdcm_ros.device.twin``: ``DeviceTwin``, ``PtyTwin``) and :mod:`.transcript`, and
 :mod:`.constants` (the firmware's constants, used as a namespace).
 """
 
+from tdcm_ros.device.core import TRIP_FAULTS
 from tdcm_ros.device.driver import (
     DRIVER_SPECS,
     DriverConfig,
@@ -46,6 +47,7 @@ __all__ = [
     "PLANT_SPECS",
     "ROLL_SPEED",
     "SCHEDULE_SPECS",
+    "TRIP_FAULTS",
     "DeviceError",
     "DriverConfig",
     "DriverStatus",
