@@ -405,8 +405,16 @@ def test_service_cli_lists_and_calls_the_driver_commands(runtime, spawn, probe, 
                                "--runtime", runtime], check=False, capture_output=True,
                               text=True, timeout=60, cwd=REPO)
 
-    listing = tdcm("list", "-t", "--timeout", "2")
-    assert listing.returncode == 0, listing.stderr
+    # A listing is a snapshot of what a new process discovered in --timeout; a DDS participant
+    # can take longer than that on a loaded machine (CI saw a listing with only its own
+    # services), so list again until the driver's services are discovered, as a user would.
+    wanted = [f"/tension_driver/{command} [std_srvs/srv/Trigger]" for command in COMMANDS]
+    deadline = time.monotonic() + 30.0
+    while True:
+        listing = tdcm("list", "-t", "--timeout", "2")
+        assert listing.returncode == 0, listing.stderr
+        if all(line in listing.stdout for line in wanted) or time.monotonic() > deadline:
+            break
     for command in COMMANDS:
         assert f"/tension_driver/{command} [std_srvs/srv/Trigger]" in listing.stdout
     estop = tdcm("call", "/tension_driver/estop", "std_srvs/srv/Trigger", "--timeout", "20")
