@@ -79,6 +79,9 @@ def test_roll_setpoint_is_slewed_clamped_and_published_as_joint_states(
     print(f"\nroll 0 -> 0.9 rad: {slope:.3f} rad/s over {len(moving)} joint_states "
           f"(roll_rate {ROLL_RATE} rad/s)")
     assert slope == pytest.approx(ROLL_RATE, rel=0.1)
+    # joint_states reports the servo pulse; the twin's servo follows it at its own speed, so
+    # wait for it to arrive (a CI run on rclpy read it 4 mrad short, still turning).
+    probe.until(lambda: abs(twin.twin.plant.roll - 0.9) <= 2e-3, 5.0, "the servo at 0.9 rad")
     assert twin.twin.plant.roll == pytest.approx(0.9, abs=2e-3)
     probe.until(lambda: probe.actuator().get("roll_target") == f"{math.pi / 2:.3f}", 10.0,
                 "target clamped to pi/2", action=lambda: probe.roll(2.0))
@@ -100,7 +103,7 @@ def test_estop_holds_the_roll_and_refuses_it_until_clear_faults(runtime, spawn, 
     probe.estop()
     probe.until(lambda: probe.state().get("armed") == "false", 10.0, "disarmed")
     held = core.roll_mrad
-    assert -1200 < held < -400 and core.roll_target_mrad == held
+    assert -1200 < held <= -400 and core.roll_target_mrad == held  # stopped on the way
     probe.until(lambda: int(probe.actuator().get("rejected_rolls", 0)) >= 1, 10.0,
                 "a roll refused while disarmed", action=lambda: probe.roll(1.0))
     count = len(probe.joints)
