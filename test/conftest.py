@@ -16,6 +16,9 @@ from contextlib import AbstractContextManager, contextmanager
 import pytest
 from hypothesis import settings
 
+#: The multi-process fixtures (``runtime``, ``router``, ``context``, ``spawn``, ...) for every folder.
+pytest_plugins = ["test.support.graph"]
+
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
@@ -72,3 +75,15 @@ def _stopwatch(label: str) -> Iterator[None]:
 def stopwatch() -> Callable[[str], AbstractContextManager[None]]:
     """``with stopwatch(label):`` prints the block's wall time (never asserted on)."""
     return _stopwatch
+
+
+#: Fixtures that start processes or a transport: a test using one is in the process tier.
+PROCESS_FIXTURES = frozenset({"router", "spawn", "context", "runtime", "zenoh_env", "graph_env"})
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark every test that uses a process fixture ``process`` (tests that start processes by
+    other means carry the mark themselves)."""
+    for item in items:
+        if PROCESS_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.process)

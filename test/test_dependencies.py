@@ -8,7 +8,7 @@ import re
 import sys
 from importlib.metadata import packages_distributions
 
-from setup_info import REPO, requirement_name, setup_kwargs
+from test.setup_info import REPO, requirement_name, setup_kwargs
 
 #: Imported only on a ROS 2 machine (rclpy runtime), where they come from ROS, not pip.
 ROS_MODULES = {"rclpy", "rcl_interfaces", "ament_index_python"}

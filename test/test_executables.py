@@ -9,7 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from setup_info import REPO, console_scripts
+from test.setup_info import REPO, console_scripts
 
 NODES = ("model_node", "metrics_node", "mocap_node", "tension_driver", "device_twin",
          "shape_controller")

@@ -4,10 +4,11 @@ import ast
 from pathlib import Path
 from typing import Any
 
-import launch_fakes
 import pytest
 import yaml
-from setup_info import console_scripts as installed_scripts
+
+from test import launch_fakes
+from test.setup_info import console_scripts as installed_scripts
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -9,9 +9,9 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from layering import Rules, violations
 
 import tdcm_ros
+from test.layering import Rules, violations
 
 SOURCE = Path(tdcm_ros.__file__).parent
 HEAVY = frozenset({"scipy", "matplotlib", "zenoh", "rclpy", "mcap", "rosbags", "numba"})

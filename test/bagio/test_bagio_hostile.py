@@ -12,13 +12,13 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from bagio_samples import chunked_bags, sample_messages
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import SeekingReader
 
 from tdcm_ros.bagio import BagError, to_dict
 from tdcm_ros.bagio.reader import open_bag
+from test.bagio.bagio_samples import chunked_bags, sample_messages
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,6 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from bagio_samples import chunked_bags, sample_messages
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import SeekingReader
@@ -14,6 +13,7 @@ from mcap.writer import Writer
 
 from tdcm_ros.bagio import BagError, serialize, to_dict, typestore
 from tdcm_ros.bagio.reader import open_bag
+from test.bagio.bagio_samples import chunked_bags, sample_messages
 
 N = 300
 

@@ -109,9 +109,8 @@ def test_progress_bar_on_a_terminal_and_stdout_stays_json(quiet, tmp_path):
     import os
     from pathlib import Path
 
-    from pty_helpers import run_on_terminal
-
     import tdcm_ros
+    from test.runtime.pty_helpers import run_on_terminal
 
     root = Path(tdcm_ros.__file__).resolve().parents[1]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(

@@ -10,12 +10,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from pty_helpers import run_on_terminal
 
 from tdcm_ros.cli.main import EXIT_STATUSES
 from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.synthetic_bag import write_recording
 from tdcm_ros.model import preset
+from test.runtime.pty_helpers import run_on_terminal
 
 REPO = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join(

@@ -11,12 +11,12 @@ import sys
 from pathlib import Path
 
 import pytest
-from pty_helpers import run_on_terminal
 
 import tdcm_ros
 from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.synthetic_bag import write_recording
 from tdcm_ros.model import preset
+from test.runtime.pty_helpers import run_on_terminal
 
 ROOT = Path(tdcm_ros.__file__).resolve().parents[1]
 BAR = "%|"

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import pytest
 import yaml
-from test_demo import RUNTIMES, _runtime_env
 
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.demo.tracking_report import REPORTED_TOPICS, phase_errors, read_tracking
 from tdcm_ros.scenes import load_scene
 from tdcm_ros.scenes.paths import shipped_scenes
 from tdcm_ros.scenes.trajectory import FEEDBACK, FEEDFORWARD, FEEDFORWARD_LEARNED
+from test.demo.test_demo import RUNTIMES, _runtime_env
 
 REPO = Path(__file__).resolve().parents[2]
 #: The shipped scene, four 10 s laps (one feed-forward, two feedback, one feed-forward with the

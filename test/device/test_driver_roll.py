@@ -11,7 +11,6 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_driver_unit import FakePort
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.driver import DriverConfig, LinkState, StepResult, TensionDriver
@@ -28,6 +27,7 @@ from tdcm_ros.device.protocol import (
     encode,
 )
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from test.device.test_driver_unit import FakePort
 
 DT = 0.005  # s of simulated time per exchange
 

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from mcap.reader import SeekingReader
-from metrics_samples import TRUE_E, small_recording
 
 from tdcm_ros.bagio import deserialize, serialize
 from tdcm_ros.bagio.reader import BagReader, open_bag
@@ -20,6 +19,7 @@ from tdcm_ros.cli.main import main
 from tdcm_ros.metrics import bagdata
 from tdcm_ros.metrics.bagdata import BagSource, load_bag
 from tdcm_ros.metrics.synthetic_bag import write_recording
+from test.metrics.metrics_samples import TRUE_E, small_recording
 
 Change = Callable[[str, int, bytes], list[tuple[int, bytes]]]
 

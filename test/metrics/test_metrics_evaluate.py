@@ -7,13 +7,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from metrics_samples import TRUE_E, small_recording
 
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
 from tdcm_ros.metrics.api import evaluate_paths
 from tdcm_ros.metrics.options import options_from_sets
 from tdcm_ros.metrics.synthetic_bag import write_recording
+from test.metrics.metrics_samples import TRUE_E, small_recording
 
 ISSUE_KEYS = {"mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m", "n_trials",
               "n_steps", "steps"}

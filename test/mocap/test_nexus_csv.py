@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from mocap_helpers import DATA, nexus_text
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.mocap import CsvFormatError, parse_nexus_csv, read_nexus_csv
+from test.mocap.mocap_helpers import DATA, nexus_text
 
 SAMPLE = DATA / "nexus_trial.csv"
 

@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from mocap_helpers import DATA, nexus_text, straight_and_bent
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.mocap import (
@@ -20,6 +19,7 @@ from tdcm_ros.mocap import (
     read_nexus_csv,
 )
 from tdcm_ros.mocap.registration import Registration, RegistrationError
+from test.mocap.mocap_helpers import DATA, nexus_text, straight_and_bent
 
 LABELS = ("m1", "m2", "m3")
 ARCS = (0.015, 0.033, 0.053)

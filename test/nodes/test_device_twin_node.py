@@ -14,12 +14,13 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from runtime_helpers import stop, wait_for
-from tension_probe import TWIN, Probe, stamp_ns
 
 from tdcm_ros.device.driver import DriverConfig, LinkState, TensionDriver
 from tdcm_ros.errors import InputError
 from tdcm_ros.model import preset, solve
+from test.nodes.tension_probe import TWIN, Probe, stamp_ns
+from test.support.processes import stop
+from test.support.waiting import eventually
 
 
 @pytest.fixture
@@ -36,7 +37,7 @@ def test_twin_node_serves_its_plant_and_publishes_the_true_tension(runtime, spaw
     params.write_text(yaml.safe_dump({"device_twin": {"ros__parameters": {
         "link": str(link), "plant": {"bias": 1.0, "noise": 0.0}}}}))
     node = spawn("tdcm_ros.runtime.run_node", TWIN, "--params", str(params))
-    wait_for(lambda: link.is_symlink(), 30.0, "the twin's link")
+    eventually(lambda: link.is_symlink(), 30.0, "the twin's link")
     driver = TensionDriver(DriverConfig(port=str(link)), clock=time.monotonic)
     measured: list[float] = []
     try:

@@ -12,10 +12,11 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from runtime_helpers import stop, wait_for
-from tension_probe import TWIN, stamp_ns
 
 from tdcm_ros.device.driver import DriverConfig, TensionDriver
+from test.nodes.tension_probe import TWIN, stamp_ns
+from test.support.processes import stop
+from test.support.waiting import eventually
 
 
 def test_twin_node_publishes_the_true_roll(runtime, spawn, context, tmp_path: Path) -> None:
@@ -29,7 +30,7 @@ def test_twin_node_publishes_the_true_roll(runtime, spawn, context, tmp_path: Pa
     params.write_text(yaml.safe_dump({"device_twin": {"ros__parameters": {
         "link": str(link), "roll_speed": 4.0}}}))
     node = spawn("tdcm_ros.runtime.run_node", TWIN, "--params", str(params))
-    wait_for(lambda: link.is_symlink(), 30.0, "the twin's link")
+    eventually(lambda: link.is_symlink(), 30.0, "the twin's link")
     driver = TensionDriver(DriverConfig(port=str(link), roll_rate=1.5), clock=time.monotonic)
     try:
         deadline = time.monotonic() + 30.0

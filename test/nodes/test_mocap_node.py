@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from runtime_helpers import wait_for
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.mocap import read_nexus_csv
+from test.support.waiting import eventually
 
 MOCAP = "tdcm_ros.nodes.mocap_node:MocapNode"
 SAMPLE = Path(__file__).resolve().parents[1] / "mocap" / "data" / "nexus_trial.csv"
@@ -196,7 +196,7 @@ def test_relabel_republishes_relabelled_markers_from_a_live_driver(runtime, cont
 def test_bad_configuration_exits_with_one_line(runtime, spawn, tmp_path, values, phrase):
     params = params_file(tmp_path, "mocap_node", values)
     node = spawn("tdcm_ros.runtime.run_node", MOCAP, "--params", params)
-    wait_for(lambda: node.poll() is not None, 20.0, "the node to exit")
+    eventually(lambda: node.poll() is not None, 20.0, "the node to exit")
     stderr = node.stderr.read().decode()
     assert node.returncode == 2 and phrase in stderr and "Traceback" not in stderr
 

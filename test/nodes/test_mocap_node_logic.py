@@ -8,7 +8,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from mocap_helpers import DATA, nexus_text, straight_and_bent
 
 import tdcm_ros.scenes
 from tdcm_ros.bagio import from_dict
@@ -16,6 +15,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.mocap import read_nexus_csv
 from tdcm_ros.nodes.mocap_node import MocapNode
 from tdcm_ros.runtime.memory_port import MemoryPort
+from test.mocap.mocap_helpers import DATA, nexus_text, straight_and_bent
 
 LABELS = ("m1", "m2", "m3")
 ARCS = (0.015, 0.033, 0.053)

@@ -11,6 +11,7 @@ import numpy as np
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.model import preset, solve
+from test.support.processes import REPO
 
 MODEL = "tdcm_ros.nodes.model_node:ModelNode"
 Spawn = Callable[..., subprocess.Popen[bytes]]
@@ -153,15 +154,14 @@ def test_future_and_zero_stamps_are_dropped_and_diagnostics_recover(runtime, con
 
 def test_node_survives_its_peer_restarting(runtime, context, graph_env):
     import sys
-    from pathlib import Path
 
     spawn_node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", MODEL],
                                   env=graph_env)
     probe = Probe(context)
-    peer = Path(__file__).resolve().parents[1] / "runtime" / "peer_publisher.py"
     try:
         for _ in range(2):
-            publisher = subprocess.Popen([sys.executable, str(peer), "16.0"], env=graph_env)
+            publisher = subprocess.Popen([sys.executable, "-m", "test.runtime.peer_publisher", "16.0"],
+                                         env=graph_env, cwd=REPO)
             probe.paths.clear()
             deadline = time.monotonic() + 20
             while time.monotonic() < deadline and not probe.paths:

@@ -9,7 +9,6 @@ import time
 from typing import Any
 
 import numpy as np
-from runtime_helpers import spin_until
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.bagio import from_dict
@@ -18,6 +17,7 @@ from tdcm_ros.nodes.model_node import ModelNode
 from tdcm_ros.nodes.tf_messages import station_lengths
 from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 MODEL = "tdcm_ros.nodes.model_node:ModelNode"
 PAPER = preset("paper-experiment")
@@ -181,15 +181,15 @@ def test_a_peer_sees_the_rolled_tip_on_tf(runtime, context, spawn) -> None:
     later = -1.1
     rolls.publish(joint_states(["roll"], [later], stamp + 200_000_000))    # after the tension
     tension.publish(wrench(20.0, stamp))
-    spin_until(context, lambda: tip_for(stamp) is not None, 15.0, "the tip at roll 0.6")
+    eventually(lambda: tip_for(stamp) is not None, 15.0, "the tip at roll 0.6", spin=context)
     expected = solve(PAPER, 20.0)
     for roll, check in ((first, stamp), (later, None)):
         if check is None:
             context.spin_for(0.4)                                  # past the later roll's stamp
             check = time.time_ns()
             tension.publish(wrench(20.0, check))
-            spin_until(context, lambda at=check: tip_for(at) is not None, 15.0,
-                       f"the tip at roll {roll}")
+            eventually(lambda at=check: tip_for(at) is not None, 15.0,
+                       f"the tip at roll {roll}", spin=context)
         got = tip_for(check)
         assert got is not None
         on_tf, on_topic = got

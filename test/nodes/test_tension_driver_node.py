@@ -19,13 +19,21 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import stop
-from tension_probe import DRIVER, REPO, Probe, driver_params, level, stamp_ns, values
 
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.plant import PlantConfig
 from tdcm_ros.device.protocol import Fault, Mode
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from test.nodes.tension_probe import (
+    DRIVER,
+    REPO,
+    Probe,
+    driver_params,
+    level,
+    stamp_ns,
+    values,
+)
+from test.support.processes import stop
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 BAND = 0.25      #: N, settling band around the setpoint

@@ -12,12 +12,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import stop
-from tension_probe import DRIVER, Probe, driver_params, stamp_ns, values
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.device.plant import PlantConfig
 from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from test.nodes.tension_probe import DRIVER, Probe, driver_params, stamp_ns, values
+from test.support.processes import stop
 
 ROLL_RATE = 0.8  #: rad/s, the driver's slew in these tests
 

@@ -13,7 +13,6 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from runtime_helpers import spin_until
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
@@ -24,6 +23,7 @@ from tdcm_ros.nodes.model_node import ModelNode
 from tdcm_ros.nodes.tf_messages import station_lengths
 from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 MODEL = "tdcm_ros.nodes.model_node:ModelNode"
 Spawn = Callable[..., subprocess.Popen[bytes]]
@@ -87,7 +87,7 @@ def test_a_peer_receives_the_tendon_frame_and_the_models_tip(runtime, context, s
     static: list[Any] = []
     context.create_port("late_joiner").create_subscription(
         "/tf_static", TF, static.append, QoS(depth=1, durability="transient_local"))
-    spin_until(context, lambda: bool(static), 15.0, "/tf_static from the model node")
+    eventually( lambda: bool(static), 15.0, "/tf_static from the model node", spin=context)
     (tendon,) = static[-1].transforms
     assert (tendon.header.frame_id, tendon.child_frame_id) == ("tdcm_base", "tdcm_tendon")
     assert np.allclose(xyz(tendon), [preset("paper-experiment").R_c, 0.0, 0.0], atol=1e-15)

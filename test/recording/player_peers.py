@@ -11,11 +11,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from runtime_helpers import spin_until
-
 from tdcm_ros.bagio import from_dict, serialize
 from tdcm_ros.bagio.writer import BagWriter, OfferedQos
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 T0_NS = 1_700_000_000 * 10**9      # log time of the bag's first message
 STEP_NS = 50_000_000               # spacing of the first burst (50 ms)
@@ -70,7 +69,7 @@ class RawPeer:
         self._names = itertools.count()
 
     def subscribe(self, topic: str, type_name: str, qos: QoS = DEEP) -> None:
-        from plain_rclpy import PlainRclpyContext
+        from test.support.plain_rclpy import PlainRclpyContext
 
         name = f"raw_peer_{next(self._names)}"
         if isinstance(self.context, PlainRclpyContext):
@@ -93,7 +92,7 @@ class RawPeer:
         return [at for t, _, at in self.got if t == topic]
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        spin_until(self.context, predicate, timeout, what)
+        eventually(predicate, timeout, what, spin=self.context)
 
     def spin_while_running(self, process: subprocess.Popen[bytes], timeout: float) -> int:
         """Spin until ``process`` exits; its exit status."""

@@ -21,11 +21,11 @@ from typing import Any
 
 import pytest
 import yaml
-from player_peers import spin_until
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.runtime.port import CLOCK_QOS, CLOCK_TOPIC, CLOCK_TYPE, QoS
+from test.support.waiting import eventually
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE = REPO / "bags" / "paper_experiment"
@@ -92,7 +92,7 @@ class Outputs:
                                         {kv.key: kv.value for kv in status.values})
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        spin_until(self.context, predicate, timeout, what)
+        eventually( predicate, timeout, what, spin=self.context)
 
 
 def test_the_sample_bag_played_into_the_nodes_gives_evaluates_table(

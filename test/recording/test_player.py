@@ -10,7 +10,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from player_peers import (
+
+from tdcm_ros.bagio import deserialize
+from tdcm_ros.runtime.port import CLOCK_QOS, CLOCK_TOPIC, CLOCK_TYPE, QoS
+from test.recording.player_peers import (
     FIRST_BURST,
     GAP_S,
     SECOND_BURST,
@@ -23,10 +26,7 @@ from player_peers import (
     sample_messages,
     write_bag,
 )
-from pty_helpers import run_on_terminal
-
-from tdcm_ros.bagio import deserialize
-from tdcm_ros.runtime.port import CLOCK_QOS, CLOCK_TOPIC, CLOCK_TYPE, QoS
+from test.runtime.pty_helpers import run_on_terminal
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 REPO = Path(__file__).resolve().parents[2]

@@ -1,6 +1,6 @@
 """A peer process for restart tests: publishes ``tension`` (WrenchStamped, N) at 20 Hz until killed.
 
-``python test/runtime/peer_publisher.py <tension N>``; the runtime comes from ``TDCM_RUNTIME``
+``python -m test.runtime.peer_publisher <tension N>``; the runtime comes from ``TDCM_RUNTIME``
 (a plain rclpy node on rclpy, a zenoh context otherwise).
 """
 
@@ -9,9 +9,6 @@ from __future__ import annotations
 import os
 import sys
 import time
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from tdcm_ros.bagio import from_dict
 
@@ -19,7 +16,7 @@ from tdcm_ros.bagio import from_dict
 def main() -> None:
     tension = float(sys.argv[1])
     if os.environ.get("TDCM_RUNTIME") == "rclpy":
-        from plain_rclpy import PlainRclpyContext
+        from test.support.plain_rclpy import PlainRclpyContext
 
         ctx = PlainRclpyContext()
     else:

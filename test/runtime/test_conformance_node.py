@@ -19,7 +19,16 @@ from typing import Any
 
 import pytest
 import yaml
-from ros_peer import RosPeer, Token, dds_type, gid, key_expr, qos_chunk, type_hash
+
+from test.runtime.ros_peer import (
+    RosPeer,
+    Token,
+    dds_type,
+    gid,
+    key_expr,
+    qos_chunk,
+    type_hash,
+)
 
 pytest.importorskip("zenoh")
 

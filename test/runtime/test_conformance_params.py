@@ -26,7 +26,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import wait_for
+
+from test.support.waiting import eventually
 
 zenoh = pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
 
@@ -192,7 +193,7 @@ def test_a_plain_zenoh_peer_lists_gets_and_sets_parameters_and_sees_the_event(
     try:
         server = ("/SS/%/%/talker/%talker%get_parameters/rcl_interfaces::srv::dds_::"
                   f"GetParameters_/{HASHES['GetParameters']}/::,1000:,:,:,,")
-        wait_for(lambda: any(t.endswith(server) for t in peer.tokens()), 30.0,
+        eventually(lambda: any(t.endswith(server) for t in peer.tokens()), 30.0,
                  "the talker's get_parameters server token")
 
         result = peer.call("talker", "list_parameters", "ListParameters", list_request())
@@ -222,7 +223,7 @@ def test_a_plain_zenoh_peer_lists_gets_and_sets_parameters_and_sees_the_event(
         def changed() -> bool:
             with lock:
                 return ("/talker", [("period", 0.25)]) in events
-        wait_for(changed, 5.0, "the change on /parameter_events")
+        eventually(changed, 5.0, "the change on /parameter_events")
         with lock:
             assert not any(("period", -1.0) in params for _, params in events)
     finally:

@@ -13,7 +13,11 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from ros_peer import (
+
+from tdcm_ros.bagio import service_type_hash, type_hash
+from tdcm_ros.runtime import wire
+from tdcm_ros.runtime.port import QoS
+from test.runtime.ros_peer import (
     SERVICES,
     STORE,
     attachment,
@@ -22,12 +26,8 @@ from ros_peer import (
     parse_token,
     qos_chunk,
 )
-from ros_peer import key_expr as peer_key
-from ros_peer import type_hash as peer_hash
-
-from tdcm_ros.bagio import service_type_hash, type_hash
-from tdcm_ros.runtime import wire
-from tdcm_ros.runtime.port import QoS
+from test.runtime.ros_peer import key_expr as peer_key
+from test.runtime.ros_peer import type_hash as peer_hash
 
 ZID = "8f2b9c0d4e5a61728394a5b6c7d8e9f0"
 NODE = wire.NodeIdentity(domain_id=7, zid=ZID, node_id=3, namespace="/robot/arm",

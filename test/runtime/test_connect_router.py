@@ -13,7 +13,9 @@ import time
 from pathlib import Path
 
 import pytest
-from runtime_helpers import free_port, listening, stop, wait_for
+
+from test.support.processes import free_port, listening, stop
+from test.support.waiting import eventually
 
 zenoh = pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
 
@@ -59,10 +61,10 @@ def test_up_connects_to_a_router_with_rmw_zenohs_defaults_and_starts_none(
     launcher = None
     session = None
     try:
-        wait_for(lambda: listening(port), 10.0, "the router")
+        eventually(lambda: listening(port), 10.0, "the router")
         launcher = _start(env, "tdcm_ros.cli.main", "up", "--connect", endpoint,
                           "--nodes", "talker")
-        wait_for(lambda: len(_children(launcher.pid)) == 1, 15.0, "the talker process")
+        eventually(lambda: len(_children(launcher.pid)) == 1, 15.0, "the talker process")
         config = zenoh.Config()
         config.insert_json5("mode", json.dumps("client"))
         config.insert_json5("connect/endpoints", json.dumps([endpoint]))
@@ -70,7 +72,7 @@ def test_up_connects_to_a_router_with_rmw_zenohs_defaults_and_starts_none(
         received: list[str] = []
         subscriber = session.declare_subscriber("0/chatter/**",
                                                 lambda sample: received.append(str(sample.key_expr)))
-        wait_for(lambda: bool(received), 20.0, "the talker's data through the router")
+        eventually(lambda: bool(received), 20.0, "the talker's data through the router")
         assert received[0].startswith("0/chatter/std_msgs::msg::dds_::String_/RIHS01_")
         tokens = [str(reply.ok.key_expr) for reply in
                   session.liveliness().get("@ros2_lv/0/**", timeout=5.0) if reply.ok]

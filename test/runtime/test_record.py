@@ -16,13 +16,13 @@ from typing import Any
 import pytest
 import yaml
 from mcap.reader import make_reader
-from runtime_helpers import wait_for
 
 from tdcm_ros.bagio import from_dict, serialize
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.bagio.typestore import typestore
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
+from test.support.waiting import eventually
 
 REPO = Path(__file__).resolve().parents[2]
 RATE_HZ = 200.0
@@ -89,13 +89,13 @@ def _record_until(spawn: Spawn, env: dict[str, str], tmp_path: Path, stop: signa
     log, bag = tmp_path / "published.txt", tmp_path / "bag"
     publisher = _start_publisher(env, log)
     try:
-        wait_for(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
+        eventually(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
         recorder = spawn("tdcm_ros.cli.main", "record", str(bag))
         out = Lines(recorder)
-        wait_for(lambda: out.has("subscribed /count") and out.has("subscribed /latched"), 20.0,
+        eventually(lambda: out.has("subscribed /count") and out.has("subscribed /latched"), 20.0,
                  "the recorder to subscribe")
         first = len(_published(log))
-        wait_for(lambda: len(_published(log)) > first + 200, 20.0, "200 more messages")
+        eventually(lambda: len(_published(log)) > first + 200, 20.0, "200 more messages")
         signalled_ns = time.time_ns()
         recorder.send_signal(stop)
         recorder.wait(20.0)
@@ -124,7 +124,7 @@ def test_signal_closes_a_bag_with_every_message_before_it(
     # everything published 0.2 s (loopback delivery allowance) before the signal is in the bag
     before = max(n for n, stamp in published if stamp < signalled_ns - 200_000_000)
     assert values[-1] >= before
-    wait_for(lambda: out.has("messages in"), 5.0, "the summary")
+    eventually(lambda: out.has("messages in"), 5.0, "the summary")
     assert any(line.startswith(f"/count [std_msgs/msg/Float64]: {len(values)} messages")
                for line in out.lines)
     reader = open_bag(bag)
@@ -190,7 +190,7 @@ def test_a_named_topic_is_recorded_from_its_first_message_to_its_last(
     bag = tmp_path / "bag"
     recorder = spawn("tdcm_ros.cli.main", "record", str(bag), "tick")
     out = Lines(recorder)
-    wait_for(lambda: out.has("recording to"), 20.0, "the recorder to start")
+    eventually(lambda: out.has("recording to"), 20.0, "the recorder to start")
     ticker = subprocess.run([sys.executable, "-c", TICKER], check=False, env=graph_env,
                             cwd=REPO, capture_output=True, timeout=120.0)
     assert ticker.returncode == 0, ticker.stderr.decode()
@@ -212,13 +212,13 @@ def test_named_topics_keep_the_offered_qos_and_the_latched_message(
     log, bag = tmp_path / "published.txt", tmp_path / "bag"
     publisher = _start_publisher(graph_env, log)
     try:
-        wait_for(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
+        eventually(lambda: log.exists() and len(_published(log)) > 0, 20.0, "the publisher")
         recorder = spawn("tdcm_ros.cli.main", "record", str(bag), "count", "latched")
         out = Lines(recorder)
-        wait_for(lambda: out.has("subscribed /count") and out.has("subscribed /latched"), 20.0,
+        eventually(lambda: out.has("subscribed /count") and out.has("subscribed /latched"), 20.0,
                  "the recorder to subscribe")
         first = len(_published(log))
-        wait_for(lambda: len(_published(log)) > first + 50, 20.0, "50 more messages")
+        eventually(lambda: len(_published(log)) > first + 50, 20.0, "50 more messages")
         recorder.send_signal(signal.SIGINT)
         recorder.wait(20.0)
     finally:
@@ -253,8 +253,8 @@ def test_a_type_without_an_rclpy_class_is_reported_and_skipped(
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         out = Lines(recorder)
-        wait_for(lambda: out.has("subscribed /count"), 20.0, "the recorder to subscribe")
-        wait_for(lambda: len(_published(log)) > 100, 20.0, "100 messages")
+        eventually(lambda: out.has("subscribed /count"), 20.0, "the recorder to subscribe")
+        eventually(lambda: len(_published(log)) > 100, 20.0, "100 messages")
         recorder.send_signal(signal.SIGINT)
         recorder.wait(20.0)
     finally:

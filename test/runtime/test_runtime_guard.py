@@ -14,16 +14,16 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import stop, wait_for
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.guard import CallbackGuard
 from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.port import NodeLogic, QoS
 from tdcm_ros.runtime.run_node import LOOP_DIED, run_node
+from test.support.processes import REPO, stop
+from test.support.waiting import eventually
 
-HERE = Path(__file__).resolve().parent
-FRAGILE = "fragile_node:FragileNode"
+FRAGILE = "test.runtime.fragile_node:FragileNode"
 
 
 class Sink:
@@ -104,9 +104,8 @@ def test_a_loop_that_dies_anyway_closes_the_node_and_exits_non_zero(monkeypatch)
 
 @pytest.fixture
 def fragile(runtime: str, graph_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
-    env = {**graph_env, "PYTHONPATH": os.pathsep.join([str(HERE), graph_env["PYTHONPATH"]])}
     node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", FRAGILE],
-                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                            env=graph_env, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     yield node
     if node.poll() is None:
         node.kill()
@@ -155,16 +154,15 @@ def test_a_failing_callback_is_reported_and_the_node_goes_on(runtime, context, p
 def test_hostile_parameter_queries_get_errors_and_the_node_goes_on(context, zenoh_env) -> None:
     """Bodies that are no CDR request of the embedded runtime's rcl_interfaces parameter services
     (rclpy's own services are rclpy's business) get an error reply; the node goes on."""
-    env = {**zenoh_env, "PYTHONPATH": os.pathsep.join([str(HERE), zenoh_env["PYTHONPATH"]])}
     node = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.run_node", FRAGILE],
-                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                            env=zenoh_env, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         from tdcm_ros.bagio import service_type_hash
         from tdcm_ros.runtime import wire
         from tdcm_ros.runtime.param_client import ParameterClient
         from tdcm_ros.runtime.param_services import SERVICES
 
-        wait_for(lambda: _answers(context), 30.0, "the node's parameter services")
+        eventually(lambda: _answers(context), 30.0, "the node's parameter services")
         gid = bytes(range(16))
         for body in ("null", "[]", "7", '"x"', '{"name": 5}', "{not json", '{"name": null}'):
             for seq, (service, type_name) in enumerate(SERVICES.items(), start=1):
@@ -203,7 +201,7 @@ def _children(pid: int) -> list[int]:
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
 def test_tdcm_up_reports_a_dead_node_and_exits_non_zero(runtime, spawn) -> None:
     launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--runtime", runtime)
-    wait_for(lambda: len(_children(launcher.pid)) == 1, 20.0, "the talker process")
+    eventually(lambda: len(_children(launcher.pid)) == 1, 20.0, "the talker process")
     time.sleep(1.0)
     os.kill(_children(launcher.pid)[0], signal.SIGKILL)
     status = launcher.wait(30)  # every node has exited: tdcm up ends by itself

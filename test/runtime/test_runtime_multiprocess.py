@@ -12,10 +12,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import spin_until, stop, wait_for
 
 from tdcm_ros.bagio import from_dict, to_dict
 from tdcm_ros.runtime.port import QoS
+from test.support.processes import stop
+from test.support.waiting import eventually
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 TALKER = "tdcm_ros.nodes.talker:Talker"
@@ -32,7 +33,7 @@ def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
     port.create_raw_subscription("tension", "geometry_msgs/msg/WrenchStamped", raw.append)
     spawn("tdcm_ros.cli.main", "topic", "pub", "tension", "geometry_msgs/msg/WrenchStamped",
           values, "--rate", "20")
-    spin_until(context, lambda: len(got) >= 2 and len(raw) >= 2, 15.0, "tension messages")
+    eventually( lambda: len(got) >= 2 and len(raw) >= 2, 15.0, "tension messages", spin=context)
     expected = from_dict("geometry_msgs/msg/WrenchStamped",
                          {"header": {"frame_id": "tdcm_base", "stamp": {"sec": 5, "nanosec": 7}},
                           "wrench": {"force": {"z": 20.0}}})
@@ -48,7 +49,7 @@ def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
         return [(t.topic, t.type_name, t.node_name) for t in graph_tokens(context.session, 0)
                 if t.kind == "MP" and t.topic not in ("/parameter_events", "/rosout")]
 
-    wait_for(lambda: publishers() == [("/tension", "geometry_msgs/msg/WrenchStamped",
+    eventually(lambda: publishers() == [("/tension", "geometry_msgs/msg/WrenchStamped",
                                        "_tdcm_topic")], 10.0, "the publisher's liveliness token")
 
 
@@ -60,12 +61,12 @@ def test_parameter_change_at_runtime(runtime: str, context: Any, spawn: Spawn, p
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data), QoS(depth=50))
     spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(path))
-    spin_until(context, lambda: any(t.startswith("p1 ") for t in texts), 15.0, "p1 messages")
+    eventually( lambda: any(t.startswith("p1 ") for t in texts), 15.0, "p1 messages", spin=context)
 
     talker = params("/talker")
     assert {"period", "prefix"} <= set(talker.names())
     assert talker.set("prefix", "p2") == {"successful": True, "reason": ""}
-    spin_until(context, lambda: texts[-1].startswith("p2 "), 5.0, "p2 messages")
+    eventually( lambda: texts[-1].startswith("p2 "), 5.0, "p2 messages", spin=context)
     bad = talker.set("period", -1.0)
     assert not bad["successful"] and "out of range" in bad["reason"] and "period" in bad["reason"]
     assert talker.get("period") == 0.05
@@ -133,13 +134,13 @@ def test_subscriber_survives_publisher_restart(runtime: str, context: Any, spawn
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
     first = spawn("tdcm_ros.runtime.run_node", TALKER)
-    spin_until(context, lambda: len(texts) >= 1, 30.0, "the first talker")
+    eventually( lambda: len(texts) >= 1, 30.0, "the first talker", spin=context)
     assert stop(first) == 0
     second = tmp_path / "second.yaml"
     second.write_text("talker:\n  ros__parameters:\n    prefix: second\n")
     spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(second))
-    spin_until(context, lambda: any(t.startswith("second ") for t in texts), 30.0,
-               "the restarted talker")
+    eventually( lambda: any(t.startswith("second ") for t in texts), 30.0,
+               "the restarted talker", spin=context)
 
 
 def _children(pid: int) -> list[int]:
@@ -160,12 +161,12 @@ def _alive(pid: int) -> bool:
 def test_tdcm_up_sigint_stops_every_child(runtime: str, context: Any, spawn: Spawn) -> None:
     launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--runtime", runtime)
     # The talker alone: on zenoh the fixture's router already listens on the endpoint.
-    wait_for(lambda: len(_children(launcher.pid)) == 1, 15.0, "the talker process")
+    eventually(lambda: len(_children(launcher.pid)) == 1, 15.0, "the talker process")
     children = _children(launcher.pid)
     texts: list[str] = []
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
-    spin_until(context, lambda: any(t.startswith("hello") for t in texts), 20.0, "the talker")
+    eventually( lambda: any(t.startswith("hello") for t in texts), 20.0, "the talker", spin=context)
     launcher.send_signal(signal.SIGINT)
     assert launcher.wait(15) == 0
     assert not [pid for pid in children if _alive(pid)]
@@ -175,7 +176,7 @@ def test_tdcm_up_sigint_stops_every_child(runtime: str, context: Any, spawn: Spa
 def test_tdcm_up_starts_a_router_when_none_listens(zenoh_env: dict[str, str],
                                                    spawn: Spawn) -> None:
     launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker")
-    wait_for(lambda: len(_children(launcher.pid)) == 2, 15.0, "router and talker processes")
+    eventually(lambda: len(_children(launcher.pid)) == 2, 15.0, "router and talker processes")
     children = _children(launcher.pid)
     echo = spawn("tdcm_ros.cli.main", "topic", "echo", "chatter", "--once")
     assert b"data: hello" in echo.communicate(timeout=20)[0]
@@ -196,6 +197,6 @@ def test_transient_local_reaches_late_subscriber(context: Any) -> None:
         got: list[str] = []
         late.create_port("late").create_subscription("config", "std_msgs/msg/String",
                                                      lambda m: got.append(m.data), latched)
-        spin_until(late, lambda: got == ["v1"], 10.0, "the cached sample")
+        eventually( lambda: got == ["v1"], 10.0, "the cached sample", spin=late)
     finally:
         late.close()

@@ -12,12 +12,12 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from graph_fixtures import private_domain_id, require_rclpy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.parameters import ParamSpec
+from test.support.graph import private_domain_id, require_rclpy
 
 JSON = st.recursive(
     st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=20),

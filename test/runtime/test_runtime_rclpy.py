@@ -8,11 +8,11 @@ import sys
 from typing import Any
 
 import pytest
-from graph_fixtures import REPO, private_domain_id, require_rclpy
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.talker import Talker
 from tdcm_ros.runtime.errors import RuntimePortError
+from test.support.graph import REPO, private_domain_id, require_rclpy
 
 CORE = ("model", "metrics", "mocap", "device", "bagio", "scenes")
 

@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 import yaml
-from runtime_helpers import wait_for
 
 from tdcm_ros.bagio import from_dict
+from test.support.waiting import eventually
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 BURST = 300
@@ -39,7 +39,7 @@ def documents(output: bytes) -> list[Any]:
 def test_echo_prints_exactly_the_requested_number_of_a_burst(port, spawn: Spawn, args, expected):
     publisher = port.create_publisher("chatter", "std_msgs/msg/String")
     echo = spawn("tdcm_ros.cli.main", "topic", "echo", "chatter", *args)
-    wait_for(publisher.matched, 15.0, "topic echo to subscribe")
+    eventually(publisher.matched, 15.0, "topic echo to subscribe")
     # Back to back, so many samples wait in the tool's queue when the first one is printed.
     for k in range(BURST):
         publisher.publish(from_dict("std_msgs/msg/String", {"data": f"burst {k}"}))
@@ -77,7 +77,7 @@ def test_hz_reports_the_rate_of_a_live_publisher(port, spawn: Spawn):
     """50 Hz published; the reported rate only has to be in a wide band (loaded CI boxes)."""
     publisher = port.create_publisher("chatter", "std_msgs/msg/String")
     hz = spawn("tdcm_ros.cli.main", "topic", "hz", "chatter", "--duration", "3")
-    wait_for(publisher.matched, 15.0, "topic hz to subscribe")
+    eventually(publisher.matched, 15.0, "topic hz to subscribe")
     message = from_dict("std_msgs/msg/String", {"data": "tick"})
     start = time.monotonic()
     k = 0

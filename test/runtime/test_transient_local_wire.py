@@ -14,10 +14,10 @@ import time
 from typing import Any
 
 import pytest
-from runtime_helpers import wait_for
 
 from tdcm_ros.bagio import from_dict, serialize, type_hash
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 zenoh = pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
 pytest.importorskip("zenoh.ext", reason="eclipse-zenoh without zenoh.ext")
@@ -54,7 +54,7 @@ def test_a_reliable_latched_publisher_is_detectable_caches_and_sends_heartbeats(
         publisher = context.create_port("latched").create_publisher("config", STRING, LATCHED)
         for text in ("v1", "v2", "v3", "v4"):
             publisher.publish(from_dict(STRING, {"data": text}))
-        wait_for(lambda: bool(heartbeats), 5.0, "a heartbeat")
+        eventually(lambda: bool(heartbeats), 5.0, "a heartbeat")
         name, payload = heartbeats[-1]
         assert struct.unpack("<I", payload) == (3,)  # sequence numbers of the 4 samples: 0..3
         tokens = [str(r.ok.key_expr) for r in
@@ -65,7 +65,7 @@ def test_a_reliable_latched_publisher_is_detectable_caches_and_sends_heartbeats(
             session, key, lambda s: got.append(s.payload.to_bytes()),
             history=zenoh.ext.HistoryConfig(detect_late_publishers=True, max_samples=3),
             recovery=zenoh.ext.RecoveryConfig(heartbeat=True))
-        wait_for(lambda: len(got) == 3, 10.0, "the cached samples")
+        eventually(lambda: len(got) == 3, 10.0, "the cached samples")
         assert [bytes(b)[-3:-1] for b in got] == [b"v2", b"v3", b"v4"]  # depth 3, oldest dropped
         late.undeclare()
         listener.undeclare()
@@ -103,7 +103,7 @@ def test_a_latched_subscription_is_detectable_and_hears_a_late_publisher(
         got: list[str] = []
         context.create_port("reader").create_subscription(
             "state", STRING, lambda m: got.append(m.data), LATCHED)
-        wait_for(lambda: any(r.ok for r in session.liveliness().get(
+        eventually(lambda: any(r.ok for r in session.liveliness().get(
             f"{key}/@adv/sub/**", timeout=2.0)), 10.0, "the subscription's detection token")
         publisher = zenoh.ext.declare_advanced_publisher(
             session, key, cache=zenoh.ext.CacheConfig(3),

@@ -18,13 +18,14 @@ from typing import Any
 
 import pytest
 import zenoh
-from runtime_helpers import listening, wait_for
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import zenoh_config
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.zenoh_runtime import CONFIG_ENV, ZenohContext
+from test.support.processes import listening
+from test.support.waiting import eventually
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 EXAMPLES = Path(__file__).resolve().parents[2] / "config" / "zenoh"
@@ -115,14 +116,14 @@ def test_tdcm_up_secure_graph_admits_only_authenticated_tls_peers(
     launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--endpoint", endpoint,
                      "--zenoh-config", str(secrets["operator"]),
                      "--router-config", str(secrets["router"]))
-    wait_for(lambda: listening(tls_port), 15.0, "the TLS router of tdcm up")
+    eventually(lambda: listening(tls_port), 15.0, "the TLS router of tdcm up")
     good = probes(secrets["operator"], endpoint)
     wrong = probes(secrets["wrong"], endpoint)
     plain = probes(secrets["operator"], f"tcp/127.0.0.1:{tls_port}")
     heard = {name: listen_to(ctx, "chatter", "std_msgs/msg/String")
              for name, ctx in (("good", good), ("wrong", wrong), ("plain", plain))}
-    spin_until([good], lambda: bool(heard["good"]), 20.0, "the talker over TLS")
-    spin_until([good, wrong, plain], lambda: len(heard["good"]) >= 3, 10.0, "two more messages")
+    eventually( lambda: bool(heard["good"]), 20.0, "the talker over TLS", spin=[good])
+    eventually( lambda: len(heard["good"]) >= 3, 10.0, "two more messages", spin=[good, wrong, plain])
     assert heard["wrong"] == [] and heard["plain"] == []
     assert list(good.session.info.routers_zid())
     assert not list(wrong.session.info.routers_zid())
@@ -137,7 +138,7 @@ def test_acl_denies_observer_commands_and_allows_operator(
         probes: Callable[[Path, str], ZenohContext]) -> None:
     endpoint = f"tls/127.0.0.1:{tls_port}"
     spawn("tdcm_ros.runtime.router", "--listen", endpoint, "--config", str(secrets["router"]))
-    wait_for(lambda: listening(tls_port), 15.0, "the TLS router")
+    eventually(lambda: listening(tls_port), 15.0, "the TLS router")
     driver = probes(secrets["operator"], endpoint)
     setpoints = listen_to(driver, "tension_setpoint", "std_msgs/msg/Float64")
     estops = listen_to(driver, "estop", "std_msgs/msg/Empty")
@@ -152,13 +153,13 @@ def test_acl_denies_observer_commands_and_allows_operator(
         allowed.publish(from_dict("std_msgs/msg/Empty", {}))
         return len(estops) >= 10  # the observer's route to the driver works: keep going a while
 
-    spin_until([driver], observer_sends, 20.0, "the observer's estop messages")
+    eventually( observer_sends, 20.0, "the observer's estop messages", spin=[driver])
 
     def operator_sends() -> bool:
         commands.publish(from_dict("std_msgs/msg/Float64", {"data": 2.0}))
         return any(m.data == 2.0 for m in setpoints)
 
-    spin_until([driver], operator_sends, 20.0, "the operator's setpoint")
+    eventually( operator_sends, 20.0, "the operator's setpoint", spin=[driver])
     assert [m.data for m in setpoints if m.data != 2.0] == []
 
 
@@ -171,7 +172,7 @@ def test_acl_denies_observer_command_services_but_estop(
 
     endpoint = f"tls/127.0.0.1:{tls_port}"
     spawn("tdcm_ros.runtime.router", "--listen", endpoint, "--config", str(secrets["router"]))
-    wait_for(lambda: listening(tls_port), 15.0, "the TLS router")
+    eventually(lambda: listening(tls_port), 15.0, "the TLS router")
     driver = probes(secrets["operator"], endpoint)
     port = driver.create_port("tension_driver")
     calls: list[str] = []

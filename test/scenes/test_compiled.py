@@ -8,7 +8,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scene_helpers import make_scene
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.model.loading import Loading, NotchContact
@@ -27,6 +26,7 @@ from tdcm_ros.scenes.compiled import WORLD_STAGES
 from tdcm_ros.scenes.effects.actuation import ActuationEffect
 from tdcm_ros.scenes.effects.mechanics import MechanicsEffect
 from tdcm_ros.scenes.parts import Part
+from test.scenes.scene_helpers import make_scene
 
 #: the fields each shipped mechanics/actuation effect sets, from its documented job
 SETS = {

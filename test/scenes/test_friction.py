@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from scene_helpers import make_scene
 
 from tdcm_ros.errors import PhysicsError
 from tdcm_ros.scenes import load_scene
 from tdcm_ros.scenes.effects.friction import FrictionState, StickSlipTension
+from test.scenes.scene_helpers import make_scene
 
 S = np.linspace(0.0, 0.05, 11)
 

@@ -7,7 +7,6 @@ from pathlib import Path
 
 import pytest
 import yaml
-from scene_helpers import make_scene
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.scenes import (
@@ -18,6 +17,7 @@ from tdcm_ros.scenes import (
     scene_from_text,
 )
 from tdcm_ros.scenes.paths import SCENES_ENV, shipped_scenes
+from test.scenes.scene_helpers import make_scene
 
 REQUIRED = {"ideal", "paper_experiment", "friction_hysteresis", "gravity_horizontal", "tip_load",
             "mocap_dropout", "near_singular"}

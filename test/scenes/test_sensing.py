@@ -6,12 +6,12 @@ import math
 
 import numpy as np
 import pytest
-from scene_helpers import make_scene
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.device.plant import PlantConfig
 from tdcm_ros.scenes import InvalidSceneError
 from tdcm_ros.scenes.effects.timing import LATENCY_TOPICS
+from test.scenes.scene_helpers import make_scene
 
 
 def _frames(scene, count: int, tension: float = 8.0, rate: float = 100.0):  # type: ignore[no-untyped-def]

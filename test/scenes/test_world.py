@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
-from scene_helpers import make_scene
 from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import InputError, PhysicsError
 from tdcm_ros.model import NotchClosureError, solve, surface_points
 from tdcm_ros.scenes import CONSTRUCTED, REGISTRY, load_scene
+from test.scenes.scene_helpers import make_scene
 
 LEVELS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)
 

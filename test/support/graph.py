@@ -1,5 +1,4 @@
-"""Fixtures for multi-process node tests on both runtimes (test/runtime and test/nodes import
-them into their conftest.py; ``pythonpath`` in setup.cfg puts this folder on the import path).
+"""Fixtures for multi-process node tests on both runtimes (a plugin of test/conftest.py).
 
 ``runtime`` runs a test twice: on the embedded zenoh runtime (a router on a private loopback
 port) and on rclpy (a private ``ROS_DOMAIN_ID``, discovery on this host only). Nodes started with
@@ -17,20 +16,29 @@ import os
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
-from runtime_helpers import free_port, listening, stop, wait_for
 
-REPO = Path(__file__).resolve().parents[2]
+from test.support.processes import REPO, child_env, free_port, listening, stop
+from test.support.waiting import eventually
+
 RUNTIMES = ["zenoh", pytest.param("rclpy", marks=pytest.mark.rclpy)]
 _domains = itertools.count()
+#: ROS domain ids the tests use: 1..100 (Linux keeps DDS ports below the ephemeral range up to
+#: domain 101; ``.ci/ros.sh``'s own node uses 101). Each xdist worker owns a block of them.
+DOMAINS = 100
+BLOCK = 25
 
 
 def private_domain_id() -> int:
-    """A ROS domain id in 100..199 that differs between tests and between parallel runs."""
-    return 100 + (os.getpid() * 7 + next(_domains)) % 100
+    """A ROS domain id in 1..100 that differs between the tests of a run: worker ``gwN`` takes
+    from block ``N`` (of :data:`BLOCK` ids), shifted by the run's id so that two runs on one
+    machine rarely meet."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    index = int(worker[2:]) if worker[2:].isdigit() else 0
+    run = int(os.environ.get("PYTEST_XDIST_TESTRUNUID", "0")[:8] or "0", 16)
+    return 1 + (run + index * BLOCK + next(_domains) % BLOCK) % DOMAINS
 
 
 def require_rclpy() -> None:
@@ -45,8 +53,7 @@ def require_rclpy() -> None:
 
 def _base_env(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("TDCM_ZENOH_CONFIG", raising=False)
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(
-        [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])]))
+    monkeypatch.setenv("PYTHONPATH", child_env()["PYTHONPATH"])
 
 
 @pytest.fixture
@@ -112,7 +119,7 @@ def router(zenoh_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
                                 f"tcp/127.0.0.1:{port}"], env=zenoh_env, cwd=REPO,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
-        wait_for(lambda: listening(port), 10.0, "the router")
+        eventually(lambda: listening(port), 10.0, "the router")
         yield process
     finally:
         if process.poll() is None:
@@ -123,7 +130,7 @@ def router(zenoh_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
 def context(request: pytest.FixtureRequest) -> Iterator[Any]:
     """The test's own peer on the test's runtime (zenoh when the test has no ``runtime``)."""
     if "runtime" in request.fixturenames and request.getfixturevalue("runtime") == "rclpy":
-        from plain_rclpy import PlainRclpyContext
+        from test.support.plain_rclpy import PlainRclpyContext
 
         ctx: Any = PlainRclpyContext()
     else:
@@ -160,7 +167,7 @@ class ServiceParameterClient:
 @pytest.fixture
 def params(context: Any) -> Callable[[str], Any]:
     """``params("/node")``: a parameter client of that node on the test's runtime."""
-    from plain_rclpy import PlainParameterClient, PlainRclpyContext
+    from test.support.plain_rclpy import PlainParameterClient, PlainRclpyContext
 
     def client(node_fqn: str) -> Any:
         if isinstance(context, PlainRclpyContext):
