@@ -70,9 +70,11 @@ setup(
     extras_require={
         "plot": ["matplotlib>=3.7"],
         # The type checker and the stubs it reads are pinned: a newer one may report new errors.
-        "test": ["pytest>=7", "hypothesis>=6.80", "ruff>=0.5", "matplotlib>=3.7", "mypy==2.4.1",
-                 "scipy-stubs==1.17.1.5", "types-PyYAML==6.0.12.20261113",
-                 "types-pyserial==3.5.0.20260712"],
+        # pytest-xdist runs the suite in parallel (.ci/test.sh): most tests wait on timers and
+        # sockets, so workers overlap their waits on the 2-core CI machine.
+        "test": ["pytest>=7", "pytest-xdist>=3.5", "hypothesis>=6.80", "ruff>=0.5",
+                 "matplotlib>=3.7", "mypy==2.4.1", "scipy-stubs==1.17.1.5",
+                 "types-PyYAML==6.0.12.20261113", "types-pyserial==3.5.0.20260712"],
     },
     zip_safe=True,
     maintainer="tdcm_ros developers",

@@ -2,13 +2,15 @@
 # CI step with real ROS 2 Jazzy: rclpy 7.1 and the message packages from the package registry (pip
 # wheels for Python 3.11), colcon, and this package built and run from a colcon install space.
 #
-#   bash .ci/ros.sh            # from any directory
+#   bash .ci/ros.sh [--tests-only] [-- PYTEST_ARGS...]   # from any directory
 #
 # Phases: (1) a separate virtual environment (TDCM_ROS_VENV, default <repo>/.ros/venv; reused when
 # complete), (2) a colcon workspace (TDCM_ROS_WS, default <repo>/.ros/ws) holding tdcm_ros (this
 # repository), mocap4r2_msgs (msg_defs/) and a minimal tf2_msgs (test/fixtures/), built with
 # colcon, (3) the installed executables: each one's --help, then model_node against the plain rclpy
-# node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy). Prints the time of each phase
+# node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy, in parallel: TDCM_TEST_WORKERS
+# pytest-xdist workers, default 3; PYTEST_ARGS replace `-m rclpy`). --tests-only runs phase 4
+# alone on the venv and workspace a full run built (.ci/soak does). Prints the time of each phase
 # and the disk used. Any failure exits non-zero.
 set -euo pipefail
 
@@ -17,11 +19,21 @@ cd "$REPO"
 VENV="${TDCM_ROS_VENV:-$REPO/.ros/venv}"
 WS="${TDCM_ROS_WS:-$REPO/.ros/ws}"
 BASE_PYTHON="${TDCM_ROS_PYTHON:-python3}"
+TESTS_ONLY=0
+PYTEST_ARGS=(-m rclpy)
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --tests-only) TESTS_ONLY=1; shift ;;
+    --) shift; PYTEST_ARGS=("$@"); break ;;
+    *) echo "usage: bash .ci/ros.sh [--tests-only] [-- PYTEST_ARGS...]" >&2; exit 2 ;;
+  esac
+done
 
 export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
-# Keep DDS discovery on this machine, in a domain of our own (100..199 from our PID).
+# Keep DDS discovery on this machine. Phase 3's node runs in domain 101 (the tests take theirs
+# from 1..100, test/support/graph.py; above 101 DDS ports reach the ephemeral range).
 export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
-export ROS_DOMAIN_ID="${ROS_DOMAIN_ID:-$((100 + $$ % 100))}"
+export ROS_DOMAIN_ID="${ROS_DOMAIN_ID:-101}"
 
 ROS_PACKAGES=(
   "ros-jazzy-rclpy[fastrtps]" ros-jazzy-geometry-msgs ros-jazzy-nav-msgs ros-jazzy-std-msgs
@@ -50,7 +62,8 @@ ROS_PACKAGES=(
 # The package's own dependencies (setup.py install_requires, plot and test extras). tdcm_ros itself
 # is NOT installed with pip: it must come from the colcon install space.
 PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "xxhash>=3.0" "tqdm>=4.60"
-                  "lz4>=4" "zstandard>=0.19" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest hypothesis)
+                  "lz4>=4" "zstandard>=0.19" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest
+                  "pytest-xdist>=3.5" hypothesis)
 # Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
 VENV_RECIPE_VERSION=2
 # What `ros2 run tdcm_ros <exe>` starts: the nodes' ROS names (colcon only, see setup.py) and the
@@ -105,6 +118,9 @@ phase "venv ($VENV)"
 RECIPE="$(printf '%s\n' "$VENV_RECIPE_VERSION" "${ROS_PACKAGES[@]}" "${PROJECT_PACKAGES[@]}" \
           | sha256sum | cut -c1-16)"
 STAMP="$VENV/.tdcm_ros_ci_complete"
+if [ "$TESTS_ONLY" = 1 ] && ! [ -f "$STAMP" -a -f "$WS/install/setup.bash" ]; then
+  fail "--tests-only needs the venv and workspace of a full run of .ci/ros.sh"
+fi
 if [ -f "$STAMP" ] && [ "$(cat "$STAMP")" = "$RECIPE" ] \
    && "$VENV/bin/python" -c 'import rclpy, colcon_core, numpy, scipy, rosbags, zenoh' 2>/dev/null; then
   echo "reusing the complete virtual environment $VENV"
@@ -153,21 +169,24 @@ set +u  # the venv's activate script is fine, but keep every `source` the same
 source "$VENV/bin/activate"
 set -u
 
+# Registry gap: the typesupports are found through the ament index, and the wheels' prefix is the
+# venv, which nothing adds to AMENT_PREFIX_PATH: without it rosidl generates no typesupport.
+export AMENT_PREFIX_PATH="$VENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
+if [ "$TESTS_ONLY" = 0 ]; then
 # --- 2. colcon workspace ----------------------------------------------------------------------
 phase "colcon build ($WS)"
 mkdir -p "$WS/src"
 ln -sfn "$REPO" "$WS/src/tdcm_ros"
 ln -sfn "$REPO/msg_defs/mocap4r2_msgs" "$WS/src/mocap4r2_msgs"
 ln -sfn "$REPO/test/fixtures/tf2_msgs" "$WS/src/tf2_msgs"
-# Registry gap: the typesupports are found through the ament index, and the wheels' prefix is the
-# venv, which nothing adds to AMENT_PREFIX_PATH: without it rosidl generates no typesupport.
-export AMENT_PREFIX_PATH="$VENV${AMENT_PREFIX_PATH:+:$AMENT_PREFIX_PATH}"
 (cd "$WS" && colcon build --base-paths src) || fail "colcon build failed; logs in $WS/log/latest"
+fi
 # colcon's setup scripts read unset variables: they fail under `set -u`.
 set +u
 # shellcheck disable=SC1091
 source "$WS/install/setup.bash"
 set -u
+if [ "$TESTS_ONLY" = 0 ]; then
 
 # --- 3. the installed executables ---------------------------------------------------------------
 phase "installed executables"
@@ -210,11 +229,13 @@ if [ "$listener_status" != 0 ] || [ "$node_status" != 0 ]; then
   fail "listener exit $listener_status, model_node exit $node_status after SIGINT"
 fi
 echo "model_node stopped on SIGINT with exit status 0"
+fi
 
 # --- 4. the rclpy tests -------------------------------------------------------------------------
-phase "pytest -m rclpy"
+phase "pytest ${PYTEST_ARGS[*]}"
 pytest_status=0
-TDCM_REQUIRE_RCLPY=1 python -m pytest -q -m rclpy || pytest_status=$?
-[ "$pytest_status" = 5 ] && fail "pytest -m rclpy collected no tests: the rclpy tests are missing"
-[ "$pytest_status" = 0 ] || fail "pytest -m rclpy exited $pytest_status"
+TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" \
+  --durations=25 "${PYTEST_ARGS[@]}" || pytest_status=$?
+[ "$pytest_status" = 5 ] && fail "pytest ${PYTEST_ARGS[*]} collected no tests: the rclpy tests are missing"
+[ "$pytest_status" = 0 ] || fail "pytest ${PYTEST_ARGS[*]} exited $pytest_status"
 phase ""

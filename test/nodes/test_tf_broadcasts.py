@@ -87,7 +87,7 @@ def test_a_peer_receives_the_tendon_frame_and_the_models_tip(runtime, context, s
     static: list[Any] = []
     context.create_port("late_joiner").create_subscription(
         "/tf_static", TF, static.append, QoS(depth=1, durability="transient_local"))
-    eventually( lambda: bool(static), 15.0, "/tf_static from the model node", spin=context)
+    eventually(lambda: bool(static), 15.0, "/tf_static from the model node", spin=context)
     (tendon,) = static[-1].transforms
     assert (tendon.header.frame_id, tendon.child_frame_id) == ("tdcm_base", "tdcm_tendon")
     assert np.allclose(xyz(tendon), [preset("paper-experiment").R_c, 0.0, 0.0], atol=1e-15)

@@ -92,7 +92,7 @@ class Outputs:
                                         {kv.key: kv.value for kv in status.values})
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        eventually( predicate, timeout, what, spin=self.context)
+        eventually(predicate, timeout, what, spin=self.context)
 
 
 def test_the_sample_bag_played_into_the_nodes_gives_evaluates_table(

@@ -33,7 +33,7 @@ def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
     port.create_raw_subscription("tension", "geometry_msgs/msg/WrenchStamped", raw.append)
     spawn("tdcm_ros.cli.main", "topic", "pub", "tension", "geometry_msgs/msg/WrenchStamped",
           values, "--rate", "20")
-    eventually( lambda: len(got) >= 2 and len(raw) >= 2, 15.0, "tension messages", spin=context)
+    eventually(lambda: len(got) >= 2 and len(raw) >= 2, 15.0, "tension messages", spin=context)
     expected = from_dict("geometry_msgs/msg/WrenchStamped",
                          {"header": {"frame_id": "tdcm_base", "stamp": {"sec": 5, "nanosec": 7}},
                           "wrench": {"force": {"z": 20.0}}})
@@ -61,12 +61,12 @@ def test_parameter_change_at_runtime(runtime: str, context: Any, spawn: Spawn, p
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data), QoS(depth=50))
     spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(path))
-    eventually( lambda: any(t.startswith("p1 ") for t in texts), 15.0, "p1 messages", spin=context)
+    eventually(lambda: any(t.startswith("p1 ") for t in texts), 15.0, "p1 messages", spin=context)
 
     talker = params("/talker")
     assert {"period", "prefix"} <= set(talker.names())
     assert talker.set("prefix", "p2") == {"successful": True, "reason": ""}
-    eventually( lambda: texts[-1].startswith("p2 "), 5.0, "p2 messages", spin=context)
+    eventually(lambda: texts[-1].startswith("p2 "), 5.0, "p2 messages", spin=context)
     bad = talker.set("period", -1.0)
     assert not bad["successful"] and "out of range" in bad["reason"] and "period" in bad["reason"]
     assert talker.get("period") == 0.05
@@ -134,12 +134,12 @@ def test_subscriber_survives_publisher_restart(runtime: str, context: Any, spawn
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
     first = spawn("tdcm_ros.runtime.run_node", TALKER)
-    eventually( lambda: len(texts) >= 1, 30.0, "the first talker", spin=context)
+    eventually(lambda: len(texts) >= 1, 30.0, "the first talker", spin=context)
     assert stop(first) == 0
     second = tmp_path / "second.yaml"
     second.write_text("talker:\n  ros__parameters:\n    prefix: second\n")
     spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(second))
-    eventually( lambda: any(t.startswith("second ") for t in texts), 30.0,
+    eventually(lambda: any(t.startswith("second ") for t in texts), 30.0,
                "the restarted talker", spin=context)
 
 
@@ -166,7 +166,7 @@ def test_tdcm_up_sigint_stops_every_child(runtime: str, context: Any, spawn: Spa
     texts: list[str] = []
     context.create_port("listener").create_subscription(
         "chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
-    eventually( lambda: any(t.startswith("hello") for t in texts), 20.0, "the talker", spin=context)
+    eventually(lambda: any(t.startswith("hello") for t in texts), 20.0, "the talker", spin=context)
     launcher.send_signal(signal.SIGINT)
     assert launcher.wait(15) == 0
     assert not [pid for pid in children if _alive(pid)]
@@ -197,6 +197,6 @@ def test_transient_local_reaches_late_subscriber(context: Any) -> None:
         got: list[str] = []
         late.create_port("late").create_subscription("config", "std_msgs/msg/String",
                                                      lambda m: got.append(m.data), latched)
-        eventually( lambda: got == ["v1"], 10.0, "the cached sample", spin=late)
+        eventually(lambda: got == ["v1"], 10.0, "the cached sample", spin=late)
     finally:
         late.close()

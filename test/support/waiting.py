@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Protocol, TypeVar
 
 T = TypeVar("T")
@@ -32,15 +32,17 @@ def scaled(seconds: float) -> float:
 
 
 def eventually(predicate: Callable[[], T], timeout: float, what: str, *,
-               spin: Spinner | None = None, action: Callable[[], object] | None = None,
+               spin: Spinner | Sequence[Spinner] | None = None, action: Callable[[], object] | None = None,
                every: float = 0.3, detail: Callable[[], object] | None = None) -> T:
     """Wait until ``predicate()`` is truthy and return its value.
 
-    ``spin`` processes its callbacks while waiting (else this thread sleeps :data:`POLL_S`);
+    ``spin`` (one context or several, in turn) processes its callbacks while waiting (else this
+    thread sleeps :data:`POLL_S`);
     ``action`` runs first and then every ``every`` s while waiting (e.g. a publish a late
     subscriber may miss). After ``timeout`` s (times :data:`TIME_SCALE`) it fails naming
     ``what`` and, with ``detail``, what ``detail()`` shows of the state then.
     """
+    spinners = [] if spin is None else list(spin) if isinstance(spin, Sequence) else [spin]
     limit = scaled(timeout)
     deadline = time.monotonic() + limit
     next_action = time.monotonic()
@@ -55,9 +57,9 @@ def eventually(predicate: Callable[[], T], timeout: float, what: str, *,
         if action is not None and now >= next_action:
             action()
             next_action = now + every
-        if spin is not None:
-            spin.spin_for(min(0.05, max(deadline - now, 0.001)))
-        else:
+        for spinner in spinners:
+            spinner.spin_for(min(0.05 / len(spinners), max(deadline - now, 0.001)))
+        if not spinners:
             time.sleep(POLL_S)
 
 
