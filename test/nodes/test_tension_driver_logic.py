@@ -220,6 +220,7 @@ def test_a_pulled_cable_reconnects_after_the_backoff_and_reports_the_watchdog(ma
     reopened = bench.until(lambda: bench.loop.opens == 2, 2.0, "a new link")
     assert reopened - dropped == 1000  # backoff_initial
     assert bench.released_at is not None and bench.released_last_rx is not None
+    assert bench.released_last_rx % c.CONTROL_PERIOD_MS == 0  # see the host-stop test
     assert bench.released_at - bench.released_last_rx == c.WATCHDOG_MS
     bench.until(lambda: bench.state().get("link") == "connected"
                 and "WATCHDOG" in bench.state().get("faults", ""), 1.0,
@@ -293,6 +294,11 @@ def test_device_releases_within_its_watchdog_when_the_host_stops(bench) -> None:
     bench.watch_release()
     bench.advance(1.5, host=False)
     assert bench.released_at is not None and bench.released_last_rx is not None
+    # the firmware checks its watchdog at each 20 ms control tick, so it releases within
+    # [WATCHDOG_MS, WATCHDOG_MS + CONTROL_PERIOD_MS) of the last byte; here the host's last
+    # byte (heartbeats every 100 ms, setpoints every 20 ms of the same clock) lands on a
+    # control tick, so the release comes exactly WATCHDOG_MS after it
+    assert bench.released_last_rx % c.CONTROL_PERIOD_MS == 0
     assert bench.released_at - bench.released_last_rx == c.WATCHDOG_MS
     assert core.faults & Fault.WATCHDOG and bench.twin.plant.tension == 0.0
     bench.resume_host()
