@@ -54,7 +54,6 @@ class DriverBench:
         self.port.logger.addHandler(self.log)
         self.port.logger.setLevel(logging.DEBUG)
         self.start_ns = self.port.clock_ns
-        self.device_offset_ms = self.twin.now_ms
         self.open_attempts: list[int] = []  #: host ms of each attempt to open the port
         self.node = TensionDriverNode(self.port, clock=self.clock, open_port=self._open)
         self.released_at: int | None = None

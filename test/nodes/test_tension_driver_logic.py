@@ -483,7 +483,7 @@ def test_estop_holds_the_roll_and_refuses_it_until_clear_faults(roll_bench) -> N
     joints = bench.port.messages("joint_states")[count:]
     assert len(joints) == 50  # joint_states go on at 50 Hz: the held position
     assert {float(m.position[0]) for m in joints} == {held / 1000}
-    bench.until(lambda: abs(plant.roll - held / 1000) <= 2e-3, 1.0, "the servo at the held roll")
+    assert plant.roll == pytest.approx(held / 1000, abs=2e-3)
     assert bench.call("clear_faults").success
     bench.advance(0.5)
     assert bench.state()["armed"] == "true"
