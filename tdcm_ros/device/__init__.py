@@ -3,11 +3,13 @@
 - :mod:`.protocol` -- the versioned, checksummed line protocol (pure encode/decode, framing);
 - :mod:`.core`, :mod:`.plant`, :mod:`.twin` -- the firmware's logic in Python on a simulated bench,
   served behind a pty;
-- :mod:`.transport` -- serial devices, ptys and pyserial URLs;
+- :mod:`.transport` -- serial devices, ptys and pyserial URLs (:class:`Transport`, what the
+  driver needs of a port);
 - :mod:`.schedule`, :mod:`.driver` -- the transport-free logic of the ``tension_driver`` node.
 
 Separate entry points, kept out of this face: the scripts :mod:`.twin` (``python -m
-tdcm_ros.device.twin``: ``DeviceTwin``, ``PtyTwin``) and :mod:`.transcript`, and
+tdcm_ros.device.twin``: ``DeviceTwin``, ``PtyTwin``) and :mod:`.transcript`, :mod:`.loopback`
+(an in-process cable from the driver to a ``DeviceTwin``, for tests), and
 :mod:`.constants` (the firmware's constants, used as a namespace).
 """
 
@@ -41,6 +43,7 @@ from tdcm_ros.device.protocol import (
     encode,
 )
 from tdcm_ros.device.schedule import SCHEDULE_SPECS, StepSchedule
+from tdcm_ros.device.transport import Transport
 
 __all__ = [
     "DRIVER_SPECS",
@@ -67,6 +70,7 @@ __all__ = [
     "StepSchedule",
     "Telemetry",
     "TensionDriver",
+    "Transport",
     "decode",
     "encode",
     "fault_names",

@@ -57,6 +57,7 @@ from tdcm_ros.device import (
     StepSchedule,
     Telemetry,
     TensionDriver,
+    Transport,
     fault_names,
 )
 from tdcm_ros.errors import InputError
@@ -113,7 +114,11 @@ class TensionDriverNode(NodeLogic):
 
     default_name = "tension_driver"
 
-    def __init__(self, port: NodePort) -> None:
+    def __init__(self, port: NodePort, *, clock: Callable[[], float] = time.monotonic,
+                 open_port: Callable[[str], Transport] | None = None) -> None:
+        """``clock`` (s, monotonic) and ``open_port`` (a :class:`Transport` for the ``port``
+        parameter; default: the serial port) go to the driver: a test gives the port's simulated
+        clock and an in-process link to a device twin."""
         super().__init__(port)
         link = declare_specs(port, {name: DRIVER_SPECS[name] for name in LINK_FIELDS},
                              read_only=True)
@@ -138,7 +143,7 @@ class TensionDriverNode(NodeLogic):
         self.last_warning = ""
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
-        self.driver = TensionDriver(config, clock=time.monotonic, warn=self._warn)
+        self.driver = TensionDriver(config, clock=clock, open_port=open_port, warn=self._warn)
         if bool(port.get_parameter("enabled")):
             self.driver.enable()
 

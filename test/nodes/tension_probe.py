@@ -3,7 +3,6 @@ command services, collects what the nodes publish."""
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -12,6 +11,7 @@ import yaml
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.diagnostics import summary
+from test.support.waiting import eventually
 
 REPO = Path(__file__).resolve().parents[2]
 DRIVER = "tdcm_ros.nodes.tension_driver:TensionDriverNode"
@@ -115,18 +115,10 @@ class Probe:
 
     def until(self, predicate: Callable[[], bool], timeout: float, what: str,
               action: Callable[[], None] | None = None) -> None:
-        """Spin until ``predicate``; ``action`` (e.g. a publish) runs every 0.3 s meanwhile."""
-        deadline = time.monotonic() + timeout
-        next_action = 0.0
-        while not predicate():
-            now = time.monotonic()
-            if now > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}; "
-                                     f"last state {self.state()}")
-            if action is not None and now >= next_action:
-                action()
-                next_action = now + 0.3
-            self.ctx.spin_for(0.05)
+        """Spin until ``predicate`` (:func:`eventually`, ``timeout`` scaled); ``action`` (e.g. a
+        publish) runs first and every 0.3 s meanwhile."""
+        eventually(predicate, timeout, what, spin=self.ctx, action=action,
+                   detail=lambda: f"last state {self.state()}")
 
     def connected(self, mode: str = "tension", timeout: float = 30.0,
                   action: Callable[[], None] | None = None) -> None:
