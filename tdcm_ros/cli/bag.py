@@ -4,12 +4,18 @@
 ``--runtime rclpy``, on ROS 2 (default: ``TDCM_RUNTIME``, else zenoh), as ``ros2 bag play``
 does: ``--rate``, ``--start-offset``, ``--loop``, ``--topics``, ``--remap OLD:=NEW``, ``--clock
 [HZ]``, ``--delay``. A progress line goes to stderr when it is a terminal (not with
-``--quiet``); Ctrl-C (SIGINT) stops it with status 130, SIGTERM with 143.
+``--quiet``); Ctrl-C (SIGINT) stops it with status 130, SIGTERM with 143. Exit after a signal is
+guaranteed: the context gets :data:`CLOSE_TIMEOUT_S` s to close, after which the process leaves
+without it (output flushed, ``os._exit``); a second signal leaves at once; and a process still
+there :data:`EXIT_DEADLINE_S` s after the first signal writes every thread's stack to stderr and
+exits with status 1 (so a hang anywhere, even in the interpreter's exit, shows where it was).
 """
 
 from __future__ import annotations
 
 import argparse
+import faulthandler
+import os
 import signal
 import sys
 from types import FrameType
@@ -25,6 +31,10 @@ DEFAULT_CLOCK_HZ = 40.0
 EXIT_MEANINGS = {"bag play": {INTERRUPTED_EXIT: f"playback stopped; SIGTERM gives "
                                                 f"{128 + signal.SIGTERM}"}}
 """What ``bag play`` means by an exit status (its ``--help`` epilog)."""
+CLOSE_TIMEOUT_S = 5.0
+"""Longest wait (s) for the player's context to close before the process leaves without it."""
+EXIT_DEADLINE_S = 15.0
+"""Time (s) after a stop signal by which the process has left, whatever it is doing."""
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -104,13 +114,33 @@ class ProgressLine:
             sys.stderr.flush()
 
 
+def exit_now(status: int) -> None:
+    """Flush stdout and stderr, then leave at once (``os._exit``): no blocked thread, finaliser
+    or native library's exit hook can keep the process alive."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(status)
+
+
+def arm_exit_deadline() -> None:
+    """Past :data:`EXIT_DEADLINE_S` s from now, dump every thread's stack to stderr and exit 1
+    (faulthandler's watchdog: a C thread that needs neither the GIL nor the main thread)."""
+    faulthandler.dump_traceback_later(EXIT_DEADLINE_S, exit=True)
+
+
 def run_play(args: argparse.Namespace) -> int:
     """Play until the end, ``--loop`` until a signal; print what was published."""
     stopped_by: list[int] = []
     player: Any = None
 
     def on_signal(signum: int, _: FrameType | None) -> None:
+        if stopped_by:  # a second Ctrl-C: the first one's stop is taking too long
+            exit_now(128 + stopped_by[0])
         stopped_by.append(signum)
+        arm_exit_deadline()
         if player is not None:
             player.request_stop()
 
@@ -138,6 +168,11 @@ def run_play(args: argparse.Namespace) -> int:
         published = player.run()
     finally:
         line.end()
-        player.close()
+        closed = player.close(timeout=CLOSE_TIMEOUT_S)
     print(f"{published} messages published on {len(player.topics)} topics", flush=True)
-    return 128 + stopped_by[0] if stopped_by else 0
+    status = 128 + stopped_by[0] if stopped_by else 0
+    if not closed:
+        print(f"tdcm bag play: the {runtime} context did not close within {CLOSE_TIMEOUT_S:g} s; "
+              f"exiting without it", file=sys.stderr)
+        exit_now(status)
+    return status

@@ -68,6 +68,11 @@ from tdcm_ros.spec import Spec, by_name
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
 TABLE_TOPICS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m")
 BASE_FRAME = "tdcm_base"
+SCORED_DEPTH = 10_000
+"""History depth (messages) of the scored inputs (tension, markers, joint_states): an evaluator
+must not lose data it scores, so a backlog that builds while the node is busy (an update, a
+loaded machine) waits in the queue instead of pushing its oldest frames out. The sample bag's
+6,758 marker frames played at x2 fit whole; a depth of 100 lost 514 of them on a loaded machine."""
 #: The design preset the design.* fields start from.
 PRESET_SPECS = by_name(Spec("design.preset", description="design preset the fields start from",
                             default="paper-experiment", kind="str", choices=tuple(PRESETS)))
@@ -165,12 +170,14 @@ class MetricsNode(NodeLogic):
                                            QoS(depth=1, durability="transient_local"))
         self.values = {name: port.create_publisher(f"metrics/{name}", "std_msgs/msg/Float64",
                                                    qos) for name in TABLE_TOPICS}
+        # what it scores is queued, not dropped, while it is busy (see SCORED_DEPTH)
+        scored = QoS(depth=SCORED_DEPTH, reliability="reliable")
         port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", self._on_tension,
-                                 QoS(depth=1000))
+                                 scored)
         port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", self._on_markers,
-                                 QoS(depth=100))
+                                 scored)
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
-                                 self._on_joint_states, QoS(depth=1000))
+                                 self._on_joint_states, scored)
         if self.source in ("auto", "tf_static"):
             port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
                                      QoS(depth=10, durability="transient_local"))

@@ -255,7 +255,29 @@ class Player:
             self._on_progress(Progress(max(bag_s, 0.0), self.span_s, self.published,
                                        max(self._pass, 1)))
 
-    def close(self) -> None:
-        """Give the last samples :data:`LINGER_S` s to leave, then close the context."""
+    def close(self, timeout: float | None = None) -> bool:
+        """Give the last samples :data:`LINGER_S` s to leave, then close the context; True once
+        closed. With ``timeout``, the context closes on a daemon thread and False means it had
+        not closed ``timeout`` s after the linger (a transport blocked in its close): the thread
+        is left behind and does not hold the process, which should then exit."""
         time.sleep(LINGER_S)
-        self._context.close()
+        if timeout is None:
+            self._context.close()
+            return True
+        done = threading.Event()
+        failed: list[BaseException] = []
+
+        def close_context() -> None:
+            try:
+                self._context.close()
+            except BaseException as error:  # noqa: BLE001 - re-raised on the caller's thread
+                failed.append(error)
+            finally:
+                done.set()
+
+        threading.Thread(target=close_context, name="play-close", daemon=True).start()
+        if not done.wait(timeout):
+            return False
+        if failed:
+            raise failed[0]
+        return True

@@ -17,6 +17,7 @@ functions and classes, so the module imports where ROS is absent.
 from __future__ import annotations
 
 import importlib
+import logging
 import os
 import threading
 import time
@@ -51,6 +52,8 @@ from tdcm_ros.yamlio import load_yaml
 _NO_GID = bytes(wire.GID_SIZE)
 #: rclpy's own parameter that puts the node clock on ``/clock``.
 SIM_TIME = "use_sim_time"
+#: Longest wait (s) in :meth:`RclpyContext.close` for another thread's executor wake-up to end.
+CLOSE_SPIN_WAIT_S = 10.0
 
 
 def message_class(type_name: str) -> Any:
@@ -400,6 +403,9 @@ class RclpyContext:
         self._nodes: list[Any] = []
         self._client_node: Any = None
         self._clients: dict[tuple[str, str], Any] = {}
+        self._spinners: dict[int, int] = {}  # thread id -> spin calls under way on it
+        self._spinning = threading.Condition()
+        self._closed = False
 
     def create_port(self, name: str, namespace: str = "/",
                     overrides: Mapping[str, Any] | None = None) -> RclpyNodePort:
@@ -429,25 +435,41 @@ class RclpyContext:
         self.executor.add_node(node)
         return node
 
+    def _spin_once(self, timeout_sec: float) -> None:
+        """One executor wake-up, counted so that :meth:`close` can wait for it to end."""
+        me = threading.get_ident()
+        with self._spinning:
+            if self._closed:  # checked under the lock close() takes: no wake-up starts after
+                return
+            self._spinners[me] = self._spinners.get(me, 0) + 1
+        try:
+            self.executor.spin_once(timeout_sec=timeout_sec)
+        finally:
+            with self._spinning:
+                self._spinners[me] -= 1
+                if not self._spinners[me]:
+                    del self._spinners[me]
+                self._spinning.notify_all()
+
     def spin(self) -> None:
         """Run callbacks until :meth:`request_stop` (or rclpy shuts down)."""
         while not self._stop.is_set() and self.context.ok():
-            self.executor.spin_once(timeout_sec=0.1)
+            self._spin_once(0.1)
 
     def spin_for(self, seconds: float) -> None:
         """Run callbacks for ``seconds`` s."""
         end = time.monotonic() + seconds
         while ((left := end - time.monotonic()) > 0 and not self._stop.is_set()
                and self.context.ok()):
-            self.executor.spin_once(timeout_sec=min(left, 0.05))
+            self._spin_once(min(left, 0.05))
 
     def spin_until_future(self, future: Any, timeout: float) -> Any:
         """Spin until ``future`` is done; its result, or ``RuntimePortError`` after ``timeout``."""
         end = time.monotonic() + timeout
         while not future.done():
-            if time.monotonic() > end or not self.context.ok():
+            if time.monotonic() > end or not self.context.ok() or self._closed:
                 raise RuntimePortError(f"no answer within {timeout:g} s")
-            self.executor.spin_once(timeout_sec=0.05)
+            self._spin_once(0.05)
         return future.result()
 
     def request_stop(self) -> None:
@@ -490,7 +512,26 @@ class RclpyContext:
                       self._client_node.get_service_names_and_types() for kind in kinds)
 
     def close(self) -> None:
-        """Destroy every node, then shut the context down."""
+        """Stop spinning, wait (at most :data:`CLOSE_SPIN_WAIT_S` s, else leave the nodes alone)
+        for a wake-up under way on another thread to end, shut the executor down, destroy every
+        node, then the context.
+
+        The order matters: destroying a node while another thread is inside the executor's
+        wait on that node's entities (``spin_once``) is the classic cause of a segfault in
+        ``destroy_node``; so no node is destroyed before every other thread has left
+        ``spin_once`` and the executor is shut down (which also waits for callbacks under way).
+        """
+        self._stop.set()
+        me = threading.get_ident()
+        with self._spinning:
+            self._closed = True
+            if not self._spinning.wait_for(lambda: not set(self._spinners) - {me},
+                                           CLOSE_SPIN_WAIT_S):
+                # leaking the nodes of a process that is ending beats a segfault
+                logging.getLogger("tdcm.rclpy").warning(
+                    "another thread still spins the executor after %g s; its nodes are left "
+                    "undestroyed", CLOSE_SPIN_WAIT_S)
+                return
         self.executor.shutdown()
         for node in self._nodes:
             node.destroy_node()

@@ -5,6 +5,12 @@ until SIGINT/SIGTERM. ``--config`` (or ``TDCM_ZENOH_ROUTER_CONFIG``, else ``TDCM
 names a zenoh JSON5 file, e.g. ``config/zenoh/router.json5`` (TLS, user/password, access control);
 the router listens on ``--listen`` whatever the file says. Listening beyond loopback without
 authentication logs a warning.
+
+Exit on a signal is guaranteed: the handler only sets a flag (no lock: a ``threading.Event.set``
+in a handler deadlocks when the signal lands while the main thread holds the event's lock inside
+``Event.wait``), and a session that does not close within :data:`CLOSE_TIMEOUT_S` s (zenoh
+waiting on its connected clients) is abandoned: the process flushes its output and leaves with
+``os._exit``.
 """
 
 from __future__ import annotations
@@ -15,7 +21,8 @@ import signal
 import socket
 import sys
 import threading
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 from types import FrameType
 
 from tdcm_ros.errors import InputError, TdcmError
@@ -25,6 +32,10 @@ from tdcm_ros.runtime.zenoh_runtime import endpoint, open_session, session_confi
 
 #: Protocols whose listeners a TCP connect reaches (TLS runs over TCP).
 TCP_PROTOCOLS = ("tcp", "tls")
+#: Longest wait (s) for the zenoh session to close after a signal before the process leaves.
+CLOSE_TIMEOUT_S = 3.0
+#: Longest time (s) between a signal and the main loop seeing it.
+POLL_S = 0.1
 
 
 def tcp_address(locator: str) -> tuple[str, int]:
@@ -47,6 +58,32 @@ def is_listening(locator: str, timeout: float = 0.5) -> bool:
         return False
 
 
+def close_within(close: Callable[[], None], timeout: float) -> bool:
+    """Run ``close`` on a daemon thread; True if it returned (or raised) within ``timeout`` s.
+    A close that blocks is left behind: the daemon thread does not hold the process."""
+    done = threading.Event()
+
+    def run() -> None:
+        try:
+            close()
+        finally:
+            done.set()
+
+    threading.Thread(target=run, name="close", daemon=True).start()
+    return done.wait(timeout)
+
+
+def exit_now(status: int) -> None:
+    """Flush stdout and stderr, then leave at once (``os._exit``): no thread, no finaliser and
+    no native library's exit hook can keep the process alive."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(status)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run a router on ``--listen`` (default ``TDCM_ZENOH_ENDPOINT`` or tcp/127.0.0.1:7447)."""
     parser = argparse.ArgumentParser(prog="tdcm_router", description=__doc__.splitlines()[0])
@@ -58,10 +95,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.config:
         os.environ[ROUTER_CONFIG_ENV] = args.config
     listen = args.listen or endpoint()
-    stop = threading.Event()
+    # A list, not a threading.Event: the handler runs on the main thread between two bytecodes,
+    # possibly while the main thread holds an Event's lock in Event.wait, and Event.set would
+    # then wait for that lock forever (the router's hang after SIGINT).
+    signals: list[int] = []
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
-        stop.set()
+        signals.append(signum)
 
     # Before the session opens: the router accepts connections while open_session is still
     # running, so a client may signal it then; a KeyboardInterrupt there would leave an open
@@ -76,9 +116,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return error.exit_code
     print(f"tdcm_router: listening on {listen} (zid {session.zid()})", file=sys.stderr,
           flush=True)
-    while not stop.wait(0.2):
-        pass
-    session.close()
+    while not signals:
+        time.sleep(POLL_S)
+    if not close_within(session.close, CLOSE_TIMEOUT_S):
+        print(f"tdcm_router: the session did not close within {CLOSE_TIMEOUT_S:g} s; exiting "
+              f"without it", file=sys.stderr)
+        exit_now(0)
     return 0
 
 

@@ -29,6 +29,7 @@ from test.runtime.ros_peer import (
     qos_chunk,
     type_hash,
 )
+from test.support.waiting import eventually
 
 pytest.importorskip("zenoh")
 
@@ -46,12 +47,8 @@ def peer(router: Any, zenoh_env: dict[str, str]) -> Iterator[RosPeer]:
 
 
 def until(what: str, found: Callable[[], Any], timeout: float = 30.0) -> Any:
-    """Poll ``found`` every 0.1 s until it gives something truthy."""
-    deadline = time.monotonic() + timeout
-    while not (value := found()):
-        assert time.monotonic() < deadline, f"timed out after {timeout} s waiting for {what}"
-        time.sleep(0.1)
-    return value
+    """``found()`` once it gives something truthy (the suite's :func:`eventually`)."""
+    return eventually(found, timeout, what)
 
 
 def tokens_of(peer: RosPeer, node: str, required: list[tuple[str, str]]) -> list[Token]:

@@ -191,10 +191,20 @@ def test_a_plain_zenoh_peer_lists_gets_and_sets_parameters_and_sees_the_event(
     path.write_text("talker:\n  ros__parameters:\n    period: 0.5\n    prefix: conformance\n")
     spawn("tdcm_ros.runtime.run_node", TALKER, "--params", str(path))
     try:
-        server = ("/SS/%/%/talker/%talker%get_parameters/rcl_interfaces::srv::dds_::"
-                  f"GetParameters_/{HASHES['GetParameters']}/::,1000:,:,:,,")
-        eventually(lambda: any(t.endswith(server) for t in peer.tokens()), 30.0,
-                 "the talker's get_parameters server token")
+        # every service this test calls: a server's token says its queryable is declared (the
+        # port declares the queryable first, and both reach the router in order), one token
+        # says nothing of the others (list_parameters once answered empty after get_parameters')
+        servers = {f"/SS/%/%/talker/%talker%{service}/rcl_interfaces::srv::dds_::{kind}_/"
+                   f"{HASHES[kind]}/::,1000:,:,:,," for service, kind in (
+                       ("list_parameters", "ListParameters"), ("get_parameters", "GetParameters"),
+                       ("set_parameters", "SetParameters"))}
+
+        def missing() -> set[str]:
+            tokens = peer.tokens()
+            return {s for s in servers if not any(t.endswith(s) for t in tokens)}
+        eventually(lambda: not missing(), 30.0,
+                   "the talker's list_parameters, get_parameters and set_parameters server tokens",
+                   detail=lambda: f"missing {sorted(missing())}")
 
         result = peer.call("talker", "list_parameters", "ListParameters", list_request())
         names = result.sequence(result.string)

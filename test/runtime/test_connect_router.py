@@ -110,3 +110,92 @@ def test_connect_and_endpoint_are_exclusive(env: dict[str, str]) -> None:
                             env=env, cwd=REPO, capture_output=True, text=True, timeout=60, check=False)
     assert result.returncode == 2
     assert "not allowed with argument" in result.stderr
+
+
+class _FakeSession:
+    """A router session whose ``close`` blocks until released (zenoh waiting on its clients)."""
+
+    def __init__(self, close_blocks: bool = False) -> None:
+        import threading
+
+        self.released = threading.Event()
+        self.closed = False
+        self.close_blocks = close_blocks
+
+    def zid(self) -> str:
+        return "fake"
+
+    def close(self) -> None:
+        if self.close_blocks:
+            self.released.wait()
+        self.closed = True
+
+
+class _Exited(Exception):
+    pass
+
+
+def _run_router(monkeypatch: pytest.MonkeyPatch, session: _FakeSession, *,
+                signal_in_open: bool = False) -> tuple[int | None, list[int], list[float]]:
+    """Run the router's ``main`` in-process on ``session``; SIGINT lands during
+    ``open_session`` (``signal_in_open``) or during the first wait of its loop. Returns main's
+    status (None if it left through ``exit_now``), exit_now's statuses and the loop's sleeps."""
+    from tdcm_ros.runtime import router
+
+    exits: list[int] = []
+    sleeps: list[float] = []
+
+    def open_session(**_: object) -> _FakeSession:
+        if signal_in_open:
+            signal.raise_signal(signal.SIGINT)
+        return session
+
+    def sleep(seconds: float) -> None:
+        sleeps.append(seconds)
+        assert len(sleeps) < 100, "the router's loop never saw the signal"
+        if len(sleeps) == 1:
+            signal.raise_signal(signal.SIGINT)  # lands while the main loop waits
+
+    def exit_now(status: int) -> None:
+        exits.append(status)
+        raise _Exited
+
+    monkeypatch.setattr(router, "open_session", open_session)
+    monkeypatch.setattr(router, "warn_if_exposed", lambda *_: None)
+    monkeypatch.setattr(router.time, "sleep", sleep)
+    monkeypatch.setattr(router, "exit_now", exit_now)
+    monkeypatch.setattr(router, "CLOSE_TIMEOUT_S", 0.2)
+    previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        return router.main(["--listen", "tcp/127.0.0.1:7447"]), exits, sleeps
+    except _Exited:
+        return None, exits, sleeps
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        session.released.set()
+
+
+def test_the_router_closes_its_session_and_exits_on_sigint(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    session = _FakeSession()
+    status, exits, sleeps = _run_router(monkeypatch, session)
+    assert status == 0 and exits == [] and len(sleeps) == 1
+    assert session.closed
+
+
+def test_a_sigint_while_the_session_opens_stops_the_router_at_once(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    session = _FakeSession()
+    status, exits, sleeps = _run_router(monkeypatch, session, signal_in_open=True)
+    assert status == 0 and exits == [] and sleeps == []
+    assert session.closed
+
+
+def test_a_session_close_that_blocks_does_not_keep_the_router_alive(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    session = _FakeSession(close_blocks=True)
+    status, exits, _ = _run_router(monkeypatch, session)
+    assert status is None and exits == [0]
+    assert "did not close within 0.2 s" in capsys.readouterr().err
+

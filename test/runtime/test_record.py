@@ -17,7 +17,7 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from tdcm_ros.bagio import from_dict, serialize
+from tdcm_ros.bagio import BagError, from_dict, serialize
 from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.bagio.typestore import typestore
 from tdcm_ros.bagio.writer import BagWriter
@@ -183,17 +183,61 @@ context.close()
 """
 
 
+def _last_tick(bag: Path) -> int:
+    """The last /tick the recorder has written so far (-1: none yet or not readable yet)."""
+    try:
+        values = [int(m.data) for _, _, m in open_bag(bag).messages(["/tick"])]
+    except (BagError, OSError):
+        return -1
+    return values[-1] if values else -1
+
+
+def _wait_until_the_router_routes(topic: str, type_name: str) -> None:
+    """Until a publisher on ``topic`` connected to the test's router matches a subscriber."""
+    import json
+
+    import zenoh
+
+    from tdcm_ros.bagio.typestore import type_hash
+    from tdcm_ros.runtime import wire
+
+    config = zenoh.Config()
+    config.insert_json5("mode", '"client"')
+    config.insert_json5("connect/endpoints", json.dumps([os.environ["TDCM_ZENOH_ENDPOINT"]]))
+    config.insert_json5("scouting/multicast/enabled", "false")
+    session = zenoh.open(config)
+    try:
+        probe = session.declare_publisher(wire.topic_key(0, topic, type_name,
+                                                         type_hash(type_name)))
+        eventually(lambda: probe.matching_status.matching, 20.0,
+                   f"the router to route {topic} to the recorder")
+        probe.undeclare()
+    finally:
+        session.close()
+
+
 def test_a_named_topic_is_recorded_from_its_first_message_to_its_last(
         runtime: str, spawn: Spawn, graph_env: dict[str, str], tmp_path: Path) -> None:
     """A 1 kHz publisher that starts after the recorder: zenoh loses 0 at the head (the topic is
-    subscribed before any publisher exists); both lose 0 at the tail (it stops before SIGINT)."""
+    subscribed, and routed by the router, before any publisher exists); both lose 0 at the tail
+    (SIGINT comes once the last tick is in the bag)."""
     bag = tmp_path / "bag"
     recorder = spawn("tdcm_ros.cli.main", "record", str(bag), "tick")
     out = Lines(recorder)
     eventually(lambda: out.has("recording to"), 20.0, "the recorder to start")
+    if runtime == "zenoh":
+        # "recording to" says the recorder declared its subscription, not that the router has
+        # it yet; the ticker (whose session opens with the router's declarations) then sends
+        # its first tick to a router that may not route it (the head loss seen once)
+        _wait_until_the_router_routes("/tick", "std_msgs/msg/UInt32")
     ticker = subprocess.run([sys.executable, "-c", TICKER], check=False, env=graph_env,
                             cwd=REPO, capture_output=True, timeout=120.0)
     assert ticker.returncode == 0, ticker.stderr.decode()
+    # the ticker has sent its last tick, which may still be on its way (through the router, or
+    # in the recorder's queue on a loaded machine): a SIGINT now would close the recorder's
+    # session before it arrives. The bag is readable while it is written (to its last chunk).
+    eventually(lambda: _last_tick(bag) == TICKS - 1, 30.0, "the recorder to write the last tick",
+               detail=lambda: f"its last tick so far: {_last_tick(bag)}")
     recorder.send_signal(signal.SIGINT)
     recorder.wait(20.0)
     assert recorder.returncode == 0, recorder.stderr.read() if recorder.stderr else ""
@@ -355,3 +399,4 @@ def test_a_recording_that_wrote_nothing_exits_non_zero(runtime: str, spawn: Spaw
     err = recorder.stderr.read().decode() if recorder.stderr else ""
     assert recorder.returncode == 1, err
     assert "no message was recorded; the bag is empty" in err
+

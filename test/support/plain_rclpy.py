@@ -10,7 +10,6 @@ probe class serves both runtimes.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -19,6 +18,7 @@ from tdcm_ros.runtime.port import DEFAULT_QOS, QoS
 from tdcm_ros.runtime.rclpy_runtime import RclpyContext, plain_value
 from tdcm_ros.runtime.rclpy_runtime import message_class as native_class
 from tdcm_ros.runtime.rclpy_runtime import qos_profile as profile
+from test.support.waiting import eventually
 
 
 class NativePublisher:
@@ -79,10 +79,8 @@ class PlainParameterClient:
         self.ctx = ctx
         self.timeout = timeout
         self.client = AsyncParameterClient(ctx.nodes[0], node_fqn)
-        end = time.monotonic() + timeout
-        while not self.client.services_are_ready():
-            assert time.monotonic() < end, f"parameter services of {node_fqn} never appeared"
-            ctx.spin_for(0.1)
+        eventually(self.client.services_are_ready, timeout,
+                   f"the parameter services of {node_fqn}", spin=ctx)
 
     def get(self, name: str) -> Any:
         from rclpy.parameter import parameter_value_to_python
