@@ -32,7 +32,8 @@ MAX_SPIN_S = 0.1
 
 class Turn(Protocol):
     """One wait of the demo's loop: spin ``seconds``, fail on Ctrl-C, a dead child or
-    ``deadline`` (monotonic s; ``late()`` is then the error message)."""
+    ``deadline`` (s of the loop's clock, monotonic by default; ``late()`` is then the error
+    message)."""
 
     def __call__(self, deadline: float, late: Callable[[], str], seconds: float) -> None: ...
 
@@ -70,21 +71,29 @@ def set_mode(params: ParameterClient, mode: str) -> None:
 
 
 def follow(targets: TipTrajectory, context: Any, port: Any, turn: Turn, *,
-           say: Callable[[str], None], progress_period: float, margin_s: float) -> None:
+           say: Callable[[str], None], progress_period: float, margin_s: float,
+           clock: Callable[[], int] = time.monotonic_ns) -> None:
     """Publish every target of ``targets`` in real time, switching modes at lap starts;
-    ``turn`` waits between ticks, with a deadline ``margin_s`` past the trajectory's end."""
+    ``turn`` waits between ticks, with a deadline ``margin_s`` past the trajectory's end.
+
+    ``clock`` (ns, monotonic) paces the loop: tick ``k`` is due ``k`` periods (whole ns) after
+    the start, so a clock that ``turn`` moves by exactly the seconds asked (a test's simulated
+    one) publishes exactly on the ticks; a late tick publishes where the target is then, and the
+    ticks it missed are skipped."""
     circle = targets.circle
     point_out = port.create_publisher(TARGET_TOPIC, POINT_TYPE)
     lap_out = port.create_publisher(LAP_TOPIC, LAP_TYPE)
     params = ParameterClient(context, CONTROLLER)
     state = FollowState()
     _watch_error(port, state)
-    period = 1.0 / circle.rate
-    start = time.monotonic()
-    deadline = start + circle.duration + margin_s
+    period_ns = round(1e9 / circle.rate)
+    line_ns = round(progress_period * 1e9)
+    duration_ns = round(circle.duration * 1e9)
+    start = clock()
+    deadline = (start + duration_ns) / 1e9 + margin_s
     next_tick, next_line = start, start
-    while (now := time.monotonic()) - start < circle.duration:
-        elapsed = now - start
+    while (now := clock()) - start < duration_ns:
+        elapsed = (now - start) / 1e9
         if now >= next_tick:
             lap = circle.lap_at(elapsed)
             mode, phase = circle.mode_of_lap(lap), circle.phase_of_lap(lap)
@@ -94,12 +103,13 @@ def follow(targets: TipTrajectory, context: Any, port: Any, turn: Turn, *,
                     + (f" ({phase} phase)" if phase else ""))
             state.lap, state.mode, state.phase = lap, mode, phase
             _publish(port, point_out, lap_out, targets.point(elapsed), lap)
-            next_tick += period * max(1, math.ceil((now - next_tick) / period))
+            next_tick += period_ns * max(1, -(-(now - next_tick) // period_ns))
         if now >= next_line:
             say(state.line(elapsed, circle.laps))
-            next_line += progress_period
+            next_line += line_ns
         turn(deadline, lambda: f"the trajectory did not finish within {circle.duration:g} s + "
-                               f"{margin_s:g} s", max(1e-3, min(next_tick - now, MAX_SPIN_S)))
+                               f"{margin_s:g} s",
+             max(1e-3, min((next_tick - now) / 1e9, MAX_SPIN_S)))
 
 
 def _publish(port: Any, point_out: Any, lap_out: Any, point: tuple[float, float, float],

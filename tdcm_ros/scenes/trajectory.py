@@ -101,10 +101,15 @@ class CircleTrajectory:
         return self.approach + self.laps * self.period
 
     def lap_at(self, t: float) -> int:
-        """The lap running at ``t`` (s): 0 during the approach, 1..laps, ``laps`` after the end."""
+        """The lap running at ``t`` (s): 0 during the approach, 1..laps, ``laps`` after the end.
+
+        Counted in whole ns, so a lap starts exactly at approach + k periods (in floats,
+        2.3 - 0.3 is 1.9999999999999998 and would start the third lap of a 0.3 s approach one
+        tick late)."""
         if t < self.approach:
             return 0
-        return min(self.laps, 1 + int((t - self.approach) // self.period))
+        into_ns = round((t - self.approach) * 1e9)
+        return min(self.laps, 1 + into_ns // round(self.period * 1e9))
 
     def mode_of_lap(self, lap: int) -> str:
         """The controller mode of ``lap`` (the approach runs feed-forward)."""

@@ -48,3 +48,14 @@ def test_a_circle_beyond_the_tension_limit_is_refused_with_the_reachable_range()
     circle = parse_trajectory({"centre_m": [0.02, 0.0], "radius_m": 0.003})
     with pytest.raises(UnreachableTargetError, match="reachable|spans"):
         tip_trajectory(circle, scene.design, tension_max=20.0)
+
+
+def test_a_lap_starts_exactly_at_the_approach_plus_whole_periods() -> None:
+    # 2.3 - 0.3 is 1.9999999999999998 in floats: the third lap still starts at 2.3 s, not a tick
+    # later, and the instant before each start is still the lap before
+    circle = parse_trajectory({"period_s": 1.0, "approach_s": 0.3, "feedforward_laps": 1,
+                               "feedback_laps": 1, "learned_feedforward_laps": 1,
+                               "settle_s": 0.1})
+    assert [circle.lap_at(k / 20) for k in range(5, 8)] == [0, 1, 1]
+    assert [circle.lap_at(t) for t in (1.299999999, 1.3, 2.299999999, 2.3, 3.3, 9.0)] == \
+        [1, 2, 2, 3, 3, 3]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Protocol, TypeVar
 
 T = TypeVar("T")
@@ -26,23 +26,33 @@ class Spinner(Protocol):
     def spin_for(self, seconds: float) -> None: ...
 
 
+class Together:
+    """Several spinners as one (e.g. a test's zenoh contexts): each spins in turn."""
+
+    def __init__(self, *spinners: Spinner) -> None:
+        self.spinners = spinners
+
+    def spin_for(self, seconds: float) -> None:
+        for spinner in self.spinners:
+            spinner.spin_for(seconds / len(self.spinners))
+
+
 def scaled(seconds: float) -> float:
     """``seconds`` times :data:`TIME_SCALE`."""
     return seconds * TIME_SCALE
 
 
 def eventually(predicate: Callable[[], T], timeout: float, what: str, *,
-               spin: Spinner | Sequence[Spinner] | None = None, action: Callable[[], object] | None = None,
+               spin: Spinner | None = None, action: Callable[[], object] | None = None,
                every: float = 0.3, detail: Callable[[], object] | None = None) -> T:
     """Wait until ``predicate()`` is truthy and return its value.
 
-    ``spin`` (one context or several, in turn) processes its callbacks while waiting (else this
-    thread sleeps :data:`POLL_S`);
+    ``spin`` processes its callbacks while waiting (several: :class:`Together`; else this thread
+    sleeps :data:`POLL_S`);
     ``action`` runs first and then every ``every`` s while waiting (e.g. a publish a late
     subscriber may miss). After ``timeout`` s (times :data:`TIME_SCALE`) it fails naming
     ``what`` and, with ``detail``, what ``detail()`` shows of the state then.
     """
-    spinners = [] if spin is None else list(spin) if isinstance(spin, Sequence) else [spin]
     limit = scaled(timeout)
     deadline = time.monotonic() + limit
     next_action = time.monotonic()
@@ -57,9 +67,9 @@ def eventually(predicate: Callable[[], T], timeout: float, what: str, *,
         if action is not None and now >= next_action:
             action()
             next_action = now + every
-        for spinner in spinners:
-            spinner.spin_for(min(0.05 / len(spinners), max(deadline - now, 0.001)))
-        if not spinners:
+        if spin is not None:
+            spin.spin_for(min(0.05, max(deadline - now, 0.001)))
+        else:
             time.sleep(POLL_S)
 
 
