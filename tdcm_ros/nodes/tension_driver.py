@@ -140,6 +140,7 @@ class TensionDriverNode(NodeLogic):
         port.add_on_set_parameters(self._on_set)
 
         self.counts: Counter[str] = Counter()
+        self._last_stamp_ns = {"tension": 0, "joint_states": 0}
         self.last_warning = ""
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
@@ -353,19 +354,28 @@ class TensionDriverNode(NodeLogic):
     def _publish_frames(self, frames: tuple[Telemetry, ...], joints: tuple[RollState, ...]
                         ) -> None:
         """``tension`` for every telemetry frame, ``joint_states`` for every roll sample; stamp
-        = now minus the device-clock age relative to the newest frame read in this step."""
+        = now minus the device-clock age relative to the newest frame read in this step, never
+        before the topic's previous stamp."""
         now = self.port.now_ns()
         newest = max([frame.time for frame in frames] + [joint.time for joint in joints])
         frame_id = str(self.port.get_parameter("frame_id"))
         for frame in frames:
-            stamp = now - max(0, round((newest - frame.time) * 1e9))
             self.tension.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
-                "header": header(stamp, frame_id),
+                "header": header(self._stamp("tension", now, newest - frame.time), frame_id),
                 "wrench": {"force": {"z": frame.tension}}}))
         for joint in joints:
-            self.joints.publish(joint_state(now - max(0, round((newest - joint.time) * 1e9)),
+            self.joints.publish(joint_state(self._stamp("joint_states", now, newest - joint.time),
                                             joint.position))
         self.counts["telemetry_frames"] += len(frames)
+
+    def _stamp(self, topic: str, now: int, age: float) -> int:
+        """``now`` (ns) less ``age`` (s of device clock), raised to ``topic``'s previous stamp:
+        frames that arrive in a burst (a device or serial line that caught up) span more device
+        time than has passed on the host since the last read, and would otherwise be stamped
+        before frames already published."""
+        stamp = max(now - max(0, round(age * 1e9)), self._last_stamp_ns[topic])
+        self._last_stamp_ns[topic] = stamp
+        return stamp
 
     # --- state and diagnostics ----------------------------------------------------------------
     def _check_actuator(self) -> Status:
