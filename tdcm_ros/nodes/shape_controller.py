@@ -62,6 +62,7 @@ from tdcm_ros.runtime import (
     NodePort,
     QoS,
     Status,
+    Timer,
     declare_specs,
     grouped,
 )
@@ -131,32 +132,53 @@ def driver_name(namespace: str, driver: str) -> str:
 
 class LimitsReader:
     """Reads the driver's limits through its parameter services on a thread of its own (a
-    service call blocks), at start and every ``period_s``; ``limits`` is ``None`` until read,
-    ``problem`` says why not."""
+    service call blocks), at start and every ``period_s`` (every ``min(period_s, 1)`` s while
+    unread); ``limits`` is ``None`` until read, ``problem`` says why not.
 
-    def __init__(self, port: NodePort, driver_fqn: str, period_s: float) -> None:
+    With ``on_timer`` it reads at start and then on a timer of the port instead of a thread:
+    only for a port whose service calls return at once (:class:`MemoryPort`), where it is then
+    deterministic on the port's clock."""
+
+    def __init__(self, port: NodePort, driver_fqn: str, period_s: float, *,
+                 on_timer: bool = False) -> None:
         self.client = ParameterClient(port, driver_fqn, timeout=min(period_s, 2.0))
-        self.driver, self.period_s = driver_fqn, period_s
+        self.driver, self.period_s, self.port = driver_fqn, period_s, port
         self.limits: DriverLimits | None = None
         self.problem = f"not read from {driver_fqn} yet"
         self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="driver-limits", daemon=True)
-        self._thread.start()
+        self._thread: threading.Thread | None = None
+        self._timer: Timer | None = None
+        if on_timer:
+            self._next_ns = port.now_ns() + round(self.read() * 1e9)
+            self._timer = port.create_timer(min(period_s, 1.0), self._tick)
+        else:
+            self._thread = threading.Thread(target=self._run, name="driver-limits", daemon=True)
+            self._thread.start()
+
+    def read(self) -> float:
+        """Read the limits once; the time (s) until the next read."""
+        try:
+            values = self.client.get_values(list(DRIVER_LIMIT_NAMES))
+            self.limits, self.problem = DriverLimits.from_values(values), ""
+        except TdcmError as error:
+            self.problem = f"cannot read {self.driver}'s limits: {error}"
+        return self.period_s if self.limits else min(self.period_s, 1.0)
 
     def _run(self) -> None:
-        while True:
-            try:
-                values = self.client.get_values(list(DRIVER_LIMIT_NAMES))
-                self.limits, self.problem = DriverLimits.from_values(values), ""
-            except TdcmError as error:
-                self.problem = f"cannot read {self.driver}'s limits: {error}"
-            if self._stop.wait(self.period_s if self.limits else min(self.period_s, 1.0)):
-                return
+        while not self._stop.wait(self.read()):
+            pass
+
+    def _tick(self) -> None:
+        if self.port.now_ns() >= self._next_ns:
+            self._next_ns = self.port.now_ns() + round(self.read() * 1e9)
 
     def close(self) -> None:
         """Stop reading (waits for a call under way)."""
         self._stop.set()
-        self._thread.join(timeout=3.0)
+        if self._timer is not None:
+            self._timer.cancel()
+        if self._thread is not None:
+            self._thread.join(timeout=3.0)
 
 
 class ShapeControllerNode(NodeLogic):
@@ -164,7 +186,9 @@ class ShapeControllerNode(NodeLogic):
 
     default_name = "shape_controller"
 
-    def __init__(self, port: NodePort) -> None:
+    def __init__(self, port: NodePort, *, limits_on_timer: bool = False) -> None:
+        """``limits_on_timer``: read the driver's limits on the port's timer, not a thread
+        (see :class:`LimitsReader`; for a :class:`MemoryPort` only)."""
         super().__init__(port)
         design, layout = declare_design_and_layout(port)
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
@@ -213,7 +237,7 @@ class ShapeControllerNode(NodeLogic):
         port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
                                  QoS(depth=10, durability="transient_local"))
         self.limits = LimitsReader(port, driver_name(port.namespace, str(fixed["driver"])),
-                                   float(fixed["limits_period_s"]))
+                                   float(fixed["limits_period_s"]), on_timer=limits_on_timer)
         port.create_timer(self.period_s, self.step)
         self.diagnostics = Diagnostics(port, float(fixed["diagnostics_period_s"]))
         self.diagnostics.add("controller", "tdcm_controller", self.check)

@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import math
 import re
-import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -40,13 +38,6 @@ def driver_parameters(port: MemoryPort, values: dict[str, float]) -> None:
                             answer)
 
 
-def wait_until(predicate: Callable[[], bool], what: str, timeout: float = 5.0) -> None:
-    end = time.monotonic() + timeout
-    while not predicate():
-        assert time.monotonic() < end, f"timed out waiting for {what}"
-        time.sleep(0.01)
-
-
 def header(port: MemoryPort, frame: str) -> dict[str, Any]:
     return {"stamp": {"sec": port.clock_ns // 10**9, "nanosec": port.clock_ns % 10**9},
             "frame_id": frame}
@@ -60,9 +51,9 @@ class Bench:
                                name="shape_controller")
         if limits:
             driver_parameters(self.port, LIMITS)
-        self.node = ShapeControllerNode(self.port)
+        self.node = ShapeControllerNode(self.port, limits_on_timer=True)
         if limits:
-            wait_until(lambda: self.node.limits.limits is not None, "the driver's limits")
+            assert self.node.limits.limits is not None  # read at start
         t, q = REGISTRATION.translation, REGISTRATION.quaternion
         self.port.deliver("/tf_static", from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
             "header": header(self.port, "mocap"), "child_frame_id": "tdcm_base",
@@ -190,7 +181,7 @@ def test_bad_targets_are_refused_naming_value_and_range_and_the_old_one_stays(be
 
 def test_nothing_is_commanded_until_the_driver_limits_are_read(bench) -> None:
     b = bench(limits=False)
-    wait_until(lambda: "cannot read" in b.node.limits.problem, "a failed read")
+    assert "cannot read" in b.node.limits.problem  # the read at start failed
     b.target(model_tip(6.0, 0.0))
     b.port.advance(1.0)
     assert b.port.messages("tension_setpoint") == []
@@ -199,8 +190,29 @@ def test_nothing_is_commanded_until_the_driver_limits_are_read(bench) -> None:
     assert "commanding nothing: driver limits unknown (cannot read /tension_driver's limits" \
         in status.message
     driver_parameters(b.port, {k: v for k, v in LIMITS.items() if k != "roll_rate"})
-    wait_until(lambda: "not all declared" in b.node.limits.problem, "the undeclared roll_rate")
+    b.port.advance(0.2)  # the next read, limits_period_s later
+    assert "not all declared" in b.node.limits.problem
     assert b.node.limits.limits is None
+
+
+def test_the_driver_limits_are_read_again_every_limits_period(bench) -> None:
+    b = bench(limits=False)
+    assert "cannot read" in b.node.limits.problem
+    driver_parameters(b.port, LIMITS)
+    b.port.advance(0.199)
+    assert b.node.limits.limits is None  # no read before the retry is due
+    b.port.advance(0.001)
+    assert b.node.limits.limits is not None
+    assert b.node.limits.limits.tension_max == 20.0 and b.node.limits.problem == ""
+    driver_parameters(b.port, {**LIMITS, "tension_max": 12.0})
+    b.port.advance(0.199)
+    assert b.node.limits.limits.tension_max == 20.0
+    b.port.advance(0.001)
+    assert b.node.limits.limits.tension_max == 12.0
+    b.close()
+    driver_parameters(b.port, {**LIMITS, "tension_max": 9.0})
+    b.port.advance(1.0)
+    assert b.node.limits.limits.tension_max == 12.0  # closed: no more reads
 
 
 @pytest.mark.parametrize("modulus_ratio", [1.3, 0.8])
