@@ -1,0 +1,139 @@
+"""model_node's input gating in-process (MemoryPort, manual clock): which tensions it solves and
+which it drops and counts, with the age and future limits checked to the ns, and the node
+solving on once bad inputs have passed. The same node in its own process: test_model_node.py."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.model import preset, solve
+from tdcm_ros.nodes.model_node import ModelNode
+from tdcm_ros.runtime.memory_port import MemoryPort
+
+MS = 10**6
+KEYS = ("dropped_non_finite", "dropped_negative", "dropped_above_max", "dropped_stale",
+        "dropped_future", "dropped_unstamped")
+
+
+def wrench(tension: float, stamp_ns: int) -> Any:
+    return from_dict("geometry_msgs/msg/WrenchStamped", {
+        "header": {"stamp": {"sec": stamp_ns // 10**9, "nanosec": stamp_ns % 10**9},
+                   "frame_id": "tendon"},
+        "wrench": {"force": {"z": tension}}})
+
+
+def stamp(message: Any) -> int:
+    return int(message.header.stamp.sec) * 10**9 + int(message.header.stamp.nanosec)
+
+
+class Node:
+    """model_node on a MemoryPort; :meth:`send` delivers a tension and runs the solver tick."""
+
+    def __init__(self, overrides: dict[str, Any] | None = None) -> None:
+        self.port = MemoryPort(overrides, name="model_node")
+        self.node = ModelNode(self.port)
+
+    def send(self, tension: float, stamp_ns: int) -> bool:
+        """Deliver ``tension`` stamped ``stamp_ns``; True if a midline with that stamp came."""
+        before = len(self.port.messages("midline"))
+        self.port.deliver("tension", wrench(tension, stamp_ns))
+        self.port.advance(0.001)  # one process_period_s
+        paths = self.port.messages("midline")[before:]
+        assert len(paths) <= 1
+        return bool(paths) and stamp(paths[0]) == stamp_ns
+
+    def counts(self) -> dict[str, int]:
+        return {k: self.node.counts[k] for k in KEYS}
+
+
+def test_a_good_tension_is_solved_at_its_stamp_as_the_library_solves_it() -> None:
+    n = Node()
+    now = n.port.now_ns()
+    assert n.send(20.0, now - 3 * MS)
+    path = n.port.messages("midline")[-1]
+    expected = solve(preset("paper-experiment"), 20.0).tip_position
+    p = path.poses[-1].pose.position
+    assert np.allclose([p.x, p.y, p.z], expected, atol=1e-12)
+    assert path.header.frame_id == "tdcm_base"
+    assert n.counts() == dict.fromkeys(KEYS, 0)
+
+
+@pytest.mark.parametrize(("tension", "key"), [
+    (float("nan"), "dropped_non_finite"), (float("inf"), "dropped_non_finite"),
+    (-3.0, "dropped_negative"), (200.000001, "dropped_above_max"), (1e9, "dropped_above_max")])
+def test_a_bad_value_is_dropped_counted_and_named(tension: float, key: str) -> None:
+    n = Node()
+    assert not n.send(tension, n.port.now_ns())
+    assert n.counts() == {k: int(k == key) for k in KEYS}
+    assert n.node.last_problem == f"dropped tension {tension!r} N: {key.removeprefix('dropped_')}"
+    assert n.send(12.0, n.port.now_ns())  # and solves on
+
+
+def test_the_limits_themselves_are_valid() -> None:
+    n = Node()
+    assert n.send(0.0, n.port.now_ns()) and n.send(200.0, n.port.now_ns())
+    assert n.counts() == dict.fromkeys(KEYS, 0)
+
+
+def test_a_tension_exactly_max_age_old_is_solved_one_ns_older_is_stale() -> None:
+    n = Node()  # input.max_age_s = 0.5
+    assert n.send(8.0, n.port.now_ns() - 500 * MS)
+    assert not n.send(8.0, n.port.now_ns() - 500 * MS - 1)
+    assert not n.send(8.0, n.port.now_ns() - 10 * 10**9)
+    assert n.counts()["dropped_stale"] == 2 and sum(n.counts().values()) == 2
+
+
+def test_max_age_zero_disables_the_age_check() -> None:
+    n = Node({"input.max_age_s": 0.0})
+    assert n.send(8.0, n.port.now_ns() - 3600 * 10**9)
+    assert n.counts() == dict.fromkeys(KEYS, 0)
+
+
+def test_a_tension_exactly_max_future_ahead_is_solved_one_ns_further_is_dropped() -> None:
+    """Issue 13: a stamp 3 years ahead passed the age check and was solved."""
+    n = Node()  # input.max_future_s = 0.5
+    assert n.send(8.0, n.port.now_ns() + 500 * MS)
+    assert not n.send(8.0, n.port.now_ns() + 500 * MS + 1)
+    assert not n.send(30.0, n.port.now_ns() + 3 * 365 * 86400 * 10**9)
+    assert n.counts()["dropped_future"] == 2 and sum(n.counts().values()) == 2
+
+
+def test_a_zero_stamp_is_dropped_as_unstamped_even_with_the_age_check_off() -> None:
+    """Issue 13: a zero stamp skipped the age check and was solved."""
+    for overrides in ({}, {"input.max_age_s": 0.0}):
+        n = Node(overrides)
+        assert not n.send(31.0, 0)
+        assert n.counts() == {k: int(k == "dropped_unstamped") for k in KEYS}
+        assert n.node.last_problem == "dropped tension 31.0 N: unstamped"
+
+
+def test_the_limits_are_parameters_changed_at_runtime() -> None:
+    n = Node()
+    assert n.port.store.set({"input.tension_max": 10.0}).successful
+    assert not n.send(10.5, n.port.now_ns()) and n.send(10.0, n.port.now_ns())
+    assert n.port.store.set({"input.max_age_s": 2.0}).successful
+    assert n.send(8.0, n.port.now_ns() - 2 * 10**9)
+    assert not n.send(8.0, n.port.now_ns() - 2 * 10**9 - 1)
+    assert n.counts() == {k: int(k in ("dropped_above_max", "dropped_stale")) for k in KEYS}
+
+
+def test_every_drop_then_good_tensions_warn_then_recover_on_diagnostics() -> None:
+    n = Node()
+    now = n.port.now_ns()
+    for tension, stamp_ns in ((float("nan"), now), (-3.0, now), (1e9, now),
+                              (8.0, now - 10 * 10**9), (30.0, now + 10**9), (31.0, 0)):
+        assert not n.send(tension, stamp_ns)
+    assert n.counts() == dict.fromkeys(KEYS, 1)
+    assert n.port.messages("midline") == []
+    for _ in range(6 * 50):  # good tensions at 50 Hz for 6 diagnostics periods
+        assert n.send(12.0, n.port.now_ns())
+        n.port.advance(0.019)
+    statuses = [a.status[0] for a in n.port.messages("/diagnostics")]
+    assert statuses[0].level == 1 and statuses[0].message == "dropped tension 31.0 N: unstamped"
+    assert statuses[-1].level == 0 and statuses[-1].message == "ok"
+    values = {kv.key: kv.value for kv in statuses[-1].values}
+    assert {k: values[k] for k in KEYS} == dict.fromkeys(KEYS, "1")
