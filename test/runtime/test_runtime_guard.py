@@ -112,15 +112,6 @@ def fragile(runtime: str, graph_env: dict[str, str]) -> Iterator[subprocess.Pope
     node.wait()
 
 
-def _until(context: Any, predicate: Callable[[], bool], timeout: float, what: str,
-           action: Callable[[], None]) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        assert time.monotonic() < deadline, f"timed out after {timeout} s waiting for {what}"
-        action()
-        context.spin_for(0.2)
-
-
 def test_a_failing_callback_is_reported_and_the_node_goes_on(runtime, context, params,
                                                               fragile) -> None:
     port = context.create_port("poker")
@@ -136,18 +127,21 @@ def test_a_failing_callback_is_reported_and_the_node_goes_on(runtime, context, p
     def say(text: str) -> Callable[[], None]:
         return lambda: poke.publish(from_dict("std_msgs/msg/String", {"data": text}))
 
-    _until(context, lambda: "first" in echoes, 30.0, "the node's first echo", say("first"))
-    _until(context, lambda: bool(reports), 20.0, "the failure on /diagnostics", say("boom"))
+    eventually(lambda: "first" in echoes, 30.0, "the node's first echo", spin=context,
+               action=say("first"), every=0.2)
+    eventually(lambda: reports, 20.0, "the failure on /diagnostics", spin=context,
+               action=say("boom"), every=0.2)
     assert "RuntimeError: boom" in reports[0].message and "subscription /poke" in reports[0].message
-    _until(context, lambda: "after" in echoes, 20.0, "an echo after the failure", say("after"))
+    eventually(lambda: "after" in echoes, 20.0, "an echo after the failure", spin=context,
+               action=say("after"), every=0.2)
 
     node = params("/fragile")
     crashed = node.set("mode", "crash")
     assert not crashed["successful"] and "KeyError" in crashed["reason"], crashed
     assert node.get("mode") == "ok"
     assert node.set("mode", "calm") == {"successful": True, "reason": ""}
-    _until(context, lambda: "still" in echoes, 20.0, "an echo after the parameter crash",
-           say("still"))
+    eventually(lambda: "still" in echoes, 20.0, "an echo after the parameter crash",
+               spin=context, action=say("still"), every=0.2)
     assert fragile.poll() is None
 
 
@@ -162,7 +156,9 @@ def test_hostile_parameter_queries_get_errors_and_the_node_goes_on(context, zeno
         from tdcm_ros.runtime.param_client import ParameterClient
         from tdcm_ros.runtime.param_services import SERVICES
 
-        eventually(lambda: _answers(context), 30.0, "the node's parameter services")
+        eventually(lambda: _served(context, SERVICES), 30.0,
+                   "the SS tokens of the six parameter services /fragile/*",
+                   detail=lambda: _server_tokens(context))
         gid = bytes(range(16))
         for body in ("null", "[]", "7", '"x"', '{"name": 5}', "{not json", '{"name": null}'):
             for seq, (service, type_name) in enumerate(SERVICES.items(), start=1):
@@ -180,15 +176,17 @@ def test_hostile_parameter_queries_get_errors_and_the_node_goes_on(context, zeno
         node.wait()
 
 
-def _answers(context: Any) -> bool:
-    from tdcm_ros.errors import TdcmError
-    from tdcm_ros.runtime.param_client import ParameterClient
+def _server_tokens(context: Any) -> list[str]:
+    """The ``SS`` (service server) liveliness tokens on the graph."""
+    return [str(r.ok.key_expr) for r in context.session.liveliness().get("@ros2_lv/**",
+                                                                       timeout=1.0)
+            if r.ok is not None and "/SS/" in str(r.ok.key_expr)]
 
-    try:
-        ParameterClient(context, "/fragile", timeout=1.0).names()
-    except TdcmError:
-        return False
-    return True
+
+def _served(context: Any, services: Any) -> bool:
+    """Whether /fragile serves each of ``services`` (its SS token is on the graph)."""
+    tokens = _server_tokens(context)
+    return all(any(f"%fragile%{service}/" in t for t in tokens) for service in services)
 
 
 def _children(pid: int) -> list[int]:
@@ -199,10 +197,13 @@ def _children(pid: int) -> list[int]:
 
 
 @pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
-def test_tdcm_up_reports_a_dead_node_and_exits_non_zero(runtime, spawn) -> None:
+def test_tdcm_up_reports_a_dead_node_and_exits_non_zero(runtime, context, spawn) -> None:
     launcher = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--runtime", runtime)
-    eventually(lambda: len(_children(launcher.pid)) == 1, 20.0, "the talker process")
-    time.sleep(1.0)
+    heard: list[str] = []
+    context.create_port("listener").create_subscription(
+        "chatter", "std_msgs/msg/String", lambda m: heard.append(m.data))
+    eventually(lambda: heard, 30.0, "the talker's first message on chatter", spin=context)
+    assert len(_children(launcher.pid)) == 1  # the talker, the graph running
     os.kill(_children(launcher.pid)[0], signal.SIGKILL)
     status = launcher.wait(30)  # every node has exited: tdcm up ends by itself
     assert launcher.stderr is not None
