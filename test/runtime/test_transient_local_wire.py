@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import struct
-import time
 from typing import Any
 
 import pytest
@@ -74,21 +73,33 @@ def test_a_reliable_latched_publisher_is_detectable_caches_and_sends_heartbeats(
 
 
 def test_a_best_effort_latched_publisher_sends_no_heartbeat(context: Any) -> None:
+    """Beside it a reliable latched publisher, declared and published after it, whose second
+    heartbeat (a heartbeat period after its first, so after a tick of the best-effort one's
+    period too, had it one) is heard before the best-effort one is checked."""
     session = _plain_session()
     try:
-        key = _key("/loose")
-        heartbeats: list[str] = []
-        listener = session.declare_subscriber(f"{key}/@adv/pub/**",
-                                              lambda s: heartbeats.append(str(s.key_expr)))
-        loose = QoS(depth=1, reliability="best_effort", durability="transient_local")
-        publisher = context.create_port("loose").create_publisher("loose", STRING, loose)
-        publisher.publish(from_dict(STRING, {"data": "x"}))
-        time.sleep(3 * 0.5 + 0.5)  # three heartbeat periods of a reliable one
-        assert heartbeats == []
+        loose_key, firm_key = _key("/loose"), _key("/firm")
+        heartbeats: dict[str, list[bytes]] = {loose_key: [], firm_key: []}
+        listeners = [session.declare_subscriber(
+            f"{key}/@adv/pub/**", lambda s, key=key: heartbeats[key].append(s.payload.to_bytes()))
+            for key in heartbeats]
+        port = context.create_port("latched")
+        loose = port.create_publisher("loose", STRING, QoS(depth=1, reliability="best_effort",
+                                                            durability="transient_local"))
+        firm = port.create_publisher("firm", STRING, LATCHED)
+        loose.publish(from_dict(STRING, {"data": "x"}))
+        firm.publish(from_dict(STRING, {"data": "a"}))
+        eventually(lambda: heartbeats[firm_key], 10.0, "the reliable publisher's heartbeat")
+        firm.publish(from_dict(STRING, {"data": "b"}))
+        eventually(lambda: len(heartbeats[firm_key]) >= 2, 10.0,
+                   "the reliable publisher's next heartbeat")
+        assert struct.unpack("<I", heartbeats[firm_key][-1]) == (1,)  # its second sample
+        assert heartbeats[loose_key] == []
         tokens = [str(r.ok.key_expr) for r in
-                  session.liveliness().get(f"{key}/@adv/pub/**", timeout=5.0) if r.ok]
+                  session.liveliness().get(f"{loose_key}/@adv/pub/**", timeout=5.0) if r.ok]
         assert len(tokens) == 1  # still detectable, with its cache
-        listener.undeclare()
+        for listener in listeners:
+            listener.undeclare()
     finally:
         session.close()
 
@@ -110,9 +121,7 @@ def test_a_latched_subscription_is_detectable_and_hears_a_late_publisher(
             sample_miss_detection=zenoh.ext.MissDetectionConfig(sporadic_heartbeat=0.5),
             publisher_detection=True)
         publisher.put(serialize(from_dict(STRING, {"data": "seen"}), STRING))
-        deadline = time.monotonic() + 10.0
-        while got != ["seen"] and time.monotonic() < deadline:
-            context.spin_for(0.05)
+        eventually(lambda: got, 10.0, "the late publisher's sample", spin=context)
         assert got == ["seen"]
         publisher.undeclare()
     finally:
