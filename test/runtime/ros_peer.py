@@ -51,6 +51,8 @@ import xxhash
 import zenoh
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+from test.support.waiting import eventually
+
 ADMIN_SPACE = "@ros2_lv"
 #: rmw_zenoh's QoS defaults (``qos.cpp``) as ``rmw/types.h`` enum values.
 DEFAULT_RELIABILITY, DEFAULT_DURABILITY, DEFAULT_DEPTH = 1, 2, 42  # history: keep-last (1) always
@@ -227,12 +229,11 @@ class Subscription:
             self.samples.append(received)
 
     def wait(self, count: int = 1, timeout: float = 20.0) -> list[Received]:
-        deadline = time.monotonic() + timeout
-        while len(self.samples) < count:
-            if time.monotonic() > deadline:
-                raise TimeoutError(f"{len(self.samples)} of {count} {self.type_name} samples "
-                                   f"after {timeout} s")
-            time.sleep(0.02)
+        """The samples so far, once there are ``count`` (:func:`eventually`: fails after
+        ``timeout`` s, scaled)."""
+        eventually(lambda: len(self.samples) >= count, timeout,
+                   f"{count} {self.type_name} samples",
+                   detail=lambda: f"{len(self.samples)} received")
         with self._lock:
             return list(self.samples)
 
