@@ -10,7 +10,6 @@ import os
 import shutil
 import signal
 import subprocess
-import time
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack
 from pathlib import Path
@@ -25,7 +24,7 @@ from tdcm_ros.runtime import zenoh_config
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.zenoh_runtime import CONFIG_ENV, ZenohContext
 from test.support.processes import listening
-from test.support.waiting import eventually
+from test.support.waiting import Together, eventually
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
 EXAMPLES = Path(__file__).resolve().parents[2] / "config" / "zenoh"
@@ -99,16 +98,6 @@ def listen_to(context: ZenohContext, topic: str, type_name: str) -> list[Any]:
     return got
 
 
-def spin_until(contexts: list[ZenohContext], predicate: Callable[[], bool], timeout: float,
-               what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        for context in contexts:
-            context.spin_for(0.02)
-
-
 def test_tdcm_up_secure_graph_admits_only_authenticated_tls_peers(
         secrets: dict[str, Path], tls_port: int, spawn: Spawn,
         probes: Callable[[Path, str], ZenohContext]) -> None:
@@ -122,8 +111,9 @@ def test_tdcm_up_secure_graph_admits_only_authenticated_tls_peers(
     plain = probes(secrets["operator"], f"tcp/127.0.0.1:{tls_port}")
     heard = {name: listen_to(ctx, "chatter", "std_msgs/msg/String")
              for name, ctx in (("good", good), ("wrong", wrong), ("plain", plain))}
-    eventually( lambda: bool(heard["good"]), 20.0, "the talker over TLS", spin=[good])
-    eventually( lambda: len(heard["good"]) >= 3, 10.0, "two more messages", spin=[good, wrong, plain])
+    eventually(lambda: heard["good"], 20.0, "the talker over TLS", spin=good)
+    eventually(lambda: len(heard["good"]) >= 3, 10.0, "two more messages",
+               spin=Together(good, wrong, plain))
     assert heard["wrong"] == [] and heard["plain"] == []
     assert list(good.session.info.routers_zid())
     assert not list(wrong.session.info.routers_zid())
@@ -153,13 +143,13 @@ def test_acl_denies_observer_commands_and_allows_operator(
         allowed.publish(from_dict("std_msgs/msg/Empty", {}))
         return len(estops) >= 10  # the observer's route to the driver works: keep going a while
 
-    eventually( observer_sends, 20.0, "the observer's estop messages", spin=[driver])
+    eventually(observer_sends, 20.0, "the observer's estop messages", spin=driver)
 
     def operator_sends() -> bool:
         commands.publish(from_dict("std_msgs/msg/Float64", {"data": 2.0}))
         return any(m.data == 2.0 for m in setpoints)
 
-    eventually( operator_sends, 20.0, "the operator's setpoint", spin=[driver])
+    eventually(operator_sends, 20.0, "the operator's setpoint", spin=driver)
     assert [m.data for m in setpoints if m.data != 2.0] == []
 
 

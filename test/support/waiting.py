@@ -26,6 +26,17 @@ class Spinner(Protocol):
     def spin_for(self, seconds: float) -> None: ...
 
 
+class Together:
+    """Several spinners as one (e.g. a test's zenoh contexts): each spins in turn."""
+
+    def __init__(self, *spinners: Spinner) -> None:
+        self.spinners = spinners
+
+    def spin_for(self, seconds: float) -> None:
+        for spinner in self.spinners:
+            spinner.spin_for(seconds / len(self.spinners))
+
+
 def scaled(seconds: float) -> float:
     """``seconds`` times :data:`TIME_SCALE`."""
     return seconds * TIME_SCALE
