@@ -77,12 +77,23 @@ def tdcm_param(env: dict[str, str], *argv: str) -> subprocess.CompletedProcess[s
                           env=env, capture_output=True, text=True, timeout=60, check=False)
 
 
+def tdcm_param_served(env: dict[str, str], *argv: str) -> subprocess.CompletedProcess[str]:
+    """``tdcm param argv`` run again until it succeeds: the node's services are discovered
+    by a fresh process (30 s at most)."""
+    last: list[subprocess.CompletedProcess[str]] = []
+
+    def ran() -> subprocess.CompletedProcess[str] | None:
+        last[:] = [tdcm_param(env, *argv)]
+        return last[0] if last[0].returncode == 0 else None
+
+    return eventually(ran, 30.0, f"'tdcm param {' '.join(argv)}' to succeed",
+                      detail=lambda: last[0].stderr if last else "")
+
+
 def test_tdcm_param_lists_gets_and_sets(runtime: str, graph_env: dict[str, str],
                                         spawn: Spawn) -> None:
     spawn("tdcm_ros.runtime.run_node", TALKER)
-    deadline = time.monotonic() + 30
-    while (listing := tdcm_param(graph_env, "list", "talker")).returncode != 0:
-        assert time.monotonic() < deadline, listing.stderr
+    listing = tdcm_param_served(graph_env, "list", "talker")
     assert "  period: 0.5  # " in listing.stdout and "  prefix: " in listing.stdout
     assert tdcm_param(graph_env, "set", "/talker", "period", "0.2").stdout.strip() == (
         "Set parameter successful")
@@ -101,9 +112,7 @@ def test_tdcm_param_describes_and_dumps(runtime: str, graph_env: dict[str, str],
     from tdcm_ros.runtime.params import node_parameters
 
     spawn("tdcm_ros.runtime.run_node", TALKER)
-    deadline = time.monotonic() + 30
-    while (described := tdcm_param(graph_env, "describe", "talker", "period")).returncode != 0:
-        assert time.monotonic() < deadline, described.stderr
+    described = tdcm_param_served(graph_env, "describe", "talker", "period")
     assert described.stdout.splitlines()[:2] == ["Parameter name: period", "  Type: double"]
     assert "    Min value: 0.001\n    Max value: 60.0" in described.stdout
     assert tdcm_param(graph_env, "set", "talker", "prefix", "dumped").returncode == 0
@@ -119,9 +128,7 @@ def test_tdcm_param_set_reads_exponent_floats(runtime: str, graph_env: dict[str,
     """``tdcm param set NODE NAME 1.0e9``: an exponent without a dot or a sign is a float (YAML
     1.2), not YAML 1.1's string, which the node rejects."""
     spawn("tdcm_ros.runtime.run_node", TALKER)
-    deadline = time.monotonic() + 30
-    while (listing := tdcm_param(graph_env, "list", "talker")).returncode != 0:
-        assert time.monotonic() < deadline, listing.stderr
+    tdcm_param_served(graph_env, "list", "talker")
     for text, value in (("2e-1", "0.2"), ("2.5e-1", "0.25"), ("1E0", "1.0")):
         done = tdcm_param(graph_env, "set", "talker", "period", text)
         assert done.returncode == 0, f"{text}: {done.stderr}"
