@@ -65,13 +65,14 @@ def test_a_peer_receives_the_tendon_frame_and_the_models_tip(runtime, context, s
     def tip_for(stamp: int) -> list[Any]:
         return [m for m in dynamic if stamp_of(m.transforms[0]) == stamp]
 
-    stamp = 0
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline and not (stamp and tip_for(stamp)):
-        stamp = time.time_ns()
-        tension.publish(wrench(20.0, stamp))
-        context.spin_for(0.2)
-    assert stamp and tip_for(stamp), "no /tf for the tension sent"
+    sent: list[int] = []
+
+    def send() -> None:
+        sent.append(time.time_ns())
+        tension.publish(wrench(20.0, sent[-1]))
+
+    stamp = eventually(lambda: next((t for t in sent if tip_for(t)), None), 30.0,
+                       "/tf for a tension sent", spin=context, action=send, every=0.2)
     (message,) = tip_for(stamp)
     expected = solve(preset("paper-experiment"), 20.0)
     tip, *stations = message.transforms
@@ -87,7 +88,7 @@ def test_a_peer_receives_the_tendon_frame_and_the_models_tip(runtime, context, s
     static: list[Any] = []
     context.create_port("late_joiner").create_subscription(
         "/tf_static", TF, static.append, QoS(depth=1, durability="transient_local"))
-    eventually( lambda: bool(static), 15.0, "/tf_static from the model node", spin=context)
+    eventually(lambda: static, 15.0, "/tf_static from the model node", spin=context)
     (tendon,) = static[-1].transforms
     assert (tendon.header.frame_id, tendon.child_frame_id) == ("tdcm_base", "tdcm_tendon")
     assert np.allclose(xyz(tendon), [preset("paper-experiment").R_c, 0.0, 0.0], atol=1e-15)
