@@ -8,7 +8,6 @@ tested in-process in test/mocap/test_mocap_node_logic.py.
 from __future__ import annotations
 
 import subprocess
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -61,11 +60,8 @@ class Probe:
             QoS(depth=1, durability="transient_local"))
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-            self.ctx.spin_for(0.1)
+        """:func:`eventually`, spinning the probe's context."""
+        eventually(predicate, timeout, what, spin=self.ctx)
 
     def counter(self, key: str) -> str | None:
         for array in reversed(self.diagnostics):
@@ -164,13 +160,14 @@ def test_relabel_republishes_relabelled_markers_from_a_live_driver(runtime, cont
     driver = probe.port.create_publisher("/markers", "mocap4r2_msgs/msg/Markers")
     entries = [("Robot:Tip", [10.0, 20.0, 53.0]), ("Robot:Stray", [1.0, 2.0, 3.0]),
                ("Robot:Base", [10.0, 20.0, 15.0]), ("Robot:Mid", [0.0, 0.0, 0.0])]
-    frame = 7
-    deadline = time.monotonic() + 20
-    while not probe.markers and time.monotonic() < deadline:
-        frame += 1
+    frames = iter(range(8, 10**6))
+
+    def send() -> None:
+        frame = next(frames)
         driver.publish(driver_markers(1_700_000_000_123_456_789 + frame, frame, entries))
-        context.spin_for(0.2)
-    assert probe.markers, "no relabelled Markers"
+
+    eventually(lambda: probe.markers, 20.0, "relabelled Markers", spin=context, action=send,
+               every=0.2)
     message = probe.markers[-1]
     assert message.header.frame_id == "mocap"
     assert stamp_ns(message) == 1_700_000_000_123_456_789 + message.frame_number

@@ -23,6 +23,7 @@ from tdcm_ros.control import rotate_z
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import MarkerLayout, preset, solve, surface_points
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 NODE = "tdcm_ros.nodes.shape_controller:ShapeControllerNode"
 DESIGN = preset("paper-experiment")
@@ -113,15 +114,10 @@ class Peer:
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str,
                    step: Callable[[], None] | None = None) -> None:
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                status = self.status()
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}; "
-                                     f"diagnostics: {status.message if status else None}")
-            if step is not None:
-                step()
-            self.ctx.spin_for(0.05)
+        """:func:`eventually`, spinning the peer's context and running ``step`` between checks;
+        a timeout shows the node's latest diagnostics."""
+        eventually(predicate, timeout, what, spin=self.ctx, action=step, every=0.0,
+                   detail=lambda: f"diagnostics: {(s := self.status()) and s.message}")
 
 
 def params_file(tmp_path: Path, values: dict[str, Any]) -> str:
