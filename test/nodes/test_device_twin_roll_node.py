@@ -7,6 +7,7 @@ from __future__ import annotations
 import statistics
 import time
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -33,14 +34,18 @@ def test_twin_node_publishes_the_true_roll(runtime, spawn, context, tmp_path: Pa
     eventually(lambda: link.is_symlink(), 30.0, "the twin's link")
     driver = TensionDriver(DriverConfig(port=str(link), roll_rate=1.5), clock=time.monotonic)
     try:
-        deadline = time.monotonic() + 30.0
         requested = False
-        while not (joints and abs(float(joints[-1].position[0]) + 0.7) < 2e-3):
-            assert time.monotonic() < deadline, f"no -0.7 rad: {joints[-1:]}"
+
+        def step() -> None:  # the driver's loop; the probe spins 5 ms between steps
+            nonlocal requested
             known = driver.step().joints  # the device's roll is known to the driver
             if known and len(joints) >= 5 and not requested:  # and the probe hears the twin
                 requested = driver.set_roll(-0.7) is not None
-            context.spin_for(0.005)
+
+        eventually(lambda: joints and abs(float(joints[-1].position[0]) + 0.7) < 2e-3, 30.0,
+                   "the true roll at -0.7 rad", action=step, every=0.0,
+                   spin=SimpleNamespace(spin_for=lambda _: context.spin_for(0.005)),
+                   detail=lambda: joints[-1:])
     finally:
         driver.close()
     assert all(list(m.name) == ["roll"] and len(m.position) == 1 for m in joints)

@@ -9,7 +9,7 @@ import threading
 from typing import Any
 
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.bagio import deserialize, from_dict, serialize
@@ -22,6 +22,7 @@ from tdcm_ros.runtime.param_services import (
 )
 from tdcm_ros.runtime.parameters import ParameterStore, ParamSpec
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 
 def services() -> tuple[ParameterServices, ParameterStore, list[Any]]:
@@ -53,6 +54,7 @@ values = st.one_of(
     st.lists(st.floats(allow_nan=False), min_size=1), st.lists(st.text(), min_size=1))
 
 
+@settings(deadline=None)  # no wall-clock bound per example: a loaded machine is no bug
 @given(values)
 def test_values_cross_as_parameter_value_and_back(value: Any) -> None:
     message = to_value(value)
@@ -173,11 +175,21 @@ def test_an_embedded_node_serves_the_six_services_and_announces_declarations() -
                                      events.append, QoS(depth=1000))
         port = context.create_port("node", "/ns")
         port.declare_parameter("gain", 2.0, description="1", range=(0.0, 10.0))
-        context.spin_for(0.3)
-        declared = [(e.node, [p.name for p in e.new_parameters]) for e in events]
-        assert ("/ns/node", ["gain"]) in declared and ("/ns/node", ["use_sim_time"]) in declared
-        names = sorted(n for n, _ in context.service_names(0.5) if n.startswith("/ns/node/"))
-        assert names == [f"/ns/node/{s}" for s in (
+
+        def declared() -> list[tuple[str, list[str]]]:
+            return [(e.node, [p.name for p in e.new_parameters]) for e in events
+                    if e.node == "/ns/node"]
+
+        eventually(lambda: len(declared()) >= 2, 10.0, "two parameter events of /ns/node",
+                   spin=context, detail=declared)
+        assert sorted(declared()) == [("/ns/node", ["gain"]), ("/ns/node", ["use_sim_time"])]
+
+        def names() -> list[str]:
+            return sorted(n for n, _ in context.service_names(0.5) if n.startswith("/ns/node/"))
+
+        eventually(lambda: len(names()) >= 6, 10.0, "the six parameter services listed",
+                   detail=names)
+        assert names() == [f"/ns/node/{s}" for s in (
             "describe_parameters", "get_parameter_types", "get_parameters", "list_parameters",
             "set_parameters", "set_parameters_atomically")]
         client = ParameterClient(context, "/ns/node")

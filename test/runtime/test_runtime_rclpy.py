@@ -13,6 +13,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.talker import Talker
 from tdcm_ros.runtime.errors import RuntimePortError
 from test.support.graph import REPO, private_domain_id, require_rclpy
+from test.support.waiting import eventually
 
 CORE = ("model", "metrics", "mocap", "device", "bagio", "scenes")
 
@@ -63,11 +64,8 @@ def test_talker_publishes_and_parameters_are_typed_ranged_and_checked(rclpy_cont
     texts: list[str] = []
     listener = ctx.create_port("listener", "/tdcm_test")
     listener.create_subscription("chatter", "std_msgs/msg/String", lambda m: texts.append(m.data))
-    for _ in range(100):
-        ctx.spin_for(0.1)
-        if texts:
-            break
-    assert texts and texts[0].startswith("yaml ")
+    eventually(lambda: texts, 10.0, "the talker's first message", spin=ctx)
+    assert texts[0].startswith("yaml ")
 
     node = port.node
     assert logic.port.get_parameter("period") == 1.0  # a YAML int widened to the float parameter
