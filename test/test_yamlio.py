@@ -71,7 +71,7 @@ _TOKENS = st.sampled_from(["[", "]", "{", "}", ",", ": ", "- ", "\n", "  ", "a",
                            "*x", "? ", "!!str ", "'", '"', "#", "---\n", "<<: ", "2020-13-01"])
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(st.one_of(st.text(max_size=200), st.lists(_TOKENS, max_size=80).map("".join),
                  st.tuples(st.sampled_from(["[", "{a: ", "- ", "a:\n  "]),
                            st.integers(0, 3000)).map(lambda pair: pair[0] * pair[1])))
@@ -96,7 +96,7 @@ def test_near_exponent_strings_keep_their_yaml_1_1_reading(text: str) -> None:
     assert load_yaml(text, "cfg") == yaml.safe_load(text)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200)
 @given(st.floats(allow_nan=False, allow_infinity=False), st.sampled_from(["e", "E"]),
        st.sampled_from(["", "+", "-"]))
 def test_exponent_spellings_of_any_float_read_back_exactly(x: float, e: str, sign: str) -> None:

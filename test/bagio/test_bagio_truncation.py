@@ -45,7 +45,7 @@ def _unchunked(path: Path, expected: list[tuple[str, int, str, object]]) -> byte
     return path.read_bytes()
 
 
-@settings(max_examples=120, deadline=None,
+@settings(max_examples=120,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(compression=st.sampled_from(["zstd", "lz4", "none", "unchunked"]), fraction=st.floats(0.0, 1.0))
 def test_cut_file_gives_an_intact_prefix_or_bag_error(

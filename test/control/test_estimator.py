@@ -22,7 +22,7 @@ def test_the_model_depends_on_the_tension_through_t_over_e_only() -> None:
                        atol=1e-12)
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=15)
 @given(st.floats(0.6, 1.6), st.integers(0, 2**32 - 1), st.floats(2e-5, 2e-4))
 def test_the_estimate_converges_to_the_true_gain_and_its_std_shrinks(
         true_gain: float, seed: int, noise_m: float) -> None:
@@ -51,7 +51,6 @@ def test_a_zero_tension_teaches_nothing_and_the_random_walk_widens_the_std() -> 
     assert estimator.std == pytest.approx(math.hypot(before, 0.01 * 10.0))
 
 
-@settings(deadline=None)  # no wall-clock bound per example: a loaded machine is no bug
 @given(st.tuples(*[st.sampled_from([math.nan, math.inf, -math.inf, 0.01])] * 6))
 def test_non_finite_input_is_refused_and_leaves_no_nan(values: tuple[float, ...]) -> None:
     estimator = GainEstimator()

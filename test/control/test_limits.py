@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from tdcm_ros.control import DriverLimits, slew
@@ -19,7 +19,6 @@ def test_limits_come_from_the_driver_parameters_and_must_be_positive() -> None:
         DriverLimits(20.0, 40.0, 1.5, math.nan)
 
 
-@settings(deadline=None)  # no wall-clock bound per example: a loaded machine is no bug
 @given(st.floats(-50, 50), st.floats(-50, 50), st.floats(0.1, 100), st.floats(0.0, 1.0))
 def test_a_slew_moves_toward_the_goal_no_faster_than_the_rate(current: float, goal: float,
                                                               rate: float, dt: float) -> None:

@@ -15,7 +15,7 @@ from tdcm_ros.model import MarkerLayout, preset, solve, surface_points
 DESIGN = preset("paper-experiment")
 
 
-@settings(max_examples=20, deadline=None)
+@settings(max_examples=20)
 @given(st.floats(0.0, 20.0), st.floats(-1.5, 1.5), st.sampled_from([0.0, 90.0, 180.0]),
        st.sampled_from([(0.015, 0.033, 0.053), (0.01, 0.02, 0.045)]))
 def test_the_tip_is_recovered_from_rolled_markers(tension: float, roll: float, side: float,

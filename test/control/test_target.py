@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from tdcm_ros.control import (
@@ -20,7 +20,6 @@ from tdcm_ros.control import (
 ROLL_MAX = math.pi / 2
 
 
-@settings(deadline=None)  # no wall-clock bound per example: a loaded machine is no bug
 @given(st.floats(0.0005, 0.02), st.floats(-1.5, 1.5), st.floats(0.03, 0.06))
 def test_a_rolled_planar_point_resolves_to_its_roll_and_plane_point(radial: float, roll: float,
                                                                    z: float) -> None:

@@ -85,7 +85,7 @@ def test_roll_is_slewed_at_roll_rate_and_reaches_the_target(tmp_path: Path) -> N
     assert bench.twin.plant.roll == pytest.approx(0.6, abs=2e-3)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(st.floats(-10.0, 10.0, allow_nan=False), st.floats(0.1, c.ROLL_MAX_MRAD / 1000))
 def test_roll_targets_are_clamped_with_a_warning(radians: float, roll_max: float) -> None:
     warnings: list[str] = []

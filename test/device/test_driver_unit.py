@@ -186,7 +186,7 @@ def test_rejected_device_lines_are_counted_and_warned_about_once_a_second() -> N
     assert sum(int(w.split()[1]) for w in rejected) <= 30
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(st.lists(st.binary(max_size=120), max_size=10))
 def test_no_device_bytes_make_the_driver_raise(chunks: list[bytes]) -> None:
     """Whatever the device sends, a step returns a result or raises the typed version error."""

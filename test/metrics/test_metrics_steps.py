@@ -17,7 +17,7 @@ from tdcm_ros.metrics.steps import (
 from tdcm_ros.metrics.synthetic import staircase
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25)
 @given(levels=st.lists(st.floats(1.0, 25.0), min_size=1, max_size=5).map(
            lambda v: [0.0, *sorted({round(x) for x in v})]),
        trials=st.integers(1, 3), hold_s=st.floats(2.3, 4.0), lag_s=st.floats(0.0, 0.15),

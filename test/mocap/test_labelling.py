@@ -91,7 +91,7 @@ registrations = st.builds(
     st.lists(st.floats(-2, 2), min_size=3, max_size=3))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60)
 @given(st.floats(0.0, 45.0), st.permutations(range(3)), registrations,
        st.sampled_from(["straight", "predicted"]), st.booleans(), st.integers(0, 2**31))
 def test_arc_length_labelling_recovers_labels_for_any_order(tension, order, registration, axis,

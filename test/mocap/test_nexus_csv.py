@@ -67,7 +67,7 @@ def test_section_after_trajectories_is_skipped_even_without_a_blank_line():
     assert len(traj.frames) == 2 and np.allclose(traj.positions, positions)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40)
 @given(st.integers(1, 5), st.integers(1, 12), st.sampled_from([",", ";"]), st.booleans(),
        st.floats(1.0, 2000.0), st.data())
 def test_written_trajectories_round_trip(k, n, delimiter, comma, rate, data):

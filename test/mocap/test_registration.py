@@ -31,7 +31,7 @@ ZERO_BASE = markers_base(0.0)
 BENT_BASE = markers_base(20.0)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=40)
 @given(quat=st.lists(st.floats(-1, 1), min_size=4, max_size=4).filter(
            lambda q: np.linalg.norm(q) > 0.1),
        shift=st.lists(st.floats(-2, 2), min_size=3, max_size=3))

@@ -20,7 +20,7 @@ paper_family = st.builds(
     st.integers(1, 16), st.floats(0.5, 2.5), st.floats(0.6, 3.0), st.floats(3.0, 8.0))
 
 
-@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=20, suppress_health_check=[HealthCheck.too_slow])
 @given(designs=st.lists(paper_family, min_size=1, max_size=8),
        routing=st.sampled_from(["paper", "free"]), quad_order=st.integers(2, 8))
 def test_cells_of_parts_equal_the_single_grids_stacked_bit_for_bit(designs, routing,

@@ -129,7 +129,7 @@ designs_strategy = st.builds(
     st.sampled_from(["circular", "rectangular"]))
 
 
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=15, suppress_health_check=[HealthCheck.too_slow])
 @given(designs=st.lists(designs_strategy, min_size=1, max_size=6),
        routing=st.sampled_from(["paper", "free"]), kind=st.sampled_from(["adaptive", "uniform"]),
        quad_order=st.integers(2, 6))

@@ -27,7 +27,7 @@ def strip_tolerance(h: float, radius: float) -> float:
     return 4.0 * EPS * (h * radius**3 / 8.0 + h**3 * radius / 3.0)
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(r_outer=st.floats(0.5, 5.0), inner_ratio=st.floats(0.0, 0.95),
        h_ratio=st.one_of(st.floats(0.0, 1.2), st.floats(0.0, 0.06)))
 def test_notch_compliance_equals_the_section_modules_eq_12(r_outer, inner_ratio, h_ratio):

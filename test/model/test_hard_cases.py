@@ -36,7 +36,7 @@ def hard_designs(draw):
     )
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=150, suppress_health_check=[HealthCheck.too_slow])
 @given(design=hard_designs(), tension=st.floats(0.0, 5e3),
        routing=st.sampled_from(["paper", "free"]))
 def test_converges_or_raises_a_typed_limit(design, tension, routing):

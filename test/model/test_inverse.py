@@ -31,7 +31,7 @@ def target_of(kind, result):
     return result.tip_deflection_m if kind == "tip_deflection" else result.tip_angle_rad
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
 @given(name=st.sampled_from(sorted(PRESETS)),
        tension=st.floats(0.0, DEFAULT_TENSION_MAX_N),
        kind=st.sampled_from(["tip_deflection", "tip_angle", "tip_point"]))
@@ -129,7 +129,7 @@ def tip_path(name):
     return tensions, np.array([solve(design, t).tip_position[[0, 2]] for t in tensions])
 
 
-@settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=80, suppress_health_check=[HealthCheck.too_slow])
 @given(name=st.sampled_from(["paper-experiment", "fig3-wd-1.2", "fig2-wn-1"]),
        x=st.floats(-0.01, 0.04), z=st.floats(0.02, 0.06))
 def test_any_point_gets_the_closest_tip_on_the_path_or_is_beyond_its_ends(name, x, z):
@@ -190,7 +190,7 @@ def test_summary_is_json_ready():
     assert data["target"] == {"kind": "tip_point", "value": [0.005, 0.0527]}
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(coefficients=st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4),
        scales=st.lists(st.integers(-12, 0), min_size=4, max_size=4),
        ends=st.lists(st.floats(-5.0, 5.0), min_size=2, max_size=2, unique=True))

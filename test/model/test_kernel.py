@@ -37,7 +37,7 @@ def test_plain_and_compiled_builds_agree(routing, monkeypatch):
     np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-15)
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=15)
 @given(n_a=st.integers(1, 6), n_b=st.integers(1, 6), scale=st.floats(0.0, 40.0),
        routing=st.sampled_from(["paper", "free"]))
 def test_padded_stack_gives_each_member_its_own_answers(n_a, n_b, scale, routing):
@@ -143,7 +143,7 @@ def test_switch_off_never_imports_numba(tmp_path):
     assert run_copy(tmp_path, {"TDCM_JIT": "0"}, readonly=False) == ["False", "False", "True"]
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(phi=st.one_of(st.floats(-0.04, 0.04), st.floats(-0.3, 0.3), st.floats(-40.0, 40.0)))
 def test_unit_is_exp_i_phi_within_one_ulp(phi):
     """The Taylor branches of kernel.unit agree with libm's cos and sin to 1 ulp."""

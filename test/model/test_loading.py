@@ -36,7 +36,7 @@ RHO_G = 1010.0 * 9.81  # N/m^3, Nylon 12 under 1 g
 TIGHT = SolverSettings(tol=1e-14, max_iter=400)
 FINE = SolverSettings(cells_per_notch=32, cells_per_tube=32, quad_order=8, tol=1e-14,
                       max_iter=400)
-HYPO = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+HYPO = settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
 
 
 def constant(s, wrap, tension):
@@ -501,7 +501,7 @@ def test_continuation_ramps_the_external_loads_with_the_tension(contact):
     assert np.max(np.abs(shape.p.imag - reference.positions[:, 0])) <= 1e-9
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=40, suppress_health_check=[HealthCheck.too_slow])
 @given(tension=st.floats(0.0, 60.0), fx=st.floats(-40.0, 40.0), fz=st.floats(-40.0, 40.0),
        gx=st.floats(-1e6, 1e6), mu=st.floats(0.0, 1.0), contact=st.booleans(),
        routing=st.sampled_from(["paper", "free"]))

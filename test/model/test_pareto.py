@@ -26,7 +26,7 @@ POINTS = st.integers(1, 3).flatmap(lambda d: arrays(
     elements=st.sampled_from([0.0, 0.5, 1.0, 1.5, 2.0, -1.0, 3.25])))
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300)
 @given(points=POINTS, block=st.sampled_from([1, 2, 7, 256]))
 def test_front_is_exactly_the_non_dominated_points(points, block):
     original = pareto.BLOCK

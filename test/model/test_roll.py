@@ -39,7 +39,7 @@ def planar(tension):
     return solve(PAPER, tension).pose_at(SAMPLES)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(tension=TENSIONS)
 def test_zero_roll_is_the_identity_bit_for_bit(tension):
     positions, quats = planar(tension)
@@ -50,7 +50,7 @@ def test_zero_roll_is_the_identity_bit_for_bit(tension):
     assert roll_points(signed, -0.0).tobytes() == signed.tobytes()
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(tension=TENSIONS, roll=ANGLES)
 def test_a_planar_point_x_0_z_becomes_x_cos_x_sin_z(tension, roll):
     positions, _ = planar(tension)
@@ -61,7 +61,7 @@ def test_a_planar_point_x_0_z_becomes_x_cos_x_sin_z(tension, roll):
     assert np.array_equal(rolled[:, 2], positions[:, 2])
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(tension=TENSIONS, roll=ANGLES)
 def test_roll_preserves_distances_and_arc_length(tension, roll):
     positions, _ = planar(tension)
@@ -74,7 +74,7 @@ def test_roll_preserves_distances_and_arc_length(tension, roll):
     assert abs(chords.sum() - PAPER.length) < 1e-6  # the polyline spans the body's length
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(tension=TENSIONS, first=ANGLES, second=ANGLES)
 def test_rolls_compose(tension, first, second):
     positions, quats = planar(tension)
@@ -84,7 +84,7 @@ def test_rolls_compose(tension, first, second):
     np.testing.assert_allclose(twice[1], once[1], rtol=0.0, atol=1e-14)
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(tension=TENSIONS, roll=ANGLES)
 def test_frames_stay_unit_and_follow_the_rolled_midline(tension, roll):
     quats = planar(tension)[1]
@@ -103,7 +103,7 @@ def test_frames_stay_unit_and_follow_the_rolled_midline(tension, roll):
     np.testing.assert_allclose(frames.apply([1.0, 0.0, 0.0]) @ plane_normal, 0.0, atol=1e-15)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(tension=TENSIONS, roll=ANGLES, side=st.floats(-math.pi, math.pi),
        radius=st.floats(0.0, 0.01))
 def test_markers_rolled_with_the_body_sit_on_the_rolled_frames(tension, roll, side, radius):
@@ -132,7 +132,7 @@ def test_check_roll_takes_real_numbers():
     assert check_roll(-3) == -3.0
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(roll=ANGLES, fx=st.floats(-10.0, 10.0), fz=st.floats(-10.0, 10.0),
        moment=st.floats(-1.0, 1.0))
 def test_base_frame_loads_keep_their_part_in_the_rolled_plane(roll, fx, fz, moment):

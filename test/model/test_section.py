@@ -20,7 +20,7 @@ def quadrature_moment(h1: float, r_outer: float, r_inner: float) -> float:
     return 4.0 * (outer - inner)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200)
 @given(r_outer=st.floats(1e-4, 0.05), inner_ratio=st.floats(0.0, 0.95),
        h_ratio=st.floats(0.01, 1.5))
 def test_closed_form_matches_quadrature(r_outer, inner_ratio, h_ratio):

@@ -52,7 +52,7 @@ def designs(draw: st.DrawFn) -> Design:
         profile=profile_from_name(draw(st.sampled_from(["circular", "rectangular"]))))
 
 
-@settings(max_examples=100, deadline=None, database=None,
+@settings(max_examples=100, database=None,
           suppress_health_check=[HealthCheck.too_slow])
 @given(design=designs(),
        tension=st.one_of(st.just(0.0), st.just(20.0), st.floats(0.0, 1e300)),

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from tdcm_ros.bagio import service_type_hash, type_hash
@@ -113,7 +113,6 @@ def test_attachment_bytes() -> None:
     assert negative[:16] == b"\xff" * 8 + b"\xfe" + b"\xff" * 7
 
 
-@settings(deadline=None)  # no wall-clock bound per example: a loaded machine is no bug
 @given(st.text(min_size=1, max_size=300))
 def test_the_gid_matches_an_independent_xxh3_reading(token: str) -> None:
     """The package's GID (an integer to little-endian bytes) equals ros_peer's (the canonical

@@ -9,7 +9,7 @@ import threading
 from typing import Any
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
 
 from tdcm_ros.bagio import deserialize, from_dict, serialize
@@ -54,7 +54,6 @@ values = st.one_of(
     st.lists(st.floats(allow_nan=False), min_size=1), st.lists(st.text(), min_size=1))
 
 
-@settings(deadline=None)  # no wall-clock bound per example: a loaded machine is no bug
 @given(values)
 def test_values_cross_as_parameter_value_and_back(value: Any) -> None:
     message = to_value(value)

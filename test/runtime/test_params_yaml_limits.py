@@ -46,7 +46,7 @@ _PARAM_TOKENS = st.sampled_from(["/**:\n", "talker:\n", "  ros__parameters:\n", 
                                  "x", "~", "2020-13-01", "\n", "a: ", "? "])
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=150)
 @given(st.one_of(st.binary(max_size=200).map(lambda b: b.decode("latin-1")),
                  st.lists(_PARAM_TOKENS, max_size=60).map("".join),
                  st.tuples(st.sampled_from(["[", "{a: ", "- "]), st.integers(0, 3000))

@@ -25,7 +25,7 @@ JSON = st.recursive(
                                                                  max_size=4),
     max_leaves=12)
 NAMES = st.sampled_from(["period", "gain", "labels", "mode", "nope", ""]) | st.text(max_size=10)
-SETTINGS = settings(max_examples=150, deadline=None,
+SETTINGS = settings(max_examples=150,
                     suppress_health_check=[HealthCheck.function_scoped_fixture])
 
 

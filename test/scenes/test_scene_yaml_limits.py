@@ -67,7 +67,7 @@ _SCENE_LINES = st.one_of(
                      "'", "!!float ", "2020-13-01", "tendon_friction: {mu: ", "\n"]))
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=150)
 @given(st.one_of(st.text(max_size=300), st.lists(_SCENE_LINES, max_size=60).map("".join),
                  st.tuples(st.sampled_from(["effects: ", "schedule:\n  levels: "]),
                            st.sampled_from(["[", "{a: ", "- "]), st.integers(0, 3000))

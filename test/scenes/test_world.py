@@ -166,7 +166,7 @@ def test_notch_contact_replaces_the_closure_error() -> None:
     assert 0.0 < more.tip_position[0] - closed.tip_position[0] < 1e-3  # stiff once closed
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(st.floats(0.0, 30.0, allow_nan=False), min_size=1, max_size=4))
 @example([5e-324, 1.0])  # a warm start from ~0 N once overflowed into NaN wrap angles
 def test_near_singular_converges_or_raises_the_typed_limit(tensions: list[float]) -> None:
@@ -205,7 +205,7 @@ def test_midline_markers_of_a_scene_sit_on_the_midline() -> None:
     assert np.max(np.abs(scene.world().markers(1.0, 12.0).positions - mocap)) <= 1e-12
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])
 @given(tension=st.sampled_from([0.0, 6.0, 20.0]), roll=st.floats(-np.pi, np.pi))
 def test_markers_roll_with_the_body_about_the_base_z_axis(tension: float, roll: float) -> None:
     """At roll phi the markers are the phi = 0 markers turned by phi about tdcm_base's z axis,
