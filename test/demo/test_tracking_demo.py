@@ -38,6 +38,7 @@ def _short_scene(folder: Path) -> Path:
     return path
 
 
+@pytest.mark.process
 @pytest.mark.parametrize("runtime", RUNTIMES)
 def test_feedback_tracks_the_circle_better_than_feed_forward(tmp_path: Path,
                                                              runtime: str) -> None:
