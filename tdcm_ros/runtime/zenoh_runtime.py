@@ -146,7 +146,12 @@ class _Executor:
     """Single-threaded callback loop fed by zenoh threads (tasks) and timers."""
 
     def __init__(self) -> None:
-        self._tasks: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        # queue.Queue, not SimpleQueue: CPython's SimpleQueue.get(timeout) blocks until the next
+        # put when a signal interrupts it and its handler outlasts the remaining timeout (it
+        # recomputes a negative timeout, which means "forever"); a player stopped by Ctrl-C
+        # then hung, as nothing else is queued there. Queue waits on threading locks, which
+        # treat an expired deadline as a timeout.
+        self._tasks: queue.Queue[Callable[[], None]] = queue.Queue()
         self._timers: list[_Timer] = []
         self._seq = itertools.count()
         self.stop = threading.Event()
