@@ -624,9 +624,12 @@ class ZenohContext:
             self.executor.spin_once(min(left, 0.1))
 
     def request_stop(self) -> None:
-        """Make :meth:`spin` return (safe from signal handlers and other threads)."""
+        """Make :meth:`spin` return within 0.1 s (safe from signal handlers and other threads).
+
+        It only sets the stop event, which the loop reads without its lock: posting a wake-up
+        task from a signal handler would take the task queue's lock, which the main thread may
+        hold inside ``Queue.get`` when the signal lands (a deadlock)."""
         self.executor.stop.set()
-        self.executor.post(lambda: None)
 
     def close(self) -> None:
         """Close every port, then the session."""

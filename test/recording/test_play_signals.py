@@ -176,3 +176,26 @@ def test_ctrl_c_during_the_players_wait_stops_it_even_if_the_handler_is_slow() -
         interrupt.cancel()
         signal.signal(signal.SIGINT, previous)
     assert not woken.is_set(), "the player's wait outlived the stop: woken only by a new task"
+
+
+def test_a_zenoh_context_stop_takes_no_lock_the_spinning_thread_may_hold() -> None:
+    """``ZenohContext.request_stop`` runs in signal handlers (``tdcm_node``): on the thread that
+    spins, between two bytecodes, possibly inside ``Queue.get`` with the queue's lock held. It
+    used to post a wake-up task, which takes that (non-reentrant) lock: called there, it would
+    wait forever. The call is made on a thread that holds the lock, as the handler would be."""
+    zenoh_runtime = pytest.importorskip("tdcm_ros.runtime.zenoh_runtime")
+
+    context = zenoh_runtime.ZenohContext.__new__(zenoh_runtime.ZenohContext)
+    context.executor = zenoh_runtime._Executor()
+    returned = threading.Event()
+
+    def spinning_thread_interrupted_inside_get() -> None:
+        with context.executor._tasks.mutex:
+            context.request_stop()
+            returned.set()
+
+    worker = threading.Thread(target=spinning_thread_interrupted_inside_get, daemon=True)
+    worker.start()
+    worker.join(5.0)
+    assert returned.is_set(), "request_stop waited for a lock its own thread holds"
+    assert context.executor.stop.is_set()
