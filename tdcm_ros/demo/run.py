@@ -231,7 +231,9 @@ def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
     stop = threading.Event()
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
-        stop.set()
+        # set from another thread: Event.set here could wait forever for the event's lock,
+        # held by this (main) thread when the signal lands inside stop.wait
+        threading.Thread(target=stop.set, daemon=True).start()
 
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     logs = plan.out / "logs"

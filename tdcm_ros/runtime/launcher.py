@@ -53,7 +53,9 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
     stop = threading.Event()
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
-        stop.set()
+        # set from another thread: Event.set here could wait forever for the event's lock,
+        # held by this (main) thread when the signal lands inside stop.wait
+        threading.Thread(target=stop.set, daemon=True).start()
 
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     overrides, ready_paths = overrides or {}, ready_paths or {}

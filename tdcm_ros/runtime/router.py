@@ -79,8 +79,8 @@ def exit_now(status: int) -> None:
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):
-            pass
+        except (OSError, ValueError, RuntimeError):  # RuntimeError: reentrant call from a
+            pass  # signal handler that interrupted a write of the same stream
     os._exit(status)
 
 

@@ -146,7 +146,12 @@ class _Executor:
     """Single-threaded callback loop fed by zenoh threads (tasks) and timers."""
 
     def __init__(self) -> None:
-        self._tasks: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        # queue.Queue, not SimpleQueue: CPython's SimpleQueue.get(timeout) blocks until the next
+        # put when a signal interrupts it and its handler outlasts the remaining timeout (it
+        # recomputes a negative timeout, which means "forever"); a player stopped by Ctrl-C
+        # then hung, as nothing else is queued there. Queue waits on threading locks, which
+        # treat an expired deadline as a timeout.
+        self._tasks: queue.Queue[Callable[[], None]] = queue.Queue()
         self._timers: list[_Timer] = []
         self._seq = itertools.count()
         self.stop = threading.Event()
@@ -619,9 +624,12 @@ class ZenohContext:
             self.executor.spin_once(min(left, 0.1))
 
     def request_stop(self) -> None:
-        """Make :meth:`spin` return (safe from signal handlers and other threads)."""
+        """Make :meth:`spin` return within 0.1 s (safe from signal handlers and other threads).
+
+        It only sets the stop event, which the loop reads without its lock: posting a wake-up
+        task from a signal handler would take the task queue's lock, which the main thread may
+        hold inside ``Queue.get`` when the signal lands (a deadlock)."""
         self.executor.stop.set()
-        self.executor.post(lambda: None)
 
     def close(self) -> None:
         """Close every port, then the session."""

@@ -135,3 +135,67 @@ def test_player_close_with_a_timeout_reports_a_blocked_context() -> None:
         released.set()
     player._context = argparse.Namespace(close=lambda: None)
     assert player.close(timeout=5.0) is True
+
+
+def test_ctrl_c_during_the_players_wait_stops_it_even_if_the_handler_is_slow() -> None:
+    """The root cause of ``tdcm bag play`` still running after Ctrl-C (caught with the exit
+    deadline's stack: the main thread in ``_Executor.spin_once``'s queue wait, 15 s after the
+    signal): SIGINT lands while the player waits for its next message, and its handler returns
+    after the wait's remaining timeout (a loaded machine; here a handler that takes 0.15 s).
+    CPython's SimpleQueue.get then waited for the next task forever; the player queues none."""
+    zenoh_runtime = pytest.importorskip("tdcm_ros.runtime.zenoh_runtime")
+    import time
+
+    player = player_module.Player.__new__(player_module.Player)
+    context = zenoh_runtime.ZenohContext.__new__(zenoh_runtime.ZenohContext)
+    context.executor = zenoh_runtime._Executor()
+    player._context = context
+    player._stop = threading.Event()
+    player._next_clock = player._next_report = float("inf")
+    woken = threading.Event()
+
+    def slow_handler(signum: int, frame: Any) -> None:
+        player.request_stop()
+        time.sleep(0.15)  # longer than any wait of the player's loop (STOP_LATENCY_S)
+
+    def rescue() -> None:  # never needed with the fix: without it the test would hang
+        woken.set()
+        context.executor.post(lambda: None)
+
+    previous = signal.signal(signal.SIGINT, slow_handler)
+    main = threading.main_thread().ident
+    assert main is not None
+    interrupt = threading.Timer(0.2, signal.pthread_kill, (main, signal.SIGINT))
+    safety = threading.Timer(10.0, rescue)
+    interrupt.start()
+    safety.start()
+    try:
+        assert player._wait_until(time.monotonic() + 60.0) is False
+    finally:
+        safety.cancel()
+        interrupt.cancel()
+        signal.signal(signal.SIGINT, previous)
+    assert not woken.is_set(), "the player's wait outlived the stop: woken only by a new task"
+
+
+def test_a_zenoh_context_stop_takes_no_lock_the_spinning_thread_may_hold() -> None:
+    """``ZenohContext.request_stop`` runs in signal handlers (``tdcm_node``): on the thread that
+    spins, between two bytecodes, possibly inside ``Queue.get`` with the queue's lock held. It
+    used to post a wake-up task, which takes that (non-reentrant) lock: called there, it would
+    wait forever. The call is made on a thread that holds the lock, as the handler would be."""
+    zenoh_runtime = pytest.importorskip("tdcm_ros.runtime.zenoh_runtime")
+
+    context = zenoh_runtime.ZenohContext.__new__(zenoh_runtime.ZenohContext)
+    context.executor = zenoh_runtime._Executor()
+    returned = threading.Event()
+
+    def spinning_thread_interrupted_inside_get() -> None:
+        with context.executor._tasks.mutex:
+            context.request_stop()
+            returned.set()
+
+    worker = threading.Thread(target=spinning_thread_interrupted_inside_get, daemon=True)
+    worker.start()
+    worker.join(5.0)
+    assert returned.is_set(), "request_stop waited for a lock its own thread holds"
+    assert context.executor.stop.is_set()
