@@ -29,6 +29,7 @@ from tdcm_ros.metrics.synthetic import Recording, simulate
 from tdcm_ros.mocap.registration import Registration
 from tdcm_ros.model import preset
 from tdcm_ros.runtime.port import QoS
+from test.support.waiting import eventually
 
 METRICS = "tdcm_ros.nodes.metrics_node:MetricsNode"
 TRUTH = preset("paper-experiment").with_overrides(E=0.8e9)   # the node models the preset's E
@@ -130,11 +131,8 @@ class Peer:
             self.ctx.spin_for(0.05)
 
     def spin_until(self, predicate: Callable[[], bool], timeout: float, what: str) -> None:
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline:
-                raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-            self.ctx.spin_for(0.1)
+        """:func:`eventually`, spinning the probe's context."""
+        eventually(predicate, timeout, what, spin=self.ctx)
 
     def status(self) -> Any | None:
         return self.diagnostics[-1].status[0] if self.diagnostics else None
