@@ -47,6 +47,8 @@ DRIVER_STATUS_TIMEOUT_S = 15.0
 TRIP_FAULT_NAMES = frozenset(flag.name for flag in Fault if flag & TRIP_FAULTS and flag.name)
 #: The driver's ``/diagnostics`` status that carries the setpoint and the schedule state.
 DRIVER_ACTUATOR = "tension_driver: actuator"
+#: The device twin's ``/diagnostics`` status: its simulation's pauses (its thread not scheduled).
+DEVICE_TWIN = "device_twin: device twin"
 
 
 class DemoInterrupted(TdcmError):
@@ -66,6 +68,9 @@ class Progress:
     schedule_done: bool = False
     faults: str = ""               #: the driver's latched trip faults, that release the tendon
     actuator_statuses: int = 0     #: driver actuator statuses seen
+    schedule_ran: bool = False     #: a status said the schedule was running
+    disarm_reason: str = ""        #: why the driver disarmed last ("" while it never did)
+    twin_pauses: str = ""          #: the device twin's simulation pauses, as its status says
     counts: dict[str, int] = field(default_factory=dict)
 
     def count(self, topic: str) -> None:
@@ -103,7 +108,14 @@ def _watch(port: Any, progress: Progress) -> None:
                                           or values.get("schedule_done") == "true")
                 progress.faults = "|".join(name for name in values.get("faults", "").split("|")
                                            if name in TRIP_FAULT_NAMES)
+                progress.schedule_ran = progress.schedule_ran or progress.schedule == "running"
+                progress.disarm_reason = values.get("disarm_reason", progress.disarm_reason)
                 progress.actuator_statuses += 1
+            elif status.name == DEVICE_TWIN:
+                values = {kv.key: kv.value for kv in status.values}
+                if "sim_pauses" in values:
+                    progress.twin_pauses = (f"{values['sim_pauses']} time(s), "
+                                            f"{values.get('sim_paused_s', '?')} s in all")
 
     def on_markers(message: Any) -> None:
         progress.count("markers")
@@ -157,13 +169,34 @@ def clear_start_up_fault(context: Any, loop: _Loop, progress: Progress,
                                     "tendon stays released")
 
 
+def twin_pauses(progress: Progress) -> str:
+    """What the device twin said of its simulation's pauses (its thread not scheduled on time:
+    a loaded machine), for an error about the run's bench; "" before it said anything."""
+    if not progress.twin_pauses:
+        return ""
+    return (f"; the device twin's simulation paused {progress.twin_pauses} so far (its thread "
+            "not scheduled on time: a loaded machine)")
+
+
 def fault_free(progress: Progress) -> None:
     """Raise if the driver reports a latched device fault: the tendon is then released until
     an operator clears it, and the run's tracking figures would not mean anything."""
     if progress.faults:
         raise RuntimePortError(f"the driver reports device fault {progress.faults} during the "
                                "run: the tendon is released until clear_faults, so the "
-                               "tracking run stopped (the bag so far is kept)")
+                               "tracking run stopped (the bag so far is kept)"
+                               f"{twin_pauses(progress)}")
+
+
+def schedule_not_cancelled(progress: Progress) -> None:
+    """Raise once the driver reports the running schedule cancelled (it disarmed: the tendon
+    is released until ``clear_faults``), naming the driver's reason, instead of waiting for a
+    ``schedule_done`` that cannot come."""
+    if progress.schedule_ran and progress.schedule == "cancelled":
+        raise RuntimePortError(f"the driver cancelled the schedule: disarmed "
+                               f"({progress.disarm_reason or 'no reason given'}); the tendon is "
+                               "released until clear_faults (the bag so far is kept)"
+                               f"{twin_pauses(progress)}")
 
 
 def _graph_alive(graph: NodeGraph) -> None:
@@ -210,6 +243,7 @@ def _run_schedule(plan: DemoPlan, context: Any, loop: _Loop, progress: Progress,
     next_line = started
     requested = False
     while not progress.schedule_done:
+        schedule_not_cancelled(progress)
         requested = requested or start_schedule(context)
         loop.turn(deadline, lambda: f"the schedule did not finish within "
                                     f"{plan.schedule.duration:g} s + {START_MARGIN_S:g} s "

@@ -14,6 +14,7 @@ SIGTERM.
 from __future__ import annotations
 
 import argparse
+import bisect
 import errno
 import math
 import os
@@ -36,6 +37,10 @@ from tdcm_ros.errors import out_of_range
 
 TRUTH_KEPT = 4096  #: ground-truth samples kept until taken (older ones are dropped)
 RX_BUFFER = 64     #: bytes the UNO's serial receive buffer holds while its loop does not read
+#: Host s: the longest gap between two turns of the threaded twin that it catches up; a longer
+#: one (its thread was not scheduled) is a pause of the simulation. It is the driver's default
+#: heartbeat period: a turn adds at most that much silence to the host's own (watchdog 0.5 s).
+MAX_GAP = 0.1
 
 
 class DeviceTwin:
@@ -150,28 +155,52 @@ class PtyTwin:
     :meth:`reopen` (a cable pulled and plugged back). Bytes the twin sends while nobody reads
     are dropped once the pty buffer is full, as a UART would. With ``line_delay``, each line the
     device sends reaches the pty ``line_delay()`` s (drawn per line) later, in order.
+
+    The threaded twin maps simulated time onto host time (``clock``, monotonic s; ``epoch_ns``,
+    ns since the epoch) at ``speed``. Each turn of its thread reads the host's bytes, then runs
+    the simulated time due since the last turn -- at most ``max_gap`` s of host time: if the
+    thread was not scheduled for longer (a loaded machine, not the device or the host), the
+    simulation pauses for the rest, as a suspended simulator would, instead of running the
+    whole gap after the host's bytes of it. A device that caught up 0.8 s in one go would see
+    0.8 s without a host byte and trip its watchdog although the host kept writing. Truth
+    samples keep their host times across pauses (:meth:`host_time_ns`); :attr:`pauses` and
+    :attr:`paused_s` count them.
     """
 
     def __init__(self, twin: DeviceTwin, *, speed: float = 1.0, link: str | None = None,
-                 line_delay: Callable[[], float] | None = None) -> None:
+                 line_delay: Callable[[], float] | None = None, max_gap: float = MAX_GAP,
+                 clock: Callable[[], float] = time.monotonic,
+                 epoch_ns: Callable[[], int] = time.time_ns) -> None:
         if not speed > 0:
             raise out_of_range("speed", speed, "> 0", error=DeviceInputError)
+        if not max_gap > 0:
+            raise out_of_range("max_gap", max_gap, "> 0", unit="s", error=DeviceInputError)
         self.twin = twin
         self.line_delay = line_delay
         self._delayed: deque[tuple[float, bytes]] = deque()
         self._partial = b""
         self.speed = speed
+        self.max_gap = max_gap
         self.link = link
+        self._clock = clock
+        self._epoch_ns = epoch_ns
+        self.pauses = 0       #: turns that did not catch up the whole gap (the simulation paused)
+        self.paused_s = 0.0   #: host s the simulation paused in all
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._master = -1
         self._slave = -1
         self.pty_path = ""
-        self._start_wall = time.monotonic()
-        self._start_epoch_ns = time.time_ns()
-        self._start_sim = twin.time
+        self._anchor()
         self._open()
+
+    def _anchor(self) -> None:
+        """Simulated time now is host time now; no pause yet."""
+        self._start_wall, self._start_epoch_ns = self._clock(), self._epoch_ns()
+        #: (simulated s, host monotonic s) from which simulated time runs at ``speed`` again
+        #: after a pause; the first is the start.
+        self._segments: list[tuple[float, float]] = [(self.twin.time, self._start_wall)]
 
     @property
     def port(self) -> str:
@@ -204,18 +233,23 @@ class PtyTwin:
                 self.twin.reboot()
 
     def _exchange(self) -> None:
-        try:
-            data = os.read(self._master, 4096)
-        except BlockingIOError:
-            data = b""
+        data = bytearray()
+        while True:  # all the host wrote, however long the twin was not scheduled
+            try:
+                chunk = os.read(self._master, 4096)
+            except BlockingIOError:
+                break
+            data += chunk
+            if len(chunk) < 4096:
+                break
         if data:
-            self.twin.receive(data)
+            self.twin.receive(bytes(data))
 
     def _delay_lines(self, out: bytes) -> bytes:
         """Queue each complete line ``line_delay()`` s (host time) after now, in order (a serial
         line cannot reorder); return the bytes now due."""
         assert self.line_delay is not None
-        now = time.monotonic()
+        now = self._clock()
         *lines, self._partial = (self._partial + out).split(b"\n")
         for line in lines:
             delay = float(self.line_delay())
@@ -248,8 +282,8 @@ class PtyTwin:
         """Inside this block the device and its bench pause (a stalled simulation; for a
         stalled firmware loop on a running bench see :meth:`hung`).
 
-        The threaded twin then catches up the simulated time it missed in one go, with the
-        host's bytes of the pause delivered at its start.
+        The threaded twin then reads the host's bytes of the pause and goes on: a block longer
+        than ``max_gap`` is a pause of the simulated time (see the class), not caught up.
         """
         with self._lock:
             yield
@@ -281,39 +315,66 @@ class PtyTwin:
         ``speed``. The samples are taken under the lock, so no sample is seen twice or lost
         (beyond ``TRUTH_KEPT`` untaken ones).
         """
-        with self._lock:
-            samples = self.twin.take_truth()
-        return [(self.host_time_ns(t), tension) for t, tension in samples]
+        with self._lock:  # mapped under the lock: a pause may forget older mappings
+            return [(self.host_time_ns(t), tension) for t, tension in self.twin.take_truth()]
 
     def take_roll_truth(self) -> list[tuple[int, float]]:
         """Ground-truth roll samples since the last call as ``(host time ns since the epoch,
         rad)``, taken like :meth:`take_truth`."""
         with self._lock:
-            samples = self.twin.take_roll_truth()
-        return [(self.host_time_ns(t), roll) for t, roll in samples]
+            return [(self.host_time_ns(t), roll) for t, roll in self.twin.take_roll_truth()]
 
     def host_time_ns(self, sim_time: float) -> int:
-        """Host time (ns since the epoch) at which the threaded twin reaches ``sim_time`` s."""
-        return self._start_epoch_ns + round((sim_time - self._start_sim) / self.speed * 1e9)
+        """Host time (ns since the epoch) at which the threaded twin reaches ``sim_time`` s:
+        at ``speed`` from its start, shifted by every pause before ``sim_time`` (a time before
+        the oldest pause still kept maps as if after it; pauses older than every untaken truth
+        sample are forgotten)."""
+        segments = self._segments
+        index = max(0, bisect.bisect_right(segments, (sim_time, math.inf)) - 1)
+        sim, host = segments[index]
+        seconds = host - self._start_wall + (sim_time - sim) / self.speed
+        return self._start_epoch_ns + round(seconds * 1e9)
+
+    def turn(self) -> None:
+        """One turn of the serving thread (:meth:`start` calls it in a loop): take the host's
+        bytes, run the simulated time due at ``clock()`` -- at most ``max_gap`` s of host time
+        since the last turn, the rest is a pause (see the class) -- and send the output."""
+        with self._lock:
+            now = self._clock()
+            self._exchange()
+            sim, host = self._segments[-1]
+            due = sim + (now - host) * self.speed - self.twin.time
+            bound = self.max_gap * self.speed
+            if due > bound:
+                self.pauses += 1
+                self.paused_s += (due - bound) / self.speed
+                self._segments.append((self.twin.time, now - self.max_gap))
+                self._forget_old_pauses()
+                due = bound
+            self.twin.advance(max(0.0, due))
+            self._flush()
+
+    def _forget_old_pauses(self) -> None:
+        """Drop the pauses no untaken truth sample (nor a future one) is mapped through."""
+        twin = self.twin
+        oldest = min([twin.time] + [samples[0][0] for samples in (twin.truth, twin.roll_truth)
+                                    if samples])
+        keep = max(0, bisect.bisect_right(self._segments, (oldest, math.inf)) - 1)
+        del self._segments[:keep]
 
     def _run(self) -> None:
-        start_wall, start_sim = self._start_wall, self._start_sim
         while not self._stop.is_set():
             try:
                 select.select([self._master], [], [], 0.002)
             except (OSError, ValueError):  # reopen() swapped the fd under us: just go on
                 time.sleep(0.002)
-            due = start_sim + (time.monotonic() - start_wall) * self.speed
-            with self._lock:
-                self._exchange()
-                self.twin.advance(max(0.0, due - self.twin.time))
-                self._flush()
+            self.turn()
 
     def start(self) -> Self:
         """Serve from a daemon thread at ``speed`` times real time."""
         self._stop.clear()
-        self._start_wall, self._start_epoch_ns = time.monotonic(), time.time_ns()
-        self._start_sim = self.twin.time
+        with self._lock:
+            self._anchor()
         self._thread = threading.Thread(target=self._run, name="tdcm-twin", daemon=True)
         self._thread.start()
         return self

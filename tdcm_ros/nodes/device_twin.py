@@ -11,7 +11,9 @@ Publishes ``sim/tension_true`` (``geometry_msgs/msg/WrenchStamped``): the true t
 (N, ``wrench.force.z``, frame ``frame_id``) at every load-cell sample, stamped with the host time
 of the sample; ``sim/joint_states_true`` (``sensor_msgs/msg/JointState``, name ``["roll"]``): the
 simulated roll servo's true angle (rad) at the same samples and stamps; and ``/diagnostics``
-(port, simulated time, device mode, faults, roll).
+(port, simulated time, device mode, faults, roll, and the simulation's pauses: a turn of the
+twin's thread more than ``MAX_GAP`` s after the last one pauses simulated time instead of
+catching up, see :class:`~tdcm_ros.device.twin.PtyTwin`).
 """
 
 from __future__ import annotations
@@ -147,7 +149,8 @@ class DeviceTwinNode(NodeLogic):
                 "setpoint": f"{twin.core.setpoint_mn / 1000:.3f}",
                 "tension_true": f"{twin.plant.tension:.3f}", "samples": str(self.samples),
                 "roll_target": f"{twin.core.roll_target_mrad / 1000:.3f}",
-                "roll_true": f"{twin.plant.roll:.4f}"}
+                "roll_true": f"{twin.plant.roll:.4f}", "sim_pauses": str(self.server.pauses),
+                "sim_paused_s": f"{self.server.paused_s:.3f}"}
 
     def check(self) -> Status:
         """The twin's state for ``/diagnostics`` (always OK: it is a simulation)."""
@@ -158,8 +161,11 @@ class DeviceTwinNode(NodeLogic):
         """Stop the twin (the pty closes, the link is removed); logs the final device state."""
         self.server.stop()
         state = self._state()
-        self.port.logger.info("device twin stopped: mode %s, faults %s, true tension %s N",
-                              state["mode"], state["faults"] or "none", state["tension_true"])
+        self.port.logger.info("device twin stopped: mode %s, faults %s, true tension %s N; the "
+                              "simulation paused %s time(s), %s s in all (its thread not "
+                              "scheduled for over %g s)", state["mode"], state["faults"] or "none",
+                              state["tension_true"], state["sim_pauses"], state["sim_paused_s"],
+                              self.server.max_gap)
 
 
 def main() -> int:
