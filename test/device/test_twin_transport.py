@@ -82,11 +82,10 @@ def test_missing_port_is_a_port_error(tmp_path: Path) -> None:
 def test_line_delay_holds_the_devices_lines_back_in_order() -> None:
     """With ``line_delay`` what the device sends reaches the host only after the delay, whole
     lines in order; a negative delay is a typed error."""
-    import time
-
     from tdcm_ros.device.twin import DeviceTwin, PtyTwin
 
-    server = PtyTwin(DeviceTwin(), line_delay=lambda: 0.3)
+    host_s = [100.0]  # the twin's host clock, moved by the test
+    server = PtyTwin(DeviceTwin(), line_delay=lambda: 0.3, clock=lambda: host_s[0])
     host = os.open(server.port, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
 
     def read() -> bytes:
@@ -98,7 +97,10 @@ def test_line_delay_holds_the_devices_lines_back_in_order() -> None:
     try:
         server.pump(0.1)                          # banner and telemetry, all held back
         assert read() == b""
-        time.sleep(0.35)
+        host_s[0] += 0.299
+        server.pump(0.0)
+        assert read() == b""                      # 1 ms short of the delay: still held
+        host_s[0] += 0.001
         server.pump(0.0)
         lines = read().split(b"\n")
         assert len(lines) > 2 and lines[-1] == b""
