@@ -234,7 +234,7 @@ fi
 # --- 4. the rclpy tests -------------------------------------------------------------------------
 phase "pytest ${PYTEST_ARGS[*]}"
 pytest_status=0
-TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" \
+TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup \
   --durations=25 "${PYTEST_ARGS[@]}" || pytest_status=$?
 [ "$pytest_status" = 5 ] && fail "pytest ${PYTEST_ARGS[*]} collected no tests: the rclpy tests are missing"
 [ "$pytest_status" = 0 ] || fail "pytest ${PYTEST_ARGS[*]} exited $pytest_status"

@@ -30,7 +30,7 @@ python3 -m pip install -q -e '.[test]'
 python3 -m pip install -q --upgrade --only-binary :all: "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9"
 
 embedded() {
-  python3 -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" --durations=25 \
+  python3 -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup --durations=25 \
     -m "not rclpy" && bash .ci/zenoh_lowest.sh -n 2
 }
 

@@ -39,6 +39,7 @@ def _short_scene(folder: Path) -> Path:
 
 
 @pytest.mark.process
+@pytest.mark.xdist_group("demo")  # one demo graph at a time: each is 7 real-time processes
 @pytest.mark.parametrize("runtime", RUNTIMES)
 def test_feedback_tracks_the_circle_better_than_feed_forward(tmp_path: Path,
                                                              runtime: str) -> None:
