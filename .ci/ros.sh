@@ -2,15 +2,16 @@
 # CI step with real ROS 2 Jazzy: rclpy 7.1 and the message packages from the package registry (pip
 # wheels for Python 3.11), colcon, and this package built and run from a colcon install space.
 #
-#   bash .ci/ros.sh [--tests-only] [-- PYTEST_ARGS...]   # from any directory
+#   bash .ci/ros.sh [--prepare | --tests-only] [-- PYTEST_ARGS...]   # from any directory
 #
 # Phases: (1) a separate virtual environment (TDCM_ROS_VENV, default <repo>/.ros/venv; reused when
 # complete), (2) a colcon workspace (TDCM_ROS_WS, default <repo>/.ros/ws) holding tdcm_ros (this
 # repository), mocap4r2_msgs (msg_defs/) and a minimal tf2_msgs (test/fixtures/), built with
 # colcon, (3) the installed executables: each one's --help, then model_node against the plain rclpy
 # node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy, in parallel: TDCM_TEST_WORKERS
-# pytest-xdist workers, default 3; PYTEST_ARGS replace `-m rclpy`). --tests-only runs phase 4
-# alone on the venv and workspace a full run built (.ci/soak does). Prints the time of each phase
+# pytest-xdist workers, default 3; PYTEST_ARGS replace `-m rclpy`). --prepare runs phases 1-3
+# only; --tests-only runs phase 4 alone on the venv and workspace they built (.ci/test.sh runs the
+# two apart, .ci/soak the second). Prints the time of each phase
 # and the disk used. Any failure exits non-zero.
 set -euo pipefail
 
@@ -20,12 +21,14 @@ VENV="${TDCM_ROS_VENV:-$REPO/.ros/venv}"
 WS="${TDCM_ROS_WS:-$REPO/.ros/ws}"
 BASE_PYTHON="${TDCM_ROS_PYTHON:-python3}"
 TESTS_ONLY=0
+PREPARE_ONLY=0
 PYTEST_ARGS=(-m rclpy)
 while [ $# -gt 0 ]; do
   case "$1" in
     --tests-only) TESTS_ONLY=1; shift ;;
+    --prepare) PREPARE_ONLY=1; shift ;;
     --) shift; PYTEST_ARGS=("$@"); break ;;
-    *) echo "usage: bash .ci/ros.sh [--tests-only] [-- PYTEST_ARGS...]" >&2; exit 2 ;;
+    *) echo "usage: bash .ci/ros.sh [--prepare | --tests-only] [-- PYTEST_ARGS...]" >&2; exit 2 ;;
   esac
 done
 
@@ -232,6 +235,10 @@ echo "model_node stopped on SIGINT with exit status 0"
 fi
 
 # --- 4. the rclpy tests -------------------------------------------------------------------------
+if [ "$PREPARE_ONLY" = 1 ]; then
+  phase ""
+  exit 0
+fi
 phase "pytest ${PYTEST_ARGS[*]}"
 pytest_status=0
 TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup \

@@ -10,46 +10,60 @@
 #     colcon; ~600 MB), and .ros/ws, a colcon workspace, both inside the checkout (.ci/ros.sh);
 #   - nothing with apt (.ci/run's firmware step installs the AVR toolchain and simavr).
 #
-# Two halves run side by side. They share no transport (zenoh routers on free loopback ports;
-# DDS in domains 1..101, discovery on this host) and no files:
-#   1. embedded: every test not marked `rclpy`, in this Python, on TDCM_TEST_WORKERS pytest-xdist
-#      workers (default 3), then an interop subset on the lowest eclipse-zenoh allowed
-#      (.ci/zenoh_lowest.sh);
-#   2. rclpy: .ci/ros.sh (the ROS venv, colcon build of the package and its interface packages, the
-#      installed executables, then the tests marked `rclpy` with TDCM_REQUIRE_RCLPY=1 so that none
-#      of them can be skipped).
-# Each half's output is printed once it ends; every pytest run lists its 25 slowest tests.
-set -euo pipefail
+# Two halves, embedded (this Python, no ROS) and rclpy (.ci/ros.sh: the ROS venv, a colcon build of
+# the package and its interface packages, the installed executables, then the tests marked `rclpy`
+# with TDCM_REQUIRE_RCLPY=1 so that none of them can be skipped). They share no transport (zenoh
+# routers on free loopback ports; DDS in domains 1..101, discovery on this host) and no files, so
+# they may run side by side; on 2 cores they are ordered by load instead:
+#   1. the in-process tier (CPU-bound: TDCM_TEST_CPU_WORKERS pytest-xdist workers, default 2), while
+#      .ci/ros.sh --prepare builds the ROS venv and workspace in the background;
+#   2. the embedded process tier (marked `process`: processes and a transport, mostly waiting on
+#      timers and sockets: TDCM_TEST_WORKERS workers, default 3; the end-to-end demos one at a
+#      time), then an interop subset on the lowest eclipse-zenoh allowed (.ci/zenoh_lowest.sh);
+#   3. the rclpy tier (.ci/ros.sh --tests-only), so that two runtimes' real-time graphs do not
+#      starve each other.
+# Every step runs even when an earlier one failed; each pytest run lists its 25 slowest tests.
+set -uo pipefail
 cd "$(dirname "$0")/.."
 export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
 LOGS="$(mktemp -d)"
 trap 'rm -rf "$LOGS"' EXIT
+start=$SECONDS
+failed=()
+step() {  # step NAME COMMAND...: run it, say how long it took, remember a failure
+  local name="$1" t0=$SECONDS status=0
+  shift
+  echo "=== $name"
+  "$@" || status=$?
+  echo "=== $name: exit $status after $((SECONDS - t0)) s"
+  [ "$status" = 0 ] || failed+=("$name (exit $status)")
+}
 
+set -e
 python3 -m pip install -q -e '.[test]'
 # The highest eclipse-zenoh that setup.py allows (pip keeps an older one that satisfies it otherwise).
 python3 -m pip install -q --upgrade --only-binary :all: "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9"
+set +e
 
-embedded() {
-  python3 -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup --durations=25 \
-    -m "not rclpy" && bash .ci/zenoh_lowest.sh -n 2
-}
+bash .ci/ros.sh --prepare >"$LOGS/ros_prepare.log" 2>&1 &
+PREPARE=$!
+PYTEST=(python3 -m pytest -q -p no:cacheprovider --durations=25)
+step "in-process tier" "${PYTEST[@]}" -n "${TDCM_TEST_CPU_WORKERS:-2}" -m "not rclpy and not process"
+step "embedded process tier" "${PYTEST[@]}" -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup \
+  -m "process and not rclpy"
+step "lowest eclipse-zenoh" bash .ci/zenoh_lowest.sh -n 2
+prepare=0
+wait "$PREPARE" || prepare=$?
+echo "=== ROS venv and workspace (.ci/ros.sh --prepare): exit $prepare"
+cat "$LOGS/ros_prepare.log"
+if [ "$prepare" = 0 ]; then
+  step "rclpy tier" bash .ci/ros.sh --tests-only
+else
+  failed+=("ros.sh --prepare (exit $prepare)")
+fi
 
-start=$SECONDS
-embedded >"$LOGS/embedded.log" 2>&1 &
-EMBEDDED=$!
-bash .ci/ros.sh >"$LOGS/rclpy.log" 2>&1 &
-RCLPY=$!
-
-status=0
-wait "$EMBEDDED" || status=$?
-echo "=== embedded half (this Python): exit $status after $((SECONDS - start)) s"
-cat "$LOGS/embedded.log"
-ros_status=0
-wait "$RCLPY" || ros_status=$?
-echo "=== rclpy half (.ci/ros.sh): exit $ros_status after $((SECONDS - start)) s"
-cat "$LOGS/rclpy.log"
-if [ "$status" != 0 ] || [ "$ros_status" != 0 ]; then
-  echo "test.sh: FAILED (embedded half exit $status, rclpy half exit $ros_status)" >&2
+if [ "${#failed[@]}" != 0 ]; then
+  printf 'test.sh: FAILED after %s s: %s\n' "$((SECONDS - start))" "${failed[*]}" >&2
   exit 1
 fi
-echo "test.sh: both halves passed in $((SECONDS - start)) s"
+echo "test.sh: every tier passed in $((SECONDS - start)) s"

@@ -149,7 +149,9 @@ class MocapNode(NodeLogic):
         self.labels = tuple(str(v) for v in get("labelling.labels"))
         self.name_map = NameMap.parse([str(v) for v in get("labelling.map")],
                                       self.labels)
-        qos = QoS(depth=10)
+        # Reliable with a deep history: a keep-last writer drops samples a busy subscriber has not
+        # acknowledged yet (on DDS too), and metrics_node scores every frame (10 s at 100 Hz).
+        qos = QoS(depth=1000)
         self.markers_pub = port.create_publisher("markers", MARKERS_TYPE, qos)
         self.poses_pub = port.create_publisher("markers_poses", "geometry_msgs/msg/PoseArray", qos)
         self.tf_pub = port.create_publisher("/tf_static", "tf2_msgs/msg/TFMessage",

@@ -119,7 +119,7 @@ def router(zenoh_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
                                 f"tcp/127.0.0.1:{port}"], env=zenoh_env, cwd=REPO,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
-        eventually(lambda: listening(port), 10.0, "the router")
+        eventually(lambda: listening(port), 30.0, "the router")  # a loaded machine starts slowly
         yield process
     finally:
         if process.poll() is None:
