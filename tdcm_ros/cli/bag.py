@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import faulthandler
-import os
 import signal
 import sys
 from types import FrameType
@@ -23,6 +22,7 @@ from typing import Any
 
 from tdcm_ros.cli.main import INTERRUPTED_EXIT
 from tdcm_ros.cli.runtime_option import add_runtime_option
+from tdcm_ros.runtime import exit_now
 from tdcm_ros.runtime.run_node import resolve_runtime
 
 DEFAULT_CLOCK_HZ = 40.0
@@ -112,17 +112,6 @@ class ProgressLine:
         if self.shown:
             sys.stderr.write("\n")
             sys.stderr.flush()
-
-
-def exit_now(status: int) -> None:
-    """Flush stdout and stderr, then leave at once (``os._exit``): no blocked thread, finaliser
-    or native library's exit hook can keep the process alive."""
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError, RuntimeError):  # RuntimeError: reentrant call from a
-            pass  # signal handler that interrupted a write of the same stream
-    os._exit(status)
 
 
 def arm_exit_deadline() -> None:

@@ -34,6 +34,7 @@ from tdcm_ros.runtime import (
     CLOCK_TYPE,
     QoS,
     RuntimePortError,
+    close_within,
     resolve_topic,
 )
 
@@ -264,20 +265,4 @@ class Player:
         if timeout is None:
             self._context.close()
             return True
-        done = threading.Event()
-        failed: list[BaseException] = []
-
-        def close_context() -> None:
-            try:
-                self._context.close()
-            except BaseException as error:  # noqa: BLE001 - re-raised on the caller's thread
-                failed.append(error)
-            finally:
-                done.set()
-
-        threading.Thread(target=close_context, name="play-close", daemon=True).start()
-        if not done.wait(timeout):
-            return False
-        if failed:
-            raise failed[0]
-        return True
+        return close_within(self._context.close, timeout, name="play-close")

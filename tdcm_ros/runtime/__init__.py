@@ -34,6 +34,7 @@ from tdcm_ros.runtime.port import (
     Timer,
 )
 from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
+from tdcm_ros.runtime.shutdown import close_within, exit_now
 from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
 
 __all__ = [
@@ -57,7 +58,9 @@ __all__ = [
     "SetResult",
     "Status",
     "Timer",
+    "close_within",
     "declare_specs",
+    "exit_now",
     "grouped",
     "launch",
     "node_target",

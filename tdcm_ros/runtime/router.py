@@ -20,13 +20,13 @@ import os
 import signal
 import socket
 import sys
-import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from types import FrameType
 
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.runtime.run_node import configure_logging
+from tdcm_ros.runtime.shutdown import close_within, exit_now
 from tdcm_ros.runtime.zenoh_config import ROUTER_CONFIG_ENV, warn_if_exposed
 from tdcm_ros.runtime.zenoh_runtime import endpoint, open_session, session_config
 
@@ -56,32 +56,6 @@ def is_listening(locator: str, timeout: float = 0.5) -> bool:
             return True
     except OSError:
         return False
-
-
-def close_within(close: Callable[[], None], timeout: float) -> bool:
-    """Run ``close`` on a daemon thread; True if it returned (or raised) within ``timeout`` s.
-    A close that blocks is left behind: the daemon thread does not hold the process."""
-    done = threading.Event()
-
-    def run() -> None:
-        try:
-            close()
-        finally:
-            done.set()
-
-    threading.Thread(target=run, name="close", daemon=True).start()
-    return done.wait(timeout)
-
-
-def exit_now(status: int) -> None:
-    """Flush stdout and stderr, then leave at once (``os._exit``): no thread, no finaliser and
-    no native library's exit hook can keep the process alive."""
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (OSError, ValueError, RuntimeError):  # RuntimeError: reentrant call from a
-            pass  # signal handler that interrupted a write of the same stream
-    os._exit(status)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
