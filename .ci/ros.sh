@@ -9,7 +9,8 @@
 # repository), mocap4r2_msgs (msg_defs/) and a minimal tf2_msgs (test/fixtures/), built with
 # colcon, (3) the installed executables: each one's --help, then model_node against the plain rclpy
 # node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy, in parallel: TDCM_TEST_WORKERS
-# pytest-xdist workers, default 3; PYTEST_ARGS replace `-m rclpy`). --prepare runs phases 1-3
+# pytest-xdist workers, default 3, then the end-to-end demos alone; PYTEST_ARGS replace both).
+# --prepare runs phases 1-3
 # only; --tests-only runs phase 4 alone on the venv and workspace they built (.ci/test.sh runs the
 # two apart, .ci/soak the second). Prints the time of each phase
 # and the disk used. Any failure exits non-zero.
@@ -22,12 +23,13 @@ WS="${TDCM_ROS_WS:-$REPO/.ros/ws}"
 BASE_PYTHON="${TDCM_ROS_PYTHON:-python3}"
 TESTS_ONLY=0
 PREPARE_ONLY=0
-PYTEST_ARGS=(-m rclpy)
+PYTEST_ARGS=()
+CUSTOM_ARGS=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --tests-only) TESTS_ONLY=1; shift ;;
     --prepare) PREPARE_ONLY=1; shift ;;
-    --) shift; PYTEST_ARGS=("$@"); break ;;
+    --) shift; PYTEST_ARGS=("$@"); CUSTOM_ARGS=1; break ;;
     *) echo "usage: bash .ci/ros.sh [--prepare | --tests-only] [-- PYTEST_ARGS...]" >&2; exit 2 ;;
   esac
 done
@@ -239,10 +241,19 @@ if [ "$PREPARE_ONLY" = 1 ]; then
   phase ""
   exit 0
 fi
-phase "pytest ${PYTEST_ARGS[*]}"
-pytest_status=0
-TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup \
-  --durations=25 "${PYTEST_ARGS[@]}" || pytest_status=$?
-[ "$pytest_status" = 5 ] && fail "pytest ${PYTEST_ARGS[*]} collected no tests: the rclpy tests are missing"
-[ "$pytest_status" = 0 ] || fail "pytest ${PYTEST_ARGS[*]} exited $pytest_status"
+rclpy_pytest() {  # rclpy_pytest PYTEST_ARGS...: one pytest run; no test collected is a failure
+  phase "pytest $*"
+  local status=0
+  TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider --durations=25 "$@" || status=$?
+  [ "$status" = 5 ] && fail "pytest $* collected no tests: the rclpy tests are missing"
+  [ "$status" = 0 ] || fail "pytest $* exited $status"
+  return 0
+}
+if [ "$CUSTOM_ARGS" = 1 ]; then
+  rclpy_pytest -n "${TDCM_TEST_WORKERS:-3}" "${PYTEST_ARGS[@]}"
+else
+  # the end-to-end demos (7 real-time processes each) alone, after the rest
+  rclpy_pytest -n "${TDCM_TEST_WORKERS:-3}" -m "rclpy and not demo"
+  rclpy_pytest -m "rclpy and demo"
+fi
 phase ""

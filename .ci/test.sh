@@ -18,11 +18,11 @@
 #   1. the in-process tier (CPU-bound: TDCM_TEST_CPU_WORKERS pytest-xdist workers, default 2), while
 #      .ci/ros.sh --prepare builds the ROS venv and workspace in the background;
 #   2. the embedded process tier (marked `process`: processes and a transport, mostly waiting on
-#      timers and sockets: TDCM_TEST_WORKERS workers, default 3; the end-to-end demos one at a
-#      time);
-#   3. the rclpy tier (.ci/ros.sh --tests-only) after it, so that two runtimes' demo graphs do not
-#      starve each other, beside an interop subset on the lowest eclipse-zenoh allowed
-#      (.ci/zenoh_lowest.sh, no demo).
+#      timers and sockets: TDCM_TEST_WORKERS workers, default 3), then its end-to-end demos (marked
+#      `demo`: graphs of 7 real-time processes) alone, one at a time, then an interop subset on
+#      the lowest eclipse-zenoh allowed (.ci/zenoh_lowest.sh);
+#   3. the rclpy tier (.ci/ros.sh --tests-only: the same split), so that two runtimes' real-time
+#      graphs do not starve each other.
 # Every step runs even when an earlier one failed; each pytest run lists its 25 slowest tests.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -50,10 +50,10 @@ bash .ci/ros.sh --prepare >"$LOGS/ros_prepare.log" 2>&1 &
 PREPARE=$!
 PYTEST=(python3 -m pytest -q -p no:cacheprovider --durations=25)
 step "in-process tier" "${PYTEST[@]}" -n "${TDCM_TEST_CPU_WORKERS:-2}" -m "not rclpy and not process"
-step "embedded process tier" "${PYTEST[@]}" -n "${TDCM_TEST_WORKERS:-3}" --dist loadgroup \
-  -m "process and not rclpy"
-bash .ci/zenoh_lowest.sh -n 2 >"$LOGS/lowest.log" 2>&1 &
-LOWEST=$!
+step "embedded process tier" "${PYTEST[@]}" -n "${TDCM_TEST_WORKERS:-3}" \
+  -m "process and not rclpy and not demo"
+step "embedded demos, alone" "${PYTEST[@]}" -m "demo and not rclpy"
+step "lowest eclipse-zenoh" bash .ci/zenoh_lowest.sh -n 2
 prepare=0
 wait "$PREPARE" || prepare=$?
 echo "=== ROS venv and workspace (.ci/ros.sh --prepare): exit $prepare"
@@ -63,13 +63,6 @@ if [ "$prepare" = 0 ]; then
 else
   failed+=("ros.sh --prepare (exit $prepare)")
 fi
-lowest() {  # the subset's outcome and log, once it ended
-  local status=0
-  wait "$LOWEST" || status=$?
-  cat "$LOGS/lowest.log"
-  return "$status"
-}
-step "lowest eclipse-zenoh (beside the rclpy tier)" lowest
 
 if [ "${#failed[@]}" != 0 ]; then
   printf 'test.sh: FAILED after %s s: %s\n' "$((SECONDS - start))" "${failed[*]}" >&2

@@ -84,8 +84,18 @@ PROCESS_FIXTURES = frozenset({"router", "spawn", "context", "runtime", "zenoh_en
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Mark every test that uses a process fixture ``process`` (tests that start processes by
-    other means carry the mark themselves)."""
+    """Mark every test that uses a process fixture, and every end-to-end demo, ``process``
+    (tests that start processes by other means carry the mark themselves)."""
     for item in items:
-        if PROCESS_FIXTURES & set(getattr(item, "fixturenames", ())):
+        if PROCESS_FIXTURES & set(getattr(item, "fixturenames", ())) or item.get_closest_marker(
+                "demo"):
             item.add_marker(pytest.mark.process)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Iterator[None]:
+    """Keep each phase's report on the item (``item.report_call``): fixtures that own processes
+    show what those said when the test failed."""
+    outcome = yield
+    report = outcome.get_result()
+    setattr(item, f"report_{report.when}", report)

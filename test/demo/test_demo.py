@@ -68,8 +68,7 @@ def _run_demo(out: Path, *args: str, runtime: str = "zenoh") -> subprocess.Compl
                           check=False)
 
 
-@pytest.mark.process
-@pytest.mark.xdist_group("demo")  # one demo graph at a time: each is 7 real-time processes
+@pytest.mark.demo
 @pytest.mark.parametrize("runtime", RUNTIMES)
 def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: Path,
                                                                      runtime: str) -> None:
@@ -98,8 +97,7 @@ def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: P
     assert (tmp_path / "ideal" / "plots" / "shapes.png").stat().st_size > 0
 
 
-@pytest.mark.process
-@pytest.mark.xdist_group("demo")  # one demo graph at a time: each is 7 real-time processes
+@pytest.mark.demo
 def test_paper_scene_demo_calibrates_into_the_papers_range(tmp_path: Path) -> None:
     done = _run_demo(tmp_path / "paper", "--scene", "paper_experiment")
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
@@ -158,8 +156,7 @@ def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
     assert overrides["model_node"]["design.E"] == pytest.approx(1.85e9)
 
 
-@pytest.mark.process
-@pytest.mark.xdist_group("demo")  # one demo graph at a time: each is 7 real-time processes
+@pytest.mark.demo
 def test_a_short_hold_finds_every_level_and_the_demo_takes_set(tmp_path: Path) -> None:
     """``--hold 1``: the step settings follow the schedule (the defaults' 1 s shortest hold
     found 1 of 6 levels); ``--set`` reaches the evaluation as in ``tdcm evaluate``."""

@@ -38,8 +38,7 @@ def _short_scene(folder: Path) -> Path:
     return path
 
 
-@pytest.mark.process
-@pytest.mark.xdist_group("demo")  # one demo graph at a time: each is 7 real-time processes
+@pytest.mark.demo
 @pytest.mark.parametrize("runtime", RUNTIMES)
 def test_feedback_tracks_the_circle_better_than_feed_forward(tmp_path: Path,
                                                              runtime: str) -> None:

@@ -87,7 +87,8 @@ def graph_env(runtime: str) -> dict[str, str]:
     return dict(os.environ)
 
 
-def _spawner(env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen[bytes]]]:
+def _spawner(env: dict[str, str], item: pytest.Item
+             ) -> Iterator[Callable[..., subprocess.Popen[bytes]]]:
     children: list[subprocess.Popen[bytes]] = []
 
     def start(*args: str) -> subprocess.Popen[bytes]:
@@ -97,17 +98,27 @@ def _spawner(env: dict[str, str]) -> Iterator[Callable[..., subprocess.Popen[byt
         return child
 
     yield start
+    failed = getattr(item, "report_call", None) is not None and item.report_call.failed
     for child in children:
-        if child.poll() is None:
+        running = child.poll() is None
+        if running:
             child.kill()
+        try:
+            _, err = child.communicate()
+        except ValueError:  # the test closed a pipe it had read
+            err = b""
             child.wait()
+        if failed:  # what each child said, in the failure's report (teardown output)
+            state = "killed at teardown" if running else f"exited {child.returncode}"
+            tail = (err or b"")[-2000:].decode(errors="replace")
+            print(f"--- {' '.join(map(str, child.args[2:]))} ({state}); stderr ends:\n{tail}")
 
 
 @pytest.fixture
 def spawn(request: pytest.FixtureRequest) -> Iterator[Callable[..., subprocess.Popen[bytes]]]:
     """Start ``python -m <args>`` children (runtime of the test, else zenoh); stopped at teardown."""
     name = "graph_env" if "runtime" in request.fixturenames else "zenoh_env"
-    yield from _spawner(request.getfixturevalue(name))
+    yield from _spawner(request.getfixturevalue(name), request.node)
 
 
 @pytest.fixture
