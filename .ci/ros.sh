@@ -245,7 +245,11 @@ rclpy_pytest() {  # rclpy_pytest PYTEST_ARGS...: one pytest run; no test collect
   phase "pytest $*"
   local status=0
   TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider --durations=25 "$@" || status=$?
-  [ "$status" = 5 ] && fail "pytest $* collected no tests: the rclpy tests are missing"
+  if [ "$status" = 5 ]; then  # none collected: a failure, unless PYTEST_ARGS selected them
+    [ "$CUSTOM_ARGS" = 1 ] || fail "pytest $* collected no tests: the rclpy tests are missing"
+    echo "pytest $*: no test selected"
+    status=0
+  fi
   [ "$status" = 0 ] || fail "pytest $* exited $status"
   return 0
 }
