@@ -58,12 +58,13 @@ def _runtime_env(runtime: str) -> dict[str, str]:
             "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
 
 
-def _run_demo(out: Path, *args: str, runtime: str = "zenoh") -> subprocess.CompletedProcess[str]:
+def _run_demo(out: Path, *args: str, hold_s: float,
+              runtime: str = "zenoh") -> subprocess.CompletedProcess[str]:
     env = {**os.environ, **_runtime_env(runtime), "PYTHONPATH": os.pathsep.join(
         [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])])}
     env.pop("TDCM_ZENOH_ENDPOINT", None)
     return subprocess.run([sys.executable, "-m", "tdcm_ros", "demo", "--out", str(out),
-                           "--trials", "1", "--hold", "2.5", "--runtime", runtime, *args],
+                           "--trials", "1", "--hold", str(hold_s), "--runtime", runtime, *args],
                           env=env, cwd=REPO, capture_output=True, text=True, timeout=240,
                           check=False)
 
@@ -72,7 +73,9 @@ def _run_demo(out: Path, *args: str, runtime: str = "zenoh") -> subprocess.Compl
 @pytest.mark.parametrize("runtime", RUNTIMES)
 def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: Path,
                                                                      runtime: str) -> None:
-    done = _run_demo(tmp_path / "ideal", "--scene", "ideal", "--no-calibrate", runtime=runtime)
+    # 1.5 s holds: at 1 s the ideal scene's 4 N level settles too late to be found (the demo warns)
+    done = _run_demo(tmp_path / "ideal", "--scene", "ideal", "--no-calibrate", hold_s=1.5,
+                     runtime=runtime)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     assert f"graph up on {runtime}" in done.stdout
     bag = tmp_path / "ideal" / "bag"
@@ -98,11 +101,19 @@ def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: P
 
 
 @pytest.mark.demo
-def test_paper_scene_demo_calibrates_into_the_papers_range(tmp_path: Path) -> None:
-    done = _run_demo(tmp_path / "paper", "--scene", "paper_experiment")
+def test_paper_scene_demo_calibrates_into_the_papers_range_on_short_holds(tmp_path: Path) -> None:
+    """``--hold 1``: the step settings follow the schedule (the defaults' 1 s shortest hold
+    found 1 of 6 levels); ``--set`` reaches the evaluation as in ``tdcm evaluate``; the fit of E
+    lands in the paper's range."""
+    done = _run_demo(tmp_path / "paper", "--scene", "paper_experiment", "--set",
+                     "mape_threshold_m=0.002", hold_s=1.0)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert "warning: found" not in done.stdout
     results = json.loads((tmp_path / "paper" / "metrics.json").read_text())
     before = results["before_calibration"]
+    assert (before["n_trials"], before["n_steps"]) == (1, 6)
+    assert sorted(round(step["tension"]) for step in before["steps"]) == [0, 4, 8, 12, 16, 20]
+    assert before["details"]["mape_threshold_m"] == 0.002
     calibration = results["calibration"]
     after = calibration["after"]
     # Datasheet E (1.85 GPa) against a 0.70 GPa world: the tip is predicted far too stiff.
@@ -154,20 +165,6 @@ def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
     assert set(overrides) == set(NODE_ORDER) <= set(NODES)
     assert overrides["tension_driver"]["port"] == overrides["device_twin"]["link"]
     assert overrides["model_node"]["design.E"] == pytest.approx(1.85e9)
-
-
-@pytest.mark.demo
-def test_a_short_hold_finds_every_level_and_the_demo_takes_set(tmp_path: Path) -> None:
-    """``--hold 1``: the step settings follow the schedule (the defaults' 1 s shortest hold
-    found 1 of 6 levels); ``--set`` reaches the evaluation as in ``tdcm evaluate``."""
-    done = _run_demo(tmp_path / "short", "--scene", "paper_experiment", "--hold", "1",
-                     "--no-calibrate", "--set", "mape_threshold_m=0.002")
-    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
-    assert "warning: found" not in done.stdout
-    metrics = json.loads((tmp_path / "short" / "metrics.json").read_text())["before_calibration"]
-    assert (metrics["n_trials"], metrics["n_steps"]) == (1, 6)
-    assert sorted(round(step["tension"]) for step in metrics["steps"]) == [0, 4, 8, 12, 16, 20]
-    assert metrics["details"]["mape_threshold_m"] == 0.002
 
 
 def test_demo_rejects_a_bad_set_before_the_run(tmp_path: Path,
