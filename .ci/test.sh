@@ -16,7 +16,8 @@
 # routers on free loopback ports; DDS in domains 1..101, discovery on this host) and no files, so
 # they may run side by side; on 2 cores they are ordered by load instead:
 #   1. the in-process tier (CPU-bound: TDCM_TEST_CPU_WORKERS pytest-xdist workers, default 2), while
-#      .ci/ros.sh --prepare builds the ROS venv and workspace in the background;
+#      .ci/ros.sh --prepare builds the ROS venv and workspace in the background, at niceness 19 (it
+#      has no deadline: it takes what CPU the tiers leave idle, and goes on beside step 2);
 #   2. the embedded process tier (marked `process`: processes and a transport, mostly waiting on
 #      timers and sockets: TDCM_TEST_WORKERS workers, default 3), then its end-to-end demos (marked
 #      `demo`: graphs of 7 real-time processes) alone, one at a time, then an interop subset on
@@ -46,7 +47,7 @@ python3 -m pip install -q -e '.[test]'
 python3 -m pip install -q --upgrade --only-binary :all: "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9"
 set +e
 
-bash .ci/ros.sh --prepare >"$LOGS/ros_prepare.log" 2>&1 &
+TDCM_ROS_BUILD_NICE=19 bash .ci/ros.sh --prepare >"$LOGS/ros_prepare.log" 2>&1 &
 PREPARE=$!
 PYTEST=(python3 -m pytest -q -p no:cacheprovider --durations=25)
 step "in-process tier" "${PYTEST[@]}" -n "${TDCM_TEST_CPU_WORKERS:-2}" -m "not rclpy and not process"
