@@ -10,9 +10,6 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -22,15 +19,9 @@ from tdcm_ros.cli.main import COMMANDS
 from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.synthetic_bag import write_recording
 from tdcm_ros.model import preset
+from test.support.cli import tdcm
 
 ROOT = Path(tdcm_ros.__file__).resolve().parents[1]
-
-
-def tdcm(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)}
-    return subprocess.run([sys.executable, "-m", "tdcm_ros", *args], capture_output=True,
-                          text=True, env=env, cwd=cwd, timeout=300, check=False)
 
 
 def solve_json(*args: str) -> dict[str, object]:

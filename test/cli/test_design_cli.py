@@ -3,12 +3,12 @@ design re-solved at its tension, --out files, the table, and the exit statuses."
 
 import csv
 import json
-import subprocess
 import sys
 
 import pytest
 
 from tdcm_ros.model import Design, solve
+from test.support.cli import tdcm
 
 KEYS = {"design", "target", "tension_budget_n", "allowable_strain", "tol", "ladder",
         "base_design", "free", "sampling", "seed", "samples", "counts", "solves", "rounds",
@@ -17,11 +17,6 @@ ROW_KEYS = {"index", "free", "design", "tension_n", "tip_angle", "peak_strain", 
             "reach_tension_n"}
 SEARCH = ("--tip-angle", "0.45", "--free", "w_n=0.5e-3:3e-3", "--free", "N=3:12",
           "--free", "w_d=0.6e-3:2.2e-3", "--samples", "300", "--allowable-strain", "0.03")
-
-
-def tdcm(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", *args],
-                          capture_output=True, text=True, timeout=300, check=False, cwd=cwd)
 
 
 @pytest.fixture(scope="module")

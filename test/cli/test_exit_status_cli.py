@@ -16,6 +16,7 @@ from tdcm_ros.metrics.synthetic import simulate
 from tdcm_ros.metrics.synthetic_bag import write_recording
 from tdcm_ros.model import preset
 from test.runtime.pty_helpers import run_on_terminal
+from test.support.cli import tdcm as run_tdcm
 
 REPO = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join(
@@ -23,8 +24,7 @@ ENV = {**os.environ, "PYTHONPATH": os.pathsep.join(
 
 
 def tdcm(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "tdcm_ros", *args], capture_output=True,
-                          text=True, env=ENV, cwd=REPO, timeout=120, check=False)
+    return run_tdcm(*args, cwd=REPO)
 
 
 def on_terminal(*args: str) -> tuple[int, str]:

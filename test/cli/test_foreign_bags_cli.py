@@ -6,9 +6,7 @@ out as the simulated truth gives it."""
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +20,7 @@ from tdcm_ros.metrics.options import options_from_sets
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.synthetic import Recording, simulate
 from tdcm_ros.model import MarkerLayout, preset, solve
+from test.support.cli import tdcm as run_tdcm
 
 REPO = Path(__file__).resolve().parents[2]
 VICON = ("tdcm:M15", "tdcm:M33", "tdcm:M53")
@@ -100,10 +99,7 @@ def bag(recording: Recording, tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def tdcm(*args: str) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        [str(REPO), *filter(None, [os.environ.get("PYTHONPATH")])])}
-    return subprocess.run([sys.executable, "-m", "tdcm_ros", *args], env=env, cwd=REPO,
-                          capture_output=True, text=True, timeout=300, check=False)
+    return run_tdcm(*args, cwd=REPO)
 
 
 TOPICS = ("--tension-topic", "/force", "--markers-topic", "/vicon/markers")

@@ -2,20 +2,14 @@
 to ``tdcm solve``, the human summary and the exit statuses."""
 
 import json
-import subprocess
-import sys
 
 import pytest
 
 from tdcm_ros.model import preset, solve
+from test.support.cli import tdcm
 
 KEYS = {"target", "tension_n", "tip_point_m", "tip_angle_rad", "tip_deflection_m", "residual",
         "residual_unit", "sensitivity", "forward_solves", "tension_bounds_n"}
-
-
-def tdcm(*args):
-    return subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", *args],
-                          capture_output=True, text=True, timeout=120, check=False)
 
 
 def test_json_tension_round_trips_through_tdcm_solve():
