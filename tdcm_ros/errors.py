@@ -13,7 +13,7 @@ its specific errors derive from it and from one of the categories.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sized
 from typing import Any
 
 
@@ -45,10 +45,29 @@ class PhysicsError(TdcmError):
     exit_code = 3
 
 
+#: Longest ``repr`` of a value an error message shows whole.
+SHOWN_CHARS = 80
+
+
+def shown_value(value: Any) -> str:
+    """``repr(value)``, or its first :data:`SHOWN_CHARS` characters and the value's length."""
+    text = repr(value)
+    if len(text) <= SHOWN_CHARS:
+        return text
+    if isinstance(value, str):
+        size = f"{len(value)} characters"
+    elif isinstance(value, Sized):
+        size = f"{len(value)} elements"
+    else:
+        size = f"{len(text)} characters"
+    return f"{text[:SHOWN_CHARS]}... ({size})"
+
+
 def out_of_range(parameter: str, value: Any, allowed: str, *, unit: str = "",
                  error: type[InputError] = InputError) -> InputError:
-    """Build an :class:`InputError` (or subclass) with the standard one-line message."""
-    shown = f"{value!r} {unit}".rstrip()
+    """Build an :class:`InputError` (or subclass) with the standard one-line message (a long
+    value is shown by its start and its length)."""
+    shown = f"{shown_value(value)} {unit}".rstrip()
     return error(f"{parameter} = {shown} is out of range; allowed: {allowed}",
                  parameter=parameter, value=value, allowed=allowed)
 

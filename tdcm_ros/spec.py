@@ -19,12 +19,17 @@ import numbers
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import Any
 
-from tdcm_ros.errors import InputError, out_of_range, reject_unknown
+from tdcm_ros.errors import InputError, out_of_range, reject_unknown, shown_value
 
 #: float | int | bool | str (``choices`` optional) | names (distinct non-empty strings) |
 #: vector (``size`` numbers) | list (numbers, length >= 1)
 KINDS = ("float", "int", "bool", "str", "names", "vector", "list")
 _SEQUENCES = ("names", "vector", "list")
+#: Longest string value (characters): Linux's PATH_MAX, room for any path, name or frame. A
+#: parameter is echoed in every message that carries it (a frame_id in each 50 Hz tension).
+MAX_TEXT_CHARS = 4096
+#: Most elements of a sequence value.
+MAX_ITEMS = 10_000
 _TRUE, _FALSE = ("true", "yes", "on", "1"), ("false", "no", "off", "0")
 _METADATA_KEY = "tdcm_spec"
 _SAME: Any = object()  # renamed(): keep the default
@@ -143,6 +148,8 @@ class Spec:
         if isinstance(items, (str, bytes, Mapping)) or not isinstance(items, Collection):
             raise self._wrong_type(where, value, error)
         items = list(items)
+        if len(items) > MAX_ITEMS:
+            raise out_of_range(where, value, f"at most {MAX_ITEMS} elements", error=error)
         if not items or (self.kind == "vector" and len(items) != self.size):
             raise out_of_range(where, value, self.allowed(), error=error)
         if self.kind == "names":
@@ -164,6 +171,9 @@ class Spec:
         if self.kind == "str":
             if not isinstance(value, str):
                 raise self._wrong_type(where, value, error)
+            if len(value) > MAX_TEXT_CHARS:
+                raise out_of_range(where, value, f"at most {MAX_TEXT_CHARS} characters",
+                                   error=error)
             if not self.choices:
                 return value
             chosen = spelled_as(value, self.choices)  # '-' and '_' alike: the choice's spelling
@@ -199,7 +209,7 @@ class Spec:
     def _wrong_type(self, where: str, value: Any, error: type[InputError]) -> InputError:
         noun = {"float": "a number", "int": "an integer", "bool": "true or false",
                 "str": "a string"}.get(self.kind, "a list")
-        return error(f"{where} = {value!r} is not {noun}; allowed: {self.allowed()}",
+        return error(f"{where} = {shown_value(value)} is not {noun}; allowed: {self.allowed()}",
                      parameter=where, value=value, allowed=self.allowed())
 
 

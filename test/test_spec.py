@@ -13,6 +13,8 @@ from hypothesis import strategies as st
 from tdcm_ros.errors import InputError
 from tdcm_ros.model import InvalidSettingsError
 from tdcm_ros.spec import (
+    MAX_ITEMS,
+    MAX_TEXT_CHARS,
     Spec,
     check_fields,
     kind_of,
@@ -287,3 +289,24 @@ def test_a_choice_matches_with_hyphen_and_underscore_alike_and_keeps_its_spellin
     with pytest.raises(InputError) as refused:
         snake.check("tip marker")
     assert "allowed: tip_marker | body" in str(refused.value)
+
+
+@pytest.mark.parametrize("kind", ["str", "names", "list", "vector"])
+def test_strings_and_sequences_are_bounded_and_the_error_stays_short(kind: str) -> None:
+    """A parameter's value is echoed in messages (a frame_id in every tension): at most
+    MAX_TEXT_CHARS characters and MAX_ITEMS elements; the refusal names the parameter and the
+    limit and shows only the value's start and length."""
+    spec = Spec("frame_id", kind=kind, size=MAX_ITEMS + 1)
+    fits = "f" * MAX_TEXT_CHARS if kind == "str" else \
+        [f"n{i}" if kind == "names" else float(i) for i in range(MAX_ITEMS)]
+    too_long = fits + "f" if kind == "str" else [*fits, "extra" if kind == "names" else 1.0]
+    if kind != "vector":
+        assert len(spec.check(fits)) == len(fits)
+    with pytest.raises(InputError) as caught:
+        spec.check(too_long)
+    unit = "characters" if kind == "str" else "elements"
+    limit = MAX_TEXT_CHARS if kind == "str" else MAX_ITEMS
+    assert f"allowed: at most {limit} {unit}" in str(caught.value)
+    assert str(caught.value).startswith("frame_id = ")
+    assert f"({len(too_long)} {unit})" in str(caught.value)
+    assert len(str(caught.value)) < 200
