@@ -70,10 +70,12 @@ from tdcm_ros.runtime import (
     NodePort,
     QoS,
     Status,
+    Throttled,
     declare_specs,
     grouped,
     read_specs,
     summary,
+    template,
 )
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
@@ -142,6 +144,7 @@ class TensionDriverNode(NodeLogic):
         self.counts: Counter[str] = Counter()
         self._last_stamp_ns = {"tension": 0, "joint_states": 0}
         self.last_warning = ""
+        self._warnings = Throttled(port.logger, clock=clock)
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
         self.driver = TensionDriver(config, clock=clock, open_port=open_port, warn=self._warn)
@@ -222,8 +225,9 @@ class TensionDriverNode(NodeLogic):
 
     # --- inputs -----------------------------------------------------------------------------
     def _warn(self, text: str) -> None:
+        """Keep ``text`` as the latest warning (diagnostics) and log it, throttled per kind."""
         self.last_warning = text
-        self.port.logger.warning("%s", text)
+        self._warnings.warn(template(text), text)
 
     def _request(self, newtons: float) -> None:
         applied = self.driver.set_setpoint(newtons)

@@ -36,6 +36,7 @@ from tdcm_ros.runtime.port import (
 from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
 from tdcm_ros.runtime.shutdown import close_within, exit_now
 from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
+from tdcm_ros.runtime.throttle import Throttled, template
 
 __all__ = [
     "CLOCK_QOS",
@@ -57,6 +58,7 @@ __all__ = [
     "RuntimePortError",
     "SetResult",
     "Status",
+    "Throttled",
     "Timer",
     "close_within",
     "declare_specs",
@@ -67,4 +69,5 @@ __all__ = [
     "read_specs",
     "resolve_topic",
     "summary",
+    "template",
 ]

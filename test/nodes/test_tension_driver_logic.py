@@ -15,6 +15,7 @@ from tdcm_ros.device.protocol import Fault, Mode
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.tension_driver import TensionDriverNode
 from tdcm_ros.runtime.memory_port import MemoryPort
+from tdcm_ros.runtime.throttle import PERIOD_S
 from test.nodes.driver_bench import COMPONENTS, URL, DriverBench
 from test.nodes.tension_probe import level, stamp_ns, values
 
@@ -84,6 +85,28 @@ def test_frames_arriving_in_a_burst_are_stamped_in_order(bench) -> None:
         stamps = [stamp_ns(m) for m in bench.port.messages(topic)]
         assert stamps == sorted(stamps), topic
     assert len(bench.port.messages("tension")) - before == 10  # every frame of the burst kept
+
+
+def test_a_flood_of_clamped_setpoints_is_counted_whole_and_logged_once_a_period(make) -> None:
+    """10,000 out-of-range setpoints in 1 s (49,694 log lines in 10 s before): every one is
+    counted, one warning is logged at once and the next one after the period, with the number
+    left out; another kind of warning is not held back by the flood."""
+    bench = make(tension_max=12.0)
+    bench.connected()
+    lines = len(bench.log.lines)
+    for i in range(10_000):
+        bench.setpoint(30.0 + i * 1e-3)
+        if i % 10 == 9:
+            bench.advance(0.001)
+    bench.setpoint(math.nan)
+    flood = bench.log.lines[lines:]
+    assert sum("out of range" in line for line in flood) == 1
+    assert sum("is not finite" in line for line in flood) == 1
+    bench.advance(PERIOD_S)
+    bench.setpoint(40.0)
+    assert "(9999 more like it in the last" in bench.log.lines[-1]
+    bench.advance(0.2)
+    assert int(values(bench.component("actuator"))["clamped_setpoints"]) == 10_001
 
 
 def test_setpoint_above_the_maximum_is_clamped_and_a_lower_maximum_reclamps(make) -> None:
@@ -360,11 +383,24 @@ def test_schedule_waits_for_the_device_runs_the_staircase_and_reports_done(make)
     ("schedule.levels", [0.0, -4.0], "schedule.levels: levels = -4.0 N is out of range"),
     ("schedule.trials", 0, "schedule.trials = 0 is out of range"),
     ("port", " ", "port = ' ' is invalid"),
+    ("frame_id", "f" * 10_000_000, "frame_id = 'ffff"),
 ])
 def test_bad_parameters_are_refused_naming_the_parameter(name, value, message) -> None:
     with pytest.raises(InputError) as caught:
         TensionDriverNode(MemoryPort({name: value}, name="bad_driver"))
     assert message in str(caught.value)
+
+
+def test_a_frame_id_of_10_mb_is_refused_at_runtime_and_the_tension_keeps_its_frame(make) -> None:
+    """The attack of issue 25: ``tdcm param set /tension_driver frame_id <10 MB>`` was taken and
+    every 50 Hz tension then carried 10 MB."""
+    bench = make()
+    bench.connected()
+    refused = bench.port.store.set({"frame_id": "f" * 10_000_000})
+    assert not refused.successful
+    assert "allowed: at most 4096 characters" in refused.reason and len(refused.reason) < 200
+    bench.advance(0.1)
+    assert {m.header.frame_id for m in bench.port.messages("tension")} == {"tdcm_tendon"}
 
 
 def test_commands_are_trigger_services_that_answer_why(make) -> None:
