@@ -33,7 +33,8 @@ ENTRY_POINTS = frozenset(f"tdcm_ros.{name}" for name in (  # besides scripts (py
     "model.accuracy", "model.baselines",  # scipy
     "bagio.reader", "bagio.writer",  # mcap
     "metrics.api", "metrics.calibration", "metrics.synthetic", "metrics.synthetic_bag",  # bags
-    "runtime.zenoh_runtime", "runtime.zenoh_config", "runtime.rclpy_runtime",  # transports
+    "runtime.zenoh_runtime", "runtime.zenoh_config", "runtime.zenoh_query",  # transports
+    "runtime.rclpy_runtime",
     "runtime.param_client", "runtime.param_services",  # rcl_interfaces messages (rosbags)
     "runtime.wire", "device.constants",  # used as namespaces: wire.parse_token, c.TRIP_MN
 ))

@@ -26,7 +26,7 @@ import queue
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Collection, Iterator
+from collections.abc import Callable, Collection
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass, field
@@ -79,7 +79,9 @@ from tdcm_ros.runtime.port import (
     QoS,
 )
 from tdcm_ros.runtime.rosout import ROSOUT_QOS, ROSOUT_TOPIC, RosoutHandler
+from tdcm_ros.runtime.throttle import Throttled
 from tdcm_ros.runtime.wire import RawSample
+from tdcm_ros.runtime.zenoh_query import gather, graph_tokens
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
 CONFIG_ENV = "TDCM_ZENOH_CONFIG"
@@ -268,6 +270,8 @@ class _Subscription:
         self._callback = callback
         self._executor = context.executor
         self._queue: deque[RawSample] = deque(maxlen=qos.depth)
+        self.refused = 0
+        self._refusals = Throttled(logging.getLogger("tdcm.zenoh"))
         domain = identity.domain_id
         if any_type:
             self.key = f"{domain}/{topic.strip('/')}/*/*"
@@ -293,7 +297,17 @@ class _Subscription:
             self._sub = context.session.declare_subscriber(self.key, self._on_sample)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
-        chunks = str(sample.key_expr).rsplit("/", 2)
+        key = str(sample.key_expr)
+        if self._token is not None and (key != self.key or sample.attachment is None):
+            # not what an rmw_zenoh publisher sends: a put on a wildcard key overlapping this
+            # topic (which a router's access list may not match), or a sample without the
+            # attachment every rmw_zenoh publisher adds
+            self.refused += 1
+            self._refusals.warn("refused", f"refused a sample on {self.topic}: "
+                           + ("no rmw_zenoh attachment" if key == self.key
+                              else f"key {key!r} is not the topic's key"))
+            return
+        chunks = key.rsplit("/", 2)
         try:
             type_name = wire.ros_type_name(chunks[1])
             attachment = (wire.decode_attachment(sample.attachment.to_bytes())
@@ -386,10 +400,12 @@ class _Client:
         seq = next(self._seq)
         attachment = wire.encode_attachment(seq, time.time_ns(), self._gid)
         errors = []
-        for reply in self._context.session.get(
-                self.key, payload=request, attachment=attachment,
-                target=zenoh.QueryTarget.ALL_COMPLETE, consolidation=zenoh.ConsolidationMode.NONE,
-                timeout=max(0.1, end - time.monotonic())):
+        left = max(0.1, end - time.monotonic())
+        replies = gather(lambda handler: self._context.session.get(
+            self.key, handler, payload=request, attachment=attachment,
+            target=zenoh.QueryTarget.ALL_COMPLETE, consolidation=zenoh.ConsolidationMode.NONE,
+            timeout=left), left)
+        for reply in replies.kept:
             if reply.ok is None:
                 errors.append(reply.err.payload.to_string() if reply.err is not None else "?")
                 continue
@@ -678,15 +694,3 @@ class GraphWatch:
     def close(self) -> None:
         """Stop collecting."""
         self._subscriber.undeclare()
-
-
-def graph_tokens(session: zenoh.Session, domain: int, timeout: float = 1.0) -> Iterator[wire.TokenInfo]:
-    """Current rmw_zenoh liveliness tokens of ``domain`` (malformed ones skipped)."""
-    for reply in session.liveliness().get(f"{wire.ADMIN_SPACE}/{domain}/**", timeout=timeout):
-        if reply.ok is None:
-            continue
-        try:
-            yield wire.parse_token(str(reply.ok.key_expr))
-        except (RuntimePortError, ValueError):
-            continue
-

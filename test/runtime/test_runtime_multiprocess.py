@@ -42,7 +42,7 @@ def test_message_equality_across_processes(context: Any, spawn: Spawn) -> None:
     assert second.sequence_number == first.sequence_number + 1 and first.gid == second.gid
     assert abs(first.source_timestamp_ns - time.time_ns()) < 30e9
 
-    from tdcm_ros.runtime.zenoh_runtime import graph_tokens
+    from tdcm_ros.runtime.zenoh_query import graph_tokens
 
     def publishers() -> list[tuple[str, str, str]]:
         """Publisher tokens but those every ROS node has (``/parameter_events``, ``/rosout``)."""

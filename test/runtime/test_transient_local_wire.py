@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import json
 import struct
+import time
 from typing import Any
 
 import pytest
 
 from tdcm_ros.bagio import from_dict, serialize, type_hash
+from tdcm_ros.runtime import wire
 from tdcm_ros.runtime.port import QoS
 from test.support.waiting import eventually
 
@@ -120,7 +122,10 @@ def test_a_latched_subscription_is_detectable_and_hears_a_late_publisher(
             session, key, cache=zenoh.ext.CacheConfig(3),
             sample_miss_detection=zenoh.ext.MissDetectionConfig(sporadic_heartbeat=0.5),
             publisher_detection=True)
-        publisher.put(serialize(from_dict(STRING, {"data": "seen"}), STRING))
+        # with rmw_zenoh's attachment, as every rmw_zenoh publisher sends it (a subscription
+        # refuses a sample without one)
+        publisher.put(serialize(from_dict(STRING, {"data": "seen"}), STRING),
+                      attachment=wire.encode_attachment(1, time.time_ns(), bytes(wire.GID_SIZE)))
         eventually(lambda: got, 10.0, "the late publisher's sample", spin=context)
         assert got == ["seen"]
         publisher.undeclare()
