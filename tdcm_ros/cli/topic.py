@@ -27,9 +27,13 @@ if TYPE_CHECKING:
     from tdcm_ros.runtime.zenoh_runtime import GraphWatch
 
 TOOL_NODE = "_tdcm_topic"
+NOT_RECEIVED_EXIT = 1
+"""``topic pub``: no subscriber matched while it published (nothing received the messages)."""
 EXIT_MEANINGS = {f"topic {verb}": {InputError.exit_code: "also: the type given is not the one "
                                                          "the graph uses on the topic"}
                  for verb in ("echo", "pub")}
+EXIT_MEANINGS["topic pub"][NOT_RECEIVED_EXIT] = ("no subscriber matched while it published: "
+                                                 "nothing received the messages")
 """What ``topic echo|pub`` mean by an exit status (their ``--help`` epilogs)."""
 
 
@@ -212,15 +216,21 @@ def run_pub(args: argparse.Namespace) -> int:
                   f"publishing anyway", file=sys.stderr, flush=True)
         print(f"publisher: beginning loop\npublishing #1: {message}", flush=True)
         sent = 0
+        heard = publisher.matched()
         while True:
             publisher.publish(message)
             sent += 1
+            heard = heard or publisher.matched()
             if times and sent >= times:
                 break
             context.spin_for(1.0 / args.rate)
         context.spin_for(0.2)
     finally:
         context.close()
+    if not heard:  # a command (estop) that reached nobody must not look delivered
+        print(f"tdcm topic pub: no subscriber of {publisher.topic} matched while it published; "
+              f"nothing received the {sent} message(s)", file=sys.stderr)
+        return NOT_RECEIVED_EXIT
     return 0
 
 

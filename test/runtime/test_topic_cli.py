@@ -227,14 +227,28 @@ def test_pub_with_another_type_than_the_graph_is_an_error_not_a_publish(port, sp
     assert "publishing" not in out.decode()
 
 
-def test_pub_without_a_matching_subscriber_warns_with_similar_names(port, spawn: Spawn):
+def test_pub_without_a_matching_subscriber_warns_with_similar_names_and_exits_1(
+        port, spawn: Spawn):
+    """Issue 25: ``tdcm topic pub estop`` with the driver gone printed "publishing anyway" and
+    exited 0; a publish that nothing received is a failure."""
     port.create_subscription("tension", "std_msgs/msg/Float64", lambda _: None)
     pub = spawn("tdcm_ros.cli.main", "topic", "pub", "tensoin", "std_msgs/msg/Float64",
                 "{data: 1.0}", "--once", "--wait-matching", "0.5")
     out, err = pub.communicate(timeout=20)
-    assert pub.returncode == 0, err.decode()
+    assert pub.returncode == 1, err.decode()
     assert "no subscriber of /tensoin matched within 0.5 s; similar topics: /tension" in (
         err.decode())
+    assert "publishing #1" in out.decode()
+    assert "nothing received the 1 message(s)" in err.decode()
+
+
+def test_pub_to_a_subscriber_exits_0(port, spawn: Spawn):
+    got: list[Any] = []
+    port.create_subscription("estop", "std_msgs/msg/Empty", got.append)
+    pub = spawn("tdcm_ros.cli.main", "topic", "pub", "estop", "std_msgs/msg/Empty", "{}",
+                "--once", "--wait-matching", "15")
+    out, err = pub.communicate(timeout=30)
+    assert pub.returncode == 0, err.decode()
     assert "publishing #1" in out.decode()
 
 
