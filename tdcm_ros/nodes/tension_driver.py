@@ -144,7 +144,7 @@ class TensionDriverNode(NodeLogic):
         self.counts: Counter[str] = Counter()
         self._last_stamp_ns = {"tension": 0, "joint_states": 0}
         self.last_warning = ""
-        self._warnings = Throttled(port.logger, clock=clock)
+        self._warnings = Throttled(clock=clock)
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
         self.driver = TensionDriver(config, clock=clock, open_port=open_port, warn=self._warn)
@@ -227,7 +227,9 @@ class TensionDriverNode(NodeLogic):
     def _warn(self, text: str) -> None:
         """Keep ``text`` as the latest warning (diagnostics) and log it, throttled per kind."""
         self.last_warning = text
-        self._warnings.warn(template(text), text)
+        suffix = self._warnings.admit(template(text))
+        if suffix is not None:
+            self.port.logger.warning("%s%s", text, suffix)
 
     def _request(self, newtons: float) -> None:
         applied = self.driver.set_setpoint(newtons)

@@ -7,8 +7,6 @@ import re
 import time
 from collections.abc import Callable
 
-from tdcm_ros.runtime.port import Logger
-
 #: Shortest time between two warnings of one key (s).
 PERIOD_S = 5.0
 _NUMBER = re.compile(r"[-+]?(?:(?:\d+\.?\d*|\.\d+)(?:e[-+]?\d+)?|\b(?:nan|inf)\b)",
@@ -22,27 +20,27 @@ def template(text: str) -> str:
 
 
 class Throttled:
-    """``warn(key, text)`` logs the first warning of ``key`` at once, then at most one per
-    ``period_s`` s, saying how many were left out since the last one; :attr:`counts` holds every
-    warning's count by key, shown or not."""
+    """Which warnings to log: the first of a key at once, then at most one per ``period_s`` s.
+    The caller logs (so that the record names the caller's file and line); :attr:`counts` holds
+    every warning's count by key, logged or not."""
 
-    def __init__(self, logger: Logger, period_s: float = PERIOD_S,
+    def __init__(self, period_s: float = PERIOD_S,
                  clock: Callable[[], float] = time.monotonic) -> None:
-        self._logger, self._period_s, self._clock = logger, period_s, clock
+        self._period_s, self._clock = period_s, clock
         self._last: dict[str, float] = {}
         self._held: dict[str, int] = {}
         self.counts: dict[str, int] = {}
 
-    def warn(self, key: str, text: str) -> bool:
-        """Count a warning of ``key``; log ``text`` if the key's period is over. True if logged."""
+    def admit(self, key: str) -> str | None:
+        """Count a warning of ``key``: ``None`` to hold it back, else the text to append to it
+        (empty, or how many were held back since the last one of ``key``)."""
         self.counts[key] = self.counts.get(key, 0) + 1
         now = self._clock()
         last = self._last.get(key)
         if last is not None and now - last < self._period_s:
             self._held[key] = self._held.get(key, 0) + 1
-            return False
+            return None
         held = self._held.pop(key, 0)
         self._last[key] = now
-        suffix = f" ({held} more like it in the last {now - last:.1f} s)" if held and last is not None else ""
-        self._logger.warning("%s%s", text, suffix)
-        return True
+        return f" ({held} more like it in the last {now - last:.1f} s)" if held and last is not None \
+            else ""

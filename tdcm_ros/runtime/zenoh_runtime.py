@@ -272,7 +272,7 @@ class _Subscription:
         self._executor = context.executor
         self._queue: deque[RawSample] = deque(maxlen=qos.depth)
         self.refused = 0
-        self._refusals = Throttled(logging.getLogger("tdcm.zenoh"))
+        self._refusals = Throttled()
         domain = identity.domain_id
         if any_type:
             self.key = f"{domain}/{topic.strip('/')}/*/*"
@@ -304,9 +304,11 @@ class _Subscription:
             # topic (which a router's access list may not match), or a sample without the
             # attachment every rmw_zenoh publisher adds
             self.refused += 1
-            self._refusals.warn("refused", f"refused a sample on {self.topic}: "
-                           + ("no rmw_zenoh attachment" if key == self.key
-                              else f"key {key!r} is not the topic's key"))
+            suffix = self._refusals.admit("refused")
+            if suffix is not None:
+                logging.getLogger("tdcm.zenoh").warning(
+                    "refused a sample on %s: %s%s", self.topic, "no rmw_zenoh attachment"
+                    if key == self.key else f"key {key!r} is not the topic's key", suffix)
             return
         chunks = key.rsplit("/", 2)
         try:

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import logging
-
-import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -19,21 +16,18 @@ class Clock:
         return self.now
 
 
-def test_one_warning_per_key_and_period_and_the_count_of_those_held(
-        caplog: pytest.LogCaptureFixture) -> None:
+def test_one_warning_per_key_and_period_and_the_count_of_those_held() -> None:
     clock = Clock()
-    throttled = Throttled(logging.getLogger("throttle_test"), period_s=2.0, clock=clock)
-    with caplog.at_level(logging.WARNING, "throttle_test"):
-        shown = [throttled.warn("a", f"a {i}") for i in range(5)]
-        assert throttled.warn("b", "b 0")  # another key is not held back
-        clock.now = 1.999
-        assert not throttled.warn("a", "a 5")
-        clock.now = 2.0
-        assert throttled.warn("a", "a 6")
-    assert shown == [True, False, False, False, False]
-    assert [r.getMessage() for r in caplog.records] == [
-        "a 0", "b 0", "a 6 (5 more like it in the last 2.0 s)"]
-    assert throttled.counts == {"a": 7, "b": 1}
+    throttled = Throttled(period_s=2.0, clock=clock)
+    admitted = [throttled.admit("a") for _ in range(5)]
+    assert throttled.admit("b") == ""  # another key is not held back
+    clock.now = 1.999
+    assert throttled.admit("a") is None
+    clock.now = 2.0
+    assert throttled.admit("a") == " (5 more like it in the last 2.0 s)"
+    assert throttled.admit("a") is None
+    assert admitted == ["", None, None, None, None]
+    assert throttled.counts == {"a": 8, "b": 1}
 
 
 @given(a=st.floats(allow_nan=True, allow_infinity=True), b=st.floats(allow_nan=True))
