@@ -36,6 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                "  tdcm param specs model_node               # offline: units, defaults, ranges")
     common = argparse.ArgumentParser(add_help=False)
     add_runtime_option(common, "the node")
+    common.add_argument("--timeout", type=float, metavar="S",
+                        help="longest wait for each answer of the node, s (default: the "
+                             "parameter client's PARAM_TIMEOUT_S, 5 s); Ctrl-C stops the wait")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
     get = verbs.add_parser("get", parents=[common], help="print a parameter value")
     get.add_argument("node")
@@ -72,9 +75,14 @@ def _with_client(args: argparse.Namespace, use: Callable[[ParameterClient], R]) 
     from tdcm_ros.runtime.param_client import ParameterClient
     from tdcm_ros.runtime.run_node import open_context, resolve_runtime
 
+    if args.timeout is not None and not args.timeout > 0:
+        raise InputError(f"--timeout = {args.timeout} s is out of range; allowed: > 0 s",
+                         parameter="timeout", value=args.timeout, allowed="> 0 s")
     context = open_context(resolve_runtime(args.runtime))
     try:
-        return use(ParameterClient(context, args.node))
+        if args.timeout is None:
+            return use(ParameterClient(context, args.node))
+        return use(ParameterClient(context, args.node, args.timeout))
     finally:
         context.close()
 

@@ -8,6 +8,7 @@ import pytest
 
 from tdcm_ros.cli.main import main
 from tdcm_ros.runtime.registry import NODES
+from test.support.cli import tdcm
 
 
 @pytest.mark.parametrize("node", sorted(NODES))
@@ -33,3 +34,10 @@ def test_a_row_shows_unit_default_and_range(capsys: pytest.CaptureFixture[str]) 
 def test_an_unknown_node_is_an_input_error(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["param", "specs", "nope"]) == 2
     assert "unknown node 'nope'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("timeout", ["0", "-1", "nan"])
+def test_a_timeout_that_is_not_positive_is_refused_before_any_connection(timeout: str) -> None:
+    done = tdcm("param", "get", "/model_node", "design.E", "--timeout", timeout)
+    assert done.returncode == 2
+    assert f"--timeout = {float(timeout)} s is out of range; allowed: > 0 s" in done.stderr

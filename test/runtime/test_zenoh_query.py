@@ -53,13 +53,13 @@ def test_3000_extra_endpoints_are_listed_and_parameter_clients_answer_and_stop_o
     assert ParameterClient(context, "/talker", 30.0).get("prefix") == "hello"
     # a client waiting for a server that is not there stops on Ctrl-C (its token is the sign
     # that it is waiting)
-    waiting = tdcm_param("get", "/nobody", "prefix")
+    waiting = tdcm_param("get", "/nobody", "prefix", "--timeout", "300")
     eventually(lambda: any(t.kind == wire.CLIENT and t.topic.startswith("/nobody/") for t in
                            graph_tokens(context.session, context.domain_id)),
                30.0, "the waiting client's token")
     waiting.send_signal(signal.SIGINT)
-    waiting.communicate(timeout=10)
-    assert waiting.returncode == 130
+    _, err = waiting.communicate(timeout=20)
+    assert waiting.returncode == 130, err
     for token in tokens:
         token.undeclare()
 
