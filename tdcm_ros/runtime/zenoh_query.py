@@ -51,18 +51,21 @@ def gather(start: Callable[[zenoh.handlers.Callback], Any], timeout: float,
         else:
             replies.dropped += 1
 
-    start(zenoh.handlers.Callback(take, done.set))
+    # indirect=False: ``take`` runs on zenoh's own thread (it only appends), not behind a queue
+    # to a Python thread that a busy machine lets fall behind
+    start(zenoh.handlers.Callback(take, done.set, indirect=False))
     replies.complete = done.wait(timeout + GRACE_S)
     if replies.dropped:
         _LOG.warning("a query kept %d replies and left out %d", limit, replies.dropped)
     return replies
 
 
-def graph_tokens(session: zenoh.Session, domain: int,
-                 timeout: float = 1.0) -> list[wire.TokenInfo]:
-    """The rmw_zenoh liveliness tokens of ``domain`` now (malformed ones skipped)."""
+def graph_tokens(session: zenoh.Session, domain: int, timeout: float = 1.0,
+                 selector: str = "**") -> list[wire.TokenInfo]:
+    """The rmw_zenoh liveliness tokens of ``domain`` now whose key after the domain matches
+    ``selector`` (default: all; malformed ones skipped)."""
     replies = gather(lambda handler: session.liveliness().get(
-        f"{wire.ADMIN_SPACE}/{domain}/**", handler, timeout=timeout), timeout)
+        f"{wire.ADMIN_SPACE}/{domain}/{selector}", handler, timeout=timeout), timeout)
     tokens = []
     for reply in replies.kept:
         if reply.ok is None:
@@ -72,3 +75,10 @@ def graph_tokens(session: zenoh.Session, domain: int,
         except (RuntimePortError, ValueError):
             continue
     return tokens
+
+
+def servers_of(name: str, type_name: str) -> str:
+    """The :func:`graph_tokens` selector of the servers of service ``name`` (absolute) of
+    ``type_name``: one reply per server however crowded the domain."""
+    return (f"*/*/*/{wire.SERVICE}/*/*/*/{wire.mangle(name)}/{wire.dds_type_name(type_name)}"
+            f"/**")

@@ -81,7 +81,7 @@ from tdcm_ros.runtime.port import (
 from tdcm_ros.runtime.rosout import ROSOUT_QOS, ROSOUT_TOPIC, RosoutHandler
 from tdcm_ros.runtime.throttle import Throttled
 from tdcm_ros.runtime.wire import RawSample
-from tdcm_ros.runtime.zenoh_query import gather, graph_tokens
+from tdcm_ros.runtime.zenoh_query import gather, graph_tokens, servers_of
 
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
 CONFIG_ENV = "TDCM_ZENOH_CONFIG"
@@ -389,7 +389,8 @@ class _Client:
 
     def _server_up(self) -> bool:
         return any(t.kind == wire.SERVICE and t.topic == self.name and t.type_name == self.type_name
-                   for t in graph_tokens(self._context.session, self._context.domain_id, 0.5))
+                   for t in graph_tokens(self._context.session, self._context.domain_id, 0.5,
+                                         servers_of(self.name, self.type_name)))
 
     def call(self, request: bytes, timeout: float) -> bytes:
         """Wait up to ``timeout`` s for a server, send ``request`` (CDR), return the response."""
