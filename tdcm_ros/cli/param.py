@@ -14,7 +14,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from tdcm_ros.cli.runtime_option import add_runtime_option
-from tdcm_ros.errors import InputError
+from tdcm_ros.errors import InputError, out_of_range
 from tdcm_ros.yamlio import load_yaml
 
 if TYPE_CHECKING:  # the client imports the message model; help must not
@@ -76,8 +76,7 @@ def _with_client(args: argparse.Namespace, use: Callable[[ParameterClient], R]) 
     from tdcm_ros.runtime.run_node import open_context, resolve_runtime
 
     if args.timeout is not None and not args.timeout > 0:
-        raise InputError(f"--timeout = {args.timeout} s is out of range; allowed: > 0 s",
-                         parameter="timeout", value=args.timeout, allowed="> 0 s")
+        raise out_of_range("--timeout", args.timeout, "> 0 s", unit="s")
     context = open_context(resolve_runtime(args.runtime))
     try:
         if args.timeout is None:
