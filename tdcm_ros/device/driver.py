@@ -31,7 +31,9 @@ on an e-stop and on every event after which the device's
 state is unknown: the link lost while connected (port error, ``link_timeout``, a version
 mismatch), a device reboot (a banner nobody asked for once telemetry has flowed, or the device
 clock running backwards)
-and a freeze (no telemetry for the device's own watchdog time while the host kept stepping).
+and a freeze (no telemetry for the device's own watchdog time while the host kept stepping: a step
+counts at most ``heartbeat_period`` s of silence, so a stall of this host -- the device's frames
+not read, or a twin on it not run -- is not taken for one).
 Disarmed, it commands mode R whatever the device reports. Only :meth:`TensionDriver.clear_faults`
 (the operator's arm command, accepted while connected) arms it again, at a target of 0 N: a new
 setpoint is needed before any tension.
@@ -215,6 +217,7 @@ class TensionDriver:
         self._disarms = 0
         self._info_pending = 0      # banner requests not yet answered
         self._silent = False        # the host saw the device silent for its watchdog time
+        self._awake_silence = 0.0   # s without telemetry counted while the host kept stepping
         self._rejects_unlogged = 0  # rejected lines since the last warning about them
         self._next_reject_log = clock()
         self._target = 0.0
@@ -233,7 +236,7 @@ class TensionDriver:
         now = clock()
         self._since = now  # start of the current link phase
         self._last_rx = self._last_heartbeat = self._last_setpoint = self._last_mode = now
-        self._last_ramp = self._last_info = now
+        self._last_ramp = self._last_info = self._last_step = now
 
     # --- public commands ------------------------------------------------------------------
     @property
@@ -379,13 +382,14 @@ class TensionDriver:
     def step(self) -> StepResult:
         """Do everything due now; raises :class:`ProtocolVersionError` on a version mismatch."""
         now = self._clock()
+        gap, self._last_step = now - self._last_step, now
         received: list[Telemetry] = []
         self._joints = []
         if self._link is LinkState.DISCONNECTED and now >= self._next_attempt:
             self._connect(now)
         if self._transport is not None:
             try:
-                self._service(now, received)
+                self._service(now, min(gap, self.config.heartbeat_period), received)
             except PortError as error:
                 self._drop(str(error))
         return StepResult(tuple(received), self._status(now), tuple(self._joints))
@@ -422,7 +426,7 @@ class TensionDriver:
             self._transport.close()
             self._transport = None
         self._sent_setpoint = None
-        self._silent = False
+        self._silent, self._awake_silence = False, 0.0
         self._retry_later(self._clock(), reason)
 
     def _on_reject(self, error: FrameError) -> None:
@@ -451,10 +455,13 @@ class TensionDriver:
         except PortError as error:
             self._drop(str(error))
 
-    def _service(self, now: float, received: list[Telemetry]) -> None:
+    def _service(self, now: float, awake: float, received: list[Telemetry]) -> None:
+        """Read and handle the device's frames, then keep the link; ``awake`` s of the time since
+        the last step count as silence (the host's own stall does not)."""
         transport = self._transport
         if transport is None:
             return
+        self._awake_silence += awake
         for message in self._decoder.feed(transport.read()):
             self._handle(message, now, received)
         if self._version_error is not None:
@@ -472,7 +479,7 @@ class TensionDriver:
                 self._send_info()
             return
         if self._latest is not None and self._banner is not None \
-                and now - self._last_rx >= self._banner.watchdog:
+                and self._awake_silence >= self._banner.watchdog:
             self._silent = True  # seen while stepping: the device, not this host, stalled
         if now - self._last_rx >= self.config.link_timeout:
             self._drop(f"no telemetry for {now - self._last_rx:.2f} s")
@@ -498,8 +505,8 @@ class TensionDriver:
     def _on_telemetry(self, frame: Telemetry, now: float) -> None:
         """Take a frame; a device clock running backwards is a reboot, a frame after the host saw
         the device silent for its watchdog time ends a freeze: either disarms."""
-        previous, silence, silent = self._latest, now - self._last_rx, self._silent
-        self._latest, self._last_rx, self._silent = frame, now, False
+        previous, silence, silent = self._latest, self._awake_silence, self._silent
+        self._latest, self._last_rx, self._silent, self._awake_silence = frame, now, False, 0.0
         if previous is not None and frame.time < previous.time \
                 and previous.time - frame.time < CLOCK_WRAP / 2:
             self._warn(f"device rebooted: its clock went back from {previous.time:.3f} s to "
@@ -539,6 +546,7 @@ class TensionDriver:
         self._forget_roll()
         self._banner, self._link = banner, LinkState.CONNECTED
         self._last_rx = self._last_ramp = now
+        self._awake_silence = 0.0
         self._backoff = self.config.backoff_initial
         self._sent_setpoint = None
 

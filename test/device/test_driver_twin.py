@@ -30,8 +30,10 @@ class Bench:
         self.twin = DeviceTwin(rx_buffer=rx_buffer)
         self.pty = PtyTwin(self.twin, link=str(tmp_path / "tdcm_port"))
         self.warnings: list[str] = []
+        self.stalled = 0.0  # s the whole host stood still (the host clock runs ahead of the twin's)
         self.driver = TensionDriver(DriverConfig(port=self.pty.port, **config),
-                                    clock=lambda: self.twin.time, warn=self.warnings.append)
+                                    clock=lambda: self.twin.time + self.stalled,
+                                    warn=self.warnings.append)
         self.telemetry: list[Telemetry] = []
         self.last: StepResult | None = None
 
@@ -250,6 +252,39 @@ def test_a_freeze_is_not_a_reboot_and_never_re_tensions(tmp_path: Path, seconds:
         assert not bench.twin.core.faults  # the device itself saw nothing wrong
         bench.assert_released_until_cleared(2.0, reason)
         assert not any("reboot" in w for w in bench.warnings), bench.warnings
+    finally:
+        bench.driver.close()
+        bench.pty.stop()
+
+
+@pytest.mark.parametrize("seconds", [0.6, 1.5])
+def test_a_stall_of_the_whole_host_is_not_a_freeze(bench: Bench, seconds: float) -> None:
+    """The machine running the driver and a twin stops for ``seconds`` (seen on a loaded CI
+    machine: 0.68 s), and the driver steps before the twin has sent the frames of the gap: the
+    silence was this host's, so the driver stays armed and holds its setpoint."""
+    bench.hold(10.0)
+    bench.stalled += seconds
+    bench.driver.step()  # the first step after the stall reads nothing yet
+    bench.run(1.0)
+    status = bench.driver.step().status
+    assert status.armed and status.disarms == 0, status
+    assert not any("silent" in w for w in bench.warnings), bench.warnings
+    assert bench.twin.plant.tension == pytest.approx(10.0, abs=0.3)
+
+
+def test_a_freeze_is_seen_by_a_host_stepping_slower_than_its_heartbeat(tmp_path: Path) -> None:
+    """A host stepping every 0.15 s counts 0.1 s (its heartbeat period) of each gap as silence:
+    a 1.5 s freeze of the device still disarms it."""
+    bench = Bench(tmp_path)
+    try:
+        bench.hold(10.0)
+        with bench.pty.hung():
+            for _ in range(10):
+                bench.pty.pump(0.15)
+                bench.driver.step()
+        bench.run(0.5)
+        status = bench.driver.step().status
+        assert not status.armed and "device silent for" in status.disarm_reason, status
     finally:
         bench.driver.close()
         bench.pty.stop()
