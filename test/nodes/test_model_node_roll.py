@@ -175,16 +175,24 @@ def test_a_peer_sees_the_rolled_tip_on_tf(runtime, context, spawn) -> None:
         rolls.publish(joint_states(["roll"], [first], sent[-1] - 1_000_000))
         tension.publish(wrench(20.0, sent[-1]))
 
-    eventually(lambda: any(tip_for(t) for t in sent), 30.0,
-               "/tf and tip_pose for a tension sent (both topics matched)", spin=context,
-               action=send, every=0.2)
+    expected = solve(PAPER, 20.0)
+    at_first = rolled(expected.tip_position[None, :], first)[0]
+
+    def rolled_tip_seen() -> bool:
+        """A tip for a tension sent, turned by the roll sent with it: the tension and the
+        joint_states routes are both matched (the first alone leaves the roll history empty,
+        and the later roll would then be the oldest kept)."""
+        tips_back = [got for t in sent if (got := tip_for(t)) is not None]
+        return any(np.max(np.abs(tip_of(on_tf)[0] - at_first)) <= 1e-12 for on_tf, _ in tips_back)
+
+    eventually(rolled_tip_seen, 30.0, "/tf and tip_pose turned by the roll sent (tension and "
+               "joint_states matched)", spin=context, action=send, every=0.2)
     context.spin_for(0.3)
     stamp = time.time_ns()
     later = -1.1
     rolls.publish(joint_states(["roll"], [later], stamp + 200_000_000))    # after the tension
     tension.publish(wrench(20.0, stamp))
     eventually(lambda: tip_for(stamp) is not None, 15.0, "the tip at roll 0.6", spin=context)
-    expected = solve(PAPER, 20.0)
     for roll, check in ((first, stamp), (later, None)):
         if check is None:
             check = stamp + 300_000_000  # past the later roll's stamp, < max_future_s ahead
