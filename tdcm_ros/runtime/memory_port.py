@@ -50,6 +50,10 @@ class MemoryPublisher:
         self.port.published[self.topic].append(deserialize(data, self.type_name))
         self.port.sent_ns[self.topic].append(self.port.clock_ns)
 
+    def matched(self) -> bool:
+        """Always: the port keeps every message published."""
+        return True
+
 
 class MemoryTimer:
     """A periodic timer due every ``period_ns`` of the port's clock."""

@@ -75,6 +75,9 @@ class Publisher(Protocol):
     def publish_cdr(self, data: bytes) -> None:
         """Send CDR bytes already serialised for ``type_name``."""
 
+    def matched(self) -> bool:
+        """True once at least one subscription matches this publisher."""
+
 
 class Timer(Protocol):
     """A periodic timer."""

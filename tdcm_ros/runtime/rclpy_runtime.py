@@ -167,6 +167,10 @@ class _Publisher:
         """Publish CDR bytes."""
         self._publisher.publish(bytes(data))
 
+    def matched(self) -> bool:
+        """True when DDS discovery has matched at least one subscription."""
+        return bool(self._publisher.get_subscription_count() > 0)
+
 
 class RclpyNodePort:
     """:class:`tdcm_ros.runtime.port.NodePort` on an ``rclpy.node.Node``.

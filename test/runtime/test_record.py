@@ -164,15 +164,24 @@ def test_sigkill_leaves_a_bag_readable_to_the_last_chunk(
 
 TICKS = 3000  # messages of the 1 kHz ticker (3 s)
 
-# On the runtime of TDCM_RUNTIME: publishes /tick (std_msgs/UInt32, data = 0, 1, ...) TICKS
-# times at 1 kHz, lets the tail be delivered for 1 s, closes and exits.
+# On the runtime of TDCM_RUNTIME: waits (up to 60 s, else exits 1) until its publisher matches
+# the recorder's subscription, publishes /tick (std_msgs/UInt32, data = 0, 1, ...) TICKS times at
+# 1 kHz, lets the tail be delivered for 1 s, closes and exits. The wait is what makes the head
+# deterministic: "recording to" says the recorder declared its subscription, not that the zenoh
+# router routes it yet, and on rclpy the recorder subscribes only once discovery has shown it
+# the ticker's publisher (it takes the type from the graph; 3 s of ticks ended before that once).
 TICKER = f"""
-import os, time
+import os, sys, time
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.runtime.run_node import open_context
 
 context = open_context(os.environ["TDCM_RUNTIME"])
 ticks = context.create_port("ticker").create_publisher("/tick", "std_msgs/msg/UInt32")
+deadline = time.monotonic() + 60.0
+while not ticks.matched():
+    if time.monotonic() > deadline:
+        sys.exit("the recorder's subscription never matched /tick")
+    context.spin_for(0.02)
 due = time.monotonic()
 for n in range({TICKS}):
     ticks.publish(from_dict("std_msgs/msg/UInt32", {{"data": n}}))
@@ -192,30 +201,6 @@ def _last_tick(bag: Path) -> int:
     return values[-1] if values else -1
 
 
-def _wait_until_the_router_routes(topic: str, type_name: str) -> None:
-    """Until a publisher on ``topic`` connected to the test's router matches a subscriber."""
-    import json
-
-    import zenoh
-
-    from tdcm_ros.bagio.typestore import type_hash
-    from tdcm_ros.runtime import wire
-
-    config = zenoh.Config()
-    config.insert_json5("mode", '"client"')
-    config.insert_json5("connect/endpoints", json.dumps([os.environ["TDCM_ZENOH_ENDPOINT"]]))
-    config.insert_json5("scouting/multicast/enabled", "false")
-    session = zenoh.open(config)
-    try:
-        probe = session.declare_publisher(wire.topic_key(0, topic, type_name,
-                                                         type_hash(type_name)))
-        eventually(lambda: probe.matching_status.matching, 20.0,
-                   f"the router to route {topic} to the recorder")
-        probe.undeclare()
-    finally:
-        session.close()
-
-
 def test_a_named_topic_is_recorded_from_its_first_message_to_its_last(
         runtime: str, spawn: Spawn, graph_env: dict[str, str], tmp_path: Path) -> None:
     """A 1 kHz publisher that starts after the recorder: zenoh loses 0 at the head (the topic is
@@ -225,11 +210,6 @@ def test_a_named_topic_is_recorded_from_its_first_message_to_its_last(
     recorder = spawn("tdcm_ros.cli.main", "record", str(bag), "tick")
     out = Lines(recorder)
     eventually(lambda: out.has("recording to"), 20.0, "the recorder to start")
-    if runtime == "zenoh":
-        # "recording to" says the recorder declared its subscription, not that the router has
-        # it yet; the ticker (whose session opens with the router's declarations) then sends
-        # its first tick to a router that may not route it (the head loss seen once)
-        _wait_until_the_router_routes("/tick", "std_msgs/msg/UInt32")
     ticker = subprocess.run([sys.executable, "-c", TICKER], check=False, env=graph_env,
                             cwd=REPO, capture_output=True, timeout=120.0)
     assert ticker.returncode == 0, ticker.stderr.decode()
