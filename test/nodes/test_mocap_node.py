@@ -106,13 +106,21 @@ def test_csv_replay_publishes_the_csv_positions_in_metres(runtime, context, spaw
             assert xyz(marker) == expected[marker.marker_name].tolist()   # bit-equal, in m
         seen_gap |= len(expected) < 3
     assert seen_gap
-    # Markers and poses of one frame are two messages: wait for the poses of the frames received
-    # (each subscription may also miss the first frames while connecting; those are not compared).
+    # Markers and poses of one frame are two messages, the poses published second: the frames
+    # between the first and the newest PoseArray received must each have theirs (each
+    # subscription may miss the first frames while connecting; those are not compared). The
+    # check is linear: the stream goes on while it runs (quadratic, it starved the probe's spin
+    # on a loaded machine until its queue dropped PoseArrays).
     def paired() -> list:
+        stamps = [stamp_ns(p) for p in probe.poses]
+        return [m for m in probe.markers if stamps and min(stamps) <= stamp_ns(m) <= max(stamps)]
+
+    def every_frame_paired() -> bool:
         stamps = {stamp_ns(p) for p in probe.poses}
-        return [m for m in probe.markers if stamps and stamp_ns(m) >= min(stamps)]
-    probe.spin_until(lambda: len(paired()) >= 30 and all(
-        stamp_ns(m) in {stamp_ns(p) for p in probe.poses} for m in paired()), 10.0, "PoseArrays")
+        frames = paired()
+        return len(frames) >= 30 and all(stamp_ns(m) in stamps for m in frames)
+
+    probe.spin_until(every_frame_paired, 10.0, "a PoseArray for every Markers frame")
     by_stamp = {stamp_ns(p): p for p in probe.poses}
     for message in paired():
         poses = by_stamp[stamp_ns(message)].poses
