@@ -81,6 +81,8 @@ from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
 TRIGGER = "std_srvs/srv/Trigger"
+ESTOP_TOPIC, ESTOP_TYPE = "estop", "std_msgs/msg/Empty"  #: open to every user (access_control)
+ESTOP_SERVICE = "estop"  #: the one command service open to every user (access_control)
 STATUS_TYPE = "diagnostic_msgs/msg/DiagnosticStatus"
 SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
 #: parameters that bound the force on the tendon and the roll: fixed at run time unless safety.limits_writable
@@ -166,10 +168,10 @@ class TensionDriverNode(NodeLogic):
                                  QoS(depth=10))
         port.create_subscription("roll_setpoint", "std_msgs/msg/Float64", self._on_roll,
                                  QoS(depth=10))
-        port.create_subscription("estop", "std_msgs/msg/Empty", self._on_estop, QoS(depth=10))
+        port.create_subscription(ESTOP_TOPIC, ESTOP_TYPE, self._on_estop, QoS(depth=10))
         for name, command in (("start_schedule", self.start_schedule),
                               ("clear_faults", self.clear_faults), ("release", self.release),
-                              ("estop", self.estop)):
+                              (ESTOP_SERVICE, self.estop)):
             port.create_service(f"~/{name}", TRIGGER, _answering(command))
         port.create_timer(step_period, self.step)
         port.create_timer(state_period, self.publish_state)

@@ -57,6 +57,9 @@ SERVICES = {
     "set_parameters": "rcl_interfaces/srv/SetParameters",
     "set_parameters_atomically": "rcl_interfaces/srv/SetParametersAtomically",
 }
+#: The services of :data:`SERVICES` that change nothing (open to observers: access_control).
+READ_ONLY_SERVICES = ("describe_parameters", "get_parameters", "get_parameter_types",
+                      "list_parameters")
 
 
 def type_of(value: ParamValue, spec: ParamSpec[Any] | None = None) -> int:

@@ -18,9 +18,9 @@ from typing import Any
 import pytest
 import zenoh
 
-from tdcm_ros.bagio import from_dict
+from tdcm_ros.bagio import from_dict, service_type_hash, type_hash
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime import zenoh_config
+from tdcm_ros.runtime import wire, zenoh_config
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.zenoh_runtime import CONFIG_ENV, ZenohContext
 from test.support.processes import listening
@@ -298,3 +298,127 @@ def test_build_rejects_an_unknown_role() -> None:
     with pytest.raises(InputError) as error:
         zenoh_config.build(mode="client", endpoint="tcp/127.0.0.1:7447", path=None)
     assert (error.value.parameter, error.value.value) == ("mode", "client")
+
+
+# --- the generated access-control list, attacked by an observer with raw zenoh keys ----------
+def data_key(topic: str, type_name: str) -> str:
+    """rmw_zenoh's data key of ``topic`` in domain 0."""
+    return wire.topic_key(0, topic, type_name, type_hash(type_name))
+
+
+def service_key(name: str, type_name: str) -> str:
+    """rmw_zenoh's queryable key of the service ``name`` in domain 0."""
+    return wire.topic_key(0, name, type_name, service_type_hash(type_name))
+
+
+FLOAT64 = "std_msgs/msg/Float64"
+#: Puts the README says an observer cannot make: command inputs, sensor topics, wildcard keys.
+DENIED_PUTS = {
+    "tension_setpoint": data_key("tension_setpoint", FLOAT64),
+    "roll_setpoint": data_key("roll_setpoint", FLOAT64),
+    "target_angle": data_key("target_angle", FLOAT64),
+    "target_point": data_key("target_point", "geometry_msgs/msg/PointStamped"),
+    "tension": data_key("tension", "geometry_msgs/msg/WrenchStamped"),
+    "wildcard in the topic": "0/tension_setpoin$*/std_msgs::msg::dds_::Float64_/*",
+    "wildcard topic of a type": "0/*/std_msgs::msg::dds_::Float64_/*",
+    "everything": "**",
+}
+SET_PARAMETERS = "rcl_interfaces/srv/SetParameters"
+#: Queries the README says an observer cannot make: parameter changes, command services, wildcards.
+DENIED_QUERIES = {
+    "set_parameters": service_key("tension_driver/set_parameters", SET_PARAMETERS),
+    "set_parameters_atomically": service_key("model_node/set_parameters_atomically",
+                                             "rcl_interfaces/srv/SetParametersAtomically"),
+    "clear_faults": service_key("tension_driver/clear_faults", "std_srvs/srv/Trigger"),
+    "start_schedule": service_key("tension_driver/start_schedule", "std_srvs/srv/Trigger"),
+    "release": service_key("tension_driver/release", "std_srvs/srv/Trigger"),
+    "wildcard set_parameters": "*/**/set_parameters/**",
+    "everything": "**",
+}
+ESTOP_KEY = data_key("estop", "std_msgs/msg/Empty")
+ESTOP_SERVICE_KEY = service_key("tension_driver/estop", "std_srvs/srv/Trigger")
+GET_PARAMETERS_KEY = service_key("tension_driver/get_parameters",
+                                 "rcl_interfaces/srv/GetParameters")
+#: A service the observer tries to serve (it asked by an operator; the victim serves it too).
+IMPERSONATED_KEY = service_key("model_node/get_parameters", "rcl_interfaces/srv/GetParameters")
+
+
+class Victim:
+    """An operator session that takes every sample and query the router routes to it, and
+    answers each query with its own key."""
+
+    def __init__(self, config: Path, endpoint: str) -> None:
+        self.session = zenoh.open(zenoh_config.build(mode="peer", endpoint=endpoint,
+                                                     path=str(config)))
+        self.samples: list[tuple[str, bytes]] = []
+        self.queries: list[str] = []
+        self._subscriber = self.session.declare_subscriber(
+            "**", lambda s: self.samples.append((str(s.key_expr), s.payload.to_bytes())))
+        self._queryable = self.session.declare_queryable("**", self._answer, complete=False)
+
+    def _answer(self, query: Any) -> None:
+        self.queries.append(str(query.key_expr))
+        if "*" not in str(query.key_expr):
+            query.reply(query.key_expr, b"answer")
+
+    def attacks(self) -> list[str]:
+        """Keys of the observer's samples and queries that reached this operator."""
+        allowed = (GET_PARAMETERS_KEY, ESTOP_SERVICE_KEY, IMPERSONATED_KEY)
+        return [key for key, payload in self.samples if payload == b"attack"] + [
+            key for key in self.queries if key not in allowed]
+
+    def close(self) -> None:
+        self.session.close()
+
+
+def test_the_generated_acl_lets_an_observer_watch_stop_and_read_but_nothing_else(
+        secrets: dict[str, Path], tls_port: int, spawn: Spawn) -> None:
+    """With the shipped router.json5 (its generated block), user ``observer`` on raw zenoh keys:
+    every put of DENIED_PUTS and query of DENIED_QUERIES (exact keys, wildcard keys, wildcard
+    queries) never reaches an operator's subscriber or queryable on ``**``, and a queryable it
+    declares is never asked; its e-stop puts, e-stop and get_parameters queries do, and it
+    receives the answers and the operator's samples."""
+    endpoint = f"tls/127.0.0.1:{tls_port}"
+    spawn("tdcm_ros.runtime.router", "--listen", endpoint, "--config", str(secrets["router"]))
+    eventually(lambda: listening(tls_port), 15.0, "the TLS router")
+    victim = Victim(secrets["operator"], endpoint)
+    observer, asker = (zenoh.open(zenoh_config.build(mode="peer", endpoint=endpoint,
+                                                     path=str(secrets[user])))
+                       for user in ("observer", "operator"))
+    try:
+        heard: list[str] = []
+        observer.declare_subscriber("0/chatter/**", lambda s: heard.append(str(s.key_expr)))
+        impostor: list[str] = []
+        observer.declare_queryable(IMPERSONATED_KEY, lambda q: impostor.append(str(q.key_expr)),
+                                   complete=True)
+        answers: list[str] = []
+        asked: list[str] = []
+
+        def attack_then_stop() -> bool:
+            for key in DENIED_PUTS.values():
+                observer.put(key, b"attack")
+            for key in DENIED_QUERIES.values():
+                observer.get(key, lambda _reply: None, timeout=1.0)
+            observer.put(ESTOP_KEY, b"estop")
+            observer.get(ESTOP_SERVICE_KEY, lambda _reply: None, timeout=1.0)
+            observer.get(GET_PARAMETERS_KEY,
+                         lambda reply: answers.append(reply.ok.payload.to_bytes().decode()),
+                         timeout=1.0)
+            victim.session.put("0/chatter/std_msgs::msg::dds_::String_/x", b"hello")
+            asker.get(IMPERSONATED_KEY,
+                      lambda reply: asked.append(reply.ok.payload.to_bytes().decode()),
+                      timeout=1.0)
+            return (sum(p == b"estop" for _, p in victim.samples) >= 5 and "answer" in answers
+                    and ESTOP_SERVICE_KEY in victim.queries and len(heard) >= 5
+                    and len(asked) >= 5)
+
+        eventually(attack_then_stop, 30.0, "the observer's e-stops, reads and watching",
+                   every=0.1, detail=lambda: (f"{len(victim.samples)} samples, queries "
+                                              f"{victim.queries[-3:]}, {len(answers)} answers, "
+                                              f"{len(heard)} heard, {len(asked)} asked"))
+        # the observer's own wildcard queries reach its queryable inside its session: not counted
+        assert victim.attacks() == [] and IMPERSONATED_KEY not in impostor
+    finally:
+        for session in (observer, asker):
+            session.close()
+        victim.close()
