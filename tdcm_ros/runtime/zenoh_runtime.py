@@ -345,14 +345,30 @@ class _Service:
         self.key = wire.topic_key(identity.domain_id, name, type_name, rihs)
         token = wire.endpoint_token(identity, context.next_id(), wire.SERVICE, name, type_name,
                                     rihs, qos)
+        self.refused = 0
+        self._refusals = Throttled()
         self._queryable = context.session.declare_queryable(self.key, self._on_query,
                                                             complete=True)
         self._token = context.session.liveliness().declare_token(token)
 
+    def _refuse(self, query: zenoh.Query, reason: str) -> None:
+        """Answer with an error, count and warn (throttled): not what an rmw_zenoh client sends."""
+        self.refused += 1
+        suffix = self._refusals.admit("refused")
+        if suffix is not None:
+            logging.getLogger("tdcm.zenoh").warning("refused a request of %s: %s%s", self.name,
+                                                    reason, suffix)
+        query.reply_err(f"{self.name}: refused: {reason}")
+
     def _on_query(self, query: zenoh.Query) -> None:
+        key = str(query.key_expr)
+        if key != self.key:  # a wildcard query overlapping this service (an ACL may not match)
+            self._refuse(query, f"key {key!r} is not the service's key")
+            return
+        if query.attachment is None:
+            self._refuse(query, "no rmw_zenoh attachment")
+            return
         try:
-            if query.attachment is None:
-                raise RuntimePortError("request without rmw_zenoh's attachment")
             request = wire.decode_attachment(query.attachment.to_bytes())
             payload = query.payload.to_bytes() if query.payload is not None else b""
             response = self._executor.call(lambda: self._answer(payload),

@@ -52,3 +52,57 @@ def test_wildcard_keys_and_samples_without_attachment_are_refused(
     refusals = [r.getMessage() for r in caplog.records if "refused a sample" in r.getMessage()]
     assert len(refusals) == 1  # the first at once, the other two held back
     assert "tension_setpoint" in refusals[0]
+
+
+def test_wildcard_and_attachment_less_requests_are_refused_with_an_error_reply(
+        context: Any, caplog: pytest.LogCaptureFixture) -> None:
+    """A service answers only a query on its exact key with rmw_zenoh's attachment; a wildcard
+    query overlapping it or one without the attachment gets an error reply naming the refusal,
+    never reaches the handler, is counted and warned about (throttled)."""
+    import threading
+
+    from tdcm_ros.bagio import service_type_hash
+
+    trigger = "std_srvs/srv/Trigger"
+    calls: list[str] = []
+
+    def handle(_request: Any) -> Any:
+        calls.append("called")
+        return from_dict(f"{trigger}_Response", {"success": True, "message": "done"})
+
+    context.create_port("tension_driver").create_service("~/clear_faults", trigger, handle)
+    key = wire.topic_key(context.domain_id, "/tension_driver/clear_faults", trigger,
+                         service_type_hash(trigger))
+    request = bytes(serialize(from_dict(f"{trigger}_Request", {}), f"{trigger}_Request"))
+    attachment = wire.encode_attachment(1, time.time_ns(), bytes(wire.GID_SIZE))
+    session = _plain_session()
+    spinner = threading.Thread(target=context.spin, daemon=True)
+    spinner.start()
+
+    def replies(selector: str, **options: Any) -> list[str]:
+        got = []
+        for reply in session.get(selector, payload=request, timeout=5.0, **options):
+            got.append(reply.ok.payload.to_bytes().decode(errors="replace") if reply.ok
+                       else "error: " + reply.err.payload.to_bytes().decode())
+        return got
+
+    try:
+        eventually(lambda: any(r.ok for r in session.liveliness().get(
+            f"{wire.ADMIN_SPACE}/{context.domain_id}/**/SS/**/%tension_driver%clear_faults/**",
+            timeout=2.0)), 15.0, "the service's token")
+        with caplog.at_level(logging.WARNING, "tdcm.zenoh"):
+            wildcard = replies(f"{context.domain_id}/tension_driver/clear_fault$*/**",
+                               attachment=attachment)
+            bare = replies(key)
+            exact = replies(key, attachment=attachment)
+    finally:
+        context.request_stop()
+        spinner.join(5.0)
+        session.close()
+    overlapping = f"'{context.domain_id}/tension_driver/clear_fault$*/**'"
+    assert wildcard == [(f"error: /tension_driver/clear_faults: refused: key {overlapping} is "
+                        f"not the service's key")]
+    assert bare == ["error: /tension_driver/clear_faults: refused: no rmw_zenoh attachment"]
+    assert len(exact) == 1 and "done" in exact[0] and calls == ["called"]
+    refusals = [r.getMessage() for r in caplog.records if "refused a request" in r.getMessage()]
+    assert len(refusals) == 1 and "clear_faults" in refusals[0]
