@@ -61,6 +61,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--router-config", default=None,
                         help="zenoh JSON5 config of the router tdcm up starts, e.g. "
                              "config/zenoh/router.json5; zenoh runtime only")
+    parser.add_argument("--on-router-exit", choices=("restart", "stop"), default="restart",
+                        help="when the router tdcm up started exits: start it again (default; "
+                             "the nodes reconnect) or stop the graph and exit 1; zenoh only")
     parser.add_argument("--twin", action="store_true",
                         help="also start device_twin and tension_driver wired to it (no hardware)")
     parser.add_argument("--scene", help="scene of the device twin (name or YAML path; needs --twin)")
@@ -136,4 +139,5 @@ def run(args: argparse.Namespace) -> int:
     if endpoint is not None:
         export_zenoh_configs(args, endpoint)
     return launch(nodes, params_file=args.params, runtime=args.runtime, endpoint=endpoint,
-                  overrides=overrides, ready_paths=ready, start_router=not args.connect)
+                  overrides=overrides, ready_paths=ready, start_router=not args.connect,
+                  on_router_exit=args.on_router_exit)

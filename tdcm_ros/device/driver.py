@@ -341,6 +341,12 @@ class TensionDriver:
         self._send_now(EStop())
         self._disarm("e-stop", send_release=False)  # E has released it
 
+    def disarm(self, reason: str) -> None:
+        """Release now and hold the device released until :meth:`clear_faults` (a fault seen
+        outside the link, e.g. the node's graph lost); nothing if already disarmed."""
+        if self._armed:
+            self._disarm(reason)
+
     def clear_faults(self) -> bool:
         """The operator's arm command: clear the device's latched faults (the device refuses
         while over the trip) and arm the driver at its current target (0 N after a disarm).

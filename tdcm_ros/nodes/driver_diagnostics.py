@@ -100,7 +100,8 @@ def actuator(status: DriverStatus | None, *, tension_max: float, schedule_state:
         "schedule": schedule_state, "schedule_done": str(schedule_state == "done").lower(),
         "disarms": status.disarms if status else 0,
         **{key: counts.get(key, 0) for key in ("clamped_setpoints", "rejected_setpoints",
-                                                "estops", "clamped_rolls", "rejected_rolls")},
+                                                "estops", "clamped_rolls", "rejected_rolls",
+                                                "graph_losses")},
         **_roll_values(status, roll_max),
         "last_warning": last_warning}
     if status is None:

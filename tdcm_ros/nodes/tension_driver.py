@@ -88,6 +88,9 @@ SCHEDULE_STATES = ("idle", "waiting", "running", "done", "cancelled")
 #: parameters that bound the force on the tendon and the roll: fixed at run time unless safety.limits_writable
 SAFETY_LIMITS = ("tension_max", "setpoint_rate", "roll_max", "roll_rate")
 LIMITS_WRITABLE = "safety.limits_writable"
+GRAPH_TIMEOUT = "safety.graph_timeout_s"
+#: s between two looks at the graph (a zenoh session's router list) in the step.
+GRAPH_CHECK_PERIOD_S = 0.1
 #: DriverConfig fields fixed at start (the link); the others change at run time.
 LINK_FIELDS = ("port", "baudrate")
 #: Parameters of the node fixed at start, besides the link.
@@ -96,6 +99,8 @@ FIXED_SPECS = by_name(
          f"{', '.join(SAFETY_LIMITS)}", default=False, kind="bool"),
     Spec("schedule.autostart", description="run the schedule once the device is connected",
          default=False, kind="bool"),
+    Spec(GRAPH_TIMEOUT, "s", "release and disarm after the graph (zenoh router) is lost this long",
+         1.0, low=0.1, high=60.0),
     Spec("step_period_s", "s", "driver step period; telemetry is 50 Hz", 0.005, low=0.001,
          high=0.02),
     Spec("state_period_s", "s", "device_state period (deprecated topic)", 0.1, low=0.01,
@@ -150,6 +155,10 @@ class TensionDriverNode(NodeLogic):
         self.schedule_state = "waiting" if autostart else "idle"
         self.status: DriverStatus | None = None
         self.driver = TensionDriver(config, clock=clock, open_port=open_port, warn=self._warn)
+        self._clock = clock
+        self.graph_timeout = float(fixed[GRAPH_TIMEOUT])
+        self._graph_checked = self._graph_seen = clock()
+        self._graph_lost = False
         if bool(port.get_parameter("enabled")):
             self.driver.enable()
 
@@ -329,6 +338,7 @@ class TensionDriverNode(NodeLogic):
     # --- the step ---------------------------------------------------------------------------
     def step(self) -> None:
         """Step the driver; publish every telemetry frame received."""
+        self._watch_graph()
         try:
             result = self.driver.step()
         except ProtocolVersionError as error:
@@ -350,6 +360,24 @@ class TensionDriverNode(NodeLogic):
         elif self.schedule_state == "running" and not self.driver.schedule_running:
             self.schedule_state = "done"
             self.port.logger.info("schedule done")
+
+    def _watch_graph(self) -> None:
+        """Every :data:`GRAPH_CHECK_PERIOD_S` s: after ``safety.graph_timeout_s`` s without a
+        graph (no zenoh router: no operator can reach the node, not even with an e-stop) the
+        driver releases the tendon and stays disarmed until ``clear_faults``."""
+        now = self._clock()
+        if now - self._graph_checked < GRAPH_CHECK_PERIOD_S:
+            return
+        self._graph_checked = now
+        if self.port.graph_connected():
+            if self._graph_lost:
+                self.port.logger.warning("graph back; the tendon stays released until "
+                                         "clear_faults")
+            self._graph_seen, self._graph_lost = now, False
+        elif not self._graph_lost and now - self._graph_seen >= self.graph_timeout:
+            self._graph_lost = True
+            self.counts["graph_losses"] += 1
+            self.driver.disarm(f"graph lost: no zenoh router for {now - self._graph_seen:.1f} s")
 
     def _log_link(self, status: DriverStatus) -> None:
         if status.link is LinkState.CONNECTED and status.banner is not None:

@@ -85,6 +85,7 @@ class NodeGraph:
         self.stop_event = stop_event or threading.Event()
         self.children: list[Child] = []
         self.router: Child | None = None
+        self.router_restarts = 0
         self._ready_paths: list[str] = []
         self._logs: list[IO[bytes]] = []
         self._folder = tempfile.TemporaryDirectory(prefix="tdcm_graph_")
@@ -128,6 +129,19 @@ class NodeGraph:
             return
         if is_listening(endpoint):
             return
+        self._start_router(endpoint, timeout)
+
+    def restart_router(self, timeout: float = 10.0) -> None:
+        """Start the router again on the endpoint after it exited (``RuntimePortError`` if it
+        does not answer within ``timeout`` s)."""
+        if self.endpoint is None or self.router is None:
+            raise RuntimePortError("no router of this graph to restart")
+        self.router_restarts += 1
+        self._start_router(self.endpoint, timeout)
+
+    def _start_router(self, endpoint: str, timeout: float) -> None:
+        from tdcm_ros.runtime.router import is_listening
+
         self.router = self.start("router", [sys.executable, "-m", "tdcm_ros.runtime.router",
                                             "--listen", endpoint])
         self.children.remove(self.router)

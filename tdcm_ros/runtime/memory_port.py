@@ -95,6 +95,7 @@ class MemoryPort:
         self.timers: list[MemoryTimer] = []
         self.services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
         self.remote_services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
+        self.connected = True  #: what :meth:`graph_connected` answers (a test cuts the graph)
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
@@ -163,6 +164,10 @@ class MemoryPort:
     def now_ns(self) -> int:
         """The port's clock, ns since the UNIX epoch."""
         return self.clock_ns
+
+    def graph_connected(self) -> bool:
+        """:attr:`connected`."""
+        return self.connected
 
     def deliver(self, topic: str, message: Any) -> None:
         """Hand ``message`` to the subscription on ``topic`` after a CDR round trip."""

@@ -155,6 +155,10 @@ class NodePort(Protocol):
         """Current time of the node's clock, ns since the UNIX epoch (with the ROS parameter
         ``use_sim_time``: the latest ``/clock``, 0 before the first)."""
 
+    def graph_connected(self) -> bool:
+        """False while the node is known to be cut off from the graph: on zenoh, no router is
+        connected to its session; on rclpy always True (DDS has no router to lose)."""
+
 
 class NodeLogic:
     """Base of every transport-agnostic node. Subclasses set ``default_name``."""

@@ -605,6 +605,10 @@ class ZenohNodePort:
         """System time, ns since the UNIX epoch; with ``use_sim_time`` the latest ``/clock``."""
         return self._clock_ns if self.use_sim_time else time.time_ns()
 
+    def graph_connected(self) -> bool:
+        """True while a zenoh router is connected to the session (the graph's hub)."""
+        return self._context.router_connected()
+
     def close(self) -> None:
         """Detach the ``/rosout`` handler; undeclare every endpoint (parameter services
         included) and the node token."""
@@ -633,6 +637,10 @@ class ZenohContext:
     def next_id(self) -> int:
         """Next node/entity id (one counter per context, as in rmw_zenoh)."""
         return next(self._ids)
+
+    def router_connected(self) -> bool:
+        """True while at least one zenoh router is connected to the session."""
+        return any(True for _ in self.session.info.routers_zid())
 
     def create_port(self, name: str, namespace: str = "/",
                     overrides: dict[str, Any] | None = None) -> ZenohNodePort:

@@ -552,3 +552,26 @@ def test_roll_limits_are_read_only_safety_limits(roll_bench) -> None:
         assert not refused.successful, refused
         assert "safety.limits_writable: true" in refused.reason, refused
     assert store.get("roll_rate") == ROLL_RATE
+
+
+def test_a_lost_graph_releases_after_the_timeout_and_stays_released_until_armed(make) -> None:
+    """No zenoh router for safety.graph_timeout_s (0.5 s here): nobody can reach the node, not
+    even with an e-stop, so the driver releases the tendon; the router's return does not arm it
+    again, clear_faults does. A loss shorter than the timeout changes nothing."""
+    bench = make(**{"safety.graph_timeout_s": 0.5})
+    bench.hold(8.0)
+    bench.port.connected = False
+    bench.advance(0.3)
+    bench.port.connected = True
+    bench.advance(0.5)
+    assert bench.state()["armed"] == "true" and bench.twin.core.mode is Mode.TENSION
+    bench.port.connected = False
+    bench.advance(0.45)
+    assert bench.state()["armed"] == "true"  # not yet: 0.4 s seen lost at the last look
+    bench.advance(0.2)
+    assert bench.state()["armed"] == "false" and bench.state()["graph_losses"] == "1"
+    assert "graph lost: no zenoh router for 0.5 s" in bench.state()["disarm_reason"]
+    bench.port.connected = True
+    bench.advance(0.2)
+    assert "graph back; the tendon stays released until clear_faults" in bench.log.text
+    released_until_armed(bench, "graph lost")
