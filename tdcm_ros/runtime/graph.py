@@ -131,6 +131,17 @@ class NodeGraph:
             return
         self._start_router(endpoint, timeout)
 
+    def check_peers_connect(self) -> None:
+        """On zenoh with a config file (``TDCM_ZENOH_CONFIG``), open a peer session as the nodes
+        will: ``RuntimePortError`` naming the cause if it reaches no router (a missing file, the
+        router's certificate, the password), before any node starts."""
+        if self.runtime != "zenoh":
+            return
+        from tdcm_ros.runtime.zenoh_runtime import CONFIG_ENV, open_session
+
+        if os.environ.get(CONFIG_ENV):
+            open_session(router_endpoint=self.endpoint).close()
+
     def restart_router(self, timeout: float = 10.0) -> None:
         """Start the router again on the endpoint after it exited (``RuntimePortError`` if it
         does not answer within ``timeout`` s)."""

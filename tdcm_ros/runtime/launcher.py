@@ -98,6 +98,7 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
                       stop_event=stop)
     try:
         graph.ensure_router(start=start_router)
+        graph.check_peers_connect()
         for name in nodes:
             if stop.is_set():
                 break

@@ -125,12 +125,29 @@ def session_config(*, mode: str = "peer", router_endpoint: str | None = None) ->
 
 
 def open_session(*, mode: str = "peer", router_endpoint: str | None = None) -> zenoh.Session:
-    """Open a zenoh session with :func:`session_config`."""
+    """Open a zenoh session with :func:`session_config`; a file the config names (certificates,
+    users) must be readable. A peer configured by a file
+    (``TDCM_ZENOH_CONFIG``: TLS, passwords) must reach its router within
+    :data:`~tdcm_ros.runtime.zenoh_diagnosis.ROUTER_WAIT_S` s, else ``RuntimePortError`` says
+    why (a missing file, the certificate, the password): a misconfiguration fails closed."""
+    from tdcm_ros.runtime.zenoh_diagnosis import missing_files, require_router
+
+    config = session_config(mode=mode, router_endpoint=router_endpoint)
+    if missing := missing_files(config):
+        raise RuntimePortError(f"cannot open zenoh session ({mode}): its config names files "
+                               f"that cannot be read: {'; '.join(missing)}")
     try:
-        return zenoh.open(session_config(mode=mode, router_endpoint=router_endpoint))
+        session = zenoh.open(config)
     except zenoh.ZError as error:
         raise RuntimePortError(f"cannot open zenoh session ({mode}, "
                                f"{router_endpoint or endpoint()}): {error}") from error
+    if mode == "peer" and os.environ.get(CONFIG_ENV):
+        try:
+            require_router(session, config, router_endpoint or endpoint())
+        except RuntimePortError:
+            session.close()
+            raise
+    return session
 
 
 @dataclass(order=True)

@@ -10,6 +10,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import ExitStack
 from pathlib import Path
@@ -422,3 +423,69 @@ def test_the_generated_acl_lets_an_observer_watch_stop_and_read_but_nothing_else
         for session in (observer, asker):
             session.close()
         victim.close()
+
+
+# --- a misconfigured peer fails closed, with the cause ----------------------------------------
+def other_certificates(folder: Path) -> None:
+    """Another CA (``other_ca.pem``) and a router certificate of the test CA for another name
+    (``bench.pem``/``bench.key``: DNS bench-pc only)."""
+    ec = ("-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes")
+    openssl(folder, "req", "-x509", *ec, "-keyout", "other_ca.key", "-out", "other_ca.pem",
+            "-days", "1", "-subj", "/CN=another CA")
+    openssl(folder, "req", *ec, "-keyout", "bench.key", "-out", "bench.csr", "-subj",
+            "/CN=bench-pc")
+    (folder / "bench_san.cnf").write_text("subjectAltName=DNS:bench-pc\n")
+    openssl(folder, "x509", "-req", "-in", "bench.csr", "-CA", "ca.pem", "-CAkey", "ca.key",
+            "-CAcreateserial", "-out", "bench.pem", "-days", "1", "-extfile", "bench_san.cnf")
+
+
+MISCONFIGURED = {  # case -> (router file edit, peer file edit, the cause the error names)
+    "wrong password": ({}, {"op-pass-7f3a": "not-the-password"},
+                       "user 'operator' with this password is not in its users file"),
+    "another CA": ({}, {"/ca.pem": "/other_ca.pem"},
+                   "fails verification: unable to get local issuer certificate"),
+    "another name": ({"/router.pem": "/bench.pem", "/router.key": "/bench.key"}, {},
+                     "a certificate for another name than '127.0.0.1'"),
+    "missing CA file": ({}, {"/ca.pem": "/no_such_ca.pem"},
+                        "root_ca_certificate = "),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MISCONFIGURED))
+def test_a_misconfigured_peer_fails_closed_naming_the_cause(
+        case: str, secrets: dict[str, Path], tls_port: int, spawn: Spawn,
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from tdcm_ros.runtime.zenoh_runtime import ENDPOINT_ENV, open_session
+
+    folder = secrets["router"].parent
+    other_certificates(folder)
+    router_edits, peer_edits, cause = MISCONFIGURED[case]
+    router, peer = folder / "bad_router.json5", folder / "bad_peer.json5"
+    for source, target, edits in ((secrets["router"], router, router_edits),
+                                  (secrets["operator"], peer, peer_edits)):
+        text = source.read_text()
+        for old, new in edits.items():
+            assert old in text
+            text = text.replace(old, new)
+        target.write_text(text)
+    endpoint = f"tls/127.0.0.1:{tls_port}"
+    spawn("tdcm_ros.runtime.router", "--listen", endpoint, "--config", str(router))
+    eventually(lambda: listening(tls_port), 15.0, "the TLS router")
+    monkeypatch.setenv(CONFIG_ENV, str(peer))
+    monkeypatch.setenv(ENDPOINT_ENV, endpoint)
+    with pytest.raises(RuntimePortError, match="cannot be read|no zenoh router after") as error:
+        open_session().close()
+    assert cause in str(error.value)
+
+
+def test_tdcm_up_with_a_wrong_password_exits_with_the_cause(
+        secrets: dict[str, Path], tls_port: int) -> None:
+    """No node starts: the launcher's own peer check fails first and tdcm up exits non-zero."""
+    endpoint = f"tls/127.0.0.1:{tls_port}"
+    up = subprocess.run([sys.executable, "-m", "tdcm_ros.cli.main", "up", "--nodes", "talker",
+                         "--endpoint", endpoint, "--router-config", str(secrets["router"]),
+                         "--zenoh-config", str(secrets["wrong"])], cwd=EXAMPLES.parents[1],
+                        env=os.environ, capture_output=True, text=True, check=False, timeout=120)
+    assert up.returncode != 0
+    assert "user 'operator' with this password is not in its users file" in up.stderr
+    assert "starting talker" not in up.stderr
