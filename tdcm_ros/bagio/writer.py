@@ -6,13 +6,19 @@ Foxglove read it without our message packages. Messages are grouped in small chu
 is handed to the operating system as soon as it is full (``chunk_size`` bytes) or
 ``flush_period_s`` old, so a writer killed outright loses only the chunk in progress.
 ``metadata.yaml`` is written by :meth:`BagWriter.close`; the reader copes without it.
+
+A failed write (the disk or the user's quota full, the file-size limit, an I/O error) ends the
+recording cleanly: the MCAP file is cut back to its last whole chunk (what a reader can read, as
+after a kill), later messages are counted in :attr:`BagWriter.lost` instead of written, and
+:meth:`BagWriter.close` writes ``metadata.yaml`` for the messages kept, in the space a small
+reserve file (:data:`RESERVE_BYTES`, removed at the close) held back from the start.
 """
 
 from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import TracebackType
 from typing import Protocol, Self
@@ -30,6 +36,9 @@ DEFAULT_FLUSH_PERIOD_S = 0.1  # oldest unflushed message age (s) before the chun
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}
 _COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4,
                 "none": CompressionType.NONE}
+#: Bytes held back in the bag folder from the start, freed to close the bag on a full disk.
+RESERVE_BYTES = 256 * 1024
+RESERVE_NAME = ".tdcm_reserve"
 
 
 class QosLike(Protocol):
@@ -81,6 +90,12 @@ class _DirectFile:
     def flush(self) -> None:
         """Nothing is buffered here."""
 
+    def truncate(self, size: int) -> None:
+        """Cut the file back to ``size`` bytes and write on from there."""
+        os.ftruncate(self._fd, size)
+        os.lseek(self._fd, size, os.SEEK_SET)
+        self.written = size
+
     def close(self) -> None:
         os.close(self._fd)
 
@@ -126,6 +141,13 @@ class BagWriter:
             raise BagError(f"cannot create bag folder {self.path}: {error}", parameter="bag",
                            value=str(self.path)) from error
         self.file_name = f"{self.path.name}_0.mcap"
+        self._reserve = self.path / RESERVE_NAME
+        try:
+            with open(self._reserve, "wb") as reserve:
+                os.posix_fallocate(reserve.fileno(), 0, RESERVE_BYTES)
+        except OSError as error:
+            raise BagError(f"cannot hold {RESERVE_BYTES} bytes in {self.path} for a clean close: "
+                           f"{error.strerror}", parameter="bag", value=str(self.path)) from error
         self._file = _DirectFile(self.path / self.file_name)
         self._writer = Writer(self._file, chunk_size=chunk_size,  # type: ignore[arg-type]
                               compression=_COMPRESSION[compression])
@@ -137,6 +159,9 @@ class BagWriter:
         self._pending = 0
         self._written_at_flush = self._file.written
         self._oldest_pending_ns = 0
+        self._kept: dict[str, _Topic] = {}  # the topics as of the last whole chunk on disk
+        self.failure = ""  #: why writing stopped ("" while it goes on)
+        self.lost = 0      #: messages given to :meth:`write` that the bag does not keep
         self.closed = False
 
     @staticmethod
@@ -182,14 +207,21 @@ class BagWriter:
         if entry is None:
             raise BagError(f"topic {topic!r} was not added to the bag; add_topic() first",
                            parameter="topic", value=topic, allowed=", ".join(self._topics))
-        self._writer.add_message(entry.channel_id, log_time_ns, cdr,
-                                 publish_time_ns if publish_time_ns is not None else log_time_ns,
-                                 sequence & 0xFFFFFFFF)
+        if self.failure:
+            self.lost += 1
+            return
         entry.count += 1
         entry.first_ns = log_time_ns if entry.first_ns < 0 else min(entry.first_ns, log_time_ns)
         entry.last_ns = max(entry.last_ns, log_time_ns)
+        try:
+            self._writer.add_message(entry.channel_id, log_time_ns, cdr,
+                                     publish_time_ns if publish_time_ns is not None
+                                     else log_time_ns, sequence & 0xFFFFFFFF)
+        except OSError as error:
+            self._fail(error)
+            return
         if self._file.written != self._written_at_flush:  # mcap wrote a full chunk just now
-            self._written_at_flush, self._pending = self._file.written, 0
+            self._chunk_written()
             return
         if not self._pending:
             self._oldest_pending_ns = time.monotonic_ns()
@@ -204,8 +236,31 @@ class BagWriter:
     def flush(self) -> None:
         """Hand every message written so far to the operating system (ends the chunk)."""
         self._check_open()
-        self._writer.flush()
+        if self.failure:
+            return
+        try:
+            self._writer.flush()
+        except OSError as error:
+            self._fail(error)
+            return
+        self._chunk_written()
+
+    def _chunk_written(self) -> None:
+        """Every message given so far is on disk in whole chunks: remember that state."""
         self._written_at_flush, self._pending = self._file.written, 0
+        self._kept = {name: replace(t) for name, t in self._topics.items()}
+
+    def _fail(self, error: OSError) -> None:
+        """A write failed: free the reserve, cut the file back to its last whole chunk, keep
+        the counts of what it holds, and write nothing more."""
+        given = sum(t.count for t in self._topics.values())
+        self._topics = {name: self._kept.get(name, replace(t, count=0, first_ns=-1, last_ns=-1))
+                        for name, t in self._topics.items()}
+        self.lost = given - sum(t.count for t in self._topics.values())
+        self.failure = (f"writing {self.path / self.file_name} failed after "
+                        f"{self._written_at_flush} bytes: {error.strerror or error}")
+        self._reserve.unlink(missing_ok=True)
+        self._file.truncate(self._written_at_flush)
 
     def _check_open(self) -> None:
         if self.closed:
@@ -248,12 +303,18 @@ class BagWriter:
         meta = self.metadata()
         text = yaml.safe_dump(meta, sort_keys=False)
         try:
-            self._writer.add_metadata("rosbag2", {"serialized_metadata": yaml.safe_dump(
-                meta["rosbag2_bagfile_information"], sort_keys=False)})
-            self._writer.finish()
+            if not self.failure:
+                self._writer.add_metadata("rosbag2", {"serialized_metadata": yaml.safe_dump(
+                    meta["rosbag2_bagfile_information"], sort_keys=False)})
+                self._writer.finish()
+        except OSError as error:  # the summary did not fit: the file ends at its last chunk
+            self._fail(error)
+            meta = self.metadata()
+            text = yaml.safe_dump(meta, sort_keys=False)
         finally:
             self._file.close()
             self.closed = True
+            self._reserve.unlink(missing_ok=True)
         partial = self.path / "metadata.yaml.tmp"
         partial.write_text(text, encoding="utf-8")
         partial.replace(self.path / "metadata.yaml")

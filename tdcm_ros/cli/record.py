@@ -19,7 +19,11 @@ from tdcm_ros.runtime.run_node import resolve_runtime
 
 EMPTY_BAG_EXIT = 1
 """Exit status of a recording that wrote no message (the empty bag is kept)."""
-EXIT_MEANINGS = {"record": {EMPTY_BAG_EXIT: "no message was recorded; the empty bag is kept"}}
+WRITE_FAILED_EXIT = 3
+"""Exit status of a recording whose writing failed (the bag keeps what was written)."""
+EXIT_MEANINGS = {"record": {EMPTY_BAG_EXIT: "no message was recorded; the empty bag is kept",
+                            WRITE_FAILED_EXIT: "writing failed (e.g. a full disk): the bag keeps "
+                                               "what was written, readable, with metadata.yaml"}}
 """What ``record`` means by an exit status (its ``--help`` epilog)."""
 
 
@@ -90,6 +94,11 @@ def run_record(args: argparse.Namespace) -> int:
         print(f"{topic} [{writer.topics[topic]}]: {counts[topic]} messages")
     print(f"{sum(counts.values())} messages in {len(counts)} topics written to {writer.path}",
           flush=True)
+    if writer.failure:
+        print(f"tdcm record: {writer.failure}; the bag keeps the {sum(counts.values())} "
+              f"messages written before (readable, metadata.yaml written); {writer.lost} "
+              f"received later were lost", file=sys.stderr)
+        return WRITE_FAILED_EXIT
     if recorder.missing:
         print(f"tdcm record: never published: {', '.join(recorder.missing)}", file=sys.stderr)
     if not sum(counts.values()):

@@ -156,6 +156,13 @@ class Recorder:
         self.total += 1
         if self._max and self.total >= self._max:
             self.request_stop()
+        self._stop_if_failed()
+
+    def _stop_if_failed(self) -> None:
+        """The writer failed (e.g. the disk is full): say so once and stop recording."""
+        if self._writer.failure and not self._stop.is_set():
+            logger.error("%s; stopping the recording", self._writer.failure)
+            self.request_stop()
 
     def request_stop(self) -> None:
         """Make :meth:`run` return (safe from signal handlers and other threads)."""
@@ -171,6 +178,7 @@ class Recorder:
         end = time.monotonic() + duration_s if duration_s > 0 else float("inf")
         while not self._stop.is_set() and (left := end - time.monotonic()) > 0:
             self._context.spin_for(min(0.1, left))
+            self._stop_if_failed()  # a chunk flushed by the timer may have failed
 
     def close(self) -> None:
         """Stop the intake, write the messages already received, close the bag."""

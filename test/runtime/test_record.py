@@ -380,3 +380,65 @@ def test_a_recording_that_wrote_nothing_exits_non_zero(runtime: str, spawn: Spaw
     assert recorder.returncode == 1, err
     assert "no message was recorded; the bag is empty" in err
 
+
+
+# On the zenoh runtime: once its publisher matches, 1 KiB strings (random hex: zstd halves them)
+# on /tick at about 1 kHz for 3 s (1.5 MiB in the bag: past the recorder's file-size limit below).
+BIG_TICKER = """
+import os, time
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.runtime.run_node import open_context
+
+context = open_context("zenoh")
+ticks = context.create_port("ticker").create_publisher("/tick", "std_msgs/msg/String")
+while not ticks.matched():
+    context.spin_for(0.02)
+for n in range(3000):
+    ticks.publish(from_dict("std_msgs/msg/String", {"data": f"{n:08d}" + os.urandom(508).hex()}))
+    time.sleep(0.001)
+context.spin_for(1.0)
+context.close()
+"""
+
+
+def test_a_full_disk_stops_the_recording_with_a_readable_bag_and_a_summary(
+        zenoh_env: dict[str, str], router: subprocess.Popen[bytes], tmp_path: Path) -> None:
+    """The recorder under a file-size limit (``RLIMIT_FSIZE``: a write fails as on a full disk)
+    while 3 MiB of strings arrive: it stops by itself, exits 3, says what the bag keeps and how
+    many received messages were lost, and the bag reads back as that many messages, with
+    ``metadata.yaml``."""
+    import resource
+
+    from tdcm_ros.bagio.writer import RESERVE_BYTES
+
+    limit = RESERVE_BYTES + 100_000  # bytes per file (the reserve file must fit)
+
+    def limited() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    bag = tmp_path / "bag"
+    recorder = subprocess.Popen([sys.executable, "-m", "tdcm_ros.cli.main", "record", str(bag),
+                                 "tick"], env=zenoh_env, cwd=REPO, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE,
+                                preexec_fn=limited)  # noqa: PLW1509 - it only sets a limit
+    try:
+        out = Lines(recorder)
+        eventually(lambda: out.has("recording to"), 20.0, "the recorder to start")
+        ticker = subprocess.run([sys.executable, "-c", BIG_TICKER], check=False,
+                                env=zenoh_env, cwd=REPO, capture_output=True, timeout=120.0)
+        assert ticker.returncode == 0, ticker.stderr.decode()
+        status = recorder.wait(30)
+    finally:
+        if recorder.poll() is None:
+            recorder.kill()
+            recorder.wait()
+    assert recorder.stderr is not None and recorder.stdout is not None
+    err = recorder.stderr.read().decode()
+    assert status == 3, (err, out.lines)
+    assert "File too large" in err and "stopping the recording" in err, err
+    kept = int(err.split("the bag keeps the ")[1].split()[0])
+    lost = int(err.split("metadata.yaml written); ")[1].split()[0])
+    values = [int(m.data[:8]) for _, _, m in open_bag(bag).messages(["/tick"])]
+    assert len(values) == kept > 0 and values == sorted(values) and lost > 0
+    meta = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert meta["message_count"] == kept
