@@ -30,6 +30,16 @@ Classes:
   count every one of them as occluded.
 - ``recorder``: a 1 kHz counter that starts after ``tdcm record`` named its topic, then SIGINT.
   Failure: a message missing at the head, inside, or at the tail of the bag.
+
+Issue 25 (each failed on the main of its filing):
+- ``wildcard_setpoints``: 12 N put on random wildcard keys overlapping the driver's
+  ``tension_setpoint`` key, with rmw_zenoh's attachment. Failure: the tendon tensions.
+- ``big_parameters``: multi-megabyte ``frame_id`` and ``schedule.levels`` set on the driver.
+  Failure: accepted.
+- ``router_loss``: ``tdcm up --twin`` holds 8 N, its router is killed (SIGKILL). Failure: no
+  router comes back, or the tendon is not slack with the driver disarmed for the lost graph.
+- ``full_disk``: the bag writer under a random file-size limit. Failure: it crashes, or the bag
+  does not read back as the messages it kept, with ``metadata.yaml``.
 """
 
 from __future__ import annotations
@@ -573,6 +583,213 @@ def campaign_recorder(tries: int, rng: random.Random, tmp: Path) -> Failures:
     return failures
 
 
+# --- issue 25: the graph's guarantees -------------------------------------------------------------
+
+def wildcard_key(rng: random.Random, exact: str) -> str:
+    """A key expression that overlaps ``exact`` without being it: a chunk made ``*``, a chunk's
+    tail made ``$*``, or a ``**`` in place of the tail."""
+    chunks = exact.split("/")
+    pick, where = rng.randrange(3), rng.randrange(1, len(chunks))
+    if pick == 0:
+        chunks[where] = "*"
+    elif pick == 1:
+        chunks[where] = chunks[where][:rng.randrange(1, len(chunks[where]))] + "$*"
+    else:
+        chunks[where:] = ["**"]
+    return "/".join(chunks)
+
+
+@contextlib.contextmanager
+def driver_graph(tmp: Path, name: str, *extra: str) -> Iterator[tuple[Any, Any]]:
+    """A threaded twin, a router and tension_driver on it; yields (twin, a zenoh context)."""
+    from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    twin = PtyTwin(DeviceTwin(), link=str(tmp / f"{name}_port")).start()
+    params = tmp / f"{name}.yaml"
+    params.write_text(f"tension_driver:\n  ros__parameters:\n    port: {twin.port}\n")
+    try:
+        with zenoh_graph(["tdcm_ros.runtime.run_node",
+                          "tdcm_ros.nodes.tension_driver:TensionDriverNode", "--params",
+                          str(params), *extra]):
+            context = ZenohContext()
+            try:
+                yield twin, context
+            finally:
+                context.close()
+    finally:
+        twin.stop()
+
+
+def campaign_wildcard_setpoints(tries: int, rng: random.Random, tmp: Path) -> Failures:
+    """12 N setpoints put on wildcard keys overlapping the driver's ``tension_setpoint`` key,
+    with rmw_zenoh's attachment: the tendon stays slack."""
+    from tdcm_ros.bagio import from_dict, serialize, type_hash
+    from tdcm_ros.device.protocol import Mode
+    from tdcm_ros.runtime import wire
+
+    float64 = "std_msgs/msg/Float64"
+    exact = wire.topic_key(0, "/tension_setpoint", float64, type_hash(float64))
+    payload = bytes(serialize(from_dict(float64, {"data": 12.0}), float64))
+    failures: Failures = []
+    with driver_graph(tmp, "wildcard") as (twin, context):
+        if not wait_until(lambda: twin.twin.core.mode is Mode.TENSION, 30.0, context.spin_for):
+            return ["the driver never armed the device"]
+        for seq in range(1, tries + 1):
+            key = wildcard_key(rng, exact)
+            context.session.put(key, payload,
+                                attachment=wire.encode_attachment(seq, time.time_ns(),
+                                                                  bytes(16)))
+            context.spin_for(0.05)
+            if twin.twin.plant.tension > 0.3:
+                failures.append(f"{key}: the tendon went to {twin.twin.plant.tension:.2f} N")
+                break
+        context.spin_for(1.0)
+        if twin.twin.plant.tension > 0.3 and not failures:
+            failures.append(f"the tendon went to {twin.twin.plant.tension:.2f} N")
+    return failures
+
+
+def campaign_big_parameters(tries: int, rng: random.Random, tmp: Path) -> Failures:
+    """Multi-megabyte strings and arrays set as the driver's ``frame_id`` and
+    ``schedule.levels``: refused."""
+    failures: Failures = []
+    with driver_graph(tmp, "big") as (_twin, context):
+        for attempt in range(tries):
+            size = rng.randrange(10_000, 10_000_000)
+            name, value = (("frame_id", "x" * size) if attempt % 2 == 0
+                           else ("schedule.levels", [1.0] * (size // 8)))
+            if _set_when_up(context, "/tension_driver", name, value):
+                failures.append(f"{name} of {size} elements accepted")
+    return failures
+
+
+def campaign_router_loss(tries: int, rng: random.Random, tmp: Path) -> Failures:
+    """``tdcm up --twin`` holding 8 N; ``kill -9`` of its router: the router comes back, the
+    driver reports itself disarmed for the lost graph and the tendon is slack."""
+    failures: Failures = []
+    for _ in range(tries):
+        port = free_port()
+        env = {**os.environ, "TDCM_ZENOH_ENDPOINT": f"tcp/127.0.0.1:{port}",
+               "TDCM_RUNTIME": "zenoh", "ROS_DOMAIN_ID": "0"}
+        env.pop("TDCM_ZENOH_CONFIG", None)
+        os.environ.update({k: env[k] for k in ("TDCM_ZENOH_ENDPOINT", "TDCM_RUNTIME",
+                                               "ROS_DOMAIN_ID")})
+        up = subprocess.Popen([sys.executable, "-m", "tdcm_ros.cli.main", "up", "--twin"],
+                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        try:
+            time.sleep(3.0)
+            failure = _router_loss_once(port)
+            if failure:
+                failures.append(failure)
+        finally:
+            up.send_signal(signal.SIGINT)
+            try:
+                up.wait(20)
+            except subprocess.TimeoutExpired:
+                up.kill()
+                up.wait()
+    return failures
+
+
+def _router_loss_once(port: int) -> str:
+    """Hold 8 N through the running graph, kill its router; what went wrong ("" if nothing)."""
+    from tdcm_ros.bagio import from_dict
+    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+
+    context = ZenohContext()
+    try:
+        node = context.create_port("campaign")
+        truth: list[float] = []
+        states: list[dict[str, str]] = []
+        node.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
+                                 lambda m: truth.append(m.wrench.force.z))
+        node.create_subscription("device_state", "diagnostic_msgs/msg/DiagnosticStatus",
+                                 lambda m: states.append({kv.key: kv.value for kv in m.values}))
+        setpoint = node.create_publisher("tension_setpoint", "std_msgs/msg/Float64")
+
+        def held() -> bool:
+            setpoint.publish(from_dict("std_msgs/msg/Float64", {"data": 8.0}))
+            return bool(truth) and abs(truth[-1] - 8.0) < 0.3
+
+        if not wait_until(held, 60.0, context.spin_for):
+            return "the twin never held 8 N"
+        routers = [int(p.name) for p in Path("/proc").iterdir() if p.name.isdigit()
+                   and _cmdline_has(p, b"tdcm_ros.runtime.router", str(port).encode())]
+        if not routers:
+            return "no router process of tdcm up found"
+        os.kill(routers[0], signal.SIGKILL)
+        truth.clear()
+        if wait_until(lambda: bool(truth) and truth[-1] < 0.3 and bool(states)
+                      and "graph lost" in states[-1].get("disarm_reason", ""),
+                      30.0, context.spin_for):
+            return ""
+        return (f"after kill -9 of the router: true tension "
+                f"{truth[-1] if truth else 'not heard'} N, driver disarmed for "
+                f"{states[-1].get('disarm_reason') if states else 'not heard'}")
+    finally:
+        context.close()
+
+
+def _cmdline_has(proc: Path, *parts: bytes) -> bool:
+    try:
+        argv = (proc / "cmdline").read_bytes()
+    except OSError:
+        return False
+    return all(part in argv for part in parts)
+
+
+FULL_DISK_WRITER = """
+import sys
+from tdcm_ros.bagio import from_dict, serialize
+from tdcm_ros.bagio.writer import BagWriter
+
+writer = BagWriter(sys.argv[1], chunk_size=4096)
+writer.add_topic("/tick", "std_msgs/msg/UInt32")
+n = 0
+while n < 200_000 and not writer.failure:
+    writer.write("/tick", 1_000_000_000 + n, bytes(serialize(
+        from_dict("std_msgs/msg/UInt32", {"data": n}), "std_msgs/msg/UInt32")))
+    n += 1
+writer.close()
+print(writer.counts.get("/tick", 0))
+"""
+
+
+def campaign_full_disk(tries: int, rng: random.Random, tmp: Path) -> Failures:
+    """The bag writer under a random file-size limit (a write fails as on a full disk): it ends
+    cleanly, the bag reads back as the messages it says it kept, with ``metadata.yaml``."""
+    import resource
+
+    import yaml
+
+    from tdcm_ros.bagio.reader import open_bag
+    from tdcm_ros.bagio.writer import RESERVE_BYTES
+
+    failures: Failures = []
+    for attempt in range(tries):
+        limit = RESERVE_BYTES + rng.randrange(2_000, 400_000)
+        bag = tmp / f"full_{attempt}"
+        child = subprocess.run(
+            [sys.executable, "-c", FULL_DISK_WRITER, str(bag)], capture_output=True, text=True,
+            check=False, timeout=120, preexec_fn=lambda limit=limit: resource.setrlimit(
+                resource.RLIMIT_FSIZE, (limit, limit)))
+        if child.returncode != 0:
+            failures.append(f"limit {limit}: exit {child.returncode}: {child.stderr[-120:]!r}")
+            continue
+        kept = int(child.stdout)
+        try:
+            read = sum(1 for _ in open_bag(bag).messages(["/tick"]))
+            meta = yaml.safe_load((bag / "metadata.yaml").read_text())
+            counted = meta["rosbag2_bagfile_information"]["message_count"]
+        except (TdcmError, OSError) as error:
+            failures.append(f"limit {limit}: {type(error).__name__}: {error}")
+            continue
+        if not read == counted == kept:
+            failures.append(f"limit {limit}: kept {kept}, read {read}, metadata {counted}")
+    return failures
+
+
 #: A short note per class printed under its row (e.g. how many tries reached the code under test).
 NOTES: dict[str, str] = {}
 
@@ -587,6 +804,10 @@ CAMPAIGNS: dict[str, tuple[Callable[[int, random.Random, Path], Failures], int, 
     "bag": (campaign_bag, 60, "untyped error or > 20 s"),
     "occlusion": (campaign_occlusion, 5, "a zero marker not counted as occluded"),
     "recorder": (campaign_recorder, 2, "a message lost at the head, inside or tail"),
+    "wildcard_setpoints": (campaign_wildcard_setpoints, 200, "a wildcard key tensioned the tendon"),
+    "big_parameters": (campaign_big_parameters, 6, "a multi-megabyte parameter accepted"),
+    "router_loss": (campaign_router_loss, 2, "tendon held, or no router, after kill -9"),
+    "full_disk": (campaign_full_disk, 10, "a crash, or the bag unreadable or miscounted"),
 }
 
 
