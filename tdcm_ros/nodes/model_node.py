@@ -68,6 +68,7 @@ from tdcm_ros.runtime import (
     NodePort,
     QoS,
     Status,
+    Throttled,
     declare_specs,
     grouped,
     read_specs,
@@ -181,6 +182,7 @@ class ModelNode(NodeLogic):
         self.counts: Counter[str] = Counter()
         self.last_problem = ""
         self.last_failure = ""
+        self._drop_warnings = Throttled(clock=lambda: self.port.now_ns() / 1e9)
         port.create_timer(period, self.process)
         self.diagnostics = Diagnostics(port, diag_period)
         self.dropped, self.failed = self.diagnostics.window(), self.diagnostics.window()
@@ -229,6 +231,9 @@ class ModelNode(NodeLogic):
         if reason:
             self.counts[f"dropped_{reason}"] += 1
             self.last_problem = f"dropped tension {tension!r} N: {reason}"
+            if (suffix := self._drop_warnings.admit(reason)) is not None:
+                self.port.logger.warning("dropped tension %r N: %s%s", tension,
+                                         self._why_dropped(reason, stamp_ns or 0, now), suffix)
             return
         if self.pending is not None:
             self.counts["coalesced"] += 1
@@ -249,6 +254,23 @@ class ModelNode(NodeLogic):
         if reason:
             self.counts[f"dropped_roll_{reason}"] += 1
             self.last_problem = f"dropped roll {roll!r} rad of joint {self.roll_joint!r}: {reason}"
+
+    def _why_dropped(self, reason: str, stamp_ns: int, now_ns: int) -> str:
+        """A dropped tension's reason in words, with the parameter that decides it."""
+        get = self.port.get_parameter
+        if reason == "unstamped":
+            return ("header.stamp is 0 (never set): stamp it (tdcm topic pub: {header: auto}), or "
+                    "send std_msgs/msg/Float64 with input.tension_type")
+        if reason == "stale":
+            return (f"stamped {(now_ns - stamp_ns) / 1e9:.3g} s before the node's clock, older "
+                    f"than input.max_age_s = {get('input.max_age_s'):g} s (a bag replay needs "
+                    f"tdcm bag play --clock and use_sim_time: true on the node)")
+        if reason == "future":
+            return (f"stamped {(stamp_ns - now_ns) / 1e9:.3g} s after the node's clock, more than "
+                    f"input.max_future_s = {get('input.max_future_s'):g} s")
+        if reason == "above_max":
+            return f"above input.tension_max = {get('input.tension_max'):g} N"
+        return f"{reason.replace('_', '-')} tension"
 
     def _reject_reason(self, tension: float, stamp_ns: int | None, now_ns: int) -> str:
         """Why a tension (N) stamped ``stamp_ns`` (ns; None: a type without a header) is

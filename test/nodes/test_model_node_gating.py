@@ -137,3 +137,32 @@ def test_every_drop_then_good_tensions_warn_then_recover_on_diagnostics() -> Non
     assert statuses[-1].level == 0 and statuses[-1].message == "ok"
     values = {kv.key: kv.value for kv in statuses[-1].values}
     assert {k: values[k] for k in KEYS} == dict.fromkeys(KEYS, "1")
+
+
+def test_drops_are_announced_on_the_log_with_the_reason_and_its_parameter(
+        caplog: pytest.LogCaptureFixture) -> None:
+    """Each kind of drop is logged at WARN the first time, naming why and the parameter that
+    decides it; more of the same kind within 5 s (the port's clock) are held back and counted
+    in the next line."""
+    import logging
+
+    n = Node()
+    now = n.port.now_ns()
+    with caplog.at_level(logging.WARNING):
+        for _ in range(3):
+            assert not n.send(20.0, 0)
+        assert not n.send(20.0, now - 2 * 10**9)
+        assert not n.send(20.0, now + 2 * 10**9)
+        assert not n.send(500.0, now)
+        n.port.advance(5.0)
+        assert not n.send(20.0, 0)
+    lines = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert lines[0] == ("dropped tension 20.0 N: header.stamp is 0 (never set): stamp it (tdcm "
+                        "topic pub: {header: auto}), or send std_msgs/msg/Float64 with "
+                        "input.tension_type")
+    assert "stamped 2 s before the node's clock, older than input.max_age_s = 0.5 s" in lines[1]
+    assert "--clock and use_sim_time: true" in lines[1]
+    assert "stamped 2 s after the node's clock, more than input.max_future_s = 0.5 s" in lines[2]
+    assert lines[3] == "dropped tension 500.0 N: above input.tension_max = 200 N"
+    assert len(lines) == 5 and lines[4].endswith("(2 more like it in the last 5.0 s)")
+    assert n.node.counts["dropped_unstamped"] == 4
