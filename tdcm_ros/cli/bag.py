@@ -17,6 +17,7 @@ import argparse
 import faulthandler
 import signal
 import sys
+import time
 from types import FrameType
 from typing import Any
 
@@ -120,6 +121,22 @@ def arm_exit_deadline() -> None:
     faulthandler.dump_traceback_later(EXIT_DEADLINE_S, exit=True)
 
 
+#: s: a bag older than this, played without ``--clock``, reaches nodes on wall time stale
+#: (model_node's ``input.max_age_s`` default).
+STALE_AFTER_S = 0.5
+
+
+def stale_stamps_warning(bag_start_ns: int, now_ns: int, clock: bool) -> str:
+    """What ``bag play`` says when nodes on wall time will drop the bag's stamps ("" if not):
+    without ``--clock`` a bag recorded more than :data:`STALE_AFTER_S` s ago."""
+    age_s = (now_ns - bag_start_ns) / 1e9
+    if clock or age_s <= STALE_AFTER_S:
+        return ""
+    return (f"WARNING: the bag's messages are stamped {age_s:.0f} s ago and no /clock is played: "
+            f"nodes on wall time drop them as stale (model_node: input.max_age_s). Play with "
+            f"--clock and run the nodes on it (tdcm up --use-sim-time).")
+
+
 def run_play(args: argparse.Namespace) -> int:
     """Play until the end, ``--loop`` until a signal; print what was published."""
     stopped_by: list[int] = []
@@ -153,6 +170,8 @@ def run_play(args: argparse.Namespace) -> int:
         player.request_stop()
     print(f"playing {player.reader.path} into the {runtime} graph at x{args.rate:g}"
           f"{', looping' if args.loop else ''}; Ctrl-C to stop", flush=True)
+    if warning := stale_stamps_warning(player.base_ns, time.time_ns(), bool(args.clock)):
+        print(warning, file=sys.stderr, flush=True)
     try:
         published = player.run()
     finally:

@@ -77,7 +77,7 @@ def _with_client(args: argparse.Namespace, use: Callable[[ParameterClient], R]) 
 
     if args.timeout is not None and not args.timeout > 0:
         raise out_of_range("--timeout", args.timeout, "> 0 s", unit="s")
-    context = open_context(resolve_runtime(args.runtime))
+    context = open_context(resolve_runtime(args.runtime), require_graph=True)
     try:
         if args.timeout is None:
             return use(ParameterClient(context, args.node))
@@ -156,12 +156,13 @@ def run_specs(args: argparse.Namespace) -> int:
     """Print the node's parameters as a Markdown table, from the specs it declares them with."""
     import importlib
 
-    from tdcm_ros.runtime import node_target
+    from tdcm_ros.runtime import NODE_COMMON, node_target
     from tdcm_ros.spec import spec_table
 
     module = importlib.import_module(node_target(args.node).partition(":")[0])
+    specs = {**module.PARAMETERS, **NODE_COMMON}
     print("| parameter | unit | default | allowed | meaning |\n|---|---|---|---|---|")
-    for name, row in zip(module.PARAMETERS, spec_table(module.PARAMETERS.values()), strict=True):
+    for name, row in zip(specs, spec_table(specs.values()), strict=True):
         default = "(derived)" if row["default"] == "None" else row["default"]
         cells = (f"`{name}`", row["unit"], default, row["allowed"], row["description"])
         print("| " + " | ".join(cell.replace("|", "\\|") for cell in cells) + " |")

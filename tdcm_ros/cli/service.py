@@ -56,7 +56,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def _context(args: argparse.Namespace) -> Any:
     from tdcm_ros.runtime.run_node import open_context, resolve_runtime
 
-    return open_context(resolve_runtime(args.runtime))
+    return open_context(resolve_runtime(args.runtime), require_graph=True)
 
 
 def run_list(args: argparse.Namespace) -> int:

@@ -46,7 +46,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                "  tdcm topic list -t\n"
                "  tdcm topic echo tip_pose --once\n"
                "  tdcm topic pub tension geometry_msgs/msg/WrenchStamped "
-               "'{wrench: {force: {z: 8.0}}}' --once\n"
+               "'{header: auto, wrench: {force: {z: 8.0}}}' --once\n"
                "  tdcm topic hz markers --duration 5")
     verbs = parser.add_subparsers(dest="verb", required=True, metavar="VERB")
 
@@ -68,7 +68,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     pub = verbs.add_parser("pub", help="publish a message given as YAML")
     pub.add_argument("topic")
     pub.add_argument("type", help="pkg/msg/Name, e.g. geometry_msgs/msg/WrenchStamped")
-    pub.add_argument("values", nargs="?", default="{}", help='YAML, e.g. "{data: 1.0}"')
+    pub.add_argument("values", nargs="?", default="{}",
+                     help='YAML, e.g. "{data: 1.0}"; a Header may be "auto" and a Time "now" '
+                          "(stamped as each message is sent)")
     pub.add_argument("-1", "--once", action="store_true", help="publish once and exit")
     pub.add_argument("-r", "--rate", type=float, default=1.0, help="publishing rate (Hz)")
     pub.add_argument("-t", "--times", type=int, default=0, help="publish N times and exit")
@@ -84,9 +86,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _context() -> Any:
-    from tdcm_ros.runtime.zenoh_runtime import ZenohContext
+    from tdcm_ros.runtime.run_node import open_context
 
-    return ZenohContext()
+    return open_context("zenoh", require_graph=True)
 
 
 def graph_topics(timeout: float) -> dict[str, set[str]]:
@@ -191,13 +193,14 @@ def _check_published(watch: GraphWatch, topic: str, type_name: str | None, waite
 
 def run_pub(args: argparse.Namespace) -> int:
     """Publish ``values`` as ``type`` at ``--rate`` Hz (or once)."""
-    from tdcm_ros.bagio import from_dict
+    from tdcm_ros.bagio import from_dict, to_dict
 
     if not args.rate > 0:
         raise InputError(f"--rate = {args.rate} Hz must be > 0", parameter="rate",
                          value=args.rate, allowed="> 0 Hz")
     values = load_yaml(args.values, "values")
-    message = from_dict(args.type, values if values is not None else {})
+    values = values if values is not None else {}
+    from_dict(args.type, with_stamps(args.type, values, 0))  # a bad value fails before connecting
     times = 1 if args.once else args.times
     context = _context()
     from tdcm_ros.runtime.zenoh_runtime import GraphWatch
@@ -214,12 +217,14 @@ def run_pub(args: argparse.Namespace) -> int:
             print(f"WARNING: no subscriber of {publisher.topic} matched within "
                   f"{args.wait_matching:g} s{similar_topics(publisher.topic, graph)}; "
                   f"publishing anyway", file=sys.stderr, flush=True)
-        print(f"publisher: beginning loop\npublishing #1: {message}", flush=True)
+        print("publisher: beginning loop", flush=True)
         sent = 0
         heard = publisher.matched()
         while True:
+            message = from_dict(args.type, with_stamps(args.type, values, time.time_ns()))
             publisher.publish(message)
             sent += 1
+            print(f"publishing #{sent}: {flow_yaml(to_dict(message))}", flush=True)
             heard = heard or publisher.matched()
             if times and sent >= times:
                 break
@@ -232,6 +237,37 @@ def run_pub(args: argparse.Namespace) -> int:
               f"nothing received the {sent} message(s)", file=sys.stderr)
         return NOT_RECEIVED_EXIT
     return 0
+
+
+HEADER, TIME = "std_msgs/msg/Header", "builtin_interfaces/msg/Time"
+
+
+def with_stamps(type_name: str, values: Any, now_ns: int) -> Any:
+    """``values`` (YAML data of ``type_name``) with ``ros2 topic pub``'s keywords filled in: a
+    ``std_msgs/msg/Header`` given ``auto`` is stamped ``now_ns`` (frame_id ""), a
+    ``builtin_interfaces/msg/Time`` given ``now`` is ``now_ns`` (ns since the epoch)."""
+    from rosbags.typesys.base import Nodetype
+
+    from tdcm_ros.bagio import normalize_type_name, typestore
+
+    name = normalize_type_name(type_name)
+    now = {"sec": now_ns // 1_000_000_000, "nanosec": now_ns % 1_000_000_000}
+    if name == HEADER and values == "auto":
+        return {"stamp": now, "frame_id": ""}
+    if name == TIME and values == "now":
+        return now
+    if not isinstance(values, dict):
+        return values
+    filled = dict(values)
+    for field, (kind, rest) in typestore().fielddefs[name][1]:
+        if field in filled and kind == Nodetype.NAME and isinstance(rest, str):
+            filled[field] = with_stamps(rest, filled[field], now_ns)
+    return filled
+
+
+def flow_yaml(data: Any) -> str:
+    """``data`` as one line of YAML flow style (how ``publishing #N:`` shows a message)."""
+    return str(yaml.safe_dump(data, default_flow_style=True, sort_keys=False, width=2**31)).strip()
 
 
 def rate_stats(arrivals: list[float]) -> tuple[float, float, float, float]:

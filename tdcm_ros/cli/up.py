@@ -26,7 +26,7 @@ import tempfile
 from typing import Any
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime import DEFAULT_NODE_SET, NODES
+from tdcm_ros.runtime import DEFAULT_NODE_SET, NODES, parse_cli_param
 
 TWIN_NODES = ("device_twin", "tension_driver")
 
@@ -61,6 +61,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--router-config", default=None,
                         help="zenoh JSON5 config of the router tdcm up starts, e.g. "
                              "config/zenoh/router.json5; zenoh runtime only")
+    parser.add_argument("-p", "--param", action="append", default=[], metavar="NODE:NAME:=VALUE",
+                        help="a parameter of one node (ros2's -p spelling, value as YAML) over "
+                             "--params; repeatable, e.g. -p model_node:input.max_age_s:=2.0")
+    parser.add_argument("--use-sim-time", action="store_true",
+                        help="every node takes its time from /clock (use_sim_time: true), e.g. "
+                             "for tdcm bag play --clock")
     parser.add_argument("--on-router-exit", choices=("restart", "stop"), default="restart",
                         help="when the router tdcm up started exits: start it again (default; "
                              "the nodes reconnect) or stop the graph and exit 1; zenoh only")
@@ -93,6 +99,20 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
         overrides["device_twin"] = {"link": link, **({"scene": args.scene} if args.scene else {})}
         overrides["tension_driver"] = {"port": link}
         ready["device_twin"] = link
+    for item in args.param:
+        node, name, value = parse_cli_param(item)
+        if not node:
+            raise InputError(f"-p {item!r} names no node; tdcm up starts several: write "
+                             f"NODE:NAME:=VALUE", parameter="-p", value=item,
+                             allowed="NODE:NAME:=VALUE")
+        if node not in nodes:
+            raise InputError(f"-p {item!r} names node {node!r}, which is not started; nodes: "
+                             f"{', '.join(nodes)}", parameter="-p", value=item,
+                             allowed=", ".join(nodes))
+        overrides.setdefault(node, {})[name] = value
+    if args.use_sim_time:
+        for node in nodes:
+            overrides.setdefault(node, {})["use_sim_time"] = True
     if args.schedule:
         if "tension_driver" not in nodes:
             raise InputError("--schedule needs tension_driver in the node set (or --twin)",

@@ -22,6 +22,7 @@ from tdcm_ros.runtime.graph import NodeGraph
 from tdcm_ros.runtime.launcher import launch
 from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
+from tdcm_ros.runtime.params import parse_cli_param
 from tdcm_ros.runtime.port import (
     CLOCK_QOS,
     CLOCK_TOPIC,
@@ -35,7 +36,7 @@ from tdcm_ros.runtime.port import (
 )
 from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
 from tdcm_ros.runtime.shutdown import close_within, exit_now
-from tdcm_ros.runtime.spec_params import declare_specs, grouped, read_specs
+from tdcm_ros.runtime.spec_params import NODE_COMMON, declare_specs, grouped, read_specs
 from tdcm_ros.runtime.throttle import Throttled, template
 
 __all__ = [
@@ -45,6 +46,7 @@ __all__ = [
     "DEFAULT_NODE_SET",
     "DEFAULT_QOS",
     "NODES",
+    "NODE_COMMON",
     "DiagnosticLevel",
     "Diagnostics",
     "EventWindow",
@@ -66,6 +68,7 @@ __all__ = [
     "grouped",
     "launch",
     "node_target",
+    "parse_cli_param",
     "read_specs",
     "resolve_topic",
     "summary",

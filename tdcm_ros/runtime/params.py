@@ -80,3 +80,14 @@ def node_parameters(path: str | Path | None, fully_qualified_name: str) -> dict[
         elif "/" + key.strip("/") == fully_qualified_name:
             exact.update(values)
     return {**wildcard, **exact}
+
+
+def parse_cli_param(item: str) -> tuple[str, str, Any]:
+    """``[NODE:]NAME:=VALUE`` (ros2's ``-p`` spelling) as ``(node or "", name, value)``; the
+    value is read as YAML. ``InputError`` naming the item if it is not of that form."""
+    target, sep, text = item.partition(":=")
+    node, _, name = target.rpartition(":")
+    if not sep or not name:
+        raise InputError(f"-p {item!r} is not [NODE:]NAME:=VALUE", parameter="-p", value=item,
+                         allowed="[NODE:]NAME:=VALUE, e.g. model_node:input.max_age_s:=2.0")
+    return node, name, load_yaml(text, f"-p {target}")

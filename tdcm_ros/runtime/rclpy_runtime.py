@@ -44,10 +44,9 @@ from tdcm_ros.runtime.parameters import (
     SetCallback,
     Validator,
 )
-from tdcm_ros.runtime.params import node_parameters
+from tdcm_ros.runtime.params import node_parameters, parse_cli_param
 from tdcm_ros.runtime.port import DEFAULT_QOS, SERVICE_TIMEOUT_S, NodePort, QoS
 from tdcm_ros.runtime.wire import RawSample
-from tdcm_ros.yamlio import load_yaml
 
 _NO_GID = bytes(wire.GID_SIZE)
 #: rclpy's own parameter that puts the node clock on ``/clock``.
@@ -428,10 +427,9 @@ class RclpyContext:
         """Values for node ``fqn`` from the parameter files, then the ``-p`` arguments."""
         values = {k: v for path in self.params_files for k, v in node_parameters(path, fqn).items()}
         for item in self.cli_params:
-            target, _, text = item.partition(":=")
-            node, _, parameter = target.rpartition(":")
+            node, parameter, value = parse_cli_param(item)
             if node in ("", name, fqn):
-                values[parameter] = load_yaml(text, f"-p {target}")
+                values[parameter] = value
         return values
 
     def create_node(self, name: str, namespace: str = "/") -> Any:

@@ -62,16 +62,24 @@ def configure_logging(level: str = "INFO") -> None:
 
 
 def open_context(runtime: str, ros_args: Sequence[str] = (),
-                 params_files: Sequence[str] = ()) -> Any:
+                 params_files: Sequence[str] = (), *, require_graph: bool = False) -> Any:
     """A new context of ``runtime`` (``zenoh`` or ``rclpy``; ``ros_args`` and the parameter
-    files whose values its nodes take are for rclpy)."""
+    files whose values its nodes take are for rclpy). ``require_graph`` (the graph tools): on
+    zenoh, ``RuntimePortError`` saying why if no router is reached (rclpy has none to reach)."""
     if runtime == "rclpy":
         from tdcm_ros.runtime.rclpy_runtime import RclpyContext
 
         return RclpyContext(ros_args, params_files)
     from tdcm_ros.runtime.zenoh_runtime import ZenohContext
 
-    return ZenohContext()
+    context = ZenohContext()
+    if require_graph:
+        try:
+            context.require_router()
+        except BaseException:
+            context.close()
+            raise
+    return context
 
 
 def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file: str | None = None,

@@ -14,8 +14,14 @@ from typing import Any
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.parameters import ParamValue
-from tdcm_ros.runtime.port import NodePort
-from tdcm_ros.spec import Spec
+from tdcm_ros.runtime.port import CLOCK_TOPIC, NodePort
+from tdcm_ros.spec import Spec, by_name
+
+#: Parameters every node has, whatever its own (the runtime declares them; rclpy its own).
+NODE_COMMON = by_name(
+    Spec("use_sim_time", description=f"take the time from {CLOCK_TOPIC} instead of the system "
+         "clock (0 until the first message), as ROS nodes do; fixed at start", default=False,
+         kind="bool"))
 
 
 def grouped(specs: Mapping[str, Spec], prefix: str = "") -> dict[str, Spec]:

@@ -3,8 +3,9 @@ missing, the router's TLS certificate fails verification (another name, another 
 answers at the endpoint, or the router refused the user and password.
 
 :func:`require_router` waits for a session's router and raises :class:`RuntimePortError` with
-that sentence; the nodes, ``tdcm up`` and the tools call it when a config file is in use
-(``TDCM_ZENOH_CONFIG``), where a misconfiguration would otherwise run a closed graph silently.
+that sentence. Every session configured by a file (``TDCM_ZENOH_CONFIG``) calls it, where a
+misconfiguration would otherwise run a closed graph silently, and so do the graph tools
+(``tdcm topic``, ``param``, ``service``), which would otherwise print nothing and exit 0.
 """
 
 from __future__ import annotations
@@ -49,15 +50,36 @@ def missing_files(config: zenoh.Config) -> list[str]:
     return missing
 
 
+def _host_port(endpoint: str) -> tuple[str, int] | None:
+    """``(host, port)`` of a ``tcp/`` or ``tls/`` endpoint; None for other protocols."""
+    protocol, _, address = endpoint.partition("/")
+    host, _, port = address.split("?")[0].split("#")[0].rpartition(":")
+    if protocol not in ("tcp", "tls") or not port.isdigit():
+        return None
+    return host.strip("[]"), int(port)
+
+
+def nothing_listens(endpoint: str, timeout: float = 1.0) -> str | None:
+    """Why a TCP connection to a ``tcp/`` or ``tls/`` endpoint fails (None if it opens, or
+    for another protocol)."""
+    address = _host_port(endpoint)
+    if address is None:
+        return None
+    try:
+        with socket.create_connection(address, timeout=timeout):
+            return None
+    except OSError as error:
+        return f"nothing answers at {endpoint}: {error.strerror or error}"
+
+
 def tls_refusal(config: zenoh.Config, endpoint: str, timeout: float = 3.0) -> str | None:
     """Why a TLS handshake with the router at a ``tls/host:port`` endpoint fails, as zenoh would
     check it (the endpoint's host against the certificate's names, the configured root CA);
     None if it succeeds or the endpoint is not TLS."""
-    protocol, _, address = endpoint.partition("/")
-    if protocol != "tls":
+    address = _host_port(endpoint)
+    if not endpoint.startswith("tls/") or address is None:
         return None
-    host, _, port = address.split("?")[0].split("#")[0].rpartition(":")
-    host = host.strip("[]")
+    host, port = address
     ca = _value(config, "transport/link/tls/root_ca_certificate")
     context = ssl.create_default_context(cafile=ca if isinstance(ca, str) and ca else None)
     certificate = _value(config, "transport/link/tls/connect_certificate")
@@ -65,7 +87,7 @@ def tls_refusal(config: zenoh.Config, endpoint: str, timeout: float = 3.0) -> st
     if isinstance(certificate, str) and certificate and isinstance(key, str) and key:
         context.load_cert_chain(certificate, key)
     try:
-        with socket.create_connection((host, int(port)), timeout=timeout) as raw, \
+        with socket.create_connection((host, port), timeout=timeout) as raw, \
                 context.wrap_socket(raw, server_hostname=host):
             return None
     except ssl.SSLCertVerificationError as error:
@@ -82,7 +104,7 @@ def why_no_router(config: zenoh.Config, endpoint: str) -> str:
     """The most likely reason a session with ``config`` reached no router at ``endpoint``."""
     if missing := missing_files(config):
         return f"the zenoh config names files that cannot be read: {'; '.join(missing)}"
-    if (refusal := tls_refusal(config, endpoint)) is not None:
+    if (refusal := nothing_listens(endpoint) or tls_refusal(config, endpoint)) is not None:
         return refusal
     user = _value(config, "transport/auth/usrpwd/user")
     if isinstance(user, str) and user:
@@ -92,12 +114,18 @@ def why_no_router(config: zenoh.Config, endpoint: str) -> str:
     return f"no zenoh router was reached at {endpoint}"
 
 
+def _connected(session: zenoh.Session) -> bool:
+    return any(True for _ in session.info.routers_zid())
+
+
 def require_router(session: zenoh.Session, config: zenoh.Config, endpoint: str,
                    timeout: float = ROUTER_WAIT_S) -> None:
     """Wait up to ``timeout`` s for ``session`` to reach a router; ``RuntimePortError`` naming
-    the cause (:func:`why_no_router`) if it does not."""
+    the cause (:func:`why_no_router`) if it does not, at once if nothing listens there."""
+    if not _connected(session) and (refusal := nothing_listens(endpoint)) is not None:
+        raise RuntimePortError(f"no zenoh router: {refusal}")
     deadline = time.monotonic() + timeout
-    while not any(True for _ in session.info.routers_zid()):
+    while not _connected(session):
         if time.monotonic() > deadline:
             raise RuntimePortError(f"no zenoh router after {timeout:g} s: "
                                    f"{why_no_router(config, endpoint)}")

@@ -79,6 +79,7 @@ from tdcm_ros.runtime.port import (
     QoS,
 )
 from tdcm_ros.runtime.rosout import ROSOUT_QOS, ROSOUT_TOPIC, RosoutHandler
+from tdcm_ros.runtime.spec_params import NODE_COMMON, declare_specs
 from tdcm_ros.runtime.throttle import Throttled
 from tdcm_ros.runtime.wire import RawSample
 from tdcm_ros.runtime.zenoh_query import gather, graph_tokens, servers_of
@@ -488,10 +489,7 @@ class ZenohNodePort:
         self._rosout = RosoutHandler(self.fqn, self.create_publisher(
             ROSOUT_TOPIC, "rcl_interfaces/msg/Log", ROSOUT_QOS))
         self.logger.addHandler(self._rosout)
-        self.use_sim_time = self.declare_parameter(
-            "use_sim_time", False, read_only=True,
-            description=f"take the time from {CLOCK_TOPIC} ({CLOCK_TYPE}) instead of the system "
-                        f"clock (0 until the first message), as ROS nodes do; fixed at start")
+        self.use_sim_time = bool(declare_specs(self, NODE_COMMON, read_only=True)["use_sim_time"])
         if self.use_sim_time:
             self.create_subscription(CLOCK_TOPIC, CLOCK_TYPE, self._on_clock, CLOCK_QOS)
 
@@ -658,6 +656,14 @@ class ZenohContext:
     def router_connected(self) -> bool:
         """True while at least one zenoh router is connected to the session."""
         return any(True for _ in self.session.info.routers_zid())
+
+    def require_router(self) -> None:
+        """``RuntimePortError`` saying why if the session reaches no router at the endpoint
+        within :data:`~tdcm_ros.runtime.zenoh_diagnosis.ROUTER_WAIT_S` s (at once if nothing
+        listens there)."""
+        from tdcm_ros.runtime.zenoh_diagnosis import require_router
+
+        require_router(self.session, session_config(), endpoint())
 
     def create_port(self, name: str, namespace: str = "/",
                     overrides: dict[str, Any] | None = None) -> ZenohNodePort:

@@ -17,7 +17,8 @@ def test_every_parameter_of_the_node_is_one_row(node: str, capsys: pytest.Captur
     assert main(["param", "specs", node]) == 0
     rows = capsys.readouterr().out.splitlines()[2:]
     module = importlib.import_module(NODES[node].partition(":")[0])
-    assert [row.split(" | ")[0].strip("| `") for row in rows] == list(module.PARAMETERS)
+    assert [row.split(" | ")[0].strip("| `") for row in rows] == [*module.PARAMETERS,
+                                                                   "use_sim_time"]
     assert all(row.count(" | ") == 4 for row in rows)  # choices' bars are escaped
 
 
@@ -29,6 +30,7 @@ def test_a_row_shows_unit_default_and_range(capsys: pytest.CaptureFixture[str]) 
     assert "| 1850000000.0 |" in rows["design.E"]  # Design's default E
     assert "| (derived) |" in rows["design.w_n"]   # no default: the preset gives it
     assert "paper \\| free" in rows["solver.routing"]
+    assert rows["use_sim_time"].startswith("| `use_sim_time` |  | False | true \\| false | take ")
 
 
 def test_an_unknown_node_is_an_input_error(capsys: pytest.CaptureFixture[str]) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import signal
 import threading
+import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -33,6 +34,7 @@ class _FakePlayer:
     def __init__(self, bag: str, options: Any, *, runtime: str, on_progress: Any,
                  on_topic: Any) -> None:
         self.reader = argparse.Namespace(path=bag)
+        self.base_ns = time.time_ns()  # a bag of now: no stale-stamp warning
         self.topics = ["/a"]
         self._stop = threading.Event()
         self.closed = False

@@ -258,3 +258,25 @@ def test_echo_refuses_a_negative_wait(capsys):
     assert main(["topic", "echo", "chatter", "--wait-matching", "-1"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--wait-matching = -1.0 s must be >= 0" in err
+
+
+def test_the_readme_example_header_auto_reaches_model_node_and_each_message_is_printed(
+        context, spawn: Spawn):
+    """``{header: auto}`` stamps each message as it is sent, so model_node solves it (an unset
+    stamp is dropped as unstamped); every message is printed as one line of YAML."""
+    tips: list[Any] = []
+    context.create_port("probe").create_subscription("tip_pose", "geometry_msgs/msg/PoseStamped",
+                                                     tips.append)
+    spawn("tdcm_ros.runtime.run_node", "tdcm_ros.nodes.model_node:ModelNode")
+    pub = spawn("tdcm_ros.cli.main", "topic", "pub", "tension",
+                "geometry_msgs/msg/WrenchStamped", "{header: auto, wrench: {force: {z: 20.0}}}",
+                "--rate", "10", "--times", "40", "--wait-matching", "30")
+    eventually(lambda: tips, 60.0, "tip_pose for a stamped tension", spin=context)
+    out, err = pub.communicate(timeout=60)
+    assert pub.returncode == 0, err.decode()
+    lines = [line for line in out.decode().splitlines() if line.startswith("publishing #")]
+    assert len(lines) == 40
+    first = yaml.safe_load(lines[0].split(": ", 1)[1])
+    assert first["wrench"]["force"]["z"] == 20.0 and first["header"]["stamp"]["sec"] > 0
+    stamps = [yaml.safe_load(line.split(": ", 1)[1])["header"]["stamp"] for line in lines]
+    assert len({(s["sec"], s["nanosec"]) for s in stamps}) == 40  # stamped at each publish

@@ -1,0 +1,47 @@
+"""``tdcm up``'s plan from its options: ``-p NODE:NAME:=VALUE`` and ``--use-sim-time`` become
+the nodes' parameter overrides (over ``--params``); bad ones are typed errors naming them."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+import pytest
+
+from tdcm_ros.cli.up import plan, register
+from tdcm_ros.errors import InputError
+from tdcm_ros.runtime.graph import merged_params
+
+
+def up_args(*argv: str) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    register(parser.add_subparsers())
+    return parser.parse_args(["up", *argv])
+
+
+def test_p_sets_one_nodes_parameter_read_as_yaml() -> None:
+    nodes, overrides, _ = plan(up_args("--nodes", "model_node,metrics_node", "-p",
+                                       "model_node:input.max_age_s:=2.0", "-p",
+                                       "metrics_node:markers.arc_lengths:=[0.02, 0.05]"), 1)
+    assert nodes == ["model_node", "metrics_node"]
+    assert overrides == {"model_node": {"input.max_age_s": 2.0},
+                         "metrics_node": {"markers.arc_lengths": [0.02, 0.05]}}
+
+
+def test_use_sim_time_sets_it_on_every_node_and_reaches_the_parameter_file(tmp_path) -> None:
+    nodes, overrides, _ = plan(up_args("--twin", "--use-sim-time"), 1)
+    assert all(overrides[node]["use_sim_time"] is True for node in nodes)
+    written = merged_params(tmp_path, "model_node", None, overrides["model_node"])
+    assert "use_sim_time: true" in Path(written).read_text()
+
+
+@pytest.mark.parametrize(("item", "message"), [
+    ("model_node:input.max_age_s=2.0", "is not [NODE:]NAME:=VALUE"),
+    ("shape_controller:mode:=feedback", "names node 'shape_controller', which is not started"),
+    ("input.max_age_s:=2.0", "names no node"),
+])
+def test_a_bad_p_is_an_input_error_naming_it(item: str, message: str) -> None:
+    with pytest.raises(InputError, match=re.escape(message)) as error:
+        plan(up_args("-p", item), 1)
+    assert error.value.parameter == "-p"
