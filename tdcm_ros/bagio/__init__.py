@@ -4,7 +4,7 @@
 that rmw_zenoh puts in its key expressions (``service_type_hash`` for ``pkg/srv/Name``).
 """
 
-from tdcm_ros.bagio.convert import from_dict, to_dict
+from tdcm_ros.bagio.convert import from_dict, prepare_codec, to_dict
 from tdcm_ros.bagio.errors import BagError
 from tdcm_ros.bagio.services import normalize_service_type
 from tdcm_ros.bagio.typestore import (
@@ -27,6 +27,7 @@ __all__ = [
     "msg_class",
     "normalize_service_type",
     "normalize_type_name",
+    "prepare_codec",
     "serialize",
     "service_type_hash",
     "to_dict",

@@ -12,7 +12,12 @@ import numpy as np
 from rosbags.typesys.base import Nodetype
 
 from tdcm_ros.bagio.errors import BagError
-from tdcm_ros.bagio.typestore import normalize_type_name, typestore
+from tdcm_ros.bagio.typestore import (
+    deserialize,
+    normalize_type_name,
+    serialize,
+    typestore,
+)
 
 _NUMPY_TYPES: dict[str, type] = {
     "bool": np.bool_, "byte": np.uint8, "char": np.uint8, "int8": np.int8, "uint8": np.uint8,
@@ -79,3 +84,10 @@ def to_dict(message: Any) -> Any:
     if isinstance(message, np.generic):
         return message.item()
     return message
+
+
+def prepare_codec(type_name: str) -> None:
+    """Build ``type_name``'s CDR serialiser and deserialiser now: rosbags generates them on first
+    use (about 20 ms a type here, many times more on a loaded machine), which a node's callback
+    thread must not pay while it has a device to keep alive."""
+    deserialize(serialize(from_dict(type_name, {}), type_name), type_name)

@@ -30,6 +30,7 @@ from tdcm_ros.bagio import (
     from_dict,
     normalize_service_type,
     normalize_type_name,
+    prepare_codec,
     serialize,
 )
 from tdcm_ros.errors import InputError
@@ -154,6 +155,7 @@ class _Publisher:
 
     def __init__(self, node: Any, topic: str, type_name: str, qos: QoS) -> None:
         self.type_name = normalize_type_name(type_name)
+        prepare_codec(self.type_name)  # not on the callback thread at the first publish
         self._publisher = node.create_publisher(message_class(self.type_name), topic,
                                                 qos_profile(qos))
         self.topic = self._publisher.topic_name

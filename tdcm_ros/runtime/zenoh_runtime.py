@@ -41,6 +41,7 @@ from tdcm_ros.bagio import (
     from_dict,
     normalize_service_type,
     normalize_type_name,
+    prepare_codec,
     serialize,
     service_type_hash,
     type_hash,
@@ -235,6 +236,7 @@ class _Publisher:
     def __init__(self, context: ZenohContext, identity: wire.NodeIdentity, topic: str,
                  type_name: str, qos: QoS) -> None:
         self.topic, self.type_name = topic, type_name
+        prepare_codec(type_name)  # not on the callback thread at the first publish
         rihs = type_hash(type_name)
         self.key = wire.topic_key(identity.domain_id, topic, type_name, rihs)
         self.token_key = wire.endpoint_token(identity, context.next_id(), wire.PUBLISHER, topic,
@@ -296,6 +298,7 @@ class _Subscription:
             self.key = f"{domain}/{topic.strip('/')}/*/*"
             self._token = None
         else:
+            prepare_codec(type_name)  # not on the callback thread at the first sample
             rihs = type_hash(type_name)
             self.key = wire.topic_key(domain, topic, type_name, rihs)
             token = wire.endpoint_token(identity, context.next_id(), wire.SUBSCRIPTION, topic,

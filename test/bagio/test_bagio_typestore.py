@@ -92,3 +92,16 @@ def test_bytes_past_the_message_are_refused_unless_not_exact() -> None:
     assert deserialize(data, "std_msgs/msg/String", exact=False).data == "hi"
     with pytest.raises(BagError):
         deserialize(data[:9], "std_msgs/msg/String", exact=False)
+
+
+def test_prepare_codec_builds_the_codec_of_a_type_and_its_fields_before_first_use() -> None:
+    """rosbags generates a type's CDR code on first use (about 20 ms a type); prepare_codec does
+    it at once, so a node's callback thread never pays it (a driver loop stalled by it misses the
+    device's watchdog on a loaded machine)."""
+    from tdcm_ros.bagio import prepare_codec, typestore
+
+    name = "diagnostic_msgs/msg/DiagnosticArray"
+    typestore().cache.pop(name, None)
+    prepare_codec(name)
+    assert {name, "diagnostic_msgs/msg/DiagnosticStatus", "diagnostic_msgs/msg/KeyValue",
+            "std_msgs/msg/Header"} <= set(typestore().cache)

@@ -120,6 +120,18 @@ class Probe:
         eventually(predicate, timeout, what, spin=self.ctx, action=action,
                    detail=lambda: f"last state {self.state()}")
 
+    def hold(self, reached: Callable[[], bool], newtons: float, timeout: float = 15.0) -> None:
+        """Until ``reached()``, publishing setpoint ``newtons`` and, whenever the device reports
+        a latched fault, calling ``clear_faults`` first, as an operator would: on a loaded
+        machine a driver process not scheduled for 0.5 s trips the device's watchdog (the
+        device failing safe, not what the callers test)."""
+        def ask() -> None:
+            if self.state().get("faults"):
+                self.clear_faults()
+            self.setpoint(newtons)
+
+        self.until(reached, timeout, f"{newtons:g} N on the tendon", action=ask)
+
     def connected(self, mode: str = "tension", timeout: float = 30.0,
                   action: Callable[[], None] | None = None) -> None:
         """Until the driver reports the link up with the device in ``mode`` (``action`` as in

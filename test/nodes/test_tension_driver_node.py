@@ -100,8 +100,7 @@ def test_a_setpoint_reaches_the_tendon_and_sigint_releases_it(runtime, spawn, pr
     node = start_driver(spawn, tmp_path, twin)
     probe.connected()
     assert abs(float(probe.state()["tension"])) < 0.1
-    probe.until(lambda: abs(twin.twin.plant.tension - 8.0) < BAND, 15.0, "8 N on the tendon",
-                action=lambda: probe.setpoint(8.0))
+    probe.hold(lambda: abs(twin.twin.plant.tension - 8.0) < BAND, 8.0)
     probe.until(lambda: probe.tension and abs(probe.tension[-1].wrench.force.z - 8.0) < BAND,
                 10.0, "8 N on the tension topic")
     assert all(m.header.frame_id == "tdcm_tendon" for m in probe.tension)
@@ -117,8 +116,7 @@ def test_device_releases_within_its_watchdog_when_heartbeats_stop(runtime, spawn
     """The driver process is frozen (SIGSTOP: a hung host); the device releases by itself."""
     node = start_driver(spawn, tmp_path, twin)
     probe.connected()
-    probe.until(lambda: twin.twin.plant.tension > 7.5, 15.0, "8 N on the tendon",
-                action=lambda: probe.setpoint(8.0))
+    probe.hold(lambda: twin.twin.plant.tension > 7.5, 8.0)
     core = twin.twin.core
     released = watch_release(core)
     os.kill(node.pid, signal.SIGSTOP)
