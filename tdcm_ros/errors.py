@@ -49,6 +49,13 @@ class PhysicsError(TdcmError):
 SHOWN_CHARS = 80
 
 
+def exact_number(value: float) -> str:
+    """``value`` as short as ``:g`` shows it when that reads back as the same float, else with
+    every digit it needs (``repr``): a printed bound is the true bound."""
+    short = f"{value:g}"
+    return short if float(short) == value else repr(float(value))
+
+
 def shown_value(value: Any) -> str:
     """``repr(value)``, or its first :data:`SHOWN_CHARS` characters and the value's length."""
     text = repr(value)

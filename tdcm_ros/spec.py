@@ -19,7 +19,13 @@ import numbers
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import Any
 
-from tdcm_ros.errors import InputError, out_of_range, reject_unknown, shown_value
+from tdcm_ros.errors import (
+    InputError,
+    exact_number,
+    out_of_range,
+    reject_unknown,
+    shown_value,
+)
 
 #: float | int | bool | str (``choices`` optional) | names (distinct non-empty strings) |
 #: vector (``size`` numbers) | list (numbers, length >= 1)
@@ -96,12 +102,12 @@ class Spec:
     def _span(self) -> str:
         low, high = math.isfinite(self.low), math.isfinite(self.high)
         if low and high:
-            return (f"{'(' if self.low_open else '['}{self.low:g}, "
-                    f"{self.high:g}{')' if self.high_open else ']'}")
+            return (f"{'(' if self.low_open else '['}{exact_number(self.low)}, "
+                    f"{exact_number(self.high)}{')' if self.high_open else ']'}")
         if low:
-            return f"{'>' if self.low_open else '>='} {self.low:g}"
+            return f"{'>' if self.low_open else '>='} {exact_number(self.low)}"
         if high:
-            return f"{'<' if self.high_open else '<='} {self.high:g}"
+            return f"{'<' if self.high_open else '<='} {exact_number(self.high)}"
         return ""
 
     def allowed(self) -> str:

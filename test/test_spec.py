@@ -62,7 +62,8 @@ def test_the_allowed_text_shows_the_bounds_their_ends_and_the_unit(spec: Spec) -
     text = spec.allowed()
     assert text[0] == ("(" if spec.low_open else "[")
     assert text.endswith((")" if spec.high_open else "]") + " m")
-    assert f"{spec.low:g}" in text and f"{spec.high:g}" in text
+    low, high = text[1:].rsplit(" ", 1)[0][:-1].split(", ")
+    assert (float(low), float(high)) == (spec.low, spec.high)  # the true bounds, not rounded
 
 
 @pytest.mark.parametrize(("spec", "allowed"), [
@@ -310,3 +311,22 @@ def test_strings_and_sequences_are_bounded_and_the_error_stays_short(kind: str) 
     assert str(caught.value).startswith("frame_id = ")
     assert f"({len(too_long)} {unit})" in str(caught.value)
     assert len(str(caught.value)) < 200
+
+
+@given(st.floats(allow_nan=False, allow_infinity=False))
+def test_a_printed_bound_reads_back_as_the_bound(value: float) -> None:
+    """exact_number is ``:g`` when that is the same float, else every digit needed."""
+    from tdcm_ros.errors import exact_number
+
+    shown = exact_number(value)
+    assert float(shown) == value
+    assert len(shown) <= len(repr(value)) or shown == f"{value:g}"
+
+
+def test_a_bound_that_g_would_round_is_printed_whole() -> None:
+    from tdcm_ros.errors import exact_number
+
+    assert exact_number(0.08) == "0.08" and exact_number(20.0) == "20"
+    assert exact_number(0.0799999999997) == "0.0799999999997"
+    assert Spec("x", "m", "", 0.01, low=0.0, high=0.0799999999997).allowed() == \
+        "[0, 0.0799999999997] m"

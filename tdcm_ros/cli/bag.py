@@ -14,6 +14,7 @@ exits with status 1 (so a hang anywhere, even in the interpreter's exit, shows w
 from __future__ import annotations
 
 import argparse
+import datetime
 import faulthandler
 import signal
 import sys
@@ -79,12 +80,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     play.set_defaults(handler=run_play)
 
 
+def utc_time(ns: int) -> str:
+    """ns since the epoch as an ISO 8601 UTC time to the microsecond."""
+    return datetime.datetime.fromtimestamp(ns / 1e9, datetime.UTC).isoformat(
+        timespec="microseconds").replace("+00:00", "Z")
+
+
 def run_info(args: argparse.Namespace) -> int:
     """Print what ``open_bag`` finds in a bag."""
     from tdcm_ros.bagio.reader import open_bag
 
     reader = open_bag(args.bag)
-    print(f"bag: {reader.path}\nmessages: {reader.message_count}\ntopics:")
+    print(f"bag: {reader.path}")
+    if reader.message_count:
+        first_ns, last_ns = reader.time_range_ns
+        print(f"duration: {(last_ns - first_ns) / 1e9:.3f} s\n"
+              f"start: {utc_time(first_ns)} ({first_ns / 1e9:.9f})\n"
+              f"end: {utc_time(last_ns)} ({last_ns / 1e9:.9f})")
+    print(f"messages: {reader.message_count}\ntopics:")
     for topic in sorted(reader.topics):
         print(f"  {topic} [{reader.topics[topic]}]: {reader.counts[topic]}")
     for warning in reader.warnings:

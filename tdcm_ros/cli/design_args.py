@@ -15,6 +15,7 @@ from tdcm_ros.model import (
     Design,
     InvalidTargetError,
     SolverSettings,
+    candidate,
     parse_field,
     preset,
 )
@@ -31,7 +32,8 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                              "the same as --set design.preset=NAME")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override a design field in SI units, e.g. --set E=1.2e9 (or "
-                             "design.E=1.2e9, as evaluate takes it)")
+                             "design.E=1.2e9, as evaluate takes it); L (the length, m) sets w_t "
+                             "as tdcm design --free L does")
     parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
     for name in ("routing", "loads"):  # choices and defaults from the settings' specs
         spec = SOLVER_SPECS[name]
@@ -58,7 +60,9 @@ def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
         if not sep or not name:
             raise InputError(f"--set {pair!r} is not NAME=VALUE", parameter="--set", value=pair,
                              allowed="NAME=VALUE with a design field name")
-        if name != "preset":
+        if name == "L":
+            values[name] = _length(text.strip())
+        elif name != "preset":
             values[name] = parse_field(name, text.strip())
         elif named is not None:
             raise InputError(f"--design {named!r} and --set {pair.strip()!r} both name the "
@@ -66,8 +70,24 @@ def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
                              allowed="--design NAME or --set design.preset=NAME, not both")
         else:
             named = text.strip()
-    design = preset(named or DEFAULT_DESIGN).with_overrides(**values)
-    return spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN, design
+    fields = {k: v for k, v in values.items() if k != "L"}
+    design = preset(named or DEFAULT_DESIGN).with_overrides(**fields)
+    if "L" in values:  # w_t (w_tip for one notch) from the length, as tdcm design --free L
+        design = candidate(design, {"L": values["L"]})
+    name = spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN
+    return (f"{name} modified ({', '.join(sorted(values))})" if values else name), design
+
+
+def _length(text: str) -> float:
+    """``--set L=VALUE``: a length in m, > 0."""
+    try:
+        length = float(text)
+    except ValueError:
+        length = float("nan")
+    if not length > 0 or length == float("inf"):
+        raise InputError(f"--set L = {text!r} is not a length > 0 m", parameter="L", value=text,
+                         allowed="a finite number > 0 (m)")
+    return length
 
 
 def add_tip_targets(group: argparse._MutuallyExclusiveGroup) -> None:

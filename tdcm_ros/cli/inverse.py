@@ -13,7 +13,8 @@ from tdcm_ros.cli.design_args import (
     design_and_settings,
     target_number,
 )
-from tdcm_ros.errors import TdcmError
+from tdcm_ros.device import constants
+from tdcm_ros.errors import TdcmError, out_of_range
 from tdcm_ros.model import (
     DEFAULT_TENSION_MAX_N,
     InvalidTargetError,
@@ -44,9 +45,17 @@ def register(subparsers: Any) -> None:
                         help="lower tension bound (N, default 0)")
     parser.add_argument("--tension-max", default=str(DEFAULT_TENSION_MAX_N), metavar="N",
                         help=f"upper tension bound (N, default {DEFAULT_TENSION_MAX_N:g})")
+    parser.add_argument("--device-max", default=str(DEVICE_MAX_N), metavar="N",
+                        help=f"largest tension the device can hold (N, default {DEVICE_MAX_N:g}: "
+                             "the tension device's largest setpoint; give your driver's "
+                             "tension_max): a target that needs more is said to be out of reach")
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.set_defaults(handler=run)
+
+
+#: N: the tension device's largest setpoint (the firmware refuses more).
+DEVICE_MAX_N = constants.SETPOINT_MAX_MN / 1000
 
 
 def _target(args: argparse.Namespace) -> dict[str, Any]:
@@ -72,15 +81,23 @@ def run(args: argparse.Namespace) -> int:
             design, **_target(args), settings=settings,
             tension_min=target_number("--tension-min", args.tension_min, "[0, tension-max) N"),
             tension_max=target_number("--tension-max", args.tension_max, "(tension-min, inf) N"))
+        device_max = target_number("--device-max", args.device_max, "> 0 N")
+        if not 0.0 < device_max < float("inf"):
+            raise out_of_range("--device-max", device_max, "a finite number > 0", unit="N")
     except TdcmError as error:
         if args.json:
             print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))
         print(f"tdcm inverse: {error}", file=sys.stderr)
         return error.exit_code
+    within = found.tension_n <= device_max
     if args.json:
-        print(json.dumps(found.summary()))
+        print(json.dumps({**found.summary(), "device_max_n": device_max,
+                          "within_device": within}))
     else:
         _print(name, found)
+    if not within:
+        print(f"tdcm inverse: WARNING: the target needs {found.tension_n:.4g} N, more than the "
+              f"device holds ({device_max:g} N, --device-max)", file=sys.stderr)
     return 0
 
 

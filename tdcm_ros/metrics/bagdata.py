@@ -1,6 +1,7 @@
 """Read the evaluation's inputs from a bag: tension, marker frames and the registration.
 
-- tension: ``geometry_msgs/msg/WrenchStamped`` (``wrench.force.z``, N);
+- tension: ``geometry_msgs/msg/WrenchStamped`` (``wrench.force.z``, N) or, as model_node takes
+  it, ``std_msgs/msg/Float64`` (``data``, N; no header: stamped by the bag's log times);
 - markers: ``mocap4r2_msgs/msg/Markers`` (positions in the message's frame, matched to the
   layout's labels by ``marker_name``; unknown names are ignored and counted in a warning; a
   layout label never seen is an error listing the names the bag holds, with their frame counts). A
@@ -35,12 +36,13 @@ import numpy as np
 
 from tdcm_ros.bagio import BagError
 from tdcm_ros.bagio.reader import BagReader, open_bag, require_topic
-from tdcm_ros.metrics.cdr import markers_frame, wrench_force_z
+from tdcm_ros.metrics.cdr import float64_data, markers_frame, wrench_force_z
 from tdcm_ros.metrics.errors import MetricsError
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.mocap import Registration, visible
 
 TENSION_TYPE = "geometry_msgs/msg/WrenchStamped"
+FLOAT_TENSION_TYPE = "std_msgs/msg/Float64"
 MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 BASE_FRAME = "tdcm_base"
@@ -186,8 +188,18 @@ def _tension_series(stamps: np.ndarray, force: np.ndarray) -> TensionSeries:
 
 
 def _tension(reader: BagReader, topic: str, warnings: list[str]) -> TensionSeries:
-    name = require_topic(reader, topic, [TENSION_TYPE])
-    stamps_ns, from_log, unique, (force,) = _read(reader, name, wrench_force_z)
+    try:
+        name = require_topic(reader, topic, [TENSION_TYPE, FLOAT_TENSION_TYPE])
+    except BagError as error:
+        raise BagError(f"{error} (the tension topic: evaluate --tension-topic, calibrate "
+                       f"--tension-topic)", parameter="tension_topic", value=topic) from error
+    floats = reader.topics[name] == FLOAT_TENSION_TYPE
+    stamps_ns, from_log, unique, (force,) = _read(reader, name, float64_data if floats
+                                                  else wrench_force_z)
+    if floats:
+        warnings.append(f"{name}: {FLOAT_TENSION_TYPE} has no header; stamped by the bag's log "
+                        f"times")
+        from_log = False  # said above, not as all-zero header stamps
     stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
     del stamps_ns  # free the stamps (ns) before the series is built
     return _tension_series(stamps, force if keep.all() else force[keep])

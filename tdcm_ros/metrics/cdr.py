@@ -110,3 +110,11 @@ def markers_frame(data: bytes) -> MarkersFrame:
     return (msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec, msg.header.frame_id,
             [m.marker_name for m in msg.markers],
             [(m.translation.x, m.translation.y, m.translation.z) for m in msg.markers])
+
+
+def float64_data(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Zero stamps (a ``std_msgs/msg/Float64`` has no header: the caller takes the log times)
+    and ``data`` (N) of Float64 CDR payloads."""
+    values = np.array([float(deserialize(data, "std_msgs/msg/Float64").data)
+                       for data in payloads])
+    return np.zeros(len(payloads), dtype=np.int64), values

@@ -20,7 +20,7 @@ from tdcm_ros.model.design import (
     parse_field,
     preset,
 )
-from tdcm_ros.model.design_sampling import FREE_FIELDS, SAMPLINGS
+from tdcm_ros.model.design_sampling import FREE_FIELDS, SAMPLINGS, candidate
 from tdcm_ros.model.design_space import (
     DEFAULT_ALLOWABLE_STRAIN,
     STATUSES,
@@ -131,6 +131,7 @@ __all__ = [
     "TensionProfile",
     "TensionRangeError",
     "UnreachableTargetError",
+    "candidate",
     "check_roll",
     "check_tension",
     "depends_on_roll",

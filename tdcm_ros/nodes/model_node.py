@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.errors import InputError, PhysicsError
+from tdcm_ros.errors import InputError, PhysicsError, exact_number
 from tdcm_ros.model import (
     FIELD_SPECS,
     MARKER_SPECS,
@@ -79,6 +79,8 @@ from tdcm_ros.spec import Spec, by_name
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
 #: Rolls kept to pair with tensions: over a second at the driver's telemetry rate.
 ROLL_HISTORY = 2048
+#: m: a marker arc length up to this far past the tip (a length rounded in a file) is the tip.
+TIP_TOLERANCE_M = 1e-9
 #: Parameters fixed at start, besides the design and solver groups.
 FIXED_SPECS = by_name(
     Spec("input.tension_type", description="message type on `tension`", default=TENSION_TYPES[0],
@@ -197,10 +199,12 @@ class ModelNode(NodeLogic):
         settings = SolverSettings(**read_specs(self.port, SOLVER_SPECS, prefix="solver.",
                                                changes=changes))
         arcs = changes.get("markers.arc_lengths", self.port.get_parameter("markers.arc_lengths"))
-        if not arcs or any(not 0.0 <= float(s) <= design.length for s in arcs):
-            raise InputError(f"markers.arc_lengths = {arcs!r} out of range; allowed: values in "
-                             f"[0, {design.length:g}] m", parameter="markers.arc_lengths",
-                             value=arcs, allowed=f"[0, {design.length:g}] m")
+        end = design.length + TIP_TOLERANCE_M
+        if not arcs or any(not 0.0 <= float(s) <= end for s in arcs):
+            allowed = (f"values in [0, {exact_number(design.length)}] m (up to "
+                       f"{TIP_TOLERANCE_M:g} m past the tip: at the tip)")
+            raise InputError(f"markers.arc_lengths = {arcs!r} out of range; allowed: {allowed}",
+                             parameter="markers.arc_lengths", value=arcs, allowed=allowed)
         return design, settings
 
     def _on_set(self, changes: Mapping[str, Any]) -> None:
@@ -316,7 +320,8 @@ class ModelNode(NodeLogic):
         for topic, message in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),
-                marker_s=np.asarray(self.port.get_parameter("markers.arc_lengths"), dtype=float),
+                marker_s=np.minimum(np.asarray(self.port.get_parameter("markers.arc_lengths"),
+                                               dtype=float), self.design.length),
                 marker_radius=radius,
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
                 roll=roll):

@@ -93,3 +93,24 @@ def test_cross_field_limits_exit_2(capsys, args, kind):
     out = capsys.readouterr()
     assert code == 2 and json.loads(out.out)["error"]["kind"] == kind
     assert len(out.err.strip().splitlines()) == 1
+
+
+def test_set_l_derives_w_t_as_design_does_and_the_design_is_named_modified(capsys):
+    """``--set L=0.06`` (refused before as an unknown field) gives the preset with w_t from the
+    length, the same design ``tdcm design --free L`` builds; the console names it modified."""
+    from tdcm_ros.model import candidate
+
+    _, data, _ = run_json(capsys, "--tension", "10", "--set", "L=0.06")
+    expected = candidate(preset("paper-experiment"), {"L": 0.06})
+    assert data["design"]["w_t"] == expected.w_t and data["design"]["L"] == pytest.approx(0.06)
+    assert main(["solve", "--tension", "10", "--set", "L=0.06", "--set", "E=1.2e9"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("design paper-experiment modified (E, L): L = 60.000 mm, E = 1.2e+09")
+    assert main(["solve", "--tension", "10"]) == 0
+    assert capsys.readouterr().out.startswith("design paper-experiment: L = 53.000 mm")
+
+
+@pytest.mark.parametrize("value", ["-0.01", "0", "nan", "inf", "short"])
+def test_a_length_that_is_not_positive_is_refused(capsys, value):
+    assert main(["solve", "--tension", "10", "--set", f"L={value}"]) == 2
+    assert "--set L = " in capsys.readouterr().err

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from mcap.reader import SeekingReader
 
-from tdcm_ros.bagio import deserialize, serialize
+from tdcm_ros.bagio import BagError, deserialize, serialize
 from tdcm_ros.bagio.reader import BagReader, open_bag
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
@@ -211,3 +211,39 @@ def test_log_times_replace_header_stamps_only_when_every_one_is_zero(
         logs = [stamp for _, stamp, _ in open_bag(path).raw_messages(["/tension"])]
         np.testing.assert_array_equal(source.tension.stamps_s,
                                       np.array(logs, dtype=np.int64) * 1e-9)
+
+
+def test_a_float64_tension_topic_is_read_as_model_node_takes_it(clean: Path,
+                                                                 tmp_path: Path) -> None:
+    """The same bag with /tension as std_msgs/msg/Float64 (no header): the same tensions, each
+    stamped by its log time, and a warning that says so (refused before)."""
+    from tdcm_ros.bagio import from_dict
+
+    reader = open_bag(clean)
+    path = tmp_path / "float"
+    logs = []
+    with BagWriter(path) as writer:
+        for topic, msgtype in reader.topics.items():
+            writer.add_topic(topic, "std_msgs/msg/Float64" if topic == "/tension" else msgtype)
+        for topic, stamp, data in reader.raw_messages():
+            if topic == "/tension":
+                force = deserialize(data, "geometry_msgs/msg/WrenchStamped").wrench.force.z
+                data = serialize(from_dict("std_msgs/msg/Float64", {"data": force}),
+                                 "std_msgs/msg/Float64")
+                logs.append(stamp)
+            writer.write(topic, stamp, data)
+    wrench, floats = load_bag(clean, labels=LABELS), load_bag(path, labels=LABELS)
+    order = np.argsort(np.asarray(logs), kind="stable")
+    by_log = np.array([deserialize(d, "geometry_msgs/msg/WrenchStamped").wrench.force.z
+                       for t, _, d in reader.raw_messages(["/tension"])])[order]
+    np.testing.assert_array_equal(floats.tension.tension_n, by_log)
+    np.testing.assert_array_equal(floats.tension.stamps_s,
+                                  np.sort(np.asarray(logs, dtype=np.int64)) * 1e-9)
+    assert sorted(floats.tension.tension_n) == sorted(wrench.tension.tension_n)
+    assert "/tension: std_msgs/msg/Float64 has no header; stamped by the bag's log times" in \
+        floats.warnings
+
+
+def test_a_missing_tension_topic_names_the_option_that_sets_it(clean: Path) -> None:
+    with pytest.raises(BagError, match=r"no topic '/force'.*evaluate --tension-topic"):
+        load_bag(clean, labels=LABELS, tension_topic="/force")

@@ -166,3 +166,19 @@ def test_drops_are_announced_on_the_log_with_the_reason_and_its_parameter(
     assert lines[3] == "dropped tension 500.0 N: above input.tension_max = 200 N"
     assert len(lines) == 5 and lines[4].endswith("(2 more like it in the last 5.0 s)")
     assert n.node.counts["dropped_unstamped"] == 4
+
+
+def test_a_marker_rounded_past_the_tip_is_the_tip_and_a_refused_bound_is_printed_true() -> None:
+    """An 80 mm tube whose notch width makes its length 0.0799999999999... m: a marker at 0.08 m
+    (what a user writes) is taken at the tip; one 1 µm past it is refused with the true bound."""
+    from tdcm_ros.errors import InputError
+    from tdcm_ros.model import preset as design_preset
+
+    base = design_preset("paper-experiment")
+    n = Node({"design.w_t": base.w_t * (1 - 1e-12), "markers.arc_lengths": [0.02, base.length]})
+    length = n.node.design.length
+    assert length < base.length
+    assert n.send(20.0, n.port.now_ns())
+    with pytest.raises(InputError) as error:
+        n.node._config({"markers.arc_lengths": [0.02, base.length + 1e-6]})
+    assert f"[0, {length!r}] m" in str(error.value)
