@@ -53,7 +53,11 @@ def exact_number(value: float) -> str:
     """``value`` as short as ``:g`` shows it when that reads back as the same float, else with
     every digit it needs (``repr``): a printed bound is the true bound."""
     short = f"{value:g}"
-    return short if float(short) == value else repr(float(value))
+    if float(short) == value:
+        return short
+    if float(value).is_integer() and abs(value) < 2**53:
+        return str(int(value))
+    return repr(float(value))
 
 
 def shown_value(value: Any) -> str:
