@@ -77,14 +77,31 @@ def free_port() -> int:
         return int(sock.getsockname()[1])
 
 
-@contextlib.contextmanager
-def zenoh_graph(*nodes: list[str]) -> Iterator[dict[str, str]]:
-    """A private router on loopback and ``nodes`` (argv tails of ``python -m``); yields the env."""
-    port = free_port()
+def private_endpoint(port: int) -> dict[str, str]:
+    """The environment of a graph on ``tcp/127.0.0.1:port`` (also applied to this process)."""
     env = {**os.environ, "TDCM_ZENOH_ENDPOINT": f"tcp/127.0.0.1:{port}", "TDCM_RUNTIME": "zenoh",
            "ROS_DOMAIN_ID": "0"}
     env.pop("TDCM_ZENOH_CONFIG", None)
     os.environ.update({k: env[k] for k in ("TDCM_ZENOH_ENDPOINT", "TDCM_RUNTIME", "ROS_DOMAIN_ID")})
+    return env
+
+
+def stop_child(child: subprocess.Popen[Any]) -> None:
+    """SIGINT, then SIGKILL after 10 s."""
+    if child.poll() is None:
+        child.send_signal(signal.SIGINT)
+        try:
+            child.wait(10)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            child.wait()
+
+
+@contextlib.contextmanager
+def zenoh_graph(*nodes: list[str]) -> Iterator[dict[str, str]]:
+    """A private router on loopback and ``nodes`` (argv tails of ``python -m``); yields the env."""
+    port = free_port()
+    env = private_endpoint(port)
     children = [subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.router", "--listen",
                                   f"tcp/127.0.0.1:{port}"], env=env, stderr=subprocess.DEVNULL)]
     time.sleep(1.0)
@@ -95,13 +112,7 @@ def zenoh_graph(*nodes: list[str]) -> Iterator[dict[str, str]]:
         yield env
     finally:
         for child in reversed(children):
-            if child.poll() is None:
-                child.send_signal(signal.SIGINT)
-                try:
-                    child.wait(10)
-                except subprocess.TimeoutExpired:
-                    child.kill()
-                    child.wait()
+            stop_child(child)
 
 
 def wait_until(predicate: Callable[[], bool], timeout: float, spin: Callable[[float], None]
@@ -670,25 +681,16 @@ def campaign_router_loss(tries: int, rng: random.Random, tmp: Path) -> Failures:
     failures: Failures = []
     for _ in range(tries):
         port = free_port()
-        env = {**os.environ, "TDCM_ZENOH_ENDPOINT": f"tcp/127.0.0.1:{port}",
-               "TDCM_RUNTIME": "zenoh", "ROS_DOMAIN_ID": "0"}
-        env.pop("TDCM_ZENOH_CONFIG", None)
-        os.environ.update({k: env[k] for k in ("TDCM_ZENOH_ENDPOINT", "TDCM_RUNTIME",
-                                               "ROS_DOMAIN_ID")})
         up = subprocess.Popen([sys.executable, "-m", "tdcm_ros.cli.main", "up", "--twin"],
-                              env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                              env=private_endpoint(port), stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL)
         try:
             time.sleep(3.0)
             failure = _router_loss_once(port)
             if failure:
                 failures.append(failure)
         finally:
-            up.send_signal(signal.SIGINT)
-            try:
-                up.wait(20)
-            except subprocess.TimeoutExpired:
-                up.kill()
-                up.wait()
+            stop_child(up)
     return failures
 
 

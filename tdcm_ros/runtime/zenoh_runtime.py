@@ -88,7 +88,6 @@ from tdcm_ros.runtime.zenoh_query import gather, graph_tokens, servers_of
 ENDPOINT_ENV = "TDCM_ZENOH_ENDPOINT"
 CONFIG_ENV = "TDCM_ZENOH_CONFIG"
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
-NAME_CHECK_TIMEOUT_S = 0.5  # longest wait for the graph's node list at a node's start (s)
 HEARTBEAT_PERIOD_S = 0.5
 """Sporadic heartbeat of a reliable transient-local publisher (s): rmw_zenoh's
 ``SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD`` (``rmw_publisher_data.cpp``)."""
@@ -480,7 +479,7 @@ class ZenohNodePort:
         self._clients: dict[tuple[str, str], _Client] = {}
         self._clients_lock = threading.Lock()
         self.guard = CallbackGuard(self.fqn, self.logger, self.create_publisher, self.now_ns)
-        self._warn_if_name_taken(context)
+        self._name_watch = self._watch_name(context)
         self._token = context.session.liveliness().declare_token(wire.node_token(self.identity))
         self._clock_ns, self.use_sim_time = 0, False
         self._parameter_services = ParameterServices(
@@ -497,16 +496,21 @@ class ZenohNodePort:
             self.create_subscription(CLOCK_TOPIC, CLOCK_TYPE, self._on_clock, CLOCK_QOS)
 
     # parameters
-    def _warn_if_name_taken(self, context: ZenohContext) -> None:
-        """Warn if a node of this name is already in the graph: ROS tools, parameter clients
-        and remapping cannot tell two nodes of one name apart."""
-        others = [t.zid for t in graph_tokens(context.session, context.domain_id,
-                                                NAME_CHECK_TIMEOUT_S)
-                  if t.kind == wire.NODE and t.node_fqn == self.fqn]
-        if others:
-            self.logger.warning("a node named %s is already in the graph (session %s); tools "
-                                "and parameter clients cannot tell the two apart", self.fqn,
-                                ", ".join(sorted(set(others))))
+    def _watch_name(self, context: ZenohContext) -> Any:
+        """Warn whenever another session's node of this name is in the graph, already or later
+        (a liveliness subscriber with history: no wait at start, no miss on a slow router):
+        ROS tools, parameter clients and remapping cannot tell two nodes of one name apart."""
+        own = wire.node_token(self.identity).split("/")
+        selector = "/".join([*own[:2], "*", "*", "*", wire.NODE, *own[6:]])
+
+        def seen(sample: zenoh.Sample) -> None:
+            zid = str(sample.key_expr).split("/")[2]
+            if sample.kind == zenoh.SampleKind.PUT and zid != context.zid:
+                self.logger.warning("another node named %s is in the graph (session %s); "
+                                    "tools and parameter clients cannot tell the two apart",
+                                    self.fqn, zid)
+
+        return context.session.liveliness().declare_subscriber(selector, seen, history=True)
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
@@ -634,6 +638,7 @@ class ZenohNodePort:
         for entity in self._entities:
             entity.close()
         self._entities.clear()
+        self._name_watch.undeclare()
         self._token.undeclare()
 
 

@@ -1,5 +1,7 @@
-"""A second node of a name already in the graph warns (issue 25: two nodes of one name ran with
-no warning); a name of its own does not."""
+"""Two nodes of one name in the graph both warn, whichever came first (issue 25: two nodes of one
+name ran with no warning); a name of its own does not. The warning comes from a liveliness
+subscriber with history, on zenoh's thread: the test waits for it (a start-time query of the
+graph with a 0.5 s bound missed the first node once beside a CPU hog)."""
 
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ from tdcm_ros.runtime.zenoh_query import graph_tokens
 from test.support.waiting import eventually
 
 
-def test_a_second_node_of_one_name_warns(context: Any,
+def test_two_nodes_of_one_name_both_warn(context: Any,
                                          caplog: pytest.LogCaptureFixture) -> None:
     from tdcm_ros.runtime.zenoh_runtime import ZenohContext
 
@@ -26,9 +28,17 @@ def test_a_second_node_of_one_name_warns(context: Any,
         with caplog.at_level(logging.WARNING, "/tension_driver"):
             other.create_port("tension_driver")
             other.create_port("model_node")
+
+            def warned() -> list[str]:
+                return sorted(r.getMessage() for r in caplog.records
+                              if "in the graph" in r.getMessage())
+
+            expected = sorted(
+                f"another node named /tension_driver is in the graph (session {zid}); tools "
+                "and parameter clients cannot tell the two apart"
+                for zid in (context.zid, other.zid))
+            eventually(lambda: warned() == expected, 15.0, "both nodes to warn",
+                       detail=warned)
     finally:
         other.close()
-    warned = [r.getMessage() for r in caplog.records if "already in the graph" in r.getMessage()]
-    expected = (f"a node named /tension_driver is already in the graph (session {context.zid}); "
-                "tools and parameter clients cannot tell the two apart")
-    assert warned == [expected]
+    assert not any("/model_node" in r.getMessage() for r in caplog.records)

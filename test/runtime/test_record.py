@@ -22,6 +22,7 @@ from tdcm_ros.bagio.reader import open_bag
 from tdcm_ros.bagio.typestore import typestore
 from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
+from test.support.processes import Lines
 from test.support.waiting import eventually
 
 REPO = Path(__file__).resolve().parents[2]
@@ -56,21 +57,6 @@ with open(sys.argv[1], "w") as log:
         time.sleep({1.0 / RATE_HZ})
 """
 Spawn = Callable[..., subprocess.Popen[bytes]]
-
-
-class Lines:
-    """Lines of a child's stdout, collected by a thread (never blocks the test)."""
-
-    def __init__(self, process: subprocess.Popen[bytes]) -> None:
-        self.lines: list[str] = []
-        assert process.stdout is not None
-        stream = process.stdout
-        self._thread = threading.Thread(
-            target=lambda: self.lines.extend(line.decode() for line in stream), daemon=True)
-        self._thread.start()
-
-    def has(self, text: str) -> bool:
-        return any(text in line for line in self.lines)
 
 
 def _published(log: Path) -> list[tuple[int, int]]:

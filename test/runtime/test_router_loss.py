@@ -9,35 +9,16 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from tdcm_ros.runtime.zenoh_runtime import ZenohContext
 from test.support.cli import tdcm
-from test.support.processes import listening
+from test.support.processes import Lines, listening
 from test.support.waiting import eventually
 
 Spawn = Callable[..., subprocess.Popen[bytes]]
-
-
-class StderrLines:
-    """Lines of a child's stderr, collected by a thread (never blocks the test)."""
-
-    def __init__(self, process: subprocess.Popen[bytes]) -> None:
-        self.lines: list[str] = []
-        assert process.stderr is not None
-        stream = process.stderr
-        self._thread = threading.Thread(
-            target=lambda: self.lines.extend(line.decode() for line in stream), daemon=True)
-        self._thread.start()
-
-    def has(self, text: str) -> bool:
-        return any(text in line for line in self.lines)
-
-    def tail(self) -> str:
-        return "".join(self.lines[-15:])
 
 
 def router_pid(port: int) -> int:
@@ -83,7 +64,7 @@ def test_tdcm_up_restarts_its_router_and_the_nodes_reconnect(
     same endpoint, and a peer hears the talker through the new router; Ctrl-C then exits 0."""
     port = int(zenoh_env["ZENOH_TEST_PORT"])
     up = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker")
-    log = StderrLines(up)
+    log = Lines(up, "stderr")
     eventually(lambda: listening(port), 30.0, "the router of tdcm up")
     context = ZenohContext()
     try:
@@ -106,7 +87,7 @@ def test_tdcm_up_on_router_exit_stop_stops_the_graph_and_exits_1(
         zenoh_env: dict[str, str], spawn: Spawn) -> None:
     port = int(zenoh_env["ZENOH_TEST_PORT"])
     up = spawn("tdcm_ros.cli.main", "up", "--nodes", "talker", "--on-router-exit", "stop")
-    log = StderrLines(up)
+    log = Lines(up, "stderr")
     eventually(lambda: listening(port) and log.has("starting talker"), 30.0, "tdcm up")
     os.kill(router_pid(port), signal.SIGKILL)
     assert up.wait(30) == 1, log.tail()

@@ -6,6 +6,7 @@ import os
 import signal
 import socket
 import subprocess
+import threading
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -53,3 +54,23 @@ def stop(process: subprocess.Popen[bytes], timeout: float = 10.0) -> int:
         tail = (err or b"")[-3000:].decode(errors="replace")
         raise AssertionError(f"{process.args} did not exit within {scaled(timeout):g} s of "
                              f"SIGINT; killed. Its stderr ends:\n{tail}") from None
+
+
+class Lines:
+    """Lines of a child's ``stdout`` or ``stderr`` pipe, collected by a thread (never blocks
+    the test)."""
+
+    def __init__(self, process: subprocess.Popen[bytes], stream: str = "stdout") -> None:
+        self.lines: list[str] = []
+        pipe = getattr(process, stream)
+        assert pipe is not None, f"the child's {stream} is not a pipe"
+        self._thread = threading.Thread(
+            target=lambda: self.lines.extend(line.decode() for line in pipe), daemon=True)
+        self._thread.start()
+
+    def has(self, text: str) -> bool:
+        return any(text in line for line in self.lines)
+
+    def tail(self, count: int = 15) -> str:
+        """The last ``count`` lines, for a failure's message."""
+        return "".join(self.lines[-count:])
