@@ -111,7 +111,7 @@ class NodeGraph:
         ``rmw_zenohd``) wait up to ``timeout`` for it to answer and never start one."""
         if self.runtime != "zenoh":
             return
-        from tdcm_ros.runtime.router import is_listening
+        from tdcm_ros.runtime.zenoh_diagnosis import is_listening
 
         endpoint = self.endpoint
         if endpoint is None:
@@ -151,7 +151,7 @@ class NodeGraph:
         self._start_router(self.endpoint, timeout)
 
     def _start_router(self, endpoint: str, timeout: float) -> None:
-        from tdcm_ros.runtime.router import is_listening
+        from tdcm_ros.runtime.zenoh_diagnosis import is_listening
 
         self.router = self.start("router", [sys.executable, "-m", "tdcm_ros.runtime.router",
                                             "--listen", endpoint])

@@ -18,44 +18,21 @@ from __future__ import annotations
 import argparse
 import os
 import signal
-import socket
 import sys
 import time
 from collections.abc import Sequence
 from types import FrameType
 
-from tdcm_ros.errors import InputError, TdcmError
+from tdcm_ros.errors import TdcmError
 from tdcm_ros.runtime.run_node import configure_logging
 from tdcm_ros.runtime.shutdown import close_within, exit_now
 from tdcm_ros.runtime.zenoh_config import ROUTER_CONFIG_ENV, warn_if_exposed
 from tdcm_ros.runtime.zenoh_runtime import endpoint, open_session, session_config
 
-#: Protocols whose listeners a TCP connect reaches (TLS runs over TCP).
-TCP_PROTOCOLS = ("tcp", "tls")
 #: Longest wait (s) for the zenoh session to close after a signal before the process leaves.
 CLOSE_TIMEOUT_S = 3.0
 #: Longest time (s) between a signal and the main loop seeing it.
 POLL_S = 0.1
-
-
-def tcp_address(locator: str) -> tuple[str, int]:
-    """``(host, port)`` of a ``tcp/host:port`` or ``tls/host:port`` locator."""
-    proto, _, address = locator.partition("/")
-    host, _, port = address.rpartition(":")
-    if proto not in TCP_PROTOCOLS or not host or not port.isdigit():
-        allowed = " or ".join(f"{p}/<host>:<port>" for p in TCP_PROTOCOLS)
-        raise InputError(f"endpoint {locator!r} is not {allowed}", parameter="endpoint",
-                         value=locator, allowed=allowed)
-    return host.strip("[]"), int(port)
-
-
-def is_listening(locator: str, timeout: float = 0.5) -> bool:
-    """True if something accepts TCP connections at the locator."""
-    try:
-        with socket.create_connection(tcp_address(locator), timeout=timeout):
-            return True
-    except OSError:
-        return False
 
 
 def main(argv: Sequence[str] | None = None) -> int:

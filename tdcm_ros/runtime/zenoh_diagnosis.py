@@ -17,8 +17,11 @@ import time
 
 import zenoh
 
+from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.errors import RuntimePortError
 
+#: Protocols whose listeners a TCP connect reaches (TLS runs over TCP).
+TCP_PROTOCOLS = ("tcp", "tls")
 #: Config keys that name files a session reads.
 FILE_KEYS = (
     "transport/link/tls/root_ca_certificate",
@@ -50,36 +53,48 @@ def missing_files(config: zenoh.Config) -> list[str]:
     return missing
 
 
-def _host_port(endpoint: str) -> tuple[str, int] | None:
-    """``(host, port)`` of a ``tcp/`` or ``tls/`` endpoint; None for other protocols."""
-    protocol, _, address = endpoint.partition("/")
+def tcp_address(locator: str) -> tuple[str, int]:
+    """``(host, port)`` of a ``tcp/host:port`` or ``tls/host:port`` locator (a ``?`` or ``#``
+    suffix ignored); ``InputError`` for any other."""
+    proto, _, address = locator.partition("/")
     host, _, port = address.split("?")[0].split("#")[0].rpartition(":")
-    if protocol not in ("tcp", "tls") or not port.isdigit():
-        return None
+    if proto not in TCP_PROTOCOLS or not host or not port.isdigit():
+        allowed = " or ".join(f"{p}/<host>:<port>" for p in TCP_PROTOCOLS)
+        raise InputError(f"endpoint {locator!r} is not {allowed}", parameter="endpoint",
+                         value=locator, allowed=allowed)
     return host.strip("[]"), int(port)
+
+
+def _connect_error(locator: str, timeout: float) -> OSError | None:
+    """Why a TCP connection to a ``tcp/`` or ``tls/`` locator fails (None if it opens)."""
+    try:
+        with socket.create_connection(tcp_address(locator), timeout=timeout):
+            return None
+    except OSError as error:
+        return error
+
+
+def is_listening(locator: str, timeout: float = 0.5) -> bool:
+    """True if something accepts TCP connections at the locator."""
+    return _connect_error(locator, timeout) is None
 
 
 def nothing_listens(endpoint: str, timeout: float = 1.0) -> str | None:
     """Why a TCP connection to a ``tcp/`` or ``tls/`` endpoint fails (None if it opens, or
     for another protocol)."""
-    address = _host_port(endpoint)
-    if address is None:
+    if endpoint.partition("/")[0] not in TCP_PROTOCOLS:
         return None
-    try:
-        with socket.create_connection(address, timeout=timeout):
-            return None
-    except OSError as error:
-        return f"nothing answers at {endpoint}: {error.strerror or error}"
+    error = _connect_error(endpoint, timeout)
+    return None if error is None else f"nothing answers at {endpoint}: {error.strerror or error}"
 
 
 def tls_refusal(config: zenoh.Config, endpoint: str, timeout: float = 3.0) -> str | None:
     """Why a TLS handshake with the router at a ``tls/host:port`` endpoint fails, as zenoh would
     check it (the endpoint's host against the certificate's names, the configured root CA);
     None if it succeeds or the endpoint is not TLS."""
-    address = _host_port(endpoint)
-    if not endpoint.startswith("tls/") or address is None:
+    if not endpoint.startswith("tls/"):
         return None
-    host, port = address
+    host, port = tcp_address(endpoint)
     ca = _value(config, "transport/link/tls/root_ca_certificate")
     context = ssl.create_default_context(cafile=ca if isinstance(ca, str) and ca else None)
     certificate = _value(config, "transport/link/tls/connect_certificate")
