@@ -67,6 +67,7 @@ class Progress:
     schedule: str = ""
     schedule_done: bool = False
     faults: str = ""               #: the driver's latched trip faults, that release the tendon
+    armed: bool | None = None      #: the driver's ``armed`` as last said (None before a status)
     actuator_statuses: int = 0     #: driver actuator statuses seen
     schedule_ran: bool = False     #: a status said the schedule was running
     disarm_reason: str = ""        #: why the driver disarmed last ("" while it never did)
@@ -110,6 +111,8 @@ def _watch(port: Any, progress: Progress) -> None:
                                            if name in TRIP_FAULT_NAMES)
                 progress.schedule_ran = progress.schedule_ran or progress.schedule == "running"
                 progress.disarm_reason = values.get("disarm_reason", progress.disarm_reason)
+                if values.get("armed") in ("true", "false"):
+                    progress.armed = values["armed"] == "true"
                 progress.actuator_statuses += 1
             elif status.name == DEVICE_TWIN:
                 values = {kv.key: kv.value for kv in status.values}
@@ -142,29 +145,41 @@ def start_schedule(context: Any) -> bool:
     return True
 
 
+def held_released(progress: Progress) -> str:
+    """Why the driver holds the tendon released, as its last status says ("" if it does not):
+    its latched trip faults, its disarm reason, or both."""
+    reasons = []
+    if progress.faults:
+        reasons.append(f"device fault {progress.faults}")
+    if progress.armed is False:
+        reasons.append(f"disarmed ({progress.disarm_reason or 'no reason given'})")
+    return " and ".join(reasons)
+
+
 def clear_start_up_fault(context: Any, loop: _Loop, progress: Progress,
                          say: Callable[[str], None]) -> None:
-    """Before a tracking run's first target: wait for the driver's actuator status; a device
-    fault latched while the graph started (e.g. the watchdog of a starved driver process) is
-    cleared once through ``clear_faults``, said, and must be gone from the statuses within
-    ``DRIVER_STATUS_TIMEOUT_S``."""
+    """Before the schedule or the first target: wait for the driver's actuator status; a device
+    fault latched or a disarm while the graph started (e.g. the watchdog of a starved driver
+    process, or a device twin not scheduled for its watchdog time) is cleared once through
+    ``clear_faults``, said, and must be gone from the statuses within
+    ``DRIVER_STATUS_TIMEOUT_S``. No target has been sent then, so arming sends none."""
     deadline = time.monotonic() + DRIVER_STATUS_TIMEOUT_S
     while not progress.actuator_statuses:
         loop.turn(deadline, lambda: f"no {DRIVER_ACTUATOR!r} status on /diagnostics within "
                                     f"{DRIVER_STATUS_TIMEOUT_S:g} s")
-    if not progress.faults:
+    held = held_released(progress)
+    if not held:
         return
-    fault = progress.faults
     answer = context.call_service(CLEAR_SERVICE, "std_srvs/srv/Trigger",
                                   timeout=DRIVER_STATUS_TIMEOUT_S)
     if not answer.success:
-        raise RuntimePortError(f"the driver latched device fault {fault} while the graph "
-                               f"started and refused clear_faults: {answer.message}")
-    say(f"the driver latched device fault {fault} while the graph started (no target sent "
-        f"yet); cleared it with clear_faults")
+        raise RuntimePortError(f"the driver latched {held} while the graph started and "
+                               f"refused clear_faults: {answer.message}")
+    say(f"the driver latched {held} while the graph started (no target sent yet); cleared it "
+        f"with clear_faults{twin_pauses(progress)}")
     deadline = time.monotonic() + DRIVER_STATUS_TIMEOUT_S
-    while progress.faults:  # a status sent before the clear may still arrive after it
-        loop.turn(deadline, lambda: f"device fault {progress.faults} is still latched "
+    while held_released(progress):  # a status sent before the clear may still arrive after it
+        loop.turn(deadline, lambda: f"{held_released(progress)} is still latched "
                                     f"{DRIVER_STATUS_TIMEOUT_S:g} s after clear_faults; the "
                                     "tendon stays released")
 
@@ -298,13 +313,13 @@ def record_live(plan: DemoPlan, *, endpoint: str, runtime: str = "zenoh",
             loop.turn(ready_by, lambda: f"the recorder wrote no {', '.join(ready)} "
                                         f"within {READY_TIMEOUT_S:g} s; see {logs}")
         started = time.monotonic()
+        clear_start_up_fault(context, loop, progress, say)
         if plan.targets is None:
             say(f"the bag holds {', '.join(ready)}; starting the schedule")
             _run_schedule(plan, context, loop, progress, say, progress_period)
         else:
             from tdcm_ros.demo.follow import follow
 
-            clear_start_up_fault(context, loop, progress, say)
             say(f"the bag holds {', '.join(ready)}; following the trajectory")
 
             def turn(deadline: float, late: Callable[[], str], seconds: float) -> None:

@@ -1,5 +1,5 @@
-"""The tracking demo and the driver's device faults: one latched while the graph started is
-cleared once before the first target; one latched during the run stops the run."""
+"""The demo and the driver's device faults and disarms: one latched while the graph started is
+cleared once before the schedule or the first target; one latched during the run stops the run."""
 
 from __future__ import annotations
 
@@ -16,7 +16,8 @@ from tdcm_ros.runtime import RuntimePortError
 class FakeGraph:
     """Statuses the driver publishes, one per turn of the demo's loop; records service calls."""
 
-    def __init__(self, progress: Progress, faults: list[str], *, clears: bool = True) -> None:
+    def __init__(self, progress: Progress, faults: list[str | tuple[str, bool]], *,
+                 clears: bool = True) -> None:
         self.progress, self.faults, self.clears = progress, faults, clears
         self.calls: list[str] = []
         self.turns = 0
@@ -25,8 +26,11 @@ class FakeGraph:
         self.turns += 1
         if self.turns > 50:
             raise RuntimePortError(late())
-        if self.faults:
-            self.progress.faults = self.faults.pop(0)
+        if self.faults:  # a status: its faults, and whether the driver is armed (default yes)
+            status = self.faults.pop(0)
+            faults, armed = status if isinstance(status, tuple) else (status, True)
+            self.progress.faults, self.progress.armed = faults, armed
+            self.progress.disarm_reason = "" if armed else "device silent for 0.67 s (frozen?)"
             self.progress.actuator_statuses += 1
 
     def call_service(self, name: str, type_name: str, *, timeout: float) -> Any:
@@ -34,7 +38,7 @@ class FakeGraph:
         return SimpleNamespace(success=self.clears, message="" if self.clears else "link down")
 
 
-def run(faults: list[str], *, clears: bool = True) -> tuple[FakeGraph, list[str]]:
+def run(faults: list[str | tuple[str, bool]], *, clears: bool = True) -> tuple[FakeGraph, list[str]]:
     progress = Progress()
     graph = FakeGraph(progress, faults, clears=clears)
     said: list[str] = []
@@ -51,6 +55,17 @@ def test_a_start_up_fault_is_cleared_once_and_said() -> None:
     graph, said = run(["WATCHDOG", "WATCHDOG", ""])
     assert graph.calls == [CLEAR_SERVICE]
     assert len(said) == 1 and "WATCHDOG" in said[0] and "no target sent" in said[0]
+
+
+def test_a_start_up_disarm_is_cleared_once_and_said_with_its_reason() -> None:
+    graph, said = run([("", False), ("", False), ("", True)])
+    assert graph.calls == [CLEAR_SERVICE]
+    assert len(said) == 1 and "disarmed (device silent for 0.67 s (frozen?))" in said[0]
+
+
+def test_a_disarm_still_held_after_clear_faults_stops_the_run() -> None:
+    with pytest.raises(RuntimePortError, match=r"disarmed \(device silent .* after clear_faults"):
+        run([("", False), ("", False)])
 
 
 def test_a_fault_still_latched_after_clear_faults_stops_the_run() -> None:
