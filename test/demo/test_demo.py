@@ -69,6 +69,15 @@ def _run_demo(out: Path, *args: str, hold_s: float,
                           check=False)
 
 
+def _said(done: subprocess.CompletedProcess[str], out: Path) -> str:
+    """What a finished demo said, and its driver's and twin's logs: the context of a failed
+    check on its results."""
+    logs = "".join(f"\n--- {log.name} (end)\n{log.read_text(errors='replace')[-2000:]}"
+                   for log in sorted((out / "logs").glob("*.log"))
+                   if log.stem in ("tension_driver", "device_twin"))
+    return done.stdout[-3000:] + done.stderr[-2000:] + logs
+
+
 @pytest.mark.demo
 @pytest.mark.parametrize("runtime", RUNTIMES)
 def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: Path,
@@ -87,10 +96,11 @@ def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: P
     assert reader.counts["/tf_static"] == 1
     assert not reader.warnings
     metrics = json.loads((tmp_path / "ideal" / "metrics.json").read_text())["before_calibration"]
-    assert metrics["n_trials"] == 1
-    assert metrics["n_steps"] == 6
+    said = _said(done, tmp_path / "ideal")
+    assert metrics["n_trials"] == 1, said
+    assert metrics["n_steps"] == 6, said
     levels = sorted(round(step["tension"]) for step in metrics["steps"])
-    assert levels == [0, 4, 8, 12, 16, 20]
+    assert levels == [0, 4, 8, 12, 16, 20], said
     # The world is the estimator's model: what is left is the load-cell reading versus the true
     # tension inside a hold and the 3-marker spline; both are far below a Vicon's noise.
     assert metrics["rmse_m"] < 2e-5
