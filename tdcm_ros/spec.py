@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import warnings
 from collections.abc import Collection, Iterable, Mapping, Sequence
 from typing import Any
 
@@ -38,6 +39,12 @@ MAX_TEXT_CHARS = 4096
 MAX_ITEMS = 10_000
 _TRUE, _FALSE = ("true", "yes", "on", "1"), ("false", "no", "off", "0")
 _METADATA_KEY = "tdcm_spec"
+
+
+class DeprecatedNameWarning(FutureWarning):
+    """A key, parameter or option was given by a deprecated name (a ``FutureWarning``: the
+    category Python shows end users by default)."""
+
 _SAME: Any = object()  # renamed(): keep the default
 
 
@@ -57,6 +64,9 @@ class Spec:
     size: int = 3
     choices: tuple[str, ...] = ()  # a str value matches one with "-" and "_" alike
     high_open: bool = False
+    #: Former names, still read with a :class:`DeprecatedNameWarning` (relative to a group's
+    #: prefix, like ``name``).
+    formerly: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -290,11 +300,32 @@ def as_mapping(where: str, raw: Any, *, error: type[InputError] = InputError
     return raw
 
 
+def current_names(where: str, specs: Iterable[Spec], data: Mapping[str, Any]) -> dict[str, Any]:
+    """``data`` with each key that is a spec's former name under the spec's name, warned as
+    deprecated (:class:`DeprecatedNameWarning`); a former name beside the current one is
+    dropped, warned."""
+    renamed = dict(data)
+    for spec in specs:
+        for old in spec.formerly:
+            if old not in renamed:
+                continue
+            value = renamed.pop(old)
+            if spec.name in renamed:
+                warnings.warn(f"{where}.{old} is deprecated and ignored: {where}.{spec.name} is "
+                              "set too", DeprecatedNameWarning, stacklevel=2)
+                continue
+            warnings.warn(f"{where}.{old} is deprecated; use {where}.{spec.name} (same meaning)",
+                          DeprecatedNameWarning, stacklevel=2)
+            renamed[spec.name] = value
+    return renamed
+
+
 def parse_mapping(where: str, specs: Iterable[Spec], raw: Any, *,
                   error: type[InputError] = InputError) -> dict[str, Any]:
-    """Values for every spec from the mapping ``raw`` (keys ``where.name``; defaults filled in);
-    unknown keys raise listing the valid ones."""
-    data = as_mapping(where, raw, error=error)
+    """Values for every spec from the mapping ``raw`` (keys ``where.name``, or a former name,
+    warned; defaults filled in); unknown keys raise listing the valid ones."""
+    specs = tuple(specs)
+    data = current_names(where, specs, as_mapping(where, raw, error=error))
     by_name = {spec.name: spec for spec in specs}
     reject_unknown(f"key in {where}", data, by_name, error=error)
     return {name: spec.parse(data[name], f"{where}.{name}", error=error) if name in data

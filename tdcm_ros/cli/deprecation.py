@@ -12,8 +12,10 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
+from tdcm_ros.spec import DeprecatedNameWarning
 
-class DeprecatedOptionWarning(FutureWarning):
+
+class DeprecatedOptionWarning(DeprecatedNameWarning):
     """An option was given by a deprecated spelling."""
 
 
@@ -36,15 +38,16 @@ class DeprecatedAlias(argparse.Action):
 
 
 def one_line_warnings() -> None:
-    """Show :class:`DeprecatedOptionWarning` as ``tdcm: warning: MESSAGE`` (one line, no source
-    location); other warnings keep Python's format."""
+    """Show a :class:`DeprecatedNameWarning` (a deprecated option, scene key or parameter name)
+    as ``tdcm: warning: MESSAGE`` (one line, no source location); other warnings keep
+    Python's format."""
     plain = warnings.formatwarning
     if getattr(plain, "tdcm_one_line", False):
         return
 
     def formatted(message: Warning | str, category: type[Warning], filename: str, lineno: int,
                   line: str | None = None) -> str:
-        if issubclass(category, DeprecatedOptionWarning):
+        if issubclass(category, DeprecatedNameWarning):
             return f"tdcm: warning: {message}\n"
         return plain(message, category, filename, lineno, line)
 

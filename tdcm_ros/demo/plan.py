@@ -85,12 +85,12 @@ class DemoPlan:
             live["markers.radial_offset"] = scene.marker_radial_offset
         nodes: dict[str, dict[str, Any]] = {
             # The bag's /tf_static carries only the registration the evaluation reads.
-            "model_node": {**design, **markers, "markers.radius": scene.marker_ball_radius,
+            "model_node": {**design, **markers, "markers.ball_radius": scene.marker_ball_radius,
                            "tf.tendon": False},
             "mocap_node": {"source": "sim", "sim.scene": self.scene_ref,
                            "labelling.labels": list(scene.marker_labels),
                            "labelling.arc_lengths": [float(s) for s in scene.marker_arc_lengths]},
-            "metrics_node": {**design, **markers, "markers.radius": scene.marker_ball_radius,
+            "metrics_node": {**design, **markers, "markers.ball_radius": scene.marker_ball_radius,
                              "markers.labels": list(scene.marker_labels), **live},
             "device_twin": {"scene": self.scene_ref, "link": self.link},
             "tension_driver": {"port": self.link, "tension_max": top,
@@ -98,7 +98,7 @@ class DemoPlan:
                                "schedule.hold_s": float(self.schedule.hold),
                                "schedule.trials": int(self.schedule.trials),
                                "schedule.autostart": False},  # the demo starts it
-            "shape_controller": {**design, **markers, "markers.radius": scene.marker_ball_radius,
+            "shape_controller": {**design, **markers, "markers.ball_radius": scene.marker_ball_radius,
                                  "markers.labels": list(scene.marker_labels),
                                  "mode": "feedforward", "driver": "tension_driver"},
         }

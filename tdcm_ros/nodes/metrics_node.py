@@ -76,9 +76,11 @@ loaded machine) waits in the queue instead of pushing its oldest frames out. The
 #: The design preset the design.* fields start from.
 PRESET_SPECS = by_name(Spec("design.preset", description="design preset the fields start from",
                             default="paper-experiment", kind="str", choices=tuple(PRESETS)))
-#: The marker layout as parameters: ``markers.radius`` is the layout's ball radius;
-#: ``markers.radial_offset`` defaults to ``design.R_outer + markers.radius`` (on the surface).
-LAYOUT_SPECS = {**MARKER_SPECS, "ball_radius": replace(MARKER_SPECS["ball_radius"], name="radius")}
+#: The marker layout as parameters ``markers.<field>``; ``markers.radial_offset`` defaults to
+#: ``design.R_outer + markers.ball_radius`` (on the surface). ``markers.radius`` is the former
+#: name of ``markers.ball_radius``.
+LAYOUT_SPECS = {**MARKER_SPECS,
+                "ball_radius": replace(MARKER_SPECS["ball_radius"], formerly=("radius",))}
 #: Parameters fixed at start, besides the evaluation options.
 FIXED_SPECS = by_name(
     Spec("registration.source", description="auto, tf_static, parameter or estimate",

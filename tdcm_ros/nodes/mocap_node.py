@@ -121,8 +121,8 @@ MOCAP_SPECS = by_name(
          "estimate)", default="", kind="str"),
     Spec("registration.x_hint", "", "mocap direction of +x if no bent_csv (mode estimate; "
          "0 = unset)", (0.0, 0.0, 0.0), kind="vector", low=-1e3, high=1e3),
-    Spec("markers.radius", "m", "marker centre distance from the midline", 0.00492, low=0.0,
-         high=0.1),
+    Spec("markers.radial_offset", "m", "marker centre distance from the midline", 0.00492,
+         low=0.0, high=0.1, formerly=("markers.radius",)),
     Spec("markers.side_deg", "deg", "marker side around the body z axis from the tendon side",
          180.0, low=-360.0, high=360.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
@@ -184,7 +184,7 @@ class MocapNode(NodeLogic):
         hint = [float(v) for v in get("registration.x_hint")]
         return estimate_from_recordings(
             zero_csv, self.name_map, [float(v) for v in get("labelling.arc_lengths")],
-            radius=float(get("markers.radius")),
+            radius=float(get("markers.radial_offset")),
             side_rad=math.radians(float(get("markers.side_deg"))),
             bent_csv=str(get("registration.bent_csv")) or None,
             x_hint=hint if any(hint) else None)

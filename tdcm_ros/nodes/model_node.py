@@ -100,7 +100,8 @@ TUNABLE_SPECS = by_name(
          MARKER_SPECS["arc_lengths"].default, kind="list"),
     Spec("markers.placement", description="surface or midline", default="surface", kind="str",
          choices=("surface", "midline")),
-    replace(MARKER_SPECS["ball_radius"], name="markers.radius"),
+    replace(MARKER_SPECS["ball_radius"], name="markers.ball_radius",
+            formerly=("markers.radius",)),
     replace(MARKER_SPECS["side_deg"], name="markers.side_deg"),
     Spec("input.tension_max", "N", "largest valid tension", 200.0, low=0.0, high=1e6),
     Spec("input.max_age_s", "s", "inputs older than this are stale; 0 disables", 0.5, low=0.0,
@@ -313,7 +314,7 @@ class ModelNode(NodeLogic):
         self.previous = result
         self.counts["solved"] += 1
         placement = self.port.get_parameter("markers.placement")
-        radius = (self.design.R_outer + float(self.port.get_parameter("markers.radius"))
+        radius = (self.design.R_outer + float(self.port.get_parameter("markers.ball_radius"))
                   if placement == "surface" else 0.0)
         frame_id = str(self.port.get_parameter("frame_id"))
         roll = self.rolls.at(stamp_ns)

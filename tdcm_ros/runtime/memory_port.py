@@ -86,7 +86,7 @@ class MemoryPort:
                  namespace: str = "/", start_ns: int = 1_700_000_000_000_000_000) -> None:
         self.node_name, self.namespace = name, namespace
         self.logger = logging.getLogger(fully_qualified_node_name(namespace, name))
-        self.store = ParameterStore(overrides)
+        self.store = ParameterStore(overrides, warn=self.logger.warning)
         self.clock_ns = start_ns
         self.published: defaultdict[str, list[Any]] = defaultdict(list)
         self.sent_ns: defaultdict[str, list[int]] = defaultdict(list)
@@ -100,14 +100,18 @@ class MemoryPort:
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> P:
+                          read_only: bool = False, formerly: tuple[str, ...] = ()) -> P:
         """Declare a parameter; returns the override or the default, checked."""
         return self.store.declare(ParamSpec(name, default, description, range, validator,
-                                            read_only))
+                                            read_only, formerly))
 
     def get_parameter(self, name: str) -> ParamValue:
         """Current value of a declared parameter."""
         return self.store.get(name)
+
+    def unused_overrides(self) -> list[str]:
+        """Names in ``overrides`` no declared parameter took."""
+        return self.store.unused_overrides()
 
     def add_on_set_parameters(self, callback: SetCallback) -> None:
         """Add a check run on each change made with :meth:`ParameterStore.set` on :attr:`store`."""

@@ -64,6 +64,8 @@ class ParamSpec(Generic[P]):
     range: tuple[float, float] | None = None
     validator: Validator | None = None
     read_only: bool = False
+    #: Former names (deprecated aliases): a parameter file may still set the value by one.
+    formerly: tuple[str, ...] = ()
 
     @property
     def kind(self) -> str:
@@ -104,13 +106,38 @@ class ParamSpec(Generic[P]):
 
 
 class ParameterStore:
-    """Declared parameters of one node, their current values and the change checks."""
+    """Declared parameters of one node, their current values and the change checks.
 
-    def __init__(self, overrides: Mapping[str, Any] | None = None) -> None:
+    ``overrides`` are the parameter file's values; ``warn`` (the node's log at WARN) hears of
+    a value set by a deprecated name."""
+
+    def __init__(self, overrides: Mapping[str, Any] | None = None, *,
+                 warn: Callable[[str], None] | None = None) -> None:
         self._overrides = dict(overrides or {})
+        self._warn = warn
+        self._taken: set[str] = set()
         self._specs: dict[str, ParamSpec[Any]] = {}
         self._values: dict[str, ParamValue] = {}
         self._callbacks: list[SetCallback] = []
+
+    def override(self, spec: ParamSpec[Any]) -> tuple[bool, Any]:
+        """``(found, value)``: the parameter file's value for ``spec``, by its name, else by a
+        former name (warned as deprecated); a former name set beside the current one is
+        ignored, warned."""
+        names = [name for name in (spec.name, *spec.formerly) if name in self._overrides]
+        if not names:
+            return False, None
+        self._taken.update(names)
+        for old in names:
+            if old != spec.name and self._warn is not None:
+                ignored = "" if old == names[0] else f"; ignored, {names[0]} is set too"
+                self._warn(f"parameter {old} is deprecated; use {spec.name} (same meaning)"
+                           f"{ignored}")
+        return True, self._overrides[names[0]]
+
+    def unused_overrides(self) -> list[str]:
+        """Names the parameter file sets that no declared parameter took (sorted)."""
+        return sorted(set(self._overrides) - self._taken)
 
     def declare(self, spec: ParamSpec[P], value: Any = None) -> P:
         """Declare ``spec``; its value is ``value`` if given (a runtime resolved it), else the
@@ -119,7 +146,8 @@ class ParameterStore:
             raise InputError(f"parameter {spec.name!r} is declared twice", parameter=spec.name)
         spec.coerce(spec.default)
         if value is None:
-            value = self._overrides.get(spec.name, spec.default)
+            found, value = self.override(spec)
+            value = value if found else spec.default
         value = spec.coerce(value)
         self._specs[spec.name] = spec
         self._values[spec.name] = value

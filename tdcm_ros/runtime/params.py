@@ -68,17 +68,25 @@ def read_param_file(path: str | Path) -> list[tuple[str, dict[str, Any]]]:
     return _entries(tree, "", where)
 
 
-def node_parameters(path: str | Path | None, fully_qualified_name: str) -> dict[str, Any]:
-    """Parameters a file gives the node ``/ns/name``: wildcard entries, then exact ones."""
-    if path is None:
-        return {}
+def node_entries(path: str | Path | None, fully_qualified_name: str
+                 ) -> tuple[dict[str, Any], dict[str, Any]]:
+    """``(wildcard, exact)``: the parameters a file gives the node ``/ns/name`` by entries
+    whose key matches it with a wildcard (``/**``), and by entries that name it."""
     wildcard: dict[str, Any] = {}
     exact: dict[str, Any] = {}
+    if path is None:
+        return wildcard, exact
     for key, values in read_param_file(path):
         if "*" in key and _pattern(key).match(fully_qualified_name):
             wildcard.update(values)
         elif "/" + key.strip("/") == fully_qualified_name:
             exact.update(values)
+    return wildcard, exact
+
+
+def node_parameters(path: str | Path | None, fully_qualified_name: str) -> dict[str, Any]:
+    """Parameters a file gives the node ``/ns/name``: wildcard entries, then exact ones."""
+    wildcard, exact = node_entries(path, fully_qualified_name)
     return {**wildcard, **exact}
 
 

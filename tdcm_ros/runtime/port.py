@@ -115,9 +115,14 @@ class NodePort(Protocol):
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> P:
+                          read_only: bool = False, formerly: tuple[str, ...] = ()) -> P:
         """Declare a parameter; returns its value (YAML override or default), checked, of the
-        default's type."""
+        default's type. A parameter file may still set it by a name in ``formerly`` (a
+        deprecated alias; the node's log warns)."""
+
+    def unused_overrides(self) -> list[str]:
+        """Names the node's parameter file sets that it did not declare (sorted): a typo, or a
+        parameter of another node."""
 
     def get_parameter(self, name: str) -> Any:
         """Current value of a declared parameter, of its default's type (``Any`` statically:

@@ -188,7 +188,7 @@ class RclpyNodePort:
         self.namespace = node.get_namespace()
         self.logger = _Logger(node.get_logger())
         self._overrides = dict(overrides or {})
-        self._params = ParameterStore()
+        self._params = ParameterStore(self._overrides, warn=self.logger.warning)
         self._clients: dict[tuple[str, str], Any] = {}
         self._clients_lock = threading.Lock()
         self.guard = CallbackGuard(node.get_fully_qualified_name(), self.logger,
@@ -203,17 +203,17 @@ class RclpyNodePort:
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> P:
+                          read_only: bool = False, formerly: tuple[str, ...] = ()) -> P:
         """Declare on the rclpy node with the checked override or default; returns the value."""
         from rclpy.exceptions import (
             InvalidParameterTypeException,
             InvalidParameterValueException,
         )
 
-        spec = ParamSpec(name, default, description, range, validator, read_only)
+        spec = ParamSpec(name, default, description, range, validator, read_only, formerly)
         spec.coerce(default)
-        from_file = name in self._overrides
-        initial = spec.coerce(self._overrides[name]) if from_file else default
+        from_file, file_value = self._params.override(spec)
+        initial = spec.coerce(file_value) if from_file else default
         try:
             value = self.node.declare_parameter(name, initial, descriptor(spec),
                                                 ignore_override=from_file).value
@@ -224,6 +224,11 @@ class RclpyNodePort:
     def get_parameter(self, name: str) -> ParamValue:
         """Current value."""
         return self._params.get(name)
+
+    def unused_overrides(self) -> list[str]:
+        """Names the parameter file sets that neither the node nor rclpy declared."""
+        return [name for name in self._params.unused_overrides()
+                if not self.node.has_parameter(name)]
 
     def add_on_set_parameters(self, callback: SetCallback) -> None:
         """Add a node-level check of runtime changes."""

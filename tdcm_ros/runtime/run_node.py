@@ -21,8 +21,8 @@ from typing import Any
 
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.runtime.names import fully_qualified_node_name
-from tdcm_ros.runtime.params import node_parameters
-from tdcm_ros.runtime.port import NodeLogic
+from tdcm_ros.runtime.params import node_entries, node_parameters
+from tdcm_ros.runtime.port import NodeLogic, NodePort
 
 RUNTIMES = ("auto", "zenoh", "rclpy")
 RUNTIME_ENV = "TDCM_RUNTIME"
@@ -82,6 +82,18 @@ def open_context(runtime: str, ros_args: Sequence[str] = (),
     return context
 
 
+def warn_unused_overrides(port: NodePort, params_file: str | None) -> None:
+    """Warn of each name an entry of the parameter file that names this node sets and the
+    node does not declare: it has no effect (a typo, or a parameter of another node). Wildcard
+    entries (``/**``) are meant for many nodes, so their extra names are not warned of."""
+    fqn = fully_qualified_node_name(port.namespace, port.node_name)
+    _, exact = node_entries(params_file, fqn)
+    for name in port.unused_overrides():
+        if name in exact:
+            port.logger.warning("parameter file %s sets %s for %s, which does not declare it: "
+                                "ignored", params_file, name, fqn)
+
+
 def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file: str | None = None,
              name: str | None = None, namespace: str = "/",
              ros_args: Sequence[str] = ()) -> int:
@@ -104,6 +116,7 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     try:
         port = context.create_port(node_name, namespace, overrides)
         node = node_class(port)
+        warn_unused_overrides(port, params_file)
         port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
         try:
             context.spin()

@@ -3,7 +3,8 @@
 A group is a mapping ``key -> Spec`` (e.g. :data:`tdcm_ros.model.SOLVER_SPECS`, keyed by the
 settings field); each spec is declared as ``prefix + spec.name`` with the spec's default (or the
 one given for its key), its finite bounds as the ROS range, its description and unit, and the
-spec's own check as validator. Both runtimes see the same names, types and defaults.
+spec's own check as validator; a parameter file may still set it by a former name
+(``spec.formerly``, warned). Both runtimes see the same names, types and defaults.
 """
 
 from __future__ import annotations
@@ -65,7 +66,8 @@ def declare_specs(port: NodePort, specs: Mapping[str, Spec], *, prefix: str = ""
         default = (defaults or {}).get(key, spec.default)
         value = port.declare_parameter(name, ros_value(spec, default), description=description(spec),
                                        range=spec.bounds, validator=partial(checked, spec, prefix),
-                                       read_only=read_only)
+                                       read_only=read_only,
+                                       formerly=tuple(prefix + old for old in spec.formerly))
         values[key] = checked(spec, prefix, value)
     return values
 

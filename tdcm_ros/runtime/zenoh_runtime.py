@@ -471,7 +471,7 @@ class ZenohNodePort:
         self.node_name = name
         self.logger = logging.getLogger(self.fqn)
         self._context = context
-        self._params = ParameterStore(overrides)
+        self._params = ParameterStore(overrides, warn=self.logger.warning)
         node_id = context.next_id()
         self.identity = wire.NodeIdentity(context.domain_id, context.zid, node_id,
                                           self.namespace, name)
@@ -515,17 +515,21 @@ class ZenohNodePort:
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
                           validator: Validator | None = None,
-                          read_only: bool = False) -> P:
+                          read_only: bool = False, formerly: tuple[str, ...] = ()) -> P:
         """Declare a parameter; returns the YAML override or the default, validated, and
         announces it on ``/parameter_events`` as a new parameter."""
         value = self._params.declare(ParamSpec(name, default, description, range, validator,
-                                               read_only))
+                                               read_only, formerly))
         self._parameter_services.publish(new=[name])
         return value
 
     def get_parameter(self, name: str) -> ParamValue:
         """Current value of a declared parameter."""
         return self._params.get(name)
+
+    def unused_overrides(self) -> list[str]:
+        """Names the parameter file sets that no declared parameter took."""
+        return self._params.unused_overrides()
 
     def add_on_set_parameters(self, callback: SetCallback) -> None:
         """Add a check run on each runtime change; raising ``InputError`` rejects it."""

@@ -65,7 +65,7 @@ class Scene:
 
     @property
     def marker_radius(self) -> float:
-        """Nominal distance of a marker centre from the midline (m): ``markers.radial_offset_m``
+        """Nominal distance of a marker centre from the midline (m): ``markers.radial_offset``
         if given, else ``R_outer`` + ball (on the surface)."""
         if self.marker_radial_offset is not None:
             return self.marker_radial_offset
@@ -173,10 +173,10 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
                               trials=schedule["trials"]),
         tension_rate_hz=sections["sensors"]["tension_hz"],
         mocap_rate_hz=sections["sensors"]["mocap_hz"],
-        marker_labels=markers["labels"], marker_arc_lengths=markers["arc_lengths_m"],
-        marker_ball_radius=markers["ball_radius_m"], marker_side_deg=markers["side_deg"],
+        marker_labels=markers["labels"], marker_arc_lengths=markers["arc_lengths"],
+        marker_ball_radius=markers["ball_radius"], marker_side_deg=markers["side_deg"],
         mocap_pose=(np.asarray(frame["translation_m"], dtype=float), quaternion),
-        source=source, marker_radial_offset=markers["radial_offset_m"],
+        source=source, marker_radial_offset=markers["radial_offset"],
         trajectory=parse_trajectory(as_mapping("trajectory", data["trajectory"]))
         if "trajectory" in data else None)
     raw_effects = as_mapping("effects", data.get("effects"))
@@ -199,13 +199,13 @@ def _design(raw: Any) -> Design:
 
 
 def _check_markers(markers: Mapping[str, Any], design: Design) -> None:
-    labels, arcs = markers["labels"], markers["arc_lengths_m"]
+    labels, arcs = markers["labels"], markers["arc_lengths"]
     if len(labels) != len(arcs):
         raise InvalidSceneError(
-            f"markers.labels has {len(labels)} entries but markers.arc_lengths_m has {len(arcs)}",
+            f"markers.labels has {len(labels)} entries but markers.arc_lengths has {len(arcs)}",
             parameter="markers.labels", value=list(labels), allowed=f"{len(arcs)} labels")
     if max(arcs) > design.length:
         raise InvalidSceneError(
-            f"markers.arc_lengths_m = {list(arcs)!r} is invalid; allowed: within "
-            f"(0, {design.length:g}] m (the body length)", parameter="markers.arc_lengths_m",
+            f"markers.arc_lengths = {list(arcs)!r} is invalid; allowed: within "
+            f"(0, {design.length:g}] m (the body length)", parameter="markers.arc_lengths",
             value=list(arcs), allowed=f"(0, {design.length:g}] m")

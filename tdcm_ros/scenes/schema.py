@@ -3,8 +3,7 @@
 A scene file is a YAML mapping with the keys of :data:`TOP_KEYS`; each section's parameters
 are :class:`~tdcm_ros.scenes.params.Param` tuples below, effects are checked against their
 own. A key that sets a field of a package dataclass is derived from that field's spec (unit,
-meaning, range and default declared once there): renamed to the scene key (``hold_s``,
-``arc_lengths_m``), its default replaced or its range narrowed where a scene differs, as said
+meaning, range and default declared once there): renamed to the scene key where it differs, its default replaced or its range narrowed where a scene differs, as said
 beside it. :func:`schema_rows` lists everything for documentation.
 """
 
@@ -66,10 +65,11 @@ SENSORS = (
 
 MARKERS = (
     MARKER_SPECS["labels"],
-    MARKER_SPECS["arc_lengths"].renamed("arc_lengths_m"),
-    MARKER_SPECS["ball_radius"].renamed("ball_radius_m"),
+    # the node parameters' names (markers.<field>); the scene files' former *_m names still read
+    replace(MARKER_SPECS["arc_lengths"], formerly=("arc_lengths_m",)),
+    replace(MARKER_SPECS["ball_radius"], formerly=("ball_radius_m",)),
     MARKER_SPECS["side_deg"],
-    MARKER_SPECS["radial_offset"].renamed("radial_offset_m"),
+    replace(MARKER_SPECS["radial_offset"], formerly=("radial_offset_m",)),
 )
 
 MOCAP_FRAME = (

@@ -35,3 +35,28 @@ def test_declared_parameters_are_the_table(node: str, tmp_path: Path) -> None:
             assert declared[name].description.startswith(spec.description), name
     finally:
         logic.close()
+
+
+@pytest.mark.parametrize(("node", "old", "new", "value"), [
+    ("model_node", "markers.radius", "markers.ball_radius", 0.002),
+    ("metrics_node", "markers.radius", "markers.ball_radius", 0.002),
+    ("shape_controller", "markers.radius", "markers.ball_radius", 0.002),
+    ("mocap_node", "markers.radius", "markers.radial_offset", 0.006),
+])
+def test_a_former_parameter_name_sets_the_new_one_and_warns(
+        node: str, old: str, new: str, value: float, tmp_path: Path,
+        caplog: pytest.LogCaptureFixture) -> None:
+    """One name per concept: the ball radius is ``markers.ball_radius`` in every node, the
+    mocap node's marker-centre distance ``markers.radial_offset``; a parameter file's former
+    ``markers.radius`` still sets them, with a WARN on the node's log."""
+    module_name, _, class_name = NODES[node].partition(":")
+    module = importlib.import_module(module_name)
+    assert old not in module.PARAMETERS and new in module.PARAMETERS
+    port = MemoryPort({**START.get(node, {}), old: value}, name=node)
+    with caplog.at_level("WARNING"):
+        logic = getattr(module, class_name)(port)
+    try:
+        assert port.get_parameter(new) == value != module.PARAMETERS[new].default
+        assert f"parameter {old} is deprecated; use {new} (same meaning)" in caplog.text
+    finally:
+        logic.close()

@@ -126,3 +126,45 @@ def test_runtime_selection(monkeypatch: pytest.MonkeyPatch) -> None:
         resolve_runtime("auto")
     monkeypatch.delenv("TDCM_RUNTIME")
     assert resolve_runtime("auto") in ("zenoh", "rclpy")
+
+
+def test_a_former_name_in_the_file_sets_the_parameter_and_warns() -> None:
+    heard: list[str] = []
+    store = ParameterStore({"markers.radius": 0.002}, warn=heard.append)
+    value = store.declare(ParamSpec("markers.ball_radius", 0.001, formerly=("markers.radius",)))
+    assert value == 0.002 and store.get("markers.ball_radius") == 0.002
+    assert heard == [("parameter markers.radius is deprecated; use markers.ball_radius "
+                     "(same meaning)")]
+    assert store.unused_overrides() == []
+
+
+def test_the_current_name_wins_over_a_former_one_which_is_warned_as_ignored() -> None:
+    heard: list[str] = []
+    store = ParameterStore({"markers.radius": 0.003, "markers.ball_radius": 0.002},
+                           warn=heard.append)
+    assert store.declare(ParamSpec("markers.ball_radius", 0.001,
+                                   formerly=("markers.radius",))) == 0.002
+    assert len(heard) == 1 and "ignored, markers.ball_radius is set too" in heard[0]
+
+
+def test_unused_overrides_are_what_no_declared_parameter_took() -> None:
+    store = ParameterStore({"rate": 2.0, "rtae": 3.0, "other.x": 1})
+    store.declare(ParamSpec("rate", 1.0))
+    assert store.unused_overrides() == ["other.x", "rtae"]
+
+
+def test_a_node_warns_of_names_its_own_entry_sets_but_not_of_wildcard_ones(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    from tdcm_ros.runtime.memory_port import MemoryPort
+    from tdcm_ros.runtime.run_node import warn_unused_overrides
+
+    path = tmp_path / "params.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    shared_by_others: 1\n"
+                    "talker:\n  ros__parameters:\n    rate: 2.0\n    rtae: 3.0\n")
+    port = MemoryPort(node_parameters(path, "/talker"), name="talker")
+    port.declare_parameter("rate", 1.0)
+    with caplog.at_level("WARNING"):
+        warn_unused_overrides(port, str(path))
+    warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
+    assert warned == [(f"parameter file {path} sets rtae for /talker, which does not declare "
+                      "it: ignored")]

@@ -15,16 +15,17 @@ from tdcm_ros.scenes import REGISTRY
 from tdcm_ros.scenes.schema import SECTIONS
 from tdcm_ros.spec import Spec
 
-#: scene key -> (source spec, the one change the scene makes: a default and/or a cap)
+#: scene key -> (source spec, the one change the scene makes: a default and/or a cap, or the
+#: former names it still reads)
 DERIVED: dict[str, tuple[Spec, dict[str, Any]]] = {
     "material.E": (FIELD_SPECS["E"], {"default": None}),
     "schedule.levels": (SCHEDULE_SPECS["levels"], {"high": 22.0}),
     "schedule.trials": (SCHEDULE_SPECS["trials"], {"default": 3, "high": 1000}),
     "markers.labels": (MARKER_SPECS["labels"], {}),
-    "markers.arc_lengths_m": (MARKER_SPECS["arc_lengths"], {}),
-    "markers.ball_radius_m": (MARKER_SPECS["ball_radius"], {}),
+    "markers.arc_lengths": (MARKER_SPECS["arc_lengths"], {"formerly": ("arc_lengths_m",)}),
+    "markers.ball_radius": (MARKER_SPECS["ball_radius"], {"formerly": ("ball_radius_m",)}),
     "markers.side_deg": (MARKER_SPECS["side_deg"], {}),
-    "markers.radial_offset_m": (MARKER_SPECS["radial_offset"], {}),
+    "markers.radial_offset": (MARKER_SPECS["radial_offset"], {"formerly": ("radial_offset_m",)}),
     "effects.actuator_dynamics.lag_s": (PLANT_SPECS["lag"], {"high": 10.0}),
     "effects.actuator_dynamics.rate_m_per_s": (PLANT_SPECS["rate"], {"high": 10.0}),
     "effects.actuator_dynamics.deadband_m": (PLANT_SPECS["deadband"], {"high": 0.01}),
@@ -54,10 +55,11 @@ def expected(key: str) -> Spec:
     if key in OWN_RANGE:
         source, changes = OWN_RANGE[key]
         return replace(source, name=key.rsplit(".", 1)[1], **changes)
-    source, changes = DERIVED[key]
-    default = changes.get("default", source.default)
-    return source.renamed(key.rsplit(".", 1)[1], default=default).narrowed(
-        low=changes.get("low"), high=changes.get("high"))
+    derived_from, derived = DERIVED[key]
+    default = derived.get("default", derived_from.default)
+    return replace(derived_from.renamed(key.rsplit(".", 1)[1], default=default).narrowed(
+        low=derived.get("low"), high=derived.get("high")),
+        formerly=derived.get("formerly", derived_from.formerly))
 
 
 @pytest.mark.parametrize("key", [*DERIVED, *OWN_RANGE])

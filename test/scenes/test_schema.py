@@ -114,7 +114,7 @@ def test_bad_value_names_the_parameter_and_range(text: str, key: str, allowed: s
     ("effects: {marker_offset: {arc_offset_m: [0.001]}}", "effects.marker_offset.arc_offset_m"),
     ("markers: {labels: [a, b]}", "markers.labels"),
     ("markers: {labels: [a, a, b]}", "markers.labels"),
-    ("markers: {arc_lengths_m: [0.01, 0.02, 0.06]}", "markers.arc_lengths_m"),
+    ("markers: {arc_lengths: [0.01, 0.02, 0.06]}", "markers.arc_lengths"),
 ])
 def test_inconsistent_values_are_rejected(text: str, key: str) -> None:
     assert _error(text).parameter == key
@@ -179,3 +179,30 @@ def test_without_and_effect_names() -> None:
     assert scene.without("gravity").effect_names() == ("marker_noise", "latency")
     with pytest.raises(InvalidSceneError, match="tip_load"):
         scene.without("tip_load")
+
+
+@pytest.mark.parametrize(("old", "new", "value", "field"), [
+    ("ball_radius_m", "ball_radius", 0.002, "marker_ball_radius"),
+    ("radial_offset_m", "radial_offset", 0.006, "marker_radial_offset"),
+    ("arc_lengths_m", "arc_lengths", [0.01, 0.02, 0.04], "marker_arc_lengths"),
+])
+def test_a_former_marker_key_still_reads_and_warns(old: str, new: str, value: object,
+                                                   field: str) -> None:
+    """The markers keys are the node parameters' names; a scene file's former ``*_m`` name
+    gives the same scene, with a DeprecatedNameWarning naming the new key."""
+    from tdcm_ros.spec import DeprecatedNameWarning
+
+    current = scene_from_text(f"markers: {{{new}: {value}}}")
+    with pytest.warns(DeprecatedNameWarning, match=f"markers.{old} is deprecated; use "
+                                                   f"markers.{new}"):
+        former = scene_from_text(f"markers: {{{old}: {value}}}")
+    assert getattr(former, field) == getattr(current, field)
+    assert getattr(current, field) != getattr(scene_from_text(""), field)
+
+
+def test_a_former_key_beside_the_current_one_is_ignored_and_warned() -> None:
+    from tdcm_ros.spec import DeprecatedNameWarning
+
+    with pytest.warns(DeprecatedNameWarning, match="ball_radius_m is deprecated and ignored"):
+        scene = scene_from_text("markers: {ball_radius: 0.002, ball_radius_m: 0.003}")
+    assert scene.marker_ball_radius == 0.002

@@ -152,7 +152,7 @@ def test_tip_moment_adds_to_the_tendon() -> None:
 
 CLOSING = {"preset": "paper-experiment",
            "overrides": {"profile": "rectangular", "w_n": 5e-4, "w_d": 8e-4, "E": 5e8}}
-SHORT = {"arc_lengths_m": [0.01, 0.025, 0.041]}  # this design is 41 mm long
+SHORT = {"arc_lengths": [0.01, 0.025, 0.041]}  # this design is 41 mm long
 
 
 def test_notch_contact_replaces_the_closure_error() -> None:
@@ -194,9 +194,9 @@ def test_near_singular_schedule_solves_and_is_near_the_limit() -> None:
 
 
 def test_midline_markers_of_a_scene_sit_on_the_midline() -> None:
-    """``markers.radial_offset_m: 0``: the simulated mocap sees the midline points (virtual
+    """``markers.radial_offset: 0``: the simulated mocap sees the midline points (virtual
     markers, as a fitted spline gives them), not the surface."""
-    scene = make_scene(markers={"radial_offset_m": 0.0})
+    scene = make_scene(markers={"radial_offset": 0.0})
     assert scene.marker_radius == 0.0
     assert make_scene().marker_radius == pytest.approx(scene.design.R_outer + 0.001)
     midline, _ = solve(scene.design, 12.0).pose_at(np.asarray(scene.marker_arc_lengths))
