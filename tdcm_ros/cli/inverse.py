@@ -102,16 +102,15 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print(name: str, found: InverseResult) -> None:
-    """The human summary (mm, rad, N)."""
-    x, z = (v * 1e3 for v in found.tip_point_m)
+    """The human summary in the units the target is given in: m (and rad, N), as the JSON."""
+    x, z = found.tip_point_m
     result, sens = found.result, found.sensitivity
     unit = "rad" if found.target_kind == "tip_angle" else "m"
     print(f"design {name}: {found.target_kind.replace('_', ' ')} {found.target} {unit} -> "
           f"tension {found.tension_n:.9g} N")
-    print(f"achieved tip (x, z) = ({x:.6f}, {z:.6f}) mm, angle {result.tip_angle_rad:.9f} rad, "
-          f"deflection {result.tip_deflection_m * 1e3:.6f} mm; residual {found.residual:.3g} "
-          f"{unit}")
-    dx, dz = (v * 1e3 for v in sens.tip_point_m_per_n)
-    print(f"d(tip)/dT: (x, z) ({dx:.6g}, {dz:.6g}) mm/N, angle {sens.tip_angle_rad_per_n:.6g} "
+    print(f"achieved tip (x, z) = ({x:.9f}, {z:.9f}) m, angle {result.tip_angle_rad:.9f} rad, "
+          f"deflection {result.tip_deflection_m:.9f} m; residual {found.residual:.3g} {unit}")
+    dx, dz = sens.tip_point_m_per_n
+    print(f"d(tip)/dT: (x, z) ({dx:.6g}, {dz:.6g}) m/N, angle {sens.tip_angle_rad_per_n:.6g} "
           f"rad/N ({sens.method} difference, step {sens.step_n:g} N); "
           f"{found.forward_solves} forward solves")

@@ -42,6 +42,18 @@ def test_human_summary_names_tension_tip_and_sensitivity():
     assert "forward solves" in proc.stdout
 
 
+def test_human_summary_answers_in_the_units_of_the_target_as_the_json():
+    """One unit convention: the target is given in m, and the summary answers in m (the JSON's
+    ``tip_point_m``, ``tip_deflection_m``), not mm."""
+    human = tdcm("inverse", "--tip-deflection", "0.005").stdout
+    data = json.loads(tdcm("inverse", "--tip-deflection", "0.005", "--json").stdout)
+    x, z = data["tip_point_m"]
+    assert f"achieved tip (x, z) = ({x:.9f}, {z:.9f}) m" in human
+    assert f"deflection {data['tip_deflection_m']:.9f} m" in human
+    assert data["tip_deflection_m"] == pytest.approx(0.005, abs=1e-9)
+    assert " mm" not in human
+
+
 @pytest.mark.parametrize(("args", "status", "kind"), [
     (["--tip-deflection", "0.05"], 3, "unreachable_target"),
     (["--tip-angle", "-0.2"], 3, "unreachable_target"),
