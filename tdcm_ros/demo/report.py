@@ -69,7 +69,8 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
     if fit is not None:
         print(f"\n== calibration of E on {plan.bag} (start: the scene's nominal E) ==")
         print(format_calibration(fit))
-        results["calibration"] = fit.to_json()
+        results["calibration"] = fit.fit_json()
+        results["after_calibration"] = fit.after.to_json()
     path = plan.out / "metrics.json"
     path.write_text(json.dumps(results, indent=2), encoding="utf-8")
     print(f"metrics written to {path}")

@@ -96,19 +96,20 @@ class Calibration:
         return self.after.options.design
 
     def to_json(self) -> dict[str, Any]:
-        """The ``tdcm calibrate --json`` document."""
-        def table(ev: Evaluation) -> dict[str, Any]:
-            doc = ev.to_json()
-            return {k: doc[k] for k in ("mape_pct", "rmse_m", "mae_m", "shape_error_m",
-                                        "deflection_mean_m", "n_trials", "n_steps")}
+        """The ``tdcm calibrate --json`` document: :meth:`fit_json` with the evaluations
+        ``before`` and ``after`` the fit (each :meth:`Evaluation.to_json`, per step too)."""
+        return {**self.fit_json(), "before": self.before.to_json(),
+                "after": self.after.to_json()}
 
+    def fit_json(self) -> dict[str, Any]:
+        """The fit alone: parameters, confidence, correlation, conditioning, residuals,
+        warnings."""
         return {"parameters": {p.name: p.to_json() for p in self.parameters},
                 "confidence": self.confidence, "identifiable": self.identifiable,
                 "correlation": [[None if not np.isfinite(c) else float(c) for c in row]
                                 for row in self.correlation],
                 "condition_number": self.condition if np.isfinite(self.condition) else None,
                 "residual_rms_m": self.residual_rms_m, "n_residuals": self.n_residuals,
-                "before": table(self.before), "after": table(self.after),
                 "warnings": list(self.warnings)}
 
 

@@ -57,6 +57,11 @@ def stations(options: EvaluateOptions) -> Array:
     return np.linspace(0.0, options.layout.arc_lengths[-1], options.stations)
 
 
+#: Table I's keys at the head of :meth:`Evaluation.to_json` (the rest go to its ``details``).
+TABLE_KEYS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m", "n_trials",
+              "n_steps")
+
+
 @dataclass(frozen=True, eq=False)
 class StepRecord:
     """One step of the evaluation (SI units, frame ``tdcm_base``); ``trial`` counts from 1,
@@ -84,9 +89,11 @@ class StepRecord:
         return self.measured_deflection_m is not None and self.predicted_deflection_m is not None
 
     def to_json(self) -> dict[str, Any]:
-        """``trial``, ``tension`` (N), ``measured``/``predicted`` tip deflection (m), extras."""
-        return {"trial": self.trial, "phase": self.phase, "tension": self.tension_n,
-                "measured": self.measured_deflection_m, "predicted": self.predicted_deflection_m,
+        """``trial``, ``phase``, ``tension_n``, ``measured_deflection_m`` and
+        ``predicted_deflection_m`` (tip), extras; units in the keys."""
+        return {"trial": self.trial, "phase": self.phase, "tension_n": self.tension_n,
+                "measured_deflection_m": self.measured_deflection_m,
+                "predicted_deflection_m": self.predicted_deflection_m,
                 "shape_error_m": self.shape_error_m, "start_s": self.start_s,
                 "end_s": self.end_s, "frames": self.frames, "missing_markers": list(self.missing),
                 "note": self.note}
@@ -131,17 +138,18 @@ class Evaluation:
         return out
 
     def to_json(self) -> dict[str, Any]:
-        """The ``--json`` document: the issue's keys first (Table I of the loading steps), then
-        extras: ``unloading`` (the same metrics of the unloading steps, or null) and each step's
-        ``hysteresis_m`` (:meth:`hysteresis_m`)."""
+        """The ``--json`` document, each number once with its unit in its key: Table I of the
+        loading steps first, then ``steps`` (each with ``hysteresis_m``, :meth:`hysteresis_m`),
+        ``unloading`` (Table I of the unloading steps, or null) and ``details`` (the rest of
+        Table I's counts, the registrations, the design, warnings)."""
         m, unloading = self.metrics, self.unloading
-        return {"mape_pct": m.mape_pct, "rmse_m": m.rmse_m, "mae_m": m.mae_m,
-                "shape_error_m": m.shape_error_m, "deflection_mean_m": m.deflection_mean_m,
-                "n_trials": m.n_trials, "n_steps": m.n_steps,
+        table = m.to_dict()
+        head = {key: table.pop(key) for key in TABLE_KEYS}
+        return {**head,
                 "steps": [{**r.to_json(), "hysteresis_m": h}
                           for r, h in zip(self.records, self.hysteresis_m(), strict=True)],
                 "unloading": None if unloading is None else unloading.to_dict(),
-                "details": {**m.to_dict(), "sources": [
+                "details": {**table, "sources": [
                     {"source": name, "registration": registration_json(reg)}
                     for name, reg in zip(self.sources, self.registrations, strict=True)],
                             "design": self.options.design.to_dict(),

@@ -126,7 +126,7 @@ def test_a_foreign_bag_gives_the_true_table_after_the_mapping(
     # 2 trials loading 0, 5, 10, 15, 20 N: 10 Table I steps; unloading to 10 N twice and the
     # final return to 0 N are reported apart
     assert (doc["n_trials"], doc["n_steps"], doc["unloading"]["n_steps"]) == (2, 10, 3)
-    phases = [(round(s["tension"]), s["phase"]) for s in doc["steps"]]
+    phases = [(round(s["tension_n"]), s["phase"]) for s in doc["steps"]]
     assert phases == [(0, "loading"), (5, "loading"), (10, "loading"), (15, "loading"),
                       (20, "loading"), (10, "unloading")] * 2 + [(0, "unloading")]
     # the same recording evaluated in memory with its true layout (on the bag's stamps, s since

@@ -99,7 +99,7 @@ def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: P
     said = _said(done, tmp_path / "ideal")
     assert metrics["n_trials"] == 1, said
     assert metrics["n_steps"] == 6, said
-    levels = sorted(round(step["tension"]) for step in metrics["steps"])
+    levels = sorted(round(step["tension_n"]) for step in metrics["steps"])
     assert levels == [0, 4, 8, 12, 16, 20], said
     # The world is the estimator's model: what is left is the load-cell reading versus the true
     # tension inside a hold and the 3-marker spline; both are far below a Vicon's noise.
@@ -122,10 +122,13 @@ def test_paper_scene_demo_calibrates_into_the_papers_range_on_short_holds(tmp_pa
     results = json.loads((tmp_path / "paper" / "metrics.json").read_text())
     before = results["before_calibration"]
     assert (before["n_trials"], before["n_steps"]) == (1, 6)
-    assert sorted(round(step["tension"]) for step in before["steps"]) == [0, 4, 8, 12, 16, 20]
+    assert sorted(round(step["tension_n"]) for step in before["steps"]) == [0, 4, 8, 12, 16, 20]
     assert before["details"]["mape_threshold_m"] == 0.002
-    calibration = results["calibration"]
-    after = calibration["after"]
+    calibration, after = results["calibration"], results["after_calibration"]
+    # each number once: the fit holds no evaluation; the one after it has its own step table
+    assert set(results) == {"scene", "before_calibration", "calibration", "after_calibration"}
+    assert not {"before", "after"} & set(calibration)
+    assert sorted(round(step["tension_n"]) for step in after["steps"]) == [0, 4, 8, 12, 16, 20]
     # Datasheet E (1.85 GPa) against a 0.70 GPa world: the tip is predicted far too stiff.
     assert before["mape_pct"] > 40.0
     # After fitting E: the paper's Table I range (MAPE 2.51 %, RMSE 0.54 mm, shape 0.85 mm),

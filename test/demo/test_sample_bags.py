@@ -22,8 +22,8 @@ def test_paper_experiment_sample_bag_holds_three_staircases(tmp_path: Path) -> N
     evaluation = evaluate_paths([bag], scene_options(plan))
     doc = evaluation.to_json()
     assert (doc["n_trials"], doc["n_steps"]) == (3, 18)
-    assert sorted({round(step["tension"]) for step in doc["steps"]}) == [0, 4, 8, 12, 16, 20]
+    assert sorted({round(step["tension_n"]) for step in doc["steps"]}) == [0, 4, 8, 12, 16, 20]
     # Recorded from a 0.70 GPa world, evaluated with the datasheet's 1.85 GPa: far too stiff.
-    assert all(step["predicted"] < step["measured"] for step in doc["steps"]
-               if step["tension"] > 1.0)
+    assert all(step["predicted_deflection_m"] < step["measured_deflection_m"]
+               for step in doc["steps"] if step["tension_n"] > 1.0)
     assert 0.015 < doc["deflection_mean_m"] < 0.0175

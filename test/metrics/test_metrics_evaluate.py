@@ -31,6 +31,35 @@ def run_json(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, dict]
     return code, json.loads(out)
 
 
+def _numbers(doc: object, path: str = "") -> dict[str, float]:
+    """Every number of a JSON document by its path (lists by index)."""
+    if isinstance(doc, dict):
+        return {k: v for key, value in doc.items() for k, v in _numbers(value, f"{path}.{key}").items()}
+    if isinstance(doc, list):
+        return {k: v for i, value in enumerate(doc) for k, v in _numbers(value, f"{path}[{i}]").items()}
+    return {path: doc} if isinstance(doc, int | float) and not isinstance(doc, bool) else {}
+
+
+def test_json_gives_each_table_number_once_and_units_in_the_step_keys(
+        bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Table I once (not again in ``details``); each step's quantities with their units in
+    the keys; the calibrate document's evaluations each with their own step table."""
+    _, doc = run_json(capsys, str(bag), "--set", f"E={TRUE_E}")
+    assert not set(doc) & set(doc["details"])
+    table = {f".{key}": doc[key] for key in ("mape_pct", "rmse_m", "mae_m", "deflection_mean_m")}
+    repeated = [path for path, value in _numbers(doc).items()
+                for key, number in table.items() if value == number and path != key]
+    assert repeated == []
+    step = doc["steps"][0]
+    assert {"tension_n", "measured_deflection_m", "predicted_deflection_m", "shape_error_m",
+            "start_s", "end_s", "hysteresis_m"} <= set(step)
+    assert not {"tension", "measured", "predicted"} & set(step)
+    assert main(["calibrate", str(bag), "--json"]) == 0
+    calibration = json.loads(capsys.readouterr().out)
+    assert len(calibration["after"]["steps"]) == len(calibration["before"]["steps"]) == len(
+        doc["steps"])
+
+
 def test_json_has_the_issue_keys_and_small_errors(bag: Path,
                                                   capsys: pytest.CaptureFixture[str]) -> None:
     code, doc = run_json(capsys, str(bag), "--set", f"E={TRUE_E}")
@@ -38,7 +67,8 @@ def test_json_has_the_issue_keys_and_small_errors(bag: Path,
     assert ISSUE_KEYS <= set(doc)
     # Table I: 0, 8, 16 twice (loading); the final return to 0 is trial 2's unloading
     assert doc["n_trials"] == 2 and doc["n_steps"] == 6
-    assert {"trial", "phase", "tension", "measured", "predicted"} <= set(doc["steps"][0])
+    assert {"trial", "phase", "tension_n", "measured_deflection_m",
+            "predicted_deflection_m"} <= set(doc["steps"][0])
     assert [s["trial"] for s in doc["steps"]] == [1, 1, 1, 2, 2, 2, 2]
     assert [s["phase"] for s in doc["steps"]] == ["loading"] * 6 + ["unloading"]
     assert doc["unloading"]["n_steps"] == 1 and doc["unloading"]["mae_m"] < 2e-5
@@ -46,7 +76,7 @@ def test_json_has_the_issue_keys_and_small_errors(bag: Path,
     assert doc["mae_m"] < 2e-5 and doc["rmse_m"] < 2e-5
     assert doc["mape_pct"] < 0.5
     assert doc["shape_error_m"] < 1e-4
-    top = [s["measured"] for s in doc["steps"] if abs(s["tension"] - 16.0) < 0.5]
+    top = [s["measured_deflection_m"] for s in doc["steps"] if abs(s["tension_n"] - 16.0) < 0.5]
     assert doc["deflection_mean_m"] == pytest.approx(np.mean(top))
     assert doc["details"]["sources"][0]["registration"]["method"] == "tf_static"
 

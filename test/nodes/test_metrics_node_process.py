@@ -210,7 +210,8 @@ def test_errors_and_running_table_equal_the_library(runtime, context, spawn, tmp
     got = json.loads(peer.tables[-1].data)
     assert (got["n_steps"], got["n_trials"]) == (3, 1)
     for live, off in zip(got["steps"], (r.to_json() for r in offline.records[:3]), strict=True):
-        for key in ("trial", "tension", "measured", "predicted", "frames", "start_s", "end_s"):
+        for key in ("trial", "tension_n", "measured_deflection_m", "predicted_deflection_m",
+                    "frames", "start_s", "end_s"):
             assert live[key] == pytest.approx(off[key], rel=1e-12), key
     assert got["details"]["sources"][0]["registration"]["method"] == "tf_static"
     for key in TABLE_KEYS:
