@@ -27,7 +27,7 @@ def register(subparsers: Any) -> None:
                     "when a parameter is not identifiable from the data.",
         epilog="examples:\n"
                "  tdcm calibrate bags/paper_experiment\n"
-               "  tdcm calibrate run.mcap --fit E,w_d --confidence 0.9 --json")
+               "  tdcm calibrate run.mcap --fit E --confidence 0.9 --json")
     add_input_arguments(parser)
     parser.add_argument("--fit", default="E", metavar="NAME[,NAME]",
                         help="real-valued design fields to fit (default: E); start values from "

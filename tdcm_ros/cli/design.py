@@ -53,7 +53,7 @@ def register(subparsers: Any) -> None:
                "  tdcm design --tip-angle 0.45 --free w_n=0.5e-3:3e-3 --free N=3:12\n"
                "  tdcm design --tip-deflection 0.012 --free w_d=0.6e-3:2.2e-3 --free w_t=1e-3:6e-3 "
                "--samples 20000 --json\n"
-               "  tdcm design --design fig2-wn-1.9 --tip-angle 0.3 --free w_n=1e-3:2.5e-3 "
+               "  tdcm design --design fig2-wn-1.9 --tip-angle 0.2 --free w_n=1e-3:2.5e-3 "
                "--free L=0.04:0.06 --out design_out")
     add_tip_targets(parser.add_mutually_exclusive_group(required=True))
     parser.add_argument("--free", action="append", default=[], metavar="NAME=MIN:MAX",

@@ -1,0 +1,88 @@
+"""Every command example the docs give (the README's shell blocks, each ``--help`` epilog's
+``examples:``) is one tdcm takes: each parses, and each that needs no running graph runs to
+exit status 0 from a folder holding the files it names. The full benchmarks are parsed only
+(minutes of timed solves; their ``--quick`` forms run); the graph's examples are parsed here
+and their commands run in the topic, param, service, record, play and demo tests."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tdcm_ros.cli.main import build_parser
+from test.support.cli import tdcm
+from test.support.examples import REPO, Example, epilog_examples, readme_examples
+
+#: Subcommands that need nothing but files: run here.
+OFFLINE = {"solve", "inverse", "design", "figures", "bench", "evaluate", "calibrate",
+           "scene list", "scene validate", "scene explain", "scene effects", "bag info",
+           "param specs"}
+#: Subcommands that talk to a graph (or start one): run by the graph examples' test.
+GRAPH = {"up", "demo", "record", "bag play", "topic list", "topic echo", "topic pub", "topic hz",
+         "param list", "param get", "param set", "param describe", "param dump", "service list",
+         "service call"}
+EXAMPLES = readme_examples() + epilog_examples(build_parser())
+#: Examples that are benchmarks, minutes of timed solves (``bench/`` measures, tests do not):
+#: parsed here, not run; their ``--quick`` forms run.
+BENCHMARKS = {("bench", "accuracy", "--markdown", "--plot", "accuracy_pareto.png"),
+              ("bench", "accuracy", "--json", "-q")}
+
+
+def _id(example: Example) -> str:
+    return f"{example.where}: {' '.join(example.argv)}"
+
+
+def test_the_docs_have_examples_of_every_kind() -> None:
+    """The collector finds the README's and the epilogs' examples (a broken one finds none)."""
+    wheres = {e.where.split(":")[0] for e in EXAMPLES}
+    assert "README.md" in wheres and "tdcm solve --help" in wheres
+    assert {e.verb for e in EXAMPLES} >= {"solve", "evaluate", "topic pub", "param set", "up"}
+
+
+@pytest.mark.parametrize("example", EXAMPLES, ids=_id)
+def test_every_example_parses_and_is_of_a_known_kind(example: Example) -> None:
+    assert example.verb in OFFLINE | GRAPH, f"classify {example.verb!r} in OFFLINE or GRAPH"
+    try:
+        build_parser(example.argv).parse_args(example.argv)
+    except SystemExit as exit_:
+        pytest.fail(f"{_id(example)} does not parse (exit {exit_.code})")
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder holding every file the offline examples name, as a checkout does: the sample
+    bag (also as ``run.mcap``, ``trial1``, ``trial2``), ``bench/``, a scene file and a bag from
+    another lab."""
+    from tdcm_ros.metrics.synthetic import simulate
+    from tdcm_ros.model import MarkerLayout
+    from test.cli.test_foreign_bags_cli import DESIGN, LEVELS, VICON, write_foreign_bag
+
+    folder = tmp_path_factory.mktemp("examples")
+    sample = REPO / "bags" / "paper_experiment"
+    (folder / "bags").symlink_to(REPO / "bags")
+    (folder / "bench").mkdir()  # figures write there, as from a checkout
+    for name in ("trial1", "trial2"):
+        shutil.copytree(sample, folder / name)
+    shutil.copy(sample / "paper_experiment_0.mcap", folder / "run.mcap")
+    shutil.copy(REPO / "config" / "scenes" / "paper_experiment.yaml", folder / "my_bench.yaml")
+    lab = simulate(DESIGN, layout=MarkerLayout(labels=VICON, radial_offset=0.0), levels=LEVELS,
+                   hold_s=2.0, trials=1, tension_hz=200.0, mocap_hz=50.0, seed=8)
+    write_foreign_bag(lab, folder / "lab_bag")
+    return folder
+
+
+def test_only_the_full_benchmarks_are_left_unrun() -> None:
+    full = {tuple(e.argv) for e in EXAMPLES if e.verb == "bench" and "--quick" not in e.argv}
+    assert full == BENCHMARKS
+
+
+@pytest.mark.parametrize("example", [e for e in EXAMPLES if e.verb in OFFLINE
+                                     and tuple(e.argv) not in BENCHMARKS], ids=_id)
+def test_every_offline_example_runs(example: Example, workdir: Path,
+                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    for name, value in example.env.items():
+        monkeypatch.setenv(name, value)
+    done = tdcm(*example.argv, cwd=workdir)
+    assert done.returncode == 0, f"{_id(example)}: exit {done.returncode}\n{done.stderr[-2000:]}"

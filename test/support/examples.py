@@ -1,0 +1,86 @@
+"""The command examples the docs give: every ``tdcm`` / ``python3 -m tdcm_ros`` line of the
+README's shell blocks and of each ``--help`` epilog's ``examples:``, as argument lists."""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shlex
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+#: A command line: optional ``NAME=VALUE`` environment, then tdcm's entry point.
+_COMMAND = re.compile(r"^((?:[A-Z_]+=\S+ )*)(tdcm|python3? -m tdcm_ros)( .*)?$")
+#: A synopsis, not an example: optional parts in brackets, alternatives, ``ARG...``.
+_SYNOPSIS = re.compile(r"\[-|\[[A-Z]|\.\.\.|\|\s*--| \| |[A-Z]\|[A-Z]")
+
+
+@dataclass(frozen=True)
+class Example:
+    """One documented command: where it is written, its environment and its arguments."""
+
+    where: str
+    env: dict[str, str]
+    argv: list[str]
+
+    @property
+    def verb(self) -> str:
+        """``solve``, ``topic pub``, ... (the subcommand and, for grouped ones, its verb)."""
+        words = [a for a in self.argv[:2] if not a.startswith("-")]
+        return " ".join(words[:2]) if words and words[0] in GROUPED else (words[:1] or [""])[0]
+
+
+#: Subcommands whose first argument is a verb.
+GROUPED = ("topic", "param", "bag", "service", "scene", "figures")
+
+
+def _parse(line: str, where: str) -> Example | None:
+    match = _COMMAND.match(line.strip())
+    if match is None or _SYNOPSIS.search(line):
+        return None
+    env = dict(item.split("=", 1) for item in match.group(1).split())
+    words = shlex.split(match.group(3) or "", comments=True)
+    for redirect in (">", ">>", "|"):  # the shell's part of a line is not tdcm's
+        if redirect in words:
+            words = words[:words.index(redirect)]
+    return Example(where, env, words)
+
+
+def readme_examples(path: Path = REPO / "README.md") -> list[Example]:
+    """The commands of the README's ``bash`` blocks (a ``\\`` continuation joined)."""
+    found: list[Example] = []
+    fenced, shell, pending, start = False, False, "", 0
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        if line.startswith("```"):
+            fenced = not fenced
+            shell = fenced and line[3:].strip() in ("bash", "sh", "")
+            continue
+        if not shell:
+            continue
+        if not pending:
+            start = number
+        if line.rstrip().endswith("\\"):
+            pending += line.rstrip()[:-1] + " "
+            continue
+        example = _parse(pending + line, f"README.md:{start}")
+        pending = ""
+        if example is not None:
+            found.append(example)
+    return found
+
+
+def epilog_examples(parser: argparse.ArgumentParser, prog: str = "tdcm") -> list[Example]:
+    """The ``examples:`` lines of every (sub)command's ``--help`` epilog."""
+    found: list[Example] = []
+    text = parser.epilog or ""
+    if "examples:" in text:
+        for line in text.split("examples:", 1)[1].splitlines():
+            example = _parse(line, f"{prog} --help")
+            if example is not None:
+                found.append(example)
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                found.extend(epilog_examples(sub, f"{prog} {name}"))
+    return found
