@@ -185,6 +185,11 @@ def run_play(args: argparse.Namespace) -> int:
           f"{', looping' if args.loop else ''}; Ctrl-C to stop", flush=True)
     if warning := stale_stamps_warning(player.base_ns, time.time_ns(), bool(args.clock)):
         print(warning, file=sys.stderr, flush=True)
+    if args.clock:
+        for node, topic in player.wall_time_readers():
+            print(f"WARNING: {node} reads {topic} on wall time (use_sim_time false): the bag's "
+                  f"time is on /clock, so a node that checks stamps drops them as stale; run it "
+                  f"with use_sim_time (tdcm up --use-sim-time)", file=sys.stderr, flush=True)
     try:
         published = player.run()
     finally:

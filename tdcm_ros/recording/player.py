@@ -39,6 +39,10 @@ from tdcm_ros.runtime import (
 )
 
 NODE_NAME = "_tdcm_play"
+#: s: longest wait for the graph's readers of the played topics (:meth:`Player.wall_time_readers`).
+READERS_WAIT_S = 1.0
+#: s: longest wait for a reader's ``use_sim_time``.
+PARAMETER_WAIT_S = 1.0
 MAX_CLOCK_HZ = 10_000.0
 LINGER_S = 0.3  # time given to the last samples to leave before the context closes (s)
 PROGRESS_PERIOD_S = 0.1  # wall time between two progress reports (s)
@@ -127,6 +131,7 @@ class Player:
                                f"[0, {(last_ns - first_ns) / 1e9:g}] s (the bag's span)",
                                unit="s")
         names = self._published_names(self._selected())
+        self._names = names
         self.published = 0
         self._stop = threading.Event()
         self._pass = 0
@@ -142,6 +147,7 @@ class Player:
             self._context.close()
             raise
         self.topics = sorted(self._publishers)
+        self._created = time.monotonic()  # the publishers exist: ``delay_s`` counts from here
 
     def _selected(self) -> list[str]:
         """Bag names of the topics to play; named undecodable topics are an error."""
@@ -183,6 +189,32 @@ class Player:
                            value=list(self.options.topics))
         return publishers
 
+    def wall_time_readers(self) -> list[tuple[str, str]]:
+        """``(node, topic)`` for each node reading a played topic whose ``use_sim_time`` is
+        false: while the bag's time is on ``/clock`` such a node still takes the wall clock, and
+        one that checks stamps drops the bag's as stale. Readers are looked for up to
+        :data:`READERS_WAIT_S` s or ``delay_s`` (the time given to discovery), less once every
+        topic has one; hidden nodes (``_`` names: tools such as a recorder) and nodes that do
+        not answer a parameter request are left out."""
+        from tdcm_ros.runtime.param_client import ParameterClient
+
+        timeout = max(READERS_WAIT_S, self.options.delay_s)
+        topics = [self._names[topic] for topic in self._publishers]
+        found = []
+        for topic, nodes in self._context.readers(topics, timeout).items():
+            for node in sorted(nodes):
+                if node.rsplit("/", 1)[-1].startswith("_"):
+                    continue
+                try:
+                    on_sim_time = ParameterClient(self._context, node, PARAMETER_WAIT_S).get(
+                        "use_sim_time")
+                except (RuntimePortError, InputError) as error:
+                    logger.info("use_sim_time of %s not known: %s", node, error)
+                    continue
+                if on_sim_time is False:
+                    found.append((node, topic))
+        return found
+
     def request_stop(self) -> None:
         """Stop playing soon (safe from signal handlers and other threads)."""
         self._stop.set()
@@ -195,7 +227,8 @@ class Player:
     def run(self) -> int:
         """Play until the end (with ``loop``: until stopped); returns the messages published."""
         now = time.monotonic()
-        self._wall0 = now + self.options.delay_s  # /clock holds the start time until then
+        # /clock holds the start time until then
+        self._wall0 = max(now, self._created + self.options.delay_s)
         self._next_clock = now if self._clock is not None else math.inf
         self._next_report = now
         if self._wait_until(self._wall0):

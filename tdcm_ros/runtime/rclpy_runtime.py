@@ -21,7 +21,7 @@ import logging
 import os
 import threading
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from typing import Any
 
 from tdcm_ros.bagio import (
@@ -37,6 +37,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import param_services, wire
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.guard import CallbackGuard
+from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.parameters import (
     P,
     ParameterStore,
@@ -475,6 +476,20 @@ class RclpyContext:
         while ((left := end - time.monotonic()) > 0 and not self._stop.is_set()
                and self.context.ok()):
             self._spin_once(min(left, 0.05))
+
+    def readers(self, topics: Collection[str], timeout: float) -> dict[str, set[str]]:
+        """Topic -> fully qualified names of the nodes (not this context's) subscribed to it,
+        as DDS discovery shows them; waits up to ``timeout`` s for every topic to have one."""
+        node = self._nodes[0] if self._nodes else self.create_node(f"_tdcm_graph_{os.getpid()}")
+        own = {n.get_fully_qualified_name() for n in self._nodes}
+        deadline = time.monotonic() + timeout
+        while True:
+            seen = {topic: {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+                            for info in node.get_subscriptions_info_by_topic(resolve_topic(topic))}
+                    - own for topic in topics}
+            if all(seen.values()) or time.monotonic() >= deadline:
+                return seen
+            self.spin_for(0.05)
 
     def spin_until_future(self, future: Any, timeout: float) -> Any:
         """Spin until ``future`` is done; its result, or ``RuntimePortError`` after ``timeout``."""

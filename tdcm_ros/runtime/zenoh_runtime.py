@@ -708,6 +708,21 @@ class ZenohContext:
             watch.close()
         return sorted((name, kind) for name, kinds in services.items() for kind in kinds)
 
+    def readers(self, topics: Collection[str], timeout: float) -> dict[str, set[str]]:
+        """Topic -> fully qualified names of the nodes of other sessions subscribed to it, as a
+        :class:`GraphWatch` sees them; waits up to ``timeout`` s for every topic to have one."""
+        watch = GraphWatch(self)
+        deadline = time.monotonic() + timeout
+        try:
+            while True:
+                nodes = watch.nodes((wire.SUBSCRIPTION,), ignore_zid=self.zid)
+                seen = {topic: nodes.get(resolve_topic(topic), set()) for topic in topics}
+                if all(seen.values()) or time.monotonic() >= deadline:
+                    return seen
+                self.spin_for(0.05)
+        finally:
+            watch.close()
+
     def spin_for(self, seconds: float) -> None:
         """Run callbacks for ``seconds`` s."""
         end = time.monotonic() + seconds
@@ -765,6 +780,22 @@ class GraphWatch:
             if token.kind in kinds and token.zid != ignore_zid:
                 topics.setdefault(token.topic, set()).add(token.type_name)
         return topics
+
+    def nodes(self, kinds: Collection[str], ignore_zid: str = "") -> dict[str, set[str]]:
+        """Topic (or service) name -> fully qualified names of the nodes with an endpoint of
+        ``kinds`` on it, leaving out those of the session ``ignore_zid``."""
+        with self._lock:
+            keys = sorted(self._alive)
+        nodes: dict[str, set[str]] = {}
+        for key in keys:
+            try:
+                token = wire.parse_token(key)
+            except (RuntimePortError, ValueError):
+                continue
+            if token.kind in kinds and token.zid != ignore_zid:
+                nodes.setdefault(token.topic, set()).add(
+                    fully_qualified_node_name(token.namespace, token.node_name))
+        return nodes
 
     def close(self) -> None:
         """Stop collecting."""

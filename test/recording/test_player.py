@@ -185,3 +185,31 @@ def test_bad_input_is_one_line_naming_the_parameter(bag: Path, args: list[str],
     assert done.returncode == 2, done.stderr
     assert expected in done.stderr and "Traceback" not in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def _reader(context: Any, name: str, topic: str, *, sim_time: bool) -> None:
+    """A node of the test's runtime subscribed to ``topic``, on ``/clock`` if ``sim_time``."""
+    from test.support.plain_rclpy import PlainRclpyContext
+
+    if isinstance(context, PlainRclpyContext):
+        from rclpy.parameter import Parameter
+
+        port = context.create_port(name)
+        port.node.set_parameters([Parameter("use_sim_time", value=sim_time)])
+    else:
+        port = context.create_port(name, overrides={"use_sim_time": sim_time})
+    port.create_subscription(topic, TYPES[topic], lambda _: None)
+
+
+def test_clock_names_each_reader_of_a_played_topic_on_wall_time(
+        runtime: str, context: Any, spawn: Spawn, bag: Path) -> None:
+    """With ``--clock``, a node that reads a played topic on wall time drops the bag's stamps
+    as stale: the player names it; nodes on /clock and hidden tools are not named."""
+    _reader(context, "wall_reader", "/a", sim_time=False)
+    _reader(context, "sim_reader", "/b", sim_time=True)
+    _reader(context, "_tool_reader", "/latched", sim_time=False)
+    player = play(spawn, runtime, bag, "--clock", "50")
+    assert RawPeer(context).spin_while_running(player, 60.0) == 0
+    stderr = player.stderr.read().decode()
+    assert ("WARNING: /wall_reader reads /a on wall time (use_sim_time false)" in stderr), stderr
+    assert "sim_reader" not in stderr and "_tool_reader" not in stderr
