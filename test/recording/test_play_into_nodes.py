@@ -37,8 +37,8 @@ TABLE_KEYS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m
 TABLE_REL = 1e-4
 #: per step: trial exact; start and end within 1 us (a header stamp as float s in the node);
 #: tension (N), deflections (m), frames within the effect of the ignored samples
-STEP_ABS = {"start_s": 1e-6, "end_s": 1e-6, "tension": 0.01, "measured": 2e-6,
-            "predicted": 2e-6, "shape_error_m": 2e-6}
+STEP_ABS = {"start_s": 1e-6, "end_s": 1e-6, "tension_n": 0.01, "measured_deflection_m": 2e-6,
+            "predicted_deflection_m": 2e-6, "shape_error_m": 2e-6}
 #: Faster than recorded where nothing is dropped (the nodes work on the messages' stamps, so the
 #: rate does not change the answer otherwise). On rclpy at x4 metrics_node lost 28 of 6758 marker
 #: frames (its subscription's 100-deep history overflowed while it scored a step); x2 lost none
