@@ -194,13 +194,13 @@ def twin_pauses(progress: Progress) -> str:
 
 
 def fault_free(progress: Progress) -> None:
-    """Raise if the driver reports a latched device fault: the tendon is then released until
-    an operator clears it, and the run's tracking figures would not mean anything."""
-    if progress.faults:
-        raise RuntimePortError(f"the driver reports device fault {progress.faults} during the "
-                               "run: the tendon is released until clear_faults, so the "
-                               "tracking run stopped (the bag so far is kept)"
-                               f"{twin_pauses(progress)}")
+    """Raise if the driver reports a latched device fault or a disarm: the tendon is then
+    released until an operator clears it, and the run's tracking figures would not mean
+    anything."""
+    if held := held_released(progress):
+        raise RuntimePortError(f"the driver reports {held} during the run: the tendon is "
+                               "released until clear_faults, so the tracking run stopped (the "
+                               f"bag so far is kept){twin_pauses(progress)}")
 
 
 def schedule_not_cancelled(progress: Progress) -> None:

@@ -91,6 +91,18 @@ def test_a_fault_during_the_run_stops_it() -> None:
         fault_free(progress)
 
 
+def test_a_disarm_during_the_run_stops_it_with_the_reason() -> None:
+    """A driver that disarmed (e.g. its device silent past the watchdog time) holds the tendon
+    released: the tracking run stops instead of reporting the tracking of a released tendon."""
+    progress = Progress(armed=True, actuator_statuses=1)
+    fault_free(progress)
+    progress.armed, progress.disarm_reason = False, "device silent for 0.54 s (frozen?)"
+    progress.twin_pauses = "2 time(s), 0.563 s in all"
+    with pytest.raises(RuntimePortError, match=r"disarmed \(device silent for 0.54 s \(frozen\?\)\) "
+                                               r"during the run.*paused 2 time\(s\)"):
+        fault_free(progress)
+
+
 def test_only_faults_that_release_the_tendon_count() -> None:
     from tdcm_ros.demo.run import TRIP_FAULT_NAMES
 
