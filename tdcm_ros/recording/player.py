@@ -37,12 +37,14 @@ from tdcm_ros.runtime import (
     close_within,
     resolve_topic,
 )
+from tdcm_ros.runtime.param_client import PARAM_TIMEOUT_S, ParameterClient
 
 NODE_NAME = "_tdcm_play"
 #: s: longest wait for the graph's readers of the played topics (:meth:`Player.wall_time_readers`).
-READERS_WAIT_S = 1.0
-#: s: longest wait for a reader's ``use_sim_time``.
-PARAMETER_WAIT_S = 1.0
+READERS_WAIT_S = 2.0
+#: s: longest wait for a reader's ``use_sim_time`` (the ``tdcm param`` tools' default: on rclpy
+#: a new client may take over 1 s to match the node's parameter service on a loaded machine).
+PARAMETER_WAIT_S = PARAM_TIMEOUT_S
 MAX_CLOCK_HZ = 10_000.0
 LINGER_S = 0.3  # time given to the last samples to leave before the context closes (s)
 PROGRESS_PERIOD_S = 0.1  # wall time between two progress reports (s)
@@ -196,8 +198,6 @@ class Player:
         :data:`READERS_WAIT_S` s or ``delay_s`` (the time given to discovery), less once every
         topic has one; hidden nodes (``_`` names: tools such as a recorder) and nodes that do
         not answer a parameter request are left out."""
-        from tdcm_ros.runtime.param_client import ParameterClient
-
         timeout = max(READERS_WAIT_S, self.options.delay_s)
         topics = [self._names[topic] for topic in self._publishers]
         found = []

@@ -53,6 +53,8 @@ from tdcm_ros.runtime.wire import RawSample
 _NO_GID = bytes(wire.GID_SIZE)
 #: rclpy's own parameter that puts the node clock on ``/clock``.
 SIM_TIME = "use_sim_time"
+#: The name rclpy's graph gives an endpoint whose node it has not heard of yet.
+UNKNOWN_NODE_NAME = "_NODE_NAME_UNKNOWN_"
 #: Longest wait (s) in :meth:`RclpyContext.close` for another thread's executor wake-up to end.
 CLOSE_SPIN_WAIT_S = 10.0
 
@@ -479,13 +481,15 @@ class RclpyContext:
 
     def readers(self, topics: Collection[str], timeout: float) -> dict[str, set[str]]:
         """Topic -> fully qualified names of the nodes (not this context's) subscribed to it,
-        as DDS discovery shows them; waits up to ``timeout`` s for every topic to have one."""
+        as DDS discovery shows them; waits up to ``timeout`` s for every topic to have one. An
+        endpoint seen before its node's name (rclpy's ``_NODE_NAME_UNKNOWN_``) is not one yet."""
         node = self._nodes[0] if self._nodes else self.create_node(f"_tdcm_graph_{os.getpid()}")
         own = {n.get_fully_qualified_name() for n in self._nodes}
         deadline = time.monotonic() + timeout
         while True:
             seen = {topic: {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-                            for info in node.get_subscriptions_info_by_topic(resolve_topic(topic))}
+                            for info in node.get_subscriptions_info_by_topic(resolve_topic(topic))
+                            if info.node_name != UNKNOWN_NODE_NAME}
                     - own for topic in topics}
             if all(seen.values()) or time.monotonic() >= deadline:
                 return seen
