@@ -765,36 +765,36 @@ class GraphWatch:
             else:
                 self._alive.add(key)
 
-    def topics(self, kinds: Collection[str] = (wire.PUBLISHER, wire.SUBSCRIPTION),
-               ignore_zid: str = "") -> dict[str, set[str]]:
-        """Topic (or service) name -> types of the endpoints of ``kinds`` (``MP``, ``MS``,
-        ``SS``, ``SC``), leaving out those of the session ``ignore_zid``."""
+    def _endpoints(self, kinds: Collection[str], ignore_zid: str) -> list[wire.TokenInfo]:
+        """The present endpoints of ``kinds``, leaving out those of the session ``ignore_zid``."""
         with self._lock:
             keys = sorted(self._alive)
-        topics: dict[str, set[str]] = {}
+        found = []
         for key in keys:
             try:
                 token = wire.parse_token(key)
             except (RuntimePortError, ValueError):
                 continue
             if token.kind in kinds and token.zid != ignore_zid:
-                topics.setdefault(token.topic, set()).add(token.type_name)
+                found.append(token)
+        return found
+
+    def topics(self, kinds: Collection[str] = (wire.PUBLISHER, wire.SUBSCRIPTION),
+               ignore_zid: str = "") -> dict[str, set[str]]:
+        """Topic (or service) name -> types of the endpoints of ``kinds`` (``MP``, ``MS``,
+        ``SS``, ``SC``), leaving out those of the session ``ignore_zid``."""
+        topics: dict[str, set[str]] = {}
+        for token in self._endpoints(kinds, ignore_zid):
+            topics.setdefault(token.topic, set()).add(token.type_name)
         return topics
 
     def nodes(self, kinds: Collection[str], ignore_zid: str = "") -> dict[str, set[str]]:
         """Topic (or service) name -> fully qualified names of the nodes with an endpoint of
         ``kinds`` on it, leaving out those of the session ``ignore_zid``."""
-        with self._lock:
-            keys = sorted(self._alive)
         nodes: dict[str, set[str]] = {}
-        for key in keys:
-            try:
-                token = wire.parse_token(key)
-            except (RuntimePortError, ValueError):
-                continue
-            if token.kind in kinds and token.zid != ignore_zid:
-                nodes.setdefault(token.topic, set()).add(
-                    fully_qualified_node_name(token.namespace, token.node_name))
+        for token in self._endpoints(kinds, ignore_zid):
+            nodes.setdefault(token.topic, set()).add(
+                fully_qualified_node_name(token.namespace, token.node_name))
         return nodes
 
     def close(self) -> None:
