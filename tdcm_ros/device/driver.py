@@ -31,9 +31,10 @@ on an e-stop and on every event after which the device's
 state is unknown: the link lost while connected (port error, ``link_timeout``, a version
 mismatch), a device reboot (a banner nobody asked for once telemetry has flowed, or the device
 clock running backwards)
-and a freeze (no telemetry for the device's own watchdog time while the host kept stepping: a step
-counts at most ``heartbeat_period`` s of silence, so a stall of this host -- the device's frames
-not read, or a twin on it not run -- is not taken for one).
+and a freeze (no telemetry for the device's own watchdog time while the host kept stepping, and
+the device's clock ran that long between its frames: a step counts at most ``heartbeat_period`` s
+of silence, so a stall of this host -- the device's frames not read -- is not taken for one, nor
+frames delayed while the device's clock stood still -- a stalled line, a twin not scheduled).
 Disarmed, it commands mode R whatever the device reports. Only :meth:`TensionDriver.clear_faults`
 (the operator's arm command, accepted while connected) arms it again, at a target of 0 N: a new
 setpoint is needed before any tension.
@@ -510,7 +511,9 @@ class TensionDriver:
 
     def _on_telemetry(self, frame: Telemetry, now: float) -> None:
         """Take a frame; a device clock running backwards is a reboot, a frame after the host saw
-        the device silent for its watchdog time ends a freeze: either disarms."""
+        the device silent for its watchdog time ends a freeze if the device's own clock ran
+        that long too: either disarms. Silence over which the device's clock stood still was
+        a delay of its frames (a stalled serial line, a suspended simulator), not a freeze."""
         previous, silence, silent = self._latest, self._awake_silence, self._silent
         self._latest, self._last_rx, self._silent, self._awake_silence = frame, now, False, 0.0
         if previous is not None and frame.time < previous.time \
@@ -520,8 +523,15 @@ class TensionDriver:
             self._forget_roll()
             if self._armed:
                 self._disarm("device rebooted")
-        elif silent and self._armed:
-            self._disarm(f"device silent for {silence:.2f} s (frozen?)")
+        elif silent and previous is not None and self._banner is not None:
+            ran = (frame.time - previous.time) % CLOCK_WRAP
+            if ran >= self._banner.watchdog:
+                if self._armed:
+                    self._disarm(f"device silent for {silence:.2f} s (frozen?)")
+            else:
+                self._warn(f"device frames delayed: none for {silence:.2f} s while its clock "
+                           f"ran {ran:.3f} s; not a freeze (a stalled serial line or a "
+                           f"suspended simulator)")
 
     def _roll_tick(self, frame: Telemetry) -> None:
         """A ``T`` frame: a ``J`` follows it if the device's roll is engaged; two ``T`` in a row
