@@ -17,7 +17,7 @@ import dataclasses
 import math
 import numbers
 import warnings
-from collections.abc import Collection, Iterable, Mapping, Sequence
+from collections.abc import Collection, Container, Iterable, Mapping, Sequence
 from typing import Any
 
 from tdcm_ros.errors import (
@@ -300,23 +300,31 @@ def as_mapping(where: str, raw: Any, *, error: type[InputError] = InputError
     return raw
 
 
+def former_name_choice(name: str, formerly: Iterable[str], present: Container[str], *,
+                       prefix: str = "") -> tuple[str | None, list[str]]:
+    """Which of ``name`` and its former names ``formerly`` to take a value from when ``present``
+    holds some: the current name first, else the first former one (``None`` if none is there);
+    and one deprecation message per former name present (``prefix`` qualifies the names)."""
+    names = [n for n in (name, *formerly) if n in present]
+    messages = [f"{prefix}{old} is deprecated; use {prefix}{name} (same meaning)"
+                + ("" if old == names[0] else f"; ignored, {prefix}{names[0]} is set too")
+                for old in names if old != name]
+    return (names[0] if names else None), messages
+
+
 def current_names(where: str, specs: Iterable[Spec], data: Mapping[str, Any]) -> dict[str, Any]:
     """``data`` with each key that is a spec's former name under the spec's name, warned as
     deprecated (:class:`DeprecatedNameWarning`); a former name beside the current one is
     dropped, warned."""
     renamed = dict(data)
     for spec in specs:
+        chosen, messages = former_name_choice(spec.name, spec.formerly, data, prefix=f"{where}.")
+        for message in messages:
+            warnings.warn(message, DeprecatedNameWarning, stacklevel=2)
         for old in spec.formerly:
-            if old not in renamed:
-                continue
-            value = renamed.pop(old)
-            if spec.name in renamed:
-                warnings.warn(f"{where}.{old} is deprecated and ignored: {where}.{spec.name} is "
-                              "set too", DeprecatedNameWarning, stacklevel=2)
-                continue
-            warnings.warn(f"{where}.{old} is deprecated; use {where}.{spec.name} (same meaning)",
-                          DeprecatedNameWarning, stacklevel=2)
-            renamed[spec.name] = value
+            renamed.pop(old, None)
+        if chosen is not None:
+            renamed[spec.name] = data[chosen]
     return renamed
 
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, Generic, TypeVar, cast
 
 from tdcm_ros.errors import InputError
+from tdcm_ros.spec import former_name_choice
 
 ParamValue = bool | int | float | str | list[bool] | list[int] | list[float] | list[str]
 #: The type of one parameter: that of its default (a declared value keeps it).
@@ -124,16 +125,14 @@ class ParameterStore:
         """``(found, value)``: the parameter file's value for ``spec``, by its name, else by a
         former name (warned as deprecated); a former name set beside the current one is
         ignored, warned."""
-        names = [name for name in (spec.name, *spec.formerly) if name in self._overrides]
-        if not names:
+        chosen, messages = former_name_choice(spec.name, spec.formerly, self._overrides)
+        if chosen is None:
             return False, None
-        self._taken.update(names)
-        for old in names:
-            if old != spec.name and self._warn is not None:
-                ignored = "" if old == names[0] else f"; ignored, {names[0]} is set too"
-                self._warn(f"parameter {old} is deprecated; use {spec.name} (same meaning)"
-                           f"{ignored}")
-        return True, self._overrides[names[0]]
+        self._taken.update(n for n in (spec.name, *spec.formerly) if n in self._overrides)
+        for message in messages:
+            if self._warn is not None:
+                self._warn(f"parameter {message}")
+        return True, self._overrides[chosen]
 
     def unused_overrides(self) -> list[str]:
         """Names the parameter file sets that no declared parameter took (sorted)."""

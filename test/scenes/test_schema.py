@@ -203,6 +203,7 @@ def test_a_former_marker_key_still_reads_and_warns(old: str, new: str, value: ob
 def test_a_former_key_beside_the_current_one_is_ignored_and_warned() -> None:
     from tdcm_ros.spec import DeprecatedNameWarning
 
-    with pytest.warns(DeprecatedNameWarning, match="ball_radius_m is deprecated and ignored"):
+    with pytest.warns(DeprecatedNameWarning, match=r"ball_radius_m is deprecated; use markers"
+                      r"\.ball_radius \(same meaning\); ignored, markers\.ball_radius is set too"):
         scene = scene_from_text("markers: {ball_radius: 0.002, ball_radius_m: 0.003}")
     assert scene.marker_ball_radius == 0.002
