@@ -37,14 +37,12 @@ from tdcm_ros.runtime import (
     close_within,
     resolve_topic,
 )
-from tdcm_ros.runtime.param_client import PARAM_TIMEOUT_S, ParameterClient
+from tdcm_ros.runtime.param_client import ParameterClient
 
 NODE_NAME = "_tdcm_play"
 #: s: longest wait for the graph's readers of the played topics (:meth:`Player.wall_time_readers`).
 READERS_WAIT_S = 2.0
-#: s: longest wait for a reader's ``use_sim_time`` (the ``tdcm param`` tools' default: on rclpy
-#: a new client may take over 1 s to match the node's parameter service on a loaded machine).
-PARAMETER_WAIT_S = PARAM_TIMEOUT_S
+READERS_POLL_S = 0.05  #: s between two looks at the graph's readers
 MAX_CLOCK_HZ = 10_000.0
 LINGER_S = 0.3  # time given to the last samples to leave before the context closes (s)
 PROGRESS_PERIOD_S = 0.1  # wall time between two progress reports (s)
@@ -201,12 +199,16 @@ class Player:
         timeout = max(READERS_WAIT_S, self.options.delay_s)
         topics = [self._names[topic] for topic in self._publishers]
         found = []
-        for topic, nodes in self._context.readers(topics, timeout).items():
+        deadline = time.monotonic() + timeout
+        while not all((readers := self._context.subscribed_nodes(topics)).values()) \
+                and time.monotonic() < deadline:
+            self._context.spin_for(READERS_POLL_S)
+        for topic, nodes in readers.items():
             for node in sorted(nodes):
                 if node.rsplit("/", 1)[-1].startswith("_"):
                     continue
                 try:
-                    on_sim_time = ParameterClient(self._context, node, PARAMETER_WAIT_S).get(
+                    on_sim_time = ParameterClient(self._context, node).get(
                         "use_sim_time")
                 except (RuntimePortError, InputError) as error:
                     logger.info("use_sim_time of %s not known: %s", node, error)

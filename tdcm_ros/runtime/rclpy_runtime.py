@@ -479,21 +479,15 @@ class RclpyContext:
                and self.context.ok()):
             self._spin_once(min(left, 0.05))
 
-    def readers(self, topics: Collection[str], timeout: float) -> dict[str, set[str]]:
-        """Topic -> fully qualified names of the nodes (not this context's) subscribed to it,
-        as DDS discovery shows them; waits up to ``timeout`` s for every topic to have one. An
-        endpoint seen before its node's name (rclpy's ``_NODE_NAME_UNKNOWN_``) is not one yet."""
+    def subscribed_nodes(self, topics: Collection[str]) -> dict[str, set[str]]:
+        """Topic -> fully qualified names of the nodes (not this context's) subscribed to it
+        now, as DDS discovery shows them. An endpoint seen before its node's name (rclpy's
+        ``_NODE_NAME_UNKNOWN_``) is not one yet."""
         node = self._nodes[0] if self._nodes else self.create_node(f"_tdcm_graph_{os.getpid()}")
         own = {n.get_fully_qualified_name() for n in self._nodes}
-        deadline = time.monotonic() + timeout
-        while True:
-            seen = {topic: {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-                            for info in node.get_subscriptions_info_by_topic(resolve_topic(topic))
-                            if info.node_name != UNKNOWN_NODE_NAME}
-                    - own for topic in topics}
-            if all(seen.values()) or time.monotonic() >= deadline:
-                return seen
-            self.spin_for(0.05)
+        return {topic: {f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+                        for info in node.get_subscriptions_info_by_topic(resolve_topic(topic))
+                        if info.node_name != UNKNOWN_NODE_NAME} - own for topic in topics}
 
     def spin_until_future(self, future: Any, timeout: float) -> Any:
         """Spin until ``future`` is done; its result, or ``RuntimePortError`` after ``timeout``."""

@@ -660,6 +660,7 @@ class ZenohContext:
         self.executor = _Executor()
         self._ids = itertools.count()
         self._ports: list[ZenohNodePort] = []
+        self._watch: GraphWatch | None = None  # the graph as subscribed_nodes sees it
 
     def next_id(self) -> int:
         """Next node/entity id (one counter per context, as in rmw_zenoh)."""
@@ -708,20 +709,14 @@ class ZenohContext:
             watch.close()
         return sorted((name, kind) for name, kinds in services.items() for kind in kinds)
 
-    def readers(self, topics: Collection[str], timeout: float) -> dict[str, set[str]]:
-        """Topic -> fully qualified names of the nodes of other sessions subscribed to it, as a
-        :class:`GraphWatch` sees them; waits up to ``timeout`` s for every topic to have one."""
-        watch = GraphWatch(self)
-        deadline = time.monotonic() + timeout
-        try:
-            while True:
-                nodes = watch.nodes((wire.SUBSCRIPTION,), ignore_zid=self.zid)
-                seen = {topic: nodes.get(resolve_topic(topic), set()) for topic in topics}
-                if all(seen.values()) or time.monotonic() >= deadline:
-                    return seen
-                self.spin_for(0.05)
-        finally:
-            watch.close()
+    def subscribed_nodes(self, topics: Collection[str]) -> dict[str, set[str]]:
+        """Topic -> fully qualified names of the nodes of other sessions subscribed to it now,
+        as this context's :class:`GraphWatch` (opened at the first call, closed with the
+        context) has seen them so far."""
+        if self._watch is None:
+            self._watch = GraphWatch(self)
+        nodes = self._watch.nodes((wire.SUBSCRIPTION,), ignore_zid=self.zid)
+        return {topic: nodes.get(resolve_topic(topic), set()) for topic in topics}
 
     def spin_for(self, seconds: float) -> None:
         """Run callbacks for ``seconds`` s."""
@@ -738,10 +733,13 @@ class ZenohContext:
         self.executor.stop.set()
 
     def close(self) -> None:
-        """Close every port, then the session."""
+        """Close every port and the graph watch, then the session."""
         for port in self._ports:
             port.close()
         self._ports.clear()
+        if self._watch is not None:
+            self._watch.close()
+            self._watch = None
         self.session.close()
 
 
