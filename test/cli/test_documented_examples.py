@@ -1,8 +1,9 @@
 """Every command example the docs give (the README's shell blocks, each ``--help`` epilog's
 ``examples:``) is one tdcm takes: each parses, and each that needs no running graph runs to
 exit status 0 from a folder holding the files it names. The full benchmarks are parsed only
-(minutes of timed solves; their ``--quick`` forms run); the graph's examples are parsed here
-and their commands run in the topic, param, service, record, play and demo tests."""
+(minutes of timed solves; their ``--quick`` forms run); the graph's examples run in
+test_graph_examples.py (all but the ``--runtime rclpy`` ones and the demos, which test/demo runs
+in shortened forms)."""
 
 from __future__ import annotations
 
