@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
 from collections.abc import Mapping, Sequence
 
@@ -116,7 +117,12 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run ``tdcm``; returns the process exit status."""
+    """Run ``tdcm``; returns the process exit status. As a process (``argv`` None), Ctrl-C
+    (SIGINT) stops a command even if it was started with SIGINT ignored, as a background job of
+    a non-interactive shell is: Python then leaves it ignored, and a command that runs until
+    Ctrl-C would never stop (rclpy's tools install their own handler for the same reason)."""
+    if argv is None:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     args_in = sys.argv[1:] if argv is None else list(argv)
     one_line_warnings()
     args = build_parser(args_in).parse_args(args_in)
