@@ -283,13 +283,17 @@ def test_the_tls_examples_bring_up_a_secure_graph_that_a_configured_peer_reads(
     (tmp_path / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in PASSWORDS.items()))
     render("router.json5", tmp_path, "router.json5")
     render("peer.json5", tmp_path, "peer.json5")
-    endpoint = f"tls/127.0.0.1:{free_port()}"
+    port = free_port()
+    endpoint = f"tls/127.0.0.1:{port}"
     up_example, echo_example = (_rewritten(e, Graph(endpoint, tmp_path, graph.env))
                                 for e in (up_example, echo_example))
     env = {k: v for k, v in graph.env.items() if k != "TDCM_ZENOH_ENDPOINT"}
     up = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *up_example.argv], env=env,
                           cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     up_err = Lines(up, "stderr")
+    # the other host's command comes once the bench is up (else: "no zenoh router", exit 1)
+    eventually(lambda: listening(port) or up.poll() is not None, 30.0, "the TLS router",
+               detail=up_err.tail)
     echo = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *echo_example.argv],
                             env={**env, **echo_example.env}, cwd=tmp_path,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
