@@ -29,6 +29,8 @@ RUNTIME_ENV = "TDCM_RUNTIME"
 #: Exit status of a node whose loop died of an unexpected error (callbacks are isolated, see
 #: :mod:`tdcm_ros.runtime.guard`; this is what is left), so ``tdcm up`` and launch see it.
 LOOP_DIED = 70
+#: Exit status of a node stopped by a signal while it was being built (128 + SIGINT, as Ctrl-C).
+INTERRUPTED_EXIT = 130
 
 
 def resolve_runtime(choice: str = "auto") -> str:
@@ -100,22 +102,33 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     """Run ``node_class`` on ``runtime`` (``auto``, ``zenoh`` or ``rclpy``) until SIGINT/SIGTERM.
 
     The node's ``close`` runs before its context shuts down, so what it logs or sends on the way
-    out (the driver's release) still reaches the graph.
+    out (the driver's release) still reaches the graph. A signal while the node is still being
+    built (imports, compiled kernels, a first solve: seconds on a loaded machine) interrupts
+    the build at once (:class:`KeyboardInterrupt`) instead of waiting for it to finish; once
+    built, it ends the loop.
     """
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
     overrides: dict[str, Any] | None = None  # rclpy: by the node's final name, in create_port
     if chosen == "zenoh":
         overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
-    context = open_context(chosen, ros_args, [params_file] if params_file else [])
+
+    def interrupt(signum: int, frame: FrameType | None) -> None:
+        for sig in previous:  # a second signal on the way out must not interrupt the close
+            signal.signal(sig, stop)
+        raise KeyboardInterrupt(signal.Signals(signum).name)
 
     def stop(signum: int, frame: FrameType | None) -> None:
         context.request_stop()
 
-    previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    context = open_context(chosen, ros_args, [params_file] if params_file else [])
+    # after the context: opening a zenoh session installs its own SIGTERM handler
+    previous = {s: signal.signal(s, interrupt) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
         port = context.create_port(node_name, namespace, overrides)
         node = node_class(port)
+        for sig in previous:
+            signal.signal(sig, stop)
         warn_unused_overrides(port, params_file)
         port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
         try:
@@ -128,9 +141,13 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
             node.close()
     finally:
         context.close()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        _restore(previous)
     return 0
+
+
+def _restore(handlers: dict[signal.Signals, Any]) -> None:
+    for sig, handler in handlers.items():
+        signal.signal(sig, handler)
 
 
 def build_parser(prog: str = "tdcm_node", *, with_target: bool = True,
@@ -169,6 +186,9 @@ def main_for(node_class: type[NodeLogic] | None, argv: Sequence[str] | None = No
     except TdcmError as error:
         print(f"{parser.prog}: {error}", file=sys.stderr)
         return error.exit_code
+    except KeyboardInterrupt as interrupted:
+        print(f"{parser.prog}: {str(interrupted) or 'SIGINT'} while starting; stopped", file=sys.stderr)
+        return INTERRUPTED_EXIT
 
 
 def executable_name() -> str:

@@ -1,0 +1,57 @@
+"""A node stops at once on SIGINT or SIGTERM while it is still being built. Seen: ``tdcm up``
+stopped 2 s after starting, model_node still loading its kernels on a loaded machine took the
+signal as a stop request for a loop it had not entered, built on for 5 s, and the launcher killed
+it ("ignored SIGINT for 5.0 s"), so ``tdcm up`` exited 1."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from test.support.processes import Lines, child_env, stop
+from test.support.waiting import eventually, scaled
+
+pytestmark = pytest.mark.process
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_node_is_built_stops_it_at_once(
+        signum: signal.Signals, router: subprocess.Popen[bytes], zenoh_env: dict[str, str],
+        tmp_path: Path) -> None:
+    starting = tmp_path / "starting"
+    child = subprocess.Popen(
+        [sys.executable, "-m", "tdcm_ros.runtime.run_node",
+         "test.runtime.slow_start_node:SlowStartNode", "--runtime", "zenoh"],
+        env=child_env(zenoh_env, TDCM_TEST_STARTING=str(starting)),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    err = Lines(child, "stderr")
+    eventually(lambda: starting.exists() or child.poll() is not None, 60.0,
+               "the node's constructor", detail=err.tail)
+    child.send_signal(signum)
+    try:
+        status = child.wait(scaled(5.0))  # the constructor would take 60 s more
+    finally:
+        stop(child)
+    assert status == 130
+    assert err.has(f"{signum.name} while starting; stopped"), err.tail()
+
+
+def test_a_second_signal_on_the_way_out_does_not_hold_the_node(
+        router: subprocess.Popen[bytes], zenoh_env: dict[str, str], tmp_path: Path) -> None:
+    """Ctrl-C twice in a row while the node is built: it still leaves, 130."""
+    starting = tmp_path / "starting"
+    child = subprocess.Popen(
+        [sys.executable, "-m", "tdcm_ros.runtime.run_node",
+         "test.runtime.slow_start_node:SlowStartNode", "--runtime", "zenoh"],
+        env=child_env(zenoh_env, TDCM_TEST_STARTING=str(starting)),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    err = Lines(child, "stderr")
+    eventually(lambda: starting.exists() or child.poll() is not None, 60.0,
+               "the node's constructor", detail=err.tail)
+    child.send_signal(signal.SIGINT)
+    child.send_signal(signal.SIGINT)
+    assert stop(child, timeout=5.0) == 130, err.tail()
