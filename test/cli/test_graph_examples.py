@@ -34,8 +34,7 @@ from test.support.examples import Example, epilog_examples, readme_examples
 from test.support.processes import REPO, Lines, child_env, free_port, listening, stop
 from test.support.waiting import eventually
 
-#: One graph, examples in order (a bag recorded, then played): one xdist worker runs them all.
-pytestmark = [pytest.mark.process, pytest.mark.xdist_group("graph_examples")]
+pytestmark = pytest.mark.process
 
 EXAMPLES = readme_examples() + epilog_examples(build_parser())
 #: The graph every other example talks to (README, "tdcm up --twin --nodes ...").
@@ -117,17 +116,36 @@ def _wait_for_nodes(endpoint: str, nodes: tuple[str, ...], what: str, child: sub
         context.close()
 
 
+def _folder(path: Path) -> Path:
+    """``path`` made a folder as a checkout is for the examples: ``bags/``, ``config/``, and
+    ``tmp/`` for their ``/tmp`` paths."""
+    (path / "bags").symlink_to(REPO / "bags")
+    (path / "config").symlink_to(REPO / "config")
+    (path / "tmp").mkdir()
+    return path
+
+
+def _env(endpoint: str) -> dict[str, str]:
+    """The examples' environment: the embedded runtime at ``endpoint``, no TLS config."""
+    env = child_env(TDCM_ZENOH_ENDPOINT=endpoint, TDCM_RUNTIME="zenoh", ROS_DOMAIN_ID="0")
+    env.pop("TDCM_ZENOH_CONFIG", None)
+    return env
+
+
+@pytest.fixture
+def elsewhere(tmp_path: Path) -> Graph:
+    """A folder and environment of their own, no graph running: for examples that start one."""
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    return Graph(endpoint, _folder(tmp_path), _env(endpoint))
+
+
 @pytest.fixture(scope="module")
 def graph(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Graph]:
     """The README's graph on a private router, run from a folder holding ``bags/``."""
     port = free_port()
     endpoint = f"tcp/127.0.0.1:{port}"
-    folder = tmp_path_factory.mktemp("graph_examples")
-    (folder / "bags").symlink_to(REPO / "bags")
-    (folder / "config").symlink_to(REPO / "config")
-    (folder / "tmp").mkdir()
-    env = child_env(TDCM_ZENOH_ENDPOINT=endpoint, TDCM_RUNTIME="zenoh", ROS_DOMAIN_ID="0")
-    env.pop("TDCM_ZENOH_CONFIG", None)
+    folder = _folder(tmp_path_factory.mktemp("graph_examples"))
+    env = _env(endpoint)
     up = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *GRAPH_ARGV], env=env, cwd=folder,
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     err = Lines(up, "stderr")
@@ -207,6 +225,8 @@ def _evidence(example: Example, folder: Path, bag_stamped: Callable[[int, int], 
     return None
 
 
+#: One graph, its examples in order (a bag recorded, then played): one xdist worker runs them.
+@pytest.mark.xdist_group("graph_examples")
 @pytest.mark.parametrize("example", GRAPH_EXAMPLES, ids=lambda e: f"{e.where}: {' '.join(e.argv)}")
 def test_every_graph_example_runs_against_the_readmes_graph(
         example: Example, graph: Graph, bag_stamped: Callable[[int, int], bool],
@@ -240,15 +260,15 @@ def test_every_graph_example_runs_against_the_readmes_graph(
 
 @pytest.mark.parametrize("example", UP_EXAMPLES, ids=lambda e: f"{e.where}: {' '.join(e.argv)}")
 def test_every_other_up_example_brings_its_graph_up_and_stops_on_ctrl_c(
-        example: Example, graph: Graph) -> None:
+        example: Example, elsewhere: Graph) -> None:
     """Each other ``tdcm up`` example on a router of its own until its nodes are on the wire,
     then Ctrl-C: one that starts its router, or, with ``--connect``, one this test starts for
     it (the example joins a router that runs elsewhere)."""
     from tdcm_ros.cli.up import plan
 
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
-    example = _rewritten(example, Graph(endpoint, graph.folder, graph.env))
-    env = {**graph.env, "TDCM_ZENOH_ENDPOINT": endpoint, **example.env}
+    endpoint = elsewhere.endpoint
+    example = _rewritten(example, elsewhere)
+    env = {**elsewhere.env, **example.env}
     nodes, _, _ = plan(build_parser(example.argv).parse_args(example.argv), os.getpid())
     started: list[subprocess.Popen[bytes]] = []
     if "--connect" in example.argv:
@@ -257,7 +277,7 @@ def test_every_other_up_example_brings_its_graph_up_and_stops_on_ctrl_c(
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE))
         eventually(lambda: listening(int(endpoint.rsplit(":", 1)[1])), 30.0, "the router")
     child = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *example.argv], env=env,
-                             cwd=graph.folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                             cwd=elsewhere.folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     err = Lines(child, "stderr")
     what = f"{example.where}: tdcm {' '.join(example.argv)}"
     try:
@@ -270,7 +290,7 @@ def test_every_other_up_example_brings_its_graph_up_and_stops_on_ctrl_c(
 
 
 def test_the_tls_examples_bring_up_a_secure_graph_that_a_configured_peer_reads(
-        graph: Graph, tmp_path: Path) -> None:
+        elsewhere: Graph) -> None:
     """README: ``tdcm up --endpoint tls/bench-pc:7447 --router-config router.json5 --zenoh-config
     peer.json5 --twin`` on the bench PC, then ``TDCM_ZENOH_ENDPOINT=... TDCM_ZENOH_CONFIG=peer.json5
     tdcm topic echo tip_pose`` from another host: bench-pc is 127.0.0.1 here, the certificates
@@ -279,23 +299,23 @@ def test_the_tls_examples_bring_up_a_secure_graph_that_a_configured_peer_reads(
 
     up_example, echo_example = (next(e for e in EXAMPLES if _tls(e) and e.verb == verb)
                                 for verb in ("up", "topic echo"))
-    make_certificates(tmp_path)
-    (tmp_path / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in PASSWORDS.items()))
-    render("router.json5", tmp_path, "router.json5")
-    render("peer.json5", tmp_path, "peer.json5")
+    make_certificates(elsewhere.folder)
+    (elsewhere.folder / "users.txt").write_text("".join(f"{u}:{p}\n" for u, p in PASSWORDS.items()))
+    render("router.json5", elsewhere.folder, "router.json5")
+    render("peer.json5", elsewhere.folder, "peer.json5")
     port = free_port()
     endpoint = f"tls/127.0.0.1:{port}"
-    up_example, echo_example = (_rewritten(e, Graph(endpoint, tmp_path, graph.env))
+    up_example, echo_example = (_rewritten(e, Graph(endpoint, elsewhere.folder, elsewhere.env))
                                 for e in (up_example, echo_example))
-    env = {k: v for k, v in graph.env.items() if k != "TDCM_ZENOH_ENDPOINT"}
+    env = {k: v for k, v in elsewhere.env.items() if k != "TDCM_ZENOH_ENDPOINT"}
     up = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *up_example.argv], env=env,
-                          cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                          cwd=elsewhere.folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     up_err = Lines(up, "stderr")
     # the other host's command comes once the bench is up (else: "no zenoh router", exit 1)
     eventually(lambda: listening(port) or up.poll() is not None, 30.0, "the TLS router",
                detail=up_err.tail)
     echo = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *echo_example.argv],
-                            env={**env, **echo_example.env}, cwd=tmp_path,
+                            env={**env, **echo_example.env}, cwd=elsewhere.folder,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     out, err = Lines(echo), Lines(echo, "stderr")
     try:
