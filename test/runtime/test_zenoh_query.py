@@ -30,15 +30,10 @@ def crowd(context: Any, count: int) -> list[Any]:
                             DEFAULT_QOS)) for i in range(count)]
 
 
-#: ``tdcm`` with Python's own SIGINT handler, as started from a terminal: a process started in
-#: the background of a non-interactive shell (a CI job) inherits SIGINT ignored, and Python then
-#: keeps it ignored.
-AT_A_TERMINAL = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
-                 "from tdcm_ros.cli.main import main; sys.exit(main(sys.argv[1:]))")
-
-
 def tdcm_param(*argv: str) -> subprocess.Popen[str]:
-    return subprocess.Popen([sys.executable, "-c", AT_A_TERMINAL, "param", *argv],
+    """``tdcm param ARGV`` as a process (Ctrl-C stops it even when this test runs as a background
+    job, which inherits SIGINT ignored: test/cli/test_ctrl_c_cli.py)."""
+    return subprocess.Popen([sys.executable, "-m", "tdcm_ros", "param", *argv],
                             env=child_env(), cwd=REPO, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
 
