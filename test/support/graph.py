@@ -20,7 +20,7 @@ from typing import Any
 
 import pytest
 
-from test.support.processes import REPO, child_env, free_port, listening, stop
+from test.support.processes import REPO, Lines, child_env, free_port, stop
 from test.support.waiting import eventually
 
 RUNTIMES = ["zenoh", pytest.param("rclpy", marks=pytest.mark.rclpy)]
@@ -121,16 +121,37 @@ def spawn(request: pytest.FixtureRequest) -> Iterator[Callable[..., subprocess.P
     yield from _spawner(request.getfixturevalue(name), request.node)
 
 
+ROUTER_ATTEMPTS = 3
+
+
 @pytest.fixture
-def router(zenoh_env: dict[str, str]) -> Iterator[subprocess.Popen[bytes]]:
-    """A zenoh router (tdcm_ros.runtime.router) on the private port."""
+def router(zenoh_env: dict[str, str], monkeypatch: pytest.MonkeyPatch
+           ) -> Iterator[subprocess.Popen[bytes]]:
+    """A zenoh router (tdcm_ros.runtime.router) on the private port, known to be this router:
+    its own "listening on" line, not merely something accepting on the port. A port that
+    :func:`free_port` found free can be taken before the router binds it (by another test's
+    zenoh peer, which listens on a random loopback port); the test's peer then joined a foreign
+    graph, and a query of it ended early with part of the replies. Such a router exits: the
+    fixture takes another port (at most :data:`ROUTER_ATTEMPTS`), in ``zenoh_env`` and the
+    environment alike."""
     pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
-    port = int(zenoh_env["ZENOH_TEST_PORT"])
-    process = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.router", "--listen",
-                                f"tcp/127.0.0.1:{port}"], env=zenoh_env, cwd=REPO,
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    for _ in range(ROUTER_ATTEMPTS):
+        port = int(zenoh_env["ZENOH_TEST_PORT"])
+        process = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.router", "--listen",
+                                    f"tcp/127.0.0.1:{port}"], env=zenoh_env, cwd=REPO,
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        err = Lines(process, "stderr")
+        # a loaded machine starts slowly
+        eventually(lambda err=err, process=process: err.has("tdcm_router: listening on")
+                   or process.poll() is not None, 30.0, "the router", detail=err.tail)
+        if process.poll() is None:
+            break
+        port = free_port()
+        monkeypatch.setenv("TDCM_ZENOH_ENDPOINT", f"tcp/127.0.0.1:{port}")
+        zenoh_env.update(TDCM_ZENOH_ENDPOINT=f"tcp/127.0.0.1:{port}", ZENOH_TEST_PORT=str(port))
+    else:
+        pytest.fail(f"no router could listen in {ROUTER_ATTEMPTS} attempts:\n{err.tail()}")
     try:
-        eventually(lambda: listening(port), 30.0, "the router")  # a loaded machine starts slowly
         yield process
     finally:
         if process.poll() is None:
