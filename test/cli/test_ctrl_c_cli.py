@@ -30,9 +30,12 @@ def test_a_command_started_with_sigint_ignored_still_stops_on_ctrl_c(
                              env=child_env(zenoh_env), stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE)
     out, err = Lines(child), Lines(child, "stderr")
-    # running: pub says it began its loop, echo that nothing publishes the topic yet
-    eventually(lambda: out.has("beginning loop") or err.has("still waiting")
-               or child.poll() is not None, 30.0, f"tdcm {' '.join(argv)} running",
-               detail=lambda: out.tail() + err.tail())
-    assert child.poll() is None, out.tail() + err.tail()
-    assert stop(child) == 130
+    try:
+        # running: pub says it began its loop, echo that nothing publishes the topic yet
+        eventually(lambda: out.has("beginning loop") or err.has("still waiting")
+                   or child.poll() is not None, 30.0, f"tdcm {' '.join(argv)} running",
+                   detail=lambda: out.tail() + err.tail())
+        assert child.poll() is None, out.tail() + err.tail()
+    finally:
+        status = stop(child)  # killed if SIGINT does not stop it: nothing is left running
+    assert status == 130
