@@ -22,6 +22,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -31,6 +32,7 @@ import pytest
 from tdcm_ros.cli.main import build_parser
 from test.support.cli import tdcm
 from test.support.examples import Example, epilog_examples, readme_examples
+from test.support.graph import start_router
 from test.support.processes import REPO, Lines, child_env, free_port, listening, stop
 from test.support.waiting import eventually
 
@@ -172,8 +174,6 @@ def bag_stamped(graph: Graph) -> Iterator[Callable[[int, int], bool]]:
     """``seen(until_ns, after_ns)``: whether a peer on the graph got a ``/tension`` message
     stamped by ``until_ns`` (a bag's last time) and received after ``after_ns`` (ns since the
     epoch): a played bag's message, not one of the driver's live ones, stamped as they arrive."""
-    import time
-
     from tdcm_ros.runtime.zenoh_runtime import ZenohContext, open_session
 
     context = ZenohContext(open_session(router_endpoint=graph.endpoint))
@@ -198,8 +198,6 @@ def _evidence(example: Example, folder: Path, bag_stamped: Callable[[int, int], 
               ) -> Callable[[Lines], bool] | None:
     """What a command that runs until Ctrl-C shows once it works (``None``: it ends by itself).
     ``out`` is the command's stdout."""
-    import time
-
     argv, started_ns = example.argv, time.time_ns()
     if example.verb == "topic echo" and "--once" not in argv:
         return lambda out: out.has("---")
@@ -272,10 +270,9 @@ def test_every_other_up_example_brings_its_graph_up_and_stops_on_ctrl_c(
     nodes, _, _ = plan(build_parser(example.argv).parse_args(example.argv), os.getpid())
     started: list[subprocess.Popen[bytes]] = []
     if "--connect" in example.argv:
-        started.append(subprocess.Popen(
-            [sys.executable, "-m", "tdcm_ros.runtime.router", "--listen", endpoint], env=env,
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE))
-        eventually(lambda: listening(int(endpoint.rsplit(":", 1)[1])), 30.0, "the router")
+        router, router_err = start_router(int(endpoint.rsplit(":", 1)[1]), env)
+        started.append(router)
+        assert router.poll() is None, f"the router to join exited:\n{router_err.tail()}"
     child = subprocess.Popen([sys.executable, "-m", "tdcm_ros", *example.argv], env=env,
                              cwd=elsewhere.folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     err = Lines(child, "stderr")

@@ -18,10 +18,9 @@ from test.support.waiting import eventually, scaled
 pytestmark = pytest.mark.process
 
 
-@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
-def test_a_signal_while_the_node_is_built_stops_it_at_once(
-        signum: signal.Signals, router: subprocess.Popen[bytes], zenoh_env: dict[str, str],
-        tmp_path: Path) -> None:
+def building_node(zenoh_env: dict[str, str], tmp_path: Path
+                  ) -> tuple[subprocess.Popen[bytes], Lines]:
+    """A SlowStartNode process, returned once it is in its 60 s constructor; its stderr."""
     starting = tmp_path / "starting"
     child = subprocess.Popen(
         [sys.executable, "-m", "tdcm_ros.runtime.run_node",
@@ -31,6 +30,14 @@ def test_a_signal_while_the_node_is_built_stops_it_at_once(
     err = Lines(child, "stderr")
     eventually(lambda: starting.exists() or child.poll() is not None, 60.0,
                "the node's constructor", detail=err.tail)
+    return child, err
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_node_is_built_stops_it_at_once(
+        signum: signal.Signals, router: subprocess.Popen[bytes], zenoh_env: dict[str, str],
+        tmp_path: Path) -> None:
+    child, err = building_node(zenoh_env, tmp_path)
     child.send_signal(signum)
     try:
         status = child.wait(scaled(5.0))  # the constructor would take 60 s more
@@ -43,15 +50,7 @@ def test_a_signal_while_the_node_is_built_stops_it_at_once(
 def test_a_second_signal_on_the_way_out_does_not_hold_the_node(
         router: subprocess.Popen[bytes], zenoh_env: dict[str, str], tmp_path: Path) -> None:
     """Ctrl-C twice in a row while the node is built: it still leaves, 130."""
-    starting = tmp_path / "starting"
-    child = subprocess.Popen(
-        [sys.executable, "-m", "tdcm_ros.runtime.run_node",
-         "test.runtime.slow_start_node:SlowStartNode", "--runtime", "zenoh"],
-        env=child_env(zenoh_env, TDCM_TEST_STARTING=str(starting)),
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    err = Lines(child, "stderr")
-    eventually(lambda: starting.exists() or child.poll() is not None, 60.0,
-               "the node's constructor", detail=err.tail)
+    child, err = building_node(zenoh_env, tmp_path)
     child.send_signal(signal.SIGINT)
     child.send_signal(signal.SIGINT)
     assert stop(child, timeout=5.0) == 130, err.tail()

@@ -124,26 +124,31 @@ def spawn(request: pytest.FixtureRequest) -> Iterator[Callable[..., subprocess.P
 ROUTER_ATTEMPTS = 3
 
 
+def start_router(port: int, env: dict[str, str]) -> tuple[subprocess.Popen[bytes], Lines]:
+    """A zenoh router (tdcm_ros.runtime.router) on 127.0.0.1:``port``, waited for until it says
+    it listens or exits: known by its own line, not merely by something accepting on the port.
+    A port :func:`free_port` found free can be taken before the router binds it (by another
+    test's zenoh peer, on a random loopback port); the router then exits ("Address already in
+    use") while the port accepts, and a peer would join a foreign graph."""
+    process = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.router", "--listen",
+                                f"tcp/127.0.0.1:{port}"], env=env, cwd=REPO,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    err = Lines(process, "stderr")
+    # a loaded machine starts slowly
+    eventually(lambda: err.has("tdcm_router: listening on") or process.poll() is not None,
+               30.0, "the router", detail=err.tail)
+    return process, err
+
+
 @pytest.fixture
 def router(zenoh_env: dict[str, str], monkeypatch: pytest.MonkeyPatch
            ) -> Iterator[subprocess.Popen[bytes]]:
-    """A zenoh router (tdcm_ros.runtime.router) on the private port, known to be this router:
-    its own "listening on" line, not merely something accepting on the port. A port that
-    :func:`free_port` found free can be taken before the router binds it (by another test's
-    zenoh peer, which listens on a random loopback port); the test's peer then joined a foreign
-    graph, and a query of it ended early with part of the replies. Such a router exits: the
-    fixture takes another port (at most :data:`ROUTER_ATTEMPTS`), in ``zenoh_env`` and the
-    environment alike."""
+    """A router from :func:`start_router` on the private port; one that exited (its port was
+    taken, a query of the foreign graph then ended early with part of its replies) is replaced
+    on another port (at most :data:`ROUTER_ATTEMPTS`), in ``zenoh_env`` and the environment."""
     pytest.importorskip("zenoh", reason="eclipse-zenoh not installed")
     for _ in range(ROUTER_ATTEMPTS):
-        port = int(zenoh_env["ZENOH_TEST_PORT"])
-        process = subprocess.Popen([sys.executable, "-m", "tdcm_ros.runtime.router", "--listen",
-                                    f"tcp/127.0.0.1:{port}"], env=zenoh_env, cwd=REPO,
-                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-        err = Lines(process, "stderr")
-        # a loaded machine starts slowly
-        eventually(lambda err=err, process=process: err.has("tdcm_router: listening on")
-                   or process.poll() is not None, 30.0, "the router", detail=err.tail)
+        process, err = start_router(int(zenoh_env["ZENOH_TEST_PORT"]), zenoh_env)
         if process.poll() is None:
             break
         port = free_port()
