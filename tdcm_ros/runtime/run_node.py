@@ -104,8 +104,9 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     The node's ``close`` runs before its context shuts down, so what it logs or sends on the way
     out (the driver's release) still reaches the graph. A signal while the node is still being
     built (imports, compiled kernels, a first solve: seconds on a loaded machine) interrupts
-    the build at once (:class:`KeyboardInterrupt`) instead of waiting for it to finish; once
-    built, it ends the loop.
+    the build at once (:class:`KeyboardInterrupt`) instead of waiting for it to finish, and is
+    remembered, so that a library which runs the handler and drops its error cannot make the
+    node spin on; once built, it ends the loop.
     """
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
@@ -113,10 +114,13 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     if chosen == "zenoh":
         overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
 
+    interrupted: list[str] = []
+
     def interrupt(signum: int, frame: FrameType | None) -> None:
         for sig in previous:  # a second signal on the way out must not interrupt the close
             signal.signal(sig, stop)
-        raise KeyboardInterrupt(signal.Signals(signum).name)
+        interrupted.append(signal.Signals(signum).name)
+        raise KeyboardInterrupt(interrupted[-1])
 
     def stop(signum: int, frame: FrameType | None) -> None:
         context.request_stop()
@@ -129,9 +133,11 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
         node = node_class(port)
         for sig in previous:
             signal.signal(sig, stop)
-        warn_unused_overrides(port, params_file)
-        port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
         try:
+            if interrupted:  # a library the build called ran the handler and dropped its error
+                raise KeyboardInterrupt(interrupted[0])
+            warn_unused_overrides(port, params_file)
+            port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
             context.spin()
         except Exception as error:  # noqa: BLE001 - the loop died: close, then exit non-zero
             port.logger.error("the node's loop died (%s: %s); closing it and exiting with %d",

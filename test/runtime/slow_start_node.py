@@ -1,9 +1,12 @@
-"""A node that takes a minute to build (run as ``slow_start_node:SlowStartNode``): it creates the
-file named by ``TDCM_TEST_STARTING`` once its port exists, then spends up to 60 s in its
-constructor, as a node loading compiled kernels on a loaded machine does for seconds."""
+"""Nodes that take a minute to build: each creates the file named by ``TDCM_TEST_STARTING`` once
+its port exists, then spends up to 60 s in its constructor, as a node loading compiled kernels on
+a loaded machine does for seconds. ``SlowStartNode`` lets a signal's error through;
+``SwallowingStartNode`` drops it and returns, as a native library that runs Python's signal
+handlers inside a call and discards their error does (seen: model_node built on and spun)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import threading
 from pathlib import Path
@@ -20,3 +23,13 @@ class SlowStartNode(NodeLogic):
         super().__init__(port)
         Path(os.environ["TDCM_TEST_STARTING"]).touch()
         threading.Event().wait(BUILD_S)  # a signal's handler still runs, and may raise, here
+
+
+class SwallowingStartNode(NodeLogic):
+    default_name = "swallowing_start"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        Path(os.environ["TDCM_TEST_STARTING"]).touch()
+        with contextlib.suppress(KeyboardInterrupt):
+            threading.Event().wait(BUILD_S)
