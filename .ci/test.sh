@@ -15,13 +15,15 @@
 # with TDCM_REQUIRE_RCLPY=1 so that none of them can be skipped). They share no transport (zenoh
 # routers on free loopback ports; DDS in domains 1..101, discovery on this host) and no files, so
 # they may run side by side; on 2 cores they are ordered by load instead:
-#   1. the in-process tier (CPU-bound: TDCM_TEST_CPU_WORKERS pytest-xdist workers, default 2), while
-#      .ci/ros.sh --prepare builds the ROS venv and workspace in the background, at niceness 19 (it
-#      has no deadline: it takes what CPU the tiers leave idle, and goes on beside step 2);
+#   1. the in-process tier (CPU-bound, on simulated time: TDCM_TEST_CPU_WORKERS pytest-xdist
+#      workers, default 2) beside an interop subset on the lowest eclipse-zenoh allowed
+#      (.ci/zenoh_lowest.sh: processes, ~0.7 of a core; the in-process tests only take longer for
+#      it, and cannot fail for it), while .ci/ros.sh --prepare builds the ROS venv and workspace in
+#      the background, at niceness 19 (it has no deadline: it takes what CPU the tiers leave idle,
+#      and goes on beside step 2);
 #   2. the embedded process tier (marked `process`: processes and a transport, mostly waiting on
 #      timers and sockets: TDCM_TEST_WORKERS workers, default 3), then its end-to-end demos (marked
-#      `demo`: graphs of 7 real-time processes) alone, one at a time, then an interop subset on
-#      the lowest eclipse-zenoh allowed (.ci/zenoh_lowest.sh);
+#      `demo`: graphs of 7 real-time processes) alone, one at a time;
 #   3. the rclpy tier (.ci/ros.sh --tests-only: the same split), so that two runtimes' real-time
 #      graphs do not starve each other.
 # Every step runs even when an earlier one failed; each pytest run lists its 25 slowest tests.
@@ -29,7 +31,20 @@ set -uo pipefail
 cd "$(dirname "$0")/.."
 export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
 LOGS="$(mktemp -d)"
-trap 'rm -rf "$LOGS"' EXIT
+BACKGROUND=()
+stop_tree() {  # stop_tree PID: SIGTERM to it and every descendant (a background job of a script
+  local child  # ignores SIGINT, so Ctrl-C on this script would leave it running)
+  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do stop_tree "$child"; done
+  kill -TERM "$1" 2>/dev/null || true
+}
+finish() {
+  local pid
+  for pid in "${BACKGROUND[@]}"; do stop_tree "$pid"; done
+  rm -rf "$LOGS"
+}
+trap finish EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
 start=$SECONDS
 failed=()
 step() {  # step NAME COMMAND...: run it, say how long it took, remember a failure
@@ -39,6 +54,7 @@ step() {  # step NAME COMMAND...: run it, say how long it took, remember a failu
   "$@" || status=$?
   echo "=== $name: exit $status after $((SECONDS - t0)) s"
   [ "$status" = 0 ] || failed+=("$name (exit $status)")
+  return "$status"
 }
 
 set -e
@@ -49,12 +65,20 @@ set +e
 
 TDCM_ROS_BUILD_NICE=19 bash .ci/ros.sh --prepare >"$LOGS/ros_prepare.log" 2>&1 &
 PREPARE=$!
+BACKGROUND+=("$PREPARE")
+step "lowest eclipse-zenoh" bash .ci/zenoh_lowest.sh -n 2 >"$LOGS/lowest.log" 2>&1 &
+LOWEST=$!
+BACKGROUND+=("$LOWEST")
 PYTEST=(python3 -m pytest -q -p no:cacheprovider --durations=25)
 step "in-process tier" "${PYTEST[@]}" -n "${TDCM_TEST_CPU_WORKERS:-2}" -m "not rclpy and not process"
+lowest=0
+wait "$LOWEST" || lowest=$?  # the step's own status line is in its log
+echo "=== beside it:"
+cat "$LOGS/lowest.log"
+[ "$lowest" = 0 ] || failed+=("lowest eclipse-zenoh (exit $lowest)")
 step "embedded process tier" "${PYTEST[@]}" -n "${TDCM_TEST_WORKERS:-3}" \
   -m "process and not rclpy and not demo"
 step "embedded demos, alone" "${PYTEST[@]}" -m "demo and not rclpy"
-step "lowest eclipse-zenoh" bash .ci/zenoh_lowest.sh -n 2
 prepare=0
 wait "$PREPARE" || prepare=$?
 echo "=== ROS venv and workspace (.ci/ros.sh --prepare): exit $prepare"

@@ -79,8 +79,16 @@ def test_only_the_full_benchmarks_are_left_unrun() -> None:
     assert full == BENCHMARKS
 
 
-@pytest.mark.parametrize("example", [e for e in EXAMPLES if e.verb in OFFLINE
-                                     and tuple(e.argv) not in BENCHMARKS], ids=_id)
+def _distinct(examples: list[Example]) -> list[Example]:
+    """Each command once (the first place it is shown): the same line in two help texts runs once."""
+    seen: dict[tuple[tuple[str, ...], tuple[tuple[str, str], ...]], Example] = {}
+    for example in examples:
+        seen.setdefault((tuple(example.argv), tuple(sorted(example.env.items()))), example)
+    return list(seen.values())
+
+
+@pytest.mark.parametrize("example", _distinct([e for e in EXAMPLES if e.verb in OFFLINE
+                                               and tuple(e.argv) not in BENCHMARKS]), ids=_id)
 def test_every_offline_example_runs(example: Example, workdir: Path,
                                     monkeypatch: pytest.MonkeyPatch) -> None:
     for name, value in example.env.items():
