@@ -65,6 +65,8 @@ setup(
         # the bag reader decompresses MCAP chunks itself (tdcm_ros/bagio/reader.py)
         "lz4>=4",
         "zstandard>=0.19",
+        # a notch section given as a polygon is checked by shapely (simple rings, holes inside)
+        "shapely>=2.0",
         ZENOH_REQUIREMENT,
     ],
     extras_require={
@@ -74,7 +76,8 @@ setup(
         # sockets, so workers overlap their waits on the 2-core CI machine.
         "test": ["pytest>=7", "pytest-xdist>=3.5", "hypothesis>=6.80", "ruff>=0.5",
                  "matplotlib>=3.7", "mypy==2.4.1", "scipy-stubs==1.17.1.5",
-                 "types-PyYAML==6.0.12.20261113", "types-pyserial==3.5.0.20260712"],
+                 "types-PyYAML==6.0.12.20261113", "types-pyserial==3.5.0.20260712",
+                 "types-shapely==2.1.0.20261030"],
     },
     zip_safe=True,
     maintainer="tdcm_ros developers",

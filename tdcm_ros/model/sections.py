@@ -1,0 +1,217 @@
+"""Cross-sections of a notch: what the mechanics needs from the material a cut leaves.
+
+Coordinates in the section plane (m): ``x`` in the bending plane, + toward the tendon's side,
+where one-sided cuts open; ``y`` across it; the tube axis at the origin. Every section type
+gives its :class:`SectionProperties` (each field an array, broadcast over the section's
+parameters, e.g. the paper's half-width ``h1`` at many stations of a notch):
+
+- ``area`` ``A`` (m^2);
+- ``centroid_x`` (m): the centroid's signed offset from the tube axis. A cut from +x moves it
+  to -x, so a tendon at offset ``d`` bends the section with the arm ``d - centroid_x``;
+- ``second_moment`` (m^4): ``int (x - centroid_x)^2 dA``, about the centroid's axis along
+  ``y``; ``E`` times it is the section's bending stiffness;
+- ``fibre_tendon_side`` / ``fibre_far_side`` (m): from the centroid to the farthest material on
+  the +x side (compressed as the tendon bends the body) and on the -x side (stretched);
+- ``face_arm`` (m): from the centroid to where the notch's faces meet as it closes, the tube's
+  outer surface on the +x side (``R_outer - centroid_x``); ``inf`` where nothing is cut there.
+  A prismatic notch of width ``w`` closes at the bend ``w / face_arm`` (rad).
+
+Three types: :class:`BandSection` (the paper's symmetric pair of cuts, eq. 12),
+:class:`OneSidedCut` (a tube cut from +x to a depth, in closed form) and
+:class:`PolygonSection` (any simple polygon of material, exact polygon integrals).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.section import notched_area, notched_moment
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class SectionProperties:
+    """What a section gives the mechanics (SI units; see the module docstring)."""
+
+    area: Array
+    centroid_x: Array
+    second_moment: Array
+    fibre_tendon_side: Array
+    fibre_far_side: Array
+    face_arm: Array
+
+
+class Section(Protocol):
+    """A notch's cross-section: its :class:`SectionProperties`."""
+
+    def properties(self) -> SectionProperties:
+        """Area, centroid, centroidal second moment, extreme fibres and face arm (SI units)."""
+        ...
+
+
+def _tube(r_outer: float, r_inner: float) -> tuple[float, float]:
+    """``(R_outer, r_inner)`` as floats, checked: ``0 < R_outer``, ``0 <= r_inner < R_outer`` (m)."""
+    r_outer, r_inner = float(r_outer), float(r_inner)
+    if not (math.isfinite(r_outer) and r_outer > 0.0):
+        raise out_of_range("R_outer", r_outer, "(0, inf) m", error=InvalidDesignError)
+    if not (math.isfinite(r_inner) and 0.0 <= r_inner < r_outer):
+        raise out_of_range("r_inner", r_inner, f"[0, R_outer = {r_outer:g}) m",
+                           error=InvalidDesignError)
+    return r_outer, r_inner
+
+
+@dataclass(frozen=True, eq=False)
+class BandSection:
+    """The paper's notch section (eq. 12): the tube's annulus ``r_inner <= rho <= R_outer``
+    where ``|x| <= h1``, cut symmetrically from both sides. ``half_width`` is ``h1`` (m, > 0;
+    an array gives one section per value); ``h1 >= R_outer`` is the uncut tube."""
+
+    half_width: ArrayLike
+    r_outer: float
+    r_inner: float
+
+    def properties(self) -> SectionProperties:
+        """Eq. 12's ``I`` and its area, about the tube axis (the centroid, by symmetry)."""
+        r_outer, r_inner = _tube(self.r_outer, self.r_inner)
+        h1 = np.asarray(self.half_width, dtype=float)
+        if not np.all(np.isfinite(h1) & (h1 > 0.0)):
+            bad = h1[~(np.isfinite(h1) & (h1 > 0.0))].ravel()[0]
+            raise out_of_range("h1", float(bad), "(0, inf) m", error=InvalidDesignError)
+        fibre = np.minimum(h1, r_outer)
+        return SectionProperties(
+            area=notched_area(h1, r_outer, r_inner), centroid_x=np.zeros_like(h1),
+            second_moment=notched_moment(h1, r_outer, r_inner), fibre_tendon_side=fibre,
+            fibre_far_side=fibre.copy(), face_arm=np.where(h1 < r_outer, r_outer, np.inf))
+
+
+@dataclass(frozen=True, eq=False)
+class OneSidedCut:
+    """A tube cut from the +x side, ``depth`` (m) deep from its outer surface: the annulus
+    ``r_inner <= rho <= R_outer`` where ``x <= R_outer - depth``. ``0 <= depth < 2 R_outer``
+    (0: uncut); an array gives one section per value. A cut past the axis opens the lumen
+    (York et al. 2015's wrist: a 1.16 mm tube cut 0.97 mm deep)."""
+
+    depth: ArrayLike
+    r_outer: float
+    r_inner: float
+
+    def properties(self) -> SectionProperties:
+        """Closed forms of the disc segments ``x <= c`` (``c = R_outer - depth``), the hole's
+        removed up to ``clip(c, -r_inner, r_inner)``; ``I`` by the parallel-axis theorem."""
+        r_outer, r_inner = _tube(self.r_outer, self.r_inner)
+        depth = np.asarray(self.depth, dtype=float)
+        ok = np.isfinite(depth) & (depth >= 0.0) & (depth < 2.0 * r_outer)
+        if not np.all(ok):
+            raise out_of_range("cut", float(depth[~ok].ravel()[0]),
+                               f"[0, 2 R_outer = {2.0 * r_outer:g}) m", error=InvalidDesignError)
+        plane = r_outer - depth
+        area, first, second = (outer - inner for outer, inner in zip(
+            _disc_below(plane, r_outer), _disc_below(plane, r_inner), strict=True))
+        centroid = first / area
+        return SectionProperties(
+            area=area, centroid_x=centroid, second_moment=second - area * centroid * centroid,
+            fibre_tendon_side=plane - centroid, fibre_far_side=centroid + r_outer,
+            face_arm=np.where(depth > 0.0, r_outer - centroid, np.inf))
+
+
+def _disc_below(plane: Array, radius: float) -> tuple[Array, Array, Array]:
+    """Area (m^2), first and second moments about ``x = 0`` (m^3, m^4) of the disc of
+    ``radius`` (m) where ``x <= plane`` (m; clipped to the disc); zeros for ``radius = 0``."""
+    if radius <= 0.0:
+        zero = np.zeros_like(plane)
+        return zero, zero, zero
+    c = np.clip(plane, -radius, radius)
+    r2 = radius * radius
+    root = np.sqrt(np.maximum(r2 - c * c, 0.0))
+    angle = np.arccos(-c / radius)  # = asin(c/R) + pi/2, accurate as c -> -R
+    area = c * root + r2 * angle
+    first = -(2.0 / 3.0) * root**3
+    second = 2.0 * ((c / 8.0) * (2.0 * c * c - r2) * root + (r2 * r2 / 8.0) * angle)
+    return area, first, second
+
+
+#: Fewest vertices of a polygon ring.
+MIN_VERTICES = 3
+
+
+@dataclass(frozen=True, eq=False)
+class PolygonSection:
+    """The material of a section as a simple polygon (m): ``shell`` (its outline, in either
+    orientation) and optional ``holes`` (e.g. the lumen), each a list of ``(x, y)`` vertices,
+    not closed (the last vertex joins the first). ``r_outer`` (m) is the tube's outer radius:
+    a polygon that stays inside it on the +x side is a cut that opens there, whose faces meet
+    at ``x = R_outer``. Validated with shapely (a maintained geometry library: simple rings,
+    holes inside the shell, no self-touching); the integrals are Green's theorem's, exact for
+    a polygon."""
+
+    shell: Sequence[Sequence[float]]
+    r_outer: float
+    holes: Sequence[Sequence[Sequence[float]]] = ()
+
+    def properties(self) -> SectionProperties:
+        """Exact polygon integrals of area, ``int x dA`` and ``int x^2 dA``, then the centroid's."""
+        r_outer = float(self.r_outer)
+        if not (math.isfinite(r_outer) and r_outer > 0.0):
+            raise out_of_range("R_outer", r_outer, "(0, inf) m", error=InvalidDesignError)
+        shell = _ring(self.shell, "polygon")
+        holes = [_ring(hole, f"polygon hole {k}") for k, hole in enumerate(self.holes)]
+        _check_simple(shell, holes)
+        moments = _ring_moments(shell) - sum((_ring_moments(h) for h in holes), np.zeros(3))
+        area, first, second = (float(v) for v in moments)
+        centroid = first / area
+        x_max = float(shell[:, 0].max())
+        return SectionProperties(
+            area=np.array(area), centroid_x=np.array(centroid),
+            second_moment=np.array(second - area * centroid * centroid),
+            fibre_tendon_side=np.array(x_max - centroid),
+            fibre_far_side=np.array(centroid - float(shell[:, 0].min())),
+            face_arm=np.array(r_outer - centroid if x_max < r_outer else np.inf))
+
+
+def _ring(points: Sequence[Sequence[float]], name: str) -> Array:
+    """``points`` as an (n, 2) array of finite coordinates (m), at least ``MIN_VERTICES``."""
+    try:
+        ring = np.asarray(points, dtype=float)
+    except (TypeError, ValueError) as error:
+        raise InvalidDesignError(f"{name} must be a list of [x, y] points in m ({error})",
+                                 parameter=name, value=points, allowed="[[x, y], ...] m") from error
+    if ring.ndim != 2 or ring.shape[1] != 2 or ring.shape[0] < MIN_VERTICES:
+        raise out_of_range(name, points, f"at least {MIN_VERTICES} [x, y] points (m)",
+                           error=InvalidDesignError)
+    if not np.all(np.isfinite(ring)):
+        raise out_of_range(name, points, "finite coordinates (m)", error=InvalidDesignError)
+    return ring
+
+
+def _check_simple(shell: Array, holes: list[Array]) -> None:
+    """Raise :class:`InvalidDesignError` with shapely's reason unless shell and holes make a
+    valid polygon of positive area (simple rings, holes inside, nothing self-touching)."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    polygon = Polygon(shell, holes)
+    if not polygon.is_valid or polygon.area <= 0.0:
+        reason = shapely.is_valid_reason(polygon) if not polygon.is_valid else "zero area"
+        raise InvalidDesignError(
+            f"polygon is not a simple polygon of material: {reason}", parameter="polygon",
+            value=shell.tolist(), allowed="a simple ring (holes inside it) of positive area")
+
+
+def _ring_moments(ring: Array) -> Array:
+    """``(A, int x dA, int x^2 dA)`` of the region a ring encloses (m^2, m^3, m^4), whatever
+    its orientation: Green's theorem over its edges."""
+    x, y = ring[:, 0], ring[:, 1]
+    x1, y1 = np.roll(x, -1), np.roll(y, -1)
+    cross = x * y1 - x1 * y
+    moments = np.array([np.sum(cross) / 2.0, np.sum((x + x1) * cross) / 6.0,
+                        np.sum((x * x + x * x1 + x1 * x1) * cross) / 12.0])
+    return moments if moments[0] > 0.0 else -moments
