@@ -7,9 +7,11 @@ import json
 import sys
 from typing import Any
 
+import numpy as np
+
 from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
 from tdcm_ros.errors import TdcmError
-from tdcm_ros.model import TensionRangeError, one_shot, solve
+from tdcm_ros.model import SolveResult, TensionRangeError, one_shot, solve
 
 
 def register(subparsers: Any) -> None:
@@ -47,15 +49,16 @@ def run(args: argparse.Namespace) -> int:
             from tdcm_ros.figures import plot_file
 
             plot_file("--plot", args.plot)
-        with one_shot():  # one solve: the plain-Python kernel, numba not imported
+        with one_shot():  # one solve and its report: the plain-Python kernel, numba not imported
             result = solve(design, _tension(args.tension), settings=settings)
+            report = json.dumps(result.summary()) if args.json else _notch_line(result)
     except TdcmError as error:
         if args.json:
             print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))
         print(f"tdcm solve: {error}", file=sys.stderr)
         return error.exit_code
     if args.json:
-        print(json.dumps(result.summary()))
+        print(report)
     else:
         x, _, z = result.tip_position * 1e3
         print(f"design {name}: L = {design.length * 1e3:.3f} mm, E = {design.E:.4g} Pa, "
@@ -63,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"tension {result.tension_n:g} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
               f"angle {result.tip_angle_rad:.5f} rad, deflection "
               f"{result.tip_deflection_m * 1e3:.4f} mm")
+        print(report)
         print(f"converged in {result.iterations} iterations ({result.strategy}), "
               f"{result.solve_time_s * 1e6:.0f} us")
     if args.plot:
@@ -72,3 +76,15 @@ def run(args: argparse.Namespace) -> int:
         if not args.json:
             print(f"plot written to {args.plot}")
     return 0
+
+
+def _notch_line(result: SolveResult) -> str:
+    """One line on the notches: their bend range, the least stop margin and the peak strain."""
+    angles = result.notch_angles_rad * 1e3
+    margins = result.notch_stop_margins_rad
+    strains = result.notch_peak_strains
+    tight = int(np.argmin(margins))
+    peak = int(np.argmax(strains))
+    return (f"{angles.size} notches: bend {angles.min():.3f}..{angles.max():.3f} mrad, least stop "
+            f"margin {margins[tight]:.4f} rad (notch {tight + 1}), peak strain "
+            f"{strains[peak] * 100:.3f} % (notch {peak + 1})")

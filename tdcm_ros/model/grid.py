@@ -11,6 +11,9 @@ For each cell the grid stores:
 - at each quadrature point ``s_q``, the partial integrals ``A0_q``, ``A1_q`` of the same
   integrands from ``a`` to ``s_q``, so the tangent angle there is known exactly and the
   cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it;
+- ``strain0``, ``strain1`` (cells, ``PEAK_SAMPLES``): the bending strain at equally spaced
+  probes of a notch cell is ``|m_a strain0 + m_b strain1|`` (``(1 - xi | xi) c min(h1,
+  R_outer)``; zero in tubes);
 - on cells the tendon crosses as a chord, ``A0_T``, ``A1_T``, ``C0_T``, ``C1_T``: the same per
   newton of tension for the chord moment's non-linear part (``m'' = -T c m``, see
   :func:`tdcm_ros.model.grid_kernel.cell_integrals`). A kernel that uses them takes ``A0 + T A0_T`` etc. in place of
@@ -98,6 +101,8 @@ class CellArrays:
     c_end: Array
     peak_c: Array
     peak_s: Array
+    strain0: Array
+    strain1: Array
     notch_left_node: IntArray
     notch_right_node: IntArray
 
@@ -350,6 +355,7 @@ class GridParts:
             ("C0", "C1", "C0_T", "C1_T", "c_start", "c_end", "peak_c", "peak_s"))}
         fq["s_q"] += seg_start[..., None]
         fc["peak_s"] += seg_start
+        strain = {"strain0": self.proto_strain[proto, 0], "strain1": self.proto_strain[proto, 1]}
         notches = int(members.N[rows].max())
         return GridStack(
             designs=tuple(members.designs[r] for r in rows), n_cells=count,
@@ -360,7 +366,7 @@ class GridParts:
             constrained=laid(table.constrained, True),
             chord_start_node=laid(table.chord_start_node, tip_node),
             chord_end_node=laid(table.chord_end_node, tip_node),
-            gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc,
+            gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc, **strain,
             notch_left_node=table.notch_left_node[rows, :notches],
             notch_right_node=table.notch_right_node[rows, :notches])
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -12,7 +13,8 @@ from tdcm_ros.errors import PhysicsError
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
-from tdcm_ros.model.kinematics import quaternions_y
+from tdcm_ros.model.kinematics import PlanarShape, quaternions_y
+from tdcm_ros.model.limits import closure_angle, notch_gaps
 from tdcm_ros.model.settings import SolverSettings
 
 if TYPE_CHECKING:
@@ -83,6 +85,43 @@ class SolveResult:
         return s.ravel(), kappa.ravel()
 
     @property
+    def notch_angles_rad(self) -> Array:
+        """Bend across each notch (rad), base to tip: the tangent angle's change from the
+        notch's start ``l_i`` to its end ``r_i``."""
+        grid = self.grid
+        return self.theta[grid.notch_right_node] - self.theta[grid.notch_left_node]
+
+    @cached_property
+    def notch_gaps_m(self) -> Array:
+        """Smallest gap (m) between each notch's two faces at the tube's surface, base to tip
+        (:func:`~tdcm_ros.model.limits.notch_gaps`; 0 where they touch)."""
+        p = self.positions[:, 2] + 1j * self.positions[:, 0]
+        shape = PlanarShape(p=p, theta=self.theta, tangent=np.exp(1j * self.theta))
+        return notch_gaps(self.grid, shape)
+
+    @property
+    def notch_stop_margins_rad(self) -> Array:
+        """Bend each notch has left before its faces touch (rad), base to tip: the closure
+        angle under a moment uniform across the notch
+        (:func:`~tdcm_ros.model.limits.closure_angle`, ``w_n / R_outer`` for a uniform
+        curvature) less :attr:`notch_angles_rad`."""
+        return closure_angle(self.grid) - self.notch_angles_rad
+
+    @property
+    def notch_peak_strains(self) -> Array:
+        """Largest bending strain in each notch, base to tip: ``|kappa|`` times the extreme
+        fibre's distance from the neutral axis (``min(h1, R_outer)``) at ``PEAK_SAMPLES``
+        equally spaced probes of each of its cells (the batch solver's
+        ``max_bending_strain`` is the largest of these)."""
+        grid = self.grid
+        moments = self.bend_moments
+        strain = np.abs(moments[:, 0:1] * grid.strain0 + moments[:, 1:2] * grid.strain1)
+        out = np.zeros(grid.notch_left_node.size)
+        notch = grid.is_notch
+        np.maximum.at(out, grid.notch_index[notch], np.max(strain[notch], axis=1))
+        return out
+
+    @property
     def quaternions(self) -> Array:
         """Orientation of the body frame at each node, ``(x, y, z, w)``."""
         return quaternions_y(self.theta)
@@ -151,6 +190,10 @@ class SolveResult:
             "tip_angle_rad": self.tip_angle_rad,
             "tip_deflection_m": self.tip_deflection_m,
             "tip_displacement_m": self.tip_displacement_m,
+            "notch_angles_rad": self.notch_angles_rad.tolist(),
+            "notch_gaps_m": self.notch_gaps_m.tolist(),
+            "notch_stop_margins_rad": self.notch_stop_margins_rad.tolist(),
+            "notch_peak_strains": self.notch_peak_strains.tolist(),
             "solve_time_s": self.solve_time_s,
             "residual_history_m": list(self.residual_history),
             "design": self.design.to_dict(),
