@@ -73,7 +73,7 @@ PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML
                   "lz4>=4" "zstandard>=0.19" "shapely>=2.0" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest
                   "pytest-xdist>=3.5" hypothesis)
 # Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
-VENV_RECIPE_VERSION=2
+VENV_RECIPE_VERSION=3
 # What `ros2 run tdcm_ros <exe>` starts: the nodes' ROS names (colcon only, see setup.py) and the
 # prefixed names a pip install puts on PATH.
 EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin shape_controller tdcm_node
@@ -136,10 +136,9 @@ else
   rm -f "$STAMP"
   [ -x "$VENV/bin/python" ] || "$BASE_PYTHON" -m venv "$VENV"
   # pip's log goes to a file: the machine's index configuration makes it print a warning per name.
-  # Byte-compiled (pip's default): --no-compile saved 23 s of CPU here, but with
-  # PYTHONDONTWRITEBYTECODE=1 (set on this machine) every rclpy process then compiled what it
-  # imported, at every start: the rclpy tier took 265 s against 229 s.
-  nice -n "$BUILD_NICE" "$VENV/bin/python" -m pip install \
+  # --no-compile: pip would byte-compile all ~600 MB (23 s of CPU here); below, Python writes the
+  # bytecode of what is imported instead, once, at its first import.
+  nice -n "$BUILD_NICE" "$VENV/bin/python" -m pip install --no-compile \
       "${ROS_PACKAGES[@]}" "${PROJECT_PACKAGES[@]}" \
       >"$VENV/pip-install.log" 2>&1 \
     || { tail -30 "$VENV/pip-install.log" >&2; fail "pip install failed; see $VENV/pip-install.log"; }
@@ -180,6 +179,10 @@ set +u  # the venv's activate script is fine, but keep every `source` the same
 # shellcheck disable=SC1091
 source "$VENV/bin/activate"
 set -u
+# The venv is installed without bytecode (--no-compile): let the first import of each module write
+# it. With PYTHONDONTWRITEBYTECODE=1 (a machine may set it) every rclpy process would compile what
+# it imports at every start (measured: the rclpy tier 265 s against 229 s).
+unset PYTHONDONTWRITEBYTECODE
 
 # Registry gap: the typesupports are found through the ament index, and the wheels' prefix is the
 # venv, which nothing adds to AMENT_PREFIX_PATH: without it rosidl generates no typesupport.
