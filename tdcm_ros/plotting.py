@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from tdcm_ros.model import DesignSearch, SolveResult
+from tdcm_ros.model import DesignSearch, SolveResult, body_outline
 from tdcm_ros.plot_backend import load_pyplot
 
 FONT_SIZE = 10
@@ -18,12 +18,16 @@ always drawn)."""
 
 
 def solution_figure(plt: Any, result: SolveResult) -> Any:
-    """Two panels: the midline (x-z plane of ``tdcm_base``, mm) with the notch centres and the
-    unloaded body, and the curvature along the arc length with the notches shaded."""
+    """Two panels: the body as it is cut (:func:`~tdcm_ros.model.body_outline`) with
+    its midline, the notch centres and the unloaded axis (x-z plane of ``tdcm_base``, mm), and
+    the curvature along the arc length with the notches shaded."""
     import numpy as np
 
     fig, (ax_shape, ax_k) = plt.subplots(1, 2, figsize=(11, 5),
                                          gridspec_kw={"width_ratios": [1, 2]})
+    outline = body_outline(result)
+    edge = np.concatenate([outline.tendon_side, outline.far_side[::-1]]) * 1e3
+    ax_shape.fill(edge[:, 0], edge[:, 1], color="0.8", ec="0.4", lw=0.6, label="body, as cut")
     positions, _ = result.pose_at(np.linspace(0.0, result.design.length, 400))
     ax_shape.plot(positions[:, 0] * 1e3, positions[:, 2] * 1e3, "-", lw=2, label="midline")
     left, right = result.design.notch_bounds()
@@ -38,8 +42,8 @@ def solution_figure(plt: Any, result: SolveResult) -> Any:
     ax_shape.set_aspect("equal")
     ax_shape.set_xlabel("x in tdcm_base (mm)", fontsize=FONT_SIZE)
     ax_shape.set_ylabel("z in tdcm_base (mm)", fontsize=FONT_SIZE)
-    ax_shape.set_title(f"midline at T = {result.tension_n:g} N", fontsize=FONT_SIZE + 1)
-    ax_shape.legend(loc="lower right", fontsize=FONT_SIZE - 1)
+    ax_shape.set_title(f"body at T = {result.tension_n:g} N", fontsize=FONT_SIZE + 1)
+    ax_shape.legend(loc="upper left", fontsize=FONT_SIZE - 1)
     s, kappa = result.curvature_profile
     ax_k.plot(s * 1e3, kappa, "-", lw=1.2, label="curvature κ(s)")
     for index, (a, b) in enumerate(zip(left, right, strict=True)):

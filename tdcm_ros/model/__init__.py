@@ -63,6 +63,7 @@ from tdcm_ros.model.loading import (
     TensionProfile,
 )
 from tdcm_ros.model.markers import MARKER_SPECS, MarkerLayout
+from tdcm_ros.model.outline import BodyOutline, body_outline
 from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
     CircularProfile,
@@ -101,6 +102,7 @@ __all__ = [
     "SAMPLINGS",
     "SOLVER_SPECS",
     "STATUSES",
+    "BodyOutline",
     "Capstan",
     "CircularProfile",
     "ConvergenceError",
@@ -131,6 +133,7 @@ __all__ = [
     "TensionProfile",
     "TensionRangeError",
     "UnreachableTargetError",
+    "body_outline",
     "candidate",
     "check_roll",
     "check_tension",

@@ -1,0 +1,65 @@
+"""The body's outline in the bending plane, as it is cut: where its material ends on each side
+of the midline along a solved shape (for drawing the notches as they are).
+
+Outside the notches the material reaches the tube's surface, ``R_outer`` from the midline on
+either side; inside a notch it ends at the backbone's edge, ``min(h1, R_outer)`` (eq. 13's
+profile). Each edge is a polyline of points ``(x, z)`` in ``tdcm_base`` (m), base to tip, with
+the segment boundaries ``l_i`` and ``r_i`` twice (the tube's and the notch's width there), so
+the cut's step shows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.model.result import SolveResult
+
+Array = NDArray[np.float64]
+
+#: Stations per segment (tube or notch), both ends included.
+STATIONS_PER_SEGMENT = 24
+
+
+@dataclass(frozen=True, eq=False)
+class BodyOutline:
+    """Stations ``s`` (m, base to tip, boundaries repeated), the material's half-width there on
+    the +x and -x sides (m), and the two edges' points ``(x, z)`` in ``tdcm_base`` (m), (k, 2)."""
+
+    s: Array
+    half_width_tendon_side: Array
+    half_width_far_side: Array
+    tendon_side: Array
+    far_side: Array
+
+
+def body_outline(result: SolveResult, stations: int = STATIONS_PER_SEGMENT) -> BodyOutline:
+    """The cut body's edges along ``result``'s shape (module docstring); ``stations`` per
+    segment (at least 2)."""
+    design = result.design
+    left, right = design.notch_bounds()
+    u = np.linspace(0.0, 1.0, max(2, int(stations)))
+    sigma = design.profile.sigma(u, design.w_n)
+    sigma[-1] = design.w_n  # the notch's end exactly, whatever the profile's rounding
+    notch_width = np.minimum(design.profile.h1(u, design.w_n, design.w_d), design.R_outer)
+    s_parts, widths = [], []
+    starts = [0.0, *right]
+    ends = [*left, design.length]
+    for k, (start, end) in enumerate(zip(starts, ends, strict=True)):
+        if end > start:
+            s_parts.append(np.linspace(start, end, u.size))
+            widths.append(np.full(u.size, design.R_outer))
+        if k < left.size:
+            s_parts.append(left[k] + sigma)
+            widths.append(notch_width)
+    s = np.concatenate(s_parts)
+    width = np.concatenate(widths)
+    positions, quaternions = result.pose_at(np.clip(s, 0.0, design.length))
+    theta = 2.0 * np.arctan2(quaternions[:, 1], quaternions[:, 3])
+    normal = np.stack([np.cos(theta), -np.sin(theta)], axis=1)  # +x of the body frame, (x, z)
+    midline = positions[:, [0, 2]]
+    return BodyOutline(s=s, half_width_tendon_side=width, half_width_far_side=width.copy(),
+                       tendon_side=midline + width[:, None] * normal,
+                       far_side=midline - width[:, None] * normal)
