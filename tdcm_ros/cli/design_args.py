@@ -12,12 +12,14 @@ from tdcm_ros.model import (
     PRESETS,
     PROFILE_NAMES,
     SOLVER_SPECS,
+    BodySpec,
     Design,
     InvalidTargetError,
     SolverSettings,
     candidate,
     parse_field,
     preset,
+    read_body_file,
 )
 from tdcm_ros.spec import spelled_as
 
@@ -27,9 +29,10 @@ DEFAULT_DESIGN = "paper-experiment"
 def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the design preset, its field overrides, the notch profile and the solver's routing
     and load form to ``parser``."""
-    parser.add_argument("--design", metavar="NAME",
+    parser.add_argument("--design", metavar="NAME|FILE",
                         help=f"design preset: {', '.join(PRESETS)} (default: {DEFAULT_DESIGN}); "
-                             "the same as --set design.preset=NAME")
+                             "the same as --set design.preset=NAME; or a body file (.yaml, "
+                             "see the README's Body files), whose tendon routing is the default")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override a design field in SI units, e.g. --set E=1.2e9 (or "
                              "design.E=1.2e9, as evaluate takes it); L (the length, m) sets w_t "
@@ -37,22 +40,33 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
     for name in ("routing", "loads"):  # choices and defaults from the settings' specs
         spec = SOLVER_SPECS[name]
-        parser.add_argument(f"--{name}", choices=spec.choices, default=spec.default,
-                            help=spec.description)
+        parser.add_argument(f"--{name}", choices=spec.choices, help=spec.description +
+                            f" (default: {spec.default}" +
+                            ("; a body file's tendon routing)" if name == "routing" else ")"))
 
 
 def design_and_settings(args: argparse.Namespace) -> tuple[str, Design, SolverSettings]:
-    """The preset's name, the design and the solver settings that the options of
+    """The design's name, the design and the solver settings that the options of
     :func:`add_design_arguments` give."""
-    name, design = _design(args.design, args.set)
+    body = read_body_file(args.design) if is_body_file(args.design) else None
+    name, design = _design(args.design, args.set, body)
     if args.profile:
         design = design.with_overrides(profile=args.profile)
-    return name, design, SolverSettings(routing=args.routing, loads=args.loads)
+    routing = args.routing or (body.routing if body else SOLVER_SPECS["routing"].default)
+    return name, design, SolverSettings(routing=routing,
+                                        loads=args.loads or SOLVER_SPECS["loads"].default)
 
 
-def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
-    """The preset's name (``--design`` or ``--set design.preset``, once) and the design: that
-    preset with the ``--set`` fields (``NAME`` or ``design.NAME``) over it."""
+def is_body_file(named: str | None) -> bool:
+    """Whether ``--design`` names a body file (a ``.yaml``/``.yml`` path) rather than a preset."""
+    return named is not None and named.lower().endswith((".yaml", ".yml"))
+
+
+def _design(named: str | None, pairs: list[str], body: BodySpec | None = None
+            ) -> tuple[str, Design]:
+    """The design's name (``--design`` or ``--set design.preset``, once) and the design: that
+    preset, or ``body`` (the body file ``named``), with the ``--set`` fields (``NAME`` or
+    ``design.NAME``) over it."""
     values: dict[str, Any] = {}
     for pair in pairs:
         name, sep, text = pair.partition("=")
@@ -71,10 +85,12 @@ def _design(named: str | None, pairs: list[str]) -> tuple[str, Design]:
         else:
             named = text.strip()
     fields = {k: v for k, v in values.items() if k != "L"}
-    design = preset(named or DEFAULT_DESIGN).with_overrides(**fields)
+    base = body.design() if body is not None else preset(named or DEFAULT_DESIGN)
+    design = base.with_overrides(**fields)
     if "L" in values:  # w_t (w_tip for one notch) from the length, as tdcm design --free L
         design = candidate(design, {"L": values["L"]})
-    name = spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN
+    name = (str(named) if body is not None else
+            spelled_as(named or DEFAULT_DESIGN, PRESETS) or DEFAULT_DESIGN)
     return (f"{name} modified ({', '.join(sorted(values))})" if values else name), design
 
 

@@ -12,6 +12,12 @@ Separate entry points, kept out of this face because they pull scipy:
 (the accuracy/speed benchmark behind ``tdcm bench``).
 """
 
+from tdcm_ros.model.body_file import (
+    BodySpec,
+    body_file_text,
+    body_from_mapping,
+    read_body_file,
+)
 from tdcm_ros.model.compiled import one_shot, use_compiled
 from tdcm_ros.model.design import (
     FIELD_SPECS,
@@ -103,6 +109,7 @@ __all__ = [
     "SOLVER_SPECS",
     "STATUSES",
     "BodyOutline",
+    "BodySpec",
     "Capstan",
     "CircularProfile",
     "ConvergenceError",
@@ -133,6 +140,8 @@ __all__ = [
     "TensionProfile",
     "TensionRangeError",
     "UnreachableTargetError",
+    "body_file_text",
+    "body_from_mapping",
     "body_outline",
     "candidate",
     "check_roll",
@@ -143,6 +152,7 @@ __all__ = [
     "one_shot",
     "parse_field",
     "preset",
+    "read_body_file",
     "report_progress",
     "roll_loading",
     "roll_points",

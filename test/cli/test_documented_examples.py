@@ -54,8 +54,8 @@ def test_every_example_parses_and_is_of_a_known_kind(example: Example) -> None:
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A folder holding every file the offline examples name, as a checkout does: the sample
-    bag (also as ``run.mcap``, ``trial1``, ``trial2``), ``bench/``, a scene file and a bag from
-    another lab."""
+    bag (also as ``run.mcap``, ``trial1``, ``trial2``), ``config/``, ``bench/``, a scene file and
+    a bag from another lab."""
     from tdcm_ros.metrics.synthetic import simulate
     from tdcm_ros.model import MarkerLayout
     from test.cli.test_foreign_bags_cli import DESIGN, LEVELS, VICON, write_foreign_bag
@@ -63,6 +63,7 @@ def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("examples")
     sample = REPO / "bags" / "paper_experiment"
     (folder / "bags").symlink_to(REPO / "bags")
+    (folder / "config").symlink_to(REPO / "config")
     (folder / "bench").mkdir()  # figures write there, as from a checkout
     for name in ("trial1", "trial2"):
         shutil.copytree(sample, folder / name)

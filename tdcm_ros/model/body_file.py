@@ -1,0 +1,354 @@
+"""Body files: a TD-CM described in YAML as a row of segments from base to tip (SI units).
+
+::
+
+    tube: {R_outer: 3.92e-3, r_inner: 1.55e-3}     # m
+    material: {E: 1.85e9}                         # Pa
+    tendons:
+      - {offset: 2.75e-3, routing: paper}         # m from the tube axis, + on the +x side
+    segments:                                     # base to tip
+      - tube: 5.0e-3                              # a plain tube of this length (m)
+      - repeat: 8                                 # these segments, 8 times
+        segments:
+          - notch: {width: 2.0e-3, band: 1.4e-3, profile: circular}
+          - tube: 4.0e-3
+
+A notch has a ``width`` along the body (m) and one section: ``band`` (the paper's symmetric
+pair of cuts leaving a backbone this wide, m; ``profile`` circular or rectangular), ``cut`` (a
+one-sided cut from +x, this deep from the surface, m) or ``polygon`` (the material left, a list
+of ``[x, y]`` in m, with optional ``holes``). Every problem is an
+:class:`~tdcm_ros.model.errors.InvalidDesignError` naming the key by its path in the file
+(``segments[1].segments[0].notch.cut``), the value and the allowed range.
+
+The solver takes today N identical, evenly spaced band notches and one tendon:
+:meth:`BodySpec.design` gives that :class:`~tdcm_ros.model.design.Design` and names the first
+segment a body departs from it by (per-notch sections are issue 27's next step).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tdcm_ros.errors import out_of_range, reject_unknown
+from tdcm_ros.model.design import MIN_SEGMENT_M, Design
+from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.profiles import PROFILE_NAMES, profile_from_name
+from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
+from tdcm_ros.yamlio import load_yaml
+
+#: Most segments a body may expand to (``repeat`` included).
+MAX_SEGMENTS = 10_000
+ROUTINGS = ("paper", "free")
+SECTION_KEYS = ("band", "cut", "polygon")
+
+
+@dataclass(frozen=True)
+class TubeSpec:
+    """A plain tube segment of ``length`` (m); ``where`` is its path in the file."""
+
+    length: float
+    where: str
+
+
+@dataclass(frozen=True, eq=False)
+class NotchSpec:
+    """A notch segment: ``width`` along the body (m) and its section, one of ``band`` (backbone
+    width, m, with ``profile``), ``cut`` (depth, m) or ``polygon`` (``shell``, ``holes``, m)."""
+
+    width: float
+    kind: str
+    band: float = math.nan
+    profile: str = "circular"
+    cut: float = math.nan
+    shell: tuple[tuple[float, float], ...] = ()
+    holes: tuple[tuple[tuple[float, float], ...], ...] = ()
+    where: str = ""
+
+    def section(self, r_outer: float, r_inner: float) -> Section:
+        """The notch's section at its narrowest (the band's centre) as a section type."""
+        if self.kind == "band":
+            return BandSection(self.band / 2.0, r_outer, r_inner)
+        if self.kind == "cut":
+            return OneSidedCut(self.cut, r_outer, r_inner)
+        return PolygonSection(self.shell, r_outer, self.holes)
+
+
+Segment = TubeSpec | NotchSpec
+
+
+@dataclass(frozen=True)
+class BodySpec:
+    """A body file's contents, checked (SI units): the tube, ``E`` (Pa), the tendon's offset (m)
+    and routing, and the segments base to tip (``repeat`` expanded)."""
+
+    R_outer: float
+    r_inner: float
+    E: float
+    tendon_offset: float
+    routing: str
+    segments: tuple[Segment, ...]
+    source: str
+
+    def design(self) -> Design:
+        """The body as the solver's uniform :class:`Design`: a base tube (or none), N identical
+        band notches, equal tubes between them and a tip tube (or none). A body that departs
+        from that raises :class:`InvalidDesignError` naming the first segment that does."""
+        merged = _merged_tubes(self.segments)
+        notches = [s for s in merged if isinstance(s, NotchSpec)]
+        if not notches:
+            raise InvalidDesignError(f"{self.source}: segments has no notch; allowed: at least "
+                                     "one", parameter="segments", value=0, allowed="[1, inf) notches")
+        first = notches[0]
+        for notch in notches:
+            if notch.kind != "band":
+                raise _not_yet(notch.where, f"a {notch.kind} section", self.source)
+            for key in ("width", "band", "profile"):
+                if getattr(notch, key) != getattr(first, key):
+                    raise _not_yet(f"{notch.where}.{key}", f"{key} {getattr(notch, key)!r} where "
+                                   f"{first.where} has {getattr(first, key)!r}", self.source)
+        head = merged[0].length if isinstance(merged[0], TubeSpec) else 0.0
+        tail = merged[-1].length if isinstance(merged[-1], TubeSpec) else 0.0
+        inner = [s for s in merged[1:-1] if isinstance(s, TubeSpec)]
+        if inner and len(inner) != len(notches) - 1:
+            raise _not_yet(notches[0].where, "notches with and without a tube between them",
+                           self.source)
+        for tube in inner:
+            if tube.length != inner[0].length:
+                raise _not_yet(tube.where, f"tube {tube.length!r} m where {inner[0].where} has "
+                               f"{inner[0].length!r} m", self.source)
+        return Design(w_base=head, w_tip=tail, w_n=first.width,
+                      w_t=inner[0].length if inner else 0.0, w_d=first.band, N=len(notches),
+                      R_outer=self.R_outer, r_inner=self.r_inner, R_c=self.tendon_offset,
+                      E=self.E, profile=profile_from_name(first.profile))
+
+
+def _not_yet(where: str, what: str, source: str) -> InvalidDesignError:
+    return InvalidDesignError(
+        f"{source}: {where}: {what}: the solver takes N identical, evenly spaced band notches "
+        "and one tendon (per-notch sections are not solvable yet)", parameter=where, value=what,
+        allowed="identical band notches, equal tubes between them")
+
+
+def _merged_tubes(segments: Sequence[Segment]) -> list[Segment]:
+    """Consecutive tubes joined into one (their lengths summed, the first one's path kept)."""
+    out: list[Segment] = []
+    for segment in segments:
+        if isinstance(segment, TubeSpec) and out and isinstance(out[-1], TubeSpec):
+            out[-1] = TubeSpec(out[-1].length + segment.length, out[-1].where)
+        else:
+            out.append(segment)
+    return out
+
+
+def read_body_file(path: str | Path) -> BodySpec:
+    """The checked :class:`BodySpec` of the body file at ``path`` (read through the package's
+    bounded YAML loader)."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise InvalidDesignError(f"cannot read body file {source}: {error}", parameter="design",
+                                 value=source, allowed="a readable UTF-8 YAML file") from error
+    return body_from_mapping(load_yaml(text, source, parameter="design",
+                                       error=InvalidDesignError), source)
+
+
+def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
+    """The checked :class:`BodySpec` of a body file's parsed YAML ``data``."""
+    top = _mapping(data, "the body file", source)
+    reject_unknown("body file key", top, ("tube", "material", "tendons", "segments"),
+                   error=InvalidDesignError)
+    tube = _mapping(_required(top, "tube", "", source), "tube", source)
+    reject_unknown("tube key", tube, ("R_outer", "r_inner"), error=InvalidDesignError)
+    r_outer = _number(tube, "R_outer", "tube.", source, low=0.0, high=0.5, open_low=True)
+    r_inner = _number(tube, "r_inner", "tube.", source, low=0.0, high=r_outer, open_high=True,
+                      default=0.0)
+    material = _mapping(_required(top, "material", "", source), "material", source)
+    reject_unknown("material key", material, ("E",), error=InvalidDesignError)
+    modulus = _number(material, "E", "material.", source, low=0.0, high=1e12, open_low=True)
+    tendons = _required(top, "tendons", "", source)
+    if not isinstance(tendons, list) or len(tendons) != 1:
+        count = len(tendons) if isinstance(tendons, list) else tendons
+        raise out_of_range(f"{source}: tendons", count, "a list of one tendon (several "
+                           "tendons are not solvable yet)", error=InvalidDesignError)
+    tendon = _mapping(tendons[0], "tendons[0]", source)
+    reject_unknown("tendon key", tendon, ("offset", "routing"), error=InvalidDesignError)
+    offset = _number(tendon, "offset", "tendons[0].", source, low=0.0, high=r_outer,
+                     open_low=True, open_high=True)
+    routing = tendon.get("routing", "paper")
+    if routing not in ROUTINGS:
+        raise out_of_range(f"{source}: tendons[0].routing", routing, " | ".join(ROUTINGS),
+                           error=InvalidDesignError)
+    segments = _segments(_required(top, "segments", "", source), "segments", source, r_outer,
+                         r_inner)
+    return BodySpec(R_outer=r_outer, r_inner=r_inner, E=modulus, tendon_offset=offset,
+                    routing=str(routing), segments=tuple(segments), source=source)
+
+
+def _segments(items: Any, where: str, source: str, r_outer: float, r_inner: float
+              ) -> list[Segment]:
+    if not isinstance(items, list) or not items:
+        raise out_of_range(f"{source}: {where}", items, "a non-empty list of segments",
+                           error=InvalidDesignError)
+    out: list[Segment] = []
+    for index, item in enumerate(items):
+        here = f"{where}[{index}]"
+        entry = _mapping(item, here, source)
+        kinds = [k for k in ("tube", "notch", "repeat") if k in entry]
+        if len(kinds) != 1:
+            raise InvalidDesignError(
+                f"{source}: {here} has {kinds or 'none'} of tube, notch, repeat; allowed: "
+                "exactly one", parameter=here, value=sorted(entry), allowed="tube | notch | repeat")
+        if kinds[0] == "tube":
+            reject_unknown(f"{here} key", entry, ("tube",), error=InvalidDesignError)
+            out.append(TubeSpec(_number(entry, "tube", f"{here}.", source, low=MIN_SEGMENT_M,
+                                        high=1.0), f"{here}.tube"))
+        elif kinds[0] == "notch":
+            reject_unknown(f"{here} key", entry, ("notch",), error=InvalidDesignError)
+            out.append(_notch(_mapping(entry["notch"], f"{here}.notch", source),
+                              f"{here}.notch", source, r_outer, r_inner))
+        else:
+            reject_unknown(f"{here} key", entry, ("repeat", "segments"), error=InvalidDesignError)
+            count = entry["repeat"]
+            if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= \
+                    MAX_SEGMENTS:
+                raise out_of_range(f"{source}: {here}.repeat", count, f"an integer in [1, "
+                                   f"{MAX_SEGMENTS}]", error=InvalidDesignError)
+            inner = _segments(_required(entry, "segments", f"{here}.", source),
+                              f"{here}.segments", source, r_outer, r_inner)
+            if len(out) + count * len(inner) > MAX_SEGMENTS:
+                raise out_of_range(f"{source}: {here}.repeat", count, f"at most {MAX_SEGMENTS}"
+                                   " segments in the body", error=InvalidDesignError)
+            out.extend(inner * count)
+        if len(out) > MAX_SEGMENTS:
+            raise out_of_range(f"{source}: {where}", len(out), f"at most {MAX_SEGMENTS} segments",
+                               error=InvalidDesignError)
+    return out
+
+
+def _notch(entry: Mapping[str, Any], where: str, source: str, r_outer: float, r_inner: float
+           ) -> NotchSpec:
+    reject_unknown(f"{where} key", entry, ("width", "band", "profile", "cut", "polygon",
+                                           "holes"), error=InvalidDesignError)
+    width = _number(entry, "width", f"{where}.", source, low=MIN_SEGMENT_M, high=1.0)
+    kinds = [k for k in SECTION_KEYS if k in entry]
+    if len(kinds) != 1:
+        raise InvalidDesignError(
+            f"{source}: {where} has {kinds or 'none'} of band, cut, polygon; allowed: exactly "
+            "one section", parameter=where, value=sorted(entry), allowed="band | cut | polygon")
+    kind = kinds[0]
+    if kind != "band" and "profile" in entry:
+        raise InvalidDesignError(f"{source}: {where}.profile goes with band only",
+                                 parameter=f"{where}.profile", value=entry["profile"],
+                                 allowed="profile with band")
+    if kind != "polygon" and "holes" in entry:
+        raise InvalidDesignError(f"{source}: {where}.holes goes with polygon only",
+                                 parameter=f"{where}.holes", value=entry["holes"],
+                                 allowed="holes with polygon")
+    notch = _notch_of_kind(entry, kind, width, where, source, r_outer)
+    try:
+        notch.section(r_outer, r_inner).properties()
+    except InvalidDesignError as error:
+        raise InvalidDesignError(f"{source}: {where}: {error}", parameter=f"{where}.{kind}",
+                                 value=error.value, allowed=error.allowed) from error
+    return notch
+
+
+def _notch_of_kind(entry: Mapping[str, Any], kind: str, width: float, where: str, source: str,
+                   r_outer: float) -> NotchSpec:
+    if kind == "band":
+        profile = entry.get("profile", "circular")
+        if profile not in PROFILE_NAMES:
+            raise out_of_range(f"{source}: {where}.profile", profile, " | ".join(PROFILE_NAMES),
+                               error=InvalidDesignError)
+        band = _number(entry, "band", f"{where}.", source, low=0.0, high=2.0 * r_outer,
+                       open_low=True, open_high=True)
+        return NotchSpec(width=width, kind=kind, band=band, profile=str(profile), where=where)
+    if kind == "cut":
+        cut = _number(entry, "cut", f"{where}.", source, low=0.0, high=2.0 * r_outer,
+                      open_low=True, open_high=True)
+        return NotchSpec(width=width, kind=kind, cut=cut, where=where)
+    return NotchSpec(width=width, kind=kind, shell=_points(entry["polygon"], f"{where}.polygon",
+                                                           source),
+                     holes=tuple(_points(h, f"{where}.holes[{k}]", source)
+                                 for k, h in enumerate(_list(entry.get("holes", []),
+                                                             f"{where}.holes", source))),
+                     where=where)
+
+
+def _points(value: Any, where: str, source: str) -> tuple[tuple[float, float], ...]:
+    points = _list(value, where, source)
+    out = []
+    for point in points:
+        if not (isinstance(point, list) and len(point) == 2 and all(
+                isinstance(c, (int, float)) and not isinstance(c, bool) for c in point)):
+            raise out_of_range(f"{source}: {where}", point, "[x, y] in m", error=InvalidDesignError)
+        out.append((float(point[0]), float(point[1])))
+    return tuple(out)
+
+
+def _list(value: Any, where: str, source: str) -> list[Any]:
+    if not isinstance(value, list):
+        raise out_of_range(f"{source}: {where}", value, "a list", error=InvalidDesignError)
+    return value
+
+
+def _mapping(value: Any, where: str, source: str) -> Mapping[str, Any]:
+    if not isinstance(value, dict):
+        raise out_of_range(f"{source}: {where}", value, "a mapping of keys to values",
+                           error=InvalidDesignError)
+    return value
+
+
+def _required(entry: Mapping[str, Any], key: str, prefix: str, source: str) -> Any:
+    if key not in entry:
+        raise InvalidDesignError(f"{source}: {prefix}{key} is missing", parameter=prefix + key,
+                                 value=None, allowed="a value")
+    return entry[key]
+
+
+def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low: float,
+            high: float, open_low: bool = False, open_high: bool = False,
+            default: float | None = None) -> float:
+    """``entry[key]`` as a finite float in the range (SI units), else a named error."""
+    if key not in entry and default is not None:
+        return default
+    value = _required(entry, key, prefix, source)
+    name = f"{source}: {prefix}{key}"
+    allowed = f"{'(' if open_low else '['}{low:g}, {high:g}{')' if open_high else ']'}"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise out_of_range(name, value, f"a number in {allowed}", error=InvalidDesignError)
+    number = float(value)
+    below = number <= low if open_low else number < low
+    above = number >= high if open_high else number > high
+    if not math.isfinite(number) or below or above:
+        raise out_of_range(name, value, allowed, error=InvalidDesignError)
+    return number
+
+
+def body_file_text(design: Design, routing: str = "paper") -> str:
+    """The body file of a uniform ``design`` whose tendon has ``routing``: reading it back gives
+    ``design`` bit for bit (every number written as its shortest round-trip form)."""
+    def number(value: float) -> str:
+        text = repr(float(value))
+        return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
+
+    notch = (f"{{width: {number(design.w_n)}, band: {number(design.w_d)}, "
+             f"profile: {design.profile.name}}}")
+    lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
+             f"material: {{E: {number(design.E)}}}", "tendons:",
+             f"  - {{offset: {number(design.R_c)}, routing: {routing}}}", "segments:"]
+    if design.w_base > 0.0:
+        lines.append(f"  - tube: {number(design.w_base)}")
+    if design.N > 1:
+        lines += [f"  - repeat: {design.N - 1}", "    segments:", f"      - notch: {notch}"]
+        if design.w_t > 0.0:
+            lines.append(f"      - tube: {number(design.w_t)}")
+    lines.append(f"  - notch: {notch}")
+    if design.w_tip > 0.0:
+        lines.append(f"  - tube: {number(design.w_tip)}")
+    return "\n".join(lines) + "\n"

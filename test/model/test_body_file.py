@@ -1,0 +1,161 @@
+"""Body files: the presets through a body file are the presets bit for bit, a hand-written file
+is read as written, and every bad input names its key by its path in the file."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tdcm_ros.model import (
+    PRESETS,
+    InvalidDesignError,
+    body_file_text,
+    body_from_mapping,
+    preset,
+    read_body_file,
+    solve,
+)
+from tdcm_ros.yamlio import load_yaml
+from test.support.cli import tdcm
+
+REPO = Path(__file__).resolve().parents[2]
+PAPER = """\
+tube: {R_outer: 3.92e-3, r_inner: 1.55e-3}
+material: {E: 1.85e9}
+tendons:
+  - {offset: 2.75e-3, routing: paper}
+segments:
+  - tube: 5.0e-3
+  - repeat: 8
+    segments:
+      - notch: {width: 2.0e-3, band: 1.4e-3, profile: circular}
+      - tube: 4.0e-3
+"""
+
+
+@pytest.mark.parametrize("name", sorted(PRESETS))
+@pytest.mark.parametrize("profile", ["circular", "rectangular"])
+def test_every_preset_through_its_body_file_is_the_preset(name: str, profile: str,
+                                                          tmp_path: Path) -> None:
+    design = preset(name).with_overrides(profile=profile)
+    path = tmp_path / "body.yaml"
+    path.write_text(body_file_text(design), encoding="utf-8")
+    assert read_body_file(path).design() == design
+
+
+def test_the_shipped_paper_body_is_written_from_the_preset_and_solves_bit_for_bit() -> None:
+    design = preset("paper-experiment")
+    path = REPO / "config" / "bodies" / "paper_experiment.yaml"
+    text = path.read_text(encoding="utf-8")
+    assert text.split("\n", 2)[2] == body_file_text(design)  # after its two comment lines
+    through_file = solve(read_body_file(path).design(), 20.0)
+    direct = solve(design, 20.0)
+    assert np.array_equal(through_file.positions, direct.positions)
+    assert np.array_equal(through_file.theta, direct.theta)
+
+
+def test_a_hand_written_body_is_read_as_written() -> None:
+    body = body_from_mapping(load_yaml(PAPER, "paper.yaml"), "paper.yaml")
+    design = body.design()
+    want = preset("paper-experiment")
+    for field in ("w_base", "w_tip", "w_n", "w_t", "w_d", "R_outer", "r_inner", "R_c", "E"):
+        assert getattr(design, field) == pytest.approx(getattr(want, field), rel=1e-15), field
+    assert design.N == 8 and design.profile.name == "circular"
+    assert len(body.segments) == 17 and body.routing == "paper"
+
+
+def with_changes(**changes: object) -> dict[str, object]:
+    data = load_yaml(PAPER, "paper.yaml")
+    for path, value in changes.items():
+        *parents, leaf = path.split("__")
+        node = data
+        for key in parents:
+            node = node[int(key)] if key.isdigit() else node[key]
+        if value is None:
+            del node[int(leaf) if leaf.isdigit() else leaf]
+        else:
+            node[int(leaf) if leaf.isdigit() else leaf] = value
+    return data
+
+
+NOTCH = "segments__1__segments__0__notch"
+BAD = [
+    (with_changes(tube=None), r"tube is missing"),
+    (with_changes(tube__R_outer=0.0), r"tube\.R_outer = 0\.0 is out of range; allowed: \(0, 0\.5\]"),
+    (with_changes(tube__r_inner=4e-3), r"tube\.r_inner = 0\.004 .*allowed: \[0, 0\.00392\)"),
+    (with_changes(material__E="stiff"), r"material\.E = 'stiff' .*a number"),
+    (with_changes(material__E=float("nan")), r"material\.E = nan"),
+    (with_changes(material__E=True), r"material\.E = True"),
+    (with_changes(tendons=[{"offset": 1e-3}, {"offset": -1e-3}]), r"tendons = 2 .*one tendon"),
+    (with_changes(tendons__0__offset=3.92e-3), r"tendons\[0\]\.offset = 0\.00392"),
+    (with_changes(tendons__0__routing="around"), r"tendons\[0\]\.routing = 'around'"),
+    (with_changes(tendons__0__anchor=0.01), r"unknown tendon key 'anchor'"),
+    (with_changes(segments=[]), r"segments = \[\] .*non-empty"),
+    (with_changes(segments__0={"tube": 1e-3, "notch": {}}), r"segments\[0\] has \['tube', 'notch'\]"),
+    (with_changes(segments__0={"tube": 0.0}), r"segments\[0\]\.tube = 0\.0 is out of range"),
+    (with_changes(segments__1__repeat=0), r"segments\[1\]\.repeat = 0 .*\[1, 10000\]"),
+    (with_changes(segments__1__repeat=True), r"segments\[1\]\.repeat = True"),
+    (with_changes(segments__1__repeat=6000), r"segments\[1\]\.repeat = 6000 .*at most 10000"),
+    (with_changes(**{f"{NOTCH}__band": None}), r"segments\[1\]\.segments\[0\]\.notch has none"),
+    (with_changes(**{f"{NOTCH}__cut": 1e-3}), r"notch has \['band', 'cut'\]"),
+    (with_changes(**{f"{NOTCH}__band": 7.84e-3}), r"notch\.band = 0\.00784 .*\(0, 0\.00784\)"),
+    (with_changes(**{f"{NOTCH}__width": -1.0}), r"notch\.width = -1"),
+    (with_changes(**{f"{NOTCH}__profile": "oval"}), r"notch\.profile = 'oval'"),
+    (with_changes(**{f"{NOTCH}__depth": 1.0}), r"unknown segments\[1\]\.segments\[0\]\.notch key"),
+    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "cut": 8e-3}}), r"notch\.cut = 0\.008 .*\(0, 0\.00784\)"),
+    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "cut": 1e-3, "profile": "circular"}}),
+     r"notch\.profile goes with band only"),
+    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "polygon": [[0, 0], [1e-3, 1e-3], [1e-3, 0],
+                                                            [0, 1e-3]]}}),
+     r"segments\[1\]\.segments\[0\]\.notch: polygon is not a simple polygon.*Self-intersection"),
+    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "polygon": [[0, 0], [1e-3]]}}),
+     r"notch\.polygon = \[1e-3\]|notch\.polygon = \[0\.001\]"),
+]
+
+
+@pytest.mark.parametrize(("data", "message"), BAD, ids=[m for _, m in BAD])
+def test_bad_bodies_name_the_key_by_its_path(data: dict[str, object], message: str) -> None:
+    with pytest.raises(InvalidDesignError, match=message):
+        body_from_mapping(data, "body.yaml").design()
+
+
+BAND = {"notch": {"width": 2.0e-3, "band": 1.4e-3}}
+
+
+@pytest.mark.parametrize(("segments", "where"), [
+    ([{"tube": 5e-3}, BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "band": 1.2e-3}}],
+     r"segments\[3\]\.notch\.band: band 0\.0012 where segments\[1\]\.notch has 0\.0014"),
+    ([{"tube": 5e-3}, BAND, {"tube": 4e-3}, BAND, {"tube": 3e-3}, BAND, {"tube": 4e-3}],
+     r"segments\[4\]\.tube: tube 0\.003 m where segments\[2\]\.tube has 0\.004 m"),
+    ([BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 1.0e-3}}],
+     r"segments\[2\]\.notch: a cut section"),
+])
+def test_bodies_the_solver_cannot_take_yet_name_the_first_segment_that_differs(
+        segments: list[object], where: str) -> None:
+    data = with_changes(segments=segments)
+    with pytest.raises(InvalidDesignError, match=where + ".*not solvable yet"):
+        body_from_mapping(data, "body.yaml").design()
+
+
+def test_solve_takes_a_body_file_and_its_routing(tmp_path: Path) -> None:
+    path = tmp_path / "paper.yaml"
+    path.write_text(body_file_text(preset("paper-experiment"), routing="free"), encoding="utf-8")
+    from_file = tdcm("solve", "--design", str(path), "--tension", "20", "--json")
+    assert from_file.returncode == 0, from_file.stderr
+    as_preset = tdcm("solve", "--design", "paper-experiment", "--routing", "free", "--tension",
+                     "20", "--json")
+    summary = json.loads(from_file.stdout)
+    assert summary["settings"]["routing"] == "free"
+    assert summary["tip_position_m"] == json.loads(as_preset.stdout)["tip_position_m"]
+    overridden = tdcm("solve", "--design", str(path), "--routing", "paper", "--set", "E=1.2e9",
+                      "--tension", "20", "--json")
+    assert json.loads(overridden.stdout)["settings"]["routing"] == "paper"
+    assert json.loads(overridden.stdout)["design"]["E"] == 1.2e9
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(PAPER.replace("3.92e-3", "-1"), encoding="utf-8")
+    refused = tdcm("solve", "--design", str(bad), "--tension", "20")
+    assert refused.returncode == 2
+    assert f"{bad}: tube.R_outer = -1 is out of range" in refused.stderr
