@@ -22,7 +22,7 @@
 #      the background, at niceness 19 (it has no deadline: it takes what CPU the tiers leave idle,
 #      and goes on beside step 2);
 #   2. the embedded process tier (marked `process`: processes and a transport, mostly waiting on
-#      timers and sockets: TDCM_TEST_WORKERS workers, default 3), then its end-to-end demos (marked
+#      timers and sockets: TDCM_TEST_WORKERS workers, default 4), then its end-to-end demos (marked
 #      `demo`: graphs of 7 real-time processes) alone, one at a time;
 #   3. the rclpy tier (.ci/ros.sh --tests-only: the same split), so that two runtimes' real-time
 #      graphs do not starve each other.
@@ -76,7 +76,7 @@ wait "$LOWEST" || lowest=$?  # the step's own status line is in its log
 echo "=== beside it:"
 cat "$LOGS/lowest.log"
 [ "$lowest" = 0 ] || failed+=("lowest eclipse-zenoh (exit $lowest)")
-step "embedded process tier" "${PYTEST[@]}" -n "${TDCM_TEST_WORKERS:-3}" \
+step "embedded process tier" "${PYTEST[@]}" -n "${TDCM_TEST_WORKERS:-4}" \
   -m "process and not rclpy and not demo"
 step "embedded demos, alone" "${PYTEST[@]}" -m "demo and not rclpy"
 prepare=0
