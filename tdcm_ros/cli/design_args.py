@@ -17,6 +17,7 @@ from tdcm_ros.model import (
     InvalidTargetError,
     SolverSettings,
     candidate,
+    is_body_file,
     parse_field,
     preset,
     read_body_file,
@@ -55,11 +56,6 @@ def design_and_settings(args: argparse.Namespace) -> tuple[str, Design, SolverSe
     routing = args.routing or (body.routing if body else SOLVER_SPECS["routing"].default)
     return name, design, SolverSettings(routing=routing,
                                         loads=args.loads or SOLVER_SPECS["loads"].default)
-
-
-def is_body_file(named: str | None) -> bool:
-    """Whether ``--design`` names a body file (a ``.yaml``/``.yml`` path) rather than a preset."""
-    return named is not None and named.lower().endswith((".yaml", ".yml"))
 
 
 def _design(named: str | None, pairs: list[str], body: BodySpec | None = None

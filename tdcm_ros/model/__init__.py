@@ -16,7 +16,9 @@ from tdcm_ros.model.body_file import (
     BodySpec,
     body_file_text,
     body_from_mapping,
+    is_body_file,
     read_body_file,
+    starting_design,
 )
 from tdcm_ros.model.compiled import one_shot, use_compiled
 from tdcm_ros.model.design import (
@@ -148,6 +150,7 @@ __all__ = [
     "check_tension",
     "depends_on_roll",
     "design_curves",
+    "is_body_file",
     "offset_points",
     "one_shot",
     "parse_field",
@@ -161,6 +164,7 @@ __all__ = [
     "search_designs",
     "solve",
     "solve_inverse",
+    "starting_design",
     "surface_points",
     "sweep",
     "use_compiled",

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from tdcm_ros.errors import out_of_range, reject_unknown
-from tdcm_ros.model.design import MIN_SEGMENT_M, Design
+from tdcm_ros.model.design import MIN_SEGMENT_M, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import PROFILE_NAMES, profile_from_name
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
@@ -352,3 +352,14 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
     if design.w_tip > 0.0:
         lines.append(f"  - tube: {number(design.w_tip)}")
     return "\n".join(lines) + "\n"
+
+
+def is_body_file(name: str | None) -> bool:
+    """Whether ``name`` is a body file's path (``.yaml``/``.yml``) rather than a preset name."""
+    return name is not None and name.lower().endswith((".yaml", ".yml"))
+
+
+def starting_design(preset_name: str, body_file: str = "") -> Design:
+    """The design a node starts from (its read-only ``design.preset`` and ``design.file``): the
+    body file if one is named (read now), else the preset."""
+    return read_body_file(body_file).design() if body_file else preset(preset_name)

@@ -50,7 +50,13 @@ from tdcm_ros.metrics import (
     StepSettings,
 )
 from tdcm_ros.mocap import Registration
-from tdcm_ros.model import FIELD_SPECS, PRESETS, Design, InvalidRollError, preset
+from tdcm_ros.model import (
+    FIELD_SPECS,
+    PRESETS,
+    Design,
+    InvalidRollError,
+    starting_design,
+)
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.runtime import (
     DiagnosticLevel,
@@ -75,7 +81,10 @@ loaded machine) waits in the queue instead of pushing its oldest frames out. The
 6,758 marker frames played at x2 fit whole; a depth of 100 lost 514 of them on a loaded machine."""
 #: The design preset the design.* fields start from.
 PRESET_SPECS = by_name(Spec("design.preset", description="design preset the fields start from",
-                            default="paper-experiment", kind="str", choices=tuple(PRESETS)))
+                            default="paper-experiment", kind="str", choices=tuple(PRESETS)),
+                       Spec("design.file", description="body file (.yaml) the design fields start "
+                            "from instead of design.preset, read at start ('': none)", default="",
+                            kind="str"))
 #: The marker layout as parameters ``markers.<field>``; ``markers.radial_offset`` defaults to
 #: ``design.R_outer + markers.ball_radius`` (on the surface). ``markers.radius`` is the former
 #: name of ``markers.ball_radius``.
@@ -107,7 +116,8 @@ def _stamp_s(message: Any) -> float:
 def declare_design_and_layout(port: NodePort) -> tuple[Design, MarkerLayout]:
     """The design (``design.preset`` then ``design.*``) and the marker layout (``markers.*``)
     as read-only parameters; bad values raise InputError."""
-    base = preset(str(declare_specs(port, PRESET_SPECS, read_only=True)["design.preset"]))
+    start = declare_specs(port, PRESET_SPECS, read_only=True)
+    base = starting_design(str(start["design.preset"]), str(start["design.file"]))
     design = base.with_overrides(**declare_specs(
         port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
     given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}

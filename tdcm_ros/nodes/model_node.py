@@ -53,8 +53,8 @@ from tdcm_ros.model import (
     RollHistory,
     SolveResult,
     SolverSettings,
-    preset,
     solve,
+    starting_design,
     warm_up,
 )
 from tdcm_ros.nodes.joint_states import joint_position
@@ -87,6 +87,8 @@ FIXED_SPECS = by_name(
          kind="str", choices=TENSION_TYPES),
     Spec("design.preset", description="design preset the fields start from",
          default="paper-experiment", kind="str", choices=tuple(PRESETS)),
+    Spec("design.file", description="body file (.yaml) the design fields start from instead of "
+         "design.preset, read at start ('': none)", default="", kind="str"),
     Spec("roll.joint", description="joint of `joint_states` the body rolls by (rad about "
          "the base +z axis)", default="roll", kind="str"),
     Spec("process_period_s", "s", "solver timer period", 0.001, low=1e-4, high=1.0),
@@ -154,8 +156,8 @@ class ModelNode(NodeLogic):
         _check_frame_names(self.tf_names)
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
-        base = preset(str(fixed["design.preset"]))
-        declare_specs(port, FIELD_SPECS, prefix="design.", defaults=base.to_dict())
+        self.base = starting_design(str(fixed["design.preset"]), str(fixed["design.file"]))
+        declare_specs(port, FIELD_SPECS, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
         declare_specs(port, TUNABLE_SPECS)
         period = float(fixed["process_period_s"])
@@ -194,8 +196,7 @@ class ModelNode(NodeLogic):
 
     def _config(self, changes: Mapping[str, Any]) -> tuple[Design, SolverSettings]:
         """Design and settings from the current parameters with ``changes`` applied."""
-        base = preset(str(self.port.get_parameter("design.preset")))
-        design = base.with_overrides(**read_specs(self.port, FIELD_SPECS, prefix="design.",
+        design = self.base.with_overrides(**read_specs(self.port, FIELD_SPECS, prefix="design.",
                                                   changes=changes))
         settings = SolverSettings(**read_specs(self.port, SOLVER_SPECS, prefix="solver.",
                                                changes=changes))

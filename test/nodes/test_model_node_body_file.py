@@ -1,0 +1,58 @@
+"""model_node and metrics_node start from a body file named by ``design.file`` (in-process,
+MemoryPort): the preset's file gives the preset's midline bit for bit, a ``design.*`` override
+still applies, and a bad file stops the start with the key's path."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from tdcm_ros.bagio import from_dict
+from tdcm_ros.model import InvalidDesignError, body_file_text, preset
+from tdcm_ros.nodes.metrics_node import declare_design_and_layout
+from tdcm_ros.nodes.model_node import ModelNode
+from tdcm_ros.runtime.memory_port import MemoryPort
+
+
+def midline_at(overrides: dict[str, Any], newtons: float) -> np.ndarray:
+    """The x, z of the midline model_node publishes for one tension."""
+    port = MemoryPort(overrides, name="model_node")
+    ModelNode(port)
+    port.deliver("tension", from_dict("geometry_msgs/msg/WrenchStamped", {
+        "header": {"stamp": {"sec": port.clock_ns // 10**9, "nanosec": port.clock_ns % 10**9}},
+        "wrench": {"force": {"z": newtons}}}))
+    port.advance(0.01)
+    path = port.messages("midline")[-1]
+    return np.array([[p.pose.position.x, p.pose.position.z] for p in path.poses])
+
+
+def test_model_node_from_the_presets_body_file_is_the_preset(tmp_path: Path) -> None:
+    body = tmp_path / "fig3.yaml"
+    body.write_text(body_file_text(preset("fig3-wd-1.2")), encoding="utf-8")
+    from_file = midline_at({"design.file": str(body)}, 12.0)
+    assert np.array_equal(from_file, midline_at({"design.preset": "fig3-wd-1.2"}, 12.0))
+    assert not np.array_equal(from_file, midline_at({}, 12.0))  # not the default preset
+    stiffer = midline_at({"design.file": str(body), "design.E": 4e9}, 12.0)
+    assert abs(stiffer[-1, 0]) < abs(from_file[-1, 0])
+
+
+def test_a_bad_body_file_stops_the_start_naming_the_key(tmp_path: Path) -> None:
+    body = tmp_path / "bad.yaml"
+    body.write_text(body_file_text(preset("paper-experiment")).replace("E: 1850000000.0",
+                                                                        "E: -1"), "utf-8")
+    with pytest.raises(InvalidDesignError, match=r"bad\.yaml: material\.E = -1 is out of range"):
+        ModelNode(MemoryPort({"design.file": str(body)}, name="model_node"))
+    with pytest.raises(InvalidDesignError, match="cannot read body file"):
+        declare_design_and_layout(MemoryPort({"design.file": str(tmp_path / "none.yaml")},
+                                             name="metrics_node"))
+
+
+def test_metrics_node_takes_the_same_file(tmp_path: Path) -> None:
+    body = tmp_path / "fig2.yaml"
+    body.write_text(body_file_text(preset("fig2-wn-2.5")), encoding="utf-8")
+    design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
+                                                     name="metrics_node"))
+    assert design == preset("fig2-wn-2.5")
