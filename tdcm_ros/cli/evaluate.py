@@ -26,9 +26,9 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
                         help="geometry_msgs/msg/WrenchStamped topic (default: tension)")
     parser.add_argument("--markers-topic", default="markers",
                         help="mocap4r2_msgs/msg/Markers topic (default: markers)")
-    parser.add_argument("--design", metavar="NAME",
-                        help="design preset the model starts from (default: paper-experiment); "
-                             "the same as --set design.preset=NAME")
+    parser.add_argument("--design", metavar="NAME|FILE",
+                        help="design preset or body file (.yaml) the model starts from (default: "
+                             "paper-experiment); the same as --set design.preset=NAME")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help=SET_HELP)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")

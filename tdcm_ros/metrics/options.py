@@ -2,7 +2,8 @@
 
 Names (SI units):
 
-- ``design.preset`` (a preset name, applied first), ``design.<field>`` or a bare design field
+- ``design.preset`` (a preset name or a body file, applied first), ``design.<field>`` or a bare
+  design field
   (``E``, ``w_d``, ``N``, ``profile``, ...);
 - ``solver.<field>``: a :class:`~tdcm_ros.model.SolverSettings` field;
 - ``steps.<field>``: a :class:`~tdcm_ros.metrics.steps.StepSettings` field;
@@ -28,6 +29,7 @@ from tdcm_ros.model import (
     InvalidSettingsError,
     MarkerLayout,
     SolverSettings,
+    named_design,
     parse_field,
     preset,
 )
@@ -104,7 +106,7 @@ def options_from_sets(pairs: Sequence[str], base: EvaluateOptions | None = None
     design = opts.design
     for name, text in parsed:  # the preset first, whatever the order given
         if name == "design.preset":
-            design = preset(text)
+            design = named_design(text)
     design_over = {n[7:]: parse_field(n[7:], t) for n, t in parsed if n.startswith("design.")
                    and n != "design.preset"}
     groups: dict[str, dict[str, Any]] = {prefix: {} for prefix in _GROUPS}

@@ -17,8 +17,8 @@ from tdcm_ros.model.body_file import (
     body_file_text,
     body_from_mapping,
     is_body_file,
+    named_design,
     read_body_file,
-    starting_design,
 )
 from tdcm_ros.model.compiled import one_shot, use_compiled
 from tdcm_ros.model.design import (
@@ -151,6 +151,7 @@ __all__ = [
     "depends_on_roll",
     "design_curves",
     "is_body_file",
+    "named_design",
     "offset_points",
     "one_shot",
     "parse_field",
@@ -164,7 +165,6 @@ __all__ = [
     "search_designs",
     "solve",
     "solve_inverse",
-    "starting_design",
     "surface_points",
     "sweep",
     "use_compiled",

@@ -359,7 +359,7 @@ def is_body_file(name: str | None) -> bool:
     return name is not None and name.lower().endswith((".yaml", ".yml"))
 
 
-def starting_design(preset_name: str, body_file: str = "") -> Design:
-    """The design a node starts from (its read-only ``design.preset`` and ``design.file``): the
-    body file if one is named (read now), else the preset."""
-    return read_body_file(body_file).design() if body_file else preset(preset_name)
+def named_design(name: str) -> Design:
+    """The design ``name`` names: a body file if it is one (:func:`is_body_file`; read now),
+    else a preset."""
+    return read_body_file(name).design() if is_body_file(name) else preset(name)

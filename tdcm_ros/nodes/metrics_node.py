@@ -55,7 +55,7 @@ from tdcm_ros.model import (
     PRESETS,
     Design,
     InvalidRollError,
-    starting_design,
+    named_design,
 )
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.runtime import (
@@ -117,7 +117,7 @@ def declare_design_and_layout(port: NodePort) -> tuple[Design, MarkerLayout]:
     """The design (``design.preset`` then ``design.*``) and the marker layout (``markers.*``)
     as read-only parameters; bad values raise InputError."""
     start = declare_specs(port, PRESET_SPECS, read_only=True)
-    base = starting_design(str(start["design.preset"]), str(start["design.file"]))
+    base = named_design(str(start["design.file"]) or str(start["design.preset"]))
     design = base.with_overrides(**declare_specs(
         port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
     given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}

@@ -53,8 +53,8 @@ from tdcm_ros.model import (
     RollHistory,
     SolveResult,
     SolverSettings,
+    named_design,
     solve,
-    starting_design,
     warm_up,
 )
 from tdcm_ros.nodes.joint_states import joint_position
@@ -156,7 +156,7 @@ class ModelNode(NodeLogic):
         _check_frame_names(self.tf_names)
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
-        self.base = starting_design(str(fixed["design.preset"]), str(fixed["design.file"]))
+        self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
         declare_specs(port, FIELD_SPECS, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
         declare_specs(port, TUNABLE_SPECS)

@@ -56,3 +56,4 @@ def test_metrics_node_takes_the_same_file(tmp_path: Path) -> None:
     design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                      name="metrics_node"))
     assert design == preset("fig2-wn-2.5")
+
