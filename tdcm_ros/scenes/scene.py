@@ -19,7 +19,14 @@ from scipy.spatial.transform import Rotation
 
 from tdcm_ros.device import PlantConfig, StepSchedule
 from tdcm_ros.errors import reject_unknown
-from tdcm_ros.model import FIELD_SPECS, Design, parse_field, preset
+from tdcm_ros.model import (
+    FIELD_SPECS,
+    Design,
+    is_body_file,
+    parse_field,
+    preset,
+    read_body_file,
+)
 from tdcm_ros.scenes.compiled import WORLD_STAGES, Bench, CompiledScene, compile_scene
 from tdcm_ros.scenes.effects import (
     REGISTRY,
@@ -157,7 +164,7 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
     seed = parse_value("seed", SEED, data.get("seed", 0))
     sections = {key: parse_params(key, specs, data.get(key))
                 for key, specs in SECTIONS.items() if key not in ("design", "trajectory")}
-    design = _design(data.get("design"))
+    design = _design(data.get("design"), source)
     material = sections["material"]
     true_e = design.E if material["E"] is None else material["E"]
     true_design = design.with_overrides(E=true_e)
@@ -186,16 +193,32 @@ def parse_scene(data: Any, *, default_name: str, source: Path | None = None) -> 
     return replace(scene, effects=effects)
 
 
-def _design(raw: Any) -> Design:
+def _design(raw: Any, source: Path | None) -> Design:
+    """The estimator's design: ``preset`` or ``file`` (a body file, relative to the scene
+    file's folder), then ``overrides``."""
     data = as_mapping("design", raw)
-    reject_unknown("key in design", data, ("preset", "overrides"), error=InvalidSceneError)
-    name = parse_params("design", SECTIONS["design"], {"preset": data.get("preset",
-                                                                          "paper-experiment")})
+    reject_unknown("key in design", data, ("preset", "file", "overrides"),
+                   error=InvalidSceneError)
+    if "preset" in data and "file" in data:
+        raise InvalidSceneError("design has both preset and file; allowed: one of them",
+                                parameter="design.file", value=data["file"],
+                                allowed="design.preset or design.file")
+    if "file" in data:
+        if not isinstance(data["file"], str) or not is_body_file(data["file"]):
+            raise InvalidSceneError(f"design.file = {data['file']!r} is not a body file path; "
+                                    "allowed: a .yaml path", parameter="design.file",
+                                    value=data["file"], allowed="a .yaml path")
+        folder = source.parent if source is not None else Path.cwd()
+        base = read_body_file(folder / data["file"]).design()
+    else:
+        name = parse_params("design", SECTIONS["design"], {"preset": data.get(
+            "preset", "paper-experiment")})
+        base = preset(name["preset"])
     overrides = dict(as_mapping("design.overrides", data.get("overrides")))
     for key, value in overrides.items():
         if isinstance(value, str) and key in FIELD_SPECS:  # YAML 1.1: 1.85e9 is a string
             overrides[key] = parse_field(key, value)
-    return preset(name["preset"]).with_overrides(**overrides)
+    return base.with_overrides(**overrides)
 
 
 def _check_markers(markers: Mapping[str, Any], design: Design) -> None:

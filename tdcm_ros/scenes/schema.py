@@ -23,7 +23,7 @@ TOP_KEYS: dict[str, str] = {
     "name": "scene name (defaults to the file's stem)",
     "description": "one line on what the scene is for",
     "seed": "random seed of every stochastic effect (integer >= 0)",
-    "design": "the estimator's design: preset + SI overrides (nominal material)",
+    "design": "the estimator's design: preset or body file + SI overrides (nominal material)",
     "material": "the world's true material (defaults: the design's)",
     "schedule": "tension staircase the driver runs",
     "sensors": "sensor rates",
@@ -96,7 +96,11 @@ def schema_rows() -> list[dict[str, str]]:
                          "default": repr(spec.default), "allowed": spec.allowed(),
                          "description": spec.description})
         if section == "design":
+            rows.append({"key": "design.file", "unit": "", "default": "",
+                         "allowed": "a body file (.yaml), relative to the scene file",
+                         "description": "instead of design.preset: a body file (read with the "
+                                        "scene)"})
             rows.append({"key": "design.overrides", "unit": "SI", "default": "{}",
                          "allowed": "Design fields (w_base, ..., E, profile)",
-                         "description": "overrides of the preset, SI units"})
+                         "description": "overrides of the preset or file, SI units"})
     return rows

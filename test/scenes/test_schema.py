@@ -207,3 +207,20 @@ def test_a_former_key_beside_the_current_one_is_ignored_and_warned() -> None:
                       r"\.ball_radius \(same meaning\); ignored, markers\.ball_radius is set too"):
         scene = scene_from_text("markers: {ball_radius: 0.002, ball_radius_m: 0.003}")
     assert scene.marker_ball_radius == 0.002
+
+
+def test_a_scene_takes_its_design_from_a_body_file_beside_it(tmp_path: Path) -> None:
+    from tdcm_ros.model import body_file_text, preset
+    from tdcm_ros.scenes import load_scene
+
+    (tmp_path / "bodies").mkdir()
+    (tmp_path / "bodies" / "fig3.yaml").write_text(body_file_text(preset("fig3-wd-2")), "utf-8")
+    scene = tmp_path / "scene.yaml"
+    scene.write_text("design: {file: bodies/fig3.yaml, overrides: {E: 1.2e9}}\n", "utf-8")
+    assert load_scene(scene).design == preset("fig3-wd-2").with_overrides(E=1.2e9)
+    scene.write_text("design: {file: bodies/fig3.yaml, preset: fig2-wn-1}\n", "utf-8")
+    with pytest.raises(InputError, match="design has both preset and file"):
+        load_scene(scene)
+    scene.write_text("design: {file: bodies/none.yaml}\n", "utf-8")
+    with pytest.raises(InputError, match="cannot read body file .*none.yaml"):
+        load_scene(scene)
