@@ -15,13 +15,13 @@ def test_solution_figure_has_legends_and_units() -> None:
     try:
         shape, curvature = fig.axes
         assert [t.get_text() for t in shape.get_legend().get_texts()] == [
-            "midline", "notch centres", "unloaded (T = 0 N)"]
+            "body, as cut", "midline", "notch centres", "unloaded (T = 0 N)"]
         assert [t.get_text() for t in curvature.get_legend().get_texts()] == [
             "curvature κ(s)", "notches"]
         assert (shape.get_xlabel(), shape.get_ylabel()) == ("x in tdcm_base (mm)",
                                                            "z in tdcm_base (mm)")
         assert curvature.get_xlabel() == "arc length s from the base (mm)"
         assert curvature.get_ylabel() == "curvature κ (1/m)"
-        assert shape.get_title() == "midline at T = 12 N"
+        assert shape.get_title() == "body at T = 12 N"
     finally:
         plt.close(fig)
