@@ -74,8 +74,10 @@ class DemoPlan:
     def node_overrides(self) -> dict[str, dict[str, Any]]:
         """Per-node parameters (ROS names), on top of each node's defaults."""
         scene = self.scene
-        design = {f"design.{name}": float(getattr(scene.design, name)) for name in FIELD_SPECS}
+        design: dict[str, Any] = {f"design.{name}": float(getattr(scene.design, name))
+                                  for name in FIELD_SPECS}
         design["design.N"] = int(scene.design.N)
+        design["design.profile"] = scene.design.profile.name
         markers = {"markers.arc_lengths": [float(s) for s in scene.marker_arc_lengths],
                    "markers.side_deg": float(scene.marker_side_deg)}
         top = max(self.schedule.levels)

@@ -23,6 +23,7 @@ from tdcm_ros.model.body_file import (
 from tdcm_ros.model.compiled import one_shot, use_compiled
 from tdcm_ros.model.design import (
     FIELD_SPECS,
+    PARAMETER_SPECS,
     PRESETS,
     Design,
     parse_field,
@@ -105,6 +106,7 @@ __all__ = [
     "FIELD_SPECS",
     "FREE_FIELDS",
     "MARKER_SPECS",
+    "PARAMETER_SPECS",
     "PRESETS",
     "PROFILE_NAMES",
     "SAMPLINGS",

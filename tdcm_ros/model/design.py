@@ -17,9 +17,14 @@ from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.profiles import CircularProfile, NotchProfile, profile_from_name
+from tdcm_ros.model.profiles import (
+    PROFILE_NAMES,
+    CircularProfile,
+    NotchProfile,
+    profile_from_name,
+)
 from tdcm_ros.model.section import tube_moment
-from tdcm_ros.spec import check_fields, spec_field, specs_of, spelled_as
+from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of, spelled_as
 
 MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
@@ -111,6 +116,10 @@ class Design:
 
 #: Specs of the numeric design fields (all but ``profile``), by name.
 FIELD_SPECS = specs_of(Design)
+#: The design as node parameters (``design.<name>``): every numeric field and the profile by name.
+PARAMETER_SPECS = {**FIELD_SPECS, "profile": Spec(
+    "profile", description="notch profile", default="circular", kind="str",
+    choices=PROFILE_NAMES)}
 
 
 def parse_field(name: str, text: str) -> Any:

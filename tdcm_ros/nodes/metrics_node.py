@@ -51,7 +51,7 @@ from tdcm_ros.metrics import (
 )
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import (
-    FIELD_SPECS,
+    PARAMETER_SPECS,
     PRESETS,
     Design,
     InvalidRollError,
@@ -119,7 +119,7 @@ def declare_design_and_layout(port: NodePort) -> tuple[Design, MarkerLayout]:
     start = declare_specs(port, PRESET_SPECS, read_only=True)
     base = named_design(str(start["design.file"]) or str(start["design.preset"]))
     design = base.with_overrides(**declare_specs(
-        port, FIELD_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
+        port, PARAMETER_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
     given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}
     fields = declare_specs(port, given, prefix="markers.", read_only=True)
     # a ROS parameter has a value: the default offset is the surface's, of the values above
@@ -147,7 +147,7 @@ def marker_rows(message: Any, index: dict[str, int]) -> tuple[np.ndarray, int]:
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(PRESET_SPECS), **grouped(FIELD_SPECS, "design."),
+PARAMETERS = {**grouped(PRESET_SPECS), **grouped(PARAMETER_SPECS, "design."),
               **grouped(LAYOUT_SPECS, "markers."), **grouped(STEP_SPECS, "steps."),
               **grouped(OPTION_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS)}
 

@@ -44,8 +44,8 @@ import numpy as np
 
 from tdcm_ros.errors import InputError, PhysicsError, exact_number
 from tdcm_ros.model import (
-    FIELD_SPECS,
     MARKER_SPECS,
+    PARAMETER_SPECS,
     PRESETS,
     SOLVER_SPECS,
     Design,
@@ -126,7 +126,7 @@ TF_SPECS = by_name(
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(FIXED_SPECS), **grouped(TF_SPECS), **grouped(FIELD_SPECS, "design."),
+PARAMETERS = {**grouped(FIXED_SPECS), **grouped(TF_SPECS), **grouped(PARAMETER_SPECS, "design."),
               **grouped(SOLVER_SPECS, "solver."), **grouped(TUNABLE_SPECS)}
 
 
@@ -157,7 +157,7 @@ class ModelNode(NodeLogic):
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
         self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
-        declare_specs(port, FIELD_SPECS, prefix="design.", defaults=self.base.to_dict())
+        declare_specs(port, PARAMETER_SPECS, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
         declare_specs(port, TUNABLE_SPECS)
         period = float(fixed["process_period_s"])
@@ -196,7 +196,7 @@ class ModelNode(NodeLogic):
 
     def _config(self, changes: Mapping[str, Any]) -> tuple[Design, SolverSettings]:
         """Design and settings from the current parameters with ``changes`` applied."""
-        design = self.base.with_overrides(**read_specs(self.port, FIELD_SPECS, prefix="design.",
+        design = self.base.with_overrides(**read_specs(self.port, PARAMETER_SPECS, prefix="design.",
                                                   changes=changes))
         settings = SolverSettings(**read_specs(self.port, SOLVER_SPECS, prefix="solver.",
                                                changes=changes))

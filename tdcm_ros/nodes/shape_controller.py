@@ -48,7 +48,7 @@ from tdcm_ros.control import (
     slew,
 )
 from tdcm_ros.errors import TdcmError
-from tdcm_ros.model import FIELD_SPECS
+from tdcm_ros.model import PARAMETER_SPECS
 from tdcm_ros.nodes.metrics_node import (
     LAYOUT_SPECS,
     PRESET_SPECS,
@@ -107,7 +107,7 @@ TUNABLE_SPECS = by_name(
          "(feedback falls back to feed-forward); changeable at run time", 0.5, low=0.01,
          high=3600.0))
 #: Every parameter of the node by full name, as declared below.
-PARAMETERS = {**grouped(PRESET_SPECS), **grouped(FIELD_SPECS, "design."),
+PARAMETERS = {**grouped(PRESET_SPECS), **grouped(PARAMETER_SPECS, "design."),
               **grouped(LAYOUT_SPECS, "markers."), **grouped(FIXED_SPECS),
               **grouped(TUNABLE_SPECS)}
 #: How long the tendon must read released while commanded before diagnostics say so (s).

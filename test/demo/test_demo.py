@@ -21,6 +21,7 @@ from tdcm_ros.device.schedule import StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.api import evaluate_paths
 from tdcm_ros.metrics.steps import StepSettings
+from tdcm_ros.model import preset
 from tdcm_ros.runtime.registry import NODES
 from tdcm_ros.scenes import load_scene
 
@@ -178,6 +179,11 @@ def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
     assert set(overrides) == set(NODE_ORDER) <= set(NODES)
     assert overrides["tension_driver"]["port"] == overrides["device_twin"]["link"]
     assert overrides["model_node"]["design.E"] == pytest.approx(1.85e9)
+    rectangular = replace(load_scene("paper_experiment"), design=preset(
+        "paper-experiment").with_overrides(profile="rectangular"))
+    given = make_plan(rectangular, "paper_experiment", tmp_path).node_overrides()
+    for node in ("model_node", "metrics_node"):  # the scene's notches, as cut
+        assert given[node]["design.profile"] == "rectangular", node
 
 
 def test_demo_rejects_a_bad_set_before_the_run(tmp_path: Path,

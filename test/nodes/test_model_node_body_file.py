@@ -57,3 +57,22 @@ def test_metrics_node_takes_the_same_file(tmp_path: Path) -> None:
                                                      name="metrics_node"))
     assert design == preset("fig2-wn-2.5")
 
+
+
+def test_the_profile_is_a_parameter_as_the_body_file_gives_it(tmp_path: Path) -> None:
+    """``design.profile``: from the start point (a body file's, or circular), and set at start or
+    at run time; a scene's rectangular notches reach the nodes (the demo passes it)."""
+    design = preset("fig3-wd-1.52").with_overrides(profile="rectangular")
+    body = tmp_path / "rect.yaml"
+    body.write_text(body_file_text(design), encoding="utf-8")
+    from_file = midline_at({"design.file": str(body)}, 12.0)
+    by_parameter = midline_at({"design.preset": "fig3-wd-1.52", "design.profile": "rectangular"},
+                              12.0)
+    assert np.array_equal(from_file, by_parameter)
+    assert not np.array_equal(from_file, midline_at({"design.preset": "fig3-wd-1.52"}, 12.0))
+    port = MemoryPort({"design.preset": "fig3-wd-1.52"}, name="model_node")
+    node = ModelNode(port)
+    assert node.design.profile.name == "circular"
+    assert port.store.set({"design.profile": "rectangular"}).successful
+    assert node.design.profile.name == "rectangular"
+    assert not port.store.set({"design.profile": "oval"}).successful
