@@ -38,6 +38,7 @@ from tdcm_ros.model.design import MIN_SEGMENT_M, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import PROFILE_NAMES, profile_from_name
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
+from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
 
 #: Most segments a body may expand to (``repeat`` included).
@@ -317,17 +318,10 @@ def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low
     """``entry[key]`` as a finite float in the range (SI units), else a named error."""
     if key not in entry and default is not None:
         return default
-    value = _required(entry, key, prefix, source)
-    name = f"{source}: {prefix}{key}"
-    allowed = f"{'(' if open_low else '['}{low:g}, {high:g}{')' if open_high else ']'}"
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise out_of_range(name, value, f"a number in {allowed}", error=InvalidDesignError)
-    number = float(value)
-    below = number <= low if open_low else number < low
-    above = number >= high if open_high else number > high
-    if not math.isfinite(number) or below or above:
-        raise out_of_range(name, value, allowed, error=InvalidDesignError)
-    return number
+    spec = Spec(key, unit="m" if key != "E" else "Pa", low=low, high=high, low_open=open_low,
+                high_open=open_high)
+    return float(spec.check(_required(entry, key, prefix, source), f"{source}: {prefix}{key}",
+                            error=InvalidDesignError))
 
 
 def body_file_text(design: Design, routing: str = "paper") -> str:
