@@ -3,7 +3,8 @@
 Run: ``python bench/fault_campaign.py [--tries N] [--only CLASS ...] [--seed S]``.
 
 Bounded (every class has a fixed number of tries and every wait a timeout) and loopback only
-(a private zenoh router on 127.0.0.1, a pty for the device). Each class prints one row
+(a private zenoh router on 127.0.0.1; the device on the in-process cable for ``reconnect``, a pty
+for the others). Each class prints one row
 ``class | tries | failures | what a failure is``; the exit status is 1 if any try failed.
 
 Classes:
@@ -145,25 +146,29 @@ def typed_within(what: str, call: Callable[[], object], budget_s: float) -> Fail
 # --- device -------------------------------------------------------------------------------------
 
 def campaign_reconnect(tries: int, rng: random.Random, tmp: Path) -> Failures:
-    """Unplug, reboot on open, reboot with the port open, freeze; never re-tensioned."""
+    """Unplug, reboot on open, reboot with the port open, freeze; never re-tensioned (lock-step
+    on the in-process cable)."""
     from tdcm_ros.device.driver import DriverConfig, LinkState, TensionDriver
+    from tdcm_ros.device.loopback import Loopback
     from tdcm_ros.device.protocol import Mode
-    from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+    from tdcm_ros.device.twin import DeviceTwin
 
     failures: Failures = []
     kinds = ("unplug", "reboot_on_open", "reboot_open_port", "freeze")
     for attempt in range(tries):
         kind = kinds[attempt % len(kinds)]
         twin = DeviceTwin(rx_buffer=64)
-        pty = PtyTwin(twin, link=str(tmp / f"port_{attempt}"))
-        driver = TensionDriver(DriverConfig(port=pty.port, backoff_initial=0.2),
-                               clock=lambda twin=twin: twin.time, warn=lambda text: None)
+        cable = Loopback(twin)
+        driver = TensionDriver(DriverConfig(port=str(tmp / f"port_{attempt}"),
+                                            backoff_initial=0.2),
+                               clock=lambda twin=twin: twin.time, open_port=cable.open,
+                               warn=lambda text: None)
 
-        def run(seconds: float, twin: DeviceTwin = twin, pty: PtyTwin = pty,
+        def run(seconds: float, twin: DeviceTwin = twin, cable: Loopback = cable,
                 driver: TensionDriver = driver) -> Any:
             end, status = twin.time + seconds, None
             while twin.time < end - 1e-9:
-                pty.pump(0.005)
+                cable.pump(0.005)
                 status = driver.step().status
             return status
 
@@ -178,14 +183,14 @@ def campaign_reconnect(tries: int, rng: random.Random, tmp: Path) -> Failures:
                 failures.append(f"{kind}: the bench never held 10 N ({twin.plant.tension:.2f})")
                 continue
             if kind == "unplug":
-                pty.reopen(reboot=False)
+                cable.reopen(reboot=False)
             elif kind == "reboot_on_open":
                 run(rng.uniform(0.5, 3.0))
-                pty.reopen(reboot=True)
+                cable.reopen(reboot=True)
             elif kind == "reboot_open_port":
                 twin.reboot()
             else:
-                with pty.hung():
+                with cable.hung():
                     run(rng.uniform(0.6, 3.0))
             run(RELEASE_WITHIN_S)  # the device watchdog or the driver's release acts
             end = twin.time + 4.0
@@ -199,7 +204,6 @@ def campaign_reconnect(tries: int, rng: random.Random, tmp: Path) -> Failures:
                 failures.append(f"{kind}: a setpoint was accepted while disarmed")
         finally:
             driver.close()
-            pty.stop()
     return failures
 
 

@@ -2,11 +2,14 @@
 
 No I/O, no threads: bytes the host writes reach :meth:`DeviceTwin.receive` at once and
 :meth:`LoopbackLink.read` returns what the twin has sent since (:meth:`DeviceTwin.take_output`).
-Whoever advances the twin owns the time, so a driver stepped on the same simulated clock runs in
-lock step with the device, as over a pty but deterministically::
+Whoever advances the twin owns the time (:meth:`Loopback.pump`), so a driver stepped on the same
+simulated clock runs in lock step with the device, deterministically::
 
     loop = Loopback(twin)
     driver = TensionDriver(config, clock=lambda: twin.time, open_port=loop.open)
+
+A pty cannot give that lock step: the bytes written at one end reach the other through a kernel
+worker, asynchronously (:class:`~tdcm_ros.device.transport.SerialTransport`).
 
 :meth:`Loopback.unplug` pulls the cable (the open link's reads and writes raise
 :class:`PortError`, opening fails) until :meth:`Loopback.plug`; :meth:`Loopback.reopen` pulls and
@@ -16,6 +19,8 @@ device sends while no link is open are lost, as on a UART nobody reads.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from tdcm_ros.device.errors import PortError
@@ -99,6 +104,21 @@ class Loopback:
         """Pull the cable and plug it back at once: the open link fails, the next open works."""
         self.unplug()
         self.plug(reboot=reboot)
+
+    def pump(self, seconds: float) -> None:
+        """Lock-step use (as :meth:`PtyTwin.pump`): run ``seconds`` of simulated time; what the
+        device sends waits for the open link's next read."""
+        self.twin.advance(seconds)
+        self.tick()
+
+    @contextmanager
+    def hung(self) -> Iterator[None]:
+        """Inside this block the firmware's loop is stalled (as :meth:`PtyTwin.hung`)."""
+        self.twin.hung = True
+        try:
+            yield
+        finally:
+            self.twin.hung = False
 
     def tick(self) -> None:
         """Drop what the device sent while no link is open (call after advancing the twin)."""

@@ -1,6 +1,6 @@
 """The driver's roll: clamp (with a warning), slew at ``roll_rate``, refusal while disarmed or
 with a trip fault, the e-stop with the servo holding where it is, and one roll sample per
-telemetry tick (lock-step against the twin over a pty, and with a fake port)."""
+telemetry tick (lock-step against the twin on the in-process cable, and with a fake port)."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.driver import DriverConfig, LinkState, StepResult, TensionDriver
 from tdcm_ros.device.errors import DeviceInputError
+from tdcm_ros.device.loopback import Loopback
 from tdcm_ros.device.protocol import (
     Ack,
     Banner,
@@ -26,21 +27,23 @@ from tdcm_ros.device.protocol import (
     decode,
     encode,
 )
-from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from tdcm_ros.device.twin import DeviceTwin
 from test.device.test_driver_unit import FakePort
 
 DT = 0.005  # s of simulated time per exchange
 
 
 class Bench:
-    """Twin behind a pty plus a driver on its simulated clock; collects what the driver returns."""
+    """Twin on the in-process cable plus a driver on its simulated clock; collects what the
+    driver returns."""
 
     def __init__(self, tmp_path: Path, **config: float) -> None:
         self.twin = DeviceTwin()
-        self.pty = PtyTwin(self.twin, link=str(tmp_path / "tdcm_port"))
+        self.cable = Loopback(self.twin)
         self.warnings: list[str] = []
-        self.driver = TensionDriver(DriverConfig(port=self.pty.port, **config),
-                                    clock=lambda: self.twin.time, warn=self.warnings.append)
+        self.driver = TensionDriver(DriverConfig(port=str(tmp_path / "tdcm_port"), **config),
+                                    clock=lambda: self.twin.time, open_port=self.cable.open,
+                                    warn=self.warnings.append)
         self.telemetry: list[Telemetry] = []
         self.joints: list[RollState] = []
         self.last: StepResult | None = None
@@ -48,7 +51,7 @@ class Bench:
     def run(self, seconds: float) -> None:
         end = self.twin.time + seconds
         while self.twin.time < end - 1e-9:
-            self.pty.pump(DT)
+            self.cable.pump(DT)
             self.last = self.driver.step()
             self.telemetry.extend(self.last.telemetry)
             self.joints.extend(self.last.joints)

@@ -1,5 +1,7 @@
-"""Integration over a real pty: the driver core against the device twin, in lock-step simulated
-time (the twin advances, then the driver steps; no sleeping)."""
+"""The driver core against the device twin on the in-process cable (:class:`Loopback`), in
+lock-step simulated time (the twin advances, then the driver steps; no sleeping). The serial
+path itself (a pty, the reader thread) is tested in test_transport.py and, with the threaded twin,
+in test/nodes/test_tension_driver_node.py."""
 
 from __future__ import annotations
 
@@ -16,24 +18,25 @@ from tdcm_ros.device.driver import (
     StepResult,
     TensionDriver,
 )
+from tdcm_ros.device.loopback import Loopback
 from tdcm_ros.device.protocol import Fault, Mode, Telemetry
 from tdcm_ros.device.schedule import StepSchedule
-from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from tdcm_ros.device.twin import DeviceTwin
 
 DT = 0.005  # s of simulated time per exchange
 
 
 class Bench:
-    """Twin behind a pty (exposed as a symlink) plus a driver reading its simulated clock."""
+    """Twin on the in-process cable plus a driver reading its simulated clock."""
 
     def __init__(self, tmp_path: Path, *, rx_buffer: int = 64, **config: float) -> None:
         self.twin = DeviceTwin(rx_buffer=rx_buffer)
-        self.pty = PtyTwin(self.twin, link=str(tmp_path / "tdcm_port"))
+        self.cable = Loopback(self.twin)
         self.warnings: list[str] = []
         self.stalled = 0.0  # s the whole host stood still (the host clock runs ahead of the twin's)
-        self.driver = TensionDriver(DriverConfig(port=self.pty.port, **config),
+        self.driver = TensionDriver(DriverConfig(port=str(tmp_path / "tdcm_port"), **config),
                                     clock=lambda: self.twin.time + self.stalled,
-                                    warn=self.warnings.append)
+                                    open_port=self.cable.open, warn=self.warnings.append)
         self.telemetry: list[Telemetry] = []
         self.last: StepResult | None = None
 
@@ -41,7 +44,7 @@ class Bench:
         """Advance ``seconds``; with ``host=False`` the driver is silent (a crashed host)."""
         end = self.twin.time + seconds
         while self.twin.time < end - 1e-9:
-            self.pty.pump(DT)
+            self.cable.pump(DT)
             if host:
                 self.last = self.driver.step()
                 self.telemetry.extend(self.last.telemetry)
@@ -96,7 +99,6 @@ def bench(tmp_path: Path) -> Iterator[Bench]:
     made = Bench(tmp_path)
     yield made
     made.driver.close()
-    made.pty.stop()
 
 
 def test_handshake_reads_the_banner(bench: Bench) -> None:
@@ -144,7 +146,7 @@ def test_estop_releases_at_once(bench: Bench) -> None:
     bench.run(2.0)
     assert bench.twin.plant.tension > 7.0
     bench.driver.estop()
-    bench.pty.pump(0.001)  # the E frame is handled as soon as it arrives
+    bench.cable.pump(0.001)  # the E frame is handled as soon as it arrives
     assert bench.twin.core.pulse_us == c.PULSE_RELEASE_US
     assert bench.twin.core.mode is Mode.RELEASE
     bench.run(0.3)
@@ -157,11 +159,10 @@ def test_estop_releases_at_once(bench: Bench) -> None:
     assert bench.telemetry[-1].mode is Mode.RELEASE  # e-stop also disabled the driver
 
 
-def test_reopened_pty_triggers_a_reconnect(bench: Bench) -> None:
+def test_a_reopened_port_triggers_a_reconnect(bench: Bench) -> None:
     bench.run_until_connected()
-    old_path = bench.pty.pty_path
-    bench.pty.reopen()
-    assert bench.pty.pty_path != old_path
+    assert bench.cable.opens == 1
+    bench.cable.reopen()
     bench.run(0.05)
     assert bench.last is not None and bench.last.status.link is LinkState.DISCONNECTED
     assert any("link lost" in w for w in bench.warnings)
@@ -181,7 +182,7 @@ def test_silent_host_releases_within_the_watchdog(bench: Bench) -> None:
     core = bench.twin.core
     assert core.mode is Mode.TENSION
     while core.mode is Mode.TENSION and bench.twin.time < 5.0:
-        bench.pty.pump(0.001)  # the device runs on; the host says nothing
+        bench.cable.pump(0.001)  # the device runs on; the host says nothing
     delay = (bench.twin.now_ms - core.last_rx_ms) / 1000
     print(f"\nwatchdog: released {delay:.3f} s after the last host byte")
     assert c.WATCHDOG_MS / 1000 <= delay <= (c.WATCHDOG_MS + c.CONTROL_PERIOD_MS) / 1000
@@ -215,14 +216,13 @@ def test_a_reconnect_never_re_tensions(tmp_path: Path, reboot: bool, outage: flo
     try:
         bench.hold(10.0)
         bench.run(2.0)  # device clock past the outage: the reboot shows as the clock running back
-        bench.pty.reopen(reboot=reboot)
+        bench.cable.reopen(reboot=reboot)
         bench.run(0.05)
         assert bench.last is not None and bench.last.status.link is LinkState.DISCONNECTED
         bench.assert_released_until_cleared(2.0, "link lost")
         assert any("device rebooted" in w for w in bench.warnings) is reboot
     finally:
         bench.driver.close()
-        bench.pty.stop()
 
 
 def test_a_reboot_on_an_open_port_is_seen_and_never_re_tensions(bench: Bench) -> None:
@@ -246,7 +246,7 @@ def test_a_freeze_is_not_a_reboot_and_never_re_tensions(tmp_path: Path, seconds:
     bench = Bench(tmp_path, rx_buffer=rx_buffer)
     try:
         bench.hold(10.0)
-        with bench.pty.hung():
+        with bench.cable.hung():
             bench.run(seconds)
         bench.run(0.5)
         assert not bench.twin.core.faults  # the device itself saw nothing wrong
@@ -254,7 +254,6 @@ def test_a_freeze_is_not_a_reboot_and_never_re_tensions(tmp_path: Path, seconds:
         assert not any("reboot" in w for w in bench.warnings), bench.warnings
     finally:
         bench.driver.close()
-        bench.pty.stop()
 
 
 @pytest.mark.parametrize("seconds", [0.6, 1.5])
@@ -278,16 +277,15 @@ def test_a_freeze_is_seen_by_a_host_stepping_slower_than_its_heartbeat(tmp_path:
     bench = Bench(tmp_path)
     try:
         bench.hold(10.0)
-        with bench.pty.hung():
+        with bench.cable.hung():
             for _ in range(10):
-                bench.pty.pump(0.15)
+                bench.cable.pump(0.15)
                 bench.driver.step()
         bench.run(0.5)
         status = bench.driver.step().status
         assert not status.armed and "device silent for" in status.disarm_reason, status
     finally:
         bench.driver.close()
-        bench.pty.stop()
 
 
 def test_a_boot_banner_when_the_port_opens_is_not_a_reboot(bench: Bench) -> None:

@@ -16,6 +16,7 @@ from tdcm_ros.device.plant import Plant, PlantConfig
 from tdcm_ros.device.protocol import Banner, Info, LineDecoder, Telemetry, encode
 from tdcm_ros.device.transport import open_transport
 from tdcm_ros.errors import InputError
+from test.support.waiting import eventually
 
 
 def test_plant_noise_is_seeded_and_quantised() -> None:
@@ -67,9 +68,12 @@ def test_twin_cli_serves_a_pty_and_stops_cleanly(tmp_path: Path) -> None:
 
 
 def test_loop_url_transport_round_trip() -> None:
+    """``loop://`` has no file descriptor: the reader thread reads it through pyserial."""
     transport = open_transport("loop://")
+    got = bytearray()
     transport.write(b"$1,H*79\n")
-    assert transport.read() == b"$1,H*79\n"
+    eventually(lambda: got.extend(transport.read()) or bytes(got) == b"$1,H*79\n", 5.0,
+               "the looped-back line")
     assert transport.read() == b""
     transport.close()
 
