@@ -97,8 +97,14 @@ class NodeGraph:
         if self.log_dir is not None:
             output = open(self.log_dir / f"{name}.log", "wb")  # noqa: SIM115 - closed in close()
             self._logs.append(output)
+        # A process group of its own: a terminal's Ctrl-C reaches the launcher only, which stops
+        # the children in order. This session, not one of its own: where the kernel shares CPU
+        # time between sessions first (autogroup), a node alone in its session is a light group
+        # that waited up to 0.6 s for a CPU beside a busy one (the driver's heartbeat, measured
+        # as run-queue wait in /proc/<pid>/task/<tid>/schedstat; the device's watchdog is 0.5 s),
+        # and a niced build beside the graph competed as an equal. A node never reads stdin.
         process = subprocess.Popen(
-            list(argv), start_new_session=True,
+            list(argv), process_group=0, stdin=subprocess.DEVNULL,
             preexec_fn=_die_with_parent,  # noqa: PLW1509 - it only calls prctl
             stdout=output, stderr=output)
         child = Child(name, process)
