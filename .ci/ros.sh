@@ -82,17 +82,23 @@ EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin 
 
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
+TICKS="$(getconf CLK_TCK)"
+cpu() { awk -v ticks="$TICKS" '{ print ($16 + $17) / ticks }' "/proc/$$/stat"; }  # children's CPU s
+cpu_since() { awk -v a="$1" -v b="$(cpu)" 'BEGIN { printf "%.0f", b - a }'; }
 T_ALL="$(now)"
 SUMMARY=()
 PHASE=""
 T_PHASE=""
+CPU_PHASE=""
 phase() {  # phase NAME: ends the current phase (if any) and starts NAME
   if [ -n "$PHASE" ]; then
-    SUMMARY+=("$(printf '%-34s %7s s' "$PHASE" "$(since "$T_PHASE")")")
-    echo "=== $PHASE: $(since "$T_PHASE") s"
+    SUMMARY+=("$(printf '%-34s %7s s %5s CPU-s' "$PHASE" "$(since "$T_PHASE")" \
+                "$(cpu_since "$CPU_PHASE")")")
+    echo "=== $PHASE: $(since "$T_PHASE") s, $(cpu_since "$CPU_PHASE") CPU-s"
   fi
   PHASE="$1"
   T_PHASE="$(now)"
+  CPU_PHASE="$(cpu)"
   [ -n "$PHASE" ] && echo "=== $PHASE"
   return 0
 }
@@ -106,7 +112,8 @@ finish() {
     kill -KILL "$NODE_PID" 2>/dev/null || true
   fi
   [ -n "$TMPDIR_CI" ] && rm -rf "$TMPDIR_CI"
-  [ -n "$PHASE" ] && SUMMARY+=("$(printf '%-34s %7s s%s' "$PHASE" "$(since "$T_PHASE")" \
+  [ -n "$PHASE" ] && SUMMARY+=("$(printf '%-34s %7s s %5s CPU-s%s' "$PHASE" "$(since "$T_PHASE")" \
+                                 "$(cpu_since "$CPU_PHASE")" \
                                  "$([ "$status" = 0 ] || echo '  (failed here)')")")
   echo "=== ros.sh summary (ROS_DOMAIN_ID=$ROS_DOMAIN_ID)"
   printf '  %s\n' "${SUMMARY[@]}"

@@ -47,12 +47,18 @@ trap 'exit 130' INT
 trap 'exit 143' TERM
 start=$SECONDS
 failed=()
-step() {  # step NAME COMMAND...: run it, say how long it took, remember a failure
-  local name="$1" t0=$SECONDS status=0
+TICKS="$(getconf CLK_TCK)"
+children_cpu() {  # children_cpu PID: CPU s used by the finished children of shell PID so far
+  awk -v ticks="$TICKS" '{ print ($16 + $17) / ticks }' "/proc/$1/stat"
+}
+step() {  # step NAME COMMAND...: run it, say how long it took (wall, CPU), remember a failure
+  local name="$1" t0=$SECONDS status=0 cpu0 shell=$BASHPID
   shift
+  cpu0="$(children_cpu "$shell")"
   echo "=== $name"
   "$@" || status=$?
-  echo "=== $name: exit $status after $((SECONDS - t0)) s"
+  echo "=== $name: exit $status after $((SECONDS - t0)) s ($(awk -v a="$cpu0" -v b="$(children_cpu "$shell")" \
+    'BEGIN { printf "%.0f", b - a }') CPU-s)"
   [ "$status" = 0 ] || failed+=("$name (exit $status)")
   return "$status"
 }
