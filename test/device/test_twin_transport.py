@@ -120,3 +120,44 @@ def test_line_delay_holds_the_devices_lines_back_in_order() -> None:
     finally:
         os.close(host)
         server.stop()
+
+
+def test_the_threaded_twins_serving_thread_never_polls_or_reads_the_pty(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A tty poll waits for the tty's buffer-flush kernel worker, which a loaded machine left
+    unscheduled for up to 0.8 s: the serving thread then paused the simulation and a demo lost
+    part of a tension hold. The threaded twin reads the host's bytes on a thread of its own."""
+    import select
+    import threading
+
+    from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+
+    callers: list[str] = []
+    real_select, real_read = select.select, os.read
+
+    def recording_select(*args: object) -> object:
+        callers.append(threading.current_thread().name)
+        return real_select(*args)  # type: ignore[arg-type]
+
+    def recording_read(fd: int, size: int) -> bytes:
+        callers.append(threading.current_thread().name)
+        return real_read(fd, size)
+
+    monkeypatch.setattr(select, "select", recording_select)
+    monkeypatch.setattr(os, "read", recording_read)
+    server = PtyTwin(DeviceTwin()).start()
+    host = os.open(server.port, os.O_RDWR | os.O_NOCTTY)
+    try:
+        os.write(host, encode(Info()))
+        decoder, got = LineDecoder(), []
+
+        def banner() -> bool:
+            got.extend(decoder.feed(real_read(host, 4096)))
+            return any(isinstance(m, Banner) for m in got)
+
+        eventually(banner, 5.0, "the banner answering the host's request")
+    finally:
+        os.close(host)
+        server.stop()
+    assert "tdcm-twin-reader" in callers
+    assert "tdcm-twin" not in callers
