@@ -71,10 +71,16 @@ def test_gather_keeps_up_to_its_limit_and_counts_the_rest(context: Any) -> None:
     key = f"{wire.ADMIN_SPACE}/{context.domain_id}/**/crowd/**"
     eventually(lambda: len(gather(lambda handler: context.session.liveliness().get(
         key, handler, timeout=1.0), 1.0).kept) == 50, 15.0, "50 crowd tokens")
-    # the query ends as soon as the router's last reply is in; its 10 s bound only matters on a
-    # loaded machine, where a 1 s bound once ended it after 8 of the 50 replies (complete, short)
-    replies = gather(lambda handler: context.session.liveliness().get(key, handler, timeout=10.0),
-                     10.0, limit=20)
+    # zenoh itself sometimes completes a liveliness query short on a loaded machine (measured by
+    # bench/bench_liveliness_query.py: 9 of 40 beside one CPU hog, as few as 0 of 50 tokens), so
+    # the limit's accounting is read from a query that zenoh answered in full
+    def whole() -> Any:
+        replies = gather(lambda handler: context.session.liveliness().get(key, handler,
+                                                                          timeout=10.0),
+                         10.0, limit=20)
+        return replies if len(replies.kept) + replies.dropped == 50 else None
+
+    replies = eventually(whole, 15.0, "a liveliness query answered with all 50 tokens")
     assert (len(replies.kept), replies.dropped, replies.complete) == (20, 30, True)
     for token in tokens:
         token.undeclare()
