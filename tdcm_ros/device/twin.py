@@ -189,10 +189,6 @@ class PtyTwin:
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self._reader: threading.Thread | None = None
-        self._fd_lock = threading.Lock()  # held to swap the pty and to read the master
-        self._inbox = bytearray()  # the host's bytes the reader took, not yet handed over
-        self._arrived = threading.Event()
         self._master = -1
         self._slave = -1
         self.pty_path = ""
@@ -222,24 +218,21 @@ class PtyTwin:
             os.replace(temporary, self.link)
 
     def _close_fds(self) -> None:
-        with self._fd_lock:
-            for fd in (self._master, self._slave):
-                if fd >= 0:
-                    os.close(fd)
-            self._master = self._slave = -1
+        for fd in (self._master, self._slave):
+            if fd >= 0:
+                os.close(fd)
+        self._master = self._slave = -1
 
     def reopen(self, *, reboot: bool = False) -> None:
         """Close the pty (the host's reads fail) and open a new one behind the same link; with
         ``reboot`` the device also resets (a UNO resets when its port is opened)."""
         with self._lock:
             self._close_fds()
-            with self._fd_lock:
-                self._open()
+            self._open()
             if reboot:
                 self.twin.reboot()
 
-    def _read_available(self) -> bytes:
-        """All the host wrote (the pty may wait for its kernel buffer worker here)."""
+    def _exchange(self) -> None:
         data = bytearray()
         while True:  # all the host wrote, however long the twin was not scheduled
             try:
@@ -249,46 +242,8 @@ class PtyTwin:
             data += chunk
             if len(chunk) < 4096:
                 break
-        return bytes(data)
-
-    def _exchange(self) -> None:
-        """Hand the host's bytes to the device: those the reader thread took (threaded twin),
-        else what the pty holds now (lock step)."""
-        if self._reader is not None:
-            with self._fd_lock:
-                data, self._inbox = bytes(self._inbox), bytearray()
-        else:
-            data = self._read_available()
         if data:
-            self.twin.receive(data)
-
-    def _read_until_stopped(self) -> None:
-        """The threaded twin's reader: waits for the host's bytes off the serving thread. A tty
-        poll waits for the tty's buffer-flush kernel worker when nothing is queued, which a
-        loaded machine left unscheduled for up to 1.1 s (see
-        :class:`~tdcm_ros.device.transport.SerialTransport`); the serving thread would have
-        paused the simulation meanwhile."""
-        while not self._stop.is_set():
-            fd = self._master
-            try:
-                ready = select.select([fd], [], [], 0.05)[0] if fd >= 0 else []
-            except (OSError, ValueError):  # reopen() swapped the fd under us: look again
-                ready = []
-            if not ready:
-                if fd < 0:
-                    time.sleep(0.002)
-                continue
-            with self._fd_lock:
-                if fd != self._master:
-                    continue
-                try:
-                    data = self._read_available()
-                except OSError:  # the host side closed: nothing to read until it opens again
-                    data = b""
-                    self._stop.wait(0.01)
-                self._inbox += data
-            if data:
-                self._arrived.set()
+            self.twin.receive(bytes(data))
 
     def _delay_lines(self, out: bytes) -> bytes:
         """Queue each complete line ``line_delay()`` s (host time) after now, in order (a serial
@@ -409,19 +364,17 @@ class PtyTwin:
 
     def _run(self) -> None:
         while not self._stop.is_set():
-            self._arrived.wait(0.002)
-            self._arrived.clear()
+            try:
+                select.select([self._master], [], [], 0.002)
+            except (OSError, ValueError):  # reopen() swapped the fd under us: just go on
+                time.sleep(0.002)
             self.turn()
 
     def start(self) -> Self:
-        """Serve from a daemon thread at ``speed`` times real time; another thread reads the
-        host's bytes."""
+        """Serve from a daemon thread at ``speed`` times real time."""
         self._stop.clear()
         with self._lock:
             self._anchor()
-        self._reader = threading.Thread(target=self._read_until_stopped, name="tdcm-twin-reader",
-                                        daemon=True)
-        self._reader.start()
         self._thread = threading.Thread(target=self._run, name="tdcm-twin", daemon=True)
         self._thread.start()
         return self
@@ -429,10 +382,9 @@ class PtyTwin:
     def stop(self) -> None:
         """Stop the thread (if any), close the pty and remove the link."""
         self._stop.set()
-        for thread in (self._thread, self._reader):
-            if thread is not None:
-                thread.join()
-        self._thread = self._reader = None
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
         with self._lock:
             self._close_fds()
         if self.link and os.path.islink(self.link):
