@@ -14,12 +14,12 @@ from test.support.waiting import eventually
 #: A child that reports its session, process group and what its stdin is, then waits for SIGINT
 #: (its own handler, as every node installs: a child of a background job inherits SIGINT ignored).
 REPORT = """
-import os, signal, sys, time
+import os, signal, sys
 signal.signal(signal.SIGINT, signal.default_int_handler)
 sys.stdout.write(f"{os.getsid(0)} {os.getpgid(0)} {os.path.realpath('/proc/self/fd/0')}\\n")
 sys.stdout.flush()
 try:
-    time.sleep(60)
+    signal.pause()
 except KeyboardInterrupt:
     sys.exit(0)
 """
