@@ -4,7 +4,8 @@ Every message goes out as the bag holds it: its CDR bytes, unchanged (no decode,
 on its topic or the name it is remapped to, in log-time order, spaced by the log times divided
 by ``rate``. Each topic is published with the QoS its recorded publishers offered
 (:meth:`BagReader.qos`: e.g. ``/tf_static`` transient local with depth 1, so a node that starts
-later still receives it, as long as the player runs). Playback starts ``start_offset_s`` after
+later still receives it, as long as the player runs), a volatile one with a history of at least
+:data:`VOLATILE_DEPTH` (:func:`played_depth`). Playback starts ``start_offset_s`` after
 the bag's first log time; ``loop`` plays it again from there until stopped. With ``clock_hz`` > 0,
 ``/clock`` (rosgraph_msgs/msg/Clock) carries the bag time (log time) at that rate (Hz of wall
 time): the start offset's time during ``delay_s``, then once at the start of each pass and
@@ -48,8 +49,22 @@ LINGER_S = 0.3  # time given to the last samples to leave before the context clo
 PROGRESS_PERIOD_S = 0.1  # wall time between two progress reports (s)
 STOP_LATENCY_S = 0.1  # longest wait between two looks at the stop request (s)
 RUNTIMES = ("zenoh", "rclpy")
+#: Writer history (messages) of a played volatile topic, at least: a reliable keep-last writer
+#: drops its oldest unacknowledged sample when the history is full, so with the recorded depth
+#: (10 on /markers) a reader starved of CPU for 25 ms at x4 lost marker frames (83 of 6,758 on
+#: rclpy/Fast DDS beside other tests). A volatile writer's depth changes nothing else a reader
+#: sees; a transient-local one keeps the recorded depth, which is what a late joiner receives.
+VOLATILE_DEPTH = 1000
+MAX_DEPTH = 10_000
 
 logger = logging.getLogger("tdcm.play")
+
+
+def played_depth(offered_depth: int, durability: str) -> int:
+    """History depth (messages) the player publishes a topic with, from the recorded one."""
+    depth = max(offered_depth, 1) if durability == "transient_local" else \
+        max(offered_depth, VOLATILE_DEPTH)
+    return min(depth, MAX_DEPTH)
 
 
 def _finite_at_least(name: str, value: float, low: float, unit: str, *, open_low: bool) -> None:
@@ -173,7 +188,7 @@ class Player:
         publishers = {}
         for topic, name in names.items():
             offered = self.reader.qos(topic)
-            qos = QoS(depth=min(max(offered.depth, 1), 10_000),
+            qos = QoS(depth=played_depth(offered.depth, offered.durability),
                       reliability=offered.reliability,  # type: ignore[arg-type]
                       durability=offered.durability)  # type: ignore[arg-type]
             msgtype = self.reader.topics[topic]

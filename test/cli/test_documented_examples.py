@@ -29,6 +29,10 @@ EXAMPLES = readme_examples() + epilog_examples(build_parser())
 #: parsed here, not run; their ``--quick`` forms run.
 BENCHMARKS = {("bench", "accuracy", "--markdown", "--plot", "accuracy_pareto.png"),
               ("bench", "accuracy", "--json", "-q")}
+#: Candidates a design example that leaves ``--samples`` at its default (100,000: 10-20 s of
+#: solves) samples here: the example runs as written otherwise (the search's size is the
+#: design tests' subject, test/model/test_design_space.py and test/cli/test_design_cli.py).
+DESIGN_SAMPLES = "4096"
 
 
 def _id(example: Example) -> str:
@@ -94,5 +98,8 @@ def test_every_offline_example_runs(example: Example, workdir: Path,
                                     monkeypatch: pytest.MonkeyPatch) -> None:
     for name, value in example.env.items():
         monkeypatch.setenv(name, value)
-    done = tdcm(*example.argv, cwd=workdir)
+    argv = list(example.argv)
+    if example.verb == "design" and "--samples" not in argv:
+        argv += ["--samples", DESIGN_SAMPLES]
+    done = tdcm(*argv, cwd=workdir)
     assert done.returncode == 0, f"{_id(example)}: exit {done.returncode}\n{done.stderr[-2000:]}"

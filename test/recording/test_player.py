@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 from tdcm_ros.bagio import deserialize
+from tdcm_ros.recording.player import MAX_DEPTH, VOLATILE_DEPTH, played_depth
 from tdcm_ros.runtime.port import CLOCK_QOS, CLOCK_TOPIC, CLOCK_TYPE, QoS
 from test.recording.player_peers import (
     FIRST_BURST,
@@ -95,7 +96,7 @@ def test_offset_topic_selection_and_remapping(runtime: str, context: Any, spawn:
     assert peer.on("/renamed") == as_received(runtime, expected)
     assert peer.on("/a") == [] and peer.on("/b") == []
     out = player.stdout.read().decode()
-    assert "publishing /renamed [std_msgs/msg/String] (reliable, volatile, depth 10) from /a" in out
+    assert "publishing /renamed [std_msgs/msg/String] (reliable, volatile, depth 1000) from /a" in out
     # /latched's only message lies before the offset: nothing of it is played
     assert f"{len(expected)} messages published on 2 topics" in out
 
@@ -165,6 +166,22 @@ def test_a_progress_line_on_a_terminal_unless_quiet(router: Any, zenoh_env: dict
     assert "\r[playing] " in shown and f"/ 5.97 s  x4  {len(sample_messages())} messages" in shown
     assert "[playing]" not in _stderr_on_a_terminal(zenoh_env, str(bag), "--rate", "4",
                                                     "--quiet")
+
+
+@pytest.mark.parametrize(("offered", "durability", "played"), [
+    (10, "volatile", VOLATILE_DEPTH),        # recorded shallow: deepened
+    (5000, "volatile", 5000),                # recorded deeper: kept
+    (10**6, "volatile", MAX_DEPTH),
+    (1, "transient_local", 1),               # what a late joiner gets: as recorded
+    (0, "transient_local", 1),
+    (10**6, "transient_local", MAX_DEPTH),
+])
+def test_a_volatile_topic_is_played_with_a_deep_history(offered: int, durability: str,
+                                                         played: int) -> None:
+    """A reliable keep-last writer drops unacknowledged samples once its history is full: a
+    volatile topic recorded at depth 10 is played at least 1000 deep, so a reader starved of CPU
+    for a moment loses nothing; a transient-local one keeps its recorded depth."""
+    assert played_depth(offered, durability) == played
 
 
 @pytest.mark.parametrize(("args", "expected"), [
