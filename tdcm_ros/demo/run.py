@@ -71,7 +71,7 @@ class Progress:
     actuator_statuses: int = 0     #: driver actuator statuses seen
     schedule_ran: bool = False     #: a status said the schedule was running
     disarm_reason: str = ""        #: why the driver disarmed last ("" while it never did)
-    twin_pauses: str = ""          #: the device twin's simulation pauses, as its status says
+    twin_pauses: str = ""          #: the device twin's late turns and pauses, as its status says
     counts: dict[str, int] = field(default_factory=dict)
 
     def count(self, topic: str) -> None:
@@ -117,8 +117,9 @@ def _watch(port: Any, progress: Progress) -> None:
             elif status.name == DEVICE_TWIN:
                 values = {kv.key: kv.value for kv in status.values}
                 if "sim_pauses" in values:
-                    progress.twin_pauses = (f"{values['sim_pauses']} time(s), "
-                                            f"{values.get('sim_paused_s', '?')} s in all")
+                    progress.twin_pauses = (
+                        f"caught up {values.get('sim_late_turns', '?')} late turn(s) and paused "
+                        f"{values['sim_pauses']} time(s), {values.get('sim_paused_s', '?')} s in all")
 
     def on_markers(message: Any) -> None:
         progress.count("markers")
@@ -185,12 +186,13 @@ def clear_start_up_fault(context: Any, loop: _Loop, progress: Progress,
 
 
 def twin_pauses(progress: Progress) -> str:
-    """What the device twin said of its simulation's pauses (its thread not scheduled on time:
-    a loaded machine), for an error about the run's bench; "" before it said anything."""
+    """What the device twin said of its late turns and its simulation's pauses (its thread not
+    scheduled on time: a loaded machine), for an error about the run's bench; "" before it said
+    anything."""
     if not progress.twin_pauses:
         return ""
-    return (f"; the device twin's simulation paused {progress.twin_pauses} so far (its thread "
-            "not scheduled on time: a loaded machine)")
+    return (f"; the device twin {progress.twin_pauses} so far (its thread not scheduled on time: "
+            "a loaded machine)")
 
 
 def fault_free(progress: Progress) -> None:

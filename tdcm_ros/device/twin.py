@@ -37,10 +37,13 @@ from tdcm_ros.errors import out_of_range
 
 TRUTH_KEPT = 4096  #: ground-truth samples kept until taken (older ones are dropped)
 RX_BUFFER = 64     #: bytes the UNO's serial receive buffer holds while its loop does not read
-#: Host s: the longest gap between two turns of the threaded twin that it catches up; a longer
-#: one (its thread was not scheduled) is a pause of the simulation. It is the driver's default
-#: heartbeat period: a turn adds at most that much silence to the host's own (watchdog 0.5 s).
-MAX_GAP = 0.1
+#: Host s: a turn of the threaded twin later than this after the last one is *late* (its thread
+#: was not scheduled): the host's bytes of the gap reach the device spread over it. It is the
+#: driver's default heartbeat period.
+LATE_TURN_S = 0.1
+#: Host s: the longest gap between two turns that the threaded twin catches up; a longer one (a
+#: suspended process) is a pause of the simulation for the rest.
+MAX_GAP = 2.0
 
 
 class DeviceTwin:
@@ -158,13 +161,18 @@ class PtyTwin:
 
     The threaded twin maps simulated time onto host time (``clock``, monotonic s; ``epoch_ns``,
     ns since the epoch) at ``speed``. Each turn of its thread reads the host's bytes, then runs
-    the simulated time due since the last turn -- at most ``max_gap`` s of host time: if the
-    thread was not scheduled for longer (a loaded machine, not the device or the host), the
-    simulation pauses for the rest, as a suspended simulator would, instead of running the
-    whole gap after the host's bytes of it. A device that caught up 0.8 s in one go would see
-    0.8 s without a host byte and trip its watchdog although the host kept writing. Truth
-    samples keep their host times across pauses (:meth:`host_time_ns`); :attr:`pauses` and
-    :attr:`paused_s` count them.
+    the simulated time due since the last turn. A turn more than ``LATE_TURN_S`` late (its thread
+    was not scheduled: on a loaded machine up to 0.8 s, waiting for a CPU, for the GIL held by a
+    preempted thread of its process, or in the tty layer, ``n_tty_poll`` waiting for the pty's
+    flush worker) delivers the host's complete lines of the gap spread evenly over it, the
+    ``k``-th of ``n`` at ``k/n`` of the gap, as a host writing steadily would have: a device
+    given them all at the gap's start would then run the gap without a host byte and trip its
+    watchdog although the host kept writing, and a simulation paused for the gap would put the
+    bench behind the host's schedule (a 1.5 s hold cut short). Its output of the gap (readings
+    carrying the device clock) leaves at the end of the turn. A gap longer than ``max_gap`` s of
+    host time (a suspended process) is caught up to ``max_gap`` and a pause of the simulation for
+    the rest. Truth samples keep their host times across pauses (:meth:`host_time_ns`);
+    :attr:`late_turns`, :attr:`pauses` and :attr:`paused_s` count them.
     """
 
     def __init__(self, twin: DeviceTwin, *, speed: float = 1.0, link: str | None = None,
@@ -184,6 +192,7 @@ class PtyTwin:
         self.link = link
         self._clock = clock
         self._epoch_ns = epoch_ns
+        self.late_turns = 0   #: turns over ``LATE_TURN_S`` late (the host's bytes spread)
         self.pauses = 0       #: turns that did not catch up the whole gap (the simulation paused)
         self.paused_s = 0.0   #: host s the simulation paused in all
         self._lock = threading.Lock()
@@ -233,6 +242,12 @@ class PtyTwin:
                 self.twin.reboot()
 
     def _exchange(self) -> None:
+        data = self._read_host()
+        if data:
+            self.twin.receive(data)
+
+    def _read_host(self) -> bytes:
+        """Every byte the host has written (b"" if none)."""
         data = bytearray()
         while True:  # all the host wrote, however long the twin was not scheduled
             try:
@@ -242,8 +257,7 @@ class PtyTwin:
             data += chunk
             if len(chunk) < 4096:
                 break
-        if data:
-            self.twin.receive(bytes(data))
+        return bytes(data)
 
     def _delay_lines(self, out: bytes) -> bytes:
         """Queue each complete line ``line_delay()`` s (host time) after now, in order (a serial
@@ -282,8 +296,8 @@ class PtyTwin:
         """Inside this block the device and its bench pause (a stalled simulation; for a
         stalled firmware loop on a running bench see :meth:`hung`).
 
-        The threaded twin then reads the host's bytes of the pause and goes on: a block longer
-        than ``max_gap`` is a pause of the simulated time (see the class), not caught up.
+        The threaded twin then catches the block up with the host's bytes of it spread over it;
+        past ``max_gap`` the rest is a pause of the simulated time (see the class).
         """
         with self._lock:
             yield
@@ -337,11 +351,12 @@ class PtyTwin:
 
     def turn(self) -> None:
         """One turn of the serving thread (:meth:`start` calls it in a loop): take the host's
-        bytes, run the simulated time due at ``clock()`` -- at most ``max_gap`` s of host time
-        since the last turn, the rest is a pause (see the class) -- and send the output."""
+        bytes, run the simulated time due at ``clock()`` -- a late turn with the host's lines
+        spread over it, at most ``max_gap`` s of host time since the last turn and the rest a
+        pause (see the class) -- and send the output."""
         with self._lock:
             now = self._clock()
-            self._exchange()
+            data = self._read_host()
             sim, host = self._segments[-1]
             due = sim + (now - host) * self.speed - self.twin.time
             bound = self.max_gap * self.speed
@@ -351,8 +366,32 @@ class PtyTwin:
                 self._segments.append((self.twin.time, now - self.max_gap))
                 self._forget_old_pauses()
                 due = bound
-            self.twin.advance(max(0.0, due))
+            if due > LATE_TURN_S * self.speed:
+                self.late_turns += 1
+                self._spread(data, due)
+            else:
+                if data:
+                    self.twin.receive(data)
+                self.twin.advance(max(0.0, due))
             self._flush()
+
+    def _spread(self, data: bytes, due: float) -> None:
+        """Run ``due`` s of simulated time with the complete lines of ``data`` delivered evenly
+        over it, the ``k``-th of ``n`` at ``k/n`` of it (to the simulated ms); a trailing partial
+        line goes with the last one."""
+        lines = data.split(b"\n")
+        pieces = [line + b"\n" for line in lines[:-1]]
+        if lines[-1]:
+            if pieces:
+                pieces[-1] += lines[-1]
+            else:
+                pieces.append(lines[-1])
+        start_ms, due_ms = self.twin.now_ms, round(due * 1000)
+        for k, piece in enumerate(pieces, start=1):
+            at_ms = start_ms + due_ms * k // len(pieces)
+            self.twin.advance((at_ms - self.twin.now_ms) / 1000)
+            self.twin.receive(piece)
+        self.twin.advance((start_ms + due_ms - self.twin.now_ms) / 1000)
 
     def _forget_old_pauses(self) -> None:
         """Drop the pauses no untaken truth sample (nor a future one) is mapped through."""

@@ -11,9 +11,10 @@ Publishes ``sim/tension_true`` (``geometry_msgs/msg/WrenchStamped``): the true t
 (N, ``wrench.force.z``, frame ``frame_id``) at every load-cell sample, stamped with the host time
 of the sample; ``sim/joint_states_true`` (``sensor_msgs/msg/JointState``, name ``["roll"]``): the
 simulated roll servo's true angle (rad) at the same samples and stamps; and ``/diagnostics``
-(port, simulated time, device mode, faults, roll, and the simulation's pauses: a turn of the
-twin's thread more than ``MAX_GAP`` s after the last one pauses simulated time instead of
-catching up, see :class:`~tdcm_ros.device.twin.PtyTwin`).
+(port, simulated time, device mode, faults, roll, and how the simulation kept up: ``sim_late_turns``
+counts turns of the twin's thread more than ``LATE_TURN_S`` late, caught up with the host's bytes
+spread over the gap; ``sim_pauses``/``sim_paused_s`` the gaps over ``MAX_GAP`` s, whose rest paused
+simulated time, see :class:`~tdcm_ros.device.twin.PtyTwin`).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import PLANT_SPECS, ROLL_SPEED, PlantConfig, fault_names
-from tdcm_ros.device.twin import DeviceTwin, PtyTwin
+from tdcm_ros.device.twin import LATE_TURN_S, DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
 from tdcm_ros.nodes.shape_messages import header
@@ -149,7 +150,9 @@ class DeviceTwinNode(NodeLogic):
                 "setpoint": f"{twin.core.setpoint_mn / 1000:.3f}",
                 "tension_true": f"{twin.plant.tension:.3f}", "samples": str(self.samples),
                 "roll_target": f"{twin.core.roll_target_mrad / 1000:.3f}",
-                "roll_true": f"{twin.plant.roll:.4f}", "sim_pauses": str(self.server.pauses),
+                "roll_true": f"{twin.plant.roll:.4f}",
+                "sim_late_turns": str(self.server.late_turns),
+                "sim_pauses": str(self.server.pauses),
                 "sim_paused_s": f"{self.server.paused_s:.3f}"}
 
     def check(self) -> Status:
@@ -161,11 +164,12 @@ class DeviceTwinNode(NodeLogic):
         """Stop the twin (the pty closes, the link is removed); logs the final device state."""
         self.server.stop()
         state = self._state()
-        self.port.logger.info("device twin stopped: mode %s, faults %s, true tension %s N; the "
-                              "simulation paused %s time(s), %s s in all (its thread not "
-                              "scheduled for over %g s)", state["mode"], state["faults"] or "none",
-                              state["tension_true"], state["sim_pauses"], state["sim_paused_s"],
-                              self.server.max_gap)
+        self.port.logger.info("device twin stopped: mode %s, faults %s, true tension %s N; its "
+                              "thread caught up %s late turn(s) (over %g s) and the simulation "
+                              "paused %s time(s), %s s in all (gaps over %g s)", state["mode"],
+                              state["faults"] or "none", state["tension_true"],
+                              state["sim_late_turns"], LATE_TURN_S, state["sim_pauses"],
+                              state["sim_paused_s"], self.server.max_gap)
 
 
 def main() -> int:

@@ -97,7 +97,7 @@ def test_a_disarm_during_the_run_stops_it_with_the_reason() -> None:
     progress = Progress(armed=True, actuator_statuses=1)
     fault_free(progress)
     progress.armed, progress.disarm_reason = False, "device silent for 0.54 s (frozen?)"
-    progress.twin_pauses = "2 time(s), 0.563 s in all"
+    progress.twin_pauses = "caught up 1 late turn(s) and paused 2 time(s), 0.563 s in all"
     with pytest.raises(RuntimePortError, match=r"disarmed \(device silent for 0.54 s \(frozen\?\)\) "
                                                r"during the run.*paused 2 time\(s\)"):
         fault_free(progress)

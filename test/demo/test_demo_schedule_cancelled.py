@@ -56,14 +56,14 @@ def test_a_schedule_cancelled_after_it_ran_stops_the_run_naming_the_reason_and_t
     schedule_not_cancelled(progress)
     diagnostics(port, status(DRIVER_ACTUATOR, schedule="cancelled",
                              disarm_reason="device silent for 0.62 s (frozen?)"),
-                status(DEVICE_TWIN, sim_pauses="2", sim_paused_s="0.517"))
+                status(DEVICE_TWIN, sim_late_turns="3", sim_pauses="2", sim_paused_s="0.517"))
     with pytest.raises(RuntimePortError) as raised:
         schedule_not_cancelled(progress)
     assert str(raised.value) == (
         "the driver cancelled the schedule: disarmed (device silent for 0.62 s (frozen?)); the "
-        "tendon is released until clear_faults (the bag so far is kept); the device twin's "
-        "simulation paused 2 time(s), 0.517 s in all so far (its thread not scheduled on time: "
-        "a loaded machine)")
+        "tendon is released until clear_faults (the bag so far is kept); the device twin "
+        "caught up 3 late turn(s) and paused 2 time(s), 0.517 s in all so far (its thread not "
+        "scheduled on time: a loaded machine)")
 
 
 def test_a_cancelled_state_before_the_schedule_ran_is_left_to_the_start(
@@ -82,6 +82,7 @@ def test_a_fault_during_the_run_names_the_twin_pauses_once_the_twin_said_them(
     diagnostics(port, status(DRIVER_ACTUATOR, faults="WATCHDOG"))
     with pytest.raises(RuntimePortError, match=r"device fault WATCHDOG during the run: .*kept\)$"):
         fault_free(progress)
-    diagnostics(port, status(DEVICE_TWIN, sim_pauses="0", sim_paused_s="0.000"))
-    with pytest.raises(RuntimePortError, match=r"simulation paused 0 time\(s\), 0.000 s in all"):
+    diagnostics(port, status(DEVICE_TWIN, sim_late_turns="0", sim_pauses="0", sim_paused_s="0.000"))
+    with pytest.raises(RuntimePortError, match=r"caught up 0 late turn\(s\) and paused 0 time\(s\), "
+                                               r"0.000 s in all"):
         fault_free(progress)
