@@ -23,11 +23,13 @@ from tdcm_ros.mocap.registration import (
     estimate_registration,
 )
 from tdcm_ros.mocap.sources import CsvReplay, RawFrame, SimSource, SourceError
+from tdcm_ros.mocap.truth import FrameClock, TruthTrack
 
 __all__ = [
     "ArcLengthLabeller",
     "CsvFormatError",
     "CsvReplay",
+    "FrameClock",
     "LabelError",
     "LabelledFrame",
     "Labeller",
@@ -40,6 +42,7 @@ __all__ = [
     "SimSource",
     "SourceError",
     "Trajectories",
+    "TruthTrack",
     "estimate_from_recordings",
     "estimate_registration",
     "given_registration",

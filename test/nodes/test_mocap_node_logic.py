@@ -114,6 +114,65 @@ def test_sim_source_samples_the_scene_world_at_its_rate_with_its_delay(monkeypat
     assert hidden > 0 and int(values["markers_occluded"]) == hidden
 
 
+def true_tension(tension: float, stamp_ns: int):
+    return from_dict("geometry_msgs/msg/WrenchStamped", {
+        "header": {"stamp": {"sec": stamp_ns // 10**9, "nanosec": stamp_ns % 10**9}},
+        "wrench": {"force": {"z": tension}}})
+
+
+def test_sim_frames_wait_for_late_truth_and_take_it_at_their_own_stamps(monkeypatch):
+    """A twin not scheduled for 1 s sends that second's truth at once: every frame of the gap
+    is made from the truth at its own stamp (none from the truth before the gap, which froze the
+    body), the frames stay on their 50 Hz grid, and none is made before the truth covers it."""
+    scene = DoubleScene()
+    monkeypatch.setattr(tdcm_ros.scenes, "load_scene", lambda name: scene)
+    port = mocap_port({"source": "sim", "sim.scene": "double"})
+    MocapNode(port)
+    start = port.now_ns()
+
+    def ramp(stamp_ns: int) -> float:  # the true tension: 2 N rising 3 N/s
+        return 2.0 + 3.0 * (stamp_ns - start) / 1e9
+
+    for _ in range(20):                      # 0.2 s of truth, each sample as it happens
+        port.advance(0.01)
+        port.deliver("sim/tension_true", true_tension(ramp(port.now_ns()), port.now_ns()))
+    gap_start = port.now_ns()
+    made = len(scene.the_world.calls)
+    port.advance(1.0)                        # no truth: the twin's thread was not scheduled
+    assert len(scene.the_world.calls) == made
+    for k in range(1, 101):                  # then the gap's truth at once, as it was
+        stamp_ns = gap_start + k * 10_000_000
+        port.deliver("sim/tension_true", true_tension(ramp(stamp_ns), stamp_ns))
+    port.advance(0.02)
+    frames = [(round(stamp_s * 1e9), tension) for stamp_s, tension in scene.the_world.calls
+              if tension > 0.0]             # after the first truth sample
+    stamps = np.array([stamp_ns for stamp_ns, _ in frames])
+    assert stamps[-1] >= gap_start + 980_000_000 and len(frames) >= 55
+    assert np.all(np.abs(np.diff(stamps) - 20_000_000) <= 1_000)
+    assert np.allclose([tension for _, tension in frames], [ramp(t) for t in stamps],
+                       rtol=0, atol=1e-6)
+
+
+def test_sim_truth_older_than_the_stale_limit_is_held_and_frames_go_on(monkeypatch):
+    """A truth stream that stops (a stopped twin) holds its last value: frames wait while it
+    may still come late, and past TRUTH_STALE_NS go on at the clock with it."""
+    from tdcm_ros.nodes.mocap_node import TRUTH_STALE_NS
+
+    scene = DoubleScene()
+    monkeypatch.setattr(tdcm_ros.scenes, "load_scene", lambda name: scene)
+    port = mocap_port({"source": "sim", "sim.scene": "double"})
+    MocapNode(port)
+    port.advance(0.01)
+    port.deliver("sim/tension_true", true_tension(4.0, port.now_ns()))
+    port.advance(0.05)
+    made = len(scene.the_world.calls)
+    port.advance(TRUTH_STALE_NS / 1e9 - 0.1)
+    assert len(scene.the_world.calls) == made          # waiting for the truth of these frames
+    port.advance(0.5)
+    held = scene.the_world.calls[made:]
+    assert len(held) >= 100 and all(tension == 4.0 for _, tension in held)
+
+
 def test_arc_length_labelling_follows_the_predicted_axis():
     # Registration: tdcm_base is rotated 90 deg about mocap x and offset.
     rpy = [math.pi / 2, 0.0, 0.0]
