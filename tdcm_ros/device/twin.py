@@ -355,8 +355,11 @@ class PtyTwin:
         spread over it, at most ``max_gap`` s of host time since the last turn and the rest a
         pause (see the class) -- and send the output."""
         with self._lock:
-            now = self._clock()
+            # the clock after the read: a read of a pty waits for the kernel's flush worker while
+            # no input is queued (n_tty_read, as n_tty_poll), so the bytes it returns may have
+            # waited there for a second, and the gap they belong to ends now
             data = self._read_host()
+            now = self._clock()
             sim, host = self._segments[-1]
             due = sim + (now - host) * self.speed - self.twin.time
             bound = self.max_gap * self.speed

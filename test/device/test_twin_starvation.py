@@ -134,6 +134,28 @@ def test_a_late_turn_delivers_the_hosts_heartbeats_at_the_times_it_wrote_them(
     assert all(abs(b - a - period_ns) <= 1_000_000 for a, b in itertools.pairwise(stamps))
 
 
+def test_a_read_that_waits_in_the_kernel_is_part_of_the_gap_it_ends(host: Host) -> None:
+    """A read of the pty can itself wait (for the kernel's flush worker) while the host writes
+    on: the bytes it returns belong to the gap up to the end of the read. Timed from before the
+    read, the turn delivered them at once and ran the next one without a byte (WATCHDOG in a
+    demo beside a CPU hog: "device frames delayed: none for 1.06 s")."""
+    armed(host)
+    read_host = host.pty._read_host
+
+    def slow_read() -> bytes:  # the read returns 0.8 s later, with the host's bytes of then
+        host.run(800, turns=False)
+        host.delivered()
+        return read_host()
+
+    host.pty._read_host = slow_read  # type: ignore[method-assign]
+    host.turn()
+    host.pty._read_host = read_host  # type: ignore[method-assign]
+    host.run(1000)
+    assert host.pty.twin.core.mode is Mode.TENSION and not host.faults, host.faults
+    assert (host.pty.late_turns, host.pty.pauses) == (1, 0)
+    assert host.pty.twin.now_ms == host.ms
+
+
 def test_a_late_turn_a_little_over_the_threshold_counts_and_an_on_time_one_does_not(
         host: Host) -> None:
     armed(host)
