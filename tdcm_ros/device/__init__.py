@@ -13,6 +13,7 @@ tdcm_ros.device.twin``: ``DeviceTwin``, ``PtyTwin``) and :mod:`.transcript`, :mo
 :mod:`.constants` (the firmware's constants, used as a namespace).
 """
 
+from tdcm_ros.device.clock_map import DeviceClockMap
 from tdcm_ros.device.core import TRIP_FAULTS
 from tdcm_ros.device.driver import (
     DRIVER_SPECS,
@@ -51,6 +52,7 @@ __all__ = [
     "ROLL_SPEED",
     "SCHEDULE_SPECS",
     "TRIP_FAULTS",
+    "DeviceClockMap",
     "DeviceError",
     "DriverConfig",
     "DriverStatus",

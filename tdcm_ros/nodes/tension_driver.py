@@ -3,8 +3,8 @@
 Wraps :class:`tdcm_ros.device.driver.TensionDriver` (handshake, heartbeats, setpoint ramp and
 clamp, reconnect with backoff, stale detection). A timer (``step_period_s``) steps the driver and
 publishes every telemetry frame as ``tension`` (``geometry_msgs/msg/WrenchStamped``,
-``wrench.force.z`` = measured tension in N, frame ``frame_id``; stamp = host receive time, frames
-read together keep their device-clock spacing). ``/diagnostics`` (every ``diagnostics_period_s``)
+``wrench.force.z`` = measured tension in N, frame ``frame_id``; stamp = the host time the device
+took it, :class:`~tdcm_ros.device.clock_map.DeviceClockMap`: a burst keeps its device spacing). ``/diagnostics`` (every ``diagnostics_period_s``)
 carries one status per component (:mod:`tdcm_ros.nodes.driver_diagnostics`): ``serial link``,
 ``load cell`` and ``actuator`` (mode, faults, setpoints, armed, the schedule state and
 ``schedule_done``, the roll). ``joint_states`` (``sensor_msgs/msg/JointState``, name ``["roll"]``)
@@ -49,6 +49,7 @@ from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import (
     DRIVER_SPECS,
     SCHEDULE_SPECS,
+    DeviceClockMap,
     DriverConfig,
     DriverStatus,
     LinkState,
@@ -150,6 +151,7 @@ class TensionDriverNode(NodeLogic):
 
         self.counts: Counter[str] = Counter()
         self._last_stamp_ns = {"tension": 0, "joint_states": 0}
+        self.clock_map = DeviceClockMap()
         self.last_warning = ""
         self._warnings = Throttled(clock=clock)
         self.schedule_state = "waiting" if autostart else "idle"
@@ -389,27 +391,26 @@ class TensionDriverNode(NodeLogic):
 
     def _publish_frames(self, frames: tuple[Telemetry, ...], joints: tuple[RollState, ...]
                         ) -> None:
-        """``tension`` for every telemetry frame, ``joint_states`` for every roll sample; stamp
-        = now minus the device-clock age relative to the newest frame read in this step, never
+        """``tension`` for every telemetry frame, ``joint_states`` for every roll sample;
+        stamp = the host time the device took it (:class:`DeviceClockMap`), never after now nor
         before the topic's previous stamp."""
         now = self.port.now_ns()
-        newest = max([frame.time for frame in frames] + [joint.time for joint in joints])
+        self.clock_map.observe(max([frame.time for frame in frames]
+                                   + [joint.time for joint in joints]), now)
         frame_id = str(self.port.get_parameter("frame_id"))
         for frame in frames:
             self.tension.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
-                "header": header(self._stamp("tension", now, newest - frame.time), frame_id),
+                "header": header(self._stamp("tension", now, frame.time), frame_id),
                 "wrench": {"force": {"z": frame.tension}}}))
         for joint in joints:
-            self.joints.publish(joint_state(self._stamp("joint_states", now, newest - joint.time),
+            self.joints.publish(joint_state(self._stamp("joint_states", now, joint.time),
                                             joint.position))
         self.counts["telemetry_frames"] += len(frames)
 
-    def _stamp(self, topic: str, now: int, age: float) -> int:
-        """``now`` (ns) less ``age`` (s of device clock), raised to ``topic``'s previous stamp:
-        frames that arrive in a burst (a device or serial line that caught up) span more device
-        time than has passed on the host since the last read, and would otherwise be stamped
-        before frames already published."""
-        stamp = max(now - max(0, round(age * 1e9)), self._last_stamp_ns[topic])
+    def _stamp(self, topic: str, now: int, device_s: float) -> int:
+        """The host time (ns) of device time ``device_s``, at most ``now`` and raised to
+        ``topic``'s previous stamp (stamps never go back)."""
+        stamp = max(min(self.clock_map.host_ns(device_s), now), self._last_stamp_ns[topic])
         self._last_stamp_ns[topic] = stamp
         return stamp
 
