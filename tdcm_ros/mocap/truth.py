@@ -7,8 +7,9 @@ arrive late: a twin whose thread was not scheduled for 1.8 s sends that stretch 
 built from the latest sample at the time of the tick instead froze the body for that long (a
 3.4 mm jump of the measured tip in the tracking demo beside a CPU hog). So a frame at time ``t``
 is made once the truth covers ``t`` (:class:`TruthTrack`, interpolated), on a fixed grid of frame
-times (:class:`FrameClock`). Truth more than ``stale_s`` behind the clock is taken as held (the
-bench stands still: a stopped twin, or stamps from another clock) and frames go on at the clock.
+times (:class:`FrameClock`). The node takes truth more than ``TRUTH_STALE_NS`` behind its clock
+as held (the bench stands still: a stopped twin, or stamps from another clock) and goes on at the
+clock (:mod:`tdcm_ros.nodes.mocap_node`).
 
 Times are ns since the epoch; values in SI units (N, rad).
 """
@@ -39,8 +40,8 @@ class TruthTrack:
         return self._stamps[-1]
 
     def add(self, stamp_ns: int, value: float) -> None:
-        """Append a sample; one stamped before the newest replaces nothing and is dropped
-        (returns without effect), so the stamps stay increasing."""
+        """Append a sample; one stamped at the newest replaces its value, one stamped before it
+        is dropped, so the stamps stay increasing."""
         if self._stamps and stamp_ns <= self._stamps[-1]:
             if stamp_ns == self._stamps[-1]:
                 self._values[-1] = value
