@@ -210,9 +210,9 @@ class Spec:
             try:
                 value = float(value)
             except ValueError:
-                raise self._wrong_type(where, given, error) from None
+                raise self._wrong_type(where, given, error, number=True) from None
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise self._wrong_type(where, given, error)
+            raise self._wrong_type(where, given, error, number=True)
         if self.kind == "float" or self.kind in _SEQUENCES:
             return float(value)
         if isinstance(value, numbers.Integral):
@@ -222,9 +222,12 @@ class Spec:
             return int(number)
         raise self._wrong_type(where, given, error)
 
-    def _wrong_type(self, where: str, value: Any, error: type[InputError]) -> InputError:
+    def _wrong_type(self, where: str, value: Any, error: type[InputError],
+                    number: bool = False) -> InputError:
+        """The error for ``value`` of the wrong type; ``number``: an element of a list of
+        numbers is not a number."""
         noun = {"float": "a number", "int": "an integer", "bool": "true or false",
-                "str": "a string"}.get(self.kind, "a list")
+                "str": "a string"}.get(self.kind, "a number" if number else "a list")
         return error(f"{where} = {shown_value(value)} is not {noun}; allowed: {self.allowed()}",
                      parameter=where, value=value, allowed=self.allowed())
 

@@ -18,7 +18,8 @@ def format_evaluation(ev: Evaluation) -> str:
     """The text report: setup, per-step table, Table I and warnings."""
     opts: EvaluateOptions = ev.options
     d = opts.design
-    lines = [(f"design: L = {d.length * 1e3:.3f} mm, w_d = {d.w_d * 1e3:.3f} mm, "
+    w_d = ", ".join(f"{w * 1e3:.3f}" for w in dict.fromkeys(d.per_notch("w_d").tolist()))
+    lines = [(f"design: L = {d.length * 1e3:.3f} mm, w_d = {w_d} mm, "
              f"E = {d.E:.4g} Pa; deflection from the {opts.deflection_axis} axis")]
     for source, reg in zip(ev.sources, ev.registrations, strict=True):
         how = {"tf_static": "from /tf_static in the bag", "given": "given",

@@ -26,6 +26,7 @@ from tdcm_ros.model.design import (
     PARAMETER_SPECS,
     PRESETS,
     Design,
+    parameter_specs,
     parse_field,
     preset,
 )
@@ -156,6 +157,7 @@ __all__ = [
     "named_design",
     "offset_points",
     "one_shot",
+    "parameter_specs",
     "parse_field",
     "preset",
     "read_body_file",

@@ -109,7 +109,8 @@ class Config:
             options = self.options
             if self.max_step_per_notch is not None:
                 options = ShootingOptions(**{**asdict(options),
-                                             "max_step": self.max_step_per_notch * design.w_n})
+                                             "max_step": self.max_step_per_notch
+                                             * float(np.min(design.per_notch("w_n")))})
             result = solve_with(self.method, design, tension, options=options, strict=False)
         return result.tip_position, result.converged
 

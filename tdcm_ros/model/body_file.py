@@ -20,9 +20,10 @@ of ``[x, y]`` in m, with optional ``holes``). Every problem is an
 :class:`~tdcm_ros.model.errors.InvalidDesignError` naming the key by its path in the file
 (``segments[1].segments[0].notch.cut``), the value and the allowed range.
 
-The solver takes today N identical, evenly spaced band notches and one tendon:
-:meth:`BodySpec.design` gives that :class:`~tdcm_ros.model.design.Design` and names the first
-segment a body departs from it by (per-notch sections are issue 27's next step).
+The solver takes today band notches of one profile, each with its own width and backbone,
+any tubes between them, and one tendon: :meth:`BodySpec.design` gives that
+:class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ) and names
+the first segment a body departs from it by (cut and polygon sections are not solvable yet).
 """
 
 from __future__ import annotations
@@ -95,9 +96,11 @@ class BodySpec:
     source: str
 
     def design(self) -> Design:
-        """The body as the solver's uniform :class:`Design`: a base tube (or none), N identical
-        band notches, equal tubes between them and a tip tube (or none). A body that departs
-        from that raises :class:`InvalidDesignError` naming the first segment that does."""
+        """The body as the solver's :class:`Design`: a base tube (or none), N band notches,
+        each with its own width and backbone, a tube (or none) between adjacent notches and a
+        tip tube (or none). A body the solver does not take yet (a cut or polygon section,
+        notches of different profiles) raises :class:`InvalidDesignError` naming the first
+        segment that departs from it."""
         merged = _merged_tubes(self.segments)
         notches = [s for s in merged if isinstance(s, NotchSpec)]
         if not notches:
@@ -107,31 +110,25 @@ class BodySpec:
         for notch in notches:
             if notch.kind != "band":
                 raise _not_yet(notch.where, f"a {notch.kind} section", self.source)
-            for key in ("width", "band", "profile"):
-                if getattr(notch, key) != getattr(first, key):
-                    raise _not_yet(f"{notch.where}.{key}", f"{key} {getattr(notch, key)!r} where "
-                                   f"{first.where} has {getattr(first, key)!r}", self.source)
+            if notch.profile != first.profile:
+                raise _not_yet(f"{notch.where}.profile", f"profile {notch.profile!r} where "
+                               f"{first.where} has {first.profile!r}", self.source)
         head = merged[0].length if isinstance(merged[0], TubeSpec) else 0.0
         tail = merged[-1].length if isinstance(merged[-1], TubeSpec) else 0.0
-        inner = [s for s in merged[1:-1] if isinstance(s, TubeSpec)]
-        if inner and len(inner) != len(notches) - 1:
-            raise _not_yet(notches[0].where, "notches with and without a tube between them",
-                           self.source)
-        for tube in inner:
-            if tube.length != inner[0].length:
-                raise _not_yet(tube.where, f"tube {tube.length!r} m where {inner[0].where} has "
-                               f"{inner[0].length!r} m", self.source)
-        return Design(w_base=head, w_tip=tail, w_n=first.width,
-                      w_t=inner[0].length if inner else 0.0, w_d=first.band, N=len(notches),
-                      R_outer=self.R_outer, r_inner=self.r_inner, R_c=self.tendon_offset,
-                      E=self.E, profile=profile_from_name(first.profile))
+        at = [k for k, segment in enumerate(merged) if isinstance(segment, NotchSpec)]
+        gaps = tuple(after.length if isinstance(after := merged[k + 1], TubeSpec) else 0.0
+                     for k in at[:-1])
+        return Design(w_base=head, w_tip=tail, w_n=tuple(n.width for n in notches), w_t=gaps,
+                      w_d=tuple(n.band for n in notches), N=len(notches), R_outer=self.R_outer,
+                      r_inner=self.r_inner, R_c=self.tendon_offset, E=self.E,
+                      profile=profile_from_name(first.profile))
 
 
 def _not_yet(where: str, what: str, source: str) -> InvalidDesignError:
     return InvalidDesignError(
-        f"{source}: {where}: {what}: the solver takes N identical, evenly spaced band notches "
-        "and one tendon (per-notch sections are not solvable yet)", parameter=where, value=what,
-        allowed="identical band notches, equal tubes between them")
+        f"{source}: {where}: {what}: the solver takes band notches of one profile and one "
+        "tendon (cut and polygon sections are not solvable yet)", parameter=where, value=what,
+        allowed="band notches of one profile")
 
 
 def _merged_tubes(segments: Sequence[Segment]) -> list[Segment]:
@@ -325,24 +322,36 @@ def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low
 
 
 def body_file_text(design: Design, routing: str = "paper") -> str:
-    """The body file of a uniform ``design`` whose tendon has ``routing``: reading it back gives
-    ``design`` bit for bit (every number written as its shortest round-trip form)."""
+    """The body file of ``design`` whose tendon has ``routing``: reading it back gives
+    ``design`` bit for bit (every number written as its shortest round-trip form). A uniform
+    design is written with ``repeat``, a per-notch one segment by segment."""
     def number(value: float) -> str:
         text = repr(float(value))
         return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
 
-    notch = (f"{{width: {number(design.w_n)}, band: {number(design.w_d)}, "
-             f"profile: {design.profile.name}}}")
+    def notch(width: float, band: float) -> str:
+        return (f"{{width: {number(width)}, band: {number(band)}, "
+                f"profile: {design.profile.name}}}")
+
     lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
              f"material: {{E: {number(design.E)}}}", "tendons:",
              f"  - {{offset: {number(design.R_c)}, routing: {routing}}}", "segments:"]
     if design.w_base > 0.0:
         lines.append(f"  - tube: {number(design.w_base)}")
-    if design.N > 1:
-        lines += [f"  - repeat: {design.N - 1}", "    segments:", f"      - notch: {notch}"]
-        if design.w_t > 0.0:
-            lines.append(f"      - tube: {number(design.w_t)}")
-    lines.append(f"  - notch: {notch}")
+    if design.is_uniform:
+        one = notch(design.uniform("w_n"), design.uniform("w_d"))
+        if design.N > 1:
+            lines += [f"  - repeat: {design.N - 1}", "    segments:", f"      - notch: {one}"]
+            if design.uniform("w_t") > 0.0:
+                lines.append(f"      - tube: {number(design.uniform('w_t'))}")
+        lines.append(f"  - notch: {one}")
+    else:
+        gaps = [*design.per_notch("w_t").tolist(), 0.0]
+        for width, band, gap in zip(design.per_notch("w_n").tolist(),
+                                    design.per_notch("w_d").tolist(), gaps, strict=True):
+            lines.append(f"  - notch: {notch(width, band)}")
+            if gap > 0.0:
+                lines.append(f"  - tube: {number(gap)}")
     if design.w_tip > 0.0:
         lines.append(f"  - tube: {number(design.w_tip)}")
     return "\n".join(lines) + "\n"

@@ -3,12 +3,18 @@
 Geometry (eq. 1): ``L = w_base + N w_n + (N-1) w_t + w_tip``; notch ``i`` (1-based) spans
 ``[l_i, r_i]`` with ``l_i = w_base + (i-1)(w_n + w_t)`` and ``r_i = l_i + w_n``.
 
+Per notch: ``w_n`` and ``w_d`` may be N values (notch ``i``'s width and backbone, base to
+tip) and ``w_t`` N - 1 values (the tube after notch ``i``); then ``l_i`` is the sum of the
+segments before notch ``i``. A list whose values are all equal is stored as that one value, so
+an evenly spaced, identical pattern is the uniform design whichever way it is written.
+
 ``E`` defaults to 1.85 GPa (Formlabs Nylon 12 powder datasheet, tensile modulus). Thin SLS
 features are often softer: treat ``E`` as a calibration parameter (``tdcm calibrate``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
@@ -30,6 +36,12 @@ MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
 #: or at least this, so no cell is negligible against the arc lengths it sits between.
 MIN_SEGMENT_M = 1e-6
+#: Fields that may hold one value per notch (base to tip).
+PER_NOTCH_FIELDS = ("w_n", "w_d")
+#: Fields that may hold one value per gap between adjacent notches (base to tip).
+PER_GAP_FIELDS = ("w_t",)
+#: A length (m): one value, or one per notch or gap (see the module docstring).
+Lengths = float | tuple[float, ...]
 
 
 @dataclass(frozen=True)
@@ -40,12 +52,13 @@ class Design:
                                low=0.0, high=1.0)
     w_tip: float = spec_field(unit="m", description="length of the distal tube segment",
                               low=0.0, high=1.0)
-    w_n: float = spec_field(unit="m", description="notch width along the body",
-                            low=MIN_SEGMENT_M, high=1.0)
-    w_t: float = spec_field(unit="m", description="tube length between adjacent notches",
-                            low=0.0, high=1.0)
-    w_d: float = spec_field(unit="m", description="backbone width (minimum, at the notch centre)",
-                            low=0.0, high=1.0, low_open=True)
+    w_n: float | tuple[float, ...] = spec_field(unit="m", description="notch width along the body (or one per "
+                              "notch)", low=MIN_SEGMENT_M, high=1.0, kind="float")
+    w_t: float | tuple[float, ...] = spec_field(unit="m", description="tube length between adjacent notches (or "
+                              "one per gap)", low=0.0, high=1.0, kind="float")
+    w_d: float | tuple[float, ...] = spec_field(unit="m", description="backbone width (minimum, at the notch "
+                              "centre; or one per notch)", low=0.0, high=1.0, low_open=True,
+                              kind="float")
     N: int = spec_field(kind="int", description="number of notches", low=1, high=1000)
     R_outer: float = spec_field(unit="m", description="outer radius of the tube", low=0.0,
                                 high=0.5, low_open=True)
@@ -58,7 +71,10 @@ class Design:
     profile: NotchProfile = field(default_factory=CircularProfile)
 
     def __post_init__(self) -> None:
-        check_fields(self, FIELD_SPECS, error=InvalidDesignError)
+        check_fields(self, {k: v for k, v in FIELD_SPECS.items() if k not in _LISTABLE},
+                     error=InvalidDesignError)
+        for name in _LISTABLE:
+            object.__setattr__(self, name, _lengths(name, getattr(self, name), self._count(name)))
         self._check_cross_fields()
         if not hasattr(self.profile, "h1"):
             raise InvalidDesignError(
@@ -74,24 +90,68 @@ class Design:
                  ("R_c", self.R_outer, f"(0, R_outer = {self.R_outer:g}) m"),
                  ("w_d", diameter, f"(0, 2 R_outer = {diameter:g}) m"))
         for name, limit, allowed in below:
-            if getattr(self, name) >= limit:
-                raise out_of_range(name, getattr(self, name), allowed, error=InvalidDesignError)
+            for where, value in _entries(name, getattr(self, name)):
+                if value >= limit:
+                    raise out_of_range(where, value, allowed, error=InvalidDesignError)
         for name in ("w_base", "w_t", "w_tip"):
-            value = getattr(self, name)
-            if 0.0 < value < MIN_SEGMENT_M:
-                raise out_of_range(name, value, f"0 (no segment) or [{MIN_SEGMENT_M:g}, 1] m",
-                                   error=InvalidDesignError)
+            for where, value in _entries(name, getattr(self, name)):
+                if 0.0 < value < MIN_SEGMENT_M:
+                    raise out_of_range(where, value, f"0 (no segment) or [{MIN_SEGMENT_M:g}, 1] m",
+                                       error=InvalidDesignError)
+
+    def _count(self, name: str) -> int:
+        """How many values a per-notch (N) or per-gap (N - 1) field holds when it is a list."""
+        return self.N if name in PER_NOTCH_FIELDS else self.N - 1
+
+    @property
+    def is_uniform(self) -> bool:
+        """Whether every notch is the same and evenly spaced (no field holds a list)."""
+        return not any(isinstance(getattr(self, name), tuple) for name in _LISTABLE)
+
+    def uniform(self, name: str, what: str = "this") -> float:
+        """Field ``name`` (``w_n``, ``w_d``, ``w_t``) where it holds one value (m); a per-notch
+        list raises :class:`InvalidDesignError` saying that ``what`` takes one value."""
+        value = getattr(self, name)
+        if isinstance(value, tuple):
+            raise InvalidDesignError(
+                f"{name} = {list(value)!r} holds one value per notch; {what} takes a uniform "
+                f"design (one {name})", parameter=name, value=list(value),
+                allowed=f"one value of {name} (a uniform design)")
+        return float(value)
+
+    def per_notch(self, name: str) -> NDArray[np.float64]:
+        """Field ``name`` (``w_n``, ``w_d``: N values; ``w_t``: N - 1) as an array (m), base
+        to tip, whether the design stores one value or a list."""
+        value = getattr(self, name)
+        return np.array(value, dtype=float) if isinstance(value, tuple) else np.full(
+            self._count(name), float(value))
 
     @property
     def length(self) -> float:
-        """Total length ``L`` (m), eq. 1."""
-        return self.w_base + self.N * self.w_n + (self.N - 1) * self.w_t + self.w_tip
+        """Total length ``L`` (m), eq. 1 (sums of the per-notch values where there are lists)."""
+        if self.is_uniform:
+            return self.w_base + self.N * self.uniform("w_n") + (self.N - 1) * self.uniform(
+                "w_t") + self.w_tip
+        return float(self._ends()[-1] + self.w_tip)
 
     def notch_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Arrays ``(l, r)`` (m) of notch start and end arc lengths, eq. 1."""
-        i = np.arange(self.N, dtype=float)
-        left = self.w_base + i * (self.w_n + self.w_t)
-        return left, left + self.w_n
+        if self.is_uniform:
+            w_n = self.uniform("w_n")
+            i = np.arange(self.N, dtype=float)
+            left = self.w_base + i * (w_n + self.uniform("w_t"))
+            return left, left + w_n
+        ends = self._ends()
+        return ends[0::2], ends[1::2]
+
+    def _ends(self) -> NDArray[np.float64]:
+        """``l_1, r_1, l_2, ..., r_N`` (m) of a per-notch design, summed segment by segment
+        from the base, so that a notch right after another starts exactly where it ends."""
+        lengths = np.zeros(2 * self.N)
+        lengths[0] = self.w_base
+        lengths[1::2] = self.per_notch("w_n")
+        lengths[2::2] = self.per_notch("w_t")
+        return np.cumsum(lengths)
 
     @property
     def tube_second_moment(self) -> float:
@@ -107,8 +167,10 @@ class Design:
         return replace(self, **overrides)
 
     def to_dict(self) -> dict[str, Any]:
-        """All fields in SI units, plus the derived length ``L``; the profile by name."""
-        data = {k: v for k, v in asdict(self).items() if k != "profile"}
+        """All fields in SI units (a per-notch field as a list), plus the derived length ``L``;
+        the profile by name."""
+        data = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()
+                if k != "profile"}
         data["profile"] = self.profile.name
         data["L"] = self.length
         return data
@@ -116,10 +178,42 @@ class Design:
 
 #: Specs of the numeric design fields (all but ``profile``), by name.
 FIELD_SPECS = specs_of(Design)
+_LISTABLE = PER_NOTCH_FIELDS + PER_GAP_FIELDS
+
+
+def _lengths(name: str, value: Any, count: int) -> Lengths:
+    """``value`` of the per-notch or per-gap field ``name`` checked (m): one number, or a list
+    of ``count`` numbers each in the field's range; a list of equal values becomes that value."""
+    spec = FIELD_SPECS[name]
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+        return float(spec.check(value, error=InvalidDesignError))
+    if count == 0 and len(value) == 0:
+        return 0.0  # a one-notch design has no gaps
+    items = replace(spec, kind="list").check(list(value), error=InvalidDesignError)
+    if len(items) != count:
+        what = "notch" if name in PER_NOTCH_FIELDS else "gap between notches"
+        raise out_of_range(name, list(items), f"one number, or {count} numbers (one per {what}:"
+                           f" N = {count if what == 'notch' else count + 1})",
+                           error=InvalidDesignError)
+    return items[0] if all(v == items[0] for v in items) else tuple(items)
+
+
+def _entries(name: str, value: Any) -> list[tuple[str, float]]:
+    """``(name, value)``, or ``(name[i], value_i)`` for each entry of a per-notch list."""
+    if isinstance(value, tuple):
+        return [(f"{name}[{i}]", float(v)) for i, v in enumerate(value)]
+    return [(name, float(value))]
 #: The design as node parameters (``design.<name>``): every numeric field and the profile by name.
 PARAMETER_SPECS = {**FIELD_SPECS, "profile": Spec(
     "profile", description="notch profile", default="circular", kind="str",
     choices=PROFILE_NAMES)}
+
+
+def parameter_specs(design: Design) -> dict[str, Spec]:
+    """:data:`PARAMETER_SPECS` that can hold ``design``'s values: all but the fields it holds
+    per notch (a body file's per-notch values are read from the file, not from parameters)."""
+    return {k: v for k, v in PARAMETER_SPECS.items()
+            if not isinstance(getattr(design, k, None), tuple)}
 
 
 def parse_field(name: str, text: str) -> Any:
@@ -131,6 +225,9 @@ def parse_field(name: str, text: str) -> Any:
         allowed = ", ".join([*FIELD_SPECS, "profile"])
         raise InvalidDesignError(f"unknown design field {name!r}; allowed: {allowed}",
                                  parameter=name, value=text, allowed=allowed)
+    stripped = text.strip()
+    if name in _LISTABLE and stripped.startswith("[") and stripped.endswith("]"):
+        return replace(spec, kind="list").parse(stripped[1:-1], name, error=InvalidDesignError)
     return spec.parse(text, error=InvalidDesignError)
 
 

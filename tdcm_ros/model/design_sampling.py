@@ -136,9 +136,10 @@ def candidate(base: Design, values: Mapping[str, float]) -> Design:
               for name, value in values.items() if name != "L"}
     if "L" in values:
         design = base.with_overrides(**fields)
-        rest = values["L"] - design.w_base - design.N * design.w_n - design.w_tip
+        w_n = design.uniform("w_n", "a design search over L")
+        rest = values["L"] - design.w_base - design.N * w_n - design.w_tip
         if design.N == 1:
-            fields["w_tip"] = values["L"] - design.w_base - design.w_n
+            fields["w_tip"] = values["L"] - design.w_base - w_n
         else:
             fields["w_t"] = rest / (design.N - 1)
         for name in ("w_t", "w_tip"):

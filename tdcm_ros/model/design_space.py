@@ -113,10 +113,11 @@ def couple(design: Design, coupling: str, pitch: float) -> Design:
         return design
     if coupling != "fixed-pitch":
         raise out_of_range("coupling", coupling, " | ".join(COUPLINGS), error=InvalidDesignError)
-    if not design.w_n <= pitch:
-        raise out_of_range("w_n", design.w_n, f"(0, {pitch:g}] m under fixed-pitch coupling "
+    w_n = design.uniform("w_n", "fixed-pitch coupling")
+    if not w_n <= pitch:
+        raise out_of_range("w_n", w_n, f"(0, {pitch:g}] m under fixed-pitch coupling "
                            "(w_t = w_tip = pitch - w_n >= 0)", error=InvalidDesignError)
-    return design.with_overrides(w_t=pitch - design.w_n, w_tip=pitch - design.w_n)
+    return design.with_overrides(w_t=pitch - w_n, w_tip=pitch - w_n)
 
 
 def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
@@ -143,7 +144,8 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
     values = tuple(_axis_values(name, axes[name]) for name in fields)
     t = _tensions(tensions)
     strain_limit = _allowable(allowable_strain)
-    pitch = base.w_n + base.w_t
+    pitch = (base.uniform("w_n", "fixed-pitch coupling") + base.uniform(
+        "w_t", "fixed-pitch coupling")) if coupling == "fixed-pitch" else math.nan
     shape = tuple(v.size for v in values)
     designs = []
     for index in np.ndindex(*shape):

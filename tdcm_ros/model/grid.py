@@ -76,6 +76,7 @@ class CellArrays:
     s_nodes: Array
     is_notch: NDArray[np.bool_]
     notch_index: IntArray
+    shape: IntArray
     seg_start: Array
     seg_length: Array
     u_a: Array
@@ -150,7 +151,8 @@ class Grid(CellArrays):
     def rows(self, cells: IntArray) -> CellRows:
         """Cell data of ``cells`` (one row each) for the per-row geometry functions."""
         return CellRows(members=self.members, member=np.zeros(cells.shape, np.int64),
-                        is_notch=self.is_notch[cells], seg_start=self.seg_start[cells],
+                        shape=self.shape[cells], is_notch=self.is_notch[cells],
+                        seg_start=self.seg_start[cells],
                         seg_length=self.seg_length[cells], a=self.s_nodes[cells],
                         length=self.s_nodes[cells + 1] - self.s_nodes[cells])
 
@@ -172,7 +174,8 @@ class Grid(CellArrays):
         u_lin = sigma / self.seg_length[cells]
         if self.design.profile.name != "circular":
             return u_lin
-        ratio = np.clip(1.0 - 2.0 * sigma / self.design.w_n, -1.0, 1.0)
+        w_n = self.members.shape_w_n[self.shape[cells]]
+        ratio = np.clip(1.0 - 2.0 * sigma / w_n, -1.0, 1.0)
         return np.where(self.is_notch[cells], np.arccos(ratio) / np.pi, u_lin)
 
     def query(self, s: Array) -> Query:
@@ -217,11 +220,13 @@ def _exact_length(weights: Array, length: Array) -> Array:
 
 @dataclass(frozen=True)
 class CellRows:
-    """Cells lined up with the first axis of a ``u`` array: each row's member, segment (m) and
-    span along s (``a``, ``length``, m); the geometry of those cells at any ``u`` there."""
+    """Cells lined up with the first axis of a ``u`` array: each row's member, notch shape
+    (within the member), segment (m) and span along s (``a``, ``length``, m); the geometry of
+    those cells at any ``u`` there."""
 
     members: Members
     member: IntArray
+    shape: IntArray
     is_notch: NDArray[np.bool_]
     seg_start: Array
     seg_length: Array
@@ -231,17 +236,17 @@ class CellRows:
     def local_sigma(self, u: Array) -> Array:
         """Arc length from each row's segment start (m) at ``u``."""
         out = per_row(self.seg_length, u) * u
-        member, notch = self._notch_points(u)
-        if member.size:
-            out[notch] = self.members.sigma(member, u[notch])
+        shape, notch = self._notch_points(u)
+        if shape.size:
+            out[notch] = self.members.sigma(shape, u[notch])
         return out
 
     def jacobian(self, u: Array) -> Array:
         """``ds/du`` (m) at ``u``."""
         out = per_row(self.seg_length, u) + 0.0 * u
-        member, notch = self._notch_points(u)
-        if member.size:
-            out[notch] = self.members.dsigma_du(member, u[notch])
+        shape, notch = self._notch_points(u)
+        if shape.size:
+            out[notch] = self.members.dsigma_du(shape, u[notch])
         return out
 
     def compliance(self, u: Array) -> Array:
@@ -249,16 +254,19 @@ class CellRows:
         m = self.members
         every = np.broadcast_to(per_row(self.member, u), u.shape)
         inertia = m.tube_moment[every]
-        member, notch = self._notch_points(u)
-        if member.size:
-            inertia[notch] = notched_moment(m.h1(member, u[notch]), m.R_outer[member],
-                                            m.r_inner[member])
+        shape, notch = self._notch_points(u)
+        if shape.size:
+            owner = m.shape_member[shape]
+            inertia[notch] = notched_moment(m.h1(shape, u[notch]), m.R_outer[owner],
+                                            m.r_inner[owner])
         return 1.0 / (m.E[every] * inertia)
 
     def _notch_points(self, u: Array) -> tuple[IntArray, NDArray[np.bool_]]:
-        """Members of the points of ``u`` inside notches (flat), and the mask of those points."""
+        """Notch shapes (rows of :class:`Members`) of the points of ``u`` inside notches
+        (flat), and the mask of those points."""
         notch = np.broadcast_to(per_row(self.is_notch, u), u.shape)
-        return np.broadcast_to(per_row(self.member, u), u.shape)[notch], notch
+        shape = self.members.shape_first[self.member] + self.shape
+        return np.broadcast_to(per_row(shape, u), u.shape)[notch], notch
 
 
 def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Array
@@ -361,6 +369,7 @@ class GridParts:
             designs=tuple(members.designs[r] for r in rows), n_cells=count,
             s_nodes=np.concatenate([laid(table.a, tip), tip], axis=1),
             is_notch=laid(table.is_notch, False), notch_index=laid(table.notch_index, -1),
+            shape=laid(table.shape, 0),
             seg_start=seg_start, seg_length=laid(table.seg_length, 0.0),
             u_a=laid(table.u_a, 0.0), u_b=laid(table.u_b, 0.0),
             constrained=laid(table.constrained, True),
@@ -381,8 +390,10 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
     cell = np.stack([table.is_notch, table.chord, table.u_a, table.u_b, table.a, table.length,
                      table.seg_length], axis=1).astype(float)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
-    design = np.stack([kinds[members.profile_of], members.w_n, members.w_d, members.R_outer,
-                       members.r_inner, members.E, members.tube_moment], axis=1)
+    owner = members.shape_member
+    design = np.stack([kinds[members.profile_of[owner]], members.shape_w_n, members.shape_w_d,
+                       members.R_outer[owner], members.r_inner[owner], members.E[owner],
+                       members.tube_moment[owner]], axis=1)
     build = grid_kernels()
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
     custom_row, custom_h1 = _custom_h1(table, build, cell, design, gauss_u, probe)
@@ -393,7 +404,7 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
     matrix = _integration_matrix(quad_order)
 
     def integrate(part: slice) -> None:
-        build.cell_integrals(table.member[part], cell[part], design, custom_row[part],
+        build.cell_integrals(table.shape[part], cell[part], design, custom_row[part],
                              custom_h1, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
                              strain[part])
 
@@ -415,7 +426,7 @@ def _custom_h1(table: Prototypes, build: Any, cell: Array, design: Array,
     """For prototype cells in notches of user profiles: a row of ``custom_h1`` each (-1 for
     the others) holding ``h1`` (m) at every evaluation point of
     :func:`tdcm_ros.model.grid_kernel.points`."""
-    custom = (design[table.member, 0] == CUSTOM) & table.is_notch
+    custom = (design[table.shape, 0] == CUSTOM) & table.is_notch
     rows = np.full(table.u_a.size, -1, np.int64)
     chosen = np.flatnonzero(custom)
     size = gauss_u.size * (gauss_u.size + 1) + probe.size + 2
@@ -423,7 +434,7 @@ def _custom_h1(table: Prototypes, build: Any, cell: Array, design: Array,
     if chosen.size:
         rows[chosen] = np.arange(chosen.size)
         build.points(np.ascontiguousarray(cell[chosen]), gauss_u, probe, u)
-        u = table.members.h1(table.member[chosen], u)
+        u = table.members.h1(table.shape[chosen], u)
     return rows, np.ascontiguousarray(u, dtype=float)
 
 

@@ -8,10 +8,10 @@ and :func:`~tdcm_ros.model.grid.build_grids` (many) both call :func:`cell_integr
 prototype cells of :mod:`tdcm_ros.model.grid_layout`; the module docstring of
 :mod:`tdcm_ros.model.grid` says what each integral is.
 
-Per prototype cell ``i`` (inputs, SI units): ``member[i]``; ``cell[i, :]`` =
+Per prototype cell ``i`` (inputs, SI units): ``shape[i]``; ``cell[i, :]`` =
 ``(is_notch, chord, u_a, u_b, a, length, seg_length)`` (``a`` from the segment start, m).
-Per member ``m``: ``design[m, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E,
-tube moment)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR` and :data:`CUSTOM`
+Per notch shape ``k`` (a member's distinct notch; a tube cell names its member's first):
+``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR` and :data:`CUSTOM`
 (``h1`` read from ``custom_h1[custom_row[i]]`` at the points of :func:`points`, ``sigma``
 linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
 (``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally
@@ -90,7 +90,7 @@ def geometry(kind: float, w_n: float, w_d: float, u: float,
 
 def point(notch: bool, d: Array, seg_length: float, u: float, custom: float
           ) -> tuple[float, float, float]:
-    """``(sigma, ds/du, 1/(E I))`` at ``u`` in a cell's segment (m, m, 1/(N m^2)) of a member
+    """``(sigma, ds/du, 1/(E I))`` at ``u`` in a cell's segment (m, m, 1/(N m^2)) of a notch shape
     with ``design`` row ``d``."""
     if not notch:
         return seg_length * u, seg_length, 1.0 / (d[E] * d[TUBE_MOMENT])
@@ -118,7 +118,7 @@ def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
         out[i, first + probe.shape[0] + 1] = cell[i, U_B]
 
 
-def cell_integrals(member: Ints, cell: Array, design: Array, custom_row: Ints,
+def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
                    custom_h1: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
                    probe: Array, fc: Array, fq: Array, strain: Array) -> None:
     """Every integral of each cell (module docstring) into ``fc`` (cells, 8) and ``fq``
@@ -129,7 +129,7 @@ def cell_integrals(member: Ints, cell: Array, design: Array, custom_row: Ints,
     first = q_count + q_count * q_count
     no_custom = np.zeros(first + probe.shape[0] + 2)
     for i in range(cell.shape[0]):
-        d = design[member[i]]
+        d = design[shape[i]]
         c = cell[i]
         custom = custom_h1[custom_row[i]] if custom_row[i] >= 0 else no_custom
         notch = c[IS_NOTCH] != 0.0

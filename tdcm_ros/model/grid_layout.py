@@ -38,11 +38,23 @@ MAX_CROSSINGS = 4
 #: Samples of a custom profile searched for crossings, and bisection steps per crossing.
 CROSSING_SAMPLES = 129
 BISECTION_STEPS = 60
+#: Narrowest piece of a notch in ``u`` that a crossing may cut off (see :func:`resolved`).
+MIN_PIECE_U = 1e-6
 
 
 @dataclass(frozen=True)
 class Members:
-    """Design parameters of every member, each an array of shape (M,) in SI units."""
+    """Design parameters of every member (SI units): per member (shape (M,)) the tube, the
+    material and the length; per *notch shape* (shape (S,): each member's distinct notches,
+    ``(w_n, w_d)`` pairs in order of first appearance, so a uniform member has one and its row is
+    the member's own) ``shape_member``, ``shape_w_n``, ``shape_w_d``; per member and segment
+    *kind* (shape (M, K): the member's base tube, each of its notch shapes, each distinct tube
+    between notches, its tip tube, then zero-length padding) ``kind_length``,
+    ``kind_is_notch`` and ``kind_shape`` (the notch shape of a notch kind, the member's first
+    shape for a tube); per member and slot (shape (M, 2 max N + 1): the base, then notch ``i``
+    and the tube after it) ``slot_kind``; per member and notch (M, max N) ``notch_left`` and
+    ``notch_right`` (m, padded with the member's length). A uniform member has the kinds BASE,
+    NOTCH, TUBE and TIP."""
 
     designs: tuple[Design, ...]
     profiles: tuple[NotchProfile, ...]
@@ -50,15 +62,22 @@ class Members:
     N: IntArray
     w_base: Array
     w_tip: Array
-    w_n: Array
-    w_t: Array
-    w_d: Array
     R_outer: Array
     r_inner: Array
     R_c: Array
     E: Array
     tube_moment: Array
     length: Array
+    shape_member: IntArray
+    shape_first: IntArray
+    shape_w_n: Array
+    shape_w_d: Array
+    kind_length: Array
+    kind_is_notch: BoolArray
+    kind_shape: IntArray
+    slot_kind: IntArray
+    notch_left: Array
+    notch_right: Array
 
     @classmethod
     def of(cls, designs: Sequence[Design]) -> Members:
@@ -81,45 +100,117 @@ class Members:
             return np.array([getattr(d, name) for d in designs], dtype=float)
 
         n = np.array([d.N for d in designs], np.int64)
-        w_base, w_n, w_t, w_tip = (column(k) for k in ("w_base", "w_n", "w_t", "w_tip"))
+        w_base, w_tip = column("w_base"), column("w_tip")
         r_outer, r_inner = column("R_outer"), column("r_inner")
+        uniform = all(d.is_uniform for d in designs)
+        layout = _uniform_layout(designs, n, w_base, w_tip) if uniform else _general_layout(
+            designs, n)
         members = cls(designs=designs, profiles=tuple(profiles), profile_of=profile_of, N=n,
-                      w_base=w_base, w_tip=w_tip, w_n=w_n, w_t=w_t, w_d=column("w_d"),
-                      R_outer=r_outer, r_inner=r_inner, R_c=column("R_c"), E=column("E"),
+                      w_base=w_base, w_tip=w_tip, R_outer=r_outer, r_inner=r_inner,
+                      R_c=column("R_c"), E=column("E"),
                       tube_moment=np.pi / 4.0 * (r_outer**4 - r_inner**4),
-                      length=w_base + n * w_n + (n - 1) * w_t + w_tip)
+                      length=np.array([d.length for d in designs], dtype=float), **layout)
         for design in designs:
             if design.profile.name not in ("circular", "rectangular"):
                 _check_custom_profile(design)
         _check_rigidity(members)
         return members
 
-    def h1(self, member: IntArray, u: Array) -> Array:
-        """Backbone half-width (m) at ``u``; ``member`` (n,) names the member of each row of u."""
-        return self._per_profile(member, u, lambda p, x, w_n, w_d: p.h1(x, w_n, w_d))
+    def h1(self, shape: IntArray, u: Array) -> Array:
+        """Backbone half-width (m) at ``u``; ``shape`` (n,) names the notch shape of each row of u."""
+        return self._per_profile(shape, u, lambda p, x, w_n, w_d: p.h1(x, w_n, w_d))
 
-    def sigma(self, member: IntArray, u: Array) -> Array:
+    def sigma(self, shape: IntArray, u: Array) -> Array:
         """Local arc length in a notch (m) at ``u``, rows of ``u`` as in :meth:`h1`."""
-        return self._per_profile(member, u, lambda p, x, w_n, w_d: p.sigma(x, w_n))
+        return self._per_profile(shape, u, lambda p, x, w_n, w_d: p.sigma(x, w_n))
 
-    def dsigma_du(self, member: IntArray, u: Array) -> Array:
+    def dsigma_du(self, shape: IntArray, u: Array) -> Array:
         """``d sigma / du`` in a notch (m) at ``u``, rows of ``u`` as in :meth:`h1`."""
-        return self._per_profile(member, u, lambda p, x, w_n, w_d: p.dsigma_du(x, w_n))
+        return self._per_profile(shape, u, lambda p, x, w_n, w_d: p.dsigma_du(x, w_n))
 
-    def _per_profile(self, member: IntArray, u: Array, evaluate: ProfileFunction) -> Array:
-        """``evaluate(profile, u, w_n, w_d)`` with each row's member's profile and widths."""
+    def _per_profile(self, shape: IntArray, u: Array, evaluate: ProfileFunction) -> Array:
+        """``evaluate(profile, u, w_n, w_d)`` with each row's notch shape's profile and widths."""
         if len(self.profiles) == 1:
-            return evaluate(self.profiles[0], u, per_row(self.w_n[member], u),
-                            per_row(self.w_d[member], u))
+            return evaluate(self.profiles[0], u, per_row(self.shape_w_n[shape], u),
+                            per_row(self.shape_w_d[shape], u))
         out = np.empty(u.shape)
-        kinds = self.profile_of[member]
+        kinds = self.profile_of[self.shape_member[shape]]
         for k, profile in enumerate(self.profiles):
             rows = kinds == k
             if np.any(rows):
                 u_k = u[rows]
-                out[rows] = evaluate(profile, u_k, per_row(self.w_n[member[rows]], u_k),
-                                     per_row(self.w_d[member[rows]], u_k))
+                out[rows] = evaluate(profile, u_k, per_row(self.shape_w_n[shape[rows]], u_k),
+                                     per_row(self.shape_w_d[shape[rows]], u_k))
         return out
+
+
+def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_tip: Array
+                    ) -> dict[str, Any]:
+    """:class:`Members`' shape, kind and slot arrays of uniform designs, vectorised: one notch
+    shape per member, the kinds BASE, NOTCH, TUBE, TIP."""
+    count = n.size
+    w_n = np.array([d.w_n for d in designs], dtype=float)
+    w_t = np.array([d.w_t for d in designs], dtype=float)
+    every = np.arange(count)
+    notch_i = np.arange(int(n.max()))
+    left = w_base[:, None] + notch_i.astype(float)[None, :] * (w_n + w_t)[:, None]
+    slots = 2 * notch_i.size + 1
+    slot_kind = np.empty((count, slots), np.int64)
+    slot_kind[:, 0] = BASE
+    slot_kind[:, 1::2] = NOTCH
+    slot_kind[:, 2::2] = np.where(notch_i[None, :] == (n - 1)[:, None], TIP, TUBE)
+    return {"shape_member": every, "shape_first": every, "shape_w_n": w_n,
+            "shape_w_d": np.array([d.w_d for d in designs], dtype=float),
+            "kind_length": np.stack([w_base, w_n, np.where(n > 1, w_t, 0.0), w_tip], axis=1),
+            "kind_is_notch": np.broadcast_to(np.arange(4) == NOTCH, (count, 4)),
+            "kind_shape": np.repeat(every[:, None], 4, axis=1), "slot_kind": slot_kind,
+            "notch_left": left, "notch_right": left + w_n[:, None]}
+
+
+def _general_layout(designs: tuple[Design, ...], n: IntArray) -> dict[str, Any]:
+    """:class:`Members`' shape, kind and slot arrays of any designs (see :class:`Members`)."""
+    count, n_max = n.size, int(n.max())
+    shapes: list[tuple[int, float, float]] = []
+    kinds: list[list[tuple[float, bool, int]]] = []
+    slot_kind = np.zeros((count, 2 * n_max + 1), np.int64)
+    left_all = np.empty((count, n_max))
+    right_all = np.empty((count, n_max))
+    first = np.empty(count, np.int64)
+    for m, design in enumerate(designs):
+        first[m] = len(shapes)
+        pairs = list(zip(design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(),
+                         strict=True))
+        distinct = list(dict.fromkeys(pairs))
+        shapes += [(m, w_n, w_d) for w_n, w_d in distinct]
+        gaps = design.per_notch("w_t").tolist()
+        distinct_gaps = list(dict.fromkeys(g for g in gaps if g > 0.0))
+        own: list[tuple[float, bool, int]] = [(design.w_base, False, int(first[m]))]
+        own += [(w_n, True, int(first[m]) + k) for k, (w_n, _) in enumerate(distinct)]
+        own += [(g, False, int(first[m])) for g in distinct_gaps]
+        own.append((design.w_tip, False, int(first[m])))
+        tip_kind = len(own) - 1
+        zero_kind = len(own)
+        own.append((0.0, False, int(first[m])))
+        kinds.append(own)
+        slot_kind[m, 1::2] = zero_kind
+        slot_kind[m, 2::2] = zero_kind
+        for i, pair in enumerate(pairs):
+            slot_kind[m, 2 * i + 1] = 1 + distinct.index(pair)
+            after = tip_kind if i == design.N - 1 else (
+                1 + len(distinct) + distinct_gaps.index(gaps[i]) if gaps[i] > 0.0 else zero_kind)
+            slot_kind[m, 2 * i + 2] = after
+        left, right = design.notch_bounds()
+        left_all[m] = np.concatenate([left, np.full(n_max - left.size, design.length)])
+        right_all[m] = np.concatenate([right, np.full(n_max - right.size, design.length)])
+    k_max = max(len(k) for k in kinds)
+    padded = [k + [k[-1]] * (k_max - len(k)) for k in kinds]
+    return {"shape_member": np.array([s[0] for s in shapes], np.int64), "shape_first": first,
+            "shape_w_n": np.array([s[1] for s in shapes], dtype=float),
+            "shape_w_d": np.array([s[2] for s in shapes], dtype=float),
+            "kind_length": np.array([[k[0] for k in row] for row in padded], dtype=float),
+            "kind_is_notch": np.array([[k[1] for k in row] for row in padded], dtype=bool),
+            "kind_shape": np.array([[k[2] for k in row] for row in padded], np.int64),
+            "slot_kind": slot_kind, "notch_left": left_all, "notch_right": right_all}
 
 
 def per_row(values: NDArray[Any], u: Array) -> NDArray[Any]:
@@ -133,24 +224,27 @@ def per_row(values: NDArray[Any], u: Array) -> NDArray[Any]:
 ProfileFunction = Callable[[NotchProfile, Array, Array, Array], Array]
 
 
-#: Segment kinds: every notch of a design is the same, and so is every tube between notches,
-#: so each member's cells are computed once per kind and copied along the body.
+#: Segment kinds of a uniform member: every notch of it is the same, and so is every tube
+#: between notches, so each member's cells are computed once per kind and copied along the body.
 BASE, NOTCH, TUBE, TIP = range(4)
 
 
 @dataclass(frozen=True)
 class Prototypes:
-    """The cells of each member's four segment kinds, flat, in the segment's own coordinates.
+    """The cells of each member's segment kinds (:class:`Members`), flat, in the segment's own
+    coordinates.
 
-    Per prototype cell (shape (p,)): ``member``, ``is_notch``, ``u_a``/``u_b`` (its ends in
-    ``u``), ``a``/``length`` (its start from the segment start and its length, m),
+    Per prototype cell (shape (p,)): ``member``, ``shape`` (its notch shape, the member's first
+    for a tube: the row of the compliance kernel's parameters), ``is_notch``, ``u_a``/``u_b``
+    (its ends in ``u``), ``a``/``length`` (its start from the segment start and its length, m),
     ``seg_length`` (m) and ``chord`` (the tendon crosses it as a chord); ``seg_start`` is 0.
-    ``first`` (M, 4) is each kind's first prototype cell and ``count`` (M, 4) its cell count
+    ``first`` (M, K) is each kind's first prototype cell and ``count`` (M, K) its cell count
     (0 for an absent segment).
     """
 
     members: Members
     member: IntArray
+    shape: IntArray
     is_notch: BoolArray
     chord: BoolArray
     u_a: Array
@@ -168,16 +262,18 @@ class CellTable:
     """Every member's cells, flat (members one after another, base to tip), SI units.
 
     Per cell (shape (n,)): ``member``, ``prototype`` (its cell in :class:`Prototypes`),
-    ``is_notch``, ``notch_index`` (-1 in tubes), ``seg_start``/``seg_length`` of its segment
-    (m), ``u_a``/``u_b``, ``a`` (its start along s, m), ``constrained`` (the tendon follows the
-    body there) and ``chord_start_node``/``chord_end_node`` (its segment's end nodes, counted
-    within the member). Per member (shape (M,)): ``count`` cells from flat index ``first``;
+    ``shape`` (its notch shape counted within the member, 0 in tubes), ``is_notch``,
+    ``notch_index`` (-1 in tubes), ``seg_start``/``seg_length`` of its segment (m),
+    ``u_a``/``u_b``, ``a`` (its start along s, m), ``constrained`` (the tendon follows the body
+    there) and ``chord_start_node``/``chord_end_node`` (its segment's end nodes, counted within
+    the member). Per member (shape (M,)): ``count`` cells from flat index ``first``;
     ``notch_left_node``/``notch_right_node`` (M, max N), padded with the member's tip node.
     """
 
     prototypes: Prototypes
     member: IntArray
     prototype: IntArray
+    shape: IntArray
     count: IntArray
     first: IntArray
     is_notch: BoolArray
@@ -196,26 +292,26 @@ class CellTable:
 
 def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
                cells_per_tube: int) -> Prototypes:
-    """Cut each member's base, notch, tube and tip into cells (see the module docstring)."""
-    m_count = members.N.size
-    is_notch_kind = np.arange(4) == NOTCH
-    constrained_kind = _constrained_kinds(routing)
+    """Cut each member's segment kinds into cells (see the module docstring)."""
+    m_count, k_count = members.kind_length.shape
+    is_notch_kind = members.kind_is_notch
     per_kind = np.where(is_notch_kind, cells_per_notch, cells_per_tube)
-    seg_length = np.stack([members.w_base, members.w_n, members.w_t, members.w_tip], axis=1)
+    seg_length = members.kind_length
     present = seg_length > 0.0
-    present[:, TUBE] &= members.N > 1
-    breaks = np.zeros((m_count, 4, MAX_CROSSINGS + 2))
+    breaks = np.zeros((m_count, k_count, MAX_CROSSINGS + 2))
     breaks[..., -1] = 1.0
     if kind == "adaptive":
-        breaks[:, NOTCH, 1:-1] = np.sort(crossings(members), axis=1)
+        notch_kind = np.nonzero(is_notch_kind)
+        breaks[notch_kind[0], notch_kind[1], 1:-1] = np.sort(
+            resolved(crossings(members))[members.kind_shape[notch_kind]], axis=1)
     width = np.diff(breaks, axis=-1)
-    counts = np.where(width > 0.0, np.maximum(1, np.rint(per_kind[None, :, None] * width)), 0)
+    counts = np.where(width > 0.0, np.maximum(1, np.rint(per_kind[..., None] * width)), 0)
     counts = (counts * present[..., None]).astype(np.int64)
 
     flat_counts = counts.ravel()
     piece = np.repeat(np.arange(flat_counts.size), flat_counts)
-    member = piece // (4 * (MAX_CROSSINGS + 1))
-    seg_kind = (piece // (MAX_CROSSINGS + 1)) % 4
+    member = piece // (k_count * (MAX_CROSSINGS + 1))
+    seg_kind = (piece // (MAX_CROSSINGS + 1)) % k_count
     j = (np.arange(piece.size) - (np.cumsum(flat_counts) - flat_counts)[piece]).astype(float)
     n_piece = flat_counts[piece]
     step = 1.0 / n_piece
@@ -223,17 +319,18 @@ def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
     u1 = breaks[..., 1:].ravel()[piece]
     u_a = u0 + (u1 - u0) * (j * step)
     u_b = np.where(j + 1.0 == n_piece, u1, u0 + (u1 - u0) * ((j + 1.0) * step))
-    is_notch = is_notch_kind[seg_kind]
+    is_notch = is_notch_kind[member, seg_kind]
+    shape = members.kind_shape[member, seg_kind]
     length_of_segment = seg_length[member, seg_kind]
-    a = np.where(is_notch, members.sigma(member, u_a), length_of_segment * u_a)
-    b = np.where(is_notch, members.sigma(member, u_b), length_of_segment * u_b)
+    a = np.where(is_notch, members.sigma(shape, u_a), length_of_segment * u_a)
+    b = np.where(is_notch, members.sigma(shape, u_b), length_of_segment * u_b)
     b = np.where(u_b == 1.0, length_of_segment, b)
     kind_counts = counts.sum(axis=-1)
-    return Prototypes(members=members, member=member, is_notch=is_notch,
-                      chord=~constrained_kind[seg_kind], u_a=u_a, u_b=u_b, a=a,
+    return Prototypes(members=members, member=member, shape=shape, is_notch=is_notch,
+                      chord=is_notch != _tendon_follows_notches(routing), u_a=u_a, u_b=u_b, a=a,
                       length=b - a, seg_length=length_of_segment, seg_start=np.zeros(a.size),
                       first=(np.cumsum(kind_counts.ravel()) - kind_counts.ravel()
-                             ).reshape(m_count, 4),
+                             ).reshape(m_count, k_count),
                       count=kind_counts)
 
 
@@ -244,19 +341,12 @@ def cell_table(proto: Prototypes, routing: str) -> CellTable:
     n_max = int(members.N.max())
     slots = 2 * n_max + 1  # base, then (notch i, tube after notch i) for every i
     notch_i = np.arange(n_max)
-    left = members.w_base[:, None] + notch_i.astype(float)[None, :] * (
-        members.w_n + members.w_t)[:, None]
-    right = left + members.w_n[:, None]
     has = notch_i[None, :] < members.N[:, None]
-    last = notch_i[None, :] == (members.N - 1)[:, None]
     start = np.empty((m_count, slots))
     start[:, 0] = 0.0
-    start[:, 1::2] = left
-    start[:, 2::2] = right
-    slot_kind = np.empty((m_count, slots), np.int64)
-    slot_kind[:, 0] = BASE
-    slot_kind[:, 1::2] = NOTCH
-    slot_kind[:, 2::2] = np.where(last, TIP, TUBE)
+    start[:, 1::2] = members.notch_left
+    start[:, 2::2] = members.notch_right
+    slot_kind = members.slot_kind
     rows = np.arange(m_count)[:, None]
     seg_counts = proto.count[rows, slot_kind]
     seg_counts[:, 1:] *= np.repeat(has, 2, axis=1)
@@ -270,43 +360,59 @@ def cell_table(proto: Prototypes, routing: str) -> CellTable:
     prototype = proto.first[member, kind] + j
     count = seg_counts.sum(axis=1)
     seg_first = np.cumsum(seg_counts, axis=1) - seg_counts
-    is_notch = kind == NOTCH
+    is_notch = members.kind_is_notch[member, kind]
     seg_start = start[member, slot]
     chord_start = seg_first[member, slot]
     tip = count[:, None]
     return CellTable(
-        prototypes=proto, member=member, prototype=prototype, count=count,
-        first=np.cumsum(count) - count, is_notch=is_notch,
+        prototypes=proto, member=member, prototype=prototype,
+        shape=np.where(is_notch, proto.shape[prototype] - members.shape_first[member], 0),
+        count=count, first=np.cumsum(count) - count, is_notch=is_notch,
         notch_index=np.where(is_notch, (slot - 1) // 2, -1), seg_start=seg_start,
         seg_length=proto.seg_length[prototype], u_a=proto.u_a[prototype],
         u_b=proto.u_b[prototype], a=np.where(j == 0, seg_start, seg_start + proto.a[prototype]),
-        constrained=_constrained_kinds(routing)[kind], chord_start_node=chord_start,
+        constrained=is_notch == _tendon_follows_notches(routing), chord_start_node=chord_start,
         chord_end_node=chord_start + seg_counts[member, slot],
         notch_left_node=np.where(has, seg_first[:, 1::2], tip),
         notch_right_node=np.where(has, seg_first[:, 1::2] + seg_counts[:, 1::2], tip))
 
 
-def _constrained_kinds(routing: str) -> BoolArray:
-    """Which segment kinds the tendon follows (``paper``: notches; ``free``: tubes)."""
-    notch = np.arange(4) == NOTCH
-    return notch if routing == "paper" else ~notch
+def _tendon_follows_notches(routing: str) -> bool:
+    """Whether the tendon follows the body in notches (``paper``) or in tubes (``free``)."""
+    return routing == "paper"
 
 
 def crossings(members: Members) -> Array:
-    """Where each member's notch profile crosses ``r_inner`` and ``R_outer``, as ``u`` in (0, 1);
-    shape (M, MAX_CROSSINGS), 0 where a crossing does not exist."""
-    out = np.zeros((members.N.size, MAX_CROSSINGS))
+    """Where each notch shape's profile crosses ``r_inner`` and ``R_outer``, as ``u`` in (0, 1);
+    shape (S, MAX_CROSSINGS), 0 where a crossing does not exist."""
+    out = np.zeros((members.shape_member.size, MAX_CROSSINGS))
+    shape_profile = members.profile_of[members.shape_member]
     for k, profile in enumerate(members.profiles):
-        rows = np.flatnonzero(members.profile_of == k)
+        rows = np.flatnonzero(shape_profile == k)
         if isinstance(profile, RectangularProfile):
             continue
-        for c, level in enumerate((members.r_inner[rows], members.R_outer[rows])):
+        owner = members.shape_member[rows]
+        for c, level in enumerate((members.r_inner[owner], members.R_outer[owner])):
             if isinstance(profile, CircularProfile):
-                lo, hi = _circular_crossings(members.w_n[rows], members.w_d[rows], level)
+                lo, hi = _circular_crossings(members.shape_w_n[rows], members.shape_w_d[rows],
+                                             level)
             else:
                 lo, hi = _searched_crossings(members, rows, level)
             out[rows, 2 * c] = lo
             out[rows, 2 * c + 1] = hi
+    return out
+
+
+def resolved(found: Array) -> Array:
+    """``found`` (:func:`crossings`) without the crossings no cell can resolve: one within
+    ``MIN_PIECE_U`` of a notch end (its piece would have no length in s: ``h1`` meets the level
+    at the notch's edge, a rounding error from it) and a pair closer than that to each other
+    (the profile touches the level); 0 marks them absent."""
+    out = np.where((found > MIN_PIECE_U) & (found < 1.0 - MIN_PIECE_U), found, 0.0)
+    for first in (0, 2):  # (r_inner pair, R_outer pair)
+        lo, hi = out[:, first], out[:, first + 1]
+        touching = (lo > 0.0) & (hi > 0.0) & (hi - lo < MIN_PIECE_U)
+        out[touching, first:first + 2] = 0.0
     return out
 
 
@@ -319,7 +425,8 @@ def _circular_crossings(w_n: Array, w_d: Array, level: Array) -> tuple[Array, Ar
 
 
 def _searched_crossings(members: Members, rows: IntArray, level: Array) -> tuple[Array, Array]:
-    """First and last sign change of ``h1 - level`` on ``CROSSING_SAMPLES`` samples, bisected."""
+    """First and last sign change of ``h1 - level`` on ``CROSSING_SAMPLES`` samples, bisected;
+    ``rows`` are notch shapes."""
     u = np.broadcast_to(np.linspace(0.0, 1.0, CROSSING_SAMPLES), (rows.size, CROSSING_SAMPLES))
     above = members.h1(rows, np.ascontiguousarray(u)) > level[:, None]
     change = above[:, 1:] != above[:, :-1]
@@ -345,37 +452,41 @@ def _searched_crossings(members: Members, rows: IntArray, level: Array) -> tuple
 def _check_custom_profile(design: Design) -> None:
     """Raise :class:`InvalidDesignError` unless a user profile gives finite ``h1 > 0`` (m)."""
     u = np.linspace(0.0, 1.0, 65)
-    try:
-        h1 = design.profile.h1(u, design.w_n, design.w_d)
-    except Exception as exc:  # a user callable may raise anything: report it as bad input
-        raise InvalidDesignError(f"h1(s) raised {exc!r}", parameter="h1(s)", value=None,
-                                 allowed="a function of sigma in [0, w_n] m") from exc
-    if h1.shape != u.shape or not np.all(np.isfinite(h1)) or np.any(h1 <= 0.0):
-        bad = h1[~(np.isfinite(h1) & (h1 > 0.0))] if h1.shape == u.shape else h1
-        raise InvalidDesignError(
-            f"h1(s) must be finite and > 0 m across the notch, got {np.ravel(bad)[:3]!r}",
-            parameter="h1(s)", value=np.ravel(bad)[:3].tolist(), allowed="(0, inf) m")
+    pairs = zip(design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(), strict=True)
+    for w_n, w_d in dict.fromkeys(pairs):
+        try:
+            h1 = design.profile.h1(u, w_n, w_d)
+        except Exception as exc:  # a user callable may raise anything: report it as bad input
+            raise InvalidDesignError(f"h1(s) raised {exc!r}", parameter="h1(s)", value=None,
+                                     allowed="a function of sigma in [0, w_n] m") from exc
+        if h1.shape != u.shape or not np.all(np.isfinite(h1)) or np.any(h1 <= 0.0):
+            bad = h1[~(np.isfinite(h1) & (h1 > 0.0))] if h1.shape == u.shape else h1
+            raise InvalidDesignError(
+                f"h1(s) must be finite and > 0 m across the notch, got {np.ravel(bad)[:3]!r}",
+                parameter="h1(s)", value=np.ravel(bad)[:3].tolist(), allowed="(0, inf) m")
 
 
 def _check_rigidity(members: Members) -> None:
-    """Raise :class:`InvalidDesignError` unless every member's flexural rigidity ``E I``
-    (N m^2) is at least the smallest normal double at ``PEAK_SAMPLES`` stations of a notch and
-    in the tubes, so the compliance ``1/(E I)`` is finite (a backbone or wall thinner than
+    """Raise :class:`InvalidDesignError` unless every notch shape's flexural rigidity ``E I``
+    (N m^2) is at least the smallest normal double at ``PEAK_SAMPLES`` stations of the notch
+    and in the tubes, so the compliance ``1/(E I)`` is finite (a backbone or wall thinner than
     floating point resolves)."""
-    every = np.arange(members.N.size)
+    every = np.arange(members.shape_member.size)
+    owner = members.shape_member
     u = np.broadcast_to(np.linspace(0.0, 1.0, PEAK_SAMPLES), (every.size, PEAK_SAMPLES))
     h1 = members.h1(every, np.ascontiguousarray(u))
-    inertia = notched_moment(h1, members.R_outer[:, None], members.r_inner[:, None])
-    rigidity = members.E[:, None] * np.concatenate([inertia, members.tube_moment[:, None]],
-                                                   axis=1)
+    inertia = notched_moment(h1, members.R_outer[owner, None], members.r_inner[owner, None])
+    rigidity = members.E[owner, None] * np.concatenate(
+        [inertia, members.tube_moment[owner, None]], axis=1)
     floor = float(np.finfo(float).tiny)
     ok = np.all(rigidity >= floor, axis=1)
     if not np.all(ok):
-        m = int(np.argmin(ok))
-        design = members.designs[m]
-        least = float(np.min(rigidity[m]))
+        shape = int(np.argmin(ok))
+        design = members.designs[int(owner[shape])]
+        least = float(np.min(rigidity[shape]))
         raise InvalidDesignError(
-            f"E*I = {least:.3g} N m^2 (E = {design.E:g} Pa, w_d = {design.w_d:g} m, R_outer = "
+            f"E*I = {least:.3g} N m^2 (E = {design.E:g} Pa, w_d = "
+            f"{members.shape_w_d[shape]:g} m, R_outer = "
             f"{design.R_outer:g} m, r_inner = {design.r_inner:g} m) is out of range; allowed: "
             f"[{floor:.3g}, inf) N m^2, so that 1/(E I) is finite",
             parameter="E*I", value=least, allowed=f"[{floor:.3g}, inf) N m^2")

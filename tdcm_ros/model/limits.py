@@ -104,17 +104,31 @@ def check_closure(grid: Grid, shape: PlanarShape, tension: float) -> None:
 
 
 @lru_cache(maxsize=64)
-def closure_angle(grid: Grid) -> float:
-    """Bend angle (rad) across a notch at which its faces touch (:func:`notch_gaps` = 0) under
-    a moment uniform over the notch; ``inf`` if they do not touch below pi. All notches of a
-    design share it. For a uniform-curvature notch it is ``w_n / R_outer`` exactly."""
-    cells = np.flatnonzero(grid.notch_index == 0)
+def closure_angles(grid: Grid) -> Array:
+    """Bend angle (rad) across each notch, base to tip, at which its faces touch
+    (:func:`notch_gaps` = 0) under a moment uniform over the notch; ``inf`` if they do not
+    touch below pi. Notches of the same shape share it (found once per shape). For a
+    uniform-curvature notch it is ``w_n / R_outer`` exactly. The array is shared: do not
+    modify it."""
+    notch = grid.notch_index
+    first_of_shape: dict[int, int] = {}
+    for k in range(grid.notch_left_node.size):
+        first_of_shape.setdefault(int(grid.shape[grid.notch_left_node[k]]), k)
+    angles = {shape: _closure_angle(grid, k, np.flatnonzero(notch == k))
+              for shape, k in first_of_shape.items()}
+    out = np.array([angles[int(grid.shape[node])] for node in grid.notch_left_node])
+    out.setflags(write=False)
+    return out
+
+
+def _closure_angle(grid: Grid, k: int, cells: NDArray[np.int64]) -> float:
+    """:func:`closure_angles` of notch ``k`` (0-based), whose cells are ``cells``."""
     per_moment = float(np.sum(grid.C0[cells] + grid.C1[cells]))
 
     def gap(angle: float) -> float:
         moment = np.zeros(grid.n_cells)
         moment[cells] = angle / per_moment
-        return float(notch_gaps(grid, integrate(grid, moment, moment))[0])
+        return float(notch_gaps(grid, integrate(grid, moment, moment))[k])
 
     low, high = 0.0, math.pi * (1.0 - 1e-9)
     if gap(high) > 0.0:

@@ -25,7 +25,7 @@ the moment of the external loads on the body beyond each cut, in frame ``tdcm_ba
   the tendon (the quadratic part of a distributed load is a discretisation error that
   shrinks with the cell length).
 - **Notch contact** (:class:`NotchContact`): once a notch's bend angle passes its closure angle
-  (:func:`tdcm_ros.model.limits.closure_angle`), the extra bend is resisted by
+  (:func:`tdcm_ros.model.limits.closure_angles`), the extra bend is resisted by
   ``stiffness_factor * E * I0`` instead of the notch's own compliance. The body's statics still
   use the actual moments; the notch's kinematics use them scaled by the per-notch factor
   ``(phi_c + rho (phi - phi_c)) / phi`` (``rho`` = notch compliance ratio closed/open).
@@ -49,7 +49,7 @@ from tdcm_ros.model import loads
 from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
-from tdcm_ros.model.limits import check_closure, check_singularity, closure_angle
+from tdcm_ros.model.limits import check_closure, check_singularity, closure_angles
 from tdcm_ros.model.moment_model import PlainRun, Plan
 from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.section import notched_area, tube_area
@@ -195,7 +195,7 @@ def _body_cells(grid: Grid) -> _BodyCells:
     d = grid.design
     span = (grid.u_b - grid.u_a)[:, None]
     u_q = grid.u_a[:, None] + span * grid.gauss_u[None, :]
-    h1 = d.profile.h1(u_q, d.w_n, d.w_d)
+    h1 = grid.members.h1(grid.shape, u_q)
     area = np.where(grid.is_notch[:, None], notched_area(h1, d.R_outer, d.r_inner),
                     tube_area(d.R_outer, d.r_inner))
     weights = grid.w_q * area
@@ -206,10 +206,11 @@ def _body_cells(grid: Grid) -> _BodyCells:
 
 @dataclass(frozen=True, eq=False)
 class _Contact:
-    """Per-grid constants of notch contact."""
+    """Per-grid constants of notch contact: per notch (base to tip) the closure angle (rad)
+    and the closed-to-open compliance ratio; the notch cells and their notch indices."""
 
-    angle: float
-    ratio: float
+    angle: Array
+    ratio: Array
     cells: NDArray[np.int64]
     notch: NDArray[np.int64]
 
@@ -217,17 +218,21 @@ class _Contact:
 def _contact(grid: Grid, contact: NotchContact) -> _Contact:
     d = grid.design
     cells = np.flatnonzero(grid.is_notch)
-    open_compliance = float(np.sum(grid.C0[cells] + grid.C1[cells])) / d.N
-    closed_compliance = d.w_n / (contact.stiffness_factor * d.E * d.tube_second_moment)
+    notch = grid.notch_index[cells]
+    w_n = d.per_notch("w_n")
+    if d.is_uniform:
+        open_compliance = np.full(d.N, float(np.sum(grid.C0[cells] + grid.C1[cells])) / d.N)
+    else:
+        open_compliance = np.bincount(notch, grid.C0[cells] + grid.C1[cells], minlength=d.N)
+    closed_compliance = w_n / (contact.stiffness_factor * d.E * d.tube_second_moment)
     ratio = closed_compliance / open_compliance
-    if ratio > 1.0:
-        least = d.w_n / (open_compliance * d.E * d.tube_second_moment)
+    if np.any(ratio > 1.0):
+        least = float(np.max(w_n / (open_compliance * d.E * d.tube_second_moment)))
         raise out_of_range("notch_contact.stiffness_factor", contact.stiffness_factor,
                            f"[{least:.3g}, {MAX_STIFFNESS_FACTOR:g}] for this design (a closed "
                            "notch must not be softer than an open one)",
                            error=InvalidLoadingError)
-    return _Contact(angle=closure_angle(grid), ratio=ratio, cells=cells,
-                    notch=grid.notch_index[cells])
+    return _Contact(angle=closure_angles(grid), ratio=ratio, cells=cells, notch=notch)
 
 
 class LoadedModel:
@@ -308,15 +313,15 @@ class LoadedModel:
         n = self.grid.n_cells
         scale = np.ones(n)
         contact = self._contact
-        if contact is None or not math.isfinite(contact.angle):
+        if contact is None or not np.any(np.isfinite(contact.angle)):
             return scale
         cells = contact.cells
         cell_angle = x[cells] * self.grid.C0[cells] + x[n + cells] * self.grid.C1[cells]
         angle = np.abs(np.bincount(contact.notch, cell_angle, minlength=self.grid.design.N))
         closed = angle > contact.angle
         factor = np.ones_like(angle)
-        factor[closed] = (contact.angle + contact.ratio * (angle[closed] - contact.angle)
-                          ) / angle[closed]
+        stop = contact.angle[closed]
+        factor[closed] = (stop + contact.ratio[closed] * (angle[closed] - stop)) / angle[closed]
         scale[cells] = factor[contact.notch]
         return scale
 

@@ -14,7 +14,7 @@ from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape, quaternions_y
-from tdcm_ros.model.limits import closure_angle, notch_gaps
+from tdcm_ros.model.limits import closure_angles, notch_gaps
 from tdcm_ros.model.settings import SolverSettings
 
 if TYPE_CHECKING:
@@ -103,9 +103,9 @@ class SolveResult:
     def notch_stop_margins_rad(self) -> Array:
         """Bend each notch has left before its faces touch (rad), base to tip: the closure
         angle under a moment uniform across the notch
-        (:func:`~tdcm_ros.model.limits.closure_angle`, ``w_n / R_outer`` for a uniform
+        (:func:`~tdcm_ros.model.limits.closure_angles`, ``w_n / R_outer`` for a uniform
         curvature) less :attr:`notch_angles_rad`."""
-        return closure_angle(self.grid) - self.notch_angles_rad
+        return closure_angles(self.grid) - self.notch_angles_rad
 
     @property
     def notch_peak_strains(self) -> Array:

@@ -56,6 +56,7 @@ from tdcm_ros.model import (
     Design,
     InvalidRollError,
     named_design,
+    parameter_specs,
 )
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.runtime import (
@@ -119,7 +120,7 @@ def declare_design_and_layout(port: NodePort) -> tuple[Design, MarkerLayout]:
     start = declare_specs(port, PRESET_SPECS, read_only=True)
     base = named_design(str(start["design.file"]) or str(start["design.preset"]))
     design = base.with_overrides(**declare_specs(
-        port, PARAMETER_SPECS, prefix="design.", defaults=base.to_dict(), read_only=True))
+        port, parameter_specs(base), prefix="design.", defaults=base.to_dict(), read_only=True))
     given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}
     fields = declare_specs(port, given, prefix="markers.", read_only=True)
     # a ROS parameter has a value: the default offset is the surface's, of the values above

@@ -54,6 +54,7 @@ from tdcm_ros.model import (
     SolveResult,
     SolverSettings,
     named_design,
+    parameter_specs,
     solve,
     warm_up,
 )
@@ -157,7 +158,8 @@ class ModelNode(NodeLogic):
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
         self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
-        declare_specs(port, PARAMETER_SPECS, prefix="design.", defaults=self.base.to_dict())
+        self.design_specs = parameter_specs(self.base)
+        declare_specs(port, self.design_specs, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
         declare_specs(port, TUNABLE_SPECS)
         period = float(fixed["process_period_s"])
@@ -196,7 +198,7 @@ class ModelNode(NodeLogic):
 
     def _config(self, changes: Mapping[str, Any]) -> tuple[Design, SolverSettings]:
         """Design and settings from the current parameters with ``changes`` applied."""
-        design = self.base.with_overrides(**read_specs(self.port, PARAMETER_SPECS, prefix="design.",
+        design = self.base.with_overrides(**read_specs(self.port, self.design_specs, prefix="design.",
                                                   changes=changes))
         settings = SolverSettings(**read_specs(self.port, SOLVER_SPECS, prefix="solver.",
                                                changes=changes))

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tdcm_ros.model import (
     PRESETS,
@@ -126,18 +128,47 @@ BAND = {"notch": {"width": 2.0e-3, "band": 1.4e-3}}
 
 
 @pytest.mark.parametrize(("segments", "where"), [
-    ([{"tube": 5e-3}, BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "band": 1.2e-3}}],
-     r"segments\[3\]\.notch\.band: band 0\.0012 where segments\[1\]\.notch has 0\.0014"),
-    ([{"tube": 5e-3}, BAND, {"tube": 4e-3}, BAND, {"tube": 3e-3}, BAND, {"tube": 4e-3}],
-     r"segments\[4\]\.tube: tube 0\.003 m where segments\[2\]\.tube has 0\.004 m"),
     ([BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 1.0e-3}}],
      r"segments\[2\]\.notch: a cut section"),
+    ([BAND, {"notch": {"width": 2.0e-3, "band": 1.4e-3, "profile": "rectangular"}}],
+     (r"segments\[1\]\.notch\.profile: profile 'rectangular' where segments\[0\]\.notch "
+      r"has 'circular'")),
 ])
 def test_bodies_the_solver_cannot_take_yet_name_the_first_segment_that_differs(
         segments: list[object], where: str) -> None:
     data = with_changes(segments=segments)
     with pytest.raises(InvalidDesignError, match=where + ".*not solvable yet"):
         body_from_mapping(data, "body.yaml").design()
+
+
+def test_notches_that_differ_are_read_per_notch_with_the_tubes_between_them() -> None:
+    data = with_changes(segments=[
+        {"tube": 5e-3}, BAND, {"tube": 4e-3}, {"notch": {"width": 2.5e-3, "band": 1.2e-3}},
+        {"notch": {"width": 2.0e-3, "band": 1.0e-3}}, {"tube": 1e-3}, {"tube": 2e-3}, BAND,
+        {"tube": 4e-3}])
+    design = body_from_mapping(data, "body.yaml").design()
+    assert (design.N, design.w_base, design.w_tip) == (4, 5e-3, 4e-3)
+    assert design.w_n == (2.0e-3, 2.5e-3, 2.0e-3, 2.0e-3)
+    assert design.w_d == (1.4e-3, 1.2e-3, 1.0e-3, 1.4e-3)
+    assert design.w_t == (4e-3, 0.0, 1e-3 + 2e-3)   # adjacent notches: no tube; tubes joined
+    left, right = design.notch_bounds()
+    assert left.tolist() == pytest.approx([5e-3, 11e-3, 13.5e-3, 18.5e-3], abs=1e-15)
+    assert design.length == pytest.approx(right[-1] + 4e-3, abs=1e-15)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(1, 6).flatmap(lambda n: st.tuples(
+    st.lists(st.sampled_from([1.0e-3, 1.5e-3, 2.0e-3]), min_size=n, max_size=n),
+    st.lists(st.sampled_from([0.8e-3, 1.1e-3, 1.4e-3]), min_size=n, max_size=n),
+    st.lists(st.sampled_from([0.0, 2.0e-3, 4.0e-3]), min_size=n - 1, max_size=n - 1),
+    st.sampled_from([0.0, 3.0e-3]), st.sampled_from(["circular", "rectangular"]))))
+def test_a_per_notch_design_round_trips_through_its_body_file(case: tuple) -> None:
+    widths, bands, gaps, ends, profile = case
+    design = preset("paper-experiment").with_overrides(
+        N=len(widths), w_n=widths, w_d=bands, w_t=gaps, w_base=ends, w_tip=ends,
+        profile=profile)
+    text = body_file_text(design)
+    assert body_from_mapping(load_yaml(text, "body"), "body").design() == design
 
 
 def test_solve_takes_a_body_file_and_its_routing(tmp_path: Path) -> None:
@@ -159,3 +190,11 @@ def test_solve_takes_a_body_file_and_its_routing(tmp_path: Path) -> None:
     refused = tdcm("solve", "--design", str(bad), "--tension", "20")
     assert refused.returncode == 2
     assert f"{bad}: tube.R_outer = -1 is out of range" in refused.stderr
+
+
+def test_the_shipped_variable_depth_wrist_bends_its_tip_first() -> None:
+    design = read_body_file(REPO / "config" / "bodies" / "variable_depth.yaml").design()
+    assert design == preset("paper-experiment").with_overrides(
+        r_inner=1.55e-3, w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3, 1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3])
+    angles = solve(design, 10.0).notch_angles_rad
+    assert np.all(np.diff(angles) > 0.0) and angles[-1] > 4.0 * angles[0]

@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from tdcm_ros.errors import InputError
@@ -12,7 +13,9 @@ from tdcm_ros.model import (
     InvalidSettingsError,
     SolverSettings,
     preset,
+    solve,
 )
+from tdcm_ros.model.design import parse_field
 
 
 def test_presets_match_the_paper():
@@ -90,3 +93,45 @@ def test_cross_field_limits_name_the_field_value_and_range(field, value, allowed
 def test_segments_at_their_floor_or_absent_are_valid():
     design = preset("paper-experiment").with_overrides(w_base=0.0, w_t=1e-6, w_tip=0.0, w_n=1e-6)
     assert design.length == pytest.approx(8e-6 + 7e-6)
+
+
+def test_a_list_of_equal_values_is_the_uniform_design_bit_for_bit():
+    design = preset("paper-experiment")
+    listed = design.with_overrides(w_n=[design.w_n] * 8, w_d=(design.w_d,) * 8,
+                                   w_t=np.full(7, design.w_t))
+    assert listed == design and hash(listed) == hash(design) and listed.is_uniform
+    assert np.array_equal(solve(listed, 20.0).positions, solve(design, 20.0).positions)
+
+
+def test_per_notch_values_give_each_notch_its_bounds_and_the_length():
+    design = preset("paper-experiment").with_overrides(
+        N=3, w_n=[1e-3, 2e-3, 3e-3], w_d=[1.4e-3, 1.2e-3, 1.0e-3], w_t=[0.0, 4e-3])
+    left, right = design.notch_bounds()
+    assert not design.is_uniform
+    assert left.tolist() == pytest.approx([5e-3, 6e-3, 12e-3], abs=1e-15)
+    assert right[0] == left[1]   # no tube between: the next notch starts where this one ends
+    assert design.length == pytest.approx(5e-3 + 6e-3 + 4e-3 + 4e-3, abs=1e-15)
+    assert design.per_notch("w_d").tolist() == [1.4e-3, 1.2e-3, 1.0e-3]
+    assert design.to_dict()["w_n"] == [1e-3, 2e-3, 3e-3]
+
+
+@pytest.mark.parametrize(("overrides", "message"), [
+    ({"w_n": [1e-3, 2e-3]}, (r"w_n = \[0.001, 0.002\] is out of range; allowed: one number, or "
+                            r"8 numbers \(one per notch: N = 8\)")),
+    ({"w_t": [4e-3] * 8}, (r"w_t = .* allowed: one number, or 7 numbers \(one per gap between "
+                          r"notches: N = 8\)")),
+    ({"w_d": [1e-3] * 7 + [9e-3]}, r"w_d\[7\] = 0.009 is out of range; allowed: \(0, 2 R_outer"),
+    ({"w_t": [4e-3] * 6 + [1e-7]}, r"w_t\[6\] = 1e-07 is out of range; allowed: 0 \(no segment\)"),
+    ({"w_n": [2e-3] * 7 + [float("nan")]}, r"w_n = .*nan.* is out of range"),
+    ({"w_n": [2e-3] * 7 + ["x"]}, r"w_n = 'x' is not a number; allowed: a list of numbers"),
+])
+def test_bad_per_notch_values_name_the_field_the_notch_and_the_range(overrides, message):
+    with pytest.raises(InvalidDesignError, match=message):
+        preset("paper-experiment").with_overrides(**overrides)
+
+
+def test_a_per_notch_override_is_parsed_from_a_bracketed_list():
+    assert parse_field("w_d", "[0.0014, 0.0012]") == (0.0014, 0.0012)
+    assert parse_field("w_d", "0.0014") == 0.0014
+    with pytest.raises(InvalidDesignError, match="w_d"):
+        parse_field("w_d", "[0.0014, wide]")

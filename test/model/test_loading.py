@@ -21,7 +21,7 @@ from tdcm_ros.model import (
 )
 from tdcm_ros.model.grid import build_grid
 from tdcm_ros.model.kinematics import integrate
-from tdcm_ros.model.limits import closure_angle
+from tdcm_ros.model.limits import closure_angles
 from tdcm_ros.model.loading import (
     Capstan,
     InvalidLoadingError,
@@ -361,7 +361,7 @@ def test_contact_stiffens_a_closing_notch(routing):
     result = solve(design, 40.0, settings=cfg, loading=Loading(notch_contact=NotchContact()))
     grid = result.grid
     angles = result.theta[grid.notch_right_node] - result.theta[grid.notch_left_node]
-    closure = closure_angle(grid)
+    closure = closure_angles(grid)[0]
     assert result.converged and result.closed_notches
     assert np.all(angles >= 0.0)
     # Past closure each notch bends only as much as the tube's stiffness allows: a few % over.
@@ -377,7 +377,16 @@ def test_contact_stiffens_a_closing_notch(routing):
 def test_closure_angle_of_a_uniform_notch():
     design = closing_design()
     grid = build_grid(design, SolverSettings())
-    assert closure_angle(grid) == pytest.approx(design.w_n / design.R_outer, rel=1e-9)
+    assert closure_angles(grid)[0] == pytest.approx(design.w_n / design.R_outer, rel=1e-9)
+
+
+def test_each_notch_closes_at_its_own_width_over_the_radius():
+    # a rectangular notch bends at uniform curvature: its faces meet at w_n / R_outer (rad)
+    widths = [0.5e-3, 1.0e-3, 0.5e-3, 1.5e-3]
+    design = closing_design().with_overrides(N=4, w_n=widths, w_t=[4e-3, 0.0, 2e-3],
+                                             w_d=[1.4e-3, 1.0e-3, 1.4e-3, 1.2e-3])
+    closure = closure_angles(build_grid(design, SolverSettings()))
+    np.testing.assert_allclose(closure, np.array(widths) / design.R_outer, rtol=1e-9)
 
 
 @pytest.mark.parametrize("stiffness", [1.0, 0.2])
@@ -401,7 +410,7 @@ def test_contact_with_a_tip_force_closes_base_notches_first(stiffness):
     grid = result.grid
     angles = result.theta[grid.notch_right_node] - result.theta[grid.notch_left_node]
     assert np.all(np.diff(angles) < 0.0)
-    assert closure_angle(grid) < angles[0] <= 1.05 * closure_angle(grid)
+    assert closure_angles(grid)[0] < angles[0] <= 1.05 * closure_angles(grid)[0]
 
 
 # --- bad input -------------------------------------------------------------------------------

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tdcm_ros.bagio import from_dict
-from tdcm_ros.model import InvalidDesignError, body_file_text, preset
+from tdcm_ros.model import InvalidDesignError, body_file_text, preset, solve
 from tdcm_ros.nodes.metrics_node import declare_design_and_layout
 from tdcm_ros.nodes.model_node import ModelNode
 from tdcm_ros.runtime.memory_port import MemoryPort
@@ -76,3 +76,24 @@ def test_the_profile_is_a_parameter_as_the_body_file_gives_it(tmp_path: Path) ->
     assert port.store.set({"design.profile": "rectangular"}).successful
     assert node.design.profile.name == "rectangular"
     assert not port.store.set({"design.profile": "oval"}).successful
+
+
+def test_a_per_notch_body_file_reaches_both_nodes_and_its_lists_are_not_parameters(
+        tmp_path: Path) -> None:
+    design = preset("paper-experiment").with_overrides(
+        w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3, 1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3])
+    body = tmp_path / "graded.yaml"
+    body.write_text(body_file_text(design), encoding="utf-8")
+    midline = midline_at({"design.file": str(body)}, 12.0)
+    expected = solve(design, 12.0).pose_at(np.linspace(0.0, design.length, midline.shape[0]))[0]
+    assert midline[-1] == pytest.approx(expected[-1, [0, 2]], abs=1e-12)   # the tip
+    port = MemoryPort({"design.file": str(body)}, name="model_node")
+    node = ModelNode(port)
+    assert node.design == design
+    names = set(port.store.specs)
+    assert {"design.E", "design.w_n", "design.w_t"} <= names and "design.w_d" not in names
+    assert port.store.set({"design.E": 2.0e9}).successful   # a uniform field is still a parameter
+    assert node.design.w_d == design.w_d and node.design.E == 2.0e9
+    metrics_design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
+                                                             name="metrics_node"))
+    assert metrics_design == design

@@ -53,6 +53,8 @@ Array = NDArray[np.float64]
 OdeMethod = Literal["RK45", "DOP853", "RK23", "LSODA", "Radau", "BDF"]
 ODE_METHODS: tuple[OdeMethod, ...] = get_args(OdeMethod)
 VARIANTS = ("whole", "segmented")
+#: Breakpoints closer than this fraction of the length are one.
+SAME_MARK = 1e-12
 
 
 @dataclass(frozen=True)
@@ -103,6 +105,8 @@ class _Rod:
         left, right = design.notch_bounds()
         self.left = left.tolist()
         self.right = right.tolist()
+        self.w_n = design.per_notch("w_n").tolist()
+        self.w_d = design.per_notch("w_d").tolist()
         self.tube_c = 1.0 / (design.E * design.tube_second_moment)
         self.kind = design.profile.name
 
@@ -113,12 +117,13 @@ class _Rod:
             return self.tube_c
         d = self.design
         sigma = s - self.left[i]
+        w_n, w_d = self.w_n[i], self.w_d[i]
         if self.kind == "circular":
-            h1 = 0.5 * (d.w_n + d.w_d) - math.sqrt(max(sigma * (d.w_n - sigma), 0.0))
+            h1 = 0.5 * (w_n + w_d) - math.sqrt(max(sigma * (w_n - sigma), 0.0))
         elif self.kind == "rectangular":
-            h1 = 0.5 * d.w_d
+            h1 = 0.5 * w_d
         else:
-            h1_arr = d.profile.h1(np.array([sigma / d.w_n]), d.w_n, d.w_d)
+            h1_arr = d.profile.h1(np.array([sigma / w_n]), w_n, w_d)
             return float(1.0 / (d.E * notched_moment(h1_arr, d.R_outer, d.r_inner)[0]))
         inertia = 4.0 * (_strip(h1, d.R_outer) - _strip(min(h1, d.r_inner), d.r_inner))
         return 1.0 / (d.E * inertia)
@@ -140,6 +145,10 @@ def _breakpoints(design: Design, variant: str) -> list[float]:
         return [0.0, design.length]
     left, right = design.notch_bounds()
     marks = np.unique(np.concatenate([[0.0, design.length], left, right]))
+    # a notch right after another (no tube between) may end a rounding error from where the
+    # next starts: one mark, not an interval no integrator can step
+    marks = marks[np.concatenate([[True], np.diff(marks) > SAME_MARK * design.length])]
+    marks[-1] = design.length
     return marks.tolist()
 
 
@@ -172,12 +181,15 @@ class _Shooter:
         states[0] = y
         for a, b in zip(self.marks[:-1], self.marks[1:], strict=True):
             inside = np.flatnonzero((s_nodes > a) & (s_nodes <= b))
+            times = s_nodes[inside]
+            # the state at b starts the next interval, whether or not a node sits there
+            t_eval = times if times.size and times[-1] == b else np.append(times, b)
             sol = solve_ivp(self.rhs, (a, b), y, method=self.options.ode_method,
-                            t_eval=s_nodes[inside], rtol=self.options.rtol,
+                            t_eval=t_eval, rtol=self.options.rtol,
                             atol=self.options.atol, max_step=self.options.max_step)
-            if sol.status != 0 or sol.y.shape[1] != inside.size:
+            if sol.status != 0 or sol.y.shape[1] != t_eval.size:
                 return states, False
-            states[inside] = sol.y.T
+            states[inside] = sol.y.T[:inside.size]
             y = sol.y[:, -1]
         return states, bool(np.all(np.isfinite(states)))
 
