@@ -4,7 +4,9 @@ Run: ``python bench/bench_solve.py [--repeats 2000] [--baseline /work/main] [--r
 Prints the median and p90 time per solve on ``paper-experiment`` at 20 N with the default
 settings (compiled kernel, and the plain-Python build of the same kernel, ``TDCM_JIT=0``),
 the tip error of that solve against a converged reference, and the iterations across presets
-and hard designs. ``--baseline`` times another checkout of the package (e.g. main's NumPy
+and hard designs. Issue 27: the same solve through the shipped body file, and a body whose 8
+notches all differ (widths, backbones, tubes), timed interleaved in this process, as ratios to
+the preset. ``--baseline`` times another checkout of the package (e.g. main's NumPy
 path) in the same run: baseline and this checkout alternate in fresh processes for
 ``--rounds`` rounds and the ratio of their medians is printed.
 Single-threaded: BLAS threads are pinned to one before NumPy loads.
@@ -24,7 +26,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
-from tdcm_ros.model import PRESETS, SolverSettings, preset, solve
+from tdcm_ros.model import PRESETS, SolverSettings, preset, read_body_file, solve
+from tdcm_ros.model.design import Design
 
 REFERENCE = SolverSettings(cells_per_notch=256, cells_per_tube=32, quad_order=16, tol=1e-14)
 FINER = SolverSettings(cells_per_notch=512, cells_per_tube=64, quad_order=16, tol=1e-14)
@@ -50,6 +53,33 @@ def time_solves(repeats: int) -> np.ndarray:
         solve(design, 20.0)
         times[k] = time.perf_counter() - start
     return times
+
+
+def all_different() -> Design:
+    """Eight notches, all different (issue 27's target: <= 1.2x the uniform body's solve);
+    built on use, so that --baseline may time a checkout without per-notch designs."""
+    return preset("paper-experiment").with_overrides(
+        w_n=[2.0e-3, 2.5e-3, 1.5e-3, 2.1e-3, 2.2e-3, 3.0e-3, 1.9e-3, 1.8e-3],
+        w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3, 1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3],
+        w_t=[4e-3, 3e-3, 5e-3, 4.5e-3, 3.5e-3, 4e-3, 2e-3])
+
+
+BODY_FILE = Path(__file__).resolve().parents[1] / "config" / "bodies" / "paper_experiment.yaml"
+
+
+def interleaved(designs: dict[str, Design], repeats: int, rounds: int = 5) -> dict[str, float]:
+    """Median solve time (s) of each design at 20 N, ``rounds`` rounds of ``repeats // rounds``
+    solves each, the designs taking turns (warm grid caches)."""
+    times: dict[str, list[float]] = {name: [] for name in designs}
+    for design in designs.values():
+        solve(design, 20.0)
+    for _ in range(rounds):
+        for name, design in designs.items():
+            for _ in range(max(repeats // rounds, 1)):
+                start = time.perf_counter()
+                solve(design, 20.0)
+                times[name].append(time.perf_counter() - start)
+    return {name: float(np.median(t)) for name, t in times.items()}
 
 
 def median_in(checkout: Path, repeats: int, jit: str = "1") -> float:
@@ -107,6 +137,13 @@ def main() -> None:
           " nm  (target <= 1000 nm)")
     print(f"  reference self-check   {np.linalg.norm(finer - reference) * 1e9:8.3f} nm "
           "(256 vs 512 cells/notch)")
+    bodies = interleaved({"preset": design, "body file": read_body_file(BODY_FILE).design(),
+                          "8 notches all different": all_different()}, args.repeats)
+    print("body path (issue 27), interleaved medians at 20 N")
+    for name, median in bodies.items():
+        print(f"  {name:24s} {median * 1e6:8.1f} us  {median / bodies['preset']:5.2f}x the preset"
+              + ("   (target <= 1.2x)" if name.startswith("8") else
+                 "   (target: no slower)" if name == "body file" else ""))
     print("iterations to converge (tol 1e-10 m), strategy")
     for name in PRESETS:
         row = [solve(preset(name), t) for t in (4.0, 12.0, 20.0)]
