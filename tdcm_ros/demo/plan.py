@@ -17,7 +17,7 @@ from tdcm_ros.demo.trajectory import TipTrajectory, tip_trajectory
 from tdcm_ros.device import StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics import settings_for_hold
-from tdcm_ros.model import FIELD_SPECS
+from tdcm_ros.model import FIELD_SPECS, body_file_text, parameter_specs
 from tdcm_ros.scenes import Scene
 
 #: Nodes in start order: consumers first, so nothing published at the start is missed; the
@@ -72,12 +72,18 @@ class DemoPlan:
         return os.path.join(tempfile.gettempdir(), f"tdcm_demo_twin_{os.getpid()}")
 
     def node_overrides(self) -> dict[str, dict[str, Any]]:
-        """Per-node parameters (ROS names), on top of each node's defaults."""
+        """Per-node parameters (ROS names), on top of each node's defaults; a per-notch design
+        goes to the nodes as a body file written to ``out/design.yaml``."""
         scene = self.scene
         design: dict[str, Any] = {f"design.{name}": float(getattr(scene.design, name))
-                                  for name in FIELD_SPECS}
+                                  for name in parameter_specs(scene.design) if name in FIELD_SPECS}
         design["design.N"] = int(scene.design.N)
         design["design.profile"] = scene.design.profile.name
+        if not scene.design.is_uniform:  # per-notch values are a body file's, not parameters
+            body = self.out / "design.yaml"
+            body.parent.mkdir(parents=True, exist_ok=True)
+            body.write_text(body_file_text(scene.design), encoding="utf-8")
+            design["design.file"] = str(body)
         markers = {"markers.arc_lengths": [float(s) for s in scene.marker_arc_lengths],
                    "markers.side_deg": float(scene.marker_side_deg)}
         top = max(self.schedule.levels)

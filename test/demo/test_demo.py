@@ -22,6 +22,8 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.api import evaluate_paths
 from tdcm_ros.metrics.steps import StepSettings
 from tdcm_ros.model import preset
+from tdcm_ros.nodes.model_node import ModelNode
+from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.registry import NODES
 from tdcm_ros.scenes import load_scene
 
@@ -184,6 +186,16 @@ def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
     given = make_plan(rectangular, "paper_experiment", tmp_path).node_overrides()
     for node in ("model_node", "metrics_node"):  # the scene's notches, as cut
         assert given[node]["design.profile"] == "rectangular", node
+
+
+def test_a_per_notch_scene_reaches_the_nodes_as_a_body_file(tmp_path: Path) -> None:
+    graded = preset("paper-experiment").with_overrides(w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3,
+                                                            1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3])
+    scene = replace(load_scene("paper_experiment"), design=graded)
+    given = make_plan(scene, "paper_experiment", tmp_path).node_overrides()["model_node"]
+    assert "design.w_d" not in given and given["design.E"] == graded.E
+    node = ModelNode(MemoryPort(given, name="model_node"))
+    assert node.design == graded
 
 
 def test_demo_rejects_a_bad_set_before_the_run(tmp_path: Path,
