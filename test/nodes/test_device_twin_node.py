@@ -54,7 +54,10 @@ def test_twin_node_serves_its_plant_and_publishes_the_true_tension(runtime, spaw
                    and len(probe.truth) > 10 and abs(probe.truth[-1].wrench.force.z - 7.0) < 0.05,
                    30.0, "8 N measured, 7 N true", action=step, every=0.0,
                    spin=SimpleNamespace(spin_for=lambda _: probe.ctx.spin_for(0.005)),
-                   detail=lambda: f"{measured[-1:]}, {probe.truth[-1:]}")
+                   detail=lambda: f"{measured[-1:]}, {probe.truth[-1:]}; driver "
+                   + (f"{results[-1].status.link.name}, armed {results[-1].status.armed}, "
+                      f"disarmed for {results[-1].status.disarm_reason!r}" if results else
+                      "never stepped"))
         result = results[-1]
         assert result.status.link is LinkState.CONNECTED and result.status.banner is not None
         assert result.status.banner.cell == "TWIN"
