@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import os
+import signal
 import subprocess
 import sys
 from collections.abc import Callable, Iterator
@@ -21,7 +22,11 @@ from typing import Any
 import pytest
 
 from test.support.processes import REPO, Lines, child_env, free_port, stop
-from test.support.waiting import eventually
+from test.support.waiting import eventually, scaled
+
+#: Seconds (scaled) a child still running at teardown has to exit after SIGINT before it is
+#: killed.
+TEARDOWN_STOP_S = 5.0
 
 RUNTIMES = ["zenoh", pytest.param("rclpy", marks=pytest.mark.rclpy)]
 _domains = itertools.count()
@@ -101,15 +106,27 @@ def _spawner(env: dict[str, str], item: pytest.Item
     failed = getattr(item, "report_call", None) is not None and item.report_call.failed
     for child in children:
         running = child.poll() is None
+        state = f"exited {child.returncode}"
         if running:
-            child.kill()
+            # SIGINT first, so that a node leaves the graph as it does when stopped, before
+            # the test's own peer is torn down (a killed DDS participant is noticed by the
+            # others later, on their threads); killed only if it does not exit
+            child.send_signal(signal.SIGINT)
+            state = "stopped at teardown (SIGINT)"
         try:
+            _, err = child.communicate(timeout=scaled(TEARDOWN_STOP_S) if running else None)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            state = f"killed at teardown ({scaled(TEARDOWN_STOP_S):g} s after SIGINT)"
             _, err = child.communicate()
         except ValueError:  # the test closed a pipe it had read
             err = b""
-            child.wait()
+            try:
+                child.wait(scaled(TEARDOWN_STOP_S) if running else None)
+            except subprocess.TimeoutExpired:
+                child.kill()
+                child.wait()
         if failed:  # what each child said, in the failure's report (teardown output)
-            state = "killed at teardown" if running else f"exited {child.returncode}"
             tail = (err or b"")[-2000:].decode(errors="replace")
             print(f"--- {' '.join(map(str, child.args[2:]))} ({state}); stderr ends:\n{tail}")
 
