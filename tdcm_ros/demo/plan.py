@@ -78,7 +78,8 @@ class DemoPlan:
         design: dict[str, Any] = {f"design.{name}": float(getattr(scene.design, name))
                                   for name in parameter_specs(scene.design) if name in FIELD_SPECS}
         design["design.N"] = int(scene.design.N)
-        design["design.profile"] = scene.design.profile.name
+        if not isinstance(scene.design.profile, tuple):
+            design["design.profile"] = scene.design.profile.name
         if not scene.design.is_uniform:  # per-notch values are a body file's, not parameters
             body = self.out / "design.yaml"
             body.parent.mkdir(parents=True, exist_ok=True)

@@ -20,8 +20,8 @@ of ``[x, y]`` in m, with optional ``holes``). Every problem is an
 :class:`~tdcm_ros.model.errors.InvalidDesignError` naming the key by its path in the file
 (``segments[1].segments[0].notch.cut``), the value and the allowed range.
 
-The solver takes today band notches of one profile, each with its own width and backbone,
-any tubes between them, and one tendon: :meth:`BodySpec.design` gives that
+The solver takes today band notches, each with its own width, backbone and profile, any tubes
+between them, and one tendon: :meth:`BodySpec.design` gives that
 :class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ) and names
 the first segment a body departs from it by (cut and polygon sections are not solvable yet).
 """
@@ -37,7 +37,7 @@ from typing import Any
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.design import MIN_SEGMENT_M, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.profiles import PROFILE_NAMES, profile_from_name
+from tdcm_ros.model.profiles import PROFILE_NAMES, NotchProfile, profile_from_name
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
 from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
@@ -97,22 +97,17 @@ class BodySpec:
 
     def design(self) -> Design:
         """The body as the solver's :class:`Design`: a base tube (or none), N band notches,
-        each with its own width and backbone, a tube (or none) between adjacent notches and a
-        tip tube (or none). A body the solver does not take yet (a cut or polygon section,
-        notches of different profiles) raises :class:`InvalidDesignError` naming the first
-        segment that departs from it."""
+        each with its own width, backbone and profile, a tube (or none) between adjacent notches
+        and a tip tube (or none). A body the solver does not take yet (a cut or polygon
+        section) raises :class:`InvalidDesignError` naming the first segment that has one."""
         merged = _merged_tubes(self.segments)
         notches = [s for s in merged if isinstance(s, NotchSpec)]
         if not notches:
             raise InvalidDesignError(f"{self.source}: segments has no notch; allowed: at least "
                                      "one", parameter="segments", value=0, allowed="[1, inf) notches")
-        first = notches[0]
         for notch in notches:
             if notch.kind != "band":
                 raise _not_yet(notch.where, f"a {notch.kind} section", self.source)
-            if notch.profile != first.profile:
-                raise _not_yet(f"{notch.where}.profile", f"profile {notch.profile!r} where "
-                               f"{first.where} has {first.profile!r}", self.source)
         head = merged[0].length if isinstance(merged[0], TubeSpec) else 0.0
         tail = merged[-1].length if isinstance(merged[-1], TubeSpec) else 0.0
         at = [k for k, segment in enumerate(merged) if isinstance(segment, NotchSpec)]
@@ -121,14 +116,14 @@ class BodySpec:
         return Design(w_base=head, w_tip=tail, w_n=tuple(n.width for n in notches), w_t=gaps,
                       w_d=tuple(n.band for n in notches), N=len(notches), R_outer=self.R_outer,
                       r_inner=self.r_inner, R_c=self.tendon_offset, E=self.E,
-                      profile=profile_from_name(first.profile))
+                      profile=tuple(profile_from_name(n.profile) for n in notches))
 
 
 def _not_yet(where: str, what: str, source: str) -> InvalidDesignError:
     return InvalidDesignError(
-        f"{source}: {where}: {what}: the solver takes band notches of one profile and one "
-        "tendon (cut and polygon sections are not solvable yet)", parameter=where, value=what,
-        allowed="band notches of one profile")
+        f"{source}: {where}: {what}: the solver takes band notches and one tendon (cut and "
+        "polygon sections are not solvable yet)", parameter=where, value=what,
+        allowed="band notches")
 
 
 def _merged_tubes(segments: Sequence[Segment]) -> list[Segment]:
@@ -329,9 +324,8 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         text = repr(float(value))
         return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
 
-    def notch(width: float, band: float) -> str:
-        return (f"{{width: {number(width)}, band: {number(band)}, "
-                f"profile: {design.profile.name}}}")
+    def notch(width: float, band: float, profile: NotchProfile) -> str:
+        return f"{{width: {number(width)}, band: {number(band)}, profile: {profile.name}}}"
 
     lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
              f"material: {{E: {number(design.E)}}}", "tendons:",
@@ -339,7 +333,7 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
     if design.w_base > 0.0:
         lines.append(f"  - tube: {number(design.w_base)}")
     if design.is_uniform:
-        one = notch(design.uniform("w_n"), design.uniform("w_d"))
+        one = notch(design.uniform("w_n"), design.uniform("w_d"), design.uniform_profile())
         if design.N > 1:
             lines += [f"  - repeat: {design.N - 1}", "    segments:", f"      - notch: {one}"]
             if design.uniform("w_t") > 0.0:
@@ -347,9 +341,10 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         lines.append(f"  - notch: {one}")
     else:
         gaps = [*design.per_notch("w_t").tolist(), 0.0]
-        for width, band, gap in zip(design.per_notch("w_n").tolist(),
-                                    design.per_notch("w_d").tolist(), gaps, strict=True):
-            lines.append(f"  - notch: {notch(width, band)}")
+        for width, band, profile, gap in zip(design.per_notch("w_n").tolist(),
+                                             design.per_notch("w_d").tolist(),
+                                             design.notch_profiles(), gaps, strict=True):
+            lines.append(f"  - notch: {notch(width, band, profile)}")
             if gap > 0.0:
                 lines.append(f"  - tube: {number(gap)}")
     if design.w_tip > 0.0:

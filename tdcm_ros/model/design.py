@@ -52,13 +52,15 @@ class Design:
                                low=0.0, high=1.0)
     w_tip: float = spec_field(unit="m", description="length of the distal tube segment",
                               low=0.0, high=1.0)
-    w_n: float | tuple[float, ...] = spec_field(unit="m", description="notch width along the body (or one per "
-                              "notch)", low=MIN_SEGMENT_M, high=1.0, kind="float")
-    w_t: float | tuple[float, ...] = spec_field(unit="m", description="tube length between adjacent notches (or "
-                              "one per gap)", low=0.0, high=1.0, kind="float")
-    w_d: float | tuple[float, ...] = spec_field(unit="m", description="backbone width (minimum, at the notch "
-                              "centre; or one per notch)", low=0.0, high=1.0, low_open=True,
-                              kind="float")
+    w_n: float | tuple[float, ...] = spec_field(
+        unit="m", description="notch width along the body (per notch: a list in Python and "
+        "--set, or a body file)", low=MIN_SEGMENT_M, high=1.0, kind="float")
+    w_t: float | tuple[float, ...] = spec_field(
+        unit="m", description="tube length between adjacent notches (per gap: a list in Python "
+        "and --set, or a body file)", low=0.0, high=1.0, kind="float")
+    w_d: float | tuple[float, ...] = spec_field(
+        unit="m", description="backbone width (minimum, at the notch centre; per notch: a list "
+        "in Python and --set, or a body file)", low=0.0, high=1.0, low_open=True, kind="float")
     N: int = spec_field(kind="int", description="number of notches", low=1, high=1000)
     R_outer: float = spec_field(unit="m", description="outer radius of the tube", low=0.0,
                                 high=0.5, low_open=True)
@@ -68,7 +70,7 @@ class Design:
                             low=0.0, high=0.5, low_open=True)
     E: float = spec_field(1.85e9, unit="Pa", description="Young's modulus (calibration parameter)",
                           low=0.0, high=1e12, low_open=True)
-    profile: NotchProfile = field(default_factory=CircularProfile)
+    profile: NotchProfile | tuple[NotchProfile, ...] = field(default_factory=CircularProfile)
 
     def __post_init__(self) -> None:
         check_fields(self, {k: v for k, v in FIELD_SPECS.items() if k not in _LISTABLE},
@@ -76,11 +78,7 @@ class Design:
         for name in _LISTABLE:
             object.__setattr__(self, name, _lengths(name, getattr(self, name), self._count(name)))
         self._check_cross_fields()
-        if not hasattr(self.profile, "h1"):
-            raise InvalidDesignError(
-                f"profile = {self.profile!r} is not a notch profile; allowed: circular, "
-                "rectangular, or CustomProfile(h1)", parameter="profile", value=self.profile,
-                allowed="circular | rectangular | CustomProfile")
+        object.__setattr__(self, "profile", _profiles(self.profile, self.N))
 
     def _check_cross_fields(self) -> None:
         """Ranges that depend on other fields: radii inside ``R_outer`` (m), the backbone
@@ -106,7 +104,23 @@ class Design:
     @property
     def is_uniform(self) -> bool:
         """Whether every notch is the same and evenly spaced (no field holds a list)."""
-        return not any(isinstance(getattr(self, name), tuple) for name in _LISTABLE)
+        return not any(isinstance(getattr(self, name), tuple) for name in (*_LISTABLE, "profile"))
+
+    def notch_profiles(self) -> tuple[NotchProfile, ...]:
+        """Each notch's profile, base to tip, whether the design stores one or a list."""
+        profile = self.profile
+        return profile if isinstance(profile, tuple) else (profile,) * self.N
+
+    def uniform_profile(self, what: str = "this") -> NotchProfile:
+        """The profile where every notch has the same one; a list raises
+        :class:`InvalidDesignError` saying that ``what`` takes one profile."""
+        profile = self.profile
+        if isinstance(profile, tuple):
+            names = [p.name for p in profile]
+            raise InvalidDesignError(
+                f"profile = {names!r} holds one profile per notch; {what} takes one profile",
+                parameter="profile", value=names, allowed="one profile")
+        return profile
 
     def uniform(self, name: str, what: str = "this") -> float:
         """Field ``name`` (``w_n``, ``w_d``, ``w_t``) where it holds one value (m); a per-notch
@@ -162,8 +176,6 @@ class Design:
         """A copy with fields replaced (validated); unknown names raise :class:`InvalidDesignError`."""
         reject_unknown("design field", overrides, (f.name for f in fields(self)),
                        error=InvalidDesignError)
-        if isinstance(overrides.get("profile"), str):
-            overrides["profile"] = profile_from_name(overrides["profile"])
         return replace(self, **overrides)
 
     def to_dict(self) -> dict[str, Any]:
@@ -171,7 +183,8 @@ class Design:
         the profile by name."""
         data = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()
                 if k != "profile"}
-        data["profile"] = self.profile.name
+        profile = self.profile
+        data["profile"] = [p.name for p in profile] if isinstance(profile, tuple) else profile.name
         data["L"] = self.length
         return data
 
@@ -198,6 +211,29 @@ def _lengths(name: str, value: Any, count: int) -> Lengths:
     return items[0] if all(v == items[0] for v in items) else tuple(items)
 
 
+def _profiles(value: Any, count: int) -> NotchProfile | tuple[NotchProfile, ...]:
+    """``value`` as a notch profile (a name or a profile), or a list of ``count`` of them (one
+    per notch); a list of equal profiles becomes that profile."""
+    def one(item: Any, where: str) -> NotchProfile:
+        if isinstance(item, str):
+            return profile_from_name(item)
+        if not hasattr(item, "h1"):
+            raise InvalidDesignError(
+                f"{where} = {item!r} is not a notch profile; allowed: circular, rectangular, or "
+                "CustomProfile(h1)", parameter=where, value=item,
+                allowed="circular | rectangular | CustomProfile")
+        return item
+
+    if isinstance(value, (list, tuple)):
+        if len(value) != count:
+            raise out_of_range("profile", [getattr(p, "name", p) for p in value],
+                               f"one profile, or {count} (one per notch: N = {count})",
+                               error=InvalidDesignError)
+        items = tuple(one(item, f"profile[{i}]") for i, item in enumerate(value))
+        return items[0] if all(item == items[0] for item in items) else items
+    return one(value, "profile")
+
+
 def _entries(name: str, value: Any) -> list[tuple[str, float]]:
     """``(name, value)``, or ``(name[i], value_i)`` for each entry of a per-notch list."""
     if isinstance(value, tuple):
@@ -219,6 +255,9 @@ def parameter_specs(design: Design) -> dict[str, Spec]:
 def parse_field(name: str, text: str) -> Any:
     """Parse a ``NAME=VALUE`` override value from text in SI units (``N`` as an integer)."""
     if name == "profile":
+        stripped = text.strip()
+        if stripped.startswith("[") and stripped.endswith("]"):
+            return [part.strip() for part in stripped[1:-1].split(",") if part.strip()]
         return text
     spec = FIELD_SPECS.get(name)
     if spec is None:

@@ -172,11 +172,14 @@ class Grid(CellArrays):
         """Inverse of :meth:`local_sigma`: reference coordinate of arc length ``s`` (m)."""
         sigma = s - self.seg_start[cells]
         u_lin = sigma / self.seg_length[cells]
-        if self.design.profile.name != "circular":
+        members = self.members
+        circular = np.array([p.name == "circular" for p in members.profiles])
+        shape = self.shape[cells]
+        arc = self.is_notch[cells] & circular[members.profile_of[shape]]
+        if not np.any(arc):
             return u_lin
-        w_n = self.members.shape_w_n[self.shape[cells]]
-        ratio = np.clip(1.0 - 2.0 * sigma / w_n, -1.0, 1.0)
-        return np.where(self.is_notch[cells], np.arccos(ratio) / np.pi, u_lin)
+        ratio = np.clip(1.0 - 2.0 * sigma / members.shape_w_n[shape], -1.0, 1.0)
+        return np.where(arc, np.arccos(ratio) / np.pi, u_lin)
 
     def query(self, s: Array) -> Query:
         """Cells of arc lengths ``s`` (m) and their :meth:`partial_integrals`, kept for the last
@@ -391,7 +394,7 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
                      table.seg_length], axis=1).astype(float)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
     owner = members.shape_member
-    design = np.stack([kinds[members.profile_of[owner]], members.shape_w_n, members.shape_w_d,
+    design = np.stack([kinds[members.profile_of], members.shape_w_n, members.shape_w_d,
                        members.R_outer[owner], members.r_inner[owner], members.E[owner],
                        members.tube_moment[owner]], axis=1)
     build = grid_kernels()

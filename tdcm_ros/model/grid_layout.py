@@ -46,8 +46,9 @@ MIN_PIECE_U = 1e-6
 class Members:
     """Design parameters of every member (SI units): per member (shape (M,)) the tube, the
     material and the length; per *notch shape* (shape (S,): each member's distinct notches,
-    ``(w_n, w_d)`` pairs in order of first appearance, so a uniform member has one and its row is
-    the member's own) ``shape_member``, ``shape_w_n``, ``shape_w_d``; per member and segment
+    ``(w_n, w_d, profile)`` in order of first appearance, so a uniform member has one and its row
+    is the member's own) ``shape_member``, ``shape_w_n``, ``shape_w_d``, ``profile_of`` (the
+    index of its profile in ``profiles``); per member and segment
     *kind* (shape (M, K): the member's base tube, each of its notch shapes, each distinct tube
     between notches, its tip tube, then zero-length padding) ``kind_length``,
     ``kind_is_notch`` and ``kind_shape`` (the notch shape of a notch kind, the member's first
@@ -58,7 +59,6 @@ class Members:
 
     designs: tuple[Design, ...]
     profiles: tuple[NotchProfile, ...]
-    profile_of: IntArray
     N: IntArray
     w_base: Array
     w_tip: Array
@@ -72,6 +72,7 @@ class Members:
     shape_first: IntArray
     shape_w_n: Array
     shape_w_d: Array
+    profile_of: IntArray
     kind_length: Array
     kind_is_notch: BoolArray
     kind_shape: IntArray
@@ -83,18 +84,7 @@ class Members:
     def of(cls, designs: Sequence[Design]) -> Members:
         """Collect and check ``designs`` (every profile finite and positive, ``E I`` finite)."""
         designs = tuple(designs)
-        profiles: list[NotchProfile] = []
-        index: dict[int, int] = {}
-        profile_of = np.empty(len(designs), np.int64)
-        for m, design in enumerate(designs):
-            key = id(design.profile)
-            if key not in index:
-                same = next((k for k, p in enumerate(profiles) if p == design.profile), None)
-                if same is None:
-                    same = len(profiles)
-                    profiles.append(design.profile)
-                index[key] = same
-            profile_of[m] = index[key]
+        profiles = _ProfileIndex()
 
         def column(name: str) -> Array:
             return np.array([getattr(d, name) for d in designs], dtype=float)
@@ -103,15 +93,15 @@ class Members:
         w_base, w_tip = column("w_base"), column("w_tip")
         r_outer, r_inner = column("R_outer"), column("r_inner")
         uniform = all(d.is_uniform for d in designs)
-        layout = _uniform_layout(designs, n, w_base, w_tip) if uniform else _general_layout(
-            designs, n)
-        members = cls(designs=designs, profiles=tuple(profiles), profile_of=profile_of, N=n,
+        layout = _uniform_layout(designs, n, w_base, w_tip, profiles) if uniform else \
+            _general_layout(designs, n, profiles)
+        members = cls(designs=designs, profiles=tuple(profiles.profiles), N=n,
                       w_base=w_base, w_tip=w_tip, R_outer=r_outer, r_inner=r_inner,
                       R_c=column("R_c"), E=column("E"),
                       tube_moment=np.pi / 4.0 * (r_outer**4 - r_inner**4),
                       length=np.array([d.length for d in designs], dtype=float), **layout)
         for design in designs:
-            if design.profile.name not in ("circular", "rectangular"):
+            if any(p.name not in ("circular", "rectangular") for p in design.notch_profiles()):
                 _check_custom_profile(design)
         _check_rigidity(members)
         return members
@@ -134,7 +124,7 @@ class Members:
             return evaluate(self.profiles[0], u, per_row(self.shape_w_n[shape], u),
                             per_row(self.shape_w_d[shape], u))
         out = np.empty(u.shape)
-        kinds = self.profile_of[self.shape_member[shape]]
+        kinds = self.profile_of[shape]
         for k, profile in enumerate(self.profiles):
             rows = kinds == k
             if np.any(rows):
@@ -144,8 +134,27 @@ class Members:
         return out
 
 
-def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_tip: Array
-                    ) -> dict[str, Any]:
+class _ProfileIndex:
+    """The distinct profiles met so far (equal ones once) and each one's index."""
+
+    def __init__(self) -> None:
+        self.profiles: list[NotchProfile] = []
+        self._by_id: dict[int, int] = {}
+
+    def index(self, profile: NotchProfile) -> int:
+        """The index of ``profile`` (added if new)."""
+        key = id(profile)
+        if key not in self._by_id:
+            same = next((k for k, p in enumerate(self.profiles) if p == profile), None)
+            if same is None:
+                same = len(self.profiles)
+                self.profiles.append(profile)
+            self._by_id[key] = same
+        return self._by_id[key]
+
+
+def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_tip: Array,
+                    profiles: _ProfileIndex) -> dict[str, Any]:
     """:class:`Members`' shape, kind and slot arrays of uniform designs, vectorised: one notch
     shape per member, the kinds BASE, NOTCH, TUBE, TIP."""
     count = n.size
@@ -161,16 +170,19 @@ def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_t
     slot_kind[:, 2::2] = np.where(notch_i[None, :] == (n - 1)[:, None], TIP, TUBE)
     return {"shape_member": every, "shape_first": every, "shape_w_n": w_n,
             "shape_w_d": np.array([d.w_d for d in designs], dtype=float),
+            "profile_of": np.array([profiles.index(d.uniform_profile()) for d in designs],
+                                   np.int64),
             "kind_length": np.stack([w_base, w_n, np.where(n > 1, w_t, 0.0), w_tip], axis=1),
             "kind_is_notch": np.broadcast_to(np.arange(4) == NOTCH, (count, 4)),
             "kind_shape": np.repeat(every[:, None], 4, axis=1), "slot_kind": slot_kind,
             "notch_left": left, "notch_right": left + w_n[:, None]}
 
 
-def _general_layout(designs: tuple[Design, ...], n: IntArray) -> dict[str, Any]:
+def _general_layout(designs: tuple[Design, ...], n: IntArray, profiles: _ProfileIndex
+                    ) -> dict[str, Any]:
     """:class:`Members`' shape, kind and slot arrays of any designs (see :class:`Members`)."""
     count, n_max = n.size, int(n.max())
-    shapes: list[tuple[int, float, float]] = []
+    shapes: list[tuple[int, float, float, int]] = []
     kinds: list[list[tuple[float, bool, int]]] = []
     slot_kind = np.zeros((count, 2 * n_max + 1), np.int64)
     left_all = np.empty((count, n_max))
@@ -179,13 +191,13 @@ def _general_layout(designs: tuple[Design, ...], n: IntArray) -> dict[str, Any]:
     for m, design in enumerate(designs):
         first[m] = len(shapes)
         pairs = list(zip(design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(),
-                         strict=True))
+                         (profiles.index(p) for p in design.notch_profiles()), strict=True))
         distinct = list(dict.fromkeys(pairs))
-        shapes += [(m, w_n, w_d) for w_n, w_d in distinct]
+        shapes += [(m, w_n, w_d, profile) for w_n, w_d, profile in distinct]
         gaps = design.per_notch("w_t").tolist()
         distinct_gaps = list(dict.fromkeys(g for g in gaps if g > 0.0))
         own: list[tuple[float, bool, int]] = [(design.w_base, False, int(first[m]))]
-        own += [(w_n, True, int(first[m]) + k) for k, (w_n, _) in enumerate(distinct)]
+        own += [(w_n, True, int(first[m]) + k) for k, (w_n, _, _) in enumerate(distinct)]
         own += [(g, False, int(first[m])) for g in distinct_gaps]
         own.append((design.w_tip, False, int(first[m])))
         tip_kind = len(own) - 1
@@ -207,6 +219,7 @@ def _general_layout(designs: tuple[Design, ...], n: IntArray) -> dict[str, Any]:
     return {"shape_member": np.array([s[0] for s in shapes], np.int64), "shape_first": first,
             "shape_w_n": np.array([s[1] for s in shapes], dtype=float),
             "shape_w_d": np.array([s[2] for s in shapes], dtype=float),
+            "profile_of": np.array([s[3] for s in shapes], np.int64),
             "kind_length": np.array([[k[0] for k in row] for row in padded], dtype=float),
             "kind_is_notch": np.array([[k[1] for k in row] for row in padded], dtype=bool),
             "kind_shape": np.array([[k[2] for k in row] for row in padded], np.int64),
@@ -386,7 +399,7 @@ def crossings(members: Members) -> Array:
     """Where each notch shape's profile crosses ``r_inner`` and ``R_outer``, as ``u`` in (0, 1);
     shape (S, MAX_CROSSINGS), 0 where a crossing does not exist."""
     out = np.zeros((members.shape_member.size, MAX_CROSSINGS))
-    shape_profile = members.profile_of[members.shape_member]
+    shape_profile = members.profile_of
     for k, profile in enumerate(members.profiles):
         rows = np.flatnonzero(shape_profile == k)
         if isinstance(profile, RectangularProfile):
@@ -452,10 +465,11 @@ def _searched_crossings(members: Members, rows: IntArray, level: Array) -> tuple
 def _check_custom_profile(design: Design) -> None:
     """Raise :class:`InvalidDesignError` unless a user profile gives finite ``h1 > 0`` (m)."""
     u = np.linspace(0.0, 1.0, 65)
-    pairs = zip(design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(), strict=True)
-    for w_n, w_d in dict.fromkeys(pairs):
+    notches = zip(design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(),
+                  design.notch_profiles(), strict=True)
+    for w_n, w_d, profile in dict.fromkeys(notches):
         try:
-            h1 = design.profile.h1(u, w_n, w_d)
+            h1 = profile.h1(u, w_n, w_d)
         except Exception as exc:  # a user callable may raise anything: report it as bad input
             raise InvalidDesignError(f"h1(s) raised {exc!r}", parameter="h1(s)", value=None,
                                      allowed="a function of sigma in [0, w_n] m") from exc

@@ -42,6 +42,7 @@ def body_outline(result: SolveResult, stations: int = STATIONS_PER_SEGMENT) -> B
     left, right = design.notch_bounds()
     u = np.linspace(0.0, 1.0, max(2, int(stations)))
     w_n, w_d = design.per_notch("w_n"), design.per_notch("w_d")
+    profiles = design.notch_profiles()
     s_parts, widths = [], []
     starts = [0.0, *right]
     ends = [*left, design.length]
@@ -50,10 +51,10 @@ def body_outline(result: SolveResult, stations: int = STATIONS_PER_SEGMENT) -> B
             s_parts.append(np.linspace(start, end, u.size))
             widths.append(np.full(u.size, design.R_outer))
         if k < left.size:
-            sigma = design.profile.sigma(u, w_n[k])
+            sigma = profiles[k].sigma(u, w_n[k])
             sigma[-1] = w_n[k]  # the notch's end exactly, whatever the profile's rounding
             s_parts.append(left[k] + sigma)
-            widths.append(np.minimum(design.profile.h1(u, w_n[k], w_d[k]), design.R_outer))
+            widths.append(np.minimum(profiles[k].h1(u, w_n[k], w_d[k]), design.R_outer))
     s = np.concatenate(s_parts)
     width = np.concatenate(widths)
     positions, quaternions = result.pose_at(np.clip(s, 0.0, design.length))

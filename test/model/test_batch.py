@@ -23,8 +23,8 @@ STATUS_OF_KIND = {"tendon_singularity": "singularity", "notch_closure": "closure
 
 def random_designs(seed: int, count: int) -> list:
     """Paper-like designs over wide ranges, several cell layouts (N, empty segments); about a
-    third per notch (each notch its own width and backbone, each gap its own tube, some
-    repeated, some none)."""
+    third per notch (each notch its own width and backbone, half of them also their own
+    profile, each gap its own tube, some repeated, some none)."""
     rng = np.random.default_rng(seed)
     base = preset("paper-experiment")
     designs = []
@@ -33,15 +33,17 @@ def random_designs(seed: int, count: int) -> list:
         w_n = rng.uniform(0.4e-3, 3e-3)
         w_t = float(rng.choice([0.0, rng.uniform(1e-3, 5e-3)]))
         w_d = rng.uniform(0.5e-3, 2.5e-3)
+        profile = RectangularProfile() if rng.random() < 0.3 else base.profile
         if rng.random() < 0.35:
             w_n = rng.choice([w_n, rng.uniform(0.4e-3, 3e-3)], n).tolist()
             w_d = rng.choice([w_d, rng.uniform(0.5e-3, 2.5e-3)], n).tolist()
             w_t = rng.choice([0.0, w_t, rng.uniform(1e-3, 5e-3)], n - 1).tolist()
+            if rng.random() < 0.5:
+                profile = rng.choice(["circular", "rectangular"], n).tolist()
         designs.append(base.with_overrides(
             N=n, w_n=w_n, w_t=w_t, w_d=w_d,
             w_tip=float(rng.choice([0.0, rng.uniform(1e-3, 5e-3)])), w_base=rng.uniform(0, 6e-3),
-            R_c=rng.uniform(1.5e-3, 3.5e-3), E=rng.uniform(0.8e9, 2.5e9),
-            profile=RectangularProfile() if rng.random() < 0.3 else base.profile))
+            R_c=rng.uniform(1.5e-3, 3.5e-3), E=rng.uniform(0.8e9, 2.5e9), profile=profile))
     return designs
 
 

@@ -130,15 +130,23 @@ BAND = {"notch": {"width": 2.0e-3, "band": 1.4e-3}}
 @pytest.mark.parametrize(("segments", "where"), [
     ([BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 1.0e-3}}],
      r"segments\[2\]\.notch: a cut section"),
-    ([BAND, {"notch": {"width": 2.0e-3, "band": 1.4e-3, "profile": "rectangular"}}],
-     (r"segments\[1\]\.notch\.profile: profile 'rectangular' where segments\[0\]\.notch "
-      r"has 'circular'")),
+    ([BAND, {"notch": {"width": 2.0e-3, "polygon": [[0, -1e-3], [1e-3, 0], [0, 1e-3]]}}],
+     r"segments\[1\]\.notch: a polygon section"),
 ])
 def test_bodies_the_solver_cannot_take_yet_name_the_first_segment_that_differs(
         segments: list[object], where: str) -> None:
     data = with_changes(segments=segments)
     with pytest.raises(InvalidDesignError, match=where + ".*not solvable yet"):
         body_from_mapping(data, "body.yaml").design()
+
+
+def test_notches_of_different_profiles_are_read_per_notch() -> None:
+    data = with_changes(segments=[
+        BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "band": 1.4e-3,
+                                         "profile": "rectangular"}}])
+    design = body_from_mapping(data, "body.yaml").design()
+    assert [p.name for p in design.notch_profiles()] == ["circular", "rectangular"]
+    assert not design.is_uniform
 
 
 def test_notches_that_differ_are_read_per_notch_with_the_tubes_between_them() -> None:
@@ -151,6 +159,7 @@ def test_notches_that_differ_are_read_per_notch_with_the_tubes_between_them() ->
     assert design.w_n == (2.0e-3, 2.5e-3, 2.0e-3, 2.0e-3)
     assert design.w_d == (1.4e-3, 1.2e-3, 1.0e-3, 1.4e-3)
     assert design.w_t == (4e-3, 0.0, 1e-3 + 2e-3)   # adjacent notches: no tube; tubes joined
+    assert design.profile.name == "circular"   # every notch the default: one profile
     left, right = design.notch_bounds()
     assert left.tolist() == pytest.approx([5e-3, 11e-3, 13.5e-3, 18.5e-3], abs=1e-15)
     assert design.length == pytest.approx(right[-1] + 4e-3, abs=1e-15)
@@ -161,7 +170,8 @@ def test_notches_that_differ_are_read_per_notch_with_the_tubes_between_them() ->
     st.lists(st.sampled_from([1.0e-3, 1.5e-3, 2.0e-3]), min_size=n, max_size=n),
     st.lists(st.sampled_from([0.8e-3, 1.1e-3, 1.4e-3]), min_size=n, max_size=n),
     st.lists(st.sampled_from([0.0, 2.0e-3, 4.0e-3]), min_size=n - 1, max_size=n - 1),
-    st.sampled_from([0.0, 3.0e-3]), st.sampled_from(["circular", "rectangular"]))))
+    st.sampled_from([0.0, 3.0e-3]),
+    st.lists(st.sampled_from(["circular", "rectangular"]), min_size=n, max_size=n))))
 def test_a_per_notch_design_round_trips_through_its_body_file(case: tuple) -> None:
     widths, bands, gaps, ends, profile = case
     design = preset("paper-experiment").with_overrides(

@@ -130,6 +130,22 @@ def test_bad_per_notch_values_name_the_field_the_notch_and_the_range(overrides, 
         preset("paper-experiment").with_overrides(**overrides)
 
 
+def test_a_profile_per_notch_is_checked_and_a_list_of_one_profile_is_that_profile():
+    design = preset("paper-experiment")
+    assert design.with_overrides(profile=["circular"] * 8) == design
+    mixed = design.with_overrides(profile=["circular", "rectangular"] * 4)
+    assert [p.name for p in mixed.notch_profiles()][:2] == ["circular", "rectangular"]
+    assert mixed.to_dict()["profile"] == ["circular", "rectangular"] * 4
+    with pytest.raises(InvalidDesignError, match=r"profile = \['circular', 'rectangular'\] is "
+                                                 r"out of range; allowed: one profile, or 8"):
+        design.with_overrides(profile=["circular", "rectangular"])
+    with pytest.raises(InvalidDesignError, match=r"profile = 'oval' is out of range"):
+        design.with_overrides(profile=["circular"] * 7 + ["oval"])
+    with pytest.raises(InvalidDesignError, match=r"profile\[1\] = 3 is not a notch profile"):
+        design.with_overrides(profile=["circular", 3] + ["circular"] * 6)
+    assert parse_field("profile", "[circular, rectangular]") == ["circular", "rectangular"]
+
+
 def test_a_per_notch_override_is_parsed_from_a_bracketed_list():
     assert parse_field("w_d", "[0.0014, 0.0012]") == (0.0014, 0.0012)
     assert parse_field("w_d", "0.0014") == 0.0014

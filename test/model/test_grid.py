@@ -138,8 +138,8 @@ designs_strategy = st.builds(
     st.sampled_from([0.0, 0.05, 4.0]), st.sampled_from([0.0, 5.0]),
     st.sampled_from([0.0, 4.0]), st.sampled_from([0.0, 0.8, 1.55]),
     st.sampled_from(["circular", "rectangular"]))
-#: Per-notch designs: each notch its own width and backbone from a few values (so some repeat),
-#: each gap its own tube (some none).
+#: Per-notch designs: each notch its own width, backbone and profile from a few values (so some
+#: repeat), each gap its own tube (some none).
 per_notch_strategy = st.integers(2, 8).flatmap(lambda n: st.builds(
     lambda w_n, w_d, w_t, profile: preset("paper-experiment").with_overrides(
         N=n, w_n=[v * MM for v in w_n], w_d=[v * MM for v in w_d], w_t=[v * MM for v in w_t],
@@ -147,7 +147,7 @@ per_notch_strategy = st.integers(2, 8).flatmap(lambda n: st.builds(
     st.lists(st.sampled_from([0.5, 2.0, 3.5]), min_size=n, max_size=n),
     st.lists(st.sampled_from([0.6, 1.4, 3.0]), min_size=n, max_size=n),
     st.lists(st.sampled_from([0.0, 0.05, 4.0]), min_size=n - 1, max_size=n - 1),
-    st.sampled_from(["circular", "rectangular"])))
+    st.lists(st.sampled_from(["circular", "rectangular"]), min_size=n, max_size=n)))
 
 
 @settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow])

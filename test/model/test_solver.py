@@ -31,10 +31,12 @@ def linear_tip_x(design, tension: float) -> float:
     def compliance(s: float) -> float:
         left, right = design.notch_bounds()
         widths, backbones = design.per_notch("w_n"), design.per_notch("w_d")
-        for lo, hi, w_n, w_d in zip(left, right, widths, backbones):
+        kinds = [p.name for p in design.notch_profiles()]
+        for lo, hi, w_n, w_d, kind in zip(left, right, widths, backbones, kinds):
             if lo < s < hi:
                 centre = 0.5 * (lo + hi)
-                h1 = (w_n + w_d) / 2 - np.sqrt(max((w_n / 2) ** 2 - (s - centre) ** 2, 0))
+                h1 = w_d / 2 if kind == "rectangular" else (w_n + w_d) / 2 - np.sqrt(
+                    max((w_n / 2) ** 2 - (s - centre) ** 2, 0))
                 return 1.0 / (design.E * float(notched_moment(h1, design.R_outer, design.r_inner)))
         return 1.0 / (design.E * design.tube_second_moment)
 
@@ -58,7 +60,9 @@ PER_NOTCH = preset("paper-experiment").with_overrides(
     w_n=[2.0e-3, 2.5e-3, 1.5e-3, 2.0e-3, 2.2e-3, 3.0e-3, 2.0e-3, 1.8e-3],
     w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3, 1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3],
     w_t=[4e-3, 3e-3, 5e-3, 4e-3, 0.0, 4e-3, 2e-3])
-CASES = {**PRESETS, "per-notch": PER_NOTCH}
+#: The same with every other notch rectangular.
+MIXED_PROFILES = PER_NOTCH.with_overrides(profile=["circular", "rectangular"] * 4)
+CASES = {**PRESETS, "per-notch": PER_NOTCH, "mixed-profiles": MIXED_PROFILES}
 
 
 @pytest.mark.parametrize("name", list(CASES))
@@ -72,13 +76,14 @@ def test_small_load_matches_linear_solution(name):
         expected, rel=1e-8)
 
 
+@pytest.mark.parametrize("design", [PER_NOTCH, MIXED_PROFILES], ids=["per-notch", "mixed"])
 @pytest.mark.parametrize("tension", [5.0, 10.0, 20.0])
-def test_a_per_notch_body_matches_a_second_solver_to_a_tenth_of_a_micron(tension):
+def test_a_per_notch_body_matches_a_second_solver_to_a_tenth_of_a_micron(design, tension):
     # segmented shooting (scipy's ODE integrator, its own compliance per notch) on the fully
     # constrained tendon: the model difference from paper routing is tens of nm on the presets
     tight = ShootingOptions(rtol=1e-11, atol=1e-14)
-    reference = solve_shooting_segmented(PER_NOTCH, tension, options=tight).tip_position
-    assert np.linalg.norm(solve(PER_NOTCH, tension).tip_position - reference) < 0.1e-6
+    reference = solve_shooting_segmented(design, tension, options=tight).tip_position
+    assert np.linalg.norm(solve(design, tension).tip_position - reference) < 0.1e-6
 
 
 def test_deeper_cuts_toward_the_tip_bend_the_tip_first():

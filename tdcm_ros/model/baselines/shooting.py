@@ -108,7 +108,7 @@ class _Rod:
         self.w_n = design.per_notch("w_n").tolist()
         self.w_d = design.per_notch("w_d").tolist()
         self.tube_c = 1.0 / (design.E * design.tube_second_moment)
-        self.kind = design.profile.name
+        self.profiles = design.notch_profiles()
 
     def compliance(self, s: float) -> float:
         """Compliance at ``s``; inside notch ``i`` when ``l_i <= s < r_i``."""
@@ -117,13 +117,13 @@ class _Rod:
             return self.tube_c
         d = self.design
         sigma = s - self.left[i]
-        w_n, w_d = self.w_n[i], self.w_d[i]
-        if self.kind == "circular":
+        w_n, w_d, profile = self.w_n[i], self.w_d[i], self.profiles[i]
+        if profile.name == "circular":
             h1 = 0.5 * (w_n + w_d) - math.sqrt(max(sigma * (w_n - sigma), 0.0))
-        elif self.kind == "rectangular":
+        elif profile.name == "rectangular":
             h1 = 0.5 * w_d
         else:
-            h1_arr = d.profile.h1(np.array([sigma / w_n]), w_n, w_d)
+            h1_arr = profile.h1(np.array([sigma / w_n]), w_n, w_d)
             return float(1.0 / (d.E * notched_moment(h1_arr, d.R_outer, d.r_inner)[0]))
         inertia = 4.0 * (_strip(h1, d.R_outer) - _strip(min(h1, d.r_inner), d.r_inner))
         return 1.0 / (d.E * inertia)
