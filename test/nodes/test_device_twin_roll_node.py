@@ -35,17 +35,25 @@ def test_twin_node_publishes_the_true_roll(runtime, spawn, context, tmp_path: Pa
     driver = TensionDriver(DriverConfig(port=str(link), roll_rate=1.5), clock=time.monotonic)
     try:
         requested = False
+        results: list[Any] = []
 
         def step() -> None:  # the driver's loop; the probe spins 5 ms between steps
             nonlocal requested
-            known = driver.step().joints  # the device's roll is known to the driver
+            results.append(driver.step())
+            known = results[-1].joints  # the device's roll is known to the driver
             if known and len(joints) >= 5 and not requested:  # and the probe hears the twin
                 requested = driver.set_roll(-0.7) is not None
+
+        def detail() -> str:
+            status = results[-1].status if results else None
+            return f"{joints[-1:]}; roll requested {requested}; driver " + (
+                f"{status.link.name}, armed {status.armed}, disarmed for "
+                f"{status.disarm_reason!r}" if status is not None else "never stepped")
 
         eventually(lambda: joints and abs(float(joints[-1].position[0]) + 0.7) < 2e-3, 30.0,
                    "the true roll at -0.7 rad", action=step, every=0.0,
                    spin=SimpleNamespace(spin_for=lambda _: context.spin_for(0.005)),
-                   detail=lambda: joints[-1:])
+                   detail=detail)
     finally:
         driver.close()
     assert all(list(m.name) == ["roll"] and len(m.position) == 1 for m in joints)
