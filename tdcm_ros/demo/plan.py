@@ -17,7 +17,7 @@ from tdcm_ros.demo.trajectory import TipTrajectory, tip_trajectory
 from tdcm_ros.device import StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics import settings_for_hold
-from tdcm_ros.model import FIELD_SPECS, body_file_text, parameter_specs
+from tdcm_ros.model import body_file_text, parameter_specs
 from tdcm_ros.scenes import Scene
 
 #: Nodes in start order: consumers first, so nothing published at the start is missed; the
@@ -75,11 +75,9 @@ class DemoPlan:
         """Per-node parameters (ROS names), on top of each node's defaults; a per-notch design
         goes to the nodes as a body file written to ``out/design.yaml``."""
         scene = self.scene
-        design: dict[str, Any] = {f"design.{name}": float(getattr(scene.design, name))
-                                  for name in parameter_specs(scene.design) if name in FIELD_SPECS}
-        design["design.N"] = int(scene.design.N)
-        if not isinstance(scene.design.profile, tuple):
-            design["design.profile"] = scene.design.profile.name
+        specs = parameter_specs(scene.design)
+        design: dict[str, Any] = {f"design.{name}": value for name, value
+                                  in scene.design.to_dict().items() if name in specs}
         if not scene.design.is_uniform:  # per-notch values are a body file's, not parameters
             body = self.out / "design.yaml"
             body.parent.mkdir(parents=True, exist_ok=True)

@@ -192,6 +192,8 @@ class Design:
 #: Specs of the numeric design fields (all but ``profile``), by name.
 FIELD_SPECS = specs_of(Design)
 _LISTABLE = PER_NOTCH_FIELDS + PER_GAP_FIELDS
+#: The specs of the per-notch and per-gap fields' lists (each entry in the field's range).
+_LIST_SPECS = {name: replace(FIELD_SPECS[name], kind="list") for name in _LISTABLE}
 
 
 def _lengths(name: str, value: Any, count: int) -> Lengths:
@@ -202,7 +204,7 @@ def _lengths(name: str, value: Any, count: int) -> Lengths:
         return float(spec.check(value, error=InvalidDesignError))
     if count == 0 and len(value) == 0:
         return 0.0  # a one-notch design has no gaps
-    items = replace(spec, kind="list").check(list(value), error=InvalidDesignError)
+    items = _LIST_SPECS[name].check(list(value), error=InvalidDesignError)
     if len(items) != count:
         what = "notch" if name in PER_NOTCH_FIELDS else "gap between notches"
         raise out_of_range(name, list(items), f"one number, or {count} numbers (one per {what}:"
@@ -239,6 +241,8 @@ def _entries(name: str, value: Any) -> list[tuple[str, float]]:
     if isinstance(value, tuple):
         return [(f"{name}[{i}]", float(v)) for i, v in enumerate(value)]
     return [(name, float(value))]
+
+
 #: The design as node parameters (``design.<name>``): every numeric field and the profile by name.
 PARAMETER_SPECS = {**FIELD_SPECS, "profile": Spec(
     "profile", description="notch profile", default="circular", kind="str",
@@ -265,8 +269,8 @@ def parse_field(name: str, text: str) -> Any:
         raise InvalidDesignError(f"unknown design field {name!r}; allowed: {allowed}",
                                  parameter=name, value=text, allowed=allowed)
     stripped = text.strip()
-    if name in _LISTABLE and stripped.startswith("[") and stripped.endswith("]"):
-        return replace(spec, kind="list").parse(stripped[1:-1], name, error=InvalidDesignError)
+    if name in _LIST_SPECS and stripped.startswith("[") and stripped.endswith("]"):
+        return _LIST_SPECS[name].parse(stripped[1:-1], name, error=InvalidDesignError)
     return spec.parse(text, error=InvalidDesignError)
 
 

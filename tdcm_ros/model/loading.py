@@ -220,7 +220,7 @@ def _contact(grid: Grid, contact: NotchContact) -> _Contact:
     cells = np.flatnonzero(grid.is_notch)
     notch = grid.notch_index[cells]
     w_n = d.per_notch("w_n")
-    if d.is_uniform:
+    if d.is_uniform:  # every notch alike: their mean, as computed before per-notch designs
         open_compliance = np.full(d.N, float(np.sum(grid.C0[cells] + grid.C1[cells])) / d.N)
     else:
         open_compliance = np.bincount(notch, grid.C0[cells] + grid.C1[cells], minlength=d.N)
