@@ -29,8 +29,8 @@ Arming: the driver starts armed. It disarms -- target and setpoint 0 N, schedule
 R sent, setpoints, schedules and roll targets refused, the roll left where the device holds it --
 on an e-stop and on every event after which the device's
 state is unknown: the link lost while connected (port error, ``link_timeout``, a version
-mismatch), a device reboot (a banner nobody asked for once telemetry has flowed, or the device
-clock running backwards)
+mismatch), a device reboot (its clock running backwards, after a banner nobody asked for or
+not)
 and a freeze (no telemetry for the device's own watchdog time while the host kept stepping, and
 the device's clock ran that long between its frames: a step counts at most ``heartbeat_period`` s
 of silence, so a stall of this host -- the device's frames not read -- is not taken for one, nor
@@ -217,6 +217,7 @@ class TensionDriver:
         self._disarm_reason = ""
         self._disarms = 0
         self._info_pending = 0      # banner requests not yet answered
+        self._banner_unexplained = False  # a banner nobody asked for: the next frame decides
         self._silent = False        # the host saw the device silent for its watchdog time
         self._awake_silence = 0.0   # s without telemetry counted while the host kept stepping
         self._rejects_unlogged = 0  # rejected lines since the last warning about them
@@ -516,10 +517,12 @@ class TensionDriver:
         a delay of its frames (a stalled serial line, a suspended simulator), not a freeze."""
         previous, silence, silent = self._latest, self._awake_silence, self._silent
         self._latest, self._last_rx, self._silent, self._awake_silence = frame, now, False, 0.0
+        banner, self._banner_unexplained = self._banner_unexplained, False
         if previous is not None and frame.time < previous.time \
                 and previous.time - frame.time < CLOCK_WRAP / 2:
-            self._warn(f"device rebooted: its clock went back from {previous.time:.3f} s to "
-                       f"{frame.time:.3f} s")
+            sent = "it sent a boot banner and " if banner else ""
+            self._warn(f"device rebooted: {sent}its clock went back from {previous.time:.3f} s "
+                       f"to {frame.time:.3f} s")
             self._forget_roll()
             if self._armed:
                 self._disarm("device rebooted")
@@ -549,16 +552,16 @@ class TensionDriver:
         self._roll_setpoint = self._sent_roll = None
 
     def _on_banner(self, banner: Banner, now: float) -> None:
-        """Complete the handshake; a banner nobody asked for while connected is a reboot, unless
-        no telemetry was ever received: then it is the boot banner of a device that reset when
-        its port was opened (a UNO does), arriving with the answer to the driver's request."""
+        """Complete the handshake. A banner nobody asked for once telemetry has flowed is a
+        reboot or the answer to the handshake's request behind a boot banner that took its
+        place (a UNO resets when its port is opened; its boot banner and first frames can
+        reach the host before the request reaches the device): the device's clock in its next
+        frame tells them apart (:meth:`_on_telemetry`: back to 0 after a reboot), and until then
+        no mode is sent (:meth:`_keep_alive`), so a rebooted device is never re-tensioned."""
         solicited = self._info_pending > 0
         self._info_pending = max(0, self._info_pending - 1)
         if self._link is LinkState.CONNECTED and not solicited and self._latest is not None:
-            self._warn("device rebooted: it sent a boot banner")
-            self._latest = None  # the old frames' clock is not the new boot's
-            if self._armed:
-                self._disarm("device rebooted")
+            self._banner_unexplained = True
         self._forget_roll()
         self._banner, self._link = banner, LinkState.CONNECTED
         self._last_rx = self._last_ramp = now
@@ -583,7 +586,7 @@ class TensionDriver:
             self._send(SetSetpoint(self._setpoint))
         self._slew_roll(now)
         latest = self._latest
-        if latest is None or now - self._last_mode < MODE_RETRY:
+        if latest is None or self._banner_unexplained or now - self._last_mode < MODE_RETRY:
             return
         holding = self._enabled and self._armed
         if holding and latest.mode is Mode.RELEASE and not latest.faults:

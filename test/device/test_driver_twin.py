@@ -230,7 +230,8 @@ def test_a_reboot_on_an_open_port_is_seen_and_never_re_tensions(bench: Bench) ->
     bench.hold(10.0)
     bench.twin.reboot()
     bench.run(0.05)
-    assert any("device rebooted: it sent a boot banner" in w for w in bench.warnings)
+    assert any("device rebooted: it sent a boot banner and its clock went back" in w
+               for w in bench.warnings), bench.warnings
     bench.assert_released_until_cleared(2.0, "device rebooted")
     assert bench.driver.step().status.reconnects == 0
 
@@ -295,6 +296,41 @@ def test_a_boot_banner_when_the_port_opens_is_not_a_reboot(bench: Bench) -> None
     bench.driver.step()  # opens the port, flushes it and asks for the banner
     bench.twin.reboot()  # the reset's boot banner comes before the answer to the request
     bench.run_until_connected()
+    bench.run(0.5)
+    status = bench.driver.step().status
+    assert status.armed and not any("reboot" in w for w in bench.warnings), bench.warnings
+    bench.driver.enable()
+    assert bench.driver.set_setpoint(8.0) == 8.0
+    bench.run(3.0)
+    assert bench.twin.plant.tension == pytest.approx(8.0, abs=0.3)
+
+
+def test_a_boot_banner_and_frames_ahead_of_the_answer_are_not_a_reboot(tmp_path: Path) -> None:
+    """The race a device twin showed on a loaded machine: the host opened the port, and the
+    device's boot banner and first frames reached it before its banner request reached the
+    device; the answer then came behind telemetry. The device's clock runs on, so it is the
+    handshake, not a reboot: the driver stays armed and tensions on request."""
+    bench = Bench(tmp_path)
+    held: list[bytes] = []
+    links: list[object] = []
+
+    def slow_open(url: str) -> object:  # the host's bytes wait in `held` until released
+        link = bench.cable.open(url)
+        link.write = held.append  # type: ignore[method-assign]
+        links.append(link)
+        return link
+
+    bench.driver._open_port = slow_open  # the port opener is the seam under test
+    bench.driver.step()  # opens the port and asks for the banner: the request is held
+    assert held, "the driver asked for the banner"
+    bench.twin.reboot()  # the reset of the open: boot banner, then frames
+    bench.run(0.05)
+    assert bench.last is not None and bench.last.status.link is LinkState.CONNECTED
+    for data in held:  # the request reaches the device now: its answer follows the frames
+        bench.twin.receive(data)
+    held.clear()
+    link = links[-1]
+    link.write = lambda data: bench.twin.receive(data)  # type: ignore[attr-defined]
     bench.run(0.5)
     status = bench.driver.step().status
     assert status.armed and not any("reboot" in w for w in bench.warnings), bench.warnings
