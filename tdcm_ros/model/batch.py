@@ -39,7 +39,14 @@ from tdcm_ros.model.errors import (
     ModelError,
     TensionRangeError,
 )
-from tdcm_ros.model.grid import PEAK_SAMPLES, Grid, GridParts, build_grid, grid_parts
+from tdcm_ros.model.grid import (
+    PEAK_SAMPLES,
+    Grid,
+    GridParts,
+    arm_weighted,
+    build_grid,
+    grid_parts,
+)
 from tdcm_ros.model.grid_layout import Members
 from tdcm_ros.model.kernel import CONVERGED
 from tdcm_ros.model.kinematics import PlanarShape
@@ -130,8 +137,11 @@ class _Stack:
         counts = parts.table.count
         proto = parts.table.prototypes
         peak = np.zeros(counts.size)
-        np.maximum.at(peak, proto.member[~proto.chord],
-                      parts.proto_fc[:-1, grid_kernel.PEAK_C][~proto.chord])
+        follows = ~proto.chord
+        fc = parts.proto_fc[:-1][follows]
+        np.maximum.at(peak, proto.member[follows], arm_weighted(
+            fc[:, grid_kernel.PEAK_C], fc[:, grid_kernel.XB_START], fc[:, grid_kernel.XB_END],
+            parts.members.R_c[proto.member[follows]]))
         out = []
         for count in np.unique(counts):
             rows = np.flatnonzero(counts == count)

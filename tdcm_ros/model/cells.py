@@ -2,7 +2,8 @@
 
 :class:`Cells` holds one grid (one member) or a stack of grids; it has the fields of
 :class:`~tdcm_ros.model.grid.Grid` the kernels read (``C0``, ``C1``, ``A0``, ``A1``, ``w_q``,
-the chord terms ``C0_T``, ``C1_T``, ``A0_T``, ``A1_T``, ``chord_start_node``, ``chord_end_node``, ``constrained``, ``notch_left_node``,
+the chord terms ``C0_T``, ``C1_T``, ``A0_T``, ``A1_T``, the off-axis centroid's ``xbar_start``,
+``xbar_end``, ``K0``, ``K1``, ``chord_start_node``, ``chord_end_node``, ``constrained``, ``notch_left_node``,
 ``notch_right_node``), each with the member axis first. Grids of different cell or notch
 counts stack by padding with zero-length cells at the tip (they move no node) and with
 notches marked -1 (never checked).
@@ -20,7 +21,7 @@ from numpy.typing import NDArray
 
 from tdcm_ros.model import grid_kernel
 from tdcm_ros.model.compiled import grid_kernels
-from tdcm_ros.model.grid import CellArrays, Grid, GridParts, GridStack
+from tdcm_ros.model.grid import CellArrays, Grid, GridParts, GridStack, arm_weighted
 
 Array = NDArray[np.float64]
 Ints = NDArray[np.int64]
@@ -48,8 +49,8 @@ class Cells:
         n = max(c.n_cells for c in parts)
         k = max(c.notch.shape[2] for c in parts)
         q = max(c.fq.shape[3] for c in parts)
-        fc = np.zeros((len(parts), 4, n))
-        fq = np.zeros((len(parts), 5, n, q))
+        fc = np.zeros((len(parts), FC_ROWS, n))
+        fq = np.zeros((len(parts), FQ_ROWS, n, q))
         ic = np.zeros((len(parts), 3, n), np.int64)
         ic[:, 2] = 1
         notch = np.full((len(parts), 2, k), -1, np.int64)
@@ -66,9 +67,11 @@ class Cells:
     def of_stack(cls, stack: GridStack) -> Cells:
         """Members = the designs of a :func:`~tdcm_ros.model.grid.build_grids` stack (its
         zero-length padding cells and tip-node padding notches are neutral here too)."""
-        peak = np.where(stack.constrained & (stack.length > 0.0), stack.peak_c, 0.0)
+        r_c = np.array([d.R_c for d in stack.designs])
+        peak = np.where(stack.constrained & (stack.length > 0.0), arm_weighted(
+            stack.peak_c, stack.xbar_start, stack.xbar_end, r_c[:, None]), 0.0)
         return _packed(stack, lambda values: values, np.stack(
-            [np.array([d.R_c for d in stack.designs]),
+            [r_c,
              np.array([d.R_outer for d in stack.designs]),
              np.array([d.length for d in stack.designs]),
              np.max(peak, axis=1, initial=0.0)], axis=1))
@@ -81,9 +84,9 @@ class Cells:
         cell, proto, valid = parts.cells_of(rows)
         table, members = parts.table, parts.members
         build = grid_kernels()
-        fc = np.empty((rows.size, 4, cell.shape[1], 1))
+        fc = np.empty((rows.size, FC_ROWS, cell.shape[1], 1))
         build.gather(proto, _FC_FIELDS, parts.proto_fc[..., None], fc)
-        fq = np.empty((rows.size, 5, cell.shape[1], parts.gauss_u.size))
+        fq = np.empty((rows.size, FQ_ROWS, cell.shape[1], parts.gauss_u.size))
         build.gather(proto, _FQ_FIELDS, parts.proto_fq, fq)
         tip = table.count[rows][:, None]
         constrained = np.where(valid, table.constrained[cell], True)
@@ -91,7 +94,10 @@ class Cells:
                        np.where(valid, table.chord_end_node[cell], tip),
                        constrained], axis=1).astype(np.int64)
         notches = int(members.N[rows].max())
-        peak = np.where(constrained, parts.proto_fc[proto, grid_kernel.PEAK_C], 0.0)
+        fc_of = parts.proto_fc[proto]
+        peak = np.where(constrained, arm_weighted(
+            fc_of[..., grid_kernel.PEAK_C], fc_of[..., grid_kernel.XB_START],
+            fc_of[..., grid_kernel.XB_END], members.R_c[rows][:, None]), 0.0)
         scal = np.stack([members.R_c[rows], members.R_outer[rows], members.length[rows],
                          np.max(peak, axis=1, initial=0.0)], axis=1)
         return cls(fc=fc[..., 0], fq=fq, ic=ic,
@@ -205,9 +211,15 @@ class Cells:
         return self.scal[:, 3]
 
 
-_FC_FIELDS = np.array([grid_kernel.C0, grid_kernel.C1, grid_kernel.C0_T, grid_kernel.C1_T])
+_FC_NAMES = ("C0", "C1", "C0_T", "C1_T", "xbar_start", "xbar_end", "D")
+_FQ_NAMES = ("A0", "A1", "w_q", "A0_T", "A1_T", "K0", "K1", "D_q", "K2")
+_FC_FIELDS = np.array([grid_kernel.C0, grid_kernel.C1, grid_kernel.C0_T, grid_kernel.C1_T,
+                       grid_kernel.XB_START, grid_kernel.XB_END, grid_kernel.D_CELL])
 _FQ_FIELDS = np.array([grid_kernel.A0, grid_kernel.A1, grid_kernel.W_Q, grid_kernel.A0_T,
-                       grid_kernel.A1_T])
+                       grid_kernel.A1_T, grid_kernel.K0, grid_kernel.K1, grid_kernel.D_Q,
+                       grid_kernel.K2])
+#: Rows of :attr:`Cells.fc` and :attr:`Cells.fq` (the kernel's layout).
+FC_ROWS, FQ_ROWS = _FC_FIELDS.size, _FQ_FIELDS.size
 
 
 @lru_cache(maxsize=512)
@@ -225,8 +237,7 @@ def _packed(grids: CellArrays, member_axis: Callable[[NDArray[Any]], NDArray[Any
         return np.ascontiguousarray(np.stack(
             [member_axis(getattr(grids, name)) for name in names], axis=1))
 
-    return Cells(fc=packed("C0", "C1", "C0_T", "C1_T"),
-                 fq=packed("A0", "A1", "w_q", "A0_T", "A1_T"),
+    return Cells(fc=packed(*_FC_NAMES), fq=packed(*_FQ_NAMES),
                  ic=packed("chord_start_node", "chord_end_node", "constrained").astype(np.int64),
                  notch=packed("notch_left_node", "notch_right_node").astype(np.int64),
                  scal=scal)

@@ -3,10 +3,15 @@
 Geometry (eq. 1): ``L = w_base + N w_n + (N-1) w_t + w_tip``; notch ``i`` (1-based) spans
 ``[l_i, r_i]`` with ``l_i = w_base + (i-1)(w_n + w_t)`` and ``r_i = l_i + w_n``.
 
-Per notch: ``w_n`` and ``w_d`` may be N values (notch ``i``'s width and backbone, base to
-tip) and ``w_t`` N - 1 values (the tube after notch ``i``); then ``l_i`` is the sum of the
+Per notch: ``w_n``, ``w_d`` and ``w_o`` may be N values (notch ``i``'s width, backbone and
+backbone offset, base to tip) and ``w_t`` N - 1 values (the tube after notch ``i``); then ``l_i`` is the sum of the
 segments before notch ``i``. A list whose values are all equal is stored as that one value, so
 an evenly spaced, identical pattern is the uniform design whichever way it is written.
+
+``w_o`` moves a notch's backbone off the tube axis: the material left is the tube where
+``w_o - h1 <= x <= w_o + h1`` (``h1`` the profile's half-width, ``w_d / 2`` at the notch centre;
+``x`` toward the tendon). 0 is the paper's symmetric pair of cuts; ``w_o = -(R_outer - w_d/2)``
+leaves the tube's ``-x`` side whole: a one-sided cut of depth ``2 R_outer - w_d`` from ``+x``.
 
 ``E`` defaults to 1.85 GPa (Formlabs Nylon 12 powder datasheet, tensile modulus). Thin SLS
 features are often softer: treat ``E`` as a calibration parameter (``tdcm calibrate``).
@@ -36,8 +41,10 @@ MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
 #: or at least this, so no cell is negligible against the arc lengths it sits between.
 MIN_SEGMENT_M = 1e-6
+#: Relative slack (of ``R_outer``) of the check ``|w_o| <= R_outer - w_d/2``, for rounding.
+OFFSET_SLACK = 1e-12
 #: Fields that may hold one value per notch (base to tip).
-PER_NOTCH_FIELDS = ("w_n", "w_d")
+PER_NOTCH_FIELDS = ("w_n", "w_d", "w_o")
 #: Fields that may hold one value per gap between adjacent notches (base to tip).
 PER_GAP_FIELDS = ("w_t",)
 #: A length (m): one value, or one per notch or gap (see the module docstring).
@@ -70,6 +77,10 @@ class Design:
                             low=0.0, high=0.5, low_open=True)
     E: float = spec_field(1.85e9, unit="Pa", description="Young's modulus (calibration parameter)",
                           low=0.0, high=1e12, low_open=True)
+    w_o: float | tuple[float, ...] = spec_field(
+        0.0, unit="m", description="backbone offset toward the tendon (+x) from the tube axis; 0: "
+        "the paper's symmetric notch, -(R_outer - w_d/2): a one-sided cut from +x (per notch: "
+        "a list in Python and --set, or a body file)", low=-0.5, high=0.5, kind="float")
     profile: NotchProfile | tuple[NotchProfile, ...] = field(default_factory=CircularProfile)
 
     def __post_init__(self) -> None:
@@ -82,7 +93,7 @@ class Design:
 
     def _check_cross_fields(self) -> None:
         """Ranges that depend on other fields: radii inside ``R_outer`` (m), the backbone
-        narrower than the tube, and tube segments absent or at least ``MIN_SEGMENT_M`` long."""
+        narrower than the tube and inside it (``|w_o| <= R_outer - w_d/2``), and tube segments absent or at least ``MIN_SEGMENT_M`` long."""
         diameter = 2.0 * self.R_outer
         below = (("r_inner", self.R_outer, f"[0, R_outer = {self.R_outer:g}) m"),
                  ("R_c", self.R_outer, f"(0, R_outer = {self.R_outer:g}) m"),
@@ -91,6 +102,13 @@ class Design:
             for where, value in _entries(name, getattr(self, name)):
                 if value >= limit:
                     raise out_of_range(where, value, allowed, error=InvalidDesignError)
+        room = self.R_outer - 0.5 * self.per_notch("w_d")
+        slack = OFFSET_SLACK * self.R_outer  # a cut's w_o = -(R_outer - w_d/2) to rounding
+        for i in np.flatnonzero(np.abs(self.per_notch("w_o")) > room + slack)[:1]:
+            where = f"w_o[{i}]" if isinstance(self.w_o, tuple) else "w_o"
+            raise out_of_range(where, float(self.per_notch("w_o")[i]),
+                               f"[-{room[i]:g}, {room[i]:g}] m (the backbone, w_d wide, inside "
+                               "the tube: |w_o| <= R_outer - w_d/2)", error=InvalidDesignError)
         for name in ("w_base", "w_t", "w_tip"):
             for where, value in _entries(name, getattr(self, name)):
                 if 0.0 < value < MIN_SEGMENT_M:
@@ -123,7 +141,7 @@ class Design:
         return profile
 
     def uniform(self, name: str, what: str = "this") -> float:
-        """Field ``name`` (``w_n``, ``w_d``, ``w_t``) where it holds one value (m); a per-notch
+        """Field ``name`` (``w_n``, ``w_d``, ``w_o``, ``w_t``) where it holds one value (m); a per-notch
         list raises :class:`InvalidDesignError` saying that ``what`` takes one value."""
         value = getattr(self, name)
         if isinstance(value, tuple):
@@ -134,7 +152,7 @@ class Design:
         return float(value)
 
     def per_notch(self, name: str) -> NDArray[np.float64]:
-        """Field ``name`` (``w_n``, ``w_d``: N values; ``w_t``: N - 1) as an array (m), base
+        """Field ``name`` (``w_n``, ``w_d``, ``w_o``: N values; ``w_t``: N - 1) as an array (m), base
         to tip, whether the design stores one value or a list."""
         value = getattr(self, name)
         return np.array(value, dtype=float) if isinstance(value, tuple) else np.full(

@@ -12,8 +12,19 @@ For each cell the grid stores:
   integrands from ``a`` to ``s_q``, so the tangent angle there is known exactly and the
   cell's planar displacement (eq. 2) is one quadrature of ``(sin, cos)`` of it;
 - ``strain0``, ``strain1`` (cells, ``PEAK_SAMPLES``): the bending strain at equally spaced
-  probes of a notch cell is ``|m_a strain0 + m_b strain1|`` (``(1 - xi | xi) c min(h1,
-  R_outer)``; zero in tubes);
+  probes of a notch cell is ``|m_a strain0 + m_b strain1|`` (``(1 - xi | xi) c fibre``, the
+  farthest material from the section's centroid, ``min(h1, R_outer)`` for the paper's
+  section; zero in tubes);
+- where a notch's backbone is off the tube axis (``Design.w_o``), its sections' centroids
+  are too: ``xbar_q``, ``xbar_start``, ``xbar_end`` (m, + toward the tendon) at the Gauss
+  points and the cell's ends. The moments ``m_a``, ``m_b`` are then taken about the centroid
+  (the neutral axis of the section, which bends without stretching), and the body is still
+  drawn along the tube axis, which stretches by ``x_bar kappa`` (m/m) there: ``K0``, ``K1``
+  (``w_q x_bar c (1 - xi | xi)``) add ``m_a K0 + m_b K1`` to each Gauss point's ds weight.
+  Integrating the axis keeps the notch faces, the tendon's offset and every output where
+  they are for symmetric sections (all zero there: the paper's model unchanged). Inside a
+  cell the moment about the moving centroid is taken linear like any other (exact where
+  ``x_bar`` is constant along the notch, e.g. a rectangular one-sided cut);
 - on cells the tendon crosses as a chord, ``A0_T``, ``A1_T``, ``C0_T``, ``C1_T``: the same per
   newton of tension for the chord moment's non-linear part (``m'' = -T c m``, see
   :func:`tdcm_ros.model.grid_kernel.cell_integrals`). A kernel that uses them takes ``A0 + T A0_T`` etc. in place of
@@ -34,7 +45,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, fields
 from functools import cached_property, lru_cache
 from itertools import pairwise
-from typing import Any, TypeVar
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,7 +54,7 @@ from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.compiled import grid_kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.grid_kernel import CIRCULAR, CUSTOM, RECTANGULAR
+from tdcm_ros.model.grid_kernel import CIRCULAR, CUSTOM, RECTANGULAR, offset_section
 from tdcm_ros.model.grid_layout import (
     PEAK_SAMPLES,
     CellTable,
@@ -60,8 +71,21 @@ from tdcm_ros.model.settings import SolverSettings
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 Scalar = TypeVar("Scalar", bound=np.generic)
-#: ``(cells, A0_s, A1_s, A0_r, A1_r, w_r)`` of :meth:`Grid.query`.
-Query = tuple[IntArray, Array, Array, Array, Array, Array]
+class Query(NamedTuple):
+    """:meth:`Grid.query`'s answer for stations ``s``: each one's cell and the integrals from
+    the cell's start to it (:meth:`Grid.partial_integrals`; SI units)."""
+
+    cells: IntArray
+    a0_s: Array
+    a1_s: Array
+    d_s: Array
+    a0_r: Array
+    a1_r: Array
+    d_r: Array
+    w_r: Array
+    k0_r: Array
+    k1_r: Array
+    k2_r: Array
 
 #: Distinct query station sets a grid keeps (see :meth:`Grid.query`).
 QUERY_CACHE_SIZE = 8
@@ -96,10 +120,18 @@ class CellArrays:
     A1: Array
     A0_T: Array
     A1_T: Array
+    xbar_q: Array
+    K0: Array
+    K1: Array
+    D_q: Array
+    K2: Array
     C0_T: Array
     C1_T: Array
     c_start: Array
     c_end: Array
+    xbar_start: Array
+    xbar_end: Array
+    D: Array
     peak_c: Array
     peak_s: Array
     strain0: Array
@@ -124,9 +156,12 @@ class Grid(CellArrays):
 
     @property
     def constrained_peak_c(self) -> float:
-        """Largest compliance (1/(N m^2)) over cells where the tendon follows the body."""
+        """Largest compliance (1/(N m^2)) over cells where the tendon follows the body, each
+        scaled by its squared arm (:func:`arm_weighted`)."""
         cells = self.constrained_cells
-        return float(np.max(self.peak_c[cells])) if cells.size else 0.0
+        return float(np.max(arm_weighted(self.peak_c[cells], self.xbar_start[cells],
+                                         self.xbar_end[cells], self.design.R_c))
+                     ) if cells.size else 0.0
 
     @property
     def n_cells(self) -> int:
@@ -190,18 +225,21 @@ class Grid(CellArrays):
         if found is None:
             cells = np.clip(np.searchsorted(self.s_nodes, s, side="right") - 1, 0,
                             self.n_cells - 1)
-            found = (cells, *self.partial_integrals(cells, s))
+            found = Query(cells, *self.partial_integrals(cells, s))
             if len(self._queries) >= QUERY_CACHE_SIZE:
                 del self._queries[next(iter(self._queries))]
             self._queries[key] = found
         return found
 
     def partial_integrals(self, cells: IntArray, s: Array
-                          ) -> tuple[Array, Array, Array, Array, Array]:
+                          ) -> tuple[Array, Array, Array, Array, Array, Array, Array, Array,
+                                     Array, Array]:
         """Integrals from each cell's start ``a`` to a query ``s`` inside it (SI units).
 
-        Returns ``(A0_s, A1_s, A0_r, A1_r, w_r)``: ``A0``/``A1`` at ``s`` (shape (k,)), at the
-        Gauss points of ``[a, s]`` (shape (k, Q)), and those points' ds weights (m).
+        Returns ``(A0_s, A1_s, D_s, A0_r, A1_r, D_r, w_r, K0_r, K1_r, K2_r)``: ``A0``, ``A1``,
+        ``D`` at ``s`` (shape (k,)) and at the Gauss points of ``[a, s]`` (shape (k, Q)), those
+        points' ds weights (m) and their tube-axis stretch terms ``K0``, ``K1``, ``K2`` (module
+        docstring; ``D`` and ``K`` are 0 where the centroid is on the axis).
         """
         rows = self.rows(cells)
         ua = self.u_a[cells][:, None]
@@ -209,9 +247,26 @@ class Grid(CellArrays):
         u_r = ua + (us - ua) * self.gauss_u[None, :]
         w_r = _exact_length((us - ua) * self.gauss_w[None, :] * rows.jacobian(u_r),
                             s - self.s_nodes[cells])
-        a0_r, a1_r = _nested(rows, self.gauss_u, self.gauss_w, ua, u_r)
-        a0_s, a1_s = _nested(rows, self.gauss_u, self.gauss_w, ua, us)
-        return a0_s[:, 0], a1_s[:, 0], a0_r, a1_r, w_r
+        ends = (self.xbar_start[cells][:, None], self.xbar_end[cells][:, None])
+        a0_r, a1_r, d_r = _nested(rows, self.gauss_u, self.gauss_w, ua, u_r, ends)
+        a0_s, a1_s, d_s = _nested(rows, self.gauss_u, self.gauss_w, ua, us, ends)
+        c_r, x_bar_r = rows.section(u_r)
+        xi_r = _xi(rows, u_r)
+        stretch = w_r * x_bar_r * c_r
+        off = x_bar_r - ((1.0 - xi_r) * ends[0] + xi_r * ends[1])
+        return (a0_s[:, 0], a1_s[:, 0], d_s[:, 0], a0_r, a1_r, d_r, w_r,
+                stretch * (1.0 - xi_r), stretch * xi_r, stretch * off)
+
+
+def arm_weighted(peak_c: Array, xbar_start: Array, xbar_end: Array, r_c: Array | float
+                 ) -> Array:
+    """Each cell's peak compliance ``c`` (1/(N m^2)) times ``((R_c - x_bar) / R_c)^2``, with
+    the centroid's offset ``x_bar`` (m) farther from the tendon of the cell's two ends: then
+    ``R_c^2 T`` times it is ``(R_c - x_bar) kappa`` under the tendon's own moment
+    ``(R_c - x_bar) T``, where the tendon's path cusps at 1 (``c`` itself where the centroid
+    is on the axis)."""
+    arm = r_c - np.minimum(xbar_start, xbar_end)
+    return peak_c * (arm / r_c) ** 2
 
 
 def _exact_length(weights: Array, length: Array) -> Array:
@@ -254,15 +309,32 @@ class CellRows:
 
     def compliance(self, u: Array) -> Array:
         """``1/(E I)`` (1/(N m^2)) at ``u``."""
+        return self.section(u)[0]
+
+    def section(self, u: Array) -> tuple[Array, Array]:
+        """``1/(E I)`` (1/(N m^2)) about the section's centroid and the centroid's offset from
+        the tube axis (m, + toward the tendon) at ``u``: eq. 12's section where the backbone is
+        centred, :func:`tdcm_ros.model.grid_kernel.offset_section` where it is not."""
         m = self.members
         every = np.broadcast_to(per_row(self.member, u), u.shape)
         inertia = m.tube_moment[every]
+        x_bar = np.zeros(u.shape)
         shape, notch = self._notch_points(u)
         if shape.size:
             owner = m.shape_member[shape]
-            inertia[notch] = notched_moment(m.h1(shape, u[notch]), m.R_outer[owner],
-                                            m.r_inner[owner])
-        return 1.0 / (m.E[every] * inertia)
+            h1 = m.h1(shape, u[notch])
+            in_notch = notched_moment(h1, m.R_outer[owner], m.r_inner[owner])
+            offset = m.shape_w_o[shape]
+            off = offset != 0.0
+            if np.any(off):
+                _, in_notch[off], x_off, _ = _offset_sections(h1[off], offset[off],
+                                                              m.R_outer[owner][off],
+                                                              m.r_inner[owner][off])
+                x_bar_notch = np.zeros(h1.shape)
+                x_bar_notch[off] = x_off
+                x_bar[notch] = x_bar_notch
+            inertia[notch] = in_notch
+        return 1.0 / (m.E[every] * inertia), x_bar
 
     def _notch_points(self, u: Array) -> tuple[IntArray, NDArray[np.bool_]]:
         """Notch shapes (rows of :class:`Members`) of the points of ``u`` inside notches
@@ -272,19 +344,33 @@ class CellRows:
         return np.broadcast_to(per_row(shape, u), u.shape)[notch], notch
 
 
-def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Array
-            ) -> tuple[Array, Array]:
-    """``A0``, ``A1`` from reference coordinate ``ua`` to each ``u_end`` of the same cell.
+_offset_sections = np.vectorize(offset_section, otypes=[float] * 4)
+""":func:`tdcm_ros.model.grid_kernel.offset_section` over arrays (query stations: a few
+hundred points, computed once per grid and station set)."""
+
+
+def _xi(rows: CellRows, u: Array) -> Array:
+    """``(s - a) / (b - a)`` of each row's cell at reference coordinates ``u``."""
+    return (per_row(rows.seg_start, u) + rows.local_sigma(u) - per_row(rows.a, u)
+            ) / per_row(rows.length, u)
+
+
+def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Array,
+            ends: tuple[Array, Array]) -> tuple[Array, Array, Array]:
+    """``A0``, ``A1`` and ``D`` from reference coordinate ``ua`` to each ``u_end`` of the same
+    cell; ``ends`` are the cells' ``x_bar`` at their start and end (m, broadcast against
+    ``u_end``).
 
     ``u_end`` has one row per cell of ``rows``; ``ua`` broadcasts against it.
     """
     span = u_end - ua
     inner_u = ua[..., None] + span[..., None] * gauss_u
     inner_ds = span[..., None] * gauss_w * rows.jacobian(inner_u)
-    s_inner = per_row(rows.seg_start, inner_u) + rows.local_sigma(inner_u)
-    xi = (s_inner - per_row(rows.a, inner_u)) / per_row(rows.length, inner_u)
-    c = rows.compliance(inner_u)
-    return np.sum(inner_ds * (1.0 - xi) * c, axis=-1), np.sum(inner_ds * xi * c, axis=-1)
+    xi = _xi(rows, inner_u)
+    c, x_bar = rows.section(inner_u)
+    off = x_bar - ((1.0 - xi) * ends[0][..., None] + xi * ends[1][..., None])
+    return (np.sum(inner_ds * (1.0 - xi) * c, axis=-1), np.sum(inner_ds * xi * c, axis=-1),
+            np.sum(inner_ds * c * off, axis=-1))
 
 
 def build_grid(design: Design, settings: SolverSettings) -> Grid:
@@ -309,7 +395,7 @@ class GridParts:
     (``table``, :mod:`tdcm_ros.model.grid_layout`) and the integrals of every prototype cell
     (:func:`tdcm_ros.model.grid_kernel.cell_integrals`), SI units.
 
-    ``proto_fc`` (P + 1, 8) and ``proto_fq`` (P + 1, 8, Q) hold the kernel's per-cell and
+    ``proto_fc`` (P + 1, 11) and ``proto_fq`` (P + 1, 13, Q) hold the kernel's per-cell and
     per-Gauss-point outputs (columns and rows named in :mod:`tdcm_ros.model.grid_kernel`),
     ``proto_strain`` (P + 1, 2, ``PEAK_SAMPLES``) its strain coefficients; their last row is
     zero, the integrals of a padding cell.
@@ -361,9 +447,11 @@ class GridParts:
 
         seg_start = laid(table.seg_start, tip)
         fq = {name: self.proto_fq[proto, k] for k, name in enumerate(
-            ("s_q", "w_q", "xi_q", "c_q", "A0", "A1", "A0_T", "A1_T"))}
+            ("s_q", "w_q", "xi_q", "c_q", "A0", "A1", "A0_T", "A1_T", "xbar_q", "K0", "K1",
+             "D_q", "K2"))}
         fc = {name: self.proto_fc[proto, k] for k, name in enumerate(
-            ("C0", "C1", "C0_T", "C1_T", "c_start", "c_end", "peak_c", "peak_s"))}
+            ("C0", "C1", "C0_T", "C1_T", "c_start", "c_end", "peak_c", "peak_s", "xbar_start",
+             "xbar_end", "D"))}
         fq["s_q"] += seg_start[..., None]
         fc["peak_s"] += seg_start
         strain = {"strain0": self.proto_strain[proto, 0], "strain1": self.proto_strain[proto, 1]}
@@ -396,13 +484,13 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
     owner = members.shape_member
     design = np.stack([kinds[members.profile_of], members.shape_w_n, members.shape_w_d,
                        members.R_outer[owner], members.r_inner[owner], members.E[owner],
-                       members.tube_moment[owner]], axis=1)
+                       members.tube_moment[owner], members.shape_w_o], axis=1)
     build = grid_kernels()
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
     custom_row, custom_h1 = _custom_h1(table, build, cell, design, gauss_u, probe)
     count = table.u_a.size
-    fc = np.zeros((count + 1, 8))
-    fq = np.zeros((count + 1, 8, quad_order))
+    fc = np.zeros((count + 1, 11))
+    fq = np.zeros((count + 1, 13, quad_order))
     strain = np.zeros((count + 1, 2, PEAK_SAMPLES))
     matrix = _integration_matrix(quad_order)
 

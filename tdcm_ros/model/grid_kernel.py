@@ -11,7 +11,7 @@ prototype cells of :mod:`tdcm_ros.model.grid_layout`; the module docstring of
 Per prototype cell ``i`` (inputs, SI units): ``shape[i]``; ``cell[i, :]`` =
 ``(is_notch, chord, u_a, u_b, a, length, seg_length)`` (``a`` from the segment start, m).
 Per notch shape ``k`` (a member's distinct notch; a tube cell names its member's first):
-``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR` and :data:`CUSTOM`
+``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment, w_o)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR` and :data:`CUSTOM`
 (``h1`` read from ``custom_h1[custom_row[i]]`` at the points of :func:`points`, ``sigma``
 linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
 (``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally
@@ -35,12 +35,18 @@ CUSTOM = 2
 
 IS_NOTCH, CHORD, U_A, U_B, START, LENGTH, SEG_LENGTH = range(7)
 """Columns of ``cell``."""
-KIND, W_N, W_D, R_OUTER, R_INNER, E, TUBE_MOMENT = range(7)
+KIND, W_N, W_D, R_OUTER, R_INNER, E, TUBE_MOMENT, W_O = range(8)
 """Columns of ``design``."""
-C0, C1, C0_T, C1_T, C_START, C_END, PEAK_C, PEAK_S = range(8)
-"""Columns of the per-cell output ``fc``."""
-S_Q, W_Q, XI_Q, C_Q, A0, A1, A0_T, A1_T = range(8)
-"""Rows of the per-Gauss-point output ``fq`` (cells, 8, Q)."""
+C0, C1, C0_T, C1_T, C_START, C_END, PEAK_C, PEAK_S, XB_START, XB_END, D_CELL = range(11)
+"""Columns of the per-cell output ``fc`` (cells, 11)."""
+S_Q, W_Q, XI_Q, C_Q, A0, A1, A0_T, A1_T, XB_Q, K0, K1, D_Q, K2 = range(13)
+"""Rows of the per-Gauss-point output ``fq`` (cells, 13, Q)."""
+
+_NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
+STRIP_NODES = 0.5 * (_NODES + 1.0)
+STRIP_WEIGHTS = 0.5 * _WEIGHTS
+"""Gauss-Legendre nodes and weights on [0, 1] of :func:`disc_strip` (24: the integrand, a
+trigonometric polynomial of degree 4 over at most pi, to rounding)."""
 
 SERIES_BELOW = 0.05
 """Below this ``h/R`` the disc-strip moment is its series (as :mod:`tdcm_ros.model.section`)."""
@@ -74,6 +80,55 @@ def notch_compliance(h1: float, r_outer: float, r_inner: float, e: float) -> flo
     return 1.0 / (e * inertia)
 
 
+def disc_strip(lo: float, hi: float, radius: float, about: float
+               ) -> tuple[float, float, float]:
+    """Area (m^2), ``int (x - about) dA`` (m^3) and ``int (x - about)^2 dA`` (m^4) of the part
+    of a disc of ``radius`` (m) centred at ``x = 0`` where ``lo <= x <= hi`` (clipped to the
+    disc); zeros for an empty part. By Gauss-Legendre quadrature in the angle ``t`` (``x = R
+    sin t``, ``dA = 2 R^2 cos^2 t dt``): the integrand is smooth, every term of the area and of
+    the second moment is positive, so a thin strip far from the centre (a deep one-sided cut's
+    backbone) keeps full precision where the closed forms' differences lose digits."""
+    if radius <= 0.0:
+        return 0.0, 0.0, 0.0
+    a = min(max(lo, -radius), radius)
+    b = min(max(hi, -radius), radius)
+    if b <= a:
+        return 0.0, 0.0, 0.0
+    t_a = math.asin(a / radius)
+    span = math.asin(b / radius) - t_a
+    area = 0.0
+    first = 0.0
+    second = 0.0
+    for k in range(STRIP_NODES.shape[0]):
+        t = t_a + span * STRIP_NODES[k]
+        cosine = math.cos(t)
+        weight = 2.0 * radius * radius * cosine * cosine * span * STRIP_WEIGHTS[k]
+        arm = radius * math.sin(t) - about
+        area += weight
+        first += weight * arm
+        second += weight * arm * arm
+    return area, first, second
+
+
+def offset_section(h1: float, offset: float, r_outer: float, r_inner: float
+                   ) -> tuple[float, float, float, float]:
+    """``(A, I, x_bar, fibre)`` of the tube ``r_inner <= rho <= r_outer`` where ``offset - h1
+    <= x <= offset + h1`` (m): the area (m^2), the second moment about the centroid's axis
+    (m^4), the centroid's offset from the tube axis (m, + toward the tendon) and the distance
+    from it to the farthest material (m). Moments are taken about the strip's middle, then
+    about the centroid (:func:`disc_strip`), each the outer disc's less the lumen's."""
+    lo = max(offset - h1, -r_outer)
+    hi = min(offset + h1, r_outer)
+    middle = 0.5 * (lo + hi)
+    area, first, _ = disc_strip(lo, hi, r_outer, middle)
+    hole, hole_first, _ = disc_strip(lo, hi, r_inner, middle)
+    area -= hole
+    x_bar = middle + (first - hole_first) / area
+    _, _, second = disc_strip(lo, hi, r_outer, x_bar)
+    _, _, hole_second = disc_strip(lo, hi, r_inner, x_bar)
+    return area, second - hole_second, x_bar, max(hi - x_bar, x_bar - lo)
+
+
 def geometry(kind: float, w_n: float, w_d: float, u: float,
              custom: float) -> tuple[float, float, float]:
     """``(sigma, d sigma/du, h1)`` (m) at ``u`` in a notch of profile ``kind``; ``custom`` is
@@ -89,13 +144,18 @@ def geometry(kind: float, w_n: float, w_d: float, u: float,
 
 
 def point(notch: bool, d: Array, seg_length: float, u: float, custom: float
-          ) -> tuple[float, float, float]:
-    """``(sigma, ds/du, 1/(E I))`` at ``u`` in a cell's segment (m, m, 1/(N m^2)) of a notch shape
-    with ``design`` row ``d``."""
+          ) -> tuple[float, float, float, float, float]:
+    """``(sigma, ds/du, 1/(E I), x_bar, fibre)`` at ``u`` in a cell's segment (m, m,
+    1/(N m^2), m, m) of a notch shape with ``design`` row ``d``: the section's centroid offset
+    and the distance from it to its farthest fibre (0 in tubes, where no strain is sampled)."""
     if not notch:
-        return seg_length * u, seg_length, 1.0 / (d[E] * d[TUBE_MOMENT])
+        return seg_length * u, seg_length, 1.0 / (d[E] * d[TUBE_MOMENT]), 0.0, 0.0
     sigma, jac, h1 = geometry(d[KIND], d[W_N], d[W_D], u, custom)
-    return sigma, jac, notch_compliance(h1, d[R_OUTER], d[R_INNER], d[E])
+    if d[W_O] == 0.0:  # eq. 12's symmetric section: the paper's formula, centroid on the axis
+        return (sigma, jac, notch_compliance(h1, d[R_OUTER], d[R_INNER], d[E]), 0.0,
+                min(h1, d[R_OUTER]))
+    _, inertia, x_bar, fibre = offset_section(h1, d[W_O], d[R_OUTER], d[R_INNER])
+    return sigma, jac, 1.0 / (d[E] * inertia), x_bar, fibre
 
 
 def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
@@ -121,10 +181,21 @@ def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
 def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
                    custom_h1: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
                    probe: Array, fc: Array, fq: Array, strain: Array) -> None:
-    """Every integral of each cell (module docstring) into ``fc`` (cells, 8) and ``fq``
-    (cells, 8, Q); ``strain`` (cells, 2, probes) gets the bending-strain coefficients
-    ``(1 - xi, xi) c min(h1, R_outer)`` at the probes of notch cells (0 elsewhere).
-    ``matrix`` (Q, Q) is the Gauss points' partial-integration matrix on [0, 1]."""
+    """Every integral of each cell (module docstring) into ``fc`` (cells, 11) and ``fq``
+    (cells, 13, Q); ``strain`` (cells, 2, probes) gets the bending-strain coefficients
+    ``(1 - xi, xi) c fibre`` at the probes of notch cells (0 elsewhere; ``fibre`` from the
+    centroid to the farthest material, ``min(h1, R_outer)`` for the paper's section).
+    ``matrix`` (Q, Q) is the Gauss points' partial-integration matrix on [0, 1].
+
+    Where a notch's backbone is off the axis (``w_o``): ``XB_START``, ``XB_END`` are the
+    centroid's offset ``x_bar`` at the cell's ends, about which its end moments are taken, and
+    ``XB_Q`` at the Gauss points. The moment about the moving centroid is the line between the
+    end moments less ``T dx``, ``dx = x_bar - ((1 - xi) x_bar_a + xi x_bar_b)`` (the tendon's
+    pull ``T`` along the body, exact where the tendon follows it): ``D_Q`` and ``D_CELL`` are
+    ``int c dx ds`` to each Gauss point and over the cell (rad/(N m)), taken ``T`` times from
+    its angles. The tube axis, ``-x_bar`` from the neutral fibre, stretches by ``x_bar kappa``
+    (m/m): ``K0``, ``K1``, ``K2`` are ``w_q x_bar c`` times ``1 - xi``, ``xi`` and ``dx``, and
+    its ds weight is ``w_q + m_a K0 + m_b K1 - T K2``."""
     q_count = gauss_u.shape[0]
     first = q_count + q_count * q_count
     no_custom = np.zeros(first + probe.shape[0] + 2)
@@ -139,46 +210,61 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
         start = c[START]
         length = c[LENGTH]
         out = fq[i]
+        ends = first + probe.shape[0]
+        _, _, fc[i, C_START], x_a, _ = point(notch, d, seg_length, u_a, custom[ends])
+        _, _, fc[i, C_END], x_b, _ = point(notch, d, seg_length, c[U_B], custom[ends + 1])
+        fc[i, XB_START] = x_a
+        fc[i, XB_END] = x_b
         total = 0.0
         for q in range(q_count):
             u_q = u_a + span * gauss_u[q]
-            sigma, jac, c_q = point(notch, d, seg_length, u_q, custom[q])
+            sigma, jac, c_q, x_bar, _ = point(notch, d, seg_length, u_q, custom[q])
             out[W_Q, q] = span * gauss_w[q] * jac
             total += out[W_Q, q]
             out[S_Q, q] = sigma
             out[XI_Q, q] = (sigma - start) / length
             out[C_Q, q] = c_q
+            out[XB_Q, q] = x_bar
             inner = u_q - u_a
             a0 = 0.0
             a1 = 0.0
+            d0 = 0.0
             for k in range(q_count):
-                s_k, jac_k, c_k = point(notch, d, seg_length, u_a + inner * gauss_u[k],
-                                        custom[q_count + q * q_count + k])
+                s_k, jac_k, c_k, x_k, _ = point(notch, d, seg_length, u_a + inner * gauss_u[k],
+                                                custom[q_count + q * q_count + k])
                 ds = inner * gauss_w[k] * jac_k
                 xi = (s_k - start) / length
                 a0 += ds * (1.0 - xi) * c_k
                 a1 += ds * xi * c_k
+                d0 += ds * c_k * (x_k - ((1.0 - xi) * x_a + xi * x_b))
             out[A0, q] = a0
             out[A1, q] = a1
+            out[D_Q, q] = d0
         _weights_and_chords(c[CHORD] != 0.0, length / total if total > 0.0 else 0.0,
                             gauss_w, matrix, out, fc[i])
+        whole = 0.0
+        for q in range(q_count):
+            xi = out[XI_Q, q]
+            w_c = out[W_Q, q] * out[C_Q, q]
+            off = out[XB_Q, q] - ((1.0 - xi) * x_a + xi * x_b)
+            stretch = w_c * out[XB_Q, q]
+            out[K0, q] = stretch * (1.0 - xi)
+            out[K1, q] = stretch * xi
+            out[K2, q] = stretch * off
+            whole += w_c * off
+        fc[i, D_CELL] = whole
         peak = -1.0
         for k in range(probe.shape[0]):
-            s_k, _, c_k = point(notch, d, seg_length, u_a + span * probe[k], custom[first + k])
+            s_k, _, c_k, _, fibre = point(notch, d, seg_length, u_a + span * probe[k],
+                                          custom[first + k])
             if c_k > peak:
                 peak = c_k
                 fc[i, PEAK_C] = c_k
                 fc[i, PEAK_S] = s_k
-            weight = 0.0
-            if notch:
-                weight = c_k * min(geometry(d[KIND], d[W_N], d[W_D], u_a + span * probe[k],
-                                            custom[first + k])[2], d[R_OUTER])
+            weight = c_k * fibre
             xi = (s_k - start) / length
             strain[i, 0, k] = (1.0 - xi) * weight
             strain[i, 1, k] = xi * weight
-        ends = first + probe.shape[0]
-        fc[i, C_START] = point(notch, d, seg_length, u_a, custom[ends])[2]
-        fc[i, C_END] = point(notch, d, seg_length, c[U_B], custom[ends + 1])[2]
 
 
 def _weights_and_chords(chord: bool, scale: float, gauss_w: Array, matrix: Array,
@@ -233,6 +319,6 @@ def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
                     out[m, f, j, q] = source[p, field, q]
 
 
-KERNELS = ("disc_strip_moment", "notch_compliance", "geometry", "point", "points",
-           "_weights_and_chords", "cell_integrals", "gather")
+KERNELS = ("disc_strip_moment", "notch_compliance", "disc_strip", "offset_section", "geometry",
+           "point", "points", "_weights_and_chords", "cell_integrals", "gather")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

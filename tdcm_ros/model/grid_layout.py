@@ -33,8 +33,10 @@ IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
 
 PEAK_SAMPLES = 17
-#: Most breakpoints inside one notch: two crossings each of ``r_inner`` and ``R_outer``.
-MAX_CROSSINGS = 4
+#: Most breakpoints inside one notch: where its section's edges ``w_o +- h1`` meet the tube's
+#: walls ``+-r_inner``, ``+-R_outer``: two crossings (``u`` and about ``1 - u``) of each of the four
+#: levels of ``h1`` (:func:`crossing_levels`), the last two absent for the paper's section.
+MAX_CROSSINGS = 8
 #: Samples of a custom profile searched for crossings, and bisection steps per crossing.
 CROSSING_SAMPLES = 129
 BISECTION_STEPS = 60
@@ -46,8 +48,9 @@ MIN_PIECE_U = 1e-6
 class Members:
     """Design parameters of every member (SI units): per member (shape (M,)) the tube, the
     material and the length; per *notch shape* (shape (S,): each member's distinct notches,
-    ``(w_n, w_d, profile)`` in order of first appearance, so a uniform member has one and its row
-    is the member's own) ``shape_member``, ``shape_w_n``, ``shape_w_d``, ``profile_of`` (the
+    ``(w_n, w_d, w_o, profile)`` in order of first appearance, so a uniform member has one and
+    its row is the member's own) ``shape_member``, ``shape_w_n``, ``shape_w_d``, ``shape_w_o``,
+    ``profile_of`` (the
     index of its profile in ``profiles``); per member and segment
     *kind* (shape (M, K): the member's base tube, each of its notch shapes, each distinct tube
     between notches, its tip tube, then zero-length padding) ``kind_length``,
@@ -72,6 +75,7 @@ class Members:
     shape_first: IntArray
     shape_w_n: Array
     shape_w_d: Array
+    shape_w_o: Array
     profile_of: IntArray
     kind_length: Array
     kind_is_notch: BoolArray
@@ -170,6 +174,7 @@ def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_t
     slot_kind[:, 2::2] = np.where(notch_i[None, :] == (n - 1)[:, None], TIP, TUBE)
     return {"shape_member": every, "shape_first": every, "shape_w_n": w_n,
             "shape_w_d": np.array([d.w_d for d in designs], dtype=float),
+            "shape_w_o": np.array([d.w_o for d in designs], dtype=float),
             "profile_of": np.array([profiles.index(d.uniform_profile()) for d in designs],
                                    np.int64),
             "kind_length": np.stack([w_base, w_n, np.where(n > 1, w_t, 0.0), w_tip], axis=1),
@@ -182,7 +187,7 @@ def _general_layout(designs: tuple[Design, ...], n: IntArray, profiles: _Profile
                     ) -> dict[str, Any]:
     """:class:`Members`' shape, kind and slot arrays of any designs (see :class:`Members`)."""
     count, n_max = n.size, int(n.max())
-    shapes: list[tuple[int, float, float, int]] = []
+    shapes: list[tuple[int, float, float, float, int]] = []
     kinds: list[list[tuple[float, bool, int]]] = []
     slot_kind = np.zeros((count, 2 * n_max + 1), np.int64)
     left_all = np.empty((count, n_max))
@@ -191,13 +196,14 @@ def _general_layout(designs: tuple[Design, ...], n: IntArray, profiles: _Profile
     for m, design in enumerate(designs):
         first[m] = len(shapes)
         pairs = list(zip(design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(),
+                         design.per_notch("w_o").tolist(),
                          (profiles.index(p) for p in design.notch_profiles()), strict=True))
         distinct = list(dict.fromkeys(pairs))
-        shapes += [(m, w_n, w_d, profile) for w_n, w_d, profile in distinct]
+        shapes += [(m, *notch) for notch in distinct]
         gaps = design.per_notch("w_t").tolist()
         distinct_gaps = list(dict.fromkeys(g for g in gaps if g > 0.0))
         own: list[tuple[float, bool, int]] = [(design.w_base, False, int(first[m]))]
-        own += [(w_n, True, int(first[m]) + k) for k, (w_n, _, _) in enumerate(distinct)]
+        own += [(w_n, True, int(first[m]) + k) for k, (w_n, *_) in enumerate(distinct)]
         own += [(g, False, int(first[m])) for g in distinct_gaps]
         own.append((design.w_tip, False, int(first[m])))
         tip_kind = len(own) - 1
@@ -219,7 +225,8 @@ def _general_layout(designs: tuple[Design, ...], n: IntArray, profiles: _Profile
     return {"shape_member": np.array([s[0] for s in shapes], np.int64), "shape_first": first,
             "shape_w_n": np.array([s[1] for s in shapes], dtype=float),
             "shape_w_d": np.array([s[2] for s in shapes], dtype=float),
-            "profile_of": np.array([s[3] for s in shapes], np.int64),
+            "shape_w_o": np.array([s[3] for s in shapes], dtype=float),
+            "profile_of": np.array([s[4] for s in shapes], np.int64),
             "kind_length": np.array([[k[0] for k in row] for row in padded], dtype=float),
             "kind_is_notch": np.array([[k[1] for k in row] for row in padded], dtype=bool),
             "kind_shape": np.array([[k[2] for k in row] for row in padded], np.int64),
@@ -395,24 +402,42 @@ def _tendon_follows_notches(routing: str) -> bool:
     return routing == "paper"
 
 
+def crossing_levels(members: Members) -> Array:
+    """The values of ``h1`` (m) at which an edge ``w_o +- h1`` of each notch shape's section
+    meets a wall ``+-r_inner`` or ``+-R_outer``, shape (S, 4): ``|r_inner - |w_o||``,
+    ``R_outer - |w_o|``, then ``r_inner + |w_o|``, ``R_outer + |w_o|`` (0, none, where
+    ``w_o = 0``: both edges meet the walls at the first two)."""
+    owner = members.shape_member
+    offset = np.abs(members.shape_w_o)
+    r_inner, r_outer = members.r_inner[owner], members.R_outer[owner]
+    centred = offset == 0.0
+    return np.stack([np.abs(r_inner - offset), r_outer - offset,
+                     np.where(centred, 0.0, r_inner + offset),
+                     np.where(centred, 0.0, r_outer + offset)], axis=1)
+
+
 def crossings(members: Members) -> Array:
-    """Where each notch shape's profile crosses ``r_inner`` and ``R_outer``, as ``u`` in (0, 1);
+    """Where each notch shape's profile meets its :func:`crossing_levels`, as ``u`` in (0, 1);
     shape (S, MAX_CROSSINGS), 0 where a crossing does not exist."""
     out = np.zeros((members.shape_member.size, MAX_CROSSINGS))
+    levels = crossing_levels(members)
     shape_profile = members.profile_of
     for k, profile in enumerate(members.profiles):
         rows = np.flatnonzero(shape_profile == k)
         if isinstance(profile, RectangularProfile):
             continue
-        owner = members.shape_member[rows]
-        for c, level in enumerate((members.r_inner[owner], members.R_outer[owner])):
+        for c in range(levels.shape[1]):
+            level = levels[rows, c]
+            if not np.any(level > 0.0):
+                continue
             if isinstance(profile, CircularProfile):
                 lo, hi = _circular_crossings(members.shape_w_n[rows], members.shape_w_d[rows],
                                              level)
             else:
                 lo, hi = _searched_crossings(members, rows, level)
-            out[rows, 2 * c] = lo
-            out[rows, 2 * c + 1] = hi
+            present = level > 0.0
+            out[rows, 2 * c] = np.where(present, lo, 0.0)
+            out[rows, 2 * c + 1] = np.where(present, hi, 0.0)
     return out
 
 
@@ -422,7 +447,7 @@ def resolved(found: Array) -> Array:
     at the notch's edge, a rounding error from it) and a pair closer than that to each other
     (the profile touches the level); 0 marks them absent."""
     out = np.where((found > MIN_PIECE_U) & (found < 1.0 - MIN_PIECE_U), found, 0.0)
-    for first in (0, 2):  # (r_inner pair, R_outer pair)
+    for first in range(0, MAX_CROSSINGS, 2):  # the pairs of each level
         lo, hi = out[:, first], out[:, first + 1]
         touching = (lo > 0.0) & (hi > 0.0) & (hi - lo < MIN_PIECE_U)
         out[touching, first:first + 2] = 0.0

@@ -7,10 +7,15 @@ by zero is inf or nan). A single solve is one member; a batch stacks many.
 
 Member arrays (SI units; ``M`` members, ``n`` cells, ``Q`` quadrature points, ``K`` notches):
 
-- ``fc`` (M, 4, n): the cells' ``C0``, ``C1`` (rad/(N m)) and chord terms ``C0_T``, ``C1_T``
-  (rad/(N^2 m));
-- ``fq`` (M, 5, n, Q): ``A0``, ``A1`` (rad/(N m)), ``w_q`` (m), ``A0_T``, ``A1_T``
-  (rad/(N^2 m)) at the Gauss points (:mod:`tdcm_ros.model.grid`: on a chord the moment is
+- ``fc`` (M, 7, n): the cells' ``C0``, ``C1`` (rad/(N m)), chord terms ``C0_T``, ``C1_T``
+  (rad/(N^2 m)), the centroid's offset ``x_bar`` at the cell's start and end (m; 0 but in
+  notches whose backbone is off the axis: the end moments are taken about the centroid) and
+  ``D`` (rad/(N m): the bend of the moment's part the centroid's motion inside the cell adds,
+  per newton of tendon tension, :func:`tdcm_ros.model.grid_kernel.cell_integrals`);
+- ``fq`` (M, 9, n, Q): ``A0``, ``A1`` (rad/(N m)), ``w_q`` (m), ``A0_T``, ``A1_T``
+  (rad/(N^2 m)), ``K0``, ``K1`` (m/(N m)), ``D_q`` (rad/N) and ``K2`` (m/N) at the Gauss
+  points: off the axis a point's angle has ``- T D_q`` and the tube axis's ds weight is
+  ``w_q + m_a K0 + m_b K1 - T K2`` (its stretch ``x_bar kappa``) (:mod:`tdcm_ros.model.grid`: on a chord the moment is
   not linear in the cell, ``m'' = -T c m``; the integrals are then ``A0 + T A0_T`` etc. with
   ``T`` the chord's tension, and the chord terms are zero where the tendon follows the body);
 - ``ic`` (M, 3, n): each cell's chord start node, chord end node, and 1 where the tendon
@@ -70,9 +75,10 @@ def unit(phi: float) -> complex:
 def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Complex,
                   theta: Array, tangent: Complex) -> None:
     """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m) and each cell's
-    tendon tension ``t`` (N; it matters only on chords, where the moment inside the cell is
-    ``m'' = -T c m`` to first order, elsewhere exactly linear): writes nodes ``p`` (m),
-    ``theta`` (rad) and ``tangent``."""
+    tendon tension ``t`` (N; on chords the moment inside the cell is ``m'' = -T c m`` to first
+    order, and off the axis the centroid's motion adds ``- T dx``; elsewhere exactly linear):
+    writes nodes ``p`` (m), ``theta`` (rad) and ``tangent`` of the tube axis (stretched by
+    ``x_bar kappa`` where the centroid is off it)."""
     n = fc.shape[1]
     nq = fq.shape[2]
     pos = 0j
@@ -85,17 +91,32 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Com
         a = m_a[i]
         b = m_b[i]
         local = 0j
-        if fc[2, i] == 0.0 and fc[3, i] == 0.0:  # the tendon follows the body: linear
+        chord = fc[2, i] != 0.0 or fc[3, i] != 0.0
+        off_axis = fc[4, i] != 0.0 or fc[5, i] != 0.0 or fq[5, i, 0] != 0.0
+        if not (chord or off_axis):  # the tendon follows the body: linear
             for q in range(nq):
                 local += fq[2, i, q] * unit(a * fq[0, i, q] + b * fq[1, i, q])
             th = th + (a * fc[0, i] + b * fc[1, i])
         else:
             tension = t[i]
             for q in range(nq):
-                phi = (a * (fq[0, i, q] + tension * fq[3, i, q])
-                       + b * (fq[1, i, q] + tension * fq[4, i, q]))
-                local += fq[2, i, q] * unit(phi)
-            th = th + (a * (fc[0, i] + tension * fc[2, i]) + b * (fc[1, i] + tension * fc[3, i]))
+                if chord:
+                    phi = (a * (fq[0, i, q] + tension * fq[3, i, q])
+                           + b * (fq[1, i, q] + tension * fq[4, i, q]))
+                else:
+                    phi = a * fq[0, i, q] + b * fq[1, i, q]
+                weight = fq[2, i, q]
+                if off_axis:
+                    phi -= tension * fq[7, i, q]
+                    weight += a * fq[5, i, q] + b * fq[6, i, q] - tension * fq[8, i, q]
+                local += weight * unit(phi)
+            if chord:
+                bend = a * (fc[0, i] + tension * fc[2, i]) + b * (fc[1, i] + tension * fc[3, i])
+            else:
+                bend = a * fc[0, i] + b * fc[1, i]
+            if off_axis:
+                bend -= tension * fc[6, i]
+            th = th + bend
         pos = pos + tan * local
         tan = complex(math.cos(th), math.sin(th))
         p[i + 1] = pos
@@ -104,24 +125,34 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Com
 
 
 def moments_row(r_c: float, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
-                m_a: Array, m_b: Array) -> None:
-    """Tendon moment ``m = (p_c - p) x (-T t_c)`` (N m) at each cell's ends for one member,
-    with the tension ``t_a``, ``t_b`` (N) at each cell's start and end: ``R_c T`` where the
-    tendon follows the offset curve, ``T`` times the distance to the chord line elsewhere."""
+                fc: Array, m_a: Array, m_b: Array) -> None:
+    """Tendon moment ``m = (p_c - q) x (-T t_c)`` (N m) at each cell's ends for one member
+    about the section's centroid ``q = p + x_bar n`` (``x_bar`` from ``fc``'s rows 4 and 5;
+    ``n`` the +x direction; the tube axis ``p`` where ``x_bar = 0``), with the tension ``t_a``,
+    ``t_b`` (N) at each cell's start and end: ``(R_c - x_bar) T`` where the tendon follows the
+    offset curve, ``T`` times the distance to the chord line elsewhere."""
     n = ic.shape[1]
     offset = 1j * r_c
     for i in range(n):
+        x_a = fc[4, i]
+        x_b = fc[5, i]
         if ic[2, i] != 0:
-            m_a[i] = r_c * t_a[i]
-            m_b[i] = r_c * t_b[i]
+            m_a[i] = (r_c - x_a) * t_a[i]
+            m_b[i] = (r_c - x_b) * t_b[i]
         else:
             start = ic[0, i]
             end = ic[1, i]
             anchor = p[start] + offset * tangent[start]
             chord = p[end] + offset * tangent[end] - anchor
             chord = chord / abs(chord)
-            m_a[i] = -t_a[i] * ((anchor - p[i]).conjugate() * chord).imag
-            m_b[i] = -t_b[i] * ((anchor - p[i + 1]).conjugate() * chord).imag
+            at_a = p[i]
+            at_b = p[i + 1]
+            if x_a != 0.0:
+                at_a = at_a + (1j * x_a) * tangent[i]
+            if x_b != 0.0:
+                at_b = at_b + (1j * x_b) * tangent[i + 1]
+            m_a[i] = -t_a[i] * ((anchor - at_a).conjugate() * chord).imag
+            m_b[i] = -t_b[i] * ((anchor - at_b).conjugate() * chord).imag
 
 
 def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Array) -> None:
@@ -154,10 +185,10 @@ def integrate(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Complex
 
 
 def moments(scal: Array, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
-            m_a: Array, m_b: Array) -> None:
+            fc: Array, m_a: Array, m_b: Array) -> None:
     """:func:`moments_row` for every member (tensions and moments (M, n))."""
     for j in range(m_a.shape[0]):
-        moments_row(scal[j, 0], p[j], tangent[j], t_a[j], t_b[j], ic[j], m_a[j], m_b[j])
+        moments_row(scal[j, 0], p[j], tangent[j], t_a[j], t_b[j], ic[j], fc[j], m_a[j], m_b[j])
 
 
 def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> None:
@@ -202,7 +233,7 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
         status = EXHAUSTED
         steps = 0
         for k in range(budget):
-            moments_row(r_c, pj, tangent[j], t_a, t_a, ic[row], g[:n], g[n:])
+            moments_row(r_c, pj, tangent[j], t_a, t_a, ic[row], fc[row], g[:n], g[n:])
             if relaxation != 1.0:
                 for i in range(2 * n):
                     g[i] = xj[i] + relaxation * (g[i] - xj[i])

@@ -49,13 +49,15 @@ def check_tension(tension: Any) -> float:
 @quiet_fp
 def check_singularity(grid: Grid, m_a: Array, m_b: Array) -> None:
     """Raise :class:`TendonSingularityError` where the tendon follows the offset curve and
-    ``R_c * kappa`` reaches 1 (the curve ``p + R_c x_b`` cusps). ``kappa`` uses each cell's
-    peak compliance, so the check is pointwise, not a cell average."""
+    ``(R_c - x_bar) * kappa`` reaches 1 (the curve ``p + R_c x_b`` cusps; ``x_bar`` the
+    centroid's offset, 0 but in notches whose backbone is off the axis). ``kappa`` uses each
+    cell's peak compliance, so the check is pointwise, not a cell average."""
     cells = grid.constrained_cells
     if cells.size == 0:
         return
     moment = np.maximum(np.abs(m_a[cells]), np.abs(m_b[cells]))
-    rc_kappa = grid.design.R_c * moment * grid.peak_c[cells]
+    arm = grid.design.R_c - np.minimum(grid.xbar_start[cells], grid.xbar_end[cells])
+    rc_kappa = arm * moment * grid.peak_c[cells]
     worst = int(np.argmax(rc_kappa))
     if rc_kappa[worst] >= 1.0:
         s = float(grid.peak_s[cells[worst]])
@@ -81,14 +83,15 @@ def notch_gaps(grid: Grid, shape: PlanarShape) -> Array:
 
 @quiet_fp
 def check_tendon_singularity(grid: Grid, tension: float) -> None:
-    """:func:`check_singularity` for the tendon's own moment ``R_c T`` (exact for the closed
-    form on the offset curve), in O(1) from the grid's peak compliance."""
+    """:func:`check_singularity` for the tendon's own moment ``(R_c - x_bar) T`` (exact for
+    the closed form on the offset curve), in O(1) from the grid's arm-weighted peak
+    compliance (:func:`tdcm_ros.model.grid.arm_weighted`)."""
     if grid.constrained_cells.size == 0:
         return
     rc_kappa = grid.design.R_c ** 2 * tension * grid.constrained_peak_c
     if rc_kappa >= 1.0:
-        moment = np.full(grid.n_cells, grid.design.R_c * tension)
-        check_singularity(grid, moment, moment)
+        arm = grid.design.R_c - np.minimum(grid.xbar_start, grid.xbar_end)
+        check_singularity(grid, arm * tension, arm * tension)
 
 
 @quiet_fp

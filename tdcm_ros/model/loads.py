@@ -68,10 +68,11 @@ def closed_form_cells(grid: Grid | Cells, shape: PlanarShape, t_a: Array, t_b: A
     lead = p.shape[:-1]
     n = p.shape[-1] - 1
     rows = int(np.prod(lead, dtype=np.int64)) if lead else 1
-    scal, ic = cells.scal, cells.ic
+    scal, ic, fc = cells.scal, cells.ic, cells.fc
     if rows != cells.members:
         scal = np.ascontiguousarray(np.broadcast_to(scal, (rows, *scal.shape[1:])))
         ic = np.ascontiguousarray(np.broadcast_to(ic, (rows, *ic.shape[1:])))
+        fc = np.ascontiguousarray(np.broadcast_to(fc, (rows, *fc.shape[1:])))
 
     def flat(values: NDArray[np.generic]) -> NDArray[np.generic]:
         return np.ascontiguousarray(np.broadcast_to(values, (*lead, values.shape[-1])
@@ -80,7 +81,7 @@ def closed_form_cells(grid: Grid | Cells, shape: PlanarShape, t_a: Array, t_b: A
     m_a = np.empty((rows, n))
     m_b = np.empty((rows, n))
     kernels().moments(scal, flat(p), flat(shape.tangent), flat(np.asarray(t_a, dtype=float)),
-                      flat(np.asarray(t_b, dtype=float)), ic, m_a, m_b)
+                      flat(np.asarray(t_b, dtype=float)), ic, fc, m_a, m_b)
     return m_a.reshape(*lead, n), m_b.reshape(*lead, n)
 
 

@@ -164,17 +164,25 @@ class SolveResult:
         length = self.design.length
         if not np.all(np.isfinite(query)) or np.any(query < 0.0) or np.any(query > length):
             raise out_of_range("s", query.tolist(), f"[0, {length:g}] m")
-        cells, a0_s, a1_s, a0_r, a1_r, w_r = self.grid.query(query)
+        found = self.grid.query(query)
+        cells = found.cells
         moments = self.bend_moments
         m_a = moments[cells, 0]
         m_b = moments[cells, 1]
-        phi_r = m_a[:, None] * a0_r + m_b[:, None] * a1_r
+        phi_r = m_a[:, None] * found.a0_r + m_b[:, None] * found.a1_r
+        w_r = found.w_r
+        theta_a = self.theta[cells]
+        theta = theta_a + m_a * found.a0_s + m_b * found.a1_s
+        if np.any(self.grid.xbar_q):  # off the axis: the centroid's motion, the axis's stretch
+            pull = self.tension_n
+            phi_r = phi_r - pull * found.d_r
+            w_r = w_r + m_a[:, None] * found.k0_r + m_b[:, None] * found.k1_r \
+                - pull * found.k2_r
+            theta = theta - pull * found.d_s
         along = np.sum(w_r * np.cos(phi_r), axis=1)
         across = np.sum(w_r * np.sin(phi_r), axis=1)
-        theta_a = self.theta[cells]
         x = self.positions[cells, 0] + along * np.sin(theta_a) + across * np.cos(theta_a)
         z = self.positions[cells, 2] + along * np.cos(theta_a) - across * np.sin(theta_a)
-        theta = theta_a + m_a * a0_s + m_b * a1_s
         positions = np.stack([x, np.zeros_like(x), z], axis=1)
         return positions, quaternions_y(theta)
 

@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.grid_kernel import offset_section
 from tdcm_ros.model.section import notched_area, notched_moment
 
 Array = NDArray[np.float64]
@@ -105,8 +106,8 @@ class OneSidedCut:
     r_inner: float
 
     def properties(self) -> SectionProperties:
-        """Closed forms of the disc segments ``x <= c`` (``c = R_outer - depth``), the hole's
-        removed up to ``clip(c, -r_inner, r_inner)``; ``I`` by the parallel-axis theorem."""
+        """The tube where ``x <= c = R_outer - depth``
+        (:func:`tdcm_ros.model.grid_kernel.offset_section`, the solver's formula)."""
         r_outer, r_inner = _tube(self.r_outer, self.r_inner)
         depth = np.asarray(self.depth, dtype=float)
         ok = np.isfinite(depth) & (depth >= 0.0) & (depth < 2.0 * r_outer)
@@ -114,29 +115,17 @@ class OneSidedCut:
             raise out_of_range("cut", float(depth[~ok].ravel()[0]),
                                f"[0, 2 R_outer = {2.0 * r_outer:g}) m", error=InvalidDesignError)
         plane = r_outer - depth
-        area, first, second = (outer - inner for outer, inner in zip(
-            _disc_below(plane, r_outer), _disc_below(plane, r_inner), strict=True))
-        centroid = first / area
+        area, second, centroid, _ = _offset_sections(0.5 * (plane + r_outer),
+                                                     0.5 * (plane - r_outer), r_outer, r_inner)
         return SectionProperties(
-            area=area, centroid_x=centroid, second_moment=second - area * centroid * centroid,
+            area=area, centroid_x=centroid, second_moment=second,
             fibre_tendon_side=plane - centroid, fibre_far_side=centroid + r_outer,
             face_arm=np.where(depth > 0.0, r_outer - centroid, np.inf))
 
 
-def _disc_below(plane: Array, radius: float) -> tuple[Array, Array, Array]:
-    """Area (m^2), first and second moments about ``x = 0`` (m^3, m^4) of the disc of
-    ``radius`` (m) where ``x <= plane`` (m; clipped to the disc); zeros for ``radius = 0``."""
-    if radius <= 0.0:
-        zero = np.zeros_like(plane)
-        return zero, zero, zero
-    c = np.clip(plane, -radius, radius)
-    r2 = radius * radius
-    root = np.sqrt(np.maximum(r2 - c * c, 0.0))
-    angle = np.arccos(-c / radius)  # = asin(c/R) + pi/2, accurate as c -> -R
-    area = c * root + r2 * angle
-    first = -(2.0 / 3.0) * root**3
-    second = 2.0 * ((c / 8.0) * (2.0 * c * c - r2) * root + (r2 * r2 / 8.0) * angle)
-    return area, first, second
+_offset_sections = np.vectorize(offset_section, otypes=[float] * 4)
+""":func:`tdcm_ros.model.grid_kernel.offset_section` over arrays: the one formula of an
+off-axis section, which the solver's cells use too."""
 
 
 #: Fewest vertices of a polygon ring.

@@ -55,3 +55,24 @@ def test_bent_edges_are_their_half_width_off_the_midline_along_its_normal() -> N
         np.testing.assert_allclose(across, width, rtol=1e-12)
     odd = body_outline(result, stations=25)  # a station at each notch's centre
     assert np.min(odd.half_width_tendon_side) == pytest.approx(design.w_d / 2, rel=1e-12)
+
+
+def test_a_one_sided_cut_leaves_the_far_side_whole_and_the_tendon_side_cut_to_its_depth(
+        ) -> None:
+    """A rectangular cut 6.4 mm deep from +x (w_d = 2 R - 6.4 mm at w_o = -3.2 mm): inside the
+    notch the material reaches R_outer - 6.4 mm on the tendon's side (past the axis) and the
+    tube's surface on the other."""
+    base = preset("paper-experiment").with_overrides(profile="rectangular")
+    design = base.with_overrides(w_d=2 * base.R_outer - 6.4e-3, w_o=-3.2e-3)
+    outline = body_outline(solve(design, 0.0))
+    left, right = design.notch_bounds()
+    inside = np.zeros(outline.s.size, dtype=bool)
+    for l_i, r_i in zip(left, right, strict=True):
+        inside |= (outline.s > l_i) & (outline.s < r_i)
+    np.testing.assert_allclose(outline.half_width_tendon_side[inside], design.R_outer - 6.4e-3,
+                               rtol=1e-12)
+    np.testing.assert_allclose(outline.half_width_far_side, design.R_outer, rtol=1e-12)
+    for boundary in (*left, *right):  # the tube's surface and the cut's floor, both drawn
+        widths = outline.half_width_tendon_side[np.isclose(outline.s, boundary, rtol=0,
+                                                           atol=1e-15)]
+        assert sorted(widths) == pytest.approx([design.R_outer - 6.4e-3, design.R_outer])

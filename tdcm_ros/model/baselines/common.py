@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.model.design import Design
+from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure
@@ -12,6 +14,18 @@ from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
+
+
+def require_centred(design: Design, method: str) -> None:
+    """Raise :class:`InvalidDesignError` naming ``w_o`` unless every notch's backbone is on the
+    tube axis: the baselines model the paper's symmetric notch only (the off-axis centroid's
+    mechanics are :func:`tdcm_ros.model.solve`'s)."""
+    offsets = design.per_notch("w_o")
+    if offsets.any():
+        raise InvalidDesignError(
+            f"w_o = {design.to_dict()['w_o']!r}: the {method} baseline takes notches centred on "
+            "the tube axis; allowed: 0 (solve such a body with algorithm1)", parameter="w_o",
+            value=design.to_dict()["w_o"], allowed="0 m")
 
 
 def node_result(grid: Grid, settings: SolverSettings, tension: float, *, x: Array, z: Array,

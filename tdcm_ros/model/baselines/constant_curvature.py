@@ -13,7 +13,11 @@ from time import perf_counter
 
 import numpy as np
 
-from tdcm_ros.model.baselines.common import node_result, uniform_moments
+from tdcm_ros.model.baselines.common import (
+    node_result,
+    require_centred,
+    uniform_moments,
+)
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.grid import build_grid
 from tdcm_ros.model.limits import check_tension
@@ -29,6 +33,7 @@ def solve_constant_curvature(design: Design, tension: float, *,
     """One arc of length ``L`` (m) with the mean curvature under ``R_c T``; nodes on the grid."""
     started = perf_counter()
     t = check_tension(tension)
+    require_centred(design, "constant-curvature")
     grid = build_grid(design, settings)
     moment = design.R_c * t
     kappa = moment * float(np.sum(grid.C0 + grid.C1)) / design.length

@@ -16,6 +16,7 @@ import numpy as np
 from tdcm_ros.model.baselines.common import (
     node_result,
     notch_compliance,
+    require_centred,
     uniform_moments,
 )
 from tdcm_ros.model.design import Design
@@ -33,6 +34,7 @@ def solve_pseudo_rigid_body(design: Design, tension: float, *,
     """Joint angles ``R_c T int_notch ds/(E I)`` at notch centres; node poses on the grid."""
     started = perf_counter()
     t = check_tension(tension)
+    require_centred(design, "pseudo-rigid-body")
     grid = build_grid(design, settings)
     moment = design.R_c * t
     joint_angle = moment * notch_compliance(grid)

@@ -39,7 +39,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import root
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model.baselines.common import node_result
+from tdcm_ros.model.baselines.common import node_result, require_centred
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidSettingsError
 from tdcm_ros.model.grid import Grid, build_grid
@@ -211,9 +211,10 @@ def _solve(design: Design, tension: float, settings: SolverSettings, options: Sh
            variant: str, strict: bool) -> SolveResult:
     started = perf_counter()
     t = check_tension(tension)
+    name = f"shooting-{variant}"
+    require_centred(design, name)
     grid = build_grid(design, settings)
     check_tendon_singularity(grid, t)
-    name = f"shooting-{variant}"
     s = grid.s_nodes
     if t == 0.0:
         zeros = np.zeros_like(s)
