@@ -14,16 +14,18 @@
           - tube: 4.0e-3
 
 A notch has a ``width`` along the body (m) and one section: ``band`` (the paper's symmetric
-pair of cuts leaving a backbone this wide, m; ``profile`` circular or rectangular), ``cut`` (a
-one-sided cut from +x, this deep from the surface, m) or ``polygon`` (the material left, a list
-of ``[x, y]`` in m, with optional ``holes``). Every problem is an
+pair of cuts leaving a backbone this wide, m, centred on the tube axis or ``offset`` from it
+toward +x, m; ``profile`` circular (default) or rectangular), ``cut`` (a one-sided cut from +x,
+this deep from the surface, m: a band ``2 R_outer - cut`` wide at ``offset = -cut/2``;
+``profile`` rectangular (default) or circular, the cut's outline along the body) or ``polygon``
+(the material left, a list of ``[x, y]`` in m, with optional ``holes``). Every problem is an
 :class:`~tdcm_ros.model.errors.InvalidDesignError` naming the key by its path in the file
 (``segments[1].segments[0].notch.cut``), the value and the allowed range.
 
-The solver takes today band notches, each with its own width, backbone and profile, any tubes
-between them, and one tendon: :meth:`BodySpec.design` gives that
+The solver takes today band and cut notches, each with its own width, backbone, offset and
+profile, any tubes between them, and one tendon: :meth:`BodySpec.design` gives that
 :class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ) and names
-the first segment a body departs from it by (cut and polygon sections are not solvable yet).
+the first segment a body departs from it by (polygon sections are not solvable yet).
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from tdcm_ros.errors import out_of_range, reject_unknown
-from tdcm_ros.model.design import MIN_SEGMENT_M, Design, preset
+from tdcm_ros.model.design import MIN_SEGMENT_M, OFFSET_SLACK, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import PROFILE_NAMES, NotchProfile, profile_from_name
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
@@ -46,6 +48,9 @@ from tdcm_ros.yamlio import load_yaml
 MAX_SEGMENTS = 10_000
 ROUTINGS = ("paper", "free")
 SECTION_KEYS = ("band", "cut", "polygon")
+#: A notch's profile where the file names none: the paper's circular band, a laser cut's
+#: rectangular slot.
+DEFAULT_PROFILE = {"band": "circular", "cut": "rectangular"}
 
 
 @dataclass(frozen=True)
@@ -59,11 +64,13 @@ class TubeSpec:
 @dataclass(frozen=True, eq=False)
 class NotchSpec:
     """A notch segment: ``width`` along the body (m) and its section, one of ``band`` (backbone
-    width, m, with ``profile``), ``cut`` (depth, m) or ``polygon`` (``shell``, ``holes``, m)."""
+    width, m, ``offset`` from the axis toward +x, m), ``cut`` (depth, m) or ``polygon``
+    (``shell``, ``holes``, m); a band or cut has a ``profile``."""
 
     width: float
     kind: str
     band: float = math.nan
+    offset: float = 0.0
     profile: str = "circular"
     cut: float = math.nan
     shell: tuple[tuple[float, float], ...] = ()
@@ -71,12 +78,18 @@ class NotchSpec:
     where: str = ""
 
     def section(self, r_outer: float, r_inner: float) -> Section:
-        """The notch's section at its narrowest (the band's centre) as a section type."""
+        """The notch's section at its narrowest (the band's centre) as a section type (a band
+        off the axis is checked by the design it makes)."""
         if self.kind == "band":
             return BandSection(self.band / 2.0, r_outer, r_inner)
         if self.kind == "cut":
             return OneSidedCut(self.cut, r_outer, r_inner)
         return PolygonSection(self.shell, r_outer, self.holes)
+
+    def backbone(self, r_outer: float) -> float:
+        """The width of the material left at the notch's centre (m): the band, or the tube
+        less the cut (``2 R_outer - cut``)."""
+        return 2.0 * r_outer - self.cut if self.kind == "cut" else self.band
 
 
 Segment = TubeSpec | NotchSpec
@@ -96,34 +109,41 @@ class BodySpec:
     source: str
 
     def design(self) -> Design:
-        """The body as the solver's :class:`Design`: a base tube (or none), N band notches,
-        each with its own width, backbone and profile, a tube (or none) between adjacent notches
-        and a tip tube (or none). A body the solver does not take yet (a cut or polygon
-        section) raises :class:`InvalidDesignError` naming the first segment that has one."""
+        """The body as the solver's :class:`Design`: a base tube (or none), N band or cut
+        notches, each with its own width, backbone, offset and profile, a tube (or none) between
+        adjacent notches and a tip tube (or none). A body the solver does not take yet (a
+        polygon section) raises :class:`InvalidDesignError` naming the first segment that has
+        one; a band off the axis past the tube's wall, naming its segment."""
         merged = _merged_tubes(self.segments)
         notches = [s for s in merged if isinstance(s, NotchSpec)]
         if not notches:
             raise InvalidDesignError(f"{self.source}: segments has no notch; allowed: at least "
                                      "one", parameter="segments", value=0, allowed="[1, inf) notches")
         for notch in notches:
-            if notch.kind != "band":
-                raise _not_yet(notch.where, f"a {notch.kind} section", self.source)
+            if notch.kind == "polygon":
+                raise _not_yet(notch.where, "a polygon section", self.source)
+            room = self.R_outer - notch.backbone(self.R_outer) / 2.0
+            if abs(notch.offset) > room + OFFSET_SLACK * self.R_outer:
+                raise out_of_range(f"{self.source}: {notch.where}.offset", notch.offset,
+                                   f"[-{room:g}, {room:g}] m (the band inside the tube: "
+                                   "|offset| <= R_outer - band/2)", error=InvalidDesignError)
         head = merged[0].length if isinstance(merged[0], TubeSpec) else 0.0
         tail = merged[-1].length if isinstance(merged[-1], TubeSpec) else 0.0
         at = [k for k, segment in enumerate(merged) if isinstance(segment, NotchSpec)]
         gaps = tuple(after.length if isinstance(after := merged[k + 1], TubeSpec) else 0.0
                      for k in at[:-1])
         return Design(w_base=head, w_tip=tail, w_n=tuple(n.width for n in notches), w_t=gaps,
-                      w_d=tuple(n.band for n in notches), N=len(notches), R_outer=self.R_outer,
+                      w_d=tuple(n.backbone(self.R_outer) for n in notches), N=len(notches),
+                      w_o=tuple(n.offset for n in notches), R_outer=self.R_outer,
                       r_inner=self.r_inner, R_c=self.tendon_offset, E=self.E,
                       profile=tuple(profile_from_name(n.profile) for n in notches))
 
 
 def _not_yet(where: str, what: str, source: str) -> InvalidDesignError:
     return InvalidDesignError(
-        f"{source}: {where}: {what}: the solver takes band notches and one tendon (cut and "
-        "polygon sections are not solvable yet)", parameter=where, value=what,
-        allowed="band notches")
+        f"{source}: {where}: {what}: the solver takes band and cut notches and one tendon "
+        "(polygon sections are not solvable yet)", parameter=where, value=what,
+        allowed="band or cut notches")
 
 
 def _merged_tubes(segments: Sequence[Segment]) -> list[Segment]:
@@ -225,8 +245,8 @@ def _segments(items: Any, where: str, source: str, r_outer: float, r_inner: floa
 
 def _notch(entry: Mapping[str, Any], where: str, source: str, r_outer: float, r_inner: float
            ) -> NotchSpec:
-    reject_unknown(f"{where} key", entry, ("width", "band", "profile", "cut", "polygon",
-                                           "holes"), error=InvalidDesignError)
+    reject_unknown(f"{where} key", entry, ("width", "band", "offset", "profile", "cut",
+                                           "polygon", "holes"), error=InvalidDesignError)
     width = _number(entry, "width", f"{where}.", source, low=MIN_SEGMENT_M, high=1.0)
     kinds = [k for k in SECTION_KEYS if k in entry]
     if len(kinds) != 1:
@@ -234,10 +254,14 @@ def _notch(entry: Mapping[str, Any], where: str, source: str, r_outer: float, r_
             f"{source}: {where} has {kinds or 'none'} of band, cut, polygon; allowed: exactly "
             "one section", parameter=where, value=sorted(entry), allowed="band | cut | polygon")
     kind = kinds[0]
-    if kind != "band" and "profile" in entry:
-        raise InvalidDesignError(f"{source}: {where}.profile goes with band only",
+    if kind == "polygon" and "profile" in entry:
+        raise InvalidDesignError(f"{source}: {where}.profile goes with band or cut only",
                                  parameter=f"{where}.profile", value=entry["profile"],
-                                 allowed="profile with band")
+                                 allowed="profile with band or cut")
+    if kind != "band" and "offset" in entry:
+        raise InvalidDesignError(f"{source}: {where}.offset goes with band only (a cut's is "
+                                 "-cut/2)", parameter=f"{where}.offset",
+                                 value=entry["offset"], allowed="offset with band")
     if kind != "polygon" and "holes" in entry:
         raise InvalidDesignError(f"{source}: {where}.holes goes with polygon only",
                                  parameter=f"{where}.holes", value=entry["holes"],
@@ -253,18 +277,22 @@ def _notch(entry: Mapping[str, Any], where: str, source: str, r_outer: float, r_
 
 def _notch_of_kind(entry: Mapping[str, Any], kind: str, width: float, where: str, source: str,
                    r_outer: float) -> NotchSpec:
+    profile = entry.get("profile", DEFAULT_PROFILE.get(kind, ""))
+    if kind in DEFAULT_PROFILE and profile not in PROFILE_NAMES:
+        raise out_of_range(f"{source}: {where}.profile", profile, " | ".join(PROFILE_NAMES),
+                           error=InvalidDesignError)
     if kind == "band":
-        profile = entry.get("profile", "circular")
-        if profile not in PROFILE_NAMES:
-            raise out_of_range(f"{source}: {where}.profile", profile, " | ".join(PROFILE_NAMES),
-                               error=InvalidDesignError)
         band = _number(entry, "band", f"{where}.", source, low=0.0, high=2.0 * r_outer,
                        open_low=True, open_high=True)
-        return NotchSpec(width=width, kind=kind, band=band, profile=str(profile), where=where)
+        offset = _number(entry, "offset", f"{where}.", source, low=-r_outer, high=r_outer,
+                         open_low=True, open_high=True, default=0.0)
+        return NotchSpec(width=width, kind=kind, band=band, offset=offset, profile=str(profile),
+                         where=where)
     if kind == "cut":
         cut = _number(entry, "cut", f"{where}.", source, low=0.0, high=2.0 * r_outer,
                       open_low=True, open_high=True)
-        return NotchSpec(width=width, kind=kind, cut=cut, where=where)
+        return NotchSpec(width=width, kind=kind, cut=cut, offset=-0.5 * cut,
+                         profile=str(profile), where=where)
     return NotchSpec(width=width, kind=kind, shell=_points(entry["polygon"], f"{where}.polygon",
                                                            source),
                      holes=tuple(_points(h, f"{where}.holes[{k}]", source)
@@ -324,8 +352,9 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         text = repr(float(value))
         return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
 
-    def notch(width: float, band: float, profile: NotchProfile) -> str:
-        return f"{{width: {number(width)}, band: {number(band)}, profile: {profile.name}}}"
+    def notch(width: float, band: float, offset: float, profile: NotchProfile) -> str:
+        at = f", offset: {number(offset)}" if offset != 0.0 else ""
+        return f"{{width: {number(width)}, band: {number(band)}{at}, profile: {profile.name}}}"
 
     lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
              f"material: {{E: {number(design.E)}}}", "tendons:",
@@ -333,7 +362,8 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
     if design.w_base > 0.0:
         lines.append(f"  - tube: {number(design.w_base)}")
     if design.is_uniform:
-        one = notch(design.uniform("w_n"), design.uniform("w_d"), design.uniform_profile())
+        one = notch(design.uniform("w_n"), design.uniform("w_d"), design.uniform("w_o"),
+                    design.uniform_profile())
         if design.N > 1:
             lines += [f"  - repeat: {design.N - 1}", "    segments:", f"      - notch: {one}"]
             if design.uniform("w_t") > 0.0:
@@ -341,10 +371,10 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         lines.append(f"  - notch: {one}")
     else:
         gaps = [*design.per_notch("w_t").tolist(), 0.0]
-        for width, band, profile, gap in zip(design.per_notch("w_n").tolist(),
-                                             design.per_notch("w_d").tolist(),
-                                             design.notch_profiles(), gaps, strict=True):
-            lines.append(f"  - notch: {notch(width, band, profile)}")
+        for width, band, offset, profile, gap in zip(
+                design.per_notch("w_n").tolist(), design.per_notch("w_d").tolist(),
+                design.per_notch("w_o").tolist(), design.notch_profiles(), gaps, strict=True):
+            lines.append(f"  - notch: {notch(width, band, offset, profile)}")
             if gap > 0.0:
                 lines.append(f"  - tube: {number(gap)}")
     if design.w_tip > 0.0:

@@ -108,8 +108,14 @@ BAD = [
     (with_changes(**{f"{NOTCH}__profile": "oval"}), r"notch\.profile = 'oval'"),
     (with_changes(**{f"{NOTCH}__depth": 1.0}), r"unknown segments\[1\]\.segments\[0\]\.notch key"),
     (with_changes(**{f"{NOTCH}": {"width": 1e-3, "cut": 8e-3}}), r"notch\.cut = 0\.008 .*\(0, 0\.00784\)"),
-    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "cut": 1e-3, "profile": "circular"}}),
-     r"notch\.profile goes with band only"),
+    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "cut": 1e-3, "offset": 0.0}}),
+     r"notch\.offset goes with band only"),
+    (with_changes(**{f"{NOTCH}": {"width": 1e-3, "polygon": [[0, -1e-3], [1e-3, 0], [0, 1e-3]],
+                                  "profile": "circular"}}),
+     r"notch\.profile goes with band or cut only"),
+    (with_changes(**{f"{NOTCH}__offset": -3.3e-3}),
+     r"segments\[1\]\.segments\[0\]\.notch\.offset = -0\.0033 .*\[-0\.00322, 0\.00322\] m"),
+    (with_changes(**{f"{NOTCH}__offset": "left"}), r"notch\.offset = 'left'"),
     (with_changes(**{f"{NOTCH}": {"width": 1e-3, "polygon": [[0, 0], [1e-3, 1e-3], [1e-3, 0],
                                                             [0, 1e-3]]}}),
      r"segments\[1\]\.segments\[0\]\.notch: polygon is not a simple polygon.*Self-intersection"),
@@ -128,16 +134,33 @@ BAND = {"notch": {"width": 2.0e-3, "band": 1.4e-3}}
 
 
 @pytest.mark.parametrize(("segments", "where"), [
-    ([BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 1.0e-3}}],
-     r"segments\[2\]\.notch: a cut section"),
-    ([BAND, {"notch": {"width": 2.0e-3, "polygon": [[0, -1e-3], [1e-3, 0], [0, 1e-3]]}}],
-     r"segments\[1\]\.notch: a polygon section"),
+    ([BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 1.0e-3}},
+      {"notch": {"width": 2.0e-3, "polygon": [[0, -1e-3], [1e-3, 0], [0, 1e-3]]}}],
+     r"segments\[3\]\.notch: a polygon section"),
 ])
 def test_bodies_the_solver_cannot_take_yet_name_the_first_segment_that_differs(
         segments: list[object], where: str) -> None:
     data = with_changes(segments=segments)
     with pytest.raises(InvalidDesignError, match=where + ".*not solvable yet"):
         body_from_mapping(data, "body.yaml").design()
+
+
+def test_a_cut_is_a_band_of_the_rest_of_the_tube_off_the_axis_and_an_offset_band_is_read(
+        ) -> None:
+    """``cut: c`` leaves ``2 R_outer - c`` of the tube on the -x side (a band that wide at
+    ``offset = -c/2``, rectangular unless the file says otherwise); a band may be moved off
+    the axis with ``offset``; the written body file reads back bit for bit."""
+    data = with_changes(segments=[
+        BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 6.4e-3}},
+        {"notch": {"width": 1.5e-3, "band": 1.2e-3, "offset": 0.5e-3}},
+        {"notch": {"width": 1.0e-3, "cut": 5e-3, "profile": "circular"}}])
+    design = body_from_mapping(data, "body.yaml").design()
+    assert design.w_d == (1.4e-3, 2 * 3.92e-3 - 6.4e-3, 1.2e-3, 2 * 3.92e-3 - 5e-3)
+    assert design.w_o == (0.0, -3.2e-3, 0.5e-3, -2.5e-3)
+    assert [p.name for p in design.notch_profiles()] == ["circular", "rectangular", "circular",
+                                                        "circular"]
+    again = body_from_mapping(load_yaml(body_file_text(design), "again.yaml"), "again.yaml").design()
+    assert again == design
 
 
 def test_notches_of_different_profiles_are_read_per_notch() -> None:
@@ -171,12 +194,13 @@ def test_notches_that_differ_are_read_per_notch_with_the_tubes_between_them() ->
     st.lists(st.sampled_from([0.8e-3, 1.1e-3, 1.4e-3]), min_size=n, max_size=n),
     st.lists(st.sampled_from([0.0, 2.0e-3, 4.0e-3]), min_size=n - 1, max_size=n - 1),
     st.sampled_from([0.0, 3.0e-3]),
-    st.lists(st.sampled_from(["circular", "rectangular"]), min_size=n, max_size=n))))
+    st.lists(st.sampled_from(["circular", "rectangular"]), min_size=n, max_size=n),
+    st.lists(st.sampled_from([0.0, -3.22e-3 + 0.4e-3, 0.3e-3]), min_size=n, max_size=n))))
 def test_a_per_notch_design_round_trips_through_its_body_file(case: tuple) -> None:
-    widths, bands, gaps, ends, profile = case
+    widths, bands, gaps, ends, profile, offsets = case
     design = preset("paper-experiment").with_overrides(
         N=len(widths), w_n=widths, w_d=bands, w_t=gaps, w_base=ends, w_tip=ends,
-        profile=profile)
+        profile=profile, w_o=offsets)
     text = body_file_text(design)
     assert body_from_mapping(load_yaml(text, "body"), "body").design() == design
 
@@ -208,3 +232,17 @@ def test_the_shipped_variable_depth_wrist_bends_its_tip_first() -> None:
         r_inner=1.55e-3, w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3, 1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3])
     angles = solve(design, 10.0).notch_angles_rad
     assert np.all(np.diff(angles) > 0.0) and angles[-1] > 4.0 * angles[0]
+
+
+def test_the_shipped_tip_first_wrist_is_four_one_sided_cuts_that_bend_the_tip_first() -> None:
+    design = read_body_file(REPO / "config" / "bodies" / "tip_first_wrist.yaml").design()
+    depths = [1.36e-3, 1.39e-3, 1.42e-3, 1.45e-3]
+    assert design.w_o == tuple(-c / 2 for c in depths)
+    assert design.w_d == tuple(2 * 0.81e-3 - c for c in depths)
+    assert [p.name for p in design.notch_profiles()] == ["rectangular"] * 4
+    result = solve(design, 1.0)
+    assert np.all(np.diff(result.notch_angles_rad) > 0.0)
+    centred = solve(design.with_overrides(w_o=0.0), 1.0)  # the same backbones on the axis
+    assert result.tip_angle_rad > 1.1 * centred.tip_angle_rad
+    assert np.all(result.notch_stop_margins_rad + result.notch_angles_rad
+                  < 0.8 * (centred.notch_stop_margins_rad + centred.notch_angles_rad))
