@@ -14,6 +14,8 @@ import logging
 import os
 import signal
 import sys
+import threading
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from types import FrameType
@@ -31,6 +33,21 @@ RUNTIME_ENV = "TDCM_RUNTIME"
 LOOP_DIED = 70
 #: Exit status of a node stopped by a signal while it was being built (128 + SIGINT, as Ctrl-C).
 INTERRUPTED_EXIT = 130
+#: s a node interrupted while it is built has to stop before it exits without its clean-up: a
+#: library the build calls may run the signal's handler and drop its error (seen: an importlib
+#: weakref callback, "Exception ignored in ... KeyboardInterrupt"), and the build goes on for
+#: seconds. Well inside ``tdcm up``'s and launch's 5 s before a kill.
+STUCK_BUILD_S = 2.0
+
+
+def _exit_if_still_running(seconds: float, what: str) -> None:
+    """After ``seconds``, if the process is still here, say so and exit ``INTERRUPTED_EXIT`` at
+    once (no clean-up: nothing of a node not yet built needs it; its sockets close with it,
+    and a device it opened releases on its own watchdog)."""
+    time.sleep(seconds)
+    print(f"{executable_name()}: {what} while starting; the build did not stop within "
+          f"{seconds:g} s: exiting", file=sys.stderr, flush=True)
+    os._exit(INTERRUPTED_EXIT)
 
 
 def resolve_runtime(choice: str = "auto") -> str:
@@ -106,7 +123,8 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     built (imports, compiled kernels, a first solve: seconds on a loaded machine) interrupts
     the build at once (:class:`KeyboardInterrupt`) instead of waiting for it to finish, and is
     remembered, so that a library which runs the handler and drops its error cannot make the
-    node spin on; once built, it ends the loop.
+    node spin on, and the process leaves ``STUCK_BUILD_S`` later whatever the build does; once
+    built, it ends the loop.
     """
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
@@ -120,6 +138,8 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
         for sig in previous:  # a second signal on the way out must not interrupt the close
             signal.signal(sig, stop)
         interrupted.append(signal.Signals(signum).name)
+        threading.Thread(target=_exit_if_still_running, args=(STUCK_BUILD_S, interrupted[-1]),
+                         name="tdcm-stuck-build", daemon=True).start()
         raise KeyboardInterrupt(interrupted[-1])
 
     def stop(signum: int, frame: FrameType | None) -> None:

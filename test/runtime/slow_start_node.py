@@ -2,7 +2,9 @@
 its port exists, then spends up to 60 s in its constructor, as a node loading compiled kernels on
 a loaded machine does for seconds. ``SlowStartNode`` lets a signal's error through;
 ``SwallowingStartNode`` drops it and returns, as a native library that runs Python's signal
-handlers inside a call and discards their error does (seen: model_node built on and spun)."""
+handlers inside a call and discards their error does (seen: model_node built on and spun);
+``SwallowingSlowNode`` drops it and builds on for another minute (seen: an importlib callback
+dropped it and model_node's build went on past the launcher's 5 s)."""
 
 from __future__ import annotations
 
@@ -33,3 +35,14 @@ class SwallowingStartNode(NodeLogic):
         Path(os.environ["TDCM_TEST_STARTING"]).touch()
         with contextlib.suppress(KeyboardInterrupt):
             threading.Event().wait(BUILD_S)
+
+
+class SwallowingSlowNode(NodeLogic):
+    default_name = "swallowing_slow"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        Path(os.environ["TDCM_TEST_STARTING"]).touch()
+        with contextlib.suppress(KeyboardInterrupt):
+            threading.Event().wait(BUILD_S)
+        threading.Event().wait(BUILD_S)  # the rest of the build, no signal's error to stop it

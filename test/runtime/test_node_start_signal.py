@@ -3,7 +3,9 @@ stopped 2 s after starting, model_node still loading its kernels on a loaded mac
 signal as a stop request for a loop it had not entered, built on for 5 s, and the launcher killed
 it ("ignored SIGINT for 5.0 s"), so ``tdcm up`` exited 1. Seen again once the build was
 interrupted at once: a library model_node's build calls ran the handler and dropped its
-``KeyboardInterrupt``, and the node built on and spun until killed."""
+``KeyboardInterrupt``, and the node built on and spun until killed. And again (CI, 2026-11-28):
+an importlib weakref callback dropped it ("Exception ignored in ... KeyboardInterrupt") and the
+rest of model_node's build outlasted the launcher's 5 s."""
 
 from __future__ import annotations
 
@@ -36,12 +38,14 @@ def building_node(zenoh_env: dict[str, str], tmp_path: Path, node: str = "SlowSt
     return child, err
 
 
-@pytest.mark.parametrize("node", ["SlowStartNode", "SwallowingStartNode"])
+@pytest.mark.parametrize("node", ["SlowStartNode", "SwallowingStartNode",
+                                  "SwallowingSlowNode"])
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_while_the_node_is_built_stops_it_at_once(
         signum: signal.Signals, node: str, router: subprocess.Popen[bytes],
         zenoh_env: dict[str, str], tmp_path: Path) -> None:
-    """Also when the build drops the signal's error and returns: the node does not spin on."""
+    """Also when the build drops the signal's error and returns (the node does not spin on)
+    or builds on (it leaves STUCK_BUILD_S after the signal, before a launcher's 5 s kill)."""
     child, err = building_node(zenoh_env, tmp_path, node)
     child.send_signal(signum)
     try:
@@ -49,7 +53,9 @@ def test_a_signal_while_the_node_is_built_stops_it_at_once(
     finally:
         stop(child)
     assert status == 130
-    assert err.has(f"{signum.name} while starting; stopped"), err.tail()
+    assert err.has(f"{signum.name} while starting; " + (
+        "the build did not stop within 2 s: exiting" if node == "SwallowingSlowNode" else
+        "stopped")), err.tail()
 
 
 def test_a_second_signal_on_the_way_out_does_not_hold_the_node(
