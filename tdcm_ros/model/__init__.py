@@ -85,6 +85,7 @@ from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.roll import (
     InvalidRollError,
     RollHistory,
+    StampedHistory,
     check_roll,
     depends_on_roll,
     roll_loading,
@@ -141,6 +142,7 @@ __all__ = [
     "Sensitivity",
     "SolveResult",
     "SolverSettings",
+    "StampedHistory",
     "TendonSingularityError",
     "TensionProfile",
     "TensionRangeError",

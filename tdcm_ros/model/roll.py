@@ -97,34 +97,44 @@ def roll_loading(loading: Loading | None, roll: float) -> Loading | None:
                    body_force_density=(density_x * c, density_z))
 
 
-class RollHistory:
-    """Recent rolls (rad) by stamp, to pair each sample of another stream (a tension, a marker
-    frame) with the roll at its time: the latest roll stamped at or before it, else the oldest
-    kept (all are newer), else 0 (none yet). Stamps in any one unit (ns, s), fed in order;
-    an out-of-order roll replaces nothing and is ignored. Keeps the last ``size``."""
+class StampedHistory:
+    """Recent values by stamp, to pair each sample of another stream with this one's value at
+    its time: the latest value stamped at or before it, else the oldest kept (all are newer),
+    else ``empty`` (none yet). Stamps in any one unit (ns, s), fed in order; an out-of-order
+    value replaces nothing and is ignored. Keeps the last ``size``."""
 
-    def __init__(self, size: int = 2048) -> None:
+    def __init__(self, size: int = 2048, empty: float = 0.0) -> None:
         if isinstance(size, bool) or not isinstance(size, int) or size < 1:
             raise out_of_range("size", size, "an integer >= 1")
         self._stamps: deque[float] = deque(maxlen=size)
-        self._rolls: deque[float] = deque(maxlen=size)
+        self._values: deque[float] = deque(maxlen=size)
+        self._empty = empty
 
     def __len__(self) -> int:
-        return len(self._rolls)
+        return len(self._values)
 
-    def add(self, stamp: float, roll: float, parameter: str = "roll") -> bool:
-        """Keep ``roll`` (rad; :class:`InvalidRollError` naming ``parameter`` unless finite) at
-        ``stamp``; False (not kept) when ``stamp`` is older than the latest kept one."""
-        phi = check_roll(roll, parameter)
+    def add(self, stamp: float, value: float) -> bool:
+        """Keep ``value`` at ``stamp``; False (not kept) when ``stamp`` is older than the latest
+        kept one."""
         if self._stamps and stamp < self._stamps[-1]:
             return False
         self._stamps.append(stamp)
-        self._rolls.append(phi)
+        self._values.append(value)
         return True
 
     def at(self, stamp: float) -> float:
-        """The roll (rad) at ``stamp`` (see the class docstring)."""
-        if not self._rolls:
-            return 0.0
+        """The value at ``stamp`` (see the class docstring)."""
+        if not self._values:
+            return self._empty
         index = bisect_right(self._stamps, stamp)
-        return self._rolls[index - 1] if index else self._rolls[0]
+        return self._values[index - 1] if index else self._values[0]
+
+
+class RollHistory(StampedHistory):
+    """Recent rolls (rad) by stamp (:class:`StampedHistory`, 0 before any), to pair each sample
+    of another stream (a tension, a marker frame) with the roll at its time."""
+
+    def add(self, stamp: float, value: float, parameter: str = "roll") -> bool:
+        """Keep the roll ``value`` (rad; :class:`InvalidRollError` naming ``parameter`` unless
+        finite) at ``stamp``; False (not kept) when ``stamp`` is older than the latest."""
+        return super().add(stamp, check_roll(value, parameter))

@@ -17,7 +17,9 @@ target, m), ``controller/gain`` and ``controller/gain_std`` (Float64: the estima
 ``g = E_model / E_world`` and its standard deviation) and ``/diagnostics``.
 
 ``mode`` (run time): ``feedforward`` commands ``T_inverse(target) / g`` with ``g`` frozen;
-``feedback`` also updates ``g`` from each measured tip. Without a measured tip for
+``feedback`` also updates ``g`` from each measured tip, with the tension and roll of the marker
+frame's own stamp (their messages' stamps; a frame that waited in the mocap pipeline while the
+tendon moved is not paired with the newer tension). Without a measured tip for
 ``measurement_timeout_s`` feedback falls back to feed-forward with the last ``g`` and says so.
 A refused target (not finite, unknown frame, past the roll limits, unreachable) is logged with
 its value and the allowed range and leaves the current target in place. The controller never
@@ -48,13 +50,14 @@ from tdcm_ros.control import (
     slew,
 )
 from tdcm_ros.errors import TdcmError
-from tdcm_ros.model import PARAMETER_SPECS
+from tdcm_ros.model import PARAMETER_SPECS, RollHistory, StampedHistory
 from tdcm_ros.nodes.metrics_node import (
     LAYOUT_SPECS,
     PRESET_SPECS,
     declare_design_and_layout,
     marker_rows,
 )
+from tdcm_ros.nodes.shape_messages import stamp_ns_of
 from tdcm_ros.runtime import (
     DiagnosticLevel,
     Diagnostics,
@@ -112,6 +115,8 @@ PARAMETERS = {**grouped(PRESET_SPECS), **grouped(PARAMETER_SPECS, "design."),
               **grouped(TUNABLE_SPECS)}
 #: How long the tendon must read released while commanded before diagnostics say so (s).
 RELEASED_AFTER_S = 1.0
+#: Tension and roll samples kept by stamp for the marker frames (seconds at 500 Hz).
+HISTORY = 2048
 NEVER = -(1 << 62)
 
 
@@ -208,6 +213,8 @@ class ShapeControllerNode(NodeLogic):
         self.last_ns: dict[str, int] = {}
         self.tension_n = 0.0
         self.roll_rad = 0.0  # measured; 0 until joint_states names the roll joint
+        # by their stamps, so a marker frame meets the tension and roll of its own instant
+        self.tensions, self.rolls = StampedHistory(HISTORY), RollHistory(HISTORY)
         self.command: tuple[float, float] | None = None
         self.sent: tuple[float, float, int] | None = None  # tension, roll, when
         self.released_since_ns: int | None = None
@@ -254,6 +261,7 @@ class ShapeControllerNode(NodeLogic):
             return
         self.counts["tension"] += 1
         self.tension_n, self.last_ns["tension"] = value, self.port.now_ns()
+        self.tensions.add(stamp_ns_of(message) or self.last_ns["tension"], value)
 
     def _on_joint_states(self, message: Any) -> None:
         names = list(message.name)
@@ -265,6 +273,7 @@ class ShapeControllerNode(NodeLogic):
             self.counts["roll_non_finite"] += 1
             return
         self.roll_rad = value
+        self.rolls.add(stamp_ns_of(message) or self.port.now_ns(), value)
 
     def _on_tf(self, message: Any) -> None:
         for problem in self.tf.add_message(message):
@@ -329,8 +338,9 @@ class ShapeControllerNode(NodeLogic):
         now = self.port.now_ns()
         dt_s = (now - self.last_ns.get("observed", now)) * 1e-9
         adapt = str(self.port.get_parameter("mode")) == "feedback"
+        taken = stamp_ns_of(message) or now  # the frame's instant: the bench's state then
         try:
-            observation = self.core.observe(self.tension_n, self.roll_rad,
+            observation = self.core.observe(self.tensions.at(taken), self.rolls.at(taken),
                                             registration.to_base(rows), dt_s, adapt=adapt)
         except TdcmError as error:  # a tension past a model limit: no prediction for it
             self.counts[f"model_{error.kind}"] += 1
