@@ -78,6 +78,8 @@ def test_feedback_tracks_the_circle_better_than_feed_forward(tmp_path: Path) -> 
     assert "controller mode -> feedforward (feedforward_learned phase)" in done.stdout
     learned = results[FEEDFORWARD_LEARNED]
     assert learned["mode"] == FEEDFORWARD and learned["samples"] > 100
-    assert learned["rmse_m"] < feedforward["rmse_m"], said
+    # the kept gain is the world's: the model now explains the measured tip (tip vs target in
+    # a feed-forward lap is the live commands' lag behind the moving target, the machine's load)
+    assert learned["model_rmse_m"] < 0.5 * feedforward["model_rmse_m"], said
     for name in ("tracking_paths.png", "tracking_error.png"):
         assert (out / "plots" / name).stat().st_size > 0
