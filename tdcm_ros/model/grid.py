@@ -179,6 +179,11 @@ class Grid(CellArrays):
         return np.diff(self.s_nodes)
 
     @cached_property
+    def off_axis(self) -> bool:
+        """Whether any notch's centroid is off the tube axis (``Design.w_o``)."""
+        return bool(np.any(self.xbar_q))
+
+    @cached_property
     def members(self) -> Members:
         """The design as a one-member :class:`Members`."""
         return Members.of([self.design])

@@ -173,7 +173,7 @@ class SolveResult:
         w_r = found.w_r
         theta_a = self.theta[cells]
         theta = theta_a + m_a * found.a0_s + m_b * found.a1_s
-        if np.any(self.grid.xbar_q):  # off the axis: the centroid's motion, the axis's stretch
+        if self.grid.off_axis:  # the centroid's motion, the axis's stretch
             pull = self.tension_n
             phi_r = phi_r - pull * found.d_r
             w_r = w_r + m_a[:, None] * found.k0_r + m_b[:, None] * found.k1_r \

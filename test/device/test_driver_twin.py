@@ -289,13 +289,9 @@ def test_a_freeze_is_seen_by_a_host_stepping_slower_than_its_heartbeat(tmp_path:
         bench.driver.close()
 
 
-def test_a_boot_banner_when_the_port_opens_is_not_a_reboot(bench: Bench) -> None:
-    """A UNO resets when its port is opened: its boot banner can arrive after the host flushed
-    the port and asked for the banner, so two banners answer one request. Nothing was tensioned
-    on this connection yet, so this is the handshake, not a reboot: the driver stays armed."""
-    bench.driver.step()  # opens the port, flushes it and asks for the banner
-    bench.twin.reboot()  # the reset's boot banner comes before the answer to the request
-    bench.run_until_connected()
+def assert_still_armed_and_tensions(bench: Bench) -> None:
+    """After a handshake the driver did not take for a reboot: armed, no reboot warned of, and
+    8 N on request."""
     bench.run(0.5)
     status = bench.driver.step().status
     assert status.armed and not any("reboot" in w for w in bench.warnings), bench.warnings
@@ -303,6 +299,16 @@ def test_a_boot_banner_when_the_port_opens_is_not_a_reboot(bench: Bench) -> None
     assert bench.driver.set_setpoint(8.0) == 8.0
     bench.run(3.0)
     assert bench.twin.plant.tension == pytest.approx(8.0, abs=0.3)
+
+
+def test_a_boot_banner_when_the_port_opens_is_not_a_reboot(bench: Bench) -> None:
+    """A UNO resets when its port is opened: its boot banner can arrive after the host flushed
+    the port and asked for the banner, so two banners answer one request. Nothing was tensioned
+    on this connection yet, so this is the handshake, not a reboot: the driver stays armed."""
+    bench.driver.step()  # opens the port, flushes it and asks for the banner
+    bench.twin.reboot()  # the reset's boot banner comes before the answer to the request
+    bench.run_until_connected()
+    assert_still_armed_and_tensions(bench)
 
 
 def test_a_boot_banner_and_frames_ahead_of_the_answer_are_not_a_reboot(tmp_path: Path) -> None:
@@ -331,10 +337,4 @@ def test_a_boot_banner_and_frames_ahead_of_the_answer_are_not_a_reboot(tmp_path:
     held.clear()
     link = links[-1]
     link.write = lambda data: bench.twin.receive(data)  # type: ignore[attr-defined]
-    bench.run(0.5)
-    status = bench.driver.step().status
-    assert status.armed and not any("reboot" in w for w in bench.warnings), bench.warnings
-    bench.driver.enable()
-    assert bench.driver.set_setpoint(8.0) == 8.0
-    bench.run(3.0)
-    assert bench.twin.plant.tension == pytest.approx(8.0, abs=0.3)
+    assert_still_armed_and_tensions(bench)

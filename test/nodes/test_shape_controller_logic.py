@@ -52,6 +52,7 @@ class Bench:
         if limits:
             driver_parameters(self.port, LIMITS)
         self.node = ShapeControllerNode(self.port, limits_on_timer=True)
+        self.taken: list[tuple[int, float, float]] = []  # (stamp ns, tension, roll) followed
         if limits:
             assert self.node.limits.limits is not None  # read at start
         t, q = REGISTRATION.translation, REGISTRATION.quaternion
@@ -95,8 +96,9 @@ class Bench:
         return self.port.messages(topic)[-1]
 
     def follow(self, seconds: float, modulus_ratio: float, rng: np.random.Generator,
-               markers: bool = True) -> None:
-        """The bench closed: the driver holds the last setpoints, the world bends."""
+               markers: bool = True, lag_steps: int = 0) -> None:
+        """The bench closed: the driver holds the last setpoints, the world bends; each marker
+        frame reaches the node ``lag_steps`` steps (0.05 s each) after it was taken."""
         for _ in range(round(seconds / 0.05)):
             self.port.advance(0.05)
             if not self.port.messages("tension_setpoint"):
@@ -105,8 +107,10 @@ class Bench:
             roll = float(self.last("roll_setpoint").data)
             self.tension(tension)
             self.roll(roll)
-            if markers:
-                self.markers(tension, roll, modulus_ratio, rng)
+            self.taken.append((self.port.clock_ns, tension, roll))
+            if markers and len(self.taken) > lag_steps:
+                stamp, then_n, then_roll = self.taken[-1 - lag_steps]
+                self.markers(then_n, then_roll, modulus_ratio, rng, stamp_ns=stamp)
 
 
 @pytest.fixture
@@ -314,21 +318,8 @@ def test_a_marker_frame_late_from_the_mocap_meets_the_tension_of_its_own_stamp(b
     Paired by stamp, the gain is the world's."""
     rng = np.random.default_rng(11)
     b = bench(overrides={"mode": "feedback"})
-    lag_steps = 4  # 0.2 s at the bench's 0.05 s
-    taken: list[tuple[int, float, float]] = []  # (stamp ns, tension, roll) of the bench
     for target_n in (6.0, 14.0, 8.0, 16.0, 7.0, 15.0) * 4:  # the tendon always on the move
         b.target(model_tip(target_n, 0.3))
-        for _ in range(round(0.3 / 0.05)):
-            b.port.advance(0.05)
-            if not b.port.messages("tension_setpoint"):
-                continue
-            tension = float(b.last("tension_setpoint").data)
-            roll = float(b.last("roll_setpoint").data)
-            b.tension(tension)
-            b.roll(roll)
-            taken.append((b.port.clock_ns, tension, roll))
-            if len(taken) > lag_steps:
-                stamp, then_n, then_roll = taken[-1 - lag_steps]
-                b.markers(then_n, then_roll, 1.1, rng, stamp_ns=stamp)
+        b.follow(0.3, 1.1, rng, lag_steps=4)  # frames 0.2 s late
     gain, std = b.last("controller/gain").data, b.last("controller/gain_std").data
     assert gain == pytest.approx(1.1, abs=4 * std + 2e-3), (gain, std)  # newest: 0.945
