@@ -402,7 +402,7 @@ class RclpyContext:
     def __init__(self, args: Sequence[str] = (), params_files: Sequence[str] = ()) -> None:
         import rclpy
         from rclpy.context import Context
-        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.executors import SingleThreadedExecutor, TimeoutObject
         from rclpy.signals import SignalHandlerOptions
 
         self.context = Context()
@@ -413,6 +413,11 @@ class RclpyContext:
             raise InputError(f"ROS arguments {' '.join(args)!r} are refused by rcl: {error}",
                              parameter="--ros-args", value=" ".join(args)) from error
         self.executor = SingleThreadedExecutor(context=self.context)
+        # One timeout object for every wake-up: rclpy keeps the ready entities of its last wait
+        # only while ``spin_once`` gets the same arguments; a new float each time (spin_for's
+        # time left) made every wake-up run just the first ready entity, so a busy subscription
+        # or timer starved the ones after it.
+        self._timeout = TimeoutObject(0.0)
         self.domain_id = int(self.context.get_domain_id())
         self.params_files = [*params_files, *_flag_values(args, ("--params-file",))]
         self.cli_params = _flag_values(args, ("-p", "--param"))
@@ -459,7 +464,8 @@ class RclpyContext:
                 return
             self._spinners[me] = self._spinners.get(me, 0) + 1
         try:
-            self.executor.spin_once(timeout_sec=timeout_sec)
+            self._timeout.timeout = timeout_sec
+            self.executor.spin_once(timeout_sec=self._timeout)
         finally:
             with self._spinning:
                 self._spinners[me] -= 1

@@ -5,6 +5,7 @@ the context's executor, nodes and rclpy context are stand-ins that record what h
 from __future__ import annotations
 
 import threading
+from types import SimpleNamespace
 from typing import Any
 
 from tdcm_ros.runtime import rclpy_runtime
@@ -58,6 +59,7 @@ def _context(log: _Recorder) -> Any:
     ctx._spinners = {}
     ctx._spinning = threading.Condition()
     ctx._closed = False
+    ctx._timeout = SimpleNamespace(timeout=0.0)
     return ctx
 
 

@@ -110,3 +110,27 @@ def test_params_files_in_ros_args_apply_by_the_remapped_name(monkeypatch, tmp_pa
         assert port.get_parameter("period") == 3.0 and port.get_parameter("prefix") == "launched"
     finally:
         context.close()
+
+
+@pytest.mark.rclpy
+def test_a_busy_timer_does_not_starve_the_entities_after_it(rclpy_context: Any) -> None:
+    """Every entity ready at one wake-up runs before the next wait, however ``spin_for`` is cut.
+
+    The first timer's callback outlasts its period, so it is ready at every wait; before the
+    fix each ``spin_once`` (a new timeout each time) ran only the first ready entity and the
+    second timer never ran (the CI symptom: a probe's ``/diagnostics`` subscription, behind two
+    400 Hz marker subscriptions, saw nothing for 10 s)."""
+    import time
+
+    port = rclpy_context.create_port("busy")
+    runs = {"busy": 0, "starved": 0}
+
+    def busy() -> None:
+        runs["busy"] += 1
+        time.sleep(0.002)  # a callback longer than the 1 ms period: ready again at once
+
+    port.create_timer(0.001, busy)
+    port.create_timer(0.001, lambda: runs.__setitem__("starved", runs["starved"] + 1))
+    eventually(lambda: runs["starved"] >= 5, 10.0, "the second timer to run",
+               spin=rclpy_context, detail=lambda: runs)
+    assert runs["busy"] >= 5
