@@ -452,9 +452,9 @@ def _cubic_roots(cubic: tuple[float, float, float, float], low: float,
     cuts = sorted(s for s in cuts if low <= s <= high)
     roots = [s for s in cuts if low < s < high and value(s) == 0.0]  # a root at a turning point
     for left, right in itertools.pairwise(cuts):
-        f_left = value(left)
-        if f_left * value(right) >= 0.0:
-            continue
+        f_left, f_right = value(left), value(right)
+        if f_left == 0.0 or f_right == 0.0 or (f_left < 0.0) == (f_right < 0.0):
+            continue  # signs compared, not multiplied: a product of tiny values underflows to 0
         s = 0.5 * (left + right)
         for _ in range(CUBIC_STEPS):
             f = value(s)

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.errors import InputError, PhysicsError
@@ -191,6 +191,8 @@ def test_summary_is_json_ready():
 
 
 @settings(max_examples=300)
+@example(coefficients=[1.0, 0.0, -3.1657934812405806e-232, 2.2250738585e-313],
+         scales=[-2, 0, 0, -9], ends=[2.0, -1.0])  # f(low) f(piece end) underflowed to -0.0
 @given(coefficients=st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4),
        scales=st.lists(st.integers(-12, 0), min_size=4, max_size=4),
        ends=st.lists(st.floats(-5.0, 5.0), min_size=2, max_size=2, unique=True))
