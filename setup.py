@@ -68,6 +68,8 @@ setup(
         "zstandard>=0.19",
         # a notch section given as a polygon is checked by shapely (simple rings, holes inside)
         "shapely>=2.0",
+        # a body given as a mesh (STL, ...) is read and sliced by trimesh (model/mesh_body.py)
+        "trimesh>=4",
         ZENOH_REQUIREMENT,
     ],
     extras_require={
@@ -78,7 +80,9 @@ setup(
         "test": ["pytest>=7", "pytest-xdist>=3.5", "hypothesis>=6.80", "ruff>=0.5",
                  "matplotlib>=3.7", "mypy==2.4.1", "scipy-stubs==1.17.1.5",
                  "types-PyYAML==6.0.12.20261113", "types-pyserial==3.5.0.20260712",
-                 "types-shapely==2.1.0.20261030"],
+                 "types-shapely==2.1.0.20261030",
+                 # builds the meshes of the mesh-body tests and bench (test/support/meshes.py)
+                 "manifold3d>=3"],
     },
     zip_safe=True,
     maintainer="tdcm_ros developers",

@@ -70,7 +70,7 @@ ROS_PACKAGES=(
 # The package's own dependencies (setup.py install_requires, plot and test extras). tdcm_ros itself
 # is NOT installed with pip: it must come from the colcon install space.
 PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "xxhash>=3.0" "tqdm>=4.60"
-                  "lz4>=4" "zstandard>=0.19" "shapely>=2.0" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest
+                  "lz4>=4" "zstandard>=0.19" "shapely>=2.0" "trimesh>=4" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest
                   "pytest-xdist>=3.5" hypothesis)
 # Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
 VENV_RECIPE_VERSION=3

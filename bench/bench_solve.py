@@ -5,7 +5,8 @@ Prints the median and p90 time per solve on ``paper-experiment`` at 20 N with th
 settings (compiled kernel, and the plain-Python build of the same kernel, ``TDCM_JIT=0``),
 the tip error of that solve against a converged reference, and the iterations across presets
 and hard designs. Issue 27: the same solve through the shipped body file, and a body whose 8
-notches all differ (widths, backbones, tubes) and the same body with one-sided cuts, timed
+notches all differ (widths, backbones, tubes), the same body with one-sided cuts and the
+paper's tube with 8 polygon (tee) notches, timed
 interleaved in this process, as ratios to the preset. ``--baseline`` times another checkout of the package (e.g. main's NumPy
 path) in the same run: baseline and this checkout alternate in fresh processes for
 ``--rounds`` rounds and the ratio of their medians is printed.
@@ -72,7 +73,8 @@ def all_different_cuts() -> Design:
     return base.with_overrides(w_d=[2 * base.R_outer - c for c in cuts], w_o=[-c / 2 for c in cuts])
 
 
-BODY_FILE = Path(__file__).resolve().parents[1] / "config" / "bodies" / "paper_experiment.yaml"
+BODIES = Path(__file__).resolve().parents[1] / "config" / "bodies"
+BODY_FILE = BODIES / "paper_experiment.yaml"
 
 
 def interleaved(designs: dict[str, Design], repeats: int, rounds: int = 5) -> dict[str, float]:
@@ -147,7 +149,9 @@ def main() -> None:
           "(256 vs 512 cells/notch)")
     bodies = interleaved({"preset": design, "body file": read_body_file(BODY_FILE).design(),
                           "8 notches all different": all_different(),
-                          "8 one-sided cuts": all_different_cuts()}, args.repeats)
+                          "8 one-sided cuts": all_different_cuts(),
+                          "8 polygon notches": read_body_file(BODIES / "tee_notches.yaml").design()},
+                         args.repeats)
     print("body path (issue 27), interleaved medians at 20 N")
     for name, median in bodies.items():
         print(f"  {name:24s} {median * 1e6:8.1f} us  {median / bodies['preset']:5.2f}x the preset"

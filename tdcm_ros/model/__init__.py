@@ -78,6 +78,7 @@ from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
     CircularProfile,
     CustomProfile,
+    PolygonProfile,
     RectangularProfile,
 )
 from tdcm_ros.model.progress import Progress, report_progress, within
@@ -136,6 +137,7 @@ __all__ = [
     "NoDesignMeetsTargetError",
     "NotchClosureError",
     "NotchContact",
+    "PolygonProfile",
     "Progress",
     "RectangularProfile",
     "RollHistory",

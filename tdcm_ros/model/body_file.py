@@ -18,14 +18,17 @@ pair of cuts leaving a backbone this wide, m, centred on the tube axis or ``offs
 toward +x, m; ``profile`` circular (default) or rectangular), ``cut`` (a one-sided cut from +x,
 this deep from the surface, m: a band ``2 R_outer - cut`` wide at ``offset = -cut/2``;
 ``profile`` rectangular (default) or circular, the cut's outline along the body) or ``polygon``
-(the material left, a list of ``[x, y]`` in m, with optional ``holes``). Every problem is an
+(the material left, a list of ``[x, y]`` in m, with optional ``holes``). Instead of ``tube`` and
+``segments``, ``mesh: {file: body.stl, unit: mm}`` gives the body as a triangle mesh (relative
+to the body file's folder), sliced into its tube and prismatic notches by
+:mod:`tdcm_ros.model.mesh_body`. Every problem is an
 :class:`~tdcm_ros.model.errors.InvalidDesignError` naming the key by its path in the file
 (``segments[1].segments[0].notch.cut``), the value and the allowed range.
 
-The solver takes today band and cut notches, each with its own width, backbone, offset and
-profile, any tubes between them, and one tendon: :meth:`BodySpec.design` gives that
-:class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ) and names
-the first segment a body departs from it by (polygon sections are not solvable yet).
+The solver takes band, cut and polygon notches, each with its own width and section, any
+tubes between them, and one tendon: :meth:`BodySpec.design` gives that
+:class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ; a polygon
+notch is a :class:`~tdcm_ros.model.profiles.PolygonProfile`, prismatic along the body).
 """
 
 from __future__ import annotations
@@ -39,7 +42,14 @@ from typing import Any
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.design import MIN_SEGMENT_M, OFFSET_SLACK, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.profiles import PROFILE_NAMES, NotchProfile, profile_from_name
+from tdcm_ros.model.profiles import (
+    PROFILE_NAMES,
+    NotchProfile,
+    PolygonProfile,
+    PrismaticProfile,
+    SlicedProfile,
+    profile_from_name,
+)
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
 from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
@@ -64,8 +74,9 @@ class TubeSpec:
 @dataclass(frozen=True, eq=False)
 class NotchSpec:
     """A notch segment: ``width`` along the body (m) and its section, one of ``band`` (backbone
-    width, m, ``offset`` from the axis toward +x, m), ``cut`` (depth, m) or ``polygon``
-    (``shell``, ``holes``, m); a band or cut has a ``profile``."""
+    width, m, ``offset`` from the axis toward +x, m), ``cut`` (depth, m), ``polygon``
+    (``shell``, ``holes``, m) or ``sliced`` (a mesh's slice, ``sliced``); a band or cut has a
+    ``profile``."""
 
     width: float
     kind: str
@@ -75,6 +86,7 @@ class NotchSpec:
     cut: float = math.nan
     shell: tuple[tuple[float, float], ...] = ()
     holes: tuple[tuple[tuple[float, float], ...], ...] = ()
+    sliced: SlicedProfile | None = None
     where: str = ""
 
     def section(self, r_outer: float, r_inner: float) -> Section:
@@ -87,9 +99,23 @@ class NotchSpec:
         return PolygonSection(self.shell, r_outer, self.holes)
 
     def backbone(self, r_outer: float) -> float:
-        """The width of the material left at the notch's centre (m): the band, or the tube
-        less the cut (``2 R_outer - cut``)."""
+        """The width of the material left at the notch's centre (m): the band, the tube less
+        the cut (``2 R_outer - cut``), or the polygon's extent in ``x``."""
+        if self.kind in ("polygon", "sliced"):
+            low, high = self.prismatic().x_extent()
+            return high - low
         return 2.0 * r_outer - self.cut if self.kind == "cut" else self.band
+
+    def prismatic(self) -> PrismaticProfile:
+        """The section of a polygon notch, or of a notch sliced from a mesh."""
+        return self.sliced if self.sliced is not None else PolygonProfile(self.shell, self.holes)
+
+    def profile_object(self) -> NotchProfile:
+        """The notch's profile for the solver: the named one of a band or cut, the polygon or
+        the mesh's slice."""
+        if self.kind in ("polygon", "sliced"):
+            return self.prismatic()
+        return profile_from_name(self.profile)
 
 
 Segment = TubeSpec | NotchSpec
@@ -109,11 +135,10 @@ class BodySpec:
     source: str
 
     def design(self) -> Design:
-        """The body as the solver's :class:`Design`: a base tube (or none), N band or cut
-        notches, each with its own width, backbone, offset and profile, a tube (or none) between
-        adjacent notches and a tip tube (or none). A body the solver does not take yet (a
-        polygon section) raises :class:`InvalidDesignError` naming the first segment that has
-        one; a band off the axis past the tube's wall, naming its segment."""
+        """The body as the solver's :class:`Design`: a base tube (or none), N band, cut or
+        polygon notches, each with its own width and section, a tube (or none) between adjacent
+        notches and a tip tube (or none). A band off the axis past the tube's wall, or a polygon
+        reaching outside the tube, raises :class:`InvalidDesignError` naming its segment."""
         merged = _merged_tubes(self.segments)
         notches = [s for s in merged if isinstance(s, NotchSpec)]
         if not notches:
@@ -121,7 +146,12 @@ class BodySpec:
                                      "one", parameter="segments", value=0, allowed="[1, inf) notches")
         for notch in notches:
             if notch.kind == "polygon":
-                raise _not_yet(notch.where, "a polygon section", self.source)
+                reach = max(math.hypot(x, y) for x, y in notch.shell)
+                if reach > self.R_outer * (1.0 + OFFSET_SLACK):
+                    raise out_of_range(f"{self.source}: {notch.where}.polygon", reach,
+                                       f"vertices within R_outer = {self.R_outer:g} m of the "
+                                       "tube axis", error=InvalidDesignError)
+                continue
             room = self.R_outer - notch.backbone(self.R_outer) / 2.0
             if abs(notch.offset) > room + OFFSET_SLACK * self.R_outer:
                 raise out_of_range(f"{self.source}: {notch.where}.offset", notch.offset,
@@ -136,14 +166,7 @@ class BodySpec:
                       w_d=tuple(n.backbone(self.R_outer) for n in notches), N=len(notches),
                       w_o=tuple(n.offset for n in notches), R_outer=self.R_outer,
                       r_inner=self.r_inner, R_c=self.tendon_offset, E=self.E,
-                      profile=tuple(profile_from_name(n.profile) for n in notches))
-
-
-def _not_yet(where: str, what: str, source: str) -> InvalidDesignError:
-    return InvalidDesignError(
-        f"{source}: {where}: {what}: the solver takes band and cut notches and one tendon "
-        "(polygon sections are not solvable yet)", parameter=where, value=what,
-        allowed="band or cut notches")
+                      profile=tuple(n.profile_object() for n in notches))
 
 
 def _merged_tubes(segments: Sequence[Segment]) -> list[Segment]:
@@ -173,13 +196,24 @@ def read_body_file(path: str | Path) -> BodySpec:
 def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
     """The checked :class:`BodySpec` of a body file's parsed YAML ``data``."""
     top = _mapping(data, "the body file", source)
-    reject_unknown("body file key", top, ("tube", "material", "tendons", "segments"),
+    reject_unknown("body file key", top, ("tube", "material", "tendons", "segments", "mesh"),
                    error=InvalidDesignError)
-    tube = _mapping(_required(top, "tube", "", source), "tube", source)
-    reject_unknown("tube key", tube, ("R_outer", "r_inner"), error=InvalidDesignError)
-    r_outer = _number(tube, "R_outer", "tube.", source, low=0.0, high=0.5, open_low=True)
-    r_inner = _number(tube, "r_inner", "tube.", source, low=0.0, high=r_outer, open_high=True,
-                      default=0.0)
+    if "mesh" in top:
+        for key in ("tube", "segments"):
+            if key in top:
+                raise InvalidDesignError(
+                    f"{source}: {key} goes with segments, not with mesh (the mesh gives the tube "
+                    "and the segments)", parameter=key, value=top[key],
+                    allowed="mesh, or tube and segments")
+        r_outer, r_inner, segments = _mesh(_mapping(top["mesh"], "mesh", source), source)
+    else:
+        tube = _mapping(_required(top, "tube", "", source), "tube", source)
+        reject_unknown("tube key", tube, ("R_outer", "r_inner"), error=InvalidDesignError)
+        r_outer = _number(tube, "R_outer", "tube.", source, low=0.0, high=0.5, open_low=True)
+        r_inner = _number(tube, "r_inner", "tube.", source, low=0.0, high=r_outer,
+                          open_high=True, default=0.0)
+        segments = _segments(_required(top, "segments", "", source), "segments", source,
+                             r_outer, r_inner)
     material = _mapping(_required(top, "material", "", source), "material", source)
     reject_unknown("material key", material, ("E",), error=InvalidDesignError)
     modulus = _number(material, "E", "material.", source, low=0.0, high=1e12, open_low=True)
@@ -196,10 +230,27 @@ def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
     if routing not in ROUTINGS:
         raise out_of_range(f"{source}: tendons[0].routing", routing, " | ".join(ROUTINGS),
                            error=InvalidDesignError)
-    segments = _segments(_required(top, "segments", "", source), "segments", source, r_outer,
-                         r_inner)
     return BodySpec(R_outer=r_outer, r_inner=r_inner, E=modulus, tendon_offset=offset,
                     routing=str(routing), segments=tuple(segments), source=source)
+
+
+def _mesh(entry: Mapping[str, Any], source: str) -> tuple[float, float, list[Segment]]:
+    """``R_outer``, ``r_inner`` (m) and the segments of the body file's ``mesh`` (its ``file``
+    relative to the body file's folder, its ``unit``), sliced by :mod:`~tdcm_ros.model.mesh_body`."""
+    from tdcm_ros.model.mesh_body import read_mesh_body
+
+    reject_unknown("mesh key", entry, ("file", "unit"), error=InvalidDesignError)
+    name = _required(entry, "file", "mesh.", source)
+    if not isinstance(name, str) or not name:
+        raise out_of_range(f"{source}: mesh.file", name, "a mesh file's path",
+                           error=InvalidDesignError)
+    path = Path(name) if Path(name).is_absolute() else Path(source).parent / name
+    body = read_mesh_body(path, str(entry.get("unit", "m")), f"{source}: mesh")
+    segments: list[Segment] = [
+        TubeSpec(s.length, s.where) if s.section is None else
+        NotchSpec(width=s.length, kind="sliced", sliced=s.section, where=s.where)
+        for s in body.segments]
+    return body.R_outer, body.r_inner, segments
 
 
 def _segments(items: Any, where: str, source: str, r_outer: float, r_inner: float
@@ -352,7 +403,14 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         text = repr(float(value))
         return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
 
+    def points(ring: Sequence[tuple[float, float]]) -> str:
+        return "[" + ", ".join(f"[{number(x)}, {number(y)}]" for x, y in ring) + "]"
+
     def notch(width: float, band: float, offset: float, profile: NotchProfile) -> str:
+        if isinstance(profile, PolygonProfile):
+            holes = (", holes: [" + ", ".join(points(h) for h in profile.holes) + "]"
+                     if profile.holes else "")
+            return f"{{width: {number(width)}, polygon: {points(profile.shell)}{holes}}}"
         at = f", offset: {number(offset)}" if offset != 0.0 else ""
         return f"{{width: {number(width)}, band: {number(band)}{at}, profile: {profile.name}}}"
 

@@ -4,7 +4,7 @@
 :class:`~tdcm_ros.model.grid.Grid` the kernels read (``C0``, ``C1``, ``A0``, ``A1``, ``w_q``,
 the chord terms ``C0_T``, ``C1_T``, ``A0_T``, ``A1_T``, the off-axis centroid's ``xbar_start``,
 ``xbar_end``, ``K0``, ``K1``, ``chord_start_node``, ``chord_end_node``, ``constrained``, ``notch_left_node``,
-``notch_right_node``), each with the member axis first. Grids of different cell or notch
+``notch_right_node``, ``notch_open``), each with the member axis first. Grids of different cell or notch
 counts stack by padding with zero-length cells at the tip (they move no node) and with
 notches marked -1 (never checked).
 """
@@ -53,7 +53,8 @@ class Cells:
         fq = np.zeros((len(parts), FQ_ROWS, n, q))
         ic = np.zeros((len(parts), 3, n), np.int64)
         ic[:, 2] = 1
-        notch = np.full((len(parts), 2, k), -1, np.int64)
+        notch = np.full((len(parts), NOTCH_ROWS, k), -1, np.int64)
+        notch[:, 2:] = 0  # a padding notch has no nodes (-1) and no side to close
         for j, c in enumerate(parts):
             cells, notches, points = c.n_cells, c.notch.shape[2], c.fq.shape[3]
             fc[j, :, :cells] = c.fc[0]
@@ -101,8 +102,10 @@ class Cells:
         scal = np.stack([members.R_c[rows], members.R_outer[rows], members.length[rows],
                          np.max(peak, axis=1, initial=0.0)], axis=1)
         return cls(fc=fc[..., 0], fq=fq, ic=ic,
-                   notch=np.stack([table.notch_left_node[rows, :notches],
-                                   table.notch_right_node[rows, :notches]], axis=1),
+                   notch=np.concatenate([np.stack([table.notch_left_node[rows, :notches],
+                                                   table.notch_right_node[rows, :notches]],
+                                                  axis=1),
+                                         members.notch_open[rows][:, :, :notches]], axis=1),
                    scal=scal)
 
     def take(self, rows: Ints) -> Cells:
@@ -220,6 +223,9 @@ _FQ_FIELDS = np.array([grid_kernel.A0, grid_kernel.A1, grid_kernel.W_Q, grid_ker
                        grid_kernel.K2])
 #: Rows of :attr:`Cells.fc` and :attr:`Cells.fq` (the kernel's layout).
 FC_ROWS, FQ_ROWS = _FC_FIELDS.size, _FQ_FIELDS.size
+#: Rows of :attr:`Cells.notch`: each notch's first and last node, then whether its faces can
+#: meet on the +x and on the -x side (:meth:`~tdcm_ros.model.design.Design.open_faces`).
+NOTCH_ROWS = 4
 
 
 @lru_cache(maxsize=512)
@@ -239,5 +245,6 @@ def _packed(grids: CellArrays, member_axis: Callable[[NDArray[Any]], NDArray[Any
 
     return Cells(fc=packed(*_FC_NAMES), fq=packed(*_FQ_NAMES),
                  ic=packed("chord_start_node", "chord_end_node", "constrained").astype(np.int64),
-                 notch=packed("notch_left_node", "notch_right_node").astype(np.int64),
+                 notch=np.concatenate([packed("notch_left_node", "notch_right_node"),
+                                       member_axis(grids.notch_open)], axis=1).astype(np.int64),
                  scal=scal)

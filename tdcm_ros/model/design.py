@@ -19,6 +19,7 @@ features are often softer: treat ``E`` as a calibration parameter (``tdcm calibr
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
@@ -29,12 +30,15 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import (
+    PRISMATIC_PROFILES,
     PROFILE_NAMES,
     CircularProfile,
     NotchProfile,
+    PolygonProfile,
     profile_from_name,
 )
 from tdcm_ros.model.section import tube_moment
+from tdcm_ros.model.sections import keeps_wall
 from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of, spelled_as
 
 MM = 1e-3
@@ -88,8 +92,36 @@ class Design:
                      error=InvalidDesignError)
         for name in _LISTABLE:
             object.__setattr__(self, name, _lengths(name, getattr(self, name), self._count(name)))
-        self._check_cross_fields()
         object.__setattr__(self, "profile", _profiles(self.profile, self.N))
+        self._take_prismatic_extents()
+        self._check_cross_fields()
+
+    def _take_prismatic_extents(self) -> None:
+        """Set ``w_d`` and ``w_o`` of each prismatic notch (a polygon or a sliced section) to
+        its section's extent in ``x`` and that extent's middle (m), after checking it (a
+        polygon: simple, of positive area, its vertices within ``R_outer`` of the axis)."""
+        prismatic = [(i, p) for i, p in enumerate(self.notch_profiles())
+                     if isinstance(p, PRISMATIC_PROFILES)]
+        if not prismatic:
+            return
+        w_d, w_o = self.per_notch("w_d"), self.per_notch("w_o")
+        for i, profile in prismatic:
+            where = f"profile[{i}]" if isinstance(self.profile, tuple) else "profile"
+            try:
+                profile.section(self.R_outer)
+            except InvalidDesignError as error:
+                raise InvalidDesignError(f"{where}: {error}", parameter=where,
+                                         value=error.value, allowed=error.allowed) from error
+            if isinstance(profile, PolygonProfile):
+                reach = max(math.hypot(x, y) for x, y in profile.shell)
+                if reach > self.R_outer * (1.0 + OFFSET_SLACK):
+                    raise out_of_range(f"{where} (polygon)", reach, f"vertices within R_outer = "
+                                       f"{self.R_outer:g} m of the tube axis",
+                                       error=InvalidDesignError)
+            low, high = profile.x_extent()
+            w_d[i], w_o[i] = high - low, 0.5 * (high + low)
+        for name, values in (("w_d", w_d), ("w_o", w_o)):
+            object.__setattr__(self, name, _lengths(name, values.tolist(), self.N))
 
     def _check_cross_fields(self) -> None:
         """Ranges that depend on other fields: radii inside ``R_outer`` (m), the backbone
@@ -114,6 +146,15 @@ class Design:
                 if 0.0 < value < MIN_SEGMENT_M:
                     raise out_of_range(where, value, f"0 (no segment) or [{MIN_SEGMENT_M:g}, 1] m",
                                        error=InvalidDesignError)
+
+    def open_faces(self) -> NDArray[np.bool_]:
+        """Per notch (shape (2, N), base to tip): whether its faces can meet at the tube's outer
+        surface on the +x side (row 0) and the -x side (row 1), i.e. whether the cut opens there
+        (the section's material, ``w_o +- w_d/2`` at the notch centre, does not keep the wall:
+        :func:`tdcm_ros.model.sections.keeps_wall`)."""
+        w_d, w_o = self.per_notch("w_d"), self.per_notch("w_o")
+        return ~np.stack([keeps_wall(w_o + 0.5 * w_d, self.R_outer),
+                          keeps_wall(0.5 * w_d - w_o, self.R_outer)])
 
     def _count(self, name: str) -> int:
         """How many values a per-notch (N) or per-gap (N - 1) field holds when it is a list."""
@@ -239,9 +280,9 @@ def _profiles(value: Any, count: int) -> NotchProfile | tuple[NotchProfile, ...]
             return profile_from_name(item)
         if not hasattr(item, "h1"):
             raise InvalidDesignError(
-                f"{where} = {item!r} is not a notch profile; allowed: circular, rectangular, or "
-                "CustomProfile(h1)", parameter=where, value=item,
-                allowed="circular | rectangular | CustomProfile")
+                f"{where} = {item!r} is not a notch profile; allowed: circular, rectangular, "
+                "CustomProfile(h1) or PolygonProfile(shell)", parameter=where, value=item,
+                allowed="circular | rectangular | CustomProfile | PolygonProfile")
         return item
 
     if isinstance(value, (list, tuple)):

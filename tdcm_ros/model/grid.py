@@ -54,7 +54,13 @@ from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.compiled import grid_kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.grid_kernel import CIRCULAR, CUSTOM, RECTANGULAR, offset_section
+from tdcm_ros.model.grid_kernel import (
+    CIRCULAR,
+    CUSTOM,
+    PRISMATIC,
+    RECTANGULAR,
+    offset_section,
+)
 from tdcm_ros.model.grid_layout import (
     PEAK_SAMPLES,
     CellTable,
@@ -138,6 +144,7 @@ class CellArrays:
     strain1: Array
     notch_left_node: IntArray
     notch_right_node: IntArray
+    notch_open: IntArray
 
 
 @dataclass(frozen=True, eq=False)
@@ -319,7 +326,8 @@ class CellRows:
     def section(self, u: Array) -> tuple[Array, Array]:
         """``1/(E I)`` (1/(N m^2)) about the section's centroid and the centroid's offset from
         the tube axis (m, + toward the tendon) at ``u``: eq. 12's section where the backbone is
-        centred, :func:`tdcm_ros.model.grid_kernel.offset_section` where it is not."""
+        centred, :func:`tdcm_ros.model.grid_kernel.offset_section` where it is not, a polygon
+        section's own where the notch has one."""
         m = self.members
         every = np.broadcast_to(per_row(self.member, u), u.shape)
         inertia = m.tube_moment[every]
@@ -329,15 +337,17 @@ class CellRows:
             owner = m.shape_member[shape]
             h1 = m.h1(shape, u[notch])
             in_notch = notched_moment(h1, m.R_outer[owner], m.r_inner[owner])
-            offset = m.shape_w_o[shape]
-            off = offset != 0.0
+            x_bar_notch = np.zeros(h1.shape)
+            given = m.shape_section[shape]  # a polygon's section, given whole (I > 0)
+            prismatic = given[:, 0] > 0.0
+            off = (m.shape_w_o[shape] != 0.0) & ~prismatic
             if np.any(off):
-                _, in_notch[off], x_off, _ = _offset_sections(h1[off], offset[off],
-                                                              m.R_outer[owner][off],
-                                                              m.r_inner[owner][off])
-                x_bar_notch = np.zeros(h1.shape)
-                x_bar_notch[off] = x_off
-                x_bar[notch] = x_bar_notch
+                _, in_notch[off], x_bar_notch[off], _ = _offset_sections(
+                    h1[off], m.shape_w_o[shape][off], m.R_outer[owner][off],
+                    m.r_inner[owner][off])
+            in_notch[prismatic] = given[prismatic, 0]
+            x_bar_notch[prismatic] = given[prismatic, 1]
+            x_bar[notch] = x_bar_notch
             inertia[notch] = in_notch
         return 1.0 / (m.E[every] * inertia), x_bar
 
@@ -473,7 +483,8 @@ class GridParts:
             chord_end_node=laid(table.chord_end_node, tip_node),
             gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc, **strain,
             notch_left_node=table.notch_left_node[rows, :notches],
-            notch_right_node=table.notch_right_node[rows, :notches])
+            notch_right_node=table.notch_right_node[rows, :notches],
+            notch_open=members.notch_open[rows][:, :, :notches])
 
 
 def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
@@ -487,9 +498,10 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
                      table.seg_length], axis=1).astype(float)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
     owner = members.shape_member
-    design = np.stack([kinds[members.profile_of], members.shape_w_n, members.shape_w_d,
-                       members.R_outer[owner], members.r_inner[owner], members.E[owner],
-                       members.tube_moment[owner], members.shape_w_o], axis=1)
+    design = np.concatenate([np.stack(
+        [kinds[members.profile_of], members.shape_w_n, members.shape_w_d,
+         members.R_outer[owner], members.r_inner[owner], members.E[owner],
+         members.tube_moment[owner], members.shape_w_o], axis=1), members.shape_section], axis=1)
     build = grid_kernels()
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
     custom_row, custom_h1 = _custom_h1(table, build, cell, design, gauss_u, probe)
@@ -514,7 +526,8 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
     return fc, fq, strain
 
 
-_PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR}
+_PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR, "polygon": PRISMATIC,
+                 "sliced": PRISMATIC}
 
 
 def _custom_h1(table: Prototypes, build: Any, cell: Array, design: Array,
@@ -581,12 +594,14 @@ class GridStack(CellArrays):
         """Member ``m`` as a :class:`Grid` (its arrays are views of the stack's, unpadded)."""
         n = int(self.n_cells[m])
         design = self.designs[m]
-        shared = ("s_nodes", "gauss_u", "gauss_w", "notch_left_node", "notch_right_node")
+        shared = ("s_nodes", "gauss_u", "gauss_w", "notch_left_node", "notch_right_node",
+                  "notch_open")
         per_cell = {f.name: getattr(self, f.name)[m, :n] for f in fields(CellArrays)
                     if f.name not in shared}
         per_cell.update(s_nodes=self.s_nodes[m, :n + 1], gauss_u=self.gauss_u,
                         gauss_w=self.gauss_w, notch_left_node=self.notch_left_node[m, :design.N],
-                        notch_right_node=self.notch_right_node[m, :design.N])
+                        notch_right_node=self.notch_right_node[m, :design.N],
+                        notch_open=self.notch_open[m, :, :design.N])
         return Grid(design=design, chord_cells=np.flatnonzero(~per_cell["constrained"]),
                     **per_cell)
 

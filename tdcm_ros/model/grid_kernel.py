@@ -11,9 +11,12 @@ prototype cells of :mod:`tdcm_ros.model.grid_layout`; the module docstring of
 Per prototype cell ``i`` (inputs, SI units): ``shape[i]``; ``cell[i, :]`` =
 ``(is_notch, chord, u_a, u_b, a, length, seg_length)`` (``a`` from the segment start, m).
 Per notch shape ``k`` (a member's distinct notch; a tube cell names its member's first):
-``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment, w_o)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR` and :data:`CUSTOM`
-(``h1`` read from ``custom_h1[custom_row[i]]`` at the points of :func:`points`, ``sigma``
-linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
+``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment, w_o, I, x_bar,
+fibre)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR`, :data:`CUSTOM` (``h1``
+read from ``custom_h1[custom_row[i]]`` at the points of :func:`points`, ``sigma`` linear in
+``u``) and :data:`PRISMATIC` (a section given whole, the same along the notch: its centroidal
+``I`` (m^4), centroid ``x_bar`` (m) and farthest fibre (m) in the last three columns, unused
+by the other kinds; ``sigma`` linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
 (``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally
 spaced probes and its two ends, in that order (:func:`points`).
 """
@@ -31,11 +34,12 @@ Ints = NDArray[np.int64]
 CIRCULAR = 0
 RECTANGULAR = 1
 CUSTOM = 2
+PRISMATIC = 3
 """Profile kinds of ``design[:, 0]``."""
 
 IS_NOTCH, CHORD, U_A, U_B, START, LENGTH, SEG_LENGTH = range(7)
 """Columns of ``cell``."""
-KIND, W_N, W_D, R_OUTER, R_INNER, E, TUBE_MOMENT, W_O = range(8)
+KIND, W_N, W_D, R_OUTER, R_INNER, E, TUBE_MOMENT, W_O, SEC_I, SEC_XBAR, SEC_FIBRE = range(11)
 """Columns of ``design``."""
 C0, C1, C0_T, C1_T, C_START, C_END, PEAK_C, PEAK_S, XB_START, XB_END, D_CELL = range(11)
 """Columns of the per-cell output ``fc`` (cells, 11)."""
@@ -150,6 +154,8 @@ def point(notch: bool, d: Array, seg_length: float, u: float, custom: float
     and the distance from it to its farthest fibre (0 in tubes, where no strain is sampled)."""
     if not notch:
         return seg_length * u, seg_length, 1.0 / (d[E] * d[TUBE_MOMENT]), 0.0, 0.0
+    if d[KIND] == PRISMATIC:
+        return d[W_N] * u, d[W_N], 1.0 / (d[E] * d[SEC_I]), d[SEC_XBAR], d[SEC_FIBRE]
     sigma, jac, h1 = geometry(d[KIND], d[W_N], d[W_D], u, custom)
     if d[W_O] == 0.0:  # eq. 12's symmetric section: the paper's formula, centroid on the axis
         return (sigma, jac, notch_compliance(h1, d[R_OUTER], d[R_INNER], d[E]), 0.0,

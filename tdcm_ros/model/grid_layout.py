@@ -25,7 +25,13 @@ from numpy.typing import NDArray
 
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.profiles import CircularProfile, NotchProfile, RectangularProfile
+from tdcm_ros.model.profiles import (
+    PRISMATIC_PROFILES,
+    CircularProfile,
+    CustomProfile,
+    NotchProfile,
+    RectangularProfile,
+)
 from tdcm_ros.model.section import notched_moment
 
 Array = NDArray[np.float64]
@@ -83,6 +89,8 @@ class Members:
     slot_kind: IntArray
     notch_left: Array
     notch_right: Array
+    notch_open: IntArray
+    shape_section: Array
 
     @classmethod
     def of(cls, designs: Sequence[Design]) -> Members:
@@ -99,13 +107,25 @@ class Members:
         uniform = all(d.is_uniform for d in designs)
         layout = _uniform_layout(designs, n, w_base, w_tip, profiles) if uniform else \
             _general_layout(designs, n, profiles)
-        members = cls(designs=designs, profiles=tuple(profiles.profiles), N=n,
+        notch_open = np.zeros((n.size, 2, int(n.max())), np.int64)
+        for m, design in enumerate(designs):
+            notch_open[m, :, :design.N] = design.open_faces()
+        kept = tuple(profiles.profiles)
+        owner = layout["shape_member"]
+        section = np.zeros((owner.size, 3))
+        for row, (k, m) in enumerate(zip(layout["profile_of"], owner, strict=True)):
+            if isinstance(kept[k], PRISMATIC_PROFILES):
+                got = kept[k].section(float(r_outer[m]))
+                section[row] = (got.second_moment, got.centroid_x,
+                                max(got.fibre_tendon_side, got.fibre_far_side))
+        members = cls(designs=designs, profiles=kept, N=n,
                       w_base=w_base, w_tip=w_tip, R_outer=r_outer, r_inner=r_inner,
                       R_c=column("R_c"), E=column("E"),
                       tube_moment=np.pi / 4.0 * (r_outer**4 - r_inner**4),
-                      length=np.array([d.length for d in designs], dtype=float), **layout)
+                      length=np.array([d.length for d in designs], dtype=float),
+                      notch_open=notch_open, shape_section=section, **layout)
         for design in designs:
-            if any(p.name not in ("circular", "rectangular") for p in design.notch_profiles()):
+            if any(isinstance(p, CustomProfile) for p in design.notch_profiles()):
                 _check_custom_profile(design)
         _check_rigidity(members)
         return members
@@ -424,8 +444,8 @@ def crossings(members: Members) -> Array:
     shape_profile = members.profile_of
     for k, profile in enumerate(members.profiles):
         rows = np.flatnonzero(shape_profile == k)
-        if isinstance(profile, RectangularProfile):
-            continue
+        if isinstance(profile, (RectangularProfile, *PRISMATIC_PROFILES)):
+            continue  # h1 is constant along the notch: it crosses no level
         for c in range(levels.shape[1]):
             level = levels[rows, c]
             if not np.any(level > 0.0):

@@ -20,7 +20,8 @@ Member arrays (SI units; ``M`` members, ``n`` cells, ``Q`` quadrature points, ``
   ``T`` the chord's tension, and the chord terms are zero where the tendon follows the body);
 - ``ic`` (M, 3, n): each cell's chord start node, chord end node, and 1 where the tendon
   follows the offset curve (0 on a chord);
-- ``notch`` (M, 2, K): left and right node of every notch, -1 in padding;
+- ``notch`` (M, 4, K): left and right node of every notch, -1 in padding, then 1 where its
+  faces can meet on the +x and on the -x side (0 where the section keeps the wall there);
 - ``scal`` (M, 4): ``R_c`` (m), ``R_outer`` (m), body length (m), constrained peak compliance.
 
 A zero-length padding cell (every one of those zero) is neutral: it moves no node.
@@ -156,9 +157,10 @@ def moments_row(r_c: float, p: Complex, tangent: Complex, t_a: Array, t_b: Array
 
 
 def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Array) -> None:
-    """Smallest gap (m) between the two faces of every notch of one member, either side of
-    the body: the signed distance of each face's outer corner from the other face (``inf``
-    for padding notches: nodes -1, or both at one node)."""
+    """Smallest gap (m) between the two faces of every notch of one member, on each side of
+    the body where its cut opens (``notch[2, k]`` the +x side, ``notch[3, k]`` the -x side):
+    the signed distance of each face's outer corner from the other face (``inf`` for padding
+    notches: nodes -1, or both at one node, and where no side opens)."""
     for k in range(notch.shape[1]):
         left = notch[0, k]
         right = notch[1, k]
@@ -169,7 +171,10 @@ def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Arr
         t_r = tangent[right]
         span = p[right] - p[left]
         smallest = math.inf
-        for side in (1.0, -1.0):
+        for row in range(2, 4):
+            if notch[row, k] == 0:
+                continue
+            side = 1.0 if row == 2 else -1.0
             delta = span + (1j * side * r_outer) * (t_r - t_l)
             smallest = min(smallest, (t_l.conjugate() * delta).real,
                            (t_r.conjugate() * delta).real)

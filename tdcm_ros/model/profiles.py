@@ -11,9 +11,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from tdcm_ros.model.sections import SectionProperties
 
 Array = NDArray[np.float64]
 #: A width (m): one number, or one per row of ``u`` (broadcasting against it).
@@ -43,11 +48,8 @@ class CircularProfile:
         return 0.5 * (w_n + w_d) - 0.5 * w_n * np.sin(np.pi * u)
 
 
-@dataclass(frozen=True)
-class RectangularProfile:
-    """A straight-bottomed slot: ``h1 = w_d/2`` across the whole notch."""
-
-    name: str = "rectangular"
+class _StraightSlot:
+    """A notch the same all along it: ``sigma = w_n u`` and ``h1 = w_d/2`` at every ``u``."""
 
     def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
@@ -58,8 +60,15 @@ class RectangularProfile:
         return np.full_like(u, w_n)
 
     def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
-        """Backbone half-width (m) at ``u``."""
+        """Backbone half-width (m) at ``u``: ``w_d / 2``."""
         return np.full_like(u, 0.5 * w_d)
+
+
+@dataclass(frozen=True)
+class RectangularProfile(_StraightSlot):
+    """A straight-bottomed slot: ``h1 = w_d/2`` across the whole notch."""
+
+    name: str = "rectangular"
 
 
 @dataclass(frozen=True)
@@ -87,7 +96,87 @@ class CustomProfile:
         return np.asarray(self.half_width(w_n * u), dtype=float) * np.ones_like(u)
 
 
-NotchProfile = CircularProfile | RectangularProfile | CustomProfile
+@dataclass(frozen=True)
+class PolygonProfile(_StraightSlot):
+    """A prismatic notch whose section is a polygon of material. Along the body it is the
+    rectangular slot; ``h1`` is half the polygon's extent in ``x``, which a
+    :class:`~tdcm_ros.model.design.Design` holds as the notch's ``w_d`` (and the extent's middle
+    as ``w_o``). The mechanics read the section whole (:meth:`section`), not ``h1``.
+
+    ``shell`` and ``holes`` are :class:`~tdcm_ros.model.sections.PolygonSection`'s (vertices
+    ``(x, y)`` in m in the section plane, ``x`` toward the tendon).
+    """
+
+    shell: tuple[tuple[float, float], ...]
+    holes: tuple[tuple[tuple[float, float], ...], ...] = ()
+    name: str = "polygon"
+
+    def __post_init__(self) -> None:
+        def ring(points: Any) -> tuple[tuple[float, float], ...]:
+            try:
+                return tuple((float(x), float(y)) for x, y in points)
+            except (TypeError, ValueError):
+                return tuple(points)  # the section's check names what is wrong with it
+
+        object.__setattr__(self, "shell", ring(self.shell))
+        object.__setattr__(self, "holes", tuple(ring(hole) for hole in self.holes))
+
+    def section(self, r_outer: float) -> SectionProperties:
+        """The polygon's section properties in a tube of outer radius ``r_outer`` (m); checked
+        (a simple polygon of positive area) and computed once per polygon and radius."""
+        return _polygon_properties(self.shell, self.holes, float(r_outer))
+
+    def x_extent(self) -> tuple[float, float]:
+        """The smallest and largest ``x`` of the polygon's material (m)."""
+        xs = [x for x, _ in self.shell]
+        return min(xs), max(xs)
+
+
+@dataclass(frozen=True)
+class SlicedProfile(_StraightSlot):
+    """A prismatic notch whose section is given by its numbers (a slice of a mesh,
+    :mod:`tdcm_ros.model.mesh_body`): ``area`` (m^2), ``centroid_x`` (m), ``second_moment``
+    about the centroid (m^4), ``x_low``/``x_high``, the material's extent in ``x`` (m)."""
+
+    area: float
+    centroid_x: float
+    second_moment: float
+    x_low: float
+    x_high: float
+    name: str = "sliced"
+
+    def section(self, r_outer: float) -> SectionProperties:
+        """The section's properties in a tube of outer radius ``r_outer`` (m)."""
+        from tdcm_ros.model.sections import SectionProperties, keeps_wall
+
+        x_bar = self.centroid_x
+        return SectionProperties(
+            area=np.array(self.area), centroid_x=np.array(x_bar),
+            second_moment=np.array(self.second_moment),
+            fibre_tendon_side=np.array(self.x_high - x_bar),
+            fibre_far_side=np.array(x_bar - self.x_low),
+            face_arm=np.array(np.inf if keeps_wall(self.x_high, r_outer) else r_outer - x_bar))
+
+    def x_extent(self) -> tuple[float, float]:
+        """The smallest and largest ``x`` of the section's material (m)."""
+        return self.x_low, self.x_high
+
+
+PrismaticProfile = PolygonProfile | SlicedProfile
+PRISMATIC_PROFILES = (PolygonProfile, SlicedProfile)
+
+
+@lru_cache(maxsize=256)
+def _polygon_properties(shell: tuple[tuple[float, float], ...],
+                        holes: tuple[tuple[tuple[float, float], ...], ...], r_outer: float
+                        ) -> SectionProperties:
+    from tdcm_ros.model.sections import PolygonSection
+
+    return PolygonSection(shell, r_outer, holes).properties()
+
+
+NotchProfile = (CircularProfile | RectangularProfile | CustomProfile | PolygonProfile
+                | SlicedProfile)
 
 PROFILE_NAMES: tuple[str, ...] = ("circular", "rectangular")
 

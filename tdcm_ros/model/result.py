@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
@@ -109,8 +110,9 @@ class SolveResult:
 
     @property
     def notch_peak_strains(self) -> Array:
-        """Largest bending strain in each notch, base to tip: ``|kappa|`` times the extreme
-        fibre's distance from the neutral axis (``min(h1, R_outer)``) at ``PEAK_SAMPLES``
+        """Largest bending strain in each notch, base to tip: ``|kappa|`` times the distance from
+        the section's centroid to its farthest material (``min(h1, R_outer)`` for the paper's
+        section; a polygon's own) at ``PEAK_SAMPLES``
         equally spaced probes of each of its cells (the batch solver's
         ``max_bending_strain`` is the largest of these)."""
         grid = self.grid
@@ -187,7 +189,8 @@ class SolveResult:
         return positions, quaternions_y(theta)
 
     def summary(self) -> dict[str, Any]:
-        """The JSON-ready summary used by ``tdcm solve --json`` (SI units)."""
+        """The JSON-ready summary used by ``tdcm solve --json`` (SI units; a notch whose faces
+        never meet, its section keeping the wall on both sides, has ``null`` gap and margin)."""
         return {
             "converged": self.converged,
             "iterations": self.iterations,
@@ -199,8 +202,8 @@ class SolveResult:
             "tip_deflection_m": self.tip_deflection_m,
             "tip_displacement_m": self.tip_displacement_m,
             "notch_angles_rad": self.notch_angles_rad.tolist(),
-            "notch_gaps_m": self.notch_gaps_m.tolist(),
-            "notch_stop_margins_rad": self.notch_stop_margins_rad.tolist(),
+            "notch_gaps_m": _finite_or_none(self.notch_gaps_m),
+            "notch_stop_margins_rad": _finite_or_none(self.notch_stop_margins_rad),
             "notch_peak_strains": self.notch_peak_strains.tolist(),
             "solve_time_s": self.solve_time_s,
             "residual_history_m": list(self.residual_history),
@@ -208,6 +211,11 @@ class SolveResult:
             "settings": self.settings.to_dict(),
             **({} if self.loading is None else {"loading": self.loading.describe()}),
         }
+
+
+def _finite_or_none(values: Array) -> list[float | None]:
+    """``values`` as a list with ``None`` (JSON ``null``) for each infinite entry."""
+    return [float(v) if math.isfinite(v) else None for v in values]
 
 
 class ConvergenceError(ModelError, PhysicsError):

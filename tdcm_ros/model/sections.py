@@ -13,8 +13,9 @@ parameters, e.g. the paper's half-width ``h1`` at many stations of a notch):
 - ``fibre_tendon_side`` / ``fibre_far_side`` (m): from the centroid to the farthest material on
   the +x side (compressed as the tendon bends the body) and on the -x side (stretched);
 - ``face_arm`` (m): from the centroid to where the notch's faces meet as it closes, the tube's
-  outer surface on the +x side (``R_outer - centroid_x``); ``inf`` where nothing is cut there.
-  A prismatic notch of width ``w`` closes at the bend ``w / face_arm`` (rad).
+  outer surface on the +x side (``R_outer - centroid_x``); ``inf`` where nothing is cut there
+  (:func:`keeps_wall`). A prismatic notch of width ``w`` closes at the bend ``w / face_arm``
+  (rad).
 
 Three types: :class:`BandSection` (the paper's symmetric pair of cuts, eq. 12),
 :class:`OneSidedCut` (a tube cut from +x to a depth, in closed form) and
@@ -37,6 +38,18 @@ from tdcm_ros.model.grid_kernel import offset_section
 from tdcm_ros.model.section import notched_area, notched_moment
 
 Array = NDArray[np.float64]
+#: A section whose material comes within this fraction of ``R_outer`` of the tube's outer
+#: surface at ``x = +-R_outer`` keeps the wall on that side: the notch's faces do not meet
+#: there (a polygon drawn round the tube with 23 or more edges reaches it wherever its vertices
+#: fall).
+SURFACE_TOL = 0.01
+
+
+def keeps_wall(reach: ArrayLike, r_outer: ArrayLike) -> NDArray[np.bool_]:
+    """Whether material reaching ``reach`` (m) toward a side keeps the tube's wall there
+    (:data:`SURFACE_TOL`): ``reach`` is the section's largest ``x`` for the +x side, minus its
+    smallest ``x`` for the -x side."""
+    return np.asarray(np.asarray(reach) >= (1.0 - SURFACE_TOL) * np.asarray(r_outer))
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,7 +104,7 @@ class BandSection:
         return SectionProperties(
             area=notched_area(h1, r_outer, r_inner), centroid_x=np.zeros_like(h1),
             second_moment=notched_moment(h1, r_outer, r_inner), fibre_tendon_side=fibre,
-            fibre_far_side=fibre.copy(), face_arm=np.where(h1 < r_outer, r_outer, np.inf))
+            fibre_far_side=fibre.copy(), face_arm=np.where(keeps_wall(h1, r_outer), np.inf, r_outer))
 
 
 @dataclass(frozen=True, eq=False)
@@ -120,7 +133,7 @@ class OneSidedCut:
         return SectionProperties(
             area=area, centroid_x=centroid, second_moment=second,
             fibre_tendon_side=plane - centroid, fibre_far_side=centroid + r_outer,
-            face_arm=np.where(depth > 0.0, r_outer - centroid, np.inf))
+            face_arm=np.where(keeps_wall(plane, r_outer), np.inf, r_outer - centroid))
 
 
 _offset_sections = np.vectorize(offset_section, otypes=[float] * 4)
@@ -163,7 +176,7 @@ class PolygonSection:
             second_moment=np.array(second - area * centroid * centroid),
             fibre_tendon_side=np.array(x_max - centroid),
             fibre_far_side=np.array(centroid - float(shell[:, 0].min())),
-            face_arm=np.array(r_outer - centroid if x_max < r_outer else np.inf))
+            face_arm=np.array(np.inf if keeps_wall(x_max, r_outer) else r_outer - centroid))
 
 
 def _ring(points: Sequence[Sequence[float]], name: str) -> Array:
@@ -197,10 +210,19 @@ def _check_simple(shell: Array, holes: list[Array]) -> None:
 
 def _ring_moments(ring: Array) -> Array:
     """``(A, int x dA, int x^2 dA)`` of the region a ring encloses (m^2, m^3, m^4), whatever
-    its orientation: Green's theorem over its edges."""
-    x, y = ring[:, 0], ring[:, 1]
-    x1, y1 = np.roll(x, -1), np.roll(y, -1)
-    cross = x * y1 - x1 * y
-    moments = np.array([np.sum(cross) / 2.0, np.sum((x + x1) * cross) / 6.0,
-                        np.sum((x * x + x * x1 + x1 * x1) * cross) / 12.0])
+    its orientation: Green's theorem over its edges (:func:`edge_moments`)."""
+    moments = edge_moments(ring, np.roll(ring, -1, axis=0))[:3]
     return moments if moments[0] > 0.0 else -moments
+
+
+def edge_moments(start: Array, end: Array) -> Array:
+    """``(A, int x dA, int x^2 dA, int y dA)`` (m^2, m^3, m^4, m^3) of the region bounded by
+    the directed edges ``start[k] -> end[k]`` ((n, 2) arrays of ``(x, y)`` in m), the material
+    on each edge's left (outer boundaries counter-clockwise, holes clockwise): Green's theorem,
+    exact for straight edges, in any order and from any number of loops."""
+    x, y = start[:, 0], start[:, 1]
+    x1, y1 = end[:, 0], end[:, 1]
+    cross = x * y1 - x1 * y
+    return np.array([np.sum(cross) / 2.0, np.sum((x + x1) * cross) / 6.0,
+                     np.sum((x * x + x * x1 + x1 * x1) * cross) / 12.0,
+                     np.sum((y + y1) * cross) / 6.0])

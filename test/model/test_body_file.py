@@ -20,6 +20,7 @@ from tdcm_ros.model import (
     read_body_file,
     solve,
 )
+from tdcm_ros.model.profiles import PolygonProfile
 from tdcm_ros.yamlio import load_yaml
 from test.support.cli import tdcm
 
@@ -133,15 +134,35 @@ def test_bad_bodies_name_the_key_by_its_path(data: dict[str, object], message: s
 BAND = {"notch": {"width": 2.0e-3, "band": 1.4e-3}}
 
 
-@pytest.mark.parametrize(("segments", "where"), [
-    ([BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "cut": 1.0e-3}},
-      {"notch": {"width": 2.0e-3, "polygon": [[0, -1e-3], [1e-3, 0], [0, 1e-3]]}}],
-     r"segments\[3\]\.notch: a polygon section"),
-])
-def test_bodies_the_solver_cannot_take_yet_name_the_first_segment_that_differs(
-        segments: list[object], where: str) -> None:
-    data = with_changes(segments=segments)
-    with pytest.raises(InvalidDesignError, match=where + ".*not solvable yet"):
+TEE = [[-3.5e-3, -1.5e-3], [-2.5e-3, -1.5e-3], [-2.5e-3, -0.3e-3], [0.5e-3, -0.3e-3],
+       [0.5e-3, 0.3e-3], [-2.5e-3, 0.3e-3], [-2.5e-3, 1.5e-3], [-3.5e-3, 1.5e-3]]
+
+
+def test_a_polygon_notch_is_read_as_its_polygon_and_written_back_bit_for_bit() -> None:
+    """A polygon notch becomes a prismatic :class:`PolygonProfile` whose ``w_d`` and ``w_o``
+    are its extent in x and that extent's middle; holes are kept; the body file written from
+    the design reads back to the same design."""
+    box = [[-1e-3, -1e-3], [1e-3, -1e-3], [1e-3, 1e-3], [-1e-3, 1e-3]]
+    lumen = [[-0.4e-3, -0.4e-3], [0.4e-3, -0.4e-3], [0.4e-3, 0.4e-3], [-0.4e-3, 0.4e-3]]
+    data = with_changes(segments=[
+        BAND, {"tube": 4e-3}, {"notch": {"width": 2.0e-3, "polygon": TEE}},
+        {"notch": {"width": 1.0e-3, "polygon": box, "holes": [lumen]}}])
+    design = body_from_mapping(data, "body.yaml").design()
+    profiles = design.notch_profiles()
+    assert isinstance(profiles[1], PolygonProfile) and isinstance(profiles[2], PolygonProfile)
+    assert profiles[1].shell == tuple(tuple(p) for p in TEE)
+    assert profiles[2].holes == (tuple(tuple(p) for p in lumen),)
+    assert design.w_d == (1.4e-3, 4.0e-3, 2.0e-3)
+    assert design.w_o == (0.0, -1.5e-3, 0.0)
+    again = body_from_mapping(load_yaml(body_file_text(design), "again.yaml"), "again.yaml").design()
+    assert again == design
+
+
+def test_a_polygon_outside_the_tube_is_refused_naming_its_segment() -> None:
+    data = with_changes(segments=[BAND, {"tube": 4e-3}, {"notch": {
+        "width": 2.0e-3, "polygon": [[-3.5e-3, -2e-3], [0.5e-3, -2e-3], [0.5e-3, 2e-3]]}}])
+    with pytest.raises(InvalidDesignError, match=r"segments\[2\]\.notch\.polygon = 0\.00403"
+                       r".* within R_outer = 0\.00392 m"):
         body_from_mapping(data, "body.yaml").design()
 
 

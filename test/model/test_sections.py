@@ -15,7 +15,12 @@ from hypothesis import strategies as st
 from scipy.integrate import quad
 
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection
+from tdcm_ros.model.sections import (
+    SURFACE_TOL,
+    BandSection,
+    OneSidedCut,
+    PolygonSection,
+)
 
 #: relative agreement the issue asks of every section type against its reference
 REL = 1e-9
@@ -77,7 +82,8 @@ def test_the_band_matches_quadrature(tube: tuple[float, float], fraction: float)
     assert float(got.centroid_x) == 0.0 and abs(centroid) <= REL * r_outer
     assert_close(float(got.second_moment), second, second, "I")
     assert float(got.fibre_tendon_side) == float(got.fibre_far_side) == min(h1, r_outer)
-    assert float(got.face_arm) == (r_outer if h1 < r_outer else math.inf)
+    # faces meet at the surface unless the band keeps the wall there (within SURFACE_TOL)
+    assert float(got.face_arm) == (r_outer if h1 < (1 - SURFACE_TOL) * r_outer else math.inf)
 
 
 @settings(max_examples=80, deadline=None)
@@ -96,7 +102,7 @@ def test_the_one_sided_cut_matches_quadrature(tube: tuple[float, float],
     assert_close(float(got.second_moment), second, second, "I")
     assert_close(float(got.fibre_tendon_side), plane - centroid, r_outer, "fibre +x")
     assert_close(float(got.fibre_far_side), centroid + r_outer, r_outer, "fibre -x")
-    want_arm = r_outer - centroid if depth > 0.0 else math.inf
+    want_arm = r_outer - centroid if plane < (1 - SURFACE_TOL) * r_outer else math.inf
     assert float(got.face_arm) == pytest.approx(want_arm, rel=REL)
 
 

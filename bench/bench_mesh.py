@@ -1,0 +1,93 @@
+"""Mesh-body benchmark (issue 27): a body file naming an STL -> the first solve.
+
+Run: ``python bench/bench_mesh.py [--notches 30] [--sides 200] [--repeats 3]``.
+Builds (manifold3d, the test extra) the paper's tube with ``--notches`` tee notches, each the
+polygon of ``config/bodies/tee_notches.yaml``, its circles ``--sides``-gons (200: ~50 k
+faces at 30 notches), writes it as a binary STL with a body file naming it, and times, in a
+fresh process each (numba's compiled kernels loaded from its cache, as on any run after the
+first), reading the body file (trimesh load, slicing) and the first solve at 5 N, and the same
+for the preset ``paper-experiment`` (the floor: imports, kernels, grid). Prints the face
+count, the medians and the target (body file -> first solve <= 2 s). ``--write FILE``
+only writes the STL (e.g. the shipped ``config/bodies/tee_notches.stl``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from shapely.geometry import Polygon
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from test.support.meshes import body_mesh
+
+TEE = Polygon([(-3.5, -1.5), (-2.5, -1.5), (-2.5, -0.3), (0.5, -0.3), (0.5, 0.3), (-2.5, 0.3),
+               (-2.5, 1.5), (-3.5, 1.5)])  # mm, as config/bodies/tee_notches.yaml
+TIMED = """
+import json, sys, time
+start = time.perf_counter()
+from tdcm_ros.model import named_design, solve
+design = named_design(sys.argv[1])
+read = time.perf_counter()
+result = solve(design, 5.0)
+done = time.perf_counter()
+print(json.dumps({"read_s": read - start, "total_s": done - start, "N": design.N,
+                  "tip_x_m": float(result.positions[-1, 0])}))
+"""
+
+
+def tee_body(notches: int, sides: int) -> object:
+    """The paper's tube (mm) with ``notches`` 2 mm tee notches 4 mm apart, 5 mm base tube."""
+    segments: list[tuple] = [("tube", 5.0)]
+    for k in range(notches):
+        segments += [("notch", 2.0, TEE), ("tube", 4.0)]
+    return body_mesh(segments, 3.92, 1.55, sides)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--notches", type=int, default=30)
+    parser.add_argument("--sides", type=int, default=200)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--write", type=Path, help="only write the STL to this file")
+    args = parser.parse_args()
+    mesh = tee_body(args.notches, args.sides)
+    if args.write:
+        mesh.export(str(args.write))
+        print(f"wrote {args.write}: {len(mesh.faces)} faces")
+        return 0
+    with tempfile.TemporaryDirectory() as folder:
+        stl = Path(folder) / "body.stl"
+        mesh.export(str(stl))
+        size = stl.stat().st_size
+        body = Path(folder) / "body.yaml"
+        body.write_text("material: {E: 1.85e9}\ntendons:\n  - {offset: 2.75e-3}\n"
+                        "mesh: {file: body.stl, unit: mm}\n")
+        runs, floor = [], []
+        for _ in range(args.repeats + 1):  # the first compiles numba's cache if it is cold
+            for name, into in ((str(body), runs), ("paper-experiment", floor)):
+                out = subprocess.run([sys.executable, "-c", TIMED, name], cwd=REPO,
+                                     capture_output=True, text=True, check=True)
+                into.append(json.loads(out.stdout))
+    runs, floor = runs[1:], floor[1:]
+    print(f"mesh body: {len(mesh.faces)} faces, {runs[0]['N']} notches "
+          f"({size} bytes)")
+    print(f"  read body file (load + slice)  {np.median([r['read_s'] for r in runs]):.3f} s "
+          "(median, in a fresh process, imports included)")
+    print(f"  body file -> first solve       {np.median([r['total_s'] for r in runs]):.3f} s "
+          "(target <= 2 s)")
+    print(f"  the preset, the same way       {np.median([r['total_s'] for r in floor]):.3f} s "
+          "(paper-experiment: imports, kernels, grid; same run)")
+    print(f"  tip x at 5 N                   {runs[0]['tip_x_m'] * 1e3:.4f} mm")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

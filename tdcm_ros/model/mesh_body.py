@@ -1,0 +1,249 @@
+"""Bodies from a triangle mesh (STL, or another format trimesh reads), sliced along the body.
+
+The mesh is the body in the body file's frame: its axis +z from ``z = 0`` at the base, cuts
+and the tendon on the +x side, lengths in ``unit`` (``m`` or ``mm``). It must be watertight
+with outward normals. A mesh changes along z only where it has vertices, so the body's
+segments end at the z values of its vertices: the mesh is sliced once between each two
+consecutive ones (trimesh, a maintained mesh library: reading every common format and
+slicing many planes in one vectorised pass), and each slice's area and moments are Green's
+theorem's over its edges (:func:`tdcm_ros.model.sections.edge_moments`), exact for the
+mesh: no loop assembly, so a section of several pieces (the paper's pair of cuts through the
+lumen leaves two) needs nothing more.
+
+Slices with the tube's full section (the largest area, to :data:`SECTION_TOL`) are tube;
+each run of other slices is one notch, which must be prismatic (the same section along it,
+to :data:`SECTION_TOL`: a slot cut straight through, as laser and wire cuts are; a notch
+whose section changes along the body, e.g. a circular-bottomed cut, is refused naming it).
+Its section is the slice's own (:class:`~tdcm_ros.model.profiles.SlicedProfile`).
+
+The tube is the circle through the outermost vertices of its slice (``R_outer``) less the
+circle through the innermost vertices of its lumen (``r_inner``; 0 where no edge of the slice
+faces the axis). A mesh coarse enough around for that annulus' second moment to differ from
+the faceted slice's by more than :data:`COARSE_TOL` gets a warning saying by how much (the
+difference is a systematic error of the tubes' stiffness; the notches are the mesh's own).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.design import MIN_SEGMENT_M
+from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.profiles import SlicedProfile
+from tdcm_ros.model.sections import edge_moments
+
+Array = NDArray[np.float64]
+LOG = logging.getLogger(__name__)
+
+#: Lengths of a mesh file in metres per unit.
+UNITS = {"m": 1.0, "mm": 1e-3}
+#: Relative tolerance of "the same section" (area and moments, against the tube's).
+SECTION_TOL = 1e-4
+#: Relative difference of the tube's second moment from the circles' that draws a warning.
+COARSE_TOL = 1e-3
+#: Vertex heights closer than this (m) are one (float32 STL coordinates round at ~1e-9 m).
+Z_MERGE_M = MIN_SEGMENT_M / 10.0
+#: The tube's section centroid must lie within this fraction of ``R_outer`` of the z axis.
+AXIS_TOL = 1e-3
+
+
+@dataclass(frozen=True)
+class Slice:
+    """One slice of the mesh at height ``z`` (m), standing for the span ``z_low``..``z_high``
+    between two consecutive vertex heights (m): ``area`` (m^2), ``first`` = ``int x dA``
+    (m^3), ``second`` = ``int x^2 dA`` (m^4), ``first_y`` = ``int y dA`` (m^3), the material's
+    extent ``x_low``..``x_high`` (m), the outermost vertex's distance from the axis and the
+    innermost of the edges facing the axis (m, 0 if none)."""
+
+    z: float
+    z_low: float
+    z_high: float
+    area: float
+    first: float
+    second: float
+    first_y: float
+    x_low: float
+    x_high: float
+    outer: float
+    inner: float
+
+    def same_as(self, other: Slice, scale: Slice) -> bool:
+        """Whether this slice's area and moments equal ``other``'s to :data:`SECTION_TOL` of
+        ``scale``'s (the tube's)."""
+        radius = scale.outer
+        return (abs(self.area - other.area) <= SECTION_TOL * scale.area
+                and abs(self.first - other.first) <= SECTION_TOL * scale.area * radius
+                and abs(self.second - other.second) <= SECTION_TOL * scale.area * radius**2)
+
+    def profile(self) -> SlicedProfile:
+        """The slice as a prismatic notch section."""
+        x_bar = self.first / self.area
+        return SlicedProfile(area=self.area, centroid_x=x_bar,
+                             second_moment=self.second - self.area * x_bar * x_bar,
+                             x_low=self.x_low, x_high=self.x_high)
+
+
+@dataclass(frozen=True)
+class MeshSegment:
+    """A segment found in the mesh: ``length`` (m) and, for a notch, its ``section``."""
+
+    length: float
+    section: SlicedProfile | None
+    where: str
+
+
+@dataclass(frozen=True)
+class MeshBody:
+    """A mesh read as a body: the tube's radii (m) and the segments base to tip."""
+
+    R_outer: float
+    r_inner: float
+    segments: tuple[MeshSegment, ...]
+
+
+def read_mesh_body(path: str | Path, unit: str, where: str = "mesh") -> MeshBody:
+    """The body of the mesh file at ``path`` whose lengths are in ``unit``; every problem is an
+    :class:`InvalidDesignError` naming ``where``'s key (``mesh.file``, ``mesh.unit``)."""
+    if unit not in UNITS:
+        raise out_of_range(f"{where}.unit", unit, " | ".join(UNITS), error=InvalidDesignError)
+    mesh = _load(path, UNITS[unit], f"{where}.file")
+    slices = _slices(mesh, f"{where}.file")
+    return _segments(slices, f"{where}.file", unit)
+
+
+def _load(path: str | Path, scale: float, key: str) -> Any:
+    """The mesh at ``path`` scaled to metres, checked: readable, one watertight solid with
+    outward normals. Zero-area triangles are dropped first: they carry no surface, and an STL's
+    float32 coordinates make slivers of a CAD export's nearly coincident vertices."""
+    import trimesh
+
+    try:
+        mesh = trimesh.load(str(path), force="mesh")
+    except Exception as error:  # trimesh raises many types for unreadable files
+        raise InvalidDesignError(f"{key} = {str(path)!r} cannot be read as a mesh: {error}",
+                                 parameter=key, value=str(path),
+                                 allowed="a mesh file trimesh reads (STL, OBJ, PLY, ...)"
+                                 ) from error
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise InvalidDesignError(f"{key} = {str(path)!r} holds no triangles", parameter=key,
+                                 value=str(path), allowed="a triangle mesh of the body")
+    mesh.update_faces(mesh.nondegenerate_faces())
+    mesh.remove_unreferenced_vertices()
+    if not mesh.is_watertight:
+        raise InvalidDesignError(
+            f"{key} = {str(path)!r} is not watertight (its surface has holes or loose edges); "
+            "allowed: a closed, watertight mesh", parameter=key, value=str(path),
+            allowed="a watertight mesh")
+    if not mesh.is_winding_consistent or mesh.volume <= 0.0:
+        raise InvalidDesignError(
+            f"{key} = {str(path)!r} has inward or inconsistent normals (volume "
+            f"{mesh.volume:.3g}); allowed: outward normals", parameter=key, value=str(path),
+            allowed="a mesh with consistent outward normals")
+    mesh.apply_scale(scale)
+    return mesh
+
+
+def _slices(mesh: Any, key: str) -> list[Slice]:
+    """One slice between each two consecutive vertex heights of ``mesh`` (m), base to tip."""
+    from trimesh.intersections import mesh_multiplane
+
+    heights = np.unique(mesh.vertices[:, 2])
+    keep = np.concatenate([[True], np.diff(heights) > Z_MERGE_M])
+    heights = heights[keep]
+    length = float(heights[-1] - heights[0])
+    if abs(float(heights[0])) > Z_MERGE_M + 1e-9 * length:
+        raise InvalidDesignError(
+            f"{key}: the body starts at z = {heights[0]:.6g} m; allowed: z = 0 at the base, "
+            "the body along +z", parameter=key, value=float(heights[0]),
+            allowed="the base at z = 0, the axis +z")
+    middles = 0.5 * (heights[1:] + heights[:-1])
+    lines, to_3d, faces = mesh_multiplane(mesh, [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], middles)
+    out = []
+    for k, z in enumerate(middles):
+        segments = np.asarray(lines[k], dtype=float).reshape(-1, 2, 2)
+        if segments.shape[0] == 0:
+            raise InvalidDesignError(
+                f"{key}: no material at z = {z:.6g} m (the body comes apart there)",
+                parameter=key, value=float(z), allowed="material at every height")
+        out.append(_slice((float(heights[k]), float(z), float(heights[k + 1])), segments,
+                          np.asarray(to_3d[k]), mesh.face_normals[np.asarray(faces[k])]))
+    return out
+
+
+def _slice(span: tuple[float, float, float], segments: Array, to_3d: Array, normals: Array
+           ) -> Slice:
+    """The :class:`Slice` of the plane at ``span[1]`` (its span from ``span[0]`` to
+    ``span[2]``, m) from its edge segments (plane coordinates, as trimesh gives them), each
+    oriented with the material on its left by its face's normal."""
+    start = segments[:, 0] @ to_3d[:2, :2].T + to_3d[:2, 3]
+    end = segments[:, 1] @ to_3d[:2, :2].T + to_3d[:2, 3]
+    direction = end - start
+    left_is_outside = direction[:, 1] * normals[:, 0] - direction[:, 0] * normals[:, 1] < 0.0
+    start, end = (np.where(left_is_outside[:, None], end, start),
+                  np.where(left_is_outside[:, None], start, end))
+    area, first, second, first_y = edge_moments(start, end)
+    points = np.concatenate([start, end])
+    radius = np.hypot(points[:, 0], points[:, 1])
+    midpoint = 0.5 * (start + end)
+    facing_axis = np.sum(midpoint * normals[:, :2], axis=1) < 0.0
+    inner = float(np.max(np.hypot(start[facing_axis, 0], start[facing_axis, 1]),
+                         initial=0.0))
+    return Slice(z=span[1], z_low=span[0], z_high=span[2], area=float(area), first=float(first), second=float(second),
+                 first_y=float(first_y), x_low=float(points[:, 0].min()),
+                 x_high=float(points[:, 0].max()), outer=float(radius.max()), inner=inner)
+
+
+def _segments(slices: list[Slice], key: str, unit: str) -> MeshBody:
+    """Tube and notch segments of ``slices`` (see the module docstring)."""
+    tube = max(slices, key=lambda s: s.area)
+    _check_axis(tube, key)
+    is_tube = [s.area >= (1.0 - SECTION_TOL) * tube.area for s in slices]
+    out: list[MeshSegment] = []
+    k = 0
+    scale = UNITS[unit]
+    while k < len(slices):
+        run = k
+        while run + 1 < len(slices) and is_tube[run + 1] == is_tube[k]:
+            run += 1
+        start, stop = slices[k].z_low, slices[run].z_high
+        here = f"{key}: z = {start / scale:.6g}..{stop / scale:.6g} {unit}"
+        if is_tube[k]:
+            out.append(MeshSegment(stop - start, None, here))
+        else:
+            notch = 1 + sum(1 for s in out if s.section is not None)
+            for other in slices[k + 1:run + 1]:
+                if not other.same_as(slices[k], tube):
+                    raise InvalidDesignError(
+                        f"{here}: notch {notch} changes its section along the body (area "
+                        f"{slices[k].area:.6g} m^2 at z = {slices[k].z / scale:.6g} {unit}, "
+                        f"{other.area:.6g} m^2 at z = {other.z / scale:.6g} {unit}); allowed: "
+                        "prismatic notches, one section each (a slot cut straight through)",
+                        parameter=key, value=other.area, allowed="a prismatic notch")
+            out.append(MeshSegment(stop - start, slices[k].profile(), f"{here} (notch {notch})"))
+        k = run + 1
+    r_outer, r_inner = tube.outer, tube.inner
+    ring = math.pi / 4.0 * (r_outer**4 - r_inner**4)
+    if abs(tube.second - ring) > COARSE_TOL * ring:
+        LOG.warning("%s: the faceted tube's second moment is %.3g %% off the circles through its "
+                    "vertices (R_outer %.6g m, r_inner %.6g m), which the tubes are taken as: "
+                    "the mesh is coarse around (use more facets for a closer tube)", key,
+                    100.0 * (tube.second - ring) / ring, r_outer, r_inner)
+    return MeshBody(R_outer=r_outer, r_inner=r_inner, segments=tuple(out))
+
+
+def _check_axis(tube: Slice, key: str) -> None:
+    """Refuse a mesh whose tube is not centred on the z axis (:data:`AXIS_TOL`)."""
+    centre = (tube.first / tube.area, tube.first_y / tube.area)
+    if math.hypot(*centre) > AXIS_TOL * tube.outer:
+        raise InvalidDesignError(
+            f"{key}: the tube's section is centred at (x, y) = ({centre[0]:.6g}, "
+            f"{centre[1]:.6g}) m; allowed: on the z axis (the body along +z from the origin)",
+            parameter=key, value=list(centre), allowed="the tube centred on the z axis")
