@@ -72,13 +72,15 @@ class DemoPlan:
         return os.path.join(tempfile.gettempdir(), f"tdcm_demo_twin_{os.getpid()}")
 
     def node_overrides(self) -> dict[str, dict[str, Any]]:
-        """Per-node parameters (ROS names), on top of each node's defaults; a per-notch design
-        goes to the nodes as a body file written to ``out/design.yaml``."""
+        """Per-node parameters (ROS names), on top of each node's defaults; a per-notch design,
+        or one with polygon or given sections, goes to the nodes as a body file written to
+        ``out/design.yaml``."""
         scene = self.scene
         specs = parameter_specs(scene.design)
         design: dict[str, Any] = {f"design.{name}": value for name, value
                                   in scene.design.to_dict().items() if name in specs}
-        if not scene.design.is_uniform:  # per-notch values are a body file's, not parameters
+        # per-notch values and sections given whole (no profile parameter) are a body file's
+        if not scene.design.is_uniform or "profile" not in specs:
             body = self.out / "design.yaml"
             body.parent.mkdir(parents=True, exist_ok=True)
             body.write_text(body_file_text(scene.design), encoding="utf-8")

@@ -18,7 +18,9 @@ pair of cuts leaving a backbone this wide, m, centred on the tube axis or ``offs
 toward +x, m; ``profile`` circular (default) or rectangular), ``cut`` (a one-sided cut from +x,
 this deep from the surface, m: a band ``2 R_outer - cut`` wide at ``offset = -cut/2``;
 ``profile`` rectangular (default) or circular, the cut's outline along the body) or ``polygon``
-(the material left, a list of ``[x, y]`` in m, with optional ``holes``). Instead of ``tube`` and
+(the material left, a list of ``[x, y]`` in m, with optional ``holes``) or ``section`` (given by
+its numbers: ``area`` m^2, ``centroid_x`` m, ``second_moment`` about the centroid m^4, the
+material's extent ``x_low``..``x_high`` m; prismatic like a polygon). Instead of ``tube`` and
 ``segments``, ``mesh: {file: body.stl, unit: mm}`` gives the body as a triangle mesh (relative
 to the body file's folder), sliced into its tube and prismatic notches by
 :mod:`tdcm_ros.model.mesh_body`. Every problem is an
@@ -47,7 +49,7 @@ from tdcm_ros.model.profiles import (
     NotchProfile,
     PolygonProfile,
     PrismaticProfile,
-    SlicedProfile,
+    SectionProfile,
     profile_from_name,
 )
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
@@ -57,7 +59,9 @@ from tdcm_ros.yamlio import load_yaml
 #: Most segments a body may expand to (``repeat`` included).
 MAX_SEGMENTS = 10_000
 ROUTINGS = ("paper", "free")
-SECTION_KEYS = ("band", "cut", "polygon")
+SECTION_KEYS = ("band", "cut", "polygon", "section")
+#: Keys of a section given by its numbers (SI units).
+GIVEN_SECTION_KEYS = ("area", "centroid_x", "second_moment", "x_low", "x_high")
 #: A notch's profile where the file names none: the paper's circular band, a laser cut's
 #: rectangular slot.
 DEFAULT_PROFILE = {"band": "circular", "cut": "rectangular"}
@@ -75,8 +79,8 @@ class TubeSpec:
 class NotchSpec:
     """A notch segment: ``width`` along the body (m) and its section, one of ``band`` (backbone
     width, m, ``offset`` from the axis toward +x, m), ``cut`` (depth, m), ``polygon``
-    (``shell``, ``holes``, m) or ``sliced`` (a mesh's slice, ``sliced``); a band or cut has a
-    ``profile``."""
+    (``shell``, ``holes``, m) or ``section`` (given by its numbers, or a mesh's slice:
+    ``given``); a band or cut has a ``profile``."""
 
     width: float
     kind: str
@@ -86,7 +90,7 @@ class NotchSpec:
     cut: float = math.nan
     shell: tuple[tuple[float, float], ...] = ()
     holes: tuple[tuple[tuple[float, float], ...], ...] = ()
-    sliced: SlicedProfile | None = None
+    given: SectionProfile | None = None
     where: str = ""
 
     def section(self, r_outer: float, r_inner: float) -> Section:
@@ -101,19 +105,19 @@ class NotchSpec:
     def backbone(self, r_outer: float) -> float:
         """The width of the material left at the notch's centre (m): the band, the tube less
         the cut (``2 R_outer - cut``), or the polygon's extent in ``x``."""
-        if self.kind in ("polygon", "sliced"):
+        if self.kind in ("polygon", "section"):
             low, high = self.prismatic().x_extent()
             return high - low
         return 2.0 * r_outer - self.cut if self.kind == "cut" else self.band
 
     def prismatic(self) -> PrismaticProfile:
-        """The section of a polygon notch, or of a notch sliced from a mesh."""
-        return self.sliced if self.sliced is not None else PolygonProfile(self.shell, self.holes)
+        """The section of a polygon notch, or one given by its numbers (or a mesh's slice)."""
+        return self.given if self.given is not None else PolygonProfile(self.shell, self.holes)
 
     def profile_object(self) -> NotchProfile:
         """The notch's profile for the solver: the named one of a band or cut, the polygon or
         the mesh's slice."""
-        if self.kind in ("polygon", "sliced"):
+        if self.kind in ("polygon", "section"):
             return self.prismatic()
         return profile_from_name(self.profile)
 
@@ -248,7 +252,7 @@ def _mesh(entry: Mapping[str, Any], source: str) -> tuple[float, float, list[Seg
     body = read_mesh_body(path, str(entry.get("unit", "m")), f"{source}: mesh")
     segments: list[Segment] = [
         TubeSpec(s.length, s.where) if s.section is None else
-        NotchSpec(width=s.length, kind="sliced", sliced=s.section, where=s.where)
+        NotchSpec(width=s.length, kind="section", given=s.section, where=s.where)
         for s in body.segments]
     return body.R_outer, body.r_inner, segments
 
@@ -297,15 +301,17 @@ def _segments(items: Any, where: str, source: str, r_outer: float, r_inner: floa
 def _notch(entry: Mapping[str, Any], where: str, source: str, r_outer: float, r_inner: float
            ) -> NotchSpec:
     reject_unknown(f"{where} key", entry, ("width", "band", "offset", "profile", "cut",
-                                           "polygon", "holes"), error=InvalidDesignError)
+                                           "polygon", "holes", "section"),
+                   error=InvalidDesignError)
     width = _number(entry, "width", f"{where}.", source, low=MIN_SEGMENT_M, high=1.0)
     kinds = [k for k in SECTION_KEYS if k in entry]
     if len(kinds) != 1:
         raise InvalidDesignError(
-            f"{source}: {where} has {kinds or 'none'} of band, cut, polygon; allowed: exactly "
-            "one section", parameter=where, value=sorted(entry), allowed="band | cut | polygon")
+            f"{source}: {where} has {kinds or 'none'} of band, cut, polygon, section; allowed: "
+            "exactly one section", parameter=where, value=sorted(entry),
+            allowed="band | cut | polygon | section")
     kind = kinds[0]
-    if kind == "polygon" and "profile" in entry:
+    if kind in ("polygon", "section") and "profile" in entry:
         raise InvalidDesignError(f"{source}: {where}.profile goes with band or cut only",
                                  parameter=f"{where}.profile", value=entry["profile"],
                                  allowed="profile with band or cut")
@@ -317,6 +323,10 @@ def _notch(entry: Mapping[str, Any], where: str, source: str, r_outer: float, r_
         raise InvalidDesignError(f"{source}: {where}.holes goes with polygon only",
                                  parameter=f"{where}.holes", value=entry["holes"],
                                  allowed="holes with polygon")
+    if kind == "section":
+        return NotchSpec(width=width, kind=kind, where=where, given=_given_section(
+            _mapping(entry["section"], f"{where}.section", source), f"{where}.section", source,
+            r_outer))
     notch = _notch_of_kind(entry, kind, width, where, source, r_outer)
     try:
         notch.section(r_outer, r_inner).properties()
@@ -350,6 +360,23 @@ def _notch_of_kind(entry: Mapping[str, Any], kind: str, width: float, where: str
                                  for k, h in enumerate(_list(entry.get("holes", []),
                                                              f"{where}.holes", source))),
                      where=where)
+
+
+def _given_section(entry: Mapping[str, Any], where: str, source: str, r_outer: float
+                   ) -> SectionProfile:
+    """A section given by its numbers (SI units), each in range and the centroid inside the
+    extent."""
+    reject_unknown(f"{where} key", entry, GIVEN_SECTION_KEYS, error=InvalidDesignError)
+    prefix = f"{where}."
+    area = _number(entry, "area", prefix, source, low=0.0, high=math.pi * r_outer**2,
+                   open_low=True)
+    second = _number(entry, "second_moment", prefix, source, low=0.0, high=1.0, open_low=True)
+    low = _number(entry, "x_low", prefix, source, low=-r_outer, high=r_outer)
+    high = _number(entry, "x_high", prefix, source, low=low, high=r_outer, open_low=True)
+    centroid = _number(entry, "centroid_x", prefix, source, low=low, high=high, open_low=True,
+                       open_high=True)
+    return SectionProfile(area=area, centroid_x=centroid, second_moment=second, x_low=low,
+                         x_high=high)
 
 
 def _points(value: Any, where: str, source: str) -> tuple[tuple[float, float], ...]:
@@ -407,6 +434,10 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         return "[" + ", ".join(f"[{number(x)}, {number(y)}]" for x, y in ring) + "]"
 
     def notch(width: float, band: float, offset: float, profile: NotchProfile) -> str:
+        if isinstance(profile, SectionProfile):
+            numbers = ", ".join(f"{key}: {number(getattr(profile, key))}"
+                                for key in GIVEN_SECTION_KEYS)
+            return f"{{width: {number(width)}, section: {{{numbers}}}}}"
         if isinstance(profile, PolygonProfile):
             holes = (", holes: [" + ", ".join(points(h) for h in profile.holes) + "]"
                      if profile.holes else "")

@@ -310,9 +310,17 @@ PARAMETER_SPECS = {**FIELD_SPECS, "profile": Spec(
 
 def parameter_specs(design: Design) -> dict[str, Spec]:
     """:data:`PARAMETER_SPECS` that can hold ``design``'s values: all but the fields it holds
-    per notch (a body file's per-notch values are read from the file, not from parameters)."""
+    per notch (a body file's per-notch values are read from the file, not from parameters), its
+    profile unless that is a named one, and ``w_d``, ``w_o`` where a notch's section is given
+    whole (a polygon or a mesh's slice: they are derived from it)."""
+    profiles = design.notch_profiles()
+    derived = set()
+    if any(p.name not in PROFILE_NAMES for p in profiles):
+        derived.add("profile")
+    if any(isinstance(p, PRISMATIC_PROFILES) for p in profiles):
+        derived |= {"w_d", "w_o"}
     return {k: v for k, v in PARAMETER_SPECS.items()
-            if not isinstance(getattr(design, k, None), tuple)}
+            if not isinstance(getattr(design, k, None), tuple) and k not in derived}
 
 
 def parse_field(name: str, text: str) -> Any:

@@ -527,7 +527,7 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
 
 
 _PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR, "polygon": PRISMATIC,
-                 "sliced": PRISMATIC}
+                 "section": PRISMATIC}
 
 
 def _custom_h1(table: Prototypes, build: Any, cell: Array, design: Array,

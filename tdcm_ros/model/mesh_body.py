@@ -14,7 +14,7 @@ Slices with the tube's full section (the largest area, to :data:`SECTION_TOL`) a
 each run of other slices is one notch, which must be prismatic (the same section along it,
 to :data:`SECTION_TOL`: a slot cut straight through, as laser and wire cuts are; a notch
 whose section changes along the body, e.g. a circular-bottomed cut, is refused naming it).
-Its section is the slice's own (:class:`~tdcm_ros.model.profiles.SlicedProfile`).
+Its section is the slice's own (:class:`~tdcm_ros.model.profiles.SectionProfile`).
 
 The tube is the circle through the outermost vertices of its slice (``R_outer``) less the
 circle through the innermost vertices of its lumen (``r_inner``; 0 where no edge of the slice
@@ -37,7 +37,7 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.design import MIN_SEGMENT_M
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.profiles import SlicedProfile
+from tdcm_ros.model.profiles import SectionProfile
 from tdcm_ros.model.sections import edge_moments
 
 Array = NDArray[np.float64]
@@ -83,10 +83,10 @@ class Slice:
                 and abs(self.first - other.first) <= SECTION_TOL * scale.area * radius
                 and abs(self.second - other.second) <= SECTION_TOL * scale.area * radius**2)
 
-    def profile(self) -> SlicedProfile:
+    def profile(self) -> SectionProfile:
         """The slice as a prismatic notch section."""
         x_bar = self.first / self.area
-        return SlicedProfile(area=self.area, centroid_x=x_bar,
+        return SectionProfile(area=self.area, centroid_x=x_bar,
                              second_moment=self.second - self.area * x_bar * x_bar,
                              x_low=self.x_low, x_high=self.x_high)
 
@@ -96,7 +96,7 @@ class MeshSegment:
     """A segment found in the mesh: ``length`` (m) and, for a notch, its ``section``."""
 
     length: float
-    section: SlicedProfile | None
+    section: SectionProfile | None
     where: str
 
 

@@ -133,7 +133,7 @@ class PolygonProfile(_StraightSlot):
 
 
 @dataclass(frozen=True)
-class SlicedProfile(_StraightSlot):
+class SectionProfile(_StraightSlot):
     """A prismatic notch whose section is given by its numbers (a slice of a mesh,
     :mod:`tdcm_ros.model.mesh_body`): ``area`` (m^2), ``centroid_x`` (m), ``second_moment``
     about the centroid (m^4), ``x_low``/``x_high``, the material's extent in ``x`` (m)."""
@@ -143,7 +143,7 @@ class SlicedProfile(_StraightSlot):
     second_moment: float
     x_low: float
     x_high: float
-    name: str = "sliced"
+    name: str = "section"
 
     def section(self, r_outer: float) -> SectionProperties:
         """The section's properties in a tube of outer radius ``r_outer`` (m)."""
@@ -162,8 +162,8 @@ class SlicedProfile(_StraightSlot):
         return self.x_low, self.x_high
 
 
-PrismaticProfile = PolygonProfile | SlicedProfile
-PRISMATIC_PROFILES = (PolygonProfile, SlicedProfile)
+PrismaticProfile = PolygonProfile | SectionProfile
+PRISMATIC_PROFILES = (PolygonProfile, SectionProfile)
 
 
 @lru_cache(maxsize=256)
@@ -176,7 +176,7 @@ def _polygon_properties(shell: tuple[tuple[float, float], ...],
 
 
 NotchProfile = (CircularProfile | RectangularProfile | CustomProfile | PolygonProfile
-                | SlicedProfile)
+                | SectionProfile)
 
 PROFILE_NAMES: tuple[str, ...] = ("circular", "rectangular")
 

@@ -21,7 +21,7 @@ from tdcm_ros.device.schedule import StepSchedule
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.api import evaluate_paths
 from tdcm_ros.metrics.steps import StepSettings
-from tdcm_ros.model import preset
+from tdcm_ros.model import named_design, preset
 from tdcm_ros.nodes.model_node import ModelNode
 from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.registry import NODES
@@ -189,14 +189,19 @@ def test_every_demo_node_is_registered_and_configured(tmp_path: Path) -> None:
         assert given[node]["design.profile"] == "rectangular", node
 
 
-def test_a_per_notch_scene_reaches_the_nodes_as_a_body_file(tmp_path: Path) -> None:
-    graded = preset("paper-experiment").with_overrides(w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3,
-                                                            1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3])
-    scene = replace(load_scene("paper_experiment"), design=graded)
+@pytest.mark.parametrize("body", ["graded", "tee_notches.yaml", "tee_mesh.yaml"])
+def test_a_per_notch_or_polygon_scene_reaches_the_nodes_as_a_body_file(tmp_path: Path,
+                                                                       body: str) -> None:
+    """Per-notch values and sections given whole (a uniform polygon body, a mesh) are not
+    parameters: the plan writes the scene's design as a body file the nodes read."""
+    design = preset("paper-experiment").with_overrides(
+        w_d=[1.6e-3, 1.5e-3, 1.4e-3, 1.3e-3, 1.2e-3, 1.1e-3, 1.0e-3, 0.9e-3]) \
+        if body == "graded" else named_design(str(REPO / "config" / "bodies" / body))
+    scene = replace(load_scene("paper_experiment"), design=design)
     given = make_plan(scene, "paper_experiment", tmp_path).node_overrides()["model_node"]
-    assert "design.w_d" not in given and given["design.E"] == graded.E
+    assert "design.w_d" not in given and given["design.E"] == design.E
     node = ModelNode(MemoryPort(given, name="model_node"))
-    assert node.design == graded
+    assert node.design == design
 
 
 def test_demo_rejects_a_bad_set_before_the_run(tmp_path: Path,

@@ -20,7 +20,7 @@ from tdcm_ros.model import (
     read_body_file,
     solve,
 )
-from tdcm_ros.model.profiles import PolygonProfile
+from tdcm_ros.model.profiles import PolygonProfile, SectionProfile
 from tdcm_ros.yamlio import load_yaml
 from test.support.cli import tdcm
 
@@ -156,6 +156,28 @@ def test_a_polygon_notch_is_read_as_its_polygon_and_written_back_bit_for_bit() -
     assert design.w_o == (0.0, -1.5e-3, 0.0)
     again = body_from_mapping(load_yaml(body_file_text(design), "again.yaml"), "again.yaml").design()
     assert again == design
+
+
+def test_a_section_given_by_its_numbers_is_read_and_a_mesh_body_written_back_as_them() -> None:
+    """``section:`` (area, centroid, I, extent: SI units) is a prismatic notch; a mesh body's
+    design is written with its slices as such sections and reads back bit for bit."""
+    given = {"area": 6.7e-6, "centroid_x": -2.3e-3, "second_moment": 3.2e-12, "x_low": -3.5e-3,
+             "x_high": 0.5e-3}
+    data = with_changes(segments=[BAND, {"tube": 4e-3}, {"notch": {"width": 2e-3,
+                                                                   "section": given}}])
+    design = body_from_mapping(data, "body.yaml").design()
+    section = design.notch_profiles()[1]
+    assert isinstance(section, SectionProfile) and section.area == 6.7e-6
+    assert design.w_d == (1.4e-3, 4.0e-3) and design.w_o == (0.0, -1.5e-3)
+    mesh = read_body_file(Path(__file__).resolve().parents[2] / "config" / "bodies"
+                          / "tee_mesh.yaml").design()
+    again = body_from_mapping(load_yaml(body_file_text(mesh), "again.yaml"), "again.yaml").design()
+    assert again == mesh
+    bad = dict(given, centroid_x=1e-3)
+    with pytest.raises(InvalidDesignError, match=r"notch\.section\.centroid_x = 0\.001 is out of "
+                       r"range; allowed: \(-0\.0035, 0\.0005\)"):
+        body_from_mapping(with_changes(segments=[{"notch": {"width": 2e-3, "section": bad}}]),
+                          "body.yaml")
 
 
 def test_a_polygon_outside_the_tube_is_refused_naming_its_segment() -> None:

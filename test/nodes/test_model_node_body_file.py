@@ -97,3 +97,24 @@ def test_a_per_notch_body_file_reaches_both_nodes_and_its_lists_are_not_paramete
     metrics_design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                              name="metrics_node"))
     assert metrics_design == design
+
+
+@pytest.mark.parametrize("name", ["tee_notches.yaml", "tee_mesh.yaml"])
+def test_a_polygon_or_mesh_body_file_reaches_both_nodes_its_sections_not_parameters(
+        name: str) -> None:
+    """A prismatic notch's section is the file's: its profile, w_d and w_o (derived from the
+    section) are not parameters; the others still are."""
+    body = Path(__file__).resolve().parents[2] / "config" / "bodies" / name
+    port = MemoryPort({"design.file": str(body)}, name="model_node")
+    node = ModelNode(port)
+    names = set(port.store.specs)
+    assert "design.E" in names  # (a mesh's widths differ in their last bits: per notch)
+    assert not names & {"design.profile", "design.w_d", "design.w_o"}
+    midline = midline_at({"design.file": str(body)}, 5.0)
+    expected = solve(node.design, 5.0).pose_at(np.linspace(0.0, node.design.length,
+                                                            midline.shape[0]))[0]
+    assert midline[-1] == pytest.approx(expected[-1, [0, 2]], abs=1e-12)
+    assert port.store.set({"design.E": 2.0e9}).successful and node.design.E == 2.0e9
+    metrics_design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
+                                                             name="metrics_node"))
+    assert metrics_design == node.design.with_overrides(E=1.85e9)
