@@ -82,6 +82,7 @@ def _design(named: str | None, pairs: list[str], body: BodySpec | None = None
             named = text.strip()
     fields = {k: v for k, v in values.items() if k != "L"}
     base = body.design() if body is not None else preset(named or DEFAULT_DESIGN)
+    base.require_free(list(fields), "--set")
     design = base.with_overrides(**fields)
     if "L" in values:  # w_t (w_tip for one notch) from the length, as tdcm design --free L
         design = candidate(design, {"L": values["L"]})

@@ -147,6 +147,28 @@ class Design:
                     raise out_of_range(where, value, f"0 (no segment) or [{MIN_SEGMENT_M:g}, 1] m",
                                        error=InvalidDesignError)
 
+    def derived_fields(self) -> frozenset[str]:
+        """Fields this design does not take as values: ``profile`` unless every notch has a
+        named one, and ``w_d``, ``w_o`` where a notch's section is given whole (a polygon or a
+        section's numbers: they are its extent). Parameters, sweeps and searches leave them."""
+        profiles = self.notch_profiles()
+        derived = set()
+        if any(p.name not in PROFILE_NAMES for p in profiles):
+            derived.add("profile")
+        if any(isinstance(p, PRISMATIC_PROFILES) for p in profiles):
+            derived |= {"w_d", "w_o"}
+        return frozenset(derived)
+
+    def require_free(self, names: Sequence[str], what: str) -> None:
+        """Raise :class:`InvalidDesignError` if ``what`` would vary a :meth:`derived_fields`
+        field of this design (naming it)."""
+        for name in names:
+            if name in self.derived_fields():
+                raise InvalidDesignError(
+                    f"{what}: {name} is derived from this design's notch sections (a polygon or "
+                    f"a section given whole: its extent in x); allowed: other fields",
+                    parameter=name, value=name, allowed="a field the design takes as a value")
+
     def open_faces(self) -> NDArray[np.bool_]:
         """Per notch (shape (2, N), base to tip): whether its faces can meet at the tube's outer
         surface on the +x side (row 0) and the -x side (row 1), i.e. whether the cut opens there
@@ -310,15 +332,9 @@ PARAMETER_SPECS = {**FIELD_SPECS, "profile": Spec(
 
 def parameter_specs(design: Design) -> dict[str, Spec]:
     """:data:`PARAMETER_SPECS` that can hold ``design``'s values: all but the fields it holds
-    per notch (a body file's per-notch values are read from the file, not from parameters), its
-    profile unless that is a named one, and ``w_d``, ``w_o`` where a notch's section is given
-    whole (a polygon or a mesh's slice: they are derived from it)."""
-    profiles = design.notch_profiles()
-    derived = set()
-    if any(p.name not in PROFILE_NAMES for p in profiles):
-        derived.add("profile")
-    if any(isinstance(p, PRISMATIC_PROFILES) for p in profiles):
-        derived |= {"w_d", "w_o"}
+    per notch (a body file's per-notch values are read from the file, not from parameters) and
+    its :meth:`~Design.derived_fields`."""
+    derived = design.derived_fields()
     return {k: v for k, v in PARAMETER_SPECS.items()
             if not isinstance(getattr(design, k, None), tuple) and k not in derived}
 

@@ -57,6 +57,7 @@ def free_ranges(base: Design, free: Mapping[str, Any]) -> tuple[FreeRange, ...]:
     if not free:
         raise InvalidDesignError("no free field: give at least one of " + ", ".join(FREE_FIELDS),
                                  parameter="free", value={}, allowed=", ".join(FREE_FIELDS))
+    base.require_free(list(free), "free fields")
     if "L" in free and "w_t" in free:
         raise InvalidDesignError("free L sets w_t: free one of L and w_t, not both",
                                  parameter="free", value=sorted(free), allowed="L or w_t")

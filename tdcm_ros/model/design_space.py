@@ -141,6 +141,7 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
                                  parameter="axes", value=list(axes),
                                  allowed="fields other than w_t, w_tip")
     fields = tuple(axes)
+    base.require_free(fields, "swept fields")
     values = tuple(_axis_values(name, axes[name]) for name in fields)
     t = _tensions(tensions)
     strain_limit = _allowable(allowable_strain)

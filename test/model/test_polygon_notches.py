@@ -8,15 +8,17 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tdcm_ros.model import PolygonProfile, solve
+from tdcm_ros.model import PolygonProfile, search_designs, solve, sweep
 from tdcm_ros.model.batch import solve_batch
 from tdcm_ros.model.design import preset
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.solver import DEFAULT_SETTINGS
+from test.support.cli import tdcm
 from test.support.second_solver import reference_tip
 
 MM = 1e-3
@@ -136,3 +138,18 @@ def test_a_polygon_that_keeps_the_wall_on_the_tendon_side_has_no_hard_stop_there
 def test_a_bad_polygon_is_refused_naming_the_notch(shell: list, message: str) -> None:
     with pytest.raises(InvalidDesignError, match=message):
         RECTANGULAR.with_overrides(profile=[PolygonProfile(shell)] + [RECTANGULAR.profile] * 7)
+
+
+def test_the_fields_a_polygon_body_derives_are_not_set_swept_or_searched() -> None:
+    """w_d and w_o of a polygon notch are its extent: --set, sweeps and searches refuse them by
+    name rather than ignore them; the fields the body takes still vary."""
+    design = RECTANGULAR.with_overrides(profile=profile(TEE))
+    assert design.derived_fields() == {"profile", "w_d", "w_o"}
+    with pytest.raises(InvalidDesignError, match="swept fields: w_d is derived"):
+        sweep(design, {"w_d": [1e-3, 2e-3]}, [1.0])
+    with pytest.raises(InvalidDesignError, match="free fields: w_d is derived"):
+        search_designs(design, free={"w_d": (1e-3, 2e-3)}, tip_deflection=1e-3)
+    assert sweep(design, {"w_n": [1e-3, 2e-3]}, [1.0]).tip_deflection_m.shape == (2, 1)
+    body = Path(__file__).resolve().parents[2] / "config" / "bodies" / "tee_notches.yaml"
+    refused = tdcm("solve", "--design", str(body), "--set", "w_o=0", "--tension", "1")
+    assert refused.returncode == 2 and "--set: w_o is derived" in refused.stderr
