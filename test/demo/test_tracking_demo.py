@@ -1,7 +1,8 @@
 """``tdcm demo --scene tracking`` end to end on a shortened circle, on zenoh: the shape
 controller on the device twin with simulated motion capture, in a world whose E is not the
-model's. Feedback must correct the model to the measured tip, feed-forward must keep the gain
-feedback learned, and metrics.json must hold what the bag gives. How close the live tip comes
+model's. Feedback must correct the model to the measured tip, the controller must keep the gain
+feedback learned (the world's) through the last feed-forward lap, and metrics.json must hold
+what the bag gives. How close the live tip comes
 to the moving target is the graph's latency, i.e. the machine's load: the controller's
 accuracy against the target is checked on simulated time in test/control/test_closed_loop.py.
 
@@ -81,8 +82,11 @@ def test_feedback_learns_the_world_and_feed_forward_keeps_what_it_learned(tmp_pa
     assert "controller mode -> feedforward (feedforward_learned phase)" in done.stdout
     learned = results[FEEDFORWARD_LEARNED]
     assert learned["mode"] == FEEDFORWARD and learned["samples"] > 100
-    # the kept gain is the world's: the model now explains the measured tip (tip vs target in
-    # a feed-forward lap is the live commands' lag behind the moving target, the machine's load)
-    assert learned["model_rmse_m"] < 0.5 * feedforward["model_rmse_m"], said
+    # the gain kept to the end (after the learned lap) is the world's, within 2 % (1.1043 and
+    # 1.1059 seen for 1.1057; 1.0, the model's own, if it had been reset). How well the model
+    # explains the tip in a feed-forward lap depends on the live lag behind the commands: 0.16
+    # mm quiet, 0.62 mm beside a CPU hog against feed-forward's 1.0 mm, so it is not asserted.
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["final_gain"] == pytest.approx(metrics["world_gain"], rel=0.02), said
     for name in ("tracking_paths.png", "tracking_error.png"):
         assert (out / "plots" / name).stat().st_size > 0
