@@ -149,12 +149,9 @@ class BodySpec:
             raise InvalidDesignError(f"{self.source}: segments has no notch; allowed: at least "
                                      "one", parameter="segments", value=0, allowed="[1, inf) notches")
         for notch in notches:
-            if notch.kind == "polygon":
-                reach = max(math.hypot(x, y) for x, y in notch.shell)
-                if reach > self.R_outer * (1.0 + OFFSET_SLACK):
-                    raise out_of_range(f"{self.source}: {notch.where}.polygon", reach,
-                                       f"vertices within R_outer = {self.R_outer:g} m of the "
-                                       "tube axis", error=InvalidDesignError)
+            if notch.kind == "polygon":  # named by its path here, not as the design's profile[i]
+                PolygonProfile(notch.shell, notch.holes).check_inside(
+                    self.R_outer, f"{self.source}: {notch.where}.polygon")
                 continue
             room = self.R_outer - notch.backbone(self.R_outer) / 2.0
             if abs(notch.offset) > room + OFFSET_SLACK * self.R_outer:

@@ -19,7 +19,6 @@ features are often softer: treat ``E`` as a calibration parameter (``tdcm calibr
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
@@ -38,15 +37,13 @@ from tdcm_ros.model.profiles import (
     profile_from_name,
 )
 from tdcm_ros.model.section import tube_moment
-from tdcm_ros.model.sections import keeps_wall
+from tdcm_ros.model.sections import OFFSET_SLACK, keeps_wall
 from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of, spelled_as
 
 MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
 #: or at least this, so no cell is negligible against the arc lengths it sits between.
 MIN_SEGMENT_M = 1e-6
-#: Relative slack (of ``R_outer``) of the check ``|w_o| <= R_outer - w_d/2``, for rounding.
-OFFSET_SLACK = 1e-12
 #: Fields that may hold one value per notch (base to tip).
 PER_NOTCH_FIELDS = ("w_n", "w_d", "w_o")
 #: Fields that may hold one value per gap between adjacent notches (base to tip).
@@ -113,11 +110,7 @@ class Design:
                 raise InvalidDesignError(f"{where}: {error}", parameter=where,
                                          value=error.value, allowed=error.allowed) from error
             if isinstance(profile, PolygonProfile):
-                reach = max(math.hypot(x, y) for x, y in profile.shell)
-                if reach > self.R_outer * (1.0 + OFFSET_SLACK):
-                    raise out_of_range(f"{where} (polygon)", reach, f"vertices within R_outer = "
-                                       f"{self.R_outer:g} m of the tube axis",
-                                       error=InvalidDesignError)
+                profile.check_inside(self.R_outer, f"{where} (polygon)")
             low, high = profile.x_extent()
             w_d[i], w_o[i] = high - low, 0.5 * (high + low)
         for name, values in (("w_d", w_d), ("w_o", w_o)):
@@ -162,8 +155,9 @@ class Design:
     def require_free(self, names: Sequence[str], what: str) -> None:
         """Raise :class:`InvalidDesignError` if ``what`` would vary a :meth:`derived_fields`
         field of this design (naming it)."""
+        derived = self.derived_fields()
         for name in names:
-            if name in self.derived_fields():
+            if name in derived:
                 raise InvalidDesignError(
                     f"{what}: {name} is derived from this design's notch sections (a polygon or "
                     f"a section given whole: its extent in x); allowed: other fields",

@@ -9,6 +9,7 @@ Quadrature and cell boundaries are placed uniformly in ``u``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -130,6 +131,18 @@ class PolygonProfile(_StraightSlot):
         """The smallest and largest ``x`` of the polygon's material (m)."""
         xs = [x for x, _ in self.shell]
         return min(xs), max(xs)
+
+    def check_inside(self, r_outer: float, where: str) -> None:
+        """Raise :class:`~tdcm_ros.model.errors.InvalidDesignError` naming ``where`` unless
+        every vertex is within ``r_outer`` (m, to rounding) of the tube axis."""
+        from tdcm_ros.errors import out_of_range
+        from tdcm_ros.model.errors import InvalidDesignError
+        from tdcm_ros.model.sections import OFFSET_SLACK
+
+        reach = max(math.hypot(x, y) for x, y in self.shell)
+        if reach > r_outer * (1.0 + OFFSET_SLACK):
+            raise out_of_range(where, reach, f"vertices within R_outer = {r_outer:g} m of the "
+                               "tube axis", error=InvalidDesignError)
 
 
 @dataclass(frozen=True)

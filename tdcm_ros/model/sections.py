@@ -43,6 +43,9 @@ Array = NDArray[np.float64]
 #: there (a polygon drawn round the tube with 23 or more edges reaches it wherever its vertices
 #: fall).
 SURFACE_TOL = 0.01
+#: Relative slack (of ``R_outer``) for rounding of a section's reach into the wall: the check
+#: ``|w_o| <= R_outer - w_d/2`` and a polygon's vertices within ``R_outer``.
+OFFSET_SLACK = 1e-12
 
 
 def keeps_wall(reach: ArrayLike, r_outer: ArrayLike) -> NDArray[np.bool_]:

@@ -37,12 +37,9 @@ class SwallowingStartNode(NodeLogic):
             threading.Event().wait(BUILD_S)
 
 
-class SwallowingSlowNode(NodeLogic):
+class SwallowingSlowNode(SwallowingStartNode):
     default_name = "swallowing_slow"
 
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
-        Path(os.environ["TDCM_TEST_STARTING"]).touch()
-        with contextlib.suppress(KeyboardInterrupt):
-            threading.Event().wait(BUILD_S)
         threading.Event().wait(BUILD_S)  # the rest of the build, no signal's error to stop it

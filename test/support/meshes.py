@@ -59,8 +59,7 @@ def as_shapely(section: Any) -> Any:
     outer, holes = [], []
     for contour in section.to_polygons():
         ring = Polygon(np.asarray(contour))
-        (outer if orient(ring, 1.0).exterior.coords[:] == ring.exterior.coords[:] else
-         holes).append(Polygon(np.asarray(contour)))
+        (outer if ring.exterior.is_ccw else holes).append(ring)
     material = unary_union(outer)
     return material.difference(unary_union(holes)) if holes else material
 
