@@ -113,6 +113,11 @@ class StampedHistory:
     def __len__(self) -> int:
         return len(self._values)
 
+    @property
+    def newest_stamp(self) -> float | None:
+        """Stamp of the newest value kept; ``None`` before any."""
+        return self._stamps[-1] if self._stamps else None
+
     def add(self, stamp: float, value: float) -> bool:
         """Keep ``value`` at ``stamp``; False (not kept) when ``stamp`` is older than the latest
         kept one."""

@@ -19,7 +19,10 @@ target, m), ``controller/gain`` and ``controller/gain_std`` (Float64: the estima
 ``mode`` (run time): ``feedforward`` commands ``T_inverse(target) / g`` with ``g`` frozen;
 ``feedback`` also updates ``g`` from each measured tip, with the tension and roll of the marker
 frame's own stamp (their messages' stamps; a frame that waited in the mocap pipeline while the
-tendon moved is not paired with the newer tension). Without a measured tip for
+tendon moved is not paired with the newer tension). A frame newer than every tension received
+waits until a tension stamped at or after it arrives (the driver's messages can be late on a
+loaded machine, and the newest tension then is an older one), and is dropped, counted as
+``markers_tension_late``, after ``measurement_timeout_s``. Without a measured tip for
 ``measurement_timeout_s`` feedback falls back to feed-forward with the last ``g`` and says so.
 A refused target (not finite, unknown frame, past the roll limits, unreachable) is logged with
 its value and the allowed range and leaves the current target in place. The controller never
@@ -32,9 +35,11 @@ from __future__ import annotations
 import math
 import sys
 import threading
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable
-from typing import Any
+from typing import Any, NamedTuple
+
+import numpy as np
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.control import (
@@ -117,6 +122,8 @@ PARAMETERS = {**grouped(PRESET_SPECS), **grouped(PARAMETER_SPECS, "design."),
 RELEASED_AFTER_S = 1.0
 #: Tension and roll samples kept by stamp for the marker frames (seconds at 500 Hz).
 HISTORY = 2048
+#: Marker frames kept waiting for the tension of their stamp (the oldest go first).
+WAITING_FRAMES = 1024
 NEVER = -(1 << 62)
 
 
@@ -126,6 +133,16 @@ def _stamp(ns: int) -> dict[str, int]:
 
 def _xyz(point: tuple[float, float, float]) -> dict[str, float]:
     return dict(zip("xyz", point, strict=True))
+
+
+class WaitingFrame(NamedTuple):
+    """A marker frame waiting for the tension of its stamp: ``taken_ns`` (its stamp),
+    ``rows`` (k, 3) in ``base_frame`` (m), its message ``header``, ``arrived_ns`` (node clock)."""
+
+    taken_ns: int
+    rows: np.ndarray
+    header: dict[str, Any]
+    arrived_ns: int
 
 
 def driver_name(namespace: str, driver: str) -> str:
@@ -215,6 +232,7 @@ class ShapeControllerNode(NodeLogic):
         self.roll_rad = 0.0  # measured; 0 until joint_states names the roll joint
         # by their stamps, so a marker frame meets the tension and roll of its own instant
         self.tensions, self.rolls = StampedHistory(HISTORY), RollHistory(HISTORY)
+        self.waiting: deque[WaitingFrame] = deque()
         self.command: tuple[float, float] | None = None
         self.sent: tuple[float, float, int] | None = None  # tension, roll, when
         self.released_since_ns: int | None = None
@@ -262,6 +280,7 @@ class ShapeControllerNode(NodeLogic):
         self.counts["tension"] += 1
         self.tension_n, self.last_ns["tension"] = value, self.port.now_ns()
         self.tensions.add(stamp_ns_of(message) or self.last_ns["tension"], value)
+        self._pair_waiting()
 
     def _on_joint_states(self, message: Any) -> None:
         names = list(message.name)
@@ -272,8 +291,9 @@ class ShapeControllerNode(NodeLogic):
         if not math.isfinite(value):
             self.counts["roll_non_finite"] += 1
             return
-        self.roll_rad = value
-        self.rolls.add(stamp_ns_of(message) or self.port.now_ns(), value)
+        self.roll_rad, self.last_ns["roll"] = value, self.port.now_ns()
+        self.rolls.add(stamp_ns_of(message) or self.last_ns["roll"], value)
+        self._pair_waiting()
 
     def _on_tf(self, message: Any) -> None:
         for problem in self.tf.add_message(message):
@@ -336,19 +356,54 @@ class ShapeControllerNode(NodeLogic):
         if ignored:
             self.counts["markers_ignored"] += ignored
         now = self.port.now_ns()
+        header = {"stamp": {"sec": int(message.header.stamp.sec),
+                            "nanosec": int(message.header.stamp.nanosec)},
+                  "frame_id": self.base_frame}
+        taken = stamp_ns_of(message) or now  # the frame's instant: the bench's state then
+        if len(self.waiting) == WAITING_FRAMES:
+            self.waiting.popleft()
+            self.counts["markers_tension_late"] += 1
+        self.waiting.append(WaitingFrame(taken, registration.to_base(rows), header, now))
+        self._pair_waiting()
+
+    def _paired(self, taken_ns: int) -> bool:
+        """Whether the tension (and the roll, unless stale) of the instant ``taken_ns`` are
+        known: a sample stamped at or after it has arrived."""
+        newest = self.tensions.newest_stamp
+        if newest is None or newest < taken_ns:
+            return False
+        newest_roll = self.rolls.newest_stamp
+        return newest_roll is None or newest_roll >= taken_ns or not self._fresh("roll")
+
+    def _pair_waiting(self) -> None:
+        """Observe the waiting frames whose tension has arrived, oldest first; drop the ones
+        that waited longer than ``measurement_timeout_s``."""
+        timeout_ns = float(self.port.get_parameter("measurement_timeout_s")) * 1e9
+        while self.waiting:
+            frame = self.waiting[0]
+            if self._paired(frame.taken_ns):
+                self.waiting.popleft()
+                self._observe(frame)
+            elif self.port.now_ns() - frame.arrived_ns > timeout_ns:
+                self.waiting.popleft()
+                self.counts["markers_tension_late"] += 1
+                self.last_ns["tension_late"] = self.port.now_ns()
+            else:
+                return
+
+    def _observe(self, frame: WaitingFrame) -> None:
+        now = self.port.now_ns()
         dt_s = (now - self.last_ns.get("observed", now)) * 1e-9
         adapt = str(self.port.get_parameter("mode")) == "feedback"
-        taken = stamp_ns_of(message) or now  # the frame's instant: the bench's state then
         try:
-            observation = self.core.observe(self.tensions.at(taken), self.rolls.at(taken),
-                                            registration.to_base(rows), dt_s, adapt=adapt)
+            observation = self.core.observe(self.tensions.at(frame.taken_ns),
+                                            self.rolls.at(frame.taken_ns), frame.rows, dt_s,
+                                            adapt=adapt)
         except TdcmError as error:  # a tension past a model limit: no prediction for it
             self.counts[f"model_{error.kind}"] += 1
             return
         self.last_ns["observed"] = now
-        header = {"stamp": {"sec": int(message.header.stamp.sec),
-                            "nanosec": int(message.header.stamp.nanosec)},
-                  "frame_id": self.base_frame}
+        header = frame.header
         self._publish_point(self.predicted_tip, header, observation.predicted)
         if observation.adapted:
             self.counts["adapted"] += 1
@@ -374,6 +429,7 @@ class ShapeControllerNode(NodeLogic):
     # --- output -----------------------------------------------------------------------------
     def step(self) -> None:
         """Slew the command toward the target's goal within the driver's limits; send it."""
+        self._pair_waiting()  # drops the frames whose tension never came
         limits = self.limits.limits
         goal = self.core.goal(limits) if limits is not None else None
         self._watch_release()
@@ -416,6 +472,9 @@ class ShapeControllerNode(NodeLogic):
             problems.append(f"no measured tip for more than {timeout_s:g} s (markers, tension "
                             f"or the registration missing): feed-forward with the last gain "
                             f"{estimator.gain:.4g}")
+        if now - self.last_ns.get("tension_late", NEVER) < 5 * self.diagnostics.period_s * 1e9:
+            problems.append(f"marker frames dropped: no tension stamped at or after them within "
+                            f"{timeout_s:g} s (the tension late, or stamped on another clock)")
         if (self.released_since_ns is not None
                 and now - self.released_since_ns > RELEASED_AFTER_S * 1e9):
             problems.append(f"tendon released ({self.tension_n:.3g} N measured, "

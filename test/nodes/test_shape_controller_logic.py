@@ -70,13 +70,14 @@ class Bench:
             "header": header(self.port, frame), "point": dict(zip("xyz", map(float, point),
                                                                   strict=True))}))
 
-    def tension(self, newtons: float) -> None:
+    def tension(self, newtons: float, stamp_ns: int | None = None) -> None:
         self.port.deliver("tension", from_dict("geometry_msgs/msg/WrenchStamped", {
-            "header": header(self.port, "tdcm_tendon"), "wrench": {"force": {"z": newtons}}}))
+            "header": header(self.port, "tdcm_tendon", stamp_ns),
+            "wrench": {"force": {"z": newtons}}}))
 
-    def roll(self, radians: float) -> None:
+    def roll(self, radians: float, stamp_ns: int | None = None) -> None:
         self.port.deliver("joint_states", from_dict("sensor_msgs/msg/JointState", {
-            "header": header(self.port, ""), "name": ["roll"], "position": [radians]}))
+            "header": header(self.port, "", stamp_ns), "name": ["roll"], "position": [radians]}))
 
     def markers(self, world_tension: float, roll: float, modulus_ratio: float,
                 rng: np.random.Generator, stamp_ns: int | None = None) -> None:
@@ -96,18 +97,21 @@ class Bench:
         return self.port.messages(topic)[-1]
 
     def follow(self, seconds: float, modulus_ratio: float, rng: np.random.Generator,
-               markers: bool = True, lag_steps: int = 0) -> None:
+               markers: bool = True, lag_steps: int = 0, tension_lag_steps: int = 0) -> None:
         """The bench closed: the driver holds the last setpoints, the world bends; each marker
-        frame reaches the node ``lag_steps`` steps (0.05 s each) after it was taken."""
+        frame reaches the node ``lag_steps`` steps (0.05 s each) after it was taken, each
+        tension and roll ``tension_lag_steps`` steps after it was measured."""
         for _ in range(round(seconds / 0.05)):
             self.port.advance(0.05)
             if not self.port.messages("tension_setpoint"):
                 continue
             tension = float(self.last("tension_setpoint").data)
             roll = float(self.last("roll_setpoint").data)
-            self.tension(tension)
-            self.roll(roll)
             self.taken.append((self.port.clock_ns, tension, roll))
+            if len(self.taken) > tension_lag_steps:
+                stamp, then_n, then_roll = self.taken[-1 - tension_lag_steps]
+                self.tension(then_n, stamp_ns=stamp)
+                self.roll(then_roll, stamp_ns=stamp)
             if markers and len(self.taken) > lag_steps:
                 stamp, then_n, then_roll = self.taken[-1 - lag_steps]
                 self.markers(then_n, then_roll, modulus_ratio, rng, stamp_ns=stamp)
@@ -323,3 +327,43 @@ def test_a_marker_frame_late_from_the_mocap_meets_the_tension_of_its_own_stamp(b
         b.follow(0.3, 1.1, rng, lag_steps=4)  # frames 0.2 s late
     gain, std = b.last("controller/gain").data, b.last("controller/gain_std").data
     assert gain == pytest.approx(1.1, abs=4 * std + 2e-3), (gain, std)  # newest: 0.945
+
+
+def test_a_marker_frame_waits_for_the_late_tension_of_its_own_stamp(bench) -> None:
+    """The driver's tension and roll reach the controller 0.4 s after they were measured (a
+    driver not scheduled on a loaded machine) while the marker frames come on time: paired with
+    the newest tension the node had, each frame showed the world's bend at another tension
+    (seen live: tensions 1.9 s old, the gain swinging 0.80-1.42 and ending at 1.27 for 1.106).
+    Each frame waits for the tension of its stamp, so the gain is the world's."""
+    rng = np.random.default_rng(12)
+    b = bench(overrides={"mode": "feedback", "measurement_timeout_s": 1.0})
+    b.tension(0.0)
+    for target_n in (6.0, 14.0, 8.0, 16.0, 7.0, 15.0) * 4:  # the tendon always on the move
+        b.target(model_tip(target_n, 0.3))
+        b.follow(0.3, 1.1, rng, tension_lag_steps=8)  # tension and roll 0.4 s late
+    gain, std = b.last("controller/gain").data, b.last("controller/gain_std").data
+    assert gain == pytest.approx(1.1, abs=4 * std + 2e-3), (gain, std)
+    assert b.node.counts["markers_tension_late"] == 0
+    assert len(b.node.waiting) == 8  # the last 0.4 s of frames, their tension on its way
+
+
+def test_a_marker_frame_whose_tension_never_comes_is_dropped_and_said(bench) -> None:
+    rng = np.random.default_rng(13)
+    b = bench(overrides={"mode": "feedback", "measurement_timeout_s": 0.5})
+    b.target(model_tip(8.0, 0.0))
+    b.tension(8.0)
+    b.port.advance(0.1)
+    b.markers(8.0, 0.0, 1.0, rng)  # newer than the only tension
+    assert b.port.messages("controller/measured_tip") == []
+    b.port.advance(0.3)
+    b.tension(8.0, stamp_ns=b.port.clock_ns - 10**8)  # stamped at the frame: it is paired
+    assert len(b.port.messages("controller/measured_tip")) == 1
+    b.markers(8.0, 0.0, 1.0, rng)  # its tension never comes
+    b.port.advance(0.45)
+    assert b.node.counts["markers_tension_late"] == 0  # still within measurement_timeout_s
+    b.port.advance(0.1)
+    assert b.node.counts["markers_tension_late"] == 1 and not b.node.waiting
+    assert len(b.port.messages("controller/measured_tip")) == 1
+    status = b.node.check()
+    assert "marker frames dropped: no tension stamped at or after them within 0.5 s" in (
+        status.message), status.message
