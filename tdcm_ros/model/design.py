@@ -248,9 +248,13 @@ class Design:
         return tube_moment(self.R_outer, self.r_inner)
 
     def with_overrides(self, **overrides: Any) -> Design:
-        """A copy with fields replaced (validated); unknown names raise :class:`InvalidDesignError`."""
+        """A copy with fields replaced (validated); unknown names, and a field derived from the
+        notch sections (:meth:`derived_fields`) unless ``profile`` is replaced too, raise
+        :class:`InvalidDesignError`."""
         reject_unknown("design field", overrides, (f.name for f in fields(self)),
                        error=InvalidDesignError)
+        if "profile" not in overrides:
+            self.require_free(list(overrides), "with_overrides")
         return replace(self, **overrides)
 
     def to_dict(self) -> dict[str, Any]:

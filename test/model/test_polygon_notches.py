@@ -150,6 +150,10 @@ def test_the_fields_a_polygon_body_derives_are_not_set_swept_or_searched() -> No
     with pytest.raises(InvalidDesignError, match="free fields: w_d is derived"):
         search_designs(design, free={"w_d": (1e-3, 2e-3)}, tip_deflection=1e-3)
     assert sweep(design, {"w_n": [1e-3, 2e-3]}, [1.0]).tip_deflection_m.shape == (2, 1)
+    with pytest.raises(InvalidDesignError, match="with_overrides: w_d is derived"):
+        design.with_overrides(w_d=1e-3)  # in Python too: refused, not silently replaced
+    assert design.with_overrides(w_n=2e-3).w_n == 2e-3
+    assert design.with_overrides(profile=RECTANGULAR.profile, w_d=1.5e-3).w_d == 1.5e-3
     body = Path(__file__).resolve().parents[2] / "config" / "bodies" / "tee_notches.yaml"
     refused = tdcm("solve", "--design", str(body), "--set", "w_o=0", "--tension", "1")
     assert refused.returncode == 2 and "--set: w_o is derived" in refused.stderr
