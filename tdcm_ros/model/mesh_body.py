@@ -10,7 +10,9 @@ theorem's over its edges (:func:`tdcm_ros.model.sections.edge_moments`), exact f
 mesh: no loop assembly, so a section of several pieces (the paper's pair of cuts through the
 lumen leaves two) needs nothing more.
 
-Slices with the tube's full section (the largest area, to :data:`SECTION_TOL`) are tube;
+Slices with the tube's section (the one most of the body's length has, to
+:data:`SECTION_TOL`) are tube; a slice with more material (a flange, a cap) is refused, naming
+where;
 each run of other slices is one notch, which must be prismatic (the same section along it,
 to :data:`SECTION_TOL`: a slot cut straight through, as laser and wire cuts are; a notch
 whose section changes along the body, e.g. a circular-bottomed cut, is refused naming it).
@@ -201,14 +203,31 @@ def _slice(span: tuple[float, float, float], segments: Array, to_3d: Array, norm
                  x_high=float(points[:, 0].max()), outer=float(radius.max()), inner=inner)
 
 
+def _tube(slices: list[Slice]) -> Slice:
+    """The tube's slice: of the sections, the one the most length of the body has (areas equal
+    to :data:`SECTION_TOL` of the largest count as one)."""
+    areas = np.array([s.area for s in slices])
+    lengths = np.array([s.z_high - s.z_low for s in slices])
+    same = np.abs(areas[:, None] - areas[None, :]) <= SECTION_TOL * areas.max()
+    return slices[int(np.argmax(same @ lengths))]
+
+
 def _segments(slices: list[Slice], key: str, unit: str) -> MeshBody:
     """Tube and notch segments of ``slices`` (see the module docstring)."""
-    tube = max(slices, key=lambda s: s.area)
+    tube = _tube(slices)
     _check_axis(tube, key)
+    scale = UNITS[unit]
+    for wider in (s for s in slices if s.area > (1.0 + SECTION_TOL) * tube.area):
+        raise InvalidDesignError(
+            f"{key}: z = {wider.z_low / scale:.6g}..{wider.z_high / scale:.6g} {unit} has more "
+            f"material than the tube ({wider.area:.6g} m^2 against the tube's {tube.area:.6g} "
+            "m^2, the section most of the body has): a flange, cap or boss, which a body of "
+            "tubes and notches does not have; allowed: the tube and its notches only (trim the "
+            "mesh to them)", parameter=key, value=wider.area,
+            allowed=f"a section of at most the tube's area, {tube.area:.6g} m^2")
     is_tube = [s.area >= (1.0 - SECTION_TOL) * tube.area for s in slices]
     out: list[MeshSegment] = []
     k = 0
-    scale = UNITS[unit]
     while k < len(slices):
         run = k
         while run + 1 < len(slices) and is_tube[run + 1] == is_tube[k]:

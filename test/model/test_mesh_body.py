@@ -121,7 +121,7 @@ def test_a_coarse_mesh_is_read_with_a_warning_saying_how_far_its_tube_is_off(
 
 
 def test_bad_meshes_are_refused_naming_what_is_wrong(tmp_path: Path) -> None:
-    for name in "zxpg":
+    for name in "zxpfg":
         (tmp_path / name).mkdir()
     cases = {
         "starts at z = 0.001 m": body_file(tmp_path / "z", z=1.0),
@@ -129,6 +129,9 @@ def test_bad_meshes_are_refused_naming_what_is_wrong(tmp_path: Path) -> None:
         "notch 1 changes its section along the body": body_file(
             tmp_path / "p", [("tube", 4.0), ("notch", 1.0, TEE), ("notch", 1.0, CUT),
                              ("tube", 4.0)]),
+        "z = 0..1 mm has more material than the tube": body_file(
+            tmp_path / "f", [("solid", 1.0, annulus(6.0, R_INNER, 256)), ("tube", 4.0),
+                             ("notch", 1.0, TEE), ("tube", 4.0)]),  # a mounting flange
         "no material at z = 0.0045 m": body_file(
             tmp_path / "g", [("tube", 4.0), ("notch", 1.0, box(10.0, 10.0, 11.0, 11.0)),
                              ("tube", 4.0)]),

@@ -13,9 +13,10 @@ from shapely.geometry import Polygon
 from shapely.geometry.polygon import orient
 from shapely.ops import unary_union
 
-#: A segment: ``("tube", length)`` or ``("notch", length, material)``, ``material`` a shapely
+#: A segment: ``("tube", length)``, ``("notch", length, material)``, ``material`` a shapely
 #: geometry of what the notch leaves (mm), clipped to the tube's outer surface here (not to its
-#: lumen: material across the lumen, a printed web, is the body's).
+#: lumen: material across the lumen, a printed web, is the body's), or ``("solid", length,
+#: material)``, the material as given (a flange wider than the tube).
 Segment = tuple[Any, ...]
 
 
@@ -48,6 +49,8 @@ def cross_section(segment: Segment, tube: Any) -> Any:
     Clipper2): the tube's, or the notch's material within the tube's outer surface."""
     import manifold3d
 
+    if segment[0] == "solid":
+        return manifold3d.CrossSection(rings(segment[2]))
     outer = Polygon(tube.exterior) if hasattr(tube, "exterior") else tube
     return manifold3d.CrossSection(rings(tube if segment[0] == "tube"
                                          else segment[2].intersection(outer)))
