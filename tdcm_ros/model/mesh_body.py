@@ -5,7 +5,8 @@ and the tendon on the +x side, lengths in ``unit`` (``m`` or ``mm``). It must be
 with outward normals. A mesh changes along z only where it has vertices, so the body's
 segments end at the z values of its vertices: the mesh is sliced once between each two
 consecutive ones (trimesh, a maintained mesh library: reading every common format and
-slicing many planes in one vectorised pass), and each slice's area and moments are Green's
+intersecting a plane with a given set of faces; each plane meets only the faces spanning its
+slab), and each slice's area and moments are Green's
 theorem's over its edges (:func:`tdcm_ros.model.sections.edge_moments`), exact for the
 mesh: no loop assembly, so a section of several pieces (the paper's pair of cuts through the
 lumen leaves two) needs nothing more.
@@ -154,8 +155,9 @@ def _load(path: str | Path, scale: float, key: str) -> Any:
 
 
 def _slices(mesh: Any, key: str) -> list[Slice]:
-    """One slice between each two consecutive vertex heights of ``mesh`` (m), base to tip."""
-    from trimesh.intersections import mesh_multiplane
+    """One slice between each two consecutive vertex heights of ``mesh`` (m), base to tip: each
+    plane meets only the faces spanning its slab, so only those are intersected."""
+    from trimesh.intersections import mesh_plane
 
     heights = np.unique(mesh.vertices[:, 2])
     keep = np.concatenate([[True], np.diff(heights) > Z_MERGE_M])
@@ -166,27 +168,28 @@ def _slices(mesh: Any, key: str) -> list[Slice]:
             f"{key}: the body starts at z = {heights[0]:.6g} m; allowed: z = 0 at the base, "
             "the body along +z", parameter=key, value=float(heights[0]),
             allowed="the base at z = 0, the axis +z")
-    middles = 0.5 * (heights[1:] + heights[:-1])
-    lines, to_3d, faces = mesh_multiplane(mesh, [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], middles)
+    face_z = mesh.vertices[mesh.faces, 2]
+    low, high = face_z.min(axis=1), face_z.max(axis=1)
     out = []
-    for k, z in enumerate(middles):
-        segments = np.asarray(lines[k], dtype=float).reshape(-1, 2, 2)
-        if segments.shape[0] == 0:
+    for k, z in enumerate(0.5 * (heights[1:] + heights[:-1])):
+        spanning = np.flatnonzero((low < z) & (high > z))
+        lines, faces = mesh_plane(mesh, [0.0, 0.0, 1.0], [0.0, 0.0, float(z)],
+                                  return_faces=True, local_faces=spanning)
+        if len(lines) == 0:
             raise InvalidDesignError(
                 f"{key}: no material at z = {z:.6g} m (the body comes apart there)",
                 parameter=key, value=float(z), allowed="material at every height")
-        out.append(_slice((float(heights[k]), float(z), float(heights[k + 1])), segments,
-                          np.asarray(to_3d[k]), mesh.face_normals[np.asarray(faces[k])]))
+        out.append(_slice((float(heights[k]), float(z), float(heights[k + 1])),
+                          np.asarray(lines, dtype=float)[:, :, :2],
+                          mesh.face_normals[np.asarray(faces)]))
     return out
 
 
-def _slice(span: tuple[float, float, float], segments: Array, to_3d: Array, normals: Array
-           ) -> Slice:
+def _slice(span: tuple[float, float, float], segments: Array, normals: Array) -> Slice:
     """The :class:`Slice` of the plane at ``span[1]`` (its span from ``span[0]`` to
-    ``span[2]``, m) from its edge segments (plane coordinates, as trimesh gives them), each
-    oriented with the material on its left by its face's normal."""
-    start = segments[:, 0] @ to_3d[:2, :2].T + to_3d[:2, 3]
-    end = segments[:, 1] @ to_3d[:2, :2].T + to_3d[:2, 3]
+    ``span[2]``, m) from its edge segments ((k, 2, 2): ends, (x, y), m), each oriented with the
+    material on its left by its face's normal."""
+    start, end = segments[:, 0], segments[:, 1]
     direction = end - start
     left_is_outside = direction[:, 1] * normals[:, 0] - direction[:, 0] * normals[:, 1] < 0.0
     start, end = (np.where(left_is_outside[:, None], end, start),
@@ -198,9 +201,10 @@ def _slice(span: tuple[float, float, float], segments: Array, to_3d: Array, norm
     facing_axis = np.sum(midpoint * normals[:, :2], axis=1) < 0.0
     inner = float(np.max(np.hypot(start[facing_axis, 0], start[facing_axis, 1]),
                          initial=0.0))
-    return Slice(z=span[1], z_low=span[0], z_high=span[2], area=float(area), first=float(first), second=float(second),
-                 first_y=float(first_y), x_low=float(points[:, 0].min()),
-                 x_high=float(points[:, 0].max()), outer=float(radius.max()), inner=inner)
+    return Slice(z=span[1], z_low=span[0], z_high=span[2], area=float(area),
+                 first=float(first), second=float(second), first_y=float(first_y),
+                 x_low=float(points[:, 0].min()), x_high=float(points[:, 0].max()),
+                 outer=float(radius.max()), inner=inner)
 
 
 def _tube(slices: list[Slice]) -> Slice:
