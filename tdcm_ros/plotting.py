@@ -35,15 +35,14 @@ def solution_figure(plt: Any, result: SolveResult) -> Any:
     ax_shape.plot(notch_pts[:, 0] * 1e3, notch_pts[:, 2] * 1e3, "o", ms=4, label="notch centres")
     ax_shape.plot([0, 0], [0, result.design.length * 1e3], "k--", lw=0.8,
                   label="unloaded (T = 0 N)")
-    length_mm = result.design.length * 1e3
-    x_mm = positions[:, 0] * 1e3
-    ax_shape.set_xlim(min(-0.15 * length_mm, x_mm.min() - 2.0),  # room for the legend
-                      max(0.45 * length_mm, x_mm.max() + 2.0))
+    ax_shape.set_xlim(edge[:, 0].min() - 2.0,  # the body whole, room to bend toward +x
+                      max(0.45 * result.design.length * 1e3, edge[:, 0].max() + 2.0))
     ax_shape.set_aspect("equal")
     ax_shape.set_xlabel("x in tdcm_base (mm)", fontsize=FONT_SIZE)
     ax_shape.set_ylabel("z in tdcm_base (mm)", fontsize=FONT_SIZE)
     ax_shape.set_title(f"body at T = {result.tension_n:g} N", fontsize=FONT_SIZE + 1)
-    ax_shape.legend(loc="upper left", fontsize=FONT_SIZE - 1)
+    ax_shape.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2,
+                    fontsize=FONT_SIZE - 1)  # below the axes: never over the body
     s, kappa = result.curvature_profile
     ax_k.plot(s * 1e3, kappa, "-", lw=1.2, label="curvature κ(s)")
     for index, (a, b) in enumerate(zip(left, right, strict=True)):
