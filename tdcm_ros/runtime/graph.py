@@ -5,7 +5,9 @@ Each node runs ``python -m tdcm_ros.runtime.run_node <module:Class>``. Per-node 
 overrides are merged over the parameter file into a per-node file in a temporary directory.
 A node given a ``ready_path`` must create it before :meth:`NodeGraph.start_node` returns (e.g. the
 twin's pty link before the driver opens it); a symlink left there at exit is removed. Stopping
-goes in reverse start order, router last: SIGINT, then SIGKILL after ``grace`` seconds. Children
+goes in reverse start order, router last: SIGINT, then SIGTERM after ``grace`` seconds, then
+SIGKILL after ``grace`` seconds more (as ROS 2 launch's ``sigterm_timeout`` and
+``sigkill_timeout``, 5 s each by default). Children
 run in their own sessions and, on Linux, get SIGTERM if the parent dies (``PR_SET_PDEATHSIG``).
 """
 
@@ -34,8 +36,8 @@ from tdcm_ros.runtime.registry import node_target
 
 log = logging.getLogger("tdcm.graph")
 _PR_SET_PDEATHSIG = 1
-#: Exit statuses of a child that stopped because it was asked to.
-CLEAN_EXITS = (0, -signal.SIGINT, 130)
+#: Exit statuses of a child that stopped because it was asked to (SIGINT, or SIGTERM after it).
+CLEAN_EXITS = (0, -signal.SIGINT, 130, -signal.SIGTERM, 143)
 
 
 def _die_with_parent() -> None:
@@ -195,15 +197,20 @@ class NodeGraph:
                 return
 
     def stop(self, child: Child) -> int:
-        """Stop one child: SIGINT, then SIGKILL after ``grace`` s; its exit status."""
-        if child.running:
-            child.process.send_signal(signal.SIGINT)
+        """Stop one child as ROS 2 launch does: SIGINT, SIGTERM after ``grace`` s, SIGKILL
+        after ``grace`` s more; its exit status."""
+        for signum, then in ((signal.SIGINT, "sending SIGTERM"), (signal.SIGTERM, "killing it")):
+            if not child.running:
+                break
+            child.process.send_signal(signum)
             try:
                 child.process.wait(self.grace)
             except subprocess.TimeoutExpired:
-                log.warning("%s ignored SIGINT for %.1f s; killing it", child.name, self.grace)
-                child.process.kill()
-                child.process.wait()
+                log.warning("%s still running %.1f s after %s; %s", child.name, self.grace,
+                            signal.Signals(signum).name, then)
+        if child.running:
+            child.process.kill()
+            child.process.wait()
         log.info("%s exited with %s", child.name, child.process.returncode)
         return int(child.process.returncode)
 

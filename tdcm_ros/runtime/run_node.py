@@ -8,6 +8,7 @@ else zenoh. Arguments after ``--ros-args`` go to rclpy unchanged.
 from __future__ import annotations
 
 import argparse
+import faulthandler
 import importlib
 import importlib.util
 import logging
@@ -38,6 +39,10 @@ INTERRUPTED_EXIT = 130
 #: weakref callback, "Exception ignored in ... KeyboardInterrupt"), and the build goes on for
 #: seconds. Well inside ``tdcm up``'s and launch's 5 s before a kill.
 STUCK_BUILD_S = 2.0
+#: s a built node may take to stop (leave its loop, close, close its context) after a signal
+#: before it writes every thread's stack to stderr (Python's faulthandler, headed "Timeout"):
+#: where a slow stop spends its time, in the launcher's log, before its SIGTERM at 5 s.
+SLOW_STOP_S = 3.0
 
 
 def _exit_if_still_running(seconds: float, what: str) -> None:
@@ -124,7 +129,8 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     the build at once (:class:`KeyboardInterrupt`) instead of waiting for it to finish, and is
     remembered, so that a library which runs the handler and drops its error cannot make the
     node spin on, and the process leaves ``STUCK_BUILD_S`` later whatever the build does; once
-    built, it ends the loop.
+    built, it ends the loop, and a stop still under way ``SLOW_STOP_S`` later writes every
+    thread's stack to stderr.
     """
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
@@ -144,6 +150,7 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
 
     def stop(signum: int, frame: FrameType | None) -> None:
         context.request_stop()
+        faulthandler.dump_traceback_later(SLOW_STOP_S)  # cancelled once closed
 
     context = open_context(chosen, ros_args, [params_file] if params_file else [])
     # after the context: opening a zenoh session installs its own SIGTERM handler
@@ -167,6 +174,7 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
             node.close()
     finally:
         context.close()
+        faulthandler.cancel_dump_traceback_later()
         _restore(previous)
     return 0
 
