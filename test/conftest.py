@@ -25,6 +25,21 @@ settings.register_profile("local", deadline=None)
 settings.register_profile("ci", settings.get_profile("local"), derandomize=True, print_blob=True)
 settings.load_profile("ci" if os.environ.get("CI") else "local")
 
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _cache_in_a_temporary_folder(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """Rows the package caches on disk (:mod:`tdcm_ros.model.file_cache`) go to a folder of
+    this session, for the processes the tests start too, not to the user's cache."""
+    before = os.environ.get("TDCM_CACHE_DIR")
+    os.environ["TDCM_CACHE_DIR"] = str(tmp_path_factory.mktemp("tdcm_cache"))
+    yield
+    if before is None:
+        os.environ.pop("TDCM_CACHE_DIR", None)
+    else:
+        os.environ["TDCM_CACHE_DIR"] = before
+
+
 NESTED_LEVELS = 5000
 HUGE_BYTES = 10_000_000
 

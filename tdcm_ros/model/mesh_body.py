@@ -9,7 +9,8 @@ intersecting a plane with a given set of faces; each plane meets only the faces 
 slab), and each slice's area and moments are Green's
 theorem's over its edges (:func:`tdcm_ros.model.sections.edge_moments`), exact for the
 mesh: no loop assembly, so a section of several pieces (the paper's pair of cuts through the
-lumen leaves two) needs nothing more.
+lumen leaves two) needs nothing more. The slices are kept on disk by the file's content
+(:mod:`tdcm_ros.model.file_cache`), so reading the same mesh again skips trimesh and slicing.
 
 Slices with the tube's section (the one most of the body's length has, to
 :data:`SECTION_TOL`) are tube; a slice with more material (a flange, a cap) is refused, naming
@@ -30,7 +31,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass, fields
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +41,7 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.design import MIN_SEGMENT_M
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.file_cache import Row, cached_rows
 from tdcm_ros.model.profiles import SectionProfile
 from tdcm_ros.model.sections import edge_moments
 
@@ -94,6 +96,10 @@ class Slice:
                              x_low=self.x_low, x_high=self.x_high)
 
 
+#: The fields of a :class:`Slice`, in order (its rows in :mod:`tdcm_ros.model.file_cache`).
+SLICE_FIELDS = tuple(f.name for f in fields(Slice))
+
+
 @dataclass(frozen=True)
 class MeshSegment:
     """A segment found in the mesh: ``length`` (m) and, for a notch, its ``section``."""
@@ -117,9 +123,13 @@ def read_mesh_body(path: str | Path, unit: str, where: str = "mesh") -> MeshBody
     :class:`InvalidDesignError` naming ``where``'s key (``mesh.file``, ``mesh.unit``)."""
     if unit not in UNITS:
         raise out_of_range(f"{where}.unit", unit, " | ".join(UNITS), error=InvalidDesignError)
-    mesh = _load(path, UNITS[unit], f"{where}.file")
-    slices = _slices(mesh, f"{where}.file")
-    return _segments(slices, f"{where}.file", unit)
+    key = f"{where}.file"
+
+    def sliced() -> list[Row]:
+        return [astuple(s) for s in _slices(_load(path, UNITS[unit], key), key)]
+
+    rows = cached_rows(Path(path), unit, SLICE_FIELDS, sliced)
+    return _segments([Slice(*row) for row in rows], key, unit)
 
 
 def _load(path: str | Path, scale: float, key: str) -> Any:
