@@ -24,12 +24,12 @@ pytestmark = pytest.mark.process
 
 def building_node(zenoh_env: dict[str, str], tmp_path: Path, node: str = "SlowStartNode"
                   ) -> tuple[subprocess.Popen[bytes], Lines]:
-    """A process of ``node`` (of slow_start_node), returned once it is in its 60 s constructor;
+    """A process of ``node`` (of signal_nodes), returned once it is in its 60 s constructor;
     its stderr."""
     starting = tmp_path / "starting"
     child = subprocess.Popen(
         [sys.executable, "-m", "tdcm_ros.runtime.run_node",
-         f"test.runtime.slow_start_node:{node}", "--runtime", "zenoh"],
+         f"test.runtime.signal_nodes:{node}", "--runtime", "zenoh"],
         env=child_env(zenoh_env, TDCM_TEST_STARTING=str(starting)),
         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     err = Lines(child, "stderr")

@@ -40,7 +40,7 @@ def test_a_node_still_stopping_after_slow_stop_s_writes_its_threads_stacks(
     starting = tmp_path / "starting"
     child = subprocess.Popen(
         [sys.executable, "-m", "tdcm_ros.runtime.run_node",
-         "test.runtime.slow_stop_node:SlowStopNode", "--runtime", "zenoh"],
+         "test.runtime.signal_nodes:SlowStopNode", "--runtime", "zenoh"],
         env=child_env(zenoh_env, TDCM_TEST_STARTING=str(starting)),
         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     err = Lines(child, "stderr")
@@ -53,7 +53,7 @@ def test_a_node_still_stopping_after_slow_stop_s_writes_its_threads_stacks(
         stop(child)
     assert status == 0, err.tail()
     assert err.has(f"Timeout (0:00:0{SLOW_STOP_S:.0f})!"), err.tail()
-    assert err.has('slow_stop_node.py", line') and err.has("in close"), err.tail()
+    assert err.has('signal_nodes.py", line') and err.has("in close"), err.tail()
 
 
 @pytest.mark.parametrize(("mode", "status", "said"), [
