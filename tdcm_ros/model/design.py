@@ -44,6 +44,8 @@ MM = 1e-3
 #: Shortest segment (m): ``w_n`` is at least this, ``w_base``, ``w_t`` and ``w_tip`` are 0 (absent)
 #: or at least this, so no cell is negligible against the arc lengths it sits between.
 MIN_SEGMENT_M = 1e-6
+#: Fields a design may derive from its notch sections (:meth:`Design.derived_fields`).
+DERIVABLE_FIELDS = frozenset({"profile", "w_d", "w_o"})
 #: Fields that may hold one value per notch (base to tip).
 PER_NOTCH_FIELDS = ("w_n", "w_d", "w_o")
 #: Fields that may hold one value per gap between adjacent notches (base to tip).
@@ -147,7 +149,7 @@ class Design:
         profiles = self.notch_profiles()
         derived = set()
         if any(p.name not in PROFILE_NAMES for p in profiles):
-            derived.add("profile")
+            derived.add("profile")  # each in DERIVABLE_FIELDS
         if any(isinstance(p, PRISMATIC_PROFILES) for p in profiles):
             derived |= {"w_d", "w_o"}
         return frozenset(derived)
@@ -253,7 +255,7 @@ class Design:
         :class:`InvalidDesignError`."""
         reject_unknown("design field", overrides, (f.name for f in fields(self)),
                        error=InvalidDesignError)
-        if "profile" not in overrides:
+        if "profile" not in overrides and DERIVABLE_FIELDS.intersection(overrides):
             self.require_free(list(overrides), "with_overrides")
         return replace(self, **overrides)
 

@@ -231,7 +231,8 @@ def _segments(slices: list[Slice], key: str, unit: str) -> MeshBody:
     tube = _tube(slices)
     _check_axis(tube, key)
     scale = UNITS[unit]
-    for wider in (s for s in slices if s.area > (1.0 + SECTION_TOL) * tube.area):
+    wider = next((s for s in slices if s.area > (1.0 + SECTION_TOL) * tube.area), None)
+    if wider is not None:
         raise InvalidDesignError(
             f"{key}: z = {wider.z_low / scale:.6g}..{wider.z_high / scale:.6g} {unit} has more "
             f"material than the tube ({wider.area:.6g} m^2 against the tube's {tube.area:.6g} "

@@ -361,8 +361,7 @@ class ShapeControllerNode(NodeLogic):
                   "frame_id": self.base_frame}
         taken = stamp_ns_of(message) or now  # the frame's instant: the bench's state then
         if len(self.waiting) == WAITING_FRAMES:
-            self.waiting.popleft()
-            self.counts["markers_tension_late"] += 1
+            self._drop_oldest_waiting()
         self.waiting.append(WaitingFrame(taken, registration.to_base(rows), header, now))
         self._pair_waiting()
 
@@ -378,6 +377,8 @@ class ShapeControllerNode(NodeLogic):
     def _pair_waiting(self) -> None:
         """Observe the waiting frames whose tension has arrived, oldest first; drop the ones
         that waited longer than ``measurement_timeout_s``."""
+        if not self.waiting:  # the usual case, on every tension: read no parameter
+            return
         timeout_ns = float(self.port.get_parameter("measurement_timeout_s")) * 1e9
         while self.waiting:
             frame = self.waiting[0]
@@ -385,11 +386,15 @@ class ShapeControllerNode(NodeLogic):
                 self.waiting.popleft()
                 self._observe(frame)
             elif self.port.now_ns() - frame.arrived_ns > timeout_ns:
-                self.waiting.popleft()
-                self.counts["markers_tension_late"] += 1
-                self.last_ns["tension_late"] = self.port.now_ns()
+                self._drop_oldest_waiting()
             else:
                 return
+
+    def _drop_oldest_waiting(self) -> None:
+        """Drop the oldest waiting frame: its tension has not come; counted and said."""
+        self.waiting.popleft()
+        self.counts["markers_tension_late"] += 1
+        self.last_ns["tension_late"] = self.port.now_ns()
 
     def _observe(self, frame: WaitingFrame) -> None:
         now = self.port.now_ns()

@@ -73,11 +73,13 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
            start_router: bool = True, on_router_exit: str = "restart") -> int:
     """Run ``nodes`` (registry names) until SIGINT/SIGTERM or until every node has exited.
 
-    ``endpoint``: the zenoh router's (``None`` on rclpy); ``grace``: s from SIGINT to SIGTERM and from
-    SIGTERM to SIGKILL of a node (as launch's ``sigterm_timeout``, ``sigkill_timeout``); ``overrides``: node name -> parameter values over ``params_file``; ``ready_paths``:
-    node name -> path it creates when ready (waited for, ``ready_timeout`` s, before the next
-    node); ``start_router``: False to use only an existing router at ``endpoint`` (fails if
-    none answers within 10 s); ``on_router_exit``: ``restart`` or ``stop`` (see the module).
+    ``endpoint``: the zenoh router's (``None`` on rclpy); ``grace``: s from SIGINT to SIGTERM
+    and from SIGTERM to SIGKILL of a node (as launch's ``sigterm_timeout``,
+    ``sigkill_timeout``); ``overrides``: node name -> parameter values over ``params_file``;
+    ``ready_paths``: node name -> path it creates when ready (waited for, ``ready_timeout`` s,
+    before the next node); ``start_router``: False to use only an existing router at
+    ``endpoint`` (fails if none answers within 10 s); ``on_router_exit``: ``restart`` or
+    ``stop`` (see the module).
     """
     if on_router_exit not in ROUTER_EXIT_ACTIONS:
         raise InputError(f"on_router_exit = {on_router_exit!r} is not one of "

@@ -23,7 +23,7 @@ pytestmark = pytest.mark.process
 #: A child that reports once its handlers are set: SIGINT ignored, SIGTERM exits 0 unless told
 #: to ignore it too.
 STUBBORN = """
-import signal, sys, time
+import signal, sys
 signal.signal(signal.SIGINT, signal.SIG_IGN)
 if sys.argv[1] == "ignore-term":
     signal.signal(signal.SIGTERM, signal.SIG_IGN)
@@ -31,7 +31,7 @@ else:
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
 print("ready", flush=True)
 while True:
-    time.sleep(1.0)
+    signal.pause()
 """
 
 
