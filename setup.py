@@ -68,7 +68,8 @@ setup(
         "zstandard>=0.19",
         # a notch section given as a polygon is checked by shapely (simple rings, holes inside)
         "shapely>=2.0",
-        # a body given as a mesh (STL, ...) is read and sliced by trimesh (model/mesh_body.py)
+        # a body given as a mesh in a format other than STL (OBJ, PLY, ...) is loaded by trimesh
+        # (model/mesh_file.py; an STL is read by NumPy, without trimesh's ~1.5 s import)
         "trimesh>=4",
         ZENOH_REQUIREMENT,
     ],

@@ -6,7 +6,7 @@ polygon of ``config/bodies/tee_notches.yaml``, its circles ``--sides``-gons (200
 faces at 30 notches), writes it as a binary STL with a body file naming it, and times, in a
 fresh process each (numba's compiled kernels loaded from its cache, as on any run after the
 first), reading the body file and the first solve at 5 N: with the mesh never seen (an empty
-``TDCM_CACHE_DIR``: trimesh load, slicing) and seen before (its slices cached,
+``TDCM_CACHE_DIR``: reading the STL, slicing) and seen before (its slices cached,
 :mod:`tdcm_ros.model.file_cache`), and the same for the preset ``paper-experiment`` (the
 floor: imports, kernels, grid). Prints the face count, the medians and the target (body file
 -> first solve <= 2 s). ``--write FILE``
@@ -91,7 +91,7 @@ def main() -> int:
     print(f"mesh body: {len(mesh.faces)} faces, {runs['cold'][0]['N']} notches "
           f"({size} bytes); medians of {args.repeats}, a fresh process each")
     print(f"  read body file, mesh not seen     {median('cold', 'read_s'):.3f} s "
-          "(imports, trimesh load, slicing)")
+          "(imports, reading the STL, slicing)")
     print(f"  body file -> first solve, same    {median('cold', 'total_s'):.3f} s")
     print(f"  read body file, slices cached     {median('warm', 'read_s'):.3f} s "
           "(TDCM_CACHE_DIR: the mesh read before)")

@@ -1,10 +1,10 @@
 """Rows of numbers computed from a file, kept on disk by the file's content.
 
-A mesh body's slices (:mod:`tdcm_ros.model.mesh_body`) cost a process trimesh's import (~1 s
-on the shared 2-core test machine, most of a first solve's time from a body file) and the
-slicing; every node of a graph reads the body again. So the slices are kept here, keyed by the
-file's bytes and a ``salt`` naming everything else they depend on (the unit), and a process
-reading the same file again skips both.
+A mesh body's slices (:mod:`tdcm_ros.model.mesh_body`) cost a process reading the mesh (for a
+format other than STL, trimesh's import: ~1.5 s on the shared 2-core test machine) and
+slicing it; every node of a graph reads the body again. So the slices are kept here, keyed by
+the file's bytes and a ``salt`` naming everything else they depend on (the unit), and a
+process reading the same file again skips both.
 
 Folder: ``TDCM_CACHE_DIR`` if set (set and empty: no cache), else ``$XDG_CACHE_HOME/tdcm_ros``
 (``~/.cache/tdcm_ros``), in its ``rows`` folder. An entry is JSON (floats round-trip exactly,
@@ -29,7 +29,7 @@ from pathlib import Path
 LOG = logging.getLogger(__name__)
 
 #: The version of the stored rows' meaning; part of every key.
-FORMAT = 1
+FORMAT = 2
 #: Environment variable naming the cache folder ("" turns the cache off).
 CACHE_ENV = "TDCM_CACHE_DIR"
 

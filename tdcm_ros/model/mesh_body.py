@@ -2,15 +2,14 @@
 
 The mesh is the body in the body file's frame: its axis +z from ``z = 0`` at the base, cuts
 and the tendon on the +x side, lengths in ``unit`` (``m`` or ``mm``). It must be watertight
-with outward normals. A mesh changes along z only where it has vertices, so the body's
-segments end at the z values of its vertices: the mesh is sliced once between each two
-consecutive ones (trimesh, a maintained mesh library: reading every common format and
-intersecting a plane with a given set of faces; each plane meets only the faces spanning its
-slab), and each slice's area and moments are Green's
-theorem's over its edges (:func:`tdcm_ros.model.sections.edge_moments`), exact for the
-mesh: no loop assembly, so a section of several pieces (the paper's pair of cuts through the
-lumen leaves two) needs nothing more. The slices are kept on disk by the file's content
-(:mod:`tdcm_ros.model.file_cache`), so reading the same mesh again skips trimesh and slicing.
+with outward normals (:mod:`tdcm_ros.model.mesh_file` reads and checks it). A mesh changes
+along z only where it has vertices, so the body's segments end at the z values of its
+vertices: the mesh is sliced once between each two consecutive ones, each plane meeting only
+the triangles spanning its slab, and each slice's area and moments are Green's theorem's over
+its edges (:func:`tdcm_ros.model.sections.edge_moments`), exact for the mesh: no loop
+assembly, so a section of several pieces (the paper's pair of cuts through the lumen leaves
+two) needs nothing more. The slices are kept on disk by the file's content
+(:mod:`tdcm_ros.model.file_cache`), so reading the same mesh again skips reading and slicing.
 
 Slices with the tube's section (the one most of the body's length has, to
 :data:`SECTION_TOL`) are tube; a slice with more material (a flange, a cap) is refused, naming
@@ -33,7 +32,6 @@ import logging
 import math
 from dataclasses import astuple, dataclass, fields
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -42,6 +40,7 @@ from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.design import MIN_SEGMENT_M
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.file_cache import Row, cached_rows
+from tdcm_ros.model.mesh_file import TriangleMesh, read_mesh
 from tdcm_ros.model.profiles import SectionProfile
 from tdcm_ros.model.sections import edge_moments
 
@@ -126,49 +125,16 @@ def read_mesh_body(path: str | Path, unit: str, where: str = "mesh") -> MeshBody
     key = f"{where}.file"
 
     def sliced() -> list[Row]:
-        return [astuple(s) for s in _slices(_load(path, UNITS[unit], key), key)]
+        return [astuple(s) for s in _slices(read_mesh(path, UNITS[unit], key), key)]
 
     rows = cached_rows(Path(path), unit, SLICE_FIELDS, sliced)
     return _segments([Slice(*row) for row in rows], key, unit)
 
 
-def _load(path: str | Path, scale: float, key: str) -> Any:
-    """The mesh at ``path`` scaled to metres, checked: readable, one watertight solid with
-    outward normals. Zero-area triangles are dropped first: they carry no surface, and an STL's
-    float32 coordinates make slivers of a CAD export's nearly coincident vertices."""
-    import trimesh
-
-    try:
-        mesh = trimesh.load(str(path), force="mesh")
-    except Exception as error:  # trimesh raises many types for unreadable files
-        raise InvalidDesignError(f"{key} = {str(path)!r} cannot be read as a mesh: {error}",
-                                 parameter=key, value=str(path),
-                                 allowed="a mesh file trimesh reads (STL, OBJ, PLY, ...)"
-                                 ) from error
-    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise InvalidDesignError(f"{key} = {str(path)!r} holds no triangles", parameter=key,
-                                 value=str(path), allowed="a triangle mesh of the body")
-    mesh.update_faces(mesh.nondegenerate_faces())
-    mesh.remove_unreferenced_vertices()
-    if not mesh.is_watertight:
-        raise InvalidDesignError(
-            f"{key} = {str(path)!r} is not watertight (its surface has holes or loose edges); "
-            "allowed: a closed, watertight mesh", parameter=key, value=str(path),
-            allowed="a watertight mesh")
-    if not mesh.is_winding_consistent or mesh.volume <= 0.0:
-        raise InvalidDesignError(
-            f"{key} = {str(path)!r} has inward or inconsistent normals (volume "
-            f"{mesh.volume:.3g}); allowed: outward normals", parameter=key, value=str(path),
-            allowed="a mesh with consistent outward normals")
-    mesh.apply_scale(scale)
-    return mesh
-
-
-def _slices(mesh: Any, key: str) -> list[Slice]:
+def _slices(mesh: TriangleMesh, key: str) -> list[Slice]:
     """One slice between each two consecutive vertex heights of ``mesh`` (m), base to tip: each
-    plane meets only the faces spanning its slab, so only those are intersected."""
-    from trimesh.intersections import mesh_plane
-
+    plane meets only the faces spanning its slab, each of them along the segment between its
+    two edges that cross the plane."""
     heights = np.unique(mesh.vertices[:, 2])
     keep = np.concatenate([[True], np.diff(heights) > Z_MERGE_M])
     heights = heights[keep]
@@ -178,21 +144,32 @@ def _slices(mesh: Any, key: str) -> list[Slice]:
             f"{key}: the body starts at z = {heights[0]:.6g} m; allowed: z = 0 at the base, "
             "the body along +z", parameter=key, value=float(heights[0]),
             allowed="the base at z = 0, the axis +z")
-    face_z = mesh.vertices[mesh.faces, 2]
+    corners = mesh.corners()
+    normals = mesh.normals()
+    face_z = corners[:, :, 2]
     low, high = face_z.min(axis=1), face_z.max(axis=1)
     out = []
     for k, z in enumerate(0.5 * (heights[1:] + heights[:-1])):
         spanning = np.flatnonzero((low < z) & (high > z))
-        lines, faces = mesh_plane(mesh, [0.0, 0.0, 1.0], [0.0, 0.0, float(z)],
-                                  return_faces=True, local_faces=spanning)
-        if len(lines) == 0:
+        if spanning.size == 0:
             raise InvalidDesignError(
                 f"{key}: no material at z = {z:.6g} m (the body comes apart there)",
                 parameter=key, value=float(z), allowed="material at every height")
         out.append(_slice((float(heights[k]), float(z), float(heights[k + 1])),
-                          np.asarray(lines, dtype=float)[:, :, :2],
-                          mesh.face_normals[np.asarray(faces)]))
+                          _plane_segments(corners[spanning], float(z)), normals[spanning]))
     return out
+
+
+def _plane_segments(corners: Array, z: float) -> Array:
+    """Where the plane at height ``z`` (m) cuts each triangle of ``corners`` (k, 3, 3), each of
+    which has corners on both sides of it: segments (k, 2, 2) of ``(x, y)`` ends (m). A corner
+    on the plane counts as below it, so each triangle has exactly two edges that cross."""
+    start, end = corners, np.roll(corners, -1, axis=1)  # edges 0-1, 1-2, 2-0
+    crosses = (start[:, :, 2] > z) != (end[:, :, 2] > z)
+    along = (z - start[:, :, 2]) / np.where(crosses, end[:, :, 2] - start[:, :, 2], 1.0)
+    points = start[:, :, :2] + along[:, :, None] * (end[:, :, :2] - start[:, :, :2])
+    first_two = np.argsort(~crosses, axis=1, kind="stable")[:, :2]
+    return np.take_along_axis(points, first_two[:, :, None], axis=1)
 
 
 def _slice(span: tuple[float, float, float], segments: Array, normals: Array) -> Slice:

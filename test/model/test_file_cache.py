@@ -90,7 +90,7 @@ def test_the_default_folder_is_the_users_cache(monkeypatch: pytest.MonkeyPatch,
     assert cache_folder() == tmp_path / "tdcm_ros" / "rows"
 
 
-def test_a_mesh_read_again_skips_trimesh_and_gives_the_same_body(
+def test_a_mesh_read_again_skips_reading_it_and_gives_the_same_body(
         folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     stl = BODIES / "tee_notches.stl"
     first = read_mesh_body(stl, "mm")
@@ -99,7 +99,7 @@ def test_a_mesh_read_again_skips_trimesh_and_gives_the_same_body(
     def no_mesh_library(*_args: object) -> None:
         raise AssertionError("the mesh was loaded again")
 
-    monkeypatch.setattr(mesh_body, "_load", no_mesh_library)
+    monkeypatch.setattr(mesh_body, "read_mesh", no_mesh_library)
     assert read_mesh_body(stl, "mm") == first  # bit for bit (frozen dataclasses compare ==)
     assert read_body_file(BODIES / "tee_mesh.yaml").design() == design
     with pytest.raises(AssertionError, match="loaded again"):

@@ -20,6 +20,7 @@ from tdcm_ros.model import solve
 from tdcm_ros.model.body_file import read_body_file
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.mesh_body import _segments, _slices
+from tdcm_ros.model.mesh_file import TriangleMesh
 from test.support.meshes import (
     annulus,
     as_shapely,
@@ -70,7 +71,8 @@ def references() -> list[tuple[float, float, float]]:
 def test_the_slices_give_each_segment_and_each_notch_section_to_1e9() -> None:
     mesh = body_mesh(SEGMENTS, R_OUTER, R_INNER)
     mesh.apply_scale(MM)
-    body = _segments(_slices(mesh, "mesh.file"), "mesh.file", "mm")
+    triangles = TriangleMesh(np.asarray(mesh.vertices), np.asarray(mesh.faces, dtype=np.int64))
+    body = _segments(_slices(triangles, "mesh.file"), "mesh.file", "mm")
     assert body.R_outer == pytest.approx(R_OUTER * MM, rel=1e-8)  # the builder's rounding
     assert body.r_inner == pytest.approx(R_INNER * MM, rel=1e-8)
     assert [s.length for s in body.segments] == pytest.approx([s[1] * MM for s in SEGMENTS],
