@@ -10,7 +10,8 @@ first), reading the body file and the first solve at 5 N: with the mesh never se
 :mod:`tdcm_ros.model.file_cache`), and the same for the preset ``paper-experiment`` (the
 floor: imports, kernels, grid). Prints the face count, the medians and the target (body file
 -> first solve <= 2 s). ``--write FILE``
-only writes the STL (e.g. the shipped ``config/bodies/tee_notches.stl``).
+only writes the STL (e.g. the shipped ``config/bodies/tee_notches.stl``); ``--slanted`` makes
+the notches slanted cuts deepening toward the tip (``config/bodies/slanted_wrist.stl``).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from shapely.geometry import Polygon
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from test.support.meshes import body_mesh
+from test.support.meshes import body_mesh, slanted_cut_mesh
 
 TEE = Polygon([(-3.5, -1.5), (-2.5, -1.5), (-2.5, -0.3), (0.5, -0.3), (0.5, 0.3), (-2.5, 0.3),
                (-2.5, 1.5), (-3.5, 1.5)])  # mm, as config/bodies/tee_notches.yaml
@@ -54,14 +55,25 @@ def tee_body(notches: int, sides: int) -> object:
     return body_mesh(segments, 3.92, 1.55, sides)
 
 
+def slanted_body(notches: int, sides: int) -> object:
+    """The paper's tube (mm) with ``notches`` 2 mm slanted cuts 4 mm apart after a 5 mm base
+    tube, each from x = 1 mm at its base face to a depth growing toward the tip (x = -0.5,
+    -1, -1.5, ... mm at its tip face): a variable-depth wrist whose notches' sections change
+    along them."""
+    cuts = [((5.0 + 6.0 * k, 7.0 + 6.0 * k), (1.0, -0.5 - 0.5 * k)) for k in range(notches)]
+    return slanted_cut_mesh(3.92, 1.55, 5.0 + 6.0 * notches, cuts, sides)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--notches", type=int, default=30)
     parser.add_argument("--sides", type=int, default=200)
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--write", type=Path, help="only write the STL to this file")
+    parser.add_argument("--slanted", action="store_true",
+                        help="slanted cuts deepening toward the tip instead of tee notches")
     args = parser.parse_args()
-    mesh = tee_body(args.notches, args.sides)
+    mesh = (slanted_body if args.slanted else tee_body)(args.notches, args.sides)
     if args.write:
         mesh.export(str(args.write))
         print(f"wrote {args.write}: {len(mesh.faces)} faces")

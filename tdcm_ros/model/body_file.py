@@ -50,6 +50,7 @@ from tdcm_ros.model.profiles import (
     PolygonProfile,
     PrismaticProfile,
     SectionProfile,
+    SlicedProfile,
     profile_from_name,
 )
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
@@ -90,7 +91,7 @@ class NotchSpec:
     cut: float = math.nan
     shell: tuple[tuple[float, float], ...] = ()
     holes: tuple[tuple[tuple[float, float], ...], ...] = ()
-    given: SectionProfile | None = None
+    given: SectionProfile | SlicedProfile | None = None
     where: str = ""
 
     def section(self, r_outer: float, r_inner: float) -> Section:
@@ -110,8 +111,8 @@ class NotchSpec:
             return high - low
         return 2.0 * r_outer - self.cut if self.kind == "cut" else self.band
 
-    def prismatic(self) -> PrismaticProfile:
-        """The section of a polygon notch, or one given by its numbers (or a mesh's slice)."""
+    def prismatic(self) -> PrismaticProfile | SlicedProfile:
+        """The section of a polygon notch, or one given by its numbers (or a mesh's slices)."""
         return self.given if self.given is not None else PolygonProfile(self.shell, self.holes)
 
     def profile_object(self) -> NotchProfile:
@@ -431,6 +432,11 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         return "[" + ", ".join(f"[{number(x)}, {number(y)}]" for x, y in ring) + "]"
 
     def notch(width: float, band: float, offset: float, profile: NotchProfile) -> str:
+        if isinstance(profile, SlicedProfile):
+            raise InvalidDesignError(
+                "a notch whose section changes along it (sliced from a mesh) has no body-file "
+                "form; allowed: the body file naming the mesh", parameter="profile",
+                value=profile.name, allowed="band, cut, polygon or section notches")
         if isinstance(profile, SectionProfile):
             numbers = ", ".join(f"{key}: {number(getattr(profile, key))}"
                                 for key in GIVEN_SECTION_KEYS)

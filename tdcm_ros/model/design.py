@@ -19,6 +19,7 @@ features are often softer: treat ``E`` as a calibration parameter (``tdcm calibr
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
@@ -29,11 +30,13 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import (
+    GIVEN_SECTION_PROFILES,
     PRISMATIC_PROFILES,
     PROFILE_NAMES,
     CircularProfile,
     NotchProfile,
     PolygonProfile,
+    SlicedProfile,
     profile_from_name,
 )
 from tdcm_ros.model.section import tube_moment
@@ -96,23 +99,31 @@ class Design:
         self._check_cross_fields()
 
     def _take_prismatic_extents(self) -> None:
-        """Set ``w_d`` and ``w_o`` of each prismatic notch (a polygon or a sliced section) to
-        its section's extent in ``x`` and that extent's middle (m), after checking it (a
-        polygon: simple, of positive area, its vertices within ``R_outer`` of the axis)."""
-        prismatic = [(i, p) for i, p in enumerate(self.notch_profiles())
-                     if isinstance(p, PRISMATIC_PROFILES)]
-        if not prismatic:
+        """Set ``w_d`` and ``w_o`` of each notch whose section is given (a polygon, a section's
+        numbers or a mesh's slices) to its extent in ``x`` and that extent's middle (m), after
+        checking a prismatic one (a polygon: simple, of positive area, its vertices within
+        ``R_outer`` of the axis)."""
+        given = [(i, p) for i, p in enumerate(self.notch_profiles())
+                 if isinstance(p, GIVEN_SECTION_PROFILES)]
+        if not given:
             return
         w_d, w_o = self.per_notch("w_d"), self.per_notch("w_o")
-        for i, profile in prismatic:
+        for i, profile in given:
             where = f"profile[{i}]" if isinstance(self.profile, tuple) else "profile"
             try:
-                profile.section(self.R_outer)
+                if isinstance(profile, PRISMATIC_PROFILES):
+                    profile.section(self.R_outer)
             except InvalidDesignError as error:
                 raise InvalidDesignError(f"{where}: {error}", parameter=where,
                                          value=error.value, allowed=error.allowed) from error
             if isinstance(profile, PolygonProfile):
                 profile.check_inside(self.R_outer, f"{where} (polygon)")
+            if isinstance(profile, SlicedProfile) and not math.isclose(
+                    float(self.per_notch("w_n")[i]), profile.width, rel_tol=1e-12):
+                name = f"w_n[{i}]" if isinstance(self.w_n, tuple) else "w_n"
+                raise out_of_range(name, float(self.per_notch("w_n")[i]),
+                                   f"{profile.width:g} m (the width of the notch's slices)",
+                                   error=InvalidDesignError)
             low, high = profile.x_extent()
             w_d[i], w_o[i] = high - low, 0.5 * (high + low)
         for name, values in (("w_d", w_d), ("w_o", w_o)):
@@ -150,7 +161,7 @@ class Design:
         derived = set()
         if any(p.name not in PROFILE_NAMES for p in profiles):
             derived.add("profile")  # each in DERIVABLE_FIELDS
-        if any(isinstance(p, PRISMATIC_PROFILES) for p in profiles):
+        if any(isinstance(p, GIVEN_SECTION_PROFILES) for p in profiles):
             derived |= {"w_d", "w_o"}
         return frozenset(derived)
 

@@ -59,6 +59,7 @@ from tdcm_ros.model.grid_kernel import (
     CUSTOM,
     PRISMATIC,
     RECTANGULAR,
+    TABULATED,
     offset_section,
 )
 from tdcm_ros.model.grid_layout import (
@@ -340,13 +341,17 @@ class CellRows:
             x_bar_notch = np.zeros(h1.shape)
             given = m.shape_section[shape]  # a polygon's section, given whole (I > 0)
             prismatic = given[:, 0] > 0.0
-            off = (m.shape_w_o[shape] != 0.0) & ~prismatic
+            tabulated = m.is_tabulated[shape]
+            off = (m.shape_w_o[shape] != 0.0) & ~prismatic & ~tabulated
             if np.any(off):
                 _, in_notch[off], x_bar_notch[off], _ = _offset_sections(
                     h1[off], m.shape_w_o[shape][off], m.R_outer[owner][off],
                     m.r_inner[owner][off])
             in_notch[prismatic] = given[prismatic, 0]
             x_bar_notch[prismatic] = given[prismatic, 1]
+            if np.any(tabulated):
+                c_t, x_bar_notch[tabulated], _ = m.tabulated(shape[tabulated], u[notch][tabulated])
+                in_notch[tabulated] = 1.0 / (m.E[owner[tabulated]] * c_t)
             x_bar[notch] = x_bar_notch
             inertia[notch] = in_notch
         return 1.0 / (m.E[every] * inertia), x_bar
@@ -504,7 +509,7 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
          members.tube_moment[owner], members.shape_w_o], axis=1), members.shape_section], axis=1)
     build = grid_kernels()
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
-    custom_row, custom_h1 = _custom_h1(table, build, cell, design, gauss_u, probe)
+    custom_row, custom_table = _custom_table(table, build, cell, design, gauss_u, probe)
     count = table.u_a.size
     fc = np.zeros((count + 1, 11))
     fq = np.zeros((count + 1, 13, quad_order))
@@ -513,7 +518,7 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
 
     def integrate(part: slice) -> None:
         build.cell_integrals(table.shape[part], cell[part], design, custom_row[part],
-                             custom_h1, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
+                             custom_table, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
                              strain[part])
 
     ends = np.linspace(0, count, workers + 1).astype(int)
@@ -527,24 +532,34 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
 
 
 _PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR, "polygon": PRISMATIC,
-                 "section": PRISMATIC}
+                 "section": PRISMATIC, "sliced": TABULATED}
 
 
-def _custom_h1(table: Prototypes, build: Any, cell: Array, design: Array,
-               gauss_u: Array, probe: Array) -> tuple[IntArray, Array]:
-    """For prototype cells in notches of user profiles: a row of ``custom_h1`` each (-1 for
-    the others) holding ``h1`` (m) at every evaluation point of
-    :func:`tdcm_ros.model.grid_kernel.points`."""
-    custom = (design[table.shape, 0] == CUSTOM) & table.is_notch
+def _custom_table(table: Prototypes, build: Any, cell: Array, design: Array,
+                  gauss_u: Array, probe: Array) -> tuple[IntArray, Array]:
+    """For prototype cells in notches of user profiles (:data:`CUSTOM`) and of sections
+    changing along the notch (:data:`TABULATED`): a row each of the custom table (-1 for the
+    others) holding, at every evaluation point of :func:`tdcm_ros.model.grid_kernel.points`,
+    ``h1`` (m; then two zeros), or ``1/(E I)`` (1/(N m^2)), ``x_bar`` (m) and the farthest
+    fibre (m)."""
+    kind = design[table.shape, 0]
+    chosen = np.flatnonzero(((kind == CUSTOM) | (kind == TABULATED)) & table.is_notch)
     rows = np.full(table.u_a.size, -1, np.int64)
-    chosen = np.flatnonzero(custom)
     size = gauss_u.size * (gauss_u.size + 1) + probe.size + 2
-    u = np.empty((chosen.size, size))
+    out = np.zeros((chosen.size, size, 3))
     if chosen.size:
         rows[chosen] = np.arange(chosen.size)
+        u = np.empty((chosen.size, size))
         build.points(np.ascontiguousarray(cell[chosen]), gauss_u, probe, u)
-        u = table.members.h1(table.shape[chosen], u)
-    return rows, np.ascontiguousarray(u, dtype=float)
+        shape = table.shape[chosen]
+        custom = kind[chosen] == CUSTOM
+        if np.any(custom):
+            out[custom, :, 0] = table.members.h1(shape[custom], u[custom])
+        tabulated = ~custom
+        if np.any(tabulated):
+            out[tabulated] = np.stack(table.members.tabulated(shape[tabulated], u[tabulated]),
+                                      axis=-1)
+    return rows, out
 
 
 @lru_cache(maxsize=32)

@@ -13,10 +13,12 @@ Per prototype cell ``i`` (inputs, SI units): ``shape[i]``; ``cell[i, :]`` =
 Per notch shape ``k`` (a member's distinct notch; a tube cell names its member's first):
 ``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment, w_o, I, x_bar,
 fibre)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR`, :data:`CUSTOM` (``h1``
-read from ``custom_h1[custom_row[i]]`` at the points of :func:`points`, ``sigma`` linear in
-``u``) and :data:`PRISMATIC` (a section given whole, the same along the notch: its centroidal
-``I`` (m^4), centroid ``x_bar`` (m) and farthest fibre (m) in the last three columns, unused
-by the other kinds; ``sigma`` linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
+read from ``custom[custom_row[i], p, 0]`` at the points ``p`` of :func:`points`, ``sigma``
+linear in ``u``), :data:`PRISMATIC` (a section given whole, the same along the notch: its
+centroidal ``I`` (m^4), centroid ``x_bar`` (m) and farthest fibre (m) in the last three
+columns, unused by the other kinds; ``sigma`` linear in ``u``) and :data:`TABULATED` (a
+section changing along the notch, given at every point: ``1/(E I)`` (1/(N m^2)), ``x_bar``
+and the farthest fibre (m) in ``custom[custom_row[i], p, :]``; ``sigma`` linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
 (``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally
 spaced probes and its two ends, in that order (:func:`points`).
 """
@@ -35,6 +37,7 @@ CIRCULAR = 0
 RECTANGULAR = 1
 CUSTOM = 2
 PRISMATIC = 3
+TABULATED = 4
 """Profile kinds of ``design[:, 0]``."""
 
 IS_NOTCH, CHORD, U_A, U_B, START, LENGTH, SEG_LENGTH = range(7)
@@ -147,16 +150,19 @@ def geometry(kind: float, w_n: float, w_d: float, u: float,
     return w_n * u, w_n, custom
 
 
-def point(notch: bool, d: Array, seg_length: float, u: float, custom: float
+def point(notch: bool, d: Array, seg_length: float, u: float, custom: Array
           ) -> tuple[float, float, float, float, float]:
     """``(sigma, ds/du, 1/(E I), x_bar, fibre)`` at ``u`` in a cell's segment (m, m,
     1/(N m^2), m, m) of a notch shape with ``design`` row ``d``: the section's centroid offset
-    and the distance from it to its farthest fibre (0 in tubes, where no strain is sampled)."""
+    and the distance from it to its farthest fibre (0 in tubes, where no strain is sampled);
+    ``custom`` is the point's row of the custom table (module docstring)."""
     if not notch:
         return seg_length * u, seg_length, 1.0 / (d[E] * d[TUBE_MOMENT]), 0.0, 0.0
     if d[KIND] == PRISMATIC:
         return d[W_N] * u, d[W_N], 1.0 / (d[E] * d[SEC_I]), d[SEC_XBAR], d[SEC_FIBRE]
-    sigma, jac, h1 = geometry(d[KIND], d[W_N], d[W_D], u, custom)
+    if d[KIND] == TABULATED:
+        return d[W_N] * u, d[W_N], custom[0], custom[1], custom[2]
+    sigma, jac, h1 = geometry(d[KIND], d[W_N], d[W_D], u, custom[0])
     if d[W_O] == 0.0:  # eq. 12's symmetric section: the paper's formula, centroid on the axis
         return (sigma, jac, notch_compliance(h1, d[R_OUTER], d[R_INNER], d[E]), 0.0,
                 min(h1, d[R_OUTER]))
@@ -185,7 +191,7 @@ def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
 
 
 def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
-                   custom_h1: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
+                   custom_table: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
                    probe: Array, fc: Array, fq: Array, strain: Array) -> None:
     """Every integral of each cell (module docstring) into ``fc`` (cells, 11) and ``fq``
     (cells, 13, Q); ``strain`` (cells, 2, probes) gets the bending-strain coefficients
@@ -204,11 +210,11 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
     its ds weight is ``w_q + m_a K0 + m_b K1 - T K2``."""
     q_count = gauss_u.shape[0]
     first = q_count + q_count * q_count
-    no_custom = np.zeros(first + probe.shape[0] + 2)
+    no_custom = np.zeros((first + probe.shape[0] + 2, custom_table.shape[2]))
     for i in range(cell.shape[0]):
         d = design[shape[i]]
         c = cell[i]
-        custom = custom_h1[custom_row[i]] if custom_row[i] >= 0 else no_custom
+        custom = custom_table[custom_row[i]] if custom_row[i] >= 0 else no_custom
         notch = c[IS_NOTCH] != 0.0
         seg_length = c[SEG_LENGTH]
         u_a = c[U_A]

@@ -31,6 +31,7 @@ from tdcm_ros.model.profiles import (
     CustomProfile,
     NotchProfile,
     RectangularProfile,
+    SlicedProfile,
 )
 from tdcm_ros.model.section import notched_moment
 
@@ -91,6 +92,29 @@ class Members:
     notch_right: Array
     notch_open: IntArray
     shape_section: Array
+
+    @property
+    def is_tabulated(self) -> BoolArray:
+        """Per notch shape: whether its section changes along it, given by slices
+        (:class:`~tdcm_ros.model.profiles.SlicedProfile`)."""
+        sliced = np.array([isinstance(p, SlicedProfile) for p in self.profiles], dtype=bool)
+        return sliced[self.profile_of]
+
+    def tabulated(self, shape: IntArray, u: Array) -> tuple[Array, Array, Array]:
+        """``1/(E I)`` (1/(N m^2)), the centroid's offset ``x_bar`` (m) and the farthest
+        fibre from it (m) at ``u`` in notch shapes of sliced sections, rows of ``u`` as in
+        :meth:`h1`."""
+        out = np.empty((3, *u.shape))
+        kinds = self.profile_of[shape]
+        for k in np.unique(kinds):
+            rows = kinds == k
+            profile = self.profiles[k]
+            assert isinstance(profile, SlicedProfile)  # is_tabulated chose these shapes
+            _, x_bar, inertia, low, high = profile.section_at(u[rows])
+            modulus = per_row(self.E[self.shape_member[shape[rows]]], u[rows])
+            out[:, rows] = (1.0 / (modulus * inertia), x_bar,
+                            np.maximum(high - x_bar, x_bar - low))
+        return out[0], out[1], out[2]
 
     @classmethod
     def of(cls, designs: Sequence[Design]) -> Members:
@@ -338,20 +362,22 @@ def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
     per_kind = np.where(is_notch_kind, cells_per_notch, cells_per_tube)
     seg_length = members.kind_length
     present = seg_length > 0.0
-    breaks = np.zeros((m_count, k_count, MAX_CROSSINGS + 2))
+    inner = resolved(crossings(members)) if kind == "adaptive" else np.zeros(
+        (members.shape_member.size, 0))
+    pieces = inner.shape[1] + 1
+    breaks = np.zeros((m_count, k_count, pieces + 1))
     breaks[..., -1] = 1.0
-    if kind == "adaptive":
-        notch_kind = np.nonzero(is_notch_kind)
-        breaks[notch_kind[0], notch_kind[1], 1:-1] = np.sort(
-            resolved(crossings(members))[members.kind_shape[notch_kind]], axis=1)
+    notch_kind = np.nonzero(is_notch_kind)
+    breaks[notch_kind[0], notch_kind[1], 1:-1] = np.sort(inner[members.kind_shape[notch_kind]],
+                                                         axis=1)
     width = np.diff(breaks, axis=-1)
     counts = np.where(width > 0.0, np.maximum(1, np.rint(per_kind[..., None] * width)), 0)
     counts = (counts * present[..., None]).astype(np.int64)
 
     flat_counts = counts.ravel()
     piece = np.repeat(np.arange(flat_counts.size), flat_counts)
-    member = piece // (k_count * (MAX_CROSSINGS + 1))
-    seg_kind = (piece // (MAX_CROSSINGS + 1)) % k_count
+    member = piece // (k_count * pieces)
+    seg_kind = (piece // pieces) % k_count
     j = (np.arange(piece.size) - (np.cumsum(flat_counts) - flat_counts)[piece]).astype(float)
     n_piece = flat_counts[piece]
     step = 1.0 / n_piece
@@ -437,13 +463,20 @@ def crossing_levels(members: Members) -> Array:
 
 
 def crossings(members: Members) -> Array:
-    """Where each notch shape's profile meets its :func:`crossing_levels`, as ``u`` in (0, 1);
-    shape (S, MAX_CROSSINGS), 0 where a crossing does not exist."""
-    out = np.zeros((members.shape_member.size, MAX_CROSSINGS))
+    """Where each notch shape's profile meets its :func:`crossing_levels`, as ``u`` in (0, 1),
+    and the inner bounds of the slabs of a sliced section (where its section's derivatives
+    jump); shape (S, max(MAX_CROSSINGS, most slab bounds)), 0 where none."""
+    slab_bounds = [p.breaks() if isinstance(p, SlicedProfile) else np.zeros(0)
+                   for p in members.profiles]
+    out = np.zeros((members.shape_member.size,
+                    max(MAX_CROSSINGS, *(b.size for b in slab_bounds))))
     levels = crossing_levels(members)
     shape_profile = members.profile_of
     for k, profile in enumerate(members.profiles):
         rows = np.flatnonzero(shape_profile == k)
+        if isinstance(profile, SlicedProfile):
+            out[rows, :slab_bounds[k].size] = slab_bounds[k]
+            continue
         if isinstance(profile, (RectangularProfile, *PRISMATIC_PROFILES)):
             continue  # h1 is constant along the notch: it crosses no level
         for c in range(levels.shape[1]):

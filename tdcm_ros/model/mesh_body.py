@@ -14,10 +14,14 @@ two) needs nothing more. The slices are kept on disk by the file's content
 Slices with the tube's section (the one most of the body's length has, to
 :data:`SECTION_TOL`) are tube; a slice with more material (a flange, a cap) is refused, naming
 where;
-each run of other slices is one notch, which must be prismatic (the same section along it,
-to :data:`SECTION_TOL`: a slot cut straight through, as laser and wire cuts are; a notch
-whose section changes along the body, e.g. a circular-bottomed cut, is refused naming it).
-Its section is the slice's own (:class:`~tdcm_ros.model.profiles.SectionProfile`).
+each run of other slices is one notch. A prismatic one (the same section all along it, to
+:data:`SECTION_TOL`: a slot cut straight through, as laser and wire cuts are) has the slice's
+own section (:class:`~tdcm_ros.model.profiles.SectionProfile`). One whose section changes
+along the body (a circular-bottomed or slanted cut, a notch of several slots) is a
+:class:`~tdcm_ros.model.profiles.SlicedProfile`: in each slab every corner of the section
+moves linearly with z, so each slab is sliced at the 5 heights of
+:data:`~tdcm_ros.model.profiles.SLAB_NODES`, which give its area and moments exactly at any
+height, and the slabs' bounds become cell bounds of the grid.
 
 The tube is the circle through the outermost vertices of its slice (``R_outer``) less the
 circle through the innermost vertices of its lumen (``r_inner``; 0 where no edge of the slice
@@ -41,7 +45,12 @@ from tdcm_ros.model.design import MIN_SEGMENT_M
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.file_cache import Row, cached_rows
 from tdcm_ros.model.mesh_file import TriangleMesh, read_mesh
-from tdcm_ros.model.profiles import SectionProfile
+from tdcm_ros.model.profiles import (
+    SLAB_NODES,
+    SLAB_QUANTITIES,
+    SectionProfile,
+    SlicedProfile,
+)
 from tdcm_ros.model.sections import edge_moments
 
 Array = NDArray[np.float64]
@@ -61,11 +70,13 @@ AXIS_TOL = 1e-3
 
 @dataclass(frozen=True)
 class Slice:
-    """One slice of the mesh at height ``z`` (m), standing for the span ``z_low``..``z_high``
-    between two consecutive vertex heights (m): ``area`` (m^2), ``first`` = ``int x dA``
-    (m^3), ``second`` = ``int x^2 dA`` (m^4), ``first_y`` = ``int y dA`` (m^3), the material's
-    extent ``x_low``..``x_high`` (m), the outermost vertex's distance from the axis and the
-    innermost of the edges facing the axis (m, 0 if none)."""
+    """The mesh's slab between two consecutive vertex heights ``z_low``..``z_high`` (m), sliced
+    at its middle ``z`` (m): ``area`` (m^2), ``first`` = ``int x dA`` (m^3), ``second`` =
+    ``int x^2 dA`` (m^4), ``first_y`` = ``int y dA`` (m^3), the material's extent
+    ``x_low``..``x_high`` (m), the outermost vertex's distance from the axis and the innermost
+    of the edges facing the axis (m, 0 if none); ``samples``: area, first, second, x_low and
+    x_high at each of :data:`~tdcm_ros.model.profiles.SLAB_NODES` across the slab (a
+    :class:`~tdcm_ros.model.profiles.SlicedProfile`'s slab)."""
 
     z: float
     z_low: float
@@ -78,14 +89,31 @@ class Slice:
     x_high: float
     outer: float
     inner: float
+    samples: tuple[float, ...]
+
+    def row(self) -> Row:
+        """The slice as one row of :data:`SLICE_FIELDS`."""
+        return (*astuple(self)[:-1], *self.samples)
+
+    @classmethod
+    def of_row(cls, row: Row) -> Slice:
+        """The slice of a row of :data:`SLICE_FIELDS`."""
+        z, z_low, z_high, area, first, second, first_y, x_low, x_high, outer, inner = (
+            float(v) for v in row[:_SCALARS])
+        return cls(z, z_low, z_high, area, first, second, first_y, x_low, x_high, outer, inner,
+                   tuple(float(v) for v in row[_SCALARS:]))
 
     def same_as(self, other: Slice, scale: Slice) -> bool:
         """Whether this slice's area and moments equal ``other``'s to :data:`SECTION_TOL` of
-        ``scale``'s (the tube's)."""
+        ``scale``'s (the tube's), at its middle and at every sample."""
+        nodes = len(SLAB_NODES)
         radius = scale.outer
-        return (abs(self.area - other.area) <= SECTION_TOL * scale.area
-                and abs(self.first - other.first) <= SECTION_TOL * scale.area * radius
-                and abs(self.second - other.second) <= SECTION_TOL * scale.area * radius**2)
+        tolerance = SECTION_TOL * scale.area * np.array([1.0, radius, radius**2])
+        mine = np.reshape(self.samples, (len(SLAB_QUANTITIES), nodes))[:3]
+        theirs = np.array([other.area, other.first, other.second])
+        return bool(np.all(np.abs(mine - theirs[:, None]) <= tolerance[:, None])
+                    and np.all(np.abs(np.array([self.area, self.first, self.second]) - theirs)
+                               <= tolerance))
 
     def profile(self) -> SectionProfile:
         """The slice as a prismatic notch section."""
@@ -95,8 +123,11 @@ class Slice:
                              x_low=self.x_low, x_high=self.x_high)
 
 
-#: The fields of a :class:`Slice`, in order (its rows in :mod:`tdcm_ros.model.file_cache`).
-SLICE_FIELDS = tuple(f.name for f in fields(Slice))
+_SCALARS = len(fields(Slice)) - 1
+#: The columns of a :class:`Slice`'s row (:mod:`tdcm_ros.model.file_cache`): its numbers, then
+#: its samples, each quantity at each node.
+SLICE_FIELDS = (*(f.name for f in fields(Slice)[:-1]),
+                *(f"{q}_{j}" for q in SLAB_QUANTITIES for j in range(len(SLAB_NODES))))
 
 
 @dataclass(frozen=True)
@@ -104,7 +135,7 @@ class MeshSegment:
     """A segment found in the mesh: ``length`` (m) and, for a notch, its ``section``."""
 
     length: float
-    section: SectionProfile | None
+    section: SectionProfile | SlicedProfile | None
     where: str
 
 
@@ -125,10 +156,10 @@ def read_mesh_body(path: str | Path, unit: str, where: str = "mesh") -> MeshBody
     key = f"{where}.file"
 
     def sliced() -> list[Row]:
-        return [astuple(s) for s in _slices(read_mesh(path, UNITS[unit], key), key)]
+        return [s.row() for s in _slices(read_mesh(path, UNITS[unit], key), key)]
 
     rows = cached_rows(Path(path), unit, SLICE_FIELDS, sliced)
-    return _segments([Slice(*row) for row in rows], key, unit)
+    return _segments([Slice.of_row(row) for row in rows], key, unit)
 
 
 def _slices(mesh: TriangleMesh, key: str) -> list[Slice]:
@@ -155,8 +186,12 @@ def _slices(mesh: TriangleMesh, key: str) -> list[Slice]:
             raise InvalidDesignError(
                 f"{key}: no material at z = {z:.6g} m (the body comes apart there)",
                 parameter=key, value=float(z), allowed="material at every height")
-        out.append(_slice((float(heights[k]), float(z), float(heights[k + 1])),
-                          _plane_segments(corners[spanning], float(z)), normals[spanning]))
+        span = (float(heights[k]), float(z), float(heights[k + 1]))
+        at = [z if node == 0.5 else span[0] + node * (span[2] - span[0]) for node in SLAB_NODES]
+        sampled = [_moments(_plane_segments(corners[spanning], float(h)), normals[spanning])
+                   for h in at]
+        out.append(_slice(span, sampled[SLAB_NODES.index(0.5)],
+                          tuple(float(m[q]) for q in (0, 1, 2, 4, 5) for m in sampled)))
     return out
 
 
@@ -172,10 +207,11 @@ def _plane_segments(corners: Array, z: float) -> Array:
     return np.take_along_axis(points, first_two[:, :, None], axis=1)
 
 
-def _slice(span: tuple[float, float, float], segments: Array, normals: Array) -> Slice:
-    """The :class:`Slice` of the plane at ``span[1]`` (its span from ``span[0]`` to
-    ``span[2]``, m) from its edge segments ((k, 2, 2): ends, (x, y), m), each oriented with the
-    material on its left by its face's normal."""
+def _moments(segments: Array, normals: Array) -> tuple[float, ...]:
+    """Area (m^2), ``int x dA`` (m^3), ``int x^2 dA`` (m^4), ``int y dA`` (m^3), the extent
+    ``x_low``, ``x_high`` (m), the outermost vertex's distance from the axis and the innermost
+    of the edges facing it (m, 0 if none) of a plane's section from its edge segments ((k, 2,
+    2): ends, (x, y), m), each oriented with the material on its left by its face's normal."""
     start, end = segments[:, 0], segments[:, 1]
     direction = end - start
     left_is_outside = direction[:, 1] * normals[:, 0] - direction[:, 0] * normals[:, 1] < 0.0
@@ -188,10 +224,17 @@ def _slice(span: tuple[float, float, float], segments: Array, normals: Array) ->
     facing_axis = np.sum(midpoint * normals[:, :2], axis=1) < 0.0
     inner = float(np.max(np.hypot(start[facing_axis, 0], start[facing_axis, 1]),
                          initial=0.0))
-    return Slice(z=span[1], z_low=span[0], z_high=span[2], area=float(area),
-                 first=float(first), second=float(second), first_y=float(first_y),
-                 x_low=float(points[:, 0].min()), x_high=float(points[:, 0].max()),
-                 outer=float(radius.max()), inner=inner)
+    return (float(area), float(first), float(second), float(first_y),
+            float(points[:, 0].min()), float(points[:, 0].max()), float(radius.max()), inner)
+
+
+def _slice(span: tuple[float, float, float], middle: tuple[float, ...],
+           samples: tuple[float, ...]) -> Slice:
+    """The :class:`Slice` of the slab ``span`` (its low, middle and high z, m) from the
+    :func:`_moments` of its middle plane and its ``samples``."""
+    area, first, second, first_y, x_low, x_high, outer, inner = middle
+    return Slice(span[1], span[0], span[2], area, first, second, first_y, x_low, x_high, outer,
+                 inner, samples)
 
 
 def _tube(slices: list[Slice]) -> Slice:
@@ -230,15 +273,10 @@ def _segments(slices: list[Slice], key: str, unit: str) -> MeshBody:
             out.append(MeshSegment(stop - start, None, here))
         else:
             notch = 1 + sum(1 for s in out if s.section is not None)
-            for other in slices[k + 1:run + 1]:
-                if not other.same_as(slices[k], tube):
-                    raise InvalidDesignError(
-                        f"{here}: notch {notch} changes its section along the body (area "
-                        f"{slices[k].area:.6g} m^2 at z = {slices[k].z / scale:.6g} {unit}, "
-                        f"{other.area:.6g} m^2 at z = {other.z / scale:.6g} {unit}); allowed: "
-                        "prismatic notches, one section each (a slot cut straight through)",
-                        parameter=key, value=other.area, allowed="a prismatic notch")
-            out.append(MeshSegment(stop - start, slices[k].profile(), f"{here} (notch {notch})"))
+            run_slices = slices[k:run + 1]
+            prismatic = all(other.same_as(slices[k], tube) for other in run_slices)
+            section = slices[k].profile() if prismatic else _sliced(run_slices, start)
+            out.append(MeshSegment(stop - start, section, f"{here} (notch {notch})"))
         k = run + 1
     r_outer, r_inner = tube.outer, tube.inner
     ring = math.pi / 4.0 * (r_outer**4 - r_inner**4)
@@ -248,6 +286,13 @@ def _segments(slices: list[Slice], key: str, unit: str) -> MeshBody:
                     "the mesh is coarse around (use more facets for a closer tube)", key,
                     100.0 * (tube.second - ring) / ring, r_outer, r_inner)
     return MeshBody(R_outer=r_outer, r_inner=r_inner, segments=tuple(out))
+
+
+def _sliced(run: list[Slice], start: float) -> SlicedProfile:
+    """The notch of the slabs ``run``, which starts at height ``start`` (m), whose section
+    changes along it."""
+    bounds = (0.0, *(s.z_high - start for s in run[:-1]), run[-1].z_high - start)
+    return SlicedProfile(bounds=bounds, samples=tuple(s.samples for s in run))
 
 
 def _check_axis(tube: Slice, key: str) -> None:

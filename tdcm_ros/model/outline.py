@@ -4,7 +4,8 @@ of the midline along a solved shape (for drawing the notches as they are).
 Outside the notches the material reaches the tube's surface, ``R_outer`` from the midline on
 either side; inside a notch it ends at the backbone's edges, ``w_o + h1`` on the +x side and
 ``h1 - w_o`` on the -x side (eq. 13's profile, the backbone offset ``w_o`` from the axis; each at
-most ``R_outer``: a one-sided cut leaves the -x side whole). Each edge is a polyline of points ``(x, z)`` in ``tdcm_base`` (m), base to tip, with
+most ``R_outer``: a one-sided cut leaves the -x side whole; a notch sliced from a mesh, its
+slices' extent). Each edge is a polyline of points ``(x, z)`` in ``tdcm_base`` (m), base to tip, with
 the segment boundaries ``l_i`` and ``r_i`` twice (the tube's and the notch's width there), so
 the cut's step shows.
 """
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.model.profiles import SlicedProfile
 from tdcm_ros.model.result import SolveResult
 
 Array = NDArray[np.float64]
@@ -56,7 +58,13 @@ def body_outline(result: SolveResult, stations: int = STATIONS_PER_SEGMENT) -> B
             sigma = profiles[k].sigma(u, w_n[k])
             sigma[-1] = w_n[k]  # the notch's end exactly, whatever the profile's rounding
             s_parts.append(left[k] + sigma)
-            h1 = profiles[k].h1(u, w_n[k], w_d[k])
+            profile = profiles[k]
+            if isinstance(profile, SlicedProfile):  # the extent of each slice
+                _, _, _, low, high = profile.section_at(u)
+                widths.append(np.minimum(high, design.R_outer))
+                far_widths.append(np.minimum(-low, design.R_outer))
+                continue
+            h1 = profile.h1(u, w_n[k], w_d[k])
             widths.append(np.minimum(h1 + w_o[k], design.R_outer))
             far_widths.append(np.minimum(h1 - w_o[k], design.R_outer))
     s = np.concatenate(s_parts)

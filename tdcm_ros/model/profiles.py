@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -175,6 +175,94 @@ class SectionProfile(_StraightSlot):
         return self.x_low, self.x_high
 
 
+#: Where a :class:`SlicedProfile` samples each slab, as fractions of it: the 5 Chebyshev
+#: points (interior; the middle one exactly 0.5), through which a quartic is exact.
+SLAB_NODES = (0.5 - 0.5 * math.cos(math.pi / 10.0), 0.5 - 0.5 * math.cos(0.3 * math.pi), 0.5,
+              0.5 + 0.5 * math.cos(0.3 * math.pi), 0.5 + 0.5 * math.cos(math.pi / 10.0))
+#: The quantities a :class:`SlicedProfile` samples, in the order of its rows.
+SLAB_QUANTITIES = ("area", "first", "second", "x_low", "x_high")
+
+
+@dataclass(frozen=True)
+class SlicedProfile(_StraightSlot):
+    """A notch whose section changes along the body, given by slices of a mesh
+    (:mod:`tdcm_ros.model.mesh_body`): ``bounds`` (m, from the notch's start, base to tip)
+    cut it into slabs between the mesh's vertex heights, in each of which every corner of the
+    section moves linearly along the body; ``samples`` holds, per slab, the section's area
+    (m^2), ``int x dA`` (m^3), ``int x^2 dA`` (m^4) and its extent ``x_low``, ``x_high`` (m)
+    at the slab's :data:`SLAB_NODES` (25 numbers: each quantity's 5 in turn).
+
+    Area, first and second moments are polynomials of degree 2, 3 and 4 in a slab (Green's
+    theorem over edges whose ends move linearly), so the 5 samples give them exactly anywhere in
+    it. The extent (the fibre farthest from the centroid, for the peak strain) is the polyline
+    through the samples: exact while one corner stays the extreme one across the slab."""
+
+    bounds: tuple[float, ...]
+    samples: tuple[tuple[float, ...], ...]
+    name: str = "sliced"
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    @cached_property
+    def _hash(self) -> int:
+        """The hash of the numbers, taken once: thousands of them, and designs holding the
+        profile key the grid caches."""
+        return hash((self.bounds, self.samples, self.name))
+
+    @property
+    def width(self) -> float:
+        """The notch's width along the body (m)."""
+        return self.bounds[-1]
+
+    def breaks(self) -> Array:
+        """The slabs' inner bounds as reference coordinates ``u`` in (0, 1)."""
+        return np.asarray(self.bounds[1:-1]) / self.width
+
+    def x_extent(self) -> tuple[float, float]:
+        """The smallest and largest ``x`` of the notch's material anywhere along it (m)."""
+        table = _slab_table(self.samples)
+        return float(table[:, 3].min()), float(table[:, 4].max())
+
+    def section_at(self, u: Array) -> tuple[Array, Array, Array, Array, Array]:
+        """Area (m^2), centroid ``x_bar`` (m), centroidal second moment (m^4) and the extent
+        ``x_low``, ``x_high`` (m) of the section at reference coordinates ``u`` (any shape)."""
+        bounds = np.asarray(self.bounds)
+        table = _slab_table(self.samples)
+        sigma = np.clip(np.asarray(u, dtype=float), 0.0, 1.0) * self.width
+        slab = np.clip(np.searchsorted(bounds, sigma, side="right") - 1, 0, len(table) - 1)
+        t = (sigma - bounds[slab]) / (bounds[slab + 1] - bounds[slab])
+        nodes = np.asarray(SLAB_NODES)
+        basis = np.ones(t.shape + (nodes.size,))
+        for j in range(nodes.size):
+            for k in range(nodes.size):
+                if k != j:
+                    basis[..., j] *= (t - nodes[k]) / (nodes[j] - nodes[k])
+        area, first, second = (np.sum(basis * table[slab, q], axis=-1) for q in range(3))
+        x_bar = first / area
+        low, high = (_polyline(t, nodes, table[slab, q]) for q in (3, 4))
+        return area, x_bar, second - area * x_bar * x_bar, low, high
+
+
+@lru_cache(maxsize=256)
+def _slab_table(samples: tuple[tuple[float, ...], ...]) -> Array:
+    """``samples`` as an array (slabs, quantities, nodes), read-only."""
+    table = np.asarray(samples, dtype=float).reshape(len(samples), len(SLAB_QUANTITIES),
+                                                     len(SLAB_NODES))
+    table.setflags(write=False)
+    return table
+
+
+def _polyline(t: Array, nodes: Array, values: Array) -> Array:
+    """The polyline through ``(nodes, values[..., j])`` at ``t`` (per point), extended
+    straight past the first and last node."""
+    segment = np.clip(np.searchsorted(nodes, t) - 1, 0, nodes.size - 2)
+    t0, t1 = nodes[segment], nodes[segment + 1]
+    v0 = np.take_along_axis(values, segment[..., None], axis=-1)[..., 0]
+    v1 = np.take_along_axis(values, segment[..., None] + 1, axis=-1)[..., 0]
+    return v0 + (t - t0) / (t1 - t0) * (v1 - v0)
+
+
 PrismaticProfile = PolygonProfile | SectionProfile
 PRISMATIC_PROFILES = (PolygonProfile, SectionProfile)
 
@@ -188,8 +276,11 @@ def _polygon_properties(shell: tuple[tuple[float, float], ...],
     return PolygonSection(shell, r_outer, holes).properties()
 
 
+#: Profiles whose section is given, not made from ``h1``: ``w_d`` and ``w_o`` are their extent.
+GIVEN_SECTION_PROFILES = (PolygonProfile, SectionProfile, SlicedProfile)
+
 NotchProfile = (CircularProfile | RectangularProfile | CustomProfile | PolygonProfile
-                | SectionProfile)
+                | SectionProfile | SlicedProfile)
 
 PROFILE_NAMES: tuple[str, ...] = ("circular", "rectangular")
 

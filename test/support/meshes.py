@@ -93,3 +93,26 @@ def write_mesh(mesh: Any, path: Path) -> Path:
     """Write ``mesh`` to ``path`` (its format from the suffix, e.g. a binary STL)."""
     mesh.export(str(path))
     return path
+
+
+def slanted_cut_mesh(r_outer: float, r_inner: float, length: float,
+                     cuts: Sequence[tuple[tuple[float, float], tuple[float, float]]],
+                     sides: int = 256) -> Any:
+    """A tube of ``length`` (mm) along +z with slanted cuts from +x: each ``((z0, z1), (x0,
+    x1))`` removes, between ``z0`` and ``z1``, the material with ``x >= x0`` at ``z0`` and
+    ``x >= x1`` at ``z1`` (linear between: a plane), so the notch's section changes all along
+    it. The material at height ``z`` in a cut is the faceted annulus with ``x`` at most the
+    plane's. A watertight ``trimesh.Trimesh`` (mm)."""
+    import manifold3d
+    import trimesh
+
+    body = manifold3d.Manifold.extrude(manifold3d.CrossSection(rings(annulus(
+        r_outer, r_inner, sides))), length)
+    far = 2.0 * r_outer
+    for (z0, z1), (x0, x1) in cuts:
+        corners = [(x, y, z) for (x, z) in ((x0, z0), (far, z0), (x1, z1), (far, z1))
+                   for y in (-far, far)]
+        body = body - manifold3d.Manifold.hull_points(np.array(corners, dtype=float))
+    mesh = body.to_mesh64()
+    return trimesh.Trimesh(np.asarray(mesh.vert_properties)[:, :3], np.asarray(mesh.tri_verts),
+                           process=False)

@@ -10,8 +10,9 @@ fixed point. Paper routing only.
 
 from __future__ import annotations
 
+import itertools
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 from scipy.integrate import quad, solve_ivp
@@ -41,15 +42,22 @@ def strip_by_quadrature(lo: float, hi: float, r_outer: float, r_inner: float
     return area, centroid, second - area * centroid**2
 
 
+#: A notch whose section changes along it: its section at ``sigma`` (m from the notch's start)
+#: as centroid offset (m) and centroidal I (m^4), and where its derivatives jump (m).
+Varying = tuple[Callable[[float], tuple[float, float]], Sequence[float]]
+
+
 def notch_motion(design: Design, k: int, tension: float,
-                 given: tuple[float, float] | None = None) -> tuple[complex, float]:
+                 given: tuple[float, float] | None = None, varying: Varying | None = None
+                 ) -> tuple[complex, float]:
     """Notch ``k``'s tube-axis displacement (z + i x, m, in the frame of its start) and bend
     (rad) under paper routing, where the tendon follows the body and the moment about the
     centroid is (R_c - x_bar) T whatever the shape. Prismatic (rectangular, or a section
     ``given`` as its centroid's offset (m) and centroidal I (m^4)): the neutral fibre is an
     arc of the notch's width, the axis reached by the jumps -x_bar n at the faces. Circular
     (eq. 13's half-width along the notch): scipy's ODE solver on the axis, which stretches by
-    x_bar kappa, with the section by quadrature at every step."""
+    x_bar kappa, with the section by quadrature at every step; a ``varying`` section the same
+    way, from break to break."""
     e, r_c, r_outer, r_inner = design.E, design.R_c, design.R_outer, design.r_inner
     w_n, w_d = design.per_notch("w_n")[k], design.per_notch("w_d")[k]
     w_o = design.per_notch("w_o")[k]
@@ -66,23 +74,34 @@ def notch_motion(design: Design, k: int, tension: float,
         arc = (np.exp(1j * bend) - 1.0) / (1j * kappa)
         return 1j * centroid + arc - 1j * centroid * np.exp(1j * bend), bend
 
+    def along(sigma: float) -> tuple[float, float]:
+        if varying is not None:
+            centroid, inertia = varying[0](sigma)
+            return centroid, e * inertia
+        return section((w_n + w_d) / 2 - math.sqrt(max(sigma * (w_n - sigma), 0.0)))
+
     def rhs(sigma: float, y: np.ndarray) -> list[float]:
-        centroid, ei = section((w_n + w_d) / 2 - math.sqrt(max(sigma * (w_n - sigma), 0.0)))
+        centroid, ei = along(sigma)
         kappa = (r_c - centroid) * tension / ei
         stretch = 1.0 + centroid * kappa
         return [stretch * math.cos(y[2]), stretch * math.sin(y[2]), kappa]
 
-    out = solve_ivp(rhs, (0.0, w_n), [0.0, 0.0, 0.0], method="DOP853", rtol=1e-12, atol=1e-15)
-    return complex(out.y[0, -1], out.y[1, -1]), float(out.y[2, -1])
+    state = np.zeros(3)
+    stations = sorted({0.0, w_n, *(b for b in (varying[1] if varying else ()) if 0 < b < w_n)})
+    for a, b in itertools.pairwise(stations):
+        state = solve_ivp(rhs, (a, b), state, method="DOP853", rtol=1e-12, atol=1e-15).y[:, -1]
+    return complex(state[0], state[1]), float(state[2])
 
 
 def reference_tip(design: Design, tension: float,
-                  given: Mapping[int, tuple[float, float]] | None = None
-                  ) -> tuple[complex, np.ndarray]:
+                  given: Mapping[int, tuple[float, float]] | None = None,
+                  varying: Mapping[int, Varying] | None = None) -> tuple[complex, np.ndarray]:
     """Tip (z + i x, m) and the bend across each notch (rad) of a design under paper routing
     by the second solver of the module docstring (:func:`notch_motion` in the notches; the
-    prismatic sections ``given`` by notch index, as centroid offset (m) and I (m^4))."""
+    prismatic sections ``given`` by notch index, as centroid offset (m) and I (m^4); the
+    sections changing along a notch ``varying`` by notch index)."""
     given = given or {}
+    varying = varying or {}
     e, r_c, r_outer, r_inner = design.E, design.R_c, design.R_outer, design.r_inner
     tube_ei = e * math.pi / 4.0 * (r_outer**4 - r_inner**4)
     left, right = design.notch_bounds()
@@ -92,8 +111,10 @@ def reference_tip(design: Design, tension: float,
         key = (design.per_notch("w_n")[k], design.per_notch("w_d")[k],
                design.per_notch("w_o")[k], float(design.notch_profiles()[k].name == "circular"),
                *given.get(k, ()))
+        if k in varying:
+            key = (*key, float(k))
         if key not in motions:
-            motions[key] = notch_motion(design, k, tension, given.get(k))
+            motions[key] = notch_motion(design, k, tension, given.get(k), varying.get(k))
         notches.append(motions[key])
     tubes = [(0.0, left[0]), *zip(right[:-1], left[1:], strict=True),
              (right[-1], design.length)]

@@ -10,6 +10,7 @@ from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure
+from tdcm_ros.model.profiles import GIVEN_SECTION_PROFILES
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SolverSettings
 
@@ -18,8 +19,18 @@ Array = NDArray[np.float64]
 
 def require_centred(design: Design, method: str) -> None:
     """Raise :class:`InvalidDesignError` naming ``w_o`` unless every notch's backbone is on the
-    tube axis: the baselines model the paper's symmetric notch only (the off-axis centroid's
-    mechanics are :func:`tdcm_ros.model.solve`'s)."""
+    tube axis, or ``profile`` where a notch's section is given whole (a polygon, a section's
+    numbers, a mesh's slices): the baselines model the paper's symmetric notch only (the
+    off-axis centroid's and given sections' mechanics are :func:`tdcm_ros.model.solve`'s)."""
+    given = [k for k, p in enumerate(design.notch_profiles())
+             if isinstance(p, GIVEN_SECTION_PROFILES)]
+    if given:
+        name = design.notch_profiles()[given[0]].name
+        raise InvalidDesignError(
+            f"profile[{given[0]}] = {name!r}: the {method} baseline takes the paper's band "
+            "notches (circular, rectangular or custom h1); allowed: those (solve a body of "
+            "given sections with algorithm1)", parameter=f"profile[{given[0]}]", value=name,
+            allowed="circular | rectangular | custom")
     offsets = design.per_notch("w_o")
     if offsets.any():
         raise InvalidDesignError(
