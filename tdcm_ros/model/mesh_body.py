@@ -187,54 +187,47 @@ def _slices(mesh: TriangleMesh, key: str) -> list[Slice]:
                 f"{key}: no material at z = {z:.6g} m (the body comes apart there)",
                 parameter=key, value=float(z), allowed="material at every height")
         span = (float(heights[k]), float(z), float(heights[k + 1]))
-        at = [z if node == 0.5 else span[0] + node * (span[2] - span[0]) for node in SLAB_NODES]
-        sampled = [_moments(_plane_segments(corners[spanning], float(h)), normals[spanning])
-                   for h in at]
-        out.append(_slice(span, sampled[SLAB_NODES.index(0.5)],
-                          tuple(float(m[q]) for q in (0, 1, 2, 4, 5) for m in sampled)))
+        at = np.array([z if node == 0.5 else span[0] + node * (span[2] - span[0])
+                       for node in SLAB_NODES])
+        out.append(_slice(span, _plane_segments(corners[spanning], at), normals[spanning]))
     return out
 
 
-def _plane_segments(corners: Array, z: float) -> Array:
-    """Where the plane at height ``z`` (m) cuts each triangle of ``corners`` (k, 3, 3), each of
-    which has corners on both sides of it: segments (k, 2, 2) of ``(x, y)`` ends (m). A corner
-    on the plane counts as below it, so each triangle has exactly two edges that cross."""
+def _plane_segments(corners: Array, heights: Array) -> Array:
+    """Where the planes at ``heights`` (h,) (m) cut each triangle of ``corners`` (k, 3, 3),
+    each of which has corners on both sides of every one of them: segments (h, k, 2, 2) of
+    ``(x, y)`` ends (m). A corner on a plane counts as below it, so each triangle has exactly
+    two edges that cross."""
     start, end = corners, np.roll(corners, -1, axis=1)  # edges 0-1, 1-2, 2-0
+    z = heights[:, None, None]
     crosses = (start[:, :, 2] > z) != (end[:, :, 2] > z)
     along = (z - start[:, :, 2]) / np.where(crosses, end[:, :, 2] - start[:, :, 2], 1.0)
-    points = start[:, :, :2] + along[:, :, None] * (end[:, :, :2] - start[:, :, :2])
-    first_two = np.argsort(~crosses, axis=1, kind="stable")[:, :2]
-    return np.take_along_axis(points, first_two[:, :, None], axis=1)
+    points = start[:, :, :2] + along[..., None] * (end[:, :, :2] - start[:, :, :2])
+    first_two = np.argsort(~crosses, axis=-1, kind="stable")[..., :2]
+    return np.take_along_axis(points, first_two[..., None], axis=-2)
 
 
-def _moments(segments: Array, normals: Array) -> tuple[float, ...]:
-    """Area (m^2), ``int x dA`` (m^3), ``int x^2 dA`` (m^4), ``int y dA`` (m^3), the extent
-    ``x_low``, ``x_high`` (m), the outermost vertex's distance from the axis and the innermost
-    of the edges facing it (m, 0 if none) of a plane's section from its edge segments ((k, 2,
-    2): ends, (x, y), m), each oriented with the material on its left by its face's normal."""
-    start, end = segments[:, 0], segments[:, 1]
+def _slice(span: tuple[float, float, float], segments: Array, normals: Array) -> Slice:
+    """The :class:`Slice` of the slab ``span`` (its low, middle and high z, m) from its planes'
+    edge segments ((h, k, 2, 2): the planes at :data:`SLAB_NODES`, ends, (x, y), m), each
+    oriented with the material on its left by its face's normal (k, 3)."""
+    start, end = segments[..., 0, :], segments[..., 1, :]
     direction = end - start
-    left_is_outside = direction[:, 1] * normals[:, 0] - direction[:, 0] * normals[:, 1] < 0.0
-    start, end = (np.where(left_is_outside[:, None], end, start),
-                  np.where(left_is_outside[:, None], start, end))
+    left_is_outside = direction[..., 1] * normals[:, 0] - direction[..., 0] * normals[:, 1] < 0.0
+    start, end = (np.where(left_is_outside[..., None], end, start),
+                  np.where(left_is_outside[..., None], start, end))
     area, first, second, first_y = edge_moments(start, end)
-    points = np.concatenate([start, end])
-    radius = np.hypot(points[:, 0], points[:, 1])
-    midpoint = 0.5 * (start + end)
-    facing_axis = np.sum(midpoint * normals[:, :2], axis=1) < 0.0
-    inner = float(np.max(np.hypot(start[facing_axis, 0], start[facing_axis, 1]),
+    points = np.concatenate([start, end], axis=-2)
+    x_low, x_high = points[..., 0].min(axis=-1), points[..., 0].max(axis=-1)
+    middle = SLAB_NODES.index(0.5)
+    radius = np.hypot(points[middle, :, 0], points[middle, :, 1])
+    facing_axis = np.sum(0.5 * (start[middle] + end[middle]) * normals[:, :2], axis=1) < 0.0
+    inner = float(np.max(np.hypot(start[middle, facing_axis, 0], start[middle, facing_axis, 1]),
                          initial=0.0))
-    return (float(area), float(first), float(second), float(first_y),
-            float(points[:, 0].min()), float(points[:, 0].max()), float(radius.max()), inner)
-
-
-def _slice(span: tuple[float, float, float], middle: tuple[float, ...],
-           samples: tuple[float, ...]) -> Slice:
-    """The :class:`Slice` of the slab ``span`` (its low, middle and high z, m) from the
-    :func:`_moments` of its middle plane and its ``samples``."""
-    area, first, second, first_y, x_low, x_high, outer, inner = middle
-    return Slice(span[1], span[0], span[2], area, first, second, first_y, x_low, x_high, outer,
-                 inner, samples)
+    samples = tuple(float(v) for v in np.concatenate([area, first, second, x_low, x_high]))
+    return Slice(span[1], span[0], span[2], float(area[middle]), float(first[middle]),
+                 float(second[middle]), float(first_y[middle]), float(x_low[middle]),
+                 float(x_high[middle]), float(radius.max()), inner, samples)
 
 
 def _tube(slices: list[Slice]) -> Slice:

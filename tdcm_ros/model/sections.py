@@ -220,12 +220,14 @@ def _ring_moments(ring: Array) -> Array:
 
 def edge_moments(start: Array, end: Array) -> Array:
     """``(A, int x dA, int x^2 dA, int y dA)`` (m^2, m^3, m^4, m^3) of the region bounded by
-    the directed edges ``start[k] -> end[k]`` ((n, 2) arrays of ``(x, y)`` in m), the material
-    on each edge's left (outer boundaries counter-clockwise, holes clockwise): Green's theorem,
-    exact for straight edges, in any order and from any number of loops."""
-    x, y = start[:, 0], start[:, 1]
-    x1, y1 = end[:, 0], end[:, 1]
+    the directed edges ``start[..., k, :] -> end[..., k, :]`` (arrays ``(..., n, 2)`` of
+    ``(x, y)`` in m; leading axes are regions of their own, and the result has them after its
+    first axis), the material on each edge's left (outer boundaries counter-clockwise, holes
+    clockwise): Green's theorem, exact for straight edges, in any order and from any number of
+    loops."""
+    x, y = start[..., 0], start[..., 1]
+    x1, y1 = end[..., 0], end[..., 1]
     cross = x * y1 - x1 * y
-    return np.array([np.sum(cross) / 2.0, np.sum((x + x1) * cross) / 6.0,
-                     np.sum((x * x + x * x1 + x1 * x1) * cross) / 12.0,
-                     np.sum((y + y1) * cross) / 6.0])
+    return np.array([np.sum(cross, axis=-1) / 2.0, np.sum((x + x1) * cross, axis=-1) / 6.0,
+                     np.sum((x * x + x * x1 + x1 * x1) * cross, axis=-1) / 12.0,
+                     np.sum((y + y1) * cross, axis=-1) / 6.0])
