@@ -164,9 +164,11 @@ class _Timer:
 
 
 class _Executor:
-    """Single-threaded callback loop fed by zenoh threads (tasks) and timers."""
+    """Single-threaded callback loop fed by zenoh threads (tasks) and timers; ``clock`` gives
+    the time its timers run on (ns, monotonic)."""
 
-    def __init__(self) -> None:
+    def __init__(self, clock: Callable[[], int] = time.monotonic_ns) -> None:
+        self._clock = clock
         # queue.Queue, not SimpleQueue: CPython's SimpleQueue.get(timeout) blocks until the next
         # put when a signal interrupts it and its handler outlasts the remaining timeout (it
         # recomputes a negative timeout, which means "forever"); a player stopped by Ctrl-C
@@ -198,21 +200,36 @@ class _Executor:
 
     def add_timer(self, period_s: float, callback: Callable[[], None]) -> _Timer:
         period_ns = int(period_s * 1e9)
-        timer = _Timer(time.monotonic_ns() + period_ns, next(self._seq), period_ns, callback)
+        timer = _Timer(self._clock() + period_ns, next(self._seq), period_ns, callback)
         heapq.heappush(self._timers, timer)
         self.post(lambda: None)
         return timer
 
     def spin_once(self, timeout: float) -> None:
-        now = time.monotonic_ns()
+        """Run each timer due now once, then wait up to ``timeout`` s (less if a timer falls
+        due sooner) for tasks and run those queued. A timer whose callback outlasts its period
+        skips the periods it missed (as rcl's timers do): it neither runs again in the same
+        call nor keeps the loop from its tasks and from a stop request."""
+        now = self._clock()
+        due: list[_Timer] = []
         while self._timers and (self._timers[0].cancelled or self._timers[0].due_ns <= now):
             timer = heapq.heappop(self._timers)
-            if timer.cancelled:
+            if not timer.cancelled:
+                due.append(timer)
+        for k, timer in enumerate(due):
+            if self.stop.is_set():  # the rest keep their due times
+                for left in due[k:]:
+                    heapq.heappush(self._timers, left)
+                return
+            if timer.cancelled:  # by a callback that ran before it here
                 continue
             timer.callback()
-            timer.due_ns = max(timer.due_ns + timer.period_ns, now)
+            timer.due_ns += timer.period_ns
+            after = self._clock()
+            if timer.due_ns <= after:  # missed periods: the next one after now, on its grid
+                timer.due_ns += ((after - timer.due_ns) // timer.period_ns + 1) * timer.period_ns
             heapq.heappush(self._timers, timer)
-            now = time.monotonic_ns()
+        now = self._clock()
         wait = timeout
         if self._timers:
             wait = min(wait, max(0.0, (self._timers[0].due_ns - now) / 1e9))
