@@ -107,11 +107,11 @@ class NotchSpec:
         """The width of the material left at the notch's centre (m): the band, the tube less
         the cut (``2 R_outer - cut``), or the polygon's extent in ``x``."""
         if self.kind in ("polygon", "section"):
-            low, high = self.prismatic().x_extent()
+            low, high = self.given_profile().x_extent()
             return high - low
         return 2.0 * r_outer - self.cut if self.kind == "cut" else self.band
 
-    def prismatic(self) -> PrismaticProfile | SlicedProfile:
+    def given_profile(self) -> PrismaticProfile | SlicedProfile:
         """The section of a polygon notch, or one given by its numbers (or a mesh's slices)."""
         return self.given if self.given is not None else PolygonProfile(self.shell, self.holes)
 
@@ -119,7 +119,7 @@ class NotchSpec:
         """The notch's profile for the solver: the named one of a band or cut, the polygon or
         the mesh's slice."""
         if self.kind in ("polygon", "section"):
-            return self.prismatic()
+            return self.given_profile()
         return profile_from_name(self.profile)
 
 
