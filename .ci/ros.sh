@@ -7,13 +7,15 @@
 # Phases: (1) a separate virtual environment (TDCM_ROS_VENV, default <repo>/.ros/venv; reused when
 # complete), (2) a colcon workspace (TDCM_ROS_WS, default <repo>/.ros/ws) holding tdcm_ros (this
 # repository), mocap4r2_msgs (msg_defs/) and a minimal tf2_msgs (test/fixtures/), built with
-# colcon, (3) the installed executables: each one's --help, then model_node against the plain rclpy
-# node .ci/ros_listener.py, (4) the rclpy tests (pytest -m rclpy, in parallel: TDCM_TEST_WORKERS
-# pytest-xdist workers, default 3, then the end-to-end demos alone; PYTEST_ARGS replace both).
-# --prepare runs phases 1-3
-# only; --tests-only runs phase 4 alone on the venv and workspace they built (.ci/test.sh runs the
-# two apart, .ci/soak the second). Prints the time of each phase
-# and the disk used. Any failure exits non-zero.
+# colcon, (3) the installed executables: each one's --help, then one solve from the install space
+# (its compiled kernel is cached by path: the first solve from a new install compiles it, ~50 s of
+# CPU), (4) model_node against the plain rclpy node .ci/ros_listener.py, (5) the rclpy tests
+# (pytest -m rclpy, in parallel: TDCM_TEST_WORKERS pytest-xdist workers, default 3, then the
+# end-to-end demos alone; PYTEST_ARGS replace both).
+# --prepare runs phases 1-3 only (at TDCM_ROS_BUILD_NICE: none of them has a deadline);
+# --tests-only runs phases 4-5 alone on the venv and workspace they built (.ci/test.sh runs the
+# two apart, .ci/soak the second). Prints the time of each phase and the disk used. Any failure
+# exits non-zero.
 set -euo pipefail
 
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd -P)"
@@ -21,8 +23,9 @@ cd "$REPO"
 VENV="${TDCM_ROS_VENV:-$REPO/.ros/venv}"
 WS="${TDCM_ROS_WS:-$REPO/.ros/ws}"
 BASE_PYTHON="${TDCM_ROS_PYTHON:-python3}"
-# Niceness of the build (pip install, colcon build): .ci/test.sh builds at 19 in the background, so
-# that the build takes the CPU that the tests beside it leave idle instead of slowing them down.
+# Niceness of phases 1-3 (pip install, colcon build, the executables' first runs): .ci/test.sh runs
+# them at 19 in the background, so that they take the CPU that the tests beside it leave idle
+# instead of slowing them down (the end-to-end demos need most of the 2 cores here).
 BUILD_NICE="${TDCM_ROS_BUILD_NICE:-0}"
 TESTS_ONLY=0
 PREPARE_ONLY=0
@@ -38,7 +41,7 @@ while [ $# -gt 0 ]; do
 done
 
 export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
-# Keep DDS discovery on this machine. Phase 3's node runs in domain 101 (the tests take theirs
+# Keep DDS discovery on this machine. Phase 4's node runs in domain 101 (the tests take theirs
 # from 1..100, test/support/graph.py; above 101 DDS ports reach the ephemeral range).
 export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 export ROS_DOMAIN_ID="${ROS_DOMAIN_ID:-101}"
@@ -208,20 +211,27 @@ set +u
 # shellcheck disable=SC1091
 source "$WS/install/setup.bash"
 set -u
+LIB="$WS/install/tdcm_ros/lib/tdcm_ros"  # where `ros2 run tdcm_ros <exe>` looks
 if [ "$TESTS_ONLY" = 0 ]; then
 
 # --- 3. the installed executables ---------------------------------------------------------------
 phase "installed executables"
-LIB="$WS/install/tdcm_ros/lib/tdcm_ros"  # where `ros2 run tdcm_ros <exe>` looks
 for exe in "${EXECUTABLES[@]}"; do
   [ -x "$LIB/$exe" ] || fail "$LIB/$exe is missing or not executable"
-  if ! out="$("$LIB/$exe" --help 2>&1)"; then
+  if ! out="$(nice -n "$BUILD_NICE" "$LIB/$exe" --help 2>&1)"; then
     echo "$out" >&2
     fail "$exe --help exited non-zero"
   fi
   echo "$exe --help: ok ($(head -1 "$LIB/$exe"))"
 done
+# From a directory outside the checkout, so that tdcm_ros comes from the install space.
+(cd /tmp && nice -n "$BUILD_NICE" python -c 'from tdcm_ros.model import preset, solve
+print("one solve from the install space: tip", solve(preset("paper-experiment"), 20.0).tip_position)') \
+  || fail "a solve from the install space failed"
+fi
 
+if [ "$PREPARE_ONLY" = 0 ]; then
+# --- 4. model_node from the install space, seen by a plain rclpy node ---------------------------
 phase "model_node + ros_listener.py"
 TMPDIR_CI="$(mktemp -d)"
 (cd "$TMPDIR_CI" && exec "$LIB/model_node" --runtime rclpy) >"$TMPDIR_CI/model_node.log" 2>&1 &
@@ -253,7 +263,7 @@ fi
 echo "model_node stopped on SIGINT with exit status 0"
 fi
 
-# --- 4. the rclpy tests -------------------------------------------------------------------------
+# --- 5. the rclpy tests -------------------------------------------------------------------------
 if [ "$PREPARE_ONLY" = 1 ]; then
   phase ""
   exit 0
