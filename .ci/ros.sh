@@ -40,7 +40,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
+source .ci/pip_env.sh
 # Keep DDS discovery on this machine. Phase 4's node runs in domain 101 (the tests take theirs
 # from 1..100, test/support/graph.py; above 101 DDS ports reach the ephemeral range).
 export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST

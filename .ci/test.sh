@@ -29,7 +29,7 @@
 # Every step runs even when an earlier one failed; each pytest run lists its 25 slowest tests.
 set -uo pipefail
 cd "$(dirname "$0")/.."
-export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
+source .ci/pip_env.sh
 LOGS="$(mktemp -d)"
 BACKGROUND=()
 stop_tree() {  # stop_tree PID: SIGTERM to it and every descendant (a background job of a script

@@ -10,7 +10,7 @@
 #   bash .ci/zenoh_lowest.sh [pytest options]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export PIP_DISABLE_PIP_VERSION_CHECK=1 PIP_ROOT_USER_ACTION=ignore
+source .ci/pip_env.sh
 
 REQUIREMENT="$(python3 -c 'import re, sys; sys.stdout.write(re.search(r"ZENOH_REQUIREMENT = \"([^\"]+)\"", open("setup.py").read()).group(1))')"
 LOWEST="$(sed -n 's/.*>=\([0-9.]*\).*/\1/p' <<<"$REQUIREMENT")"
