@@ -112,7 +112,7 @@ class _KernelArrays:
     @classmethod
     def of(cls, parts: GridParts, rows: NDArray[np.int64]) -> _KernelArrays:
         """Gathered from the prototype cells of designs ``rows`` of ``parts``."""
-        return cls(Cells.of_parts(parts, rows), *_strain_coefficients(parts, rows))
+        return cls(parts.cells(rows), *_strain_coefficients(parts, rows))
 
 
 @dataclass(frozen=True, eq=False)

@@ -35,7 +35,10 @@ cells go (``uniform`` or ``adaptive``) is :mod:`tdcm_ros.model.grid_layout`'s jo
 integrals of each segment kind's cells are computed once per design by the compiled
 :func:`tdcm_ros.model.grid_kernel.cell_integrals` (:class:`GridParts`) and copied along the
 body. :func:`build_grids` builds many designs' grids at once into a :class:`GridStack`;
-:func:`build_grid` is the same build with one member.
+:func:`build_grid` is the same build with one member. The fields the kernels read are laid out
+once, in the kernel's layout (:class:`~tdcm_ros.model.cells.Cells`, :meth:`GridParts.cells`):
+a grid's ``C0``, ``A0``, ``constrained`` ... are views of its ``cells``, and the solver, the
+batch solver and the limit checks read the same numbers.
 """
 
 from __future__ import annotations
@@ -45,12 +48,24 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, fields
 from functools import cached_property, lru_cache
 from itertools import pairwise
-from typing import Any, NamedTuple, TypeVar
+from typing import Any, Generic, NamedTuple, TypeVar, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range
+from tdcm_ros.model import grid_kernel
+from tdcm_ros.model.cells import (
+    FC_FIELDS,
+    FC_NAMES,
+    FC_ROWS,
+    FQ_FIELDS,
+    FQ_NAMES,
+    FQ_ROWS,
+    IC_NAMES,
+    NOTCH_NAMES,
+    Cells,
+)
 from tdcm_ros.model.compiled import grid_kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
@@ -98,11 +113,35 @@ class Query(NamedTuple):
 QUERY_CACHE_SIZE = 8
 
 
+class _Packed(Generic[Scalar]):
+    """A field of a grid kept in its :class:`~tdcm_ros.model.cells.Cells`: row ``row`` of the
+    block ``block`` (``fc``, ``fq``, ``ic``, ``notch``), read through the grid's member axis
+    (:meth:`CellArrays.member_view`); ``nonzero`` reads an integer row as booleans."""
+
+    def __init__(self, block: str, row: int | slice, nonzero: bool = False) -> None:
+        self.block, self.row, self.nonzero = block, row, nonzero
+
+    @overload
+    def __get__(self, grid: None, owner: type) -> _Packed[Scalar]: ...
+
+    @overload
+    def __get__(self, grid: CellArrays, owner: type) -> NDArray[Scalar]: ...
+
+    def __get__(self, grid: CellArrays | None, owner: type
+                ) -> NDArray[Scalar] | _Packed[Scalar]:
+        if grid is None:
+            return self
+        values = getattr(grid.cells, self.block)[:, self.row]
+        return grid.member_view(values != 0 if self.nonzero else values)
+
+
 @dataclass(frozen=True, eq=False)
 class CellArrays:
     """The per-cell, per-node, per-Gauss-point and per-notch arrays of a grid (SI units; the
     module docstring says what each is). :class:`Grid` holds them for one design,
-    :class:`GridStack` with a leading member axis."""
+    :class:`GridStack` with a leading member axis. The fields the kernel reads live once, in
+    ``cells`` (:class:`~tdcm_ros.model.cells.Cells`, its layout): ``C0``, ``A0``,
+    ``constrained`` ... are views of it."""
 
     s_nodes: Array
     is_notch: NDArray[np.bool_]
@@ -112,40 +151,33 @@ class CellArrays:
     seg_length: Array
     u_a: Array
     u_b: Array
-    constrained: NDArray[np.bool_]
-    chord_start_node: IntArray
-    chord_end_node: IntArray
     gauss_u: Array
     gauss_w: Array
     s_q: Array
-    w_q: Array
     xi_q: Array
     c_q: Array
-    C0: Array
-    C1: Array
-    A0: Array
-    A1: Array
-    A0_T: Array
-    A1_T: Array
     xbar_q: Array
-    K0: Array
-    K1: Array
-    D_q: Array
-    K2: Array
-    C0_T: Array
-    C1_T: Array
     c_start: Array
     c_end: Array
-    xbar_start: Array
-    xbar_end: Array
-    D: Array
     peak_c: Array
     peak_s: Array
     strain0: Array
     strain1: Array
-    notch_left_node: IntArray
-    notch_right_node: IntArray
-    notch_open: IntArray
+    cells: Cells
+
+    C0, C1, C0_T, C1_T, xbar_start, xbar_end, D = (
+        _Packed[np.float64]("fc", k) for k in range(len(FC_NAMES)))
+    A0, A1, w_q, A0_T, A1_T, K0, K1, D_q, K2 = (
+        _Packed[np.float64]("fq", k) for k in range(len(FQ_NAMES)))
+    chord_start_node, chord_end_node = (_Packed[np.int64]("ic", k) for k in range(2))
+    constrained = _Packed[np.bool_]("ic", IC_NAMES.index("constrained"), nonzero=True)
+    notch_left_node, notch_right_node = (_Packed[np.int64]("notch", k) for k in range(2))
+    notch_open = _Packed[np.int64]("notch", slice(NOTCH_NAMES.index("notch_open"), None))
+
+    def member_view(self, values: NDArray[Scalar]) -> NDArray[Scalar]:
+        """``values`` (members first, as in ``cells``) as this grid holds them: a stack keeps
+        the member axis, one grid drops it."""
+        return values
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,19 +189,25 @@ class Grid(CellArrays):
     _queries: dict[bytes, Query] = field(default_factory=dict, init=False, compare=False,
                                          repr=False)
 
-    @property
+    def member_view(self, values: NDArray[Scalar]) -> NDArray[Scalar]:
+        """``values`` of the one member."""
+        return values[0]
+
+    @cached_property
     def constrained_cells(self) -> IntArray:
         """Indices of cells where the tendon follows the offset curve."""
         return np.flatnonzero(self.constrained)
 
     @property
+    def r_c(self) -> float:
+        """The tendon's offset from the tube axis (m)."""
+        return float(self.cells.r_c[0])
+
+    @property
     def constrained_peak_c(self) -> float:
         """Largest compliance (1/(N m^2)) over cells where the tendon follows the body, each
         scaled by its squared arm (:func:`arm_weighted`)."""
-        cells = self.constrained_cells
-        return float(np.max(arm_weighted(self.peak_c[cells], self.xbar_start[cells],
-                                         self.xbar_end[cells], self.design.R_c))
-                     ) if cells.size else 0.0
+        return float(self.cells.constrained_peak_c[0])
 
     @property
     def n_cells(self) -> int:
@@ -459,23 +497,21 @@ class GridParts:
         cell, proto, valid = self.cells_of(rows)
         count = table.count[rows]
         tip = members.length[rows][:, None]
-        tip_node = count[:, None]
 
         def laid(values: NDArray[Scalar], pad: float | bool | Array | IntArray
                  ) -> NDArray[Scalar]:
             return np.where(valid, values[cell], pad).astype(values.dtype, copy=False)
 
         seg_start = laid(table.seg_start, tip)
-        fq = {name: self.proto_fq[proto, k] for k, name in enumerate(
-            ("s_q", "w_q", "xi_q", "c_q", "A0", "A1", "A0_T", "A1_T", "xbar_q", "K0", "K1",
-             "D_q", "K2"))}
-        fc = {name: self.proto_fc[proto, k] for k, name in enumerate(
-            ("C0", "C1", "C0_T", "C1_T", "c_start", "c_end", "peak_c", "peak_s", "xbar_start",
-             "xbar_end", "D"))}
+        fq = {name: self.proto_fq[proto, k] for name, k in (
+            ("s_q", grid_kernel.S_Q), ("xi_q", grid_kernel.XI_Q), ("c_q", grid_kernel.C_Q),
+            ("xbar_q", grid_kernel.XB_Q))}
+        fc = {name: self.proto_fc[proto, k] for name, k in (
+            ("c_start", grid_kernel.C_START), ("c_end", grid_kernel.C_END),
+            ("peak_c", grid_kernel.PEAK_C), ("peak_s", grid_kernel.PEAK_S))}
         fq["s_q"] += seg_start[..., None]
         fc["peak_s"] += seg_start
         strain = {"strain0": self.proto_strain[proto, 0], "strain1": self.proto_strain[proto, 1]}
-        notches = int(members.N[rows].max())
         return GridStack(
             designs=tuple(members.designs[r] for r in rows), n_cells=count,
             s_nodes=np.concatenate([laid(table.a, tip), tip], axis=1),
@@ -483,13 +519,37 @@ class GridParts:
             shape=laid(table.shape, 0),
             seg_start=seg_start, seg_length=laid(table.seg_length, 0.0),
             u_a=laid(table.u_a, 0.0), u_b=laid(table.u_b, 0.0),
-            constrained=laid(table.constrained, True),
-            chord_start_node=laid(table.chord_start_node, tip_node),
-            chord_end_node=laid(table.chord_end_node, tip_node),
             gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc, **strain,
-            notch_left_node=table.notch_left_node[rows, :notches],
-            notch_right_node=table.notch_right_node[rows, :notches],
-            notch_open=members.notch_open[rows][:, :, :notches])
+            cells=self.cells(rows))
+
+    def cells(self, rows: IntArray) -> Cells:
+        """The kernel's arrays of members ``rows``, laid out straight from their prototype
+        cells (:meth:`stack` holds the same, with its other arrays)."""
+        cell, proto, valid = self.cells_of(rows)
+        table, members = self.table, self.members
+        build = grid_kernels()
+        fc = np.empty((rows.size, FC_ROWS, cell.shape[1], 1))
+        build.gather(proto, FC_FIELDS, self.proto_fc[..., None], fc)
+        fq = np.empty((rows.size, FQ_ROWS, cell.shape[1], self.gauss_u.size))
+        build.gather(proto, FQ_FIELDS, self.proto_fq, fq)
+        tip = table.count[rows][:, None]
+        constrained = np.where(valid, table.constrained[cell], True)
+        ic = np.stack([np.where(valid, table.chord_start_node[cell], tip),
+                       np.where(valid, table.chord_end_node[cell], tip),
+                       constrained], axis=1).astype(np.int64)
+        notches = int(members.N[rows].max())
+        fc_of = self.proto_fc[proto]
+        peak = np.where(constrained, arm_weighted(
+            fc_of[..., grid_kernel.PEAK_C], fc_of[..., grid_kernel.XB_START],
+            fc_of[..., grid_kernel.XB_END], members.R_c[rows][:, None]), 0.0)
+        scal = np.stack([members.R_c[rows], members.R_outer[rows], members.length[rows],
+                         np.max(peak, axis=1, initial=0.0)], axis=1)
+        return Cells(fc=fc[..., 0], fq=fq, ic=ic,
+                     notch=np.concatenate([np.stack([table.notch_left_node[rows, :notches],
+                                                     table.notch_right_node[rows, :notches]],
+                                                    axis=1),
+                                           members.notch_open[rows][:, :, :notches]], axis=1),
+                     scal=scal)
 
 
 def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
@@ -609,16 +669,18 @@ class GridStack(CellArrays):
         """Member ``m`` as a :class:`Grid` (its arrays are views of the stack's, unpadded)."""
         n = int(self.n_cells[m])
         design = self.designs[m]
-        shared = ("s_nodes", "gauss_u", "gauss_w", "notch_left_node", "notch_right_node",
-                  "notch_open")
+        shared = ("s_nodes", "gauss_u", "gauss_w", "cells")
         per_cell = {f.name: getattr(self, f.name)[m, :n] for f in fields(CellArrays)
                     if f.name not in shared}
-        per_cell.update(s_nodes=self.s_nodes[m, :n + 1], gauss_u=self.gauss_u,
-                        gauss_w=self.gauss_w, notch_left_node=self.notch_left_node[m, :design.N],
-                        notch_right_node=self.notch_right_node[m, :design.N],
-                        notch_open=self.notch_open[m, :, :design.N])
-        return Grid(design=design, chord_cells=np.flatnonzero(~per_cell["constrained"]),
-                    **per_cell)
+        block = self.cells
+        cells = Cells(fc=np.ascontiguousarray(block.fc[m:m + 1, :, :n]),
+                      fq=np.ascontiguousarray(block.fq[m:m + 1, :, :n]),
+                      ic=np.ascontiguousarray(block.ic[m:m + 1, :, :n]),
+                      notch=np.ascontiguousarray(block.notch[m:m + 1, :, :design.N]),
+                      scal=block.scal[m:m + 1])
+        return Grid(design=design, chord_cells=np.flatnonzero(cells.ic[0, 2] == 0),
+                    s_nodes=self.s_nodes[m, :n + 1], gauss_u=self.gauss_u,
+                    gauss_w=self.gauss_w, cells=cells, **per_cell)
 
 
 def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStack:

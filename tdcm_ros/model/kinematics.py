@@ -58,7 +58,7 @@ def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
     moments; 0 treats every moment as linear), carry it. ``grid`` is one grid, whose moments
     may carry leading batch axes, or :class:`Cells` of ``M`` members with moments (M, cells).
     """
-    cells = Cells.of(grid) if isinstance(grid, Grid) else grid
+    cells = grid.cells if isinstance(grid, Grid) else grid
     m_a = np.asarray(m_a, dtype=float)
     lead = m_a.shape[:-1]
     n = m_a.shape[-1]

@@ -11,7 +11,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model.cells import Cells
 from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.errors import (
     NotchClosureError,
@@ -56,7 +55,7 @@ def check_singularity(grid: Grid, m_a: Array, m_b: Array) -> None:
     if cells.size == 0:
         return
     moment = np.maximum(np.abs(m_a[cells]), np.abs(m_b[cells]))
-    arm = grid.design.R_c - np.minimum(grid.xbar_start[cells], grid.xbar_end[cells])
+    arm = grid.r_c - np.minimum(grid.xbar_start[cells], grid.xbar_end[cells])
     rc_kappa = arm * moment * grid.peak_c[cells]
     worst = int(np.argmax(rc_kappa))
     if rc_kappa[worst] >= 1.0:
@@ -74,7 +73,7 @@ def notch_gaps(grid: Grid, shape: PlanarShape) -> Array:
     signed distance of each face's outer corner (at ``R_outer``) from the other face
     (:func:`tdcm_ros.model.kernel.gaps_row`).
     """
-    cells = Cells.of(grid)
+    cells = grid.cells
     out = np.empty((1, cells.notch.shape[2]))
     kernels().gaps(cells.scal, np.ascontiguousarray(shape.p).reshape(1, -1),
                    np.ascontiguousarray(shape.tangent).reshape(1, -1), cells.notch, out)
@@ -88,9 +87,9 @@ def check_tendon_singularity(grid: Grid, tension: float) -> None:
     compliance (:func:`tdcm_ros.model.grid.arm_weighted`)."""
     if grid.constrained_cells.size == 0:
         return
-    rc_kappa = grid.design.R_c ** 2 * tension * grid.constrained_peak_c
+    rc_kappa = grid.r_c ** 2 * tension * grid.constrained_peak_c
     if rc_kappa >= 1.0:
-        arm = grid.design.R_c - np.minimum(grid.xbar_start, grid.xbar_end)
+        arm = grid.r_c - np.minimum(grid.xbar_start, grid.xbar_end)
         check_singularity(grid, arm * tension, arm * tension)
 
 

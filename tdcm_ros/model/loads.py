@@ -63,7 +63,7 @@ def closed_form_cells(grid: Grid | Cells, shape: PlanarShape, t_a: Array, t_b: A
     tendon + distal body. On a chord the tendon runs free, so the caller passes the chord's
     one tension at both ends.
     """
-    cells = Cells.of(grid) if isinstance(grid, Grid) else grid
+    cells = grid.cells if isinstance(grid, Grid) else grid
     p = shape.p
     lead = p.shape[:-1]
     n = p.shape[-1] - 1
@@ -120,7 +120,7 @@ def tendon_wrap(grid: Grid, shape: PlanarShape) -> tuple[Array, Array]:
 def _chords(grid: Grid, shape: PlanarShape, cells: NDArray[np.int64]
             ) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
     """Start point and unit direction (``z + i x``) of the tendon chord over each cell."""
-    p_c = shape.p + (1j * grid.design.R_c) * shape.tangent
+    p_c = shape.p + (1j * grid.r_c) * shape.tangent
     anchor = p_c[grid.chord_start_node[cells]]
     chord = p_c[grid.chord_end_node[cells]] - anchor
     return anchor, chord / np.abs(chord)
@@ -133,8 +133,7 @@ def literal(grid: Grid, shape: PlanarShape, tension: float, m_a: Array, m_b: Arr
     ``m_a``, ``m_b`` are the moments that produced ``shape``; they give the curvature the
     distributed forces need.
     """
-    d = grid.design
-    r_c = d.R_c
+    r_c = grid.r_c
     x, z, th = shape.x, shape.z, shape.theta
     n = grid.n_cells
     a_nodes = np.arange(n)

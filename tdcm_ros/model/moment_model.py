@@ -22,7 +22,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.model import loads
-from tdcm_ros.model.cells import Cells
 from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
@@ -129,8 +128,8 @@ class ClosedForm:
 
     def __init__(self, grid: Grid) -> None:
         self.grid = grid
-        self.cells = Cells.of(grid)
-        self._r_c_squared = float(grid.design.R_c) ** 2
+        self.cells = grid.cells
+        self._r_c_squared = float(grid.r_c) ** 2
         self._peak_c = float(self.cells.constrained_peak_c[0])  # Python floats: no warnings
 
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:

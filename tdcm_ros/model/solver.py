@@ -210,7 +210,7 @@ def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
         if scale is not None:
             return _rescaled(warm_start.cell_moments, scale)
     x0 = np.empty(2 * grid.n_cells)
-    x0.fill(grid.design.R_c * tension)
+    x0.fill(grid.r_c * tension)
     return x0
 
 
@@ -236,7 +236,7 @@ def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
         return _adaptive_continuation(problem, tension, x0, budget)
     grid, settings = problem.grid, problem.settings
     steps = settings.continuation_steps
-    x = np.full_like(x0, grid.design.R_c * tension / steps)
+    x = np.full_like(x0, grid.r_c * tension / steps)
     history: list[float] = []
     run = _Run(x, problem.shape_of(x, tension / steps), history, False, "no steps")
     previous = tension / steps
@@ -273,7 +273,7 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
     while lam < 1.0:
         target = 1.0 if lam + step >= 1.0 - 1e-12 else lam + step
         guess = x * (target / lam) if lam > 0.0 else np.full_like(
-            x0, problem.grid.design.R_c * tension * target)
+            x0, problem.grid.r_c * tension * target)
         run = _iterate(problem, tension * target, guess, budget - len(history),
                        mode="anderson", factor=target, tol=tol if target == 1.0 else loose)
         history.extend(run.history)

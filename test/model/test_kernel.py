@@ -46,7 +46,7 @@ def test_padded_stack_gives_each_member_its_own_answers(n_a, n_b, scale, routing
     cfg = SolverSettings(routing=routing)
     base = preset("paper-experiment")
     grids = [build_grid(base.with_overrides(N=n_a), cfg), build_grid(base.with_overrides(N=n_b), cfg)]
-    cells = Cells.stack(grids)
+    cells = Cells.stack([g.cells for g in grids])
     rng = np.random.default_rng(n_a * 7 + n_b)
     moments = [rng.uniform(0.0, 1e-3 * scale, g.n_cells) for g in grids]
     padded = np.zeros((2, cells.n_cells))
@@ -161,8 +161,8 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
     cfg = SolverSettings(routing=routing)
     base = preset("paper-experiment")
     designs = [base.with_overrides(N=n, w_n=w) for n, w in ((2, 1e-3), (5, 2e-3), (8, 1.5e-3))]
-    built = Cells.of_stack(build_grids(designs, cfg))
-    mine = Cells.stack([build_grid(d, cfg) for d in designs])
+    built = build_grids(designs, cfg).cells
+    mine = Cells.stack([build_grid(d, cfg).cells for d in designs])
     np.testing.assert_array_equal(built.constrained_peak_c, mine.constrained_peak_c)
     rows = np.arange(3)
     for cells in (built, mine):
@@ -209,7 +209,7 @@ def test_iterate_strained_adds_the_peak_strain_of_converged_members_only(build):
     base = preset("paper-experiment")
     designs = [base.with_overrides(N=n, w_n=w) for n, w in ((2, 1e-3), (5, 2e-3), (8, 1.5e-3))]
     parts = grid_parts(designs, SolverSettings())
-    cells = Cells.of_stack(parts.stack(np.arange(3)))
+    cells = parts.stack(np.arange(3)).cells
     notch_cells, s0, s1 = _strain_coefficients(parts, np.arange(3))
     rows = np.array([0, 1, 2, 2], np.int64)
     tension = np.array([15.0, 3.0, 9.0, 20.0])

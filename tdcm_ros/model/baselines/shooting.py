@@ -195,7 +195,7 @@ class _Shooter:
 
     def residual(self, v: Array) -> Array:
         """Scaled tip-condition mismatch for scaled unknowns ``v = (n/T, m/(R_c T))``."""
-        t, rc_t = self.tension, self.grid.design.R_c * self.tension
+        t, rc_t = self.tension, self.grid.r_c * self.tension
         states, ok = self.shoot(v[:2] * t, float(v[2]) * rc_t)
         if not ok:
             self.history.append(math.inf)
