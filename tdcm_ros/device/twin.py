@@ -41,6 +41,14 @@ RX_BUFFER = 64     #: bytes the UNO's serial receive buffer holds while its loop
 #: was not scheduled): the host's bytes of the gap reach the device spread over it. It is the
 #: driver's default heartbeat period.
 LATE_TURN_S = 0.1
+
+#: Queue depth (samples) of the truth topics (``sim/tension_true``,
+#: ``sim/joint_states_true``) at the twin and at mocap_node: a backlog of 4 s of a
+#: 1 kHz truth (51 s at the twin's default 80 Hz) is delivered whole. With depth 10, a mocap_node
+#: 3.7 s behind on a loaded machine kept 10 samples of its backlog and interpolated across the
+#: rest: the body bent 0.4 s before the tendon pulled (a red CI, the ideal demo on rclpy).
+TRUTH_DEPTH = 4096
+
 #: Host s: the longest gap between two turns that the threaded twin catches up; a longer one (a
 #: suspended process) is a pause of the simulation for the rest.
 MAX_GAP = 2.0

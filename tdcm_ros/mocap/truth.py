@@ -7,9 +7,13 @@ arrive late: a twin whose thread was not scheduled for 1.8 s sends that stretch 
 built from the latest sample at the time of the tick instead froze the body for that long (a
 3.4 mm jump of the measured tip in the tracking demo beside a CPU hog). So a frame at time ``t``
 is made once the truth covers ``t`` (:class:`TruthTrack`, interpolated), on a fixed grid of frame
-times (:class:`FrameClock`). The node takes truth more than ``TRUTH_STALE_NS`` behind its clock
-as held (the bench stands still: a stopped twin, or stamps from another clock) and goes on at the
-clock (:mod:`tdcm_ros.nodes.mocap_node`).
+times (:class:`FrameClock`). The node takes the truth as held (the bench stands still: a stopped
+twin) when no sample has arrived for ``TRUTH_STALE_NS`` of its clock (or the stamps are on
+another clock, ``TRUTH_OTHER_CLOCK_NS`` behind), and then goes on at the
+clock (:mod:`tdcm_ros.nodes.mocap_node`); old stamps alone do not make it held, since a node
+working through a backlog of truth reads old stamps that are still to be covered. Every sample
+counts, so both ends queue :data:`tdcm_ros.device.twin.TRUTH_DEPTH` of them: a dropped sample
+would be interpolated across.
 
 Times are ns since the epoch; values in SI units (N, rad).
 """

@@ -27,7 +27,7 @@ from dataclasses import asdict
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import PLANT_SPECS, ROLL_SPEED, PlantConfig, fault_names
-from tdcm_ros.device.twin import LATE_TURN_S, DeviceTwin, PtyTwin
+from tdcm_ros.device.twin import LATE_TURN_S, TRUTH_DEPTH, DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
 from tdcm_ros.nodes.shape_messages import header
@@ -119,10 +119,11 @@ class DeviceTwinNode(NodeLogic):
         self.frame_id = str(own["frame_id"])
         period = float(own["publish_period_s"])
         diag_period = float(own["diagnostics_period_s"])
+        # every sample counts (tdcm_ros.mocap.truth): a reader behind keeps them all
         self.truth = port.create_publisher("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
-                                           QoS(depth=100))
+                                           QoS(depth=TRUTH_DEPTH))
         self.roll_truth = port.create_publisher("sim/joint_states_true", JOINT_STATE,
-                                                QoS(depth=100))
+                                                QoS(depth=TRUTH_DEPTH))
         twin = DeviceTwin(plant, roll_speed=float(own["roll_speed"]))
         self.server = PtyTwin(twin, speed=speed, link=link, line_delay=line_delay).start()
         self.samples = 0

@@ -22,8 +22,9 @@ error or rejected axis message happened within the last 5 periods, or a live sou
   one arrives; messages without that joint are ignored, non-finite rolls dropped and counted) at
   the frame's own stamp, interpolated between their stamped samples: a frame waits until the truth
   covers its time (truth sent late, e.g. by a twin not scheduled for a while, still gives every
-  frame its true pose), and truth more than ``TRUTH_STALE_NS`` (2 s) behind the node's clock counts as
-  held (:mod:`tdcm_ros.mocap.truth`). The markers roll with the body about tdcm_base's z axis.
+  frame its true pose), and when no truth sample has arrived for ``TRUTH_STALE_NS`` (2 s), or its
+  stamps are on another clock (``TRUTH_OTHER_CLOCK_NS``, 60 s, behind: an unstamped sample), the
+  truth counts as held (:mod:`tdcm_ros.mocap.truth`). The markers roll with the body about tdcm_base's z axis.
   Published ``world.delay_s("markers")`` (drawn per frame) after their stamp; the registration
   comes from the scene (``world.mocap_to_base``).
 """
@@ -38,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from tdcm_ros.bagio import from_dict
+from tdcm_ros.device.twin import TRUTH_DEPTH
 from tdcm_ros.errors import InputError
 from tdcm_ros.mocap import (
     ArcLengthLabeller,
@@ -133,9 +135,12 @@ MOCAP_SPECS = by_name(
          180.0, low=-360.0, high=360.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
 
-#: ns the simulated truth may lag the node's clock before it counts as held (see the module
-#: docstring): beyond the 1.8 s seen from a starved twin beside a CPU hog.
+#: ns of the node's clock without a simulated truth sample arriving before the truth counts as
+#: held (see the module docstring): beyond the 1.8 s seen from a starved twin beside a CPU hog.
 TRUTH_STALE_NS = 2_000_000_000
+#: ns behind the node's clock past which a truth stamp is on another clock (an unstamped sample
+#: reads 1970), not a backlog still to be covered: such truth is held too.
+TRUTH_OTHER_CLOCK_NS = 60_000_000_000
 #: Every parameter of the node by full name (parameter files are checked against it).
 PARAMETERS = grouped(MOCAP_SPECS)
 
@@ -286,10 +291,11 @@ class MocapNode(NodeLogic):
         self.true_roll = TruthTrack()
         self.frame_clock = FrameClock(float(scene.mocap_rate_hz))
         self.roll_joint = str(self.port.get_parameter("sim.roll_joint"))
+        self.truth_arrived_ns: int | None = None  # node clock at the last true tension
         self.port.create_subscription("sim/tension_true", "geometry_msgs/msg/WrenchStamped",
-                                      self._on_true_tension, QoS(depth=10))
+                                      self._on_true_tension, QoS(depth=TRUTH_DEPTH))
         self.port.create_subscription("sim/joint_states_true", "sensor_msgs/msg/JointState",
-                                      self._on_true_joint_states, QoS(depth=10))
+                                      self._on_true_joint_states, QoS(depth=TRUTH_DEPTH))
         self.port.create_timer(1.0 / float(scene.mocap_rate_hz), self._sim_tick)
         self.drain_timer: Any = None
         self.state = f"simulating scene {scene.name!r}; no sim/tension_true yet (0 N)"
@@ -305,6 +311,7 @@ class MocapNode(NodeLogic):
         if not self.true_tension:
             self.state = "simulating"
         self.true_tension.add(stamp_ns_of(message), tension)
+        self.truth_arrived_ns = self.port.now_ns()
 
     def _on_true_joint_states(self, message: Any) -> None:
         roll = joint_position(message, self.roll_joint)
@@ -319,7 +326,9 @@ class MocapNode(NodeLogic):
         """Sample every frame time the truth now covers (see the module docstring)."""
         now = self.port.now_ns()
         covered = now
-        if self.true_tension and now - self.true_tension.newest_ns <= TRUTH_STALE_NS:
+        arrived = self.truth_arrived_ns
+        if (self.true_tension and arrived is not None and now - arrived <= TRUTH_STALE_NS
+                and now - self.true_tension.newest_ns <= TRUTH_OTHER_CLOCK_NS):
             covered = min(now, self.true_tension.newest_ns)
         for stamp_ns in self.frame_clock.until(covered):
             tension = self.true_tension.at(stamp_ns) if self.true_tension else 0.0

@@ -153,6 +153,58 @@ def test_sim_frames_wait_for_late_truth_and_take_it_at_their_own_stamps(monkeypa
                        rtol=0, atol=1e-6)
 
 
+def test_a_node_working_through_a_backlog_of_truth_makes_each_frame_from_its_own_truth(
+        monkeypatch):
+    """A node 3 s behind its truth (a loaded machine: each sample reaches its callback 3 s
+    after its stamp, between the node's ticks) still makes every frame from the truth at the
+    frame's stamp: old stamps that keep arriving are a backlog to cover, not a stopped twin.
+    (Taking truth 2 s behind the clock as held made frames up to the clock from the newest
+    sample: the body bent before the tendon pulled.)"""
+    scene = DoubleScene()
+    monkeypatch.setattr(tdcm_ros.scenes, "load_scene", lambda name: scene)
+    port = mocap_port({"source": "sim", "sim.scene": "double"})
+    MocapNode(port)
+    behind = 3_000_000_000
+    origin = port.now_ns() - behind
+
+    def ramp(stamp_ns: int) -> float:  # the true tension: 0 N for 1 s, then 2 N/s
+        return max(0.0, 2.0 * (stamp_ns - origin - 1_000_000_000) / 1e9)
+
+    for _ in range(400):                    # 4 s of 100 Hz truth, each 3 s late
+        port.advance(0.01)
+        stamp_ns = port.now_ns() - behind
+        port.deliver("sim/tension_true", true_tension(ramp(stamp_ns), stamp_ns))
+    frames = [(round(stamp_s * 1e9), tension) for stamp_s, tension in scene.the_world.calls]
+    stamps = np.array([stamp_ns for stamp_ns, _ in frames])
+    assert len(frames) >= 150 and stamps[-1] <= port.now_ns() - behind
+    assert np.allclose([tension for _, tension in frames], [ramp(t) for t in stamps],
+                       rtol=0, atol=1e-6)
+
+
+def test_truth_is_queued_deep_enough_for_a_backlog_at_both_ends(monkeypatch):
+    """Every truth sample counts (a dropped one is interpolated across): mocap_node's truth
+    subscriptions and the twin's truth publishers queue TRUTH_DEPTH samples, 4 s of a 1 kHz
+    truth (depth 10 dropped most of a 3.7 s backlog in a red CI)."""
+    from tdcm_ros.device.twin import TRUTH_DEPTH
+
+    scene = DoubleScene()
+    monkeypatch.setattr(tdcm_ros.scenes, "load_scene", lambda name: scene)
+    port = mocap_port({"source": "sim", "sim.scene": "double"})
+    MocapNode(port)
+    assert TRUTH_DEPTH >= 4 * 1000
+    for topic in ("sim/tension_true", "sim/joint_states_true"):
+        assert port.subscriptions[topic][2].depth == TRUTH_DEPTH, topic
+    from tdcm_ros.nodes.device_twin import DeviceTwinNode
+
+    twin_port = MemoryPort({}, name="device_twin")
+    twin = DeviceTwinNode(twin_port)
+    try:
+        for topic in ("sim/tension_true", "sim/joint_states_true"):
+            assert twin_port.publishers[topic].qos.depth == TRUTH_DEPTH, topic
+    finally:
+        twin.close()
+
+
 def test_sim_truth_older_than_the_stale_limit_is_held_and_frames_go_on(monkeypatch):
     """A truth stream that stops (a stopped twin) holds its last value: frames wait while it
     may still come late, and past TRUTH_STALE_NS go on at the clock with it."""
