@@ -15,7 +15,6 @@ cells at the tip (they move no node) and with notches marked -1 (never checked).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,33 +35,6 @@ class Cells:
     ic: Ints
     notch: Ints
     scal: Array
-
-    @classmethod
-    def stack(cls, parts: Sequence[Cells]) -> Cells:
-        """Members = the members of ``parts`` (one each, e.g. single grids' ``cells``), padded
-        to the largest cell and notch counts."""
-        n = max(c.n_cells for c in parts)
-        k = max(c.notch.shape[2] for c in parts)
-        q = max(c.fq.shape[3] for c in parts)
-        fc = np.zeros((len(parts), FC_ROWS, n))
-        fq = np.zeros((len(parts), FQ_ROWS, n, q))
-        ic = np.zeros((len(parts), 3, n), np.int64)
-        ic[:, 2] = 1
-        notch = np.full((len(parts), NOTCH_ROWS, k), -1, np.int64)
-        notch[:, 2:] = 0  # a padding notch has no nodes (-1) and no side to close
-        for j, c in enumerate(parts):
-            cells, notches, points = c.n_cells, c.notch.shape[2], c.fq.shape[3]
-            fc[j, :, :cells] = c.fc[0]
-            fq[j, :, :cells, :points] = c.fq[0]
-            ic[j, :, :cells] = c.ic[0]
-            notch[j, :, :notches] = c.notch[0]
-        return cls(fc=fc, fq=fq, ic=ic, notch=notch,
-                   scal=np.concatenate([c.scal for c in parts]))
-
-    def take(self, rows: Ints) -> Cells:
-        """The members ``rows`` (repeats allowed)."""
-        return Cells(fc=self.fc[rows], fq=self.fq[rows], ic=self.ic[rows],
-                     notch=self.notch[rows], scal=self.scal[rows])
 
     @property
     def members(self) -> int:

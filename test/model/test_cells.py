@@ -9,10 +9,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.model import SolverSettings, grid_kernel, preset
-from tdcm_ros.model.cells import FC_FIELDS, FC_NAMES, FQ_FIELDS, FQ_NAMES, Cells
+from tdcm_ros.model.cells import FC_FIELDS, FC_NAMES, FQ_FIELDS, FQ_NAMES
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.design_space import couple
 from tdcm_ros.model.grid import build_grid, grid_parts
+from test.support.cells import stack_cells
 
 FIELDS = ("fc", "fq", "ic", "notch", "scal")
 
@@ -33,9 +34,9 @@ def test_cells_of_parts_equal_the_single_grids_stacked_bit_for_bit(designs, rout
     for count in np.unique(counts):
         rows = np.flatnonzero(counts == count)
         laid = parts.cells(rows)
-        single = Cells.stack([build_grid(designs[r], cfg).cells for r in rows])
+        single = stack_cells([build_grid(designs[r], cfg).cells for r in rows])
         stacked = parts.stack(rows).cells
-        # Cells.stack pads the notches of a design with fewer with -1, the grid stack with
+        # stack_cells pads the notches of a design with fewer with -1, the grid stack with
         # the tip node: both are never read as closed. Compare the stack's convention.
         single_notch = np.where(single.notch < 0, count, single.notch)
         for name in FIELDS:

@@ -13,11 +13,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.model import SolverSettings, compiled, kernel, preset, solve
-from tdcm_ros.model.cells import Cells
 from tdcm_ros.model.grid import build_grid
 from tdcm_ros.model.kinematics import integrate
 from tdcm_ros.model.limits import notch_gaps
 from tdcm_ros.model.loads import closed_form
+from test.support.cells import stack_cells
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -46,7 +46,7 @@ def test_padded_stack_gives_each_member_its_own_answers(n_a, n_b, scale, routing
     cfg = SolverSettings(routing=routing)
     base = preset("paper-experiment")
     grids = [build_grid(base.with_overrides(N=n_a), cfg), build_grid(base.with_overrides(N=n_b), cfg)]
-    cells = Cells.stack([g.cells for g in grids])
+    cells = stack_cells([g.cells for g in grids])
     rng = np.random.default_rng(n_a * 7 + n_b)
     moments = [rng.uniform(0.0, 1e-3 * scale, g.n_cells) for g in grids]
     padded = np.zeros((2, cells.n_cells))
@@ -162,7 +162,7 @@ def test_cells_of_a_built_stack_equal_the_stacked_grids(routing):
     base = preset("paper-experiment")
     designs = [base.with_overrides(N=n, w_n=w) for n, w in ((2, 1e-3), (5, 2e-3), (8, 1.5e-3))]
     built = build_grids(designs, cfg).cells
-    mine = Cells.stack([build_grid(d, cfg).cells for d in designs])
+    mine = stack_cells([build_grid(d, cfg).cells for d in designs])
     np.testing.assert_array_equal(built.constrained_peak_c, mine.constrained_peak_c)
     rows = np.arange(3)
     for cells in (built, mine):
