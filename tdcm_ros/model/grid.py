@@ -520,12 +520,16 @@ class GridParts:
             seg_start=seg_start, seg_length=laid(table.seg_length, 0.0),
             u_a=laid(table.u_a, 0.0), u_b=laid(table.u_b, 0.0),
             gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc, **strain,
-            cells=self.cells(rows))
+            cells=self._cells(rows, cell, proto, valid))
 
     def cells(self, rows: IntArray) -> Cells:
         """The kernel's arrays of members ``rows``, laid out straight from their prototype
         cells (:meth:`stack` holds the same, with its other arrays)."""
-        cell, proto, valid = self.cells_of(rows)
+        return self._cells(rows, *self.cells_of(rows))
+
+    def _cells(self, rows: IntArray, cell: IntArray, proto: IntArray,
+               valid: NDArray[np.bool_]) -> Cells:
+        """:meth:`cells` from the slots :meth:`cells_of` gave for ``rows``."""
         table, members = self.table, self.members
         build = grid_kernels()
         fc = np.empty((rows.size, FC_ROWS, cell.shape[1], 1))
