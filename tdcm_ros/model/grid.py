@@ -75,7 +75,6 @@ from tdcm_ros.model.grid_kernel import (
     PRISMATIC,
     RECTANGULAR,
     TABULATED,
-    offset_section,
 )
 from tdcm_ros.model.grid_layout import (
     PEAK_SAMPLES,
@@ -83,11 +82,9 @@ from tdcm_ros.model.grid_layout import (
     Members,
     Prototypes,
     cell_table,
-    per_row,
     prototypes,
 )
 from tdcm_ros.model.quiet import quiet_fp
-from tdcm_ros.model.section import notched_moment
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
@@ -234,26 +231,6 @@ class Grid(CellArrays):
         """The design as a one-member :class:`Members`."""
         return Members.of([self.design])
 
-    def rows(self, cells: IntArray) -> CellRows:
-        """Cell data of ``cells`` (one row each) for the per-row geometry functions."""
-        return CellRows(members=self.members, member=np.zeros(cells.shape, np.int64),
-                        shape=self.shape[cells], is_notch=self.is_notch[cells],
-                        seg_start=self.seg_start[cells],
-                        seg_length=self.seg_length[cells], a=self.s_nodes[cells],
-                        length=self.s_nodes[cells + 1] - self.s_nodes[cells])
-
-    def local_sigma(self, cells: IntArray, u: Array) -> Array:
-        """Arc length from each cell's segment start (m) at reference coordinate ``u``."""
-        return self.rows(cells).local_sigma(u)
-
-    def jacobian(self, cells: IntArray, u: Array) -> Array:
-        """``ds/du`` (m) at ``u`` in each cell's segment."""
-        return self.rows(cells).jacobian(u)
-
-    def compliance(self, cells: IntArray, u: Array) -> Array:
-        """``1/(E I)`` (1/(N m^2)) at reference coordinate ``u`` of each cell's segment."""
-        return self.rows(cells).compliance(u)
-
     def u_of_s(self, cells: IntArray, s: Array) -> Array:
         """Inverse of :meth:`local_sigma`: reference coordinate of arc length ``s`` (m)."""
         sigma = s - self.seg_start[cells]
@@ -285,28 +262,25 @@ class Grid(CellArrays):
     def partial_integrals(self, cells: IntArray, s: Array
                           ) -> tuple[Array, Array, Array, Array, Array, Array, Array, Array,
                                      Array, Array]:
-        """Integrals from each cell's start ``a`` to a query ``s`` inside it (SI units).
+        """Integrals from each cell's start ``a`` to a query ``s`` inside it (SI units), by the
+        kernel that integrated the cells (:func:`tdcm_ros.model.grid_kernel.cell_integrals`)
+        on the part ``[a, s]`` of each, with the whole cell's ``xi`` and end centroids.
 
         Returns ``(A0_s, A1_s, D_s, A0_r, A1_r, D_r, w_r, K0_r, K1_r, K2_r)``: ``A0``, ``A1``,
         ``D`` at ``s`` (shape (k,)) and at the Gauss points of ``[a, s]`` (shape (k, Q)), those
         points' ds weights (m) and their tube-axis stretch terms ``K0``, ``K1``, ``K2`` (module
         docstring; ``D`` and ``K`` are 0 where the centroid is on the axis).
         """
-        rows = self.rows(cells)
-        ua = self.u_a[cells][:, None]
-        us = self.u_of_s(cells, s)[:, None]
-        u_r = ua + (us - ua) * self.gauss_u[None, :]
-        w_r = _exact_length((us - ua) * self.gauss_w[None, :] * rows.jacobian(u_r),
-                            s - self.s_nodes[cells])
-        ends = (self.xbar_start[cells][:, None], self.xbar_end[cells][:, None])
-        a0_r, a1_r, d_r = _nested(rows, self.gauss_u, self.gauss_w, ua, u_r, ends)
-        a0_s, a1_s, d_s = _nested(rows, self.gauss_u, self.gauss_w, ua, us, ends)
-        c_r, x_bar_r = rows.section(u_r)
-        xi_r = _xi(rows, u_r)
-        stretch = w_r * x_bar_r * c_r
-        off = x_bar_r - ((1.0 - xi_r) * ends[0] + xi_r * ends[1])
-        return (a0_s[:, 0], a1_s[:, 0], d_s[:, 0], a0_r, a1_r, d_r, w_r,
-                stretch * (1.0 - xi_r), stretch * xi_r, stretch * off)
+        start = self.s_nodes[cells] - self.seg_start[cells]
+        cell = np.stack([self.is_notch[cells], np.zeros(cells.size), self.u_a[cells],
+                         self.u_of_s(cells, s), start, self.length[cells],
+                         self.seg_length[cells], self.u_b[cells], s - self.s_nodes[cells]],
+                        axis=1).astype(float)
+        fc, fq, _ = _integrals(self.members, self.shape[cells], cell, self.gauss_u.size)
+        fc, fq = fc[:-1], fq[:-1]
+        k = grid_kernel
+        return (fc[:, k.C0], fc[:, k.C1], fc[:, k.D_CELL], fq[:, k.A0], fq[:, k.A1],
+                fq[:, k.D_Q], fq[:, k.W_Q], fq[:, k.K0], fq[:, k.K1], fq[:, k.K2])
 
 
 def arm_weighted(peak_c: Array, xbar_start: Array, xbar_end: Array, r_c: Array | float
@@ -318,117 +292,6 @@ def arm_weighted(peak_c: Array, xbar_start: Array, xbar_end: Array, r_c: Array |
     is on the axis)."""
     arm = r_c - np.minimum(xbar_start, xbar_end)
     return peak_c * (arm / r_c) ** 2
-
-
-def _exact_length(weights: Array, length: Array) -> Array:
-    """Scale ds quadrature weights (m) so each row sums to its exact arc length (m): a straight
-    cell then integrates to its length exactly, whatever the profile's Jacobian."""
-    total = np.sum(weights, axis=-1, keepdims=True)
-    return weights * np.where(total > 0.0, length[..., None] / np.where(total > 0, total, 1.0), 0.0)
-
-
-@dataclass(frozen=True)
-class CellRows:
-    """Cells lined up with the first axis of a ``u`` array: each row's member, notch shape
-    (within the member), segment (m) and span along s (``a``, ``length``, m); the geometry of
-    those cells at any ``u`` there."""
-
-    members: Members
-    member: IntArray
-    shape: IntArray
-    is_notch: NDArray[np.bool_]
-    seg_start: Array
-    seg_length: Array
-    a: Array
-    length: Array
-
-    def local_sigma(self, u: Array) -> Array:
-        """Arc length from each row's segment start (m) at ``u``."""
-        out = per_row(self.seg_length, u) * u
-        shape, notch = self._notch_points(u)
-        if shape.size:
-            out[notch] = self.members.sigma(shape, u[notch])
-        return out
-
-    def jacobian(self, u: Array) -> Array:
-        """``ds/du`` (m) at ``u``."""
-        out = per_row(self.seg_length, u) + 0.0 * u
-        shape, notch = self._notch_points(u)
-        if shape.size:
-            out[notch] = self.members.dsigma_du(shape, u[notch])
-        return out
-
-    def compliance(self, u: Array) -> Array:
-        """``1/(E I)`` (1/(N m^2)) at ``u``."""
-        return self.section(u)[0]
-
-    def section(self, u: Array) -> tuple[Array, Array]:
-        """``1/(E I)`` (1/(N m^2)) about the section's centroid and the centroid's offset from
-        the tube axis (m, + toward the tendon) at ``u``: eq. 12's section where the backbone is
-        centred, :func:`tdcm_ros.model.grid_kernel.offset_section` where it is not, a polygon
-        section's own where the notch has one."""
-        m = self.members
-        every = np.broadcast_to(per_row(self.member, u), u.shape)
-        inertia = m.tube_moment[every]
-        x_bar = np.zeros(u.shape)
-        shape, notch = self._notch_points(u)
-        if shape.size:
-            owner = m.shape_member[shape]
-            h1 = m.h1(shape, u[notch])
-            in_notch = notched_moment(h1, m.R_outer[owner], m.r_inner[owner])
-            x_bar_notch = np.zeros(h1.shape)
-            given = m.shape_section[shape]  # a polygon's section, given whole (I > 0)
-            prismatic = given[:, 0] > 0.0
-            tabulated = m.is_tabulated[shape]
-            off = (m.shape_w_o[shape] != 0.0) & ~prismatic & ~tabulated
-            if np.any(off):
-                _, in_notch[off], x_bar_notch[off], _ = _offset_sections(
-                    h1[off], m.shape_w_o[shape][off], m.R_outer[owner][off],
-                    m.r_inner[owner][off])
-            in_notch[prismatic] = given[prismatic, 0]
-            x_bar_notch[prismatic] = given[prismatic, 1]
-            if np.any(tabulated):
-                c_t, x_bar_notch[tabulated], _ = m.tabulated(shape[tabulated], u[notch][tabulated])
-                in_notch[tabulated] = 1.0 / (m.E[owner[tabulated]] * c_t)
-            x_bar[notch] = x_bar_notch
-            inertia[notch] = in_notch
-        return 1.0 / (m.E[every] * inertia), x_bar
-
-    def _notch_points(self, u: Array) -> tuple[IntArray, NDArray[np.bool_]]:
-        """Notch shapes (rows of :class:`Members`) of the points of ``u`` inside notches
-        (flat), and the mask of those points."""
-        notch = np.broadcast_to(per_row(self.is_notch, u), u.shape)
-        shape = self.members.shape_first[self.member] + self.shape
-        return np.broadcast_to(per_row(shape, u), u.shape)[notch], notch
-
-
-_offset_sections = np.vectorize(offset_section, otypes=[float] * 4)
-""":func:`tdcm_ros.model.grid_kernel.offset_section` over arrays (query stations: a few
-hundred points, computed once per grid and station set)."""
-
-
-def _xi(rows: CellRows, u: Array) -> Array:
-    """``(s - a) / (b - a)`` of each row's cell at reference coordinates ``u``."""
-    return (per_row(rows.seg_start, u) + rows.local_sigma(u) - per_row(rows.a, u)
-            ) / per_row(rows.length, u)
-
-
-def _nested(rows: CellRows, gauss_u: Array, gauss_w: Array, ua: Array, u_end: Array,
-            ends: tuple[Array, Array]) -> tuple[Array, Array, Array]:
-    """``A0``, ``A1`` and ``D`` from reference coordinate ``ua`` to each ``u_end`` of the same
-    cell; ``ends`` are the cells' ``x_bar`` at their start and end (m, broadcast against
-    ``u_end``).
-
-    ``u_end`` has one row per cell of ``rows``; ``ua`` broadcasts against it.
-    """
-    span = u_end - ua
-    inner_u = ua[..., None] + span[..., None] * gauss_u
-    inner_ds = span[..., None] * gauss_w * rows.jacobian(inner_u)
-    xi = _xi(rows, inner_u)
-    c, x_bar = rows.section(inner_u)
-    off = x_bar - ((1.0 - xi) * ends[0][..., None] + xi * ends[1][..., None])
-    return (np.sum(inner_ds * (1.0 - xi) * c, axis=-1), np.sum(inner_ds * xi * c, axis=-1),
-            np.sum(inner_ds * c * off, axis=-1))
 
 
 def build_grid(design: Design, settings: SolverSettings) -> Grid:
@@ -561,10 +424,17 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
     """:class:`GridParts`' ``proto_fc``, ``proto_fq``, ``proto_strain`` of every prototype cell
     of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row;
     ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
-    gauss_u, gauss_w = _gauss(quad_order)
-    members = table.members
     cell = np.stack([table.is_notch, table.chord, table.u_a, table.u_b, table.a, table.length,
-                     table.seg_length], axis=1).astype(float)
+                     table.seg_length, table.u_b, table.length], axis=1).astype(float)
+    return _integrals(table.members, table.shape, cell, quad_order, workers)
+
+
+def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
+               workers: int = 1) -> tuple[Array, Array, Array]:
+    """:func:`tdcm_ros.model.grid_kernel.cell_integrals` of the cells ``cell`` (its columns)
+    of notch shapes ``shape`` (rows of ``members``), followed by a zero row: ``fc``, ``fq``,
+    ``strain``; ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
+    gauss_u, gauss_w = _gauss(quad_order)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
     owner = members.shape_member
     design = np.concatenate([np.stack(
@@ -573,15 +443,16 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
          members.tube_moment[owner], members.shape_w_o], axis=1), members.shape_section], axis=1)
     build = grid_kernels()
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
-    custom_row, custom_table = _custom_table(table, build, cell, design, gauss_u, probe)
-    count = table.u_a.size
+    custom_row, custom_table = _custom_table(members, shape, build, cell, design, gauss_u,
+                                             probe)
+    count = shape.size
     fc = np.zeros((count + 1, 11))
     fq = np.zeros((count + 1, 13, quad_order))
     strain = np.zeros((count + 1, 2, PEAK_SAMPLES))
     matrix = _integration_matrix(quad_order)
 
     def integrate(part: slice) -> None:
-        build.cell_integrals(table.shape[part], cell[part], design, custom_row[part],
+        build.cell_integrals(shape[part], cell[part], design, custom_row[part],
                              custom_table, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
                              strain[part])
 
@@ -599,29 +470,30 @@ _PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR, "polygon": PR
                  "section": PRISMATIC, "sliced": TABULATED}
 
 
-def _custom_table(table: Prototypes, build: Any, cell: Array, design: Array,
+def _custom_table(members: Members, shape: IntArray, build: Any, cell: Array, design: Array,
                   gauss_u: Array, probe: Array) -> tuple[IntArray, Array]:
-    """For prototype cells in notches of user profiles (:data:`CUSTOM`) and of sections
-    changing along the notch (:data:`TABULATED`): a row each of the custom table (-1 for the
-    others) holding, at every evaluation point of :func:`tdcm_ros.model.grid_kernel.points`,
-    ``h1`` (m; then two zeros), or ``1/(E I)`` (1/(N m^2)), ``x_bar`` (m) and the farthest
-    fibre (m)."""
-    kind = design[table.shape, 0]
-    chosen = np.flatnonzero(((kind == CUSTOM) | (kind == TABULATED)) & table.is_notch)
-    rows = np.full(table.u_a.size, -1, np.int64)
+    """For cells ``cell`` (of notch shapes ``shape``) in notches of user profiles
+    (:data:`CUSTOM`) and of sections changing along the notch (:data:`TABULATED`): a row each
+    of the custom table (-1 for the others) holding, at every evaluation point of
+    :func:`tdcm_ros.model.grid_kernel.points`, ``h1`` (m; then two zeros), or ``1/(E I)``
+    (1/(N m^2)), ``x_bar`` (m) and the farthest fibre (m)."""
+    kind = design[shape, 0]
+    is_notch = cell[:, grid_kernel.IS_NOTCH] != 0.0
+    chosen = np.flatnonzero(((kind == CUSTOM) | (kind == TABULATED)) & is_notch)
+    rows = np.full(shape.size, -1, np.int64)
     size = gauss_u.size * (gauss_u.size + 1) + probe.size + 2
     out = np.zeros((chosen.size, size, 3))
     if chosen.size:
         rows[chosen] = np.arange(chosen.size)
         u = np.empty((chosen.size, size))
         build.points(np.ascontiguousarray(cell[chosen]), gauss_u, probe, u)
-        shape = table.shape[chosen]
+        chosen_shape = shape[chosen]
         custom = kind[chosen] == CUSTOM
         if np.any(custom):
-            out[custom, :, 0] = table.members.h1(shape[custom], u[custom])
+            out[custom, :, 0] = members.h1(chosen_shape[custom], u[custom])
         tabulated = ~custom
         if np.any(tabulated):
-            out[tabulated] = np.stack(table.members.tabulated(shape[tabulated], u[tabulated]),
+            out[tabulated] = np.stack(members.tabulated(chosen_shape[tabulated], u[tabulated]),
                                       axis=-1)
     return rows, out
 

@@ -9,7 +9,12 @@ prototype cells of :mod:`tdcm_ros.model.grid_layout`; the module docstring of
 :mod:`tdcm_ros.model.grid` says what each integral is.
 
 Per prototype cell ``i`` (inputs, SI units): ``shape[i]``; ``cell[i, :]`` =
-``(is_notch, chord, u_a, u_b, a, length, seg_length)`` (``a`` from the segment start, m).
+``(is_notch, chord, u_a, u_b, a, length, seg_length, u_end, span)`` (``a`` from the segment
+start, m). A cell may be the first part ``[u_a, u_b]`` of a whole one (a query station's,
+:meth:`tdcm_ros.model.grid.Grid.query`): ``a``, ``length`` (m) and ``u_end`` are the whole
+cell's start, arc length and end, so that ``xi`` and the centroid's end offsets are the whole
+cell's, and ``span`` is the part's arc length (m), to which its ds weights sum; a whole cell
+has ``u_end = u_b`` and ``span = length``.
 Per notch shape ``k`` (a member's distinct notch; a tube cell names its member's first):
 ``design[k, :]`` = ``(profile kind, w_n, w_d, R_outer, r_inner, E, tube moment, w_o, I, x_bar,
 fibre)`` with kinds :data:`CIRCULAR` (eq. 13), :data:`RECTANGULAR`, :data:`CUSTOM` (``h1``
@@ -18,9 +23,10 @@ linear in ``u``), :data:`PRISMATIC` (a section given whole, the same along the n
 centroidal ``I`` (m^4), centroid ``x_bar`` (m) and farthest fibre (m) in the last three
 columns, unused by the other kinds; ``sigma`` linear in ``u``) and :data:`TABULATED` (a
 section changing along the notch, given at every point: ``1/(E I)`` (1/(N m^2)), ``x_bar``
-and the farthest fibre (m) in ``custom[custom_row[i], p, :]``; ``sigma`` linear in ``u``). Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points
-(``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally
-spaced probes and its two ends, in that order (:func:`points`).
+and the farthest fibre (m) in ``custom[custom_row[i], p, :]``; ``sigma`` linear in ``u``).
+Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points (``Q`` per Gauss
+point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally spaced probes and
+its whole cell's two ends ``u_a``, ``u_end``, in that order (:func:`points`).
 """
 
 from __future__ import annotations
@@ -40,7 +46,7 @@ PRISMATIC = 3
 TABULATED = 4
 """Profile kinds of ``design[:, 0]``."""
 
-IS_NOTCH, CHORD, U_A, U_B, START, LENGTH, SEG_LENGTH = range(7)
+IS_NOTCH, CHORD, U_A, U_B, START, LENGTH, SEG_LENGTH, U_END, SPAN = range(9)
 """Columns of ``cell``."""
 KIND, W_N, W_D, R_OUTER, R_INNER, E, TUBE_MOMENT, W_O, SEC_I, SEC_XBAR, SEC_FIBRE = range(11)
 """Columns of ``design``."""
@@ -187,7 +193,7 @@ def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
         for k in range(probe.shape[0]):
             out[i, first + k] = u_a + span * probe[k]
         out[i, first + probe.shape[0]] = u_a
-        out[i, first + probe.shape[0] + 1] = cell[i, U_B]
+        out[i, first + probe.shape[0] + 1] = cell[i, U_END]
 
 
 def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
@@ -224,7 +230,7 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
         out = fq[i]
         ends = first + probe.shape[0]
         _, _, fc[i, C_START], x_a, _ = point(notch, d, seg_length, u_a, custom[ends])
-        _, _, fc[i, C_END], x_b, _ = point(notch, d, seg_length, c[U_B], custom[ends + 1])
+        _, _, fc[i, C_END], x_b, _ = point(notch, d, seg_length, c[U_END], custom[ends + 1])
         fc[i, XB_START] = x_a
         fc[i, XB_END] = x_b
         total = 0.0
@@ -252,7 +258,7 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
             out[A0, q] = a0
             out[A1, q] = a1
             out[D_Q, q] = d0
-        _weights_and_chords(c[CHORD] != 0.0, length / total if total > 0.0 else 0.0,
+        _weights_and_chords(c[CHORD] != 0.0, c[SPAN] / total if total > 0.0 else 0.0,
                             gauss_w, matrix, out, fc[i])
         whole = 0.0
         for q in range(q_count):

@@ -162,10 +162,6 @@ class Members:
         """Local arc length in a notch (m) at ``u``, rows of ``u`` as in :meth:`h1`."""
         return self._per_profile(shape, u, lambda p, x, w_n, w_d: p.sigma(x, w_n))
 
-    def dsigma_du(self, shape: IntArray, u: Array) -> Array:
-        """``d sigma / du`` in a notch (m) at ``u``, rows of ``u`` as in :meth:`h1`."""
-        return self._per_profile(shape, u, lambda p, x, w_n, w_d: p.dsigma_du(x, w_n))
-
     def _per_profile(self, shape: IntArray, u: Array, evaluate: ProfileFunction) -> Array:
         """``evaluate(profile, u, w_n, w_d)`` with each row's notch shape's profile and widths."""
         if len(self.profiles) == 1:

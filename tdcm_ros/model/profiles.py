@@ -40,10 +40,6 @@ class CircularProfile:
         """Local arc length (m) at reference coordinate ``u``."""
         return 0.5 * w_n * (1.0 - np.cos(np.pi * u))
 
-    def dsigma_du(self, u: Array, w_n: Width) -> Array:
-        """Jacobian d(sigma)/du (m)."""
-        return 0.5 * w_n * np.pi * np.sin(np.pi * u)
-
     def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u``."""
         return 0.5 * (w_n + w_d) - 0.5 * w_n * np.sin(np.pi * u)
@@ -55,10 +51,6 @@ class _StraightSlot:
     def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
         return w_n * u
-
-    def dsigma_du(self, u: Array, w_n: Width) -> Array:
-        """Jacobian d(sigma)/du (m)."""
-        return np.full_like(u, w_n)
 
     def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u``: ``w_d / 2``."""
@@ -87,10 +79,6 @@ class CustomProfile:
     def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
         return w_n * u
-
-    def dsigma_du(self, u: Array, w_n: Width) -> Array:
-        """Jacobian d(sigma)/du (m)."""
-        return np.full_like(u, w_n)
 
     def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u`` from the user's function."""

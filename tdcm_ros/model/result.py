@@ -158,7 +158,11 @@ class SolveResult:
         """Positions (k, 3) m and quaternions (k, 4) at arc lengths ``s`` (m) in ``[0, L]``.
 
         Exact within the solution's moment field: each query integrates eq. 2 from the start
-        of its cell with the same quadrature as the solve.
+        of its cell by the kernel and quadrature that integrated the cells for the solve
+        (:meth:`tdcm_ros.model.grid.Grid.query`). On a chord cell (``routing="free"``) the
+        moment is taken linear between the cell's end moments, without the chord's ``-T c m``
+        part that the solve adds over the whole cell (1e-15 m at a chord cell's end for
+        paper-experiment at 6 N).
         """
         from tdcm_ros.errors import out_of_range
 

@@ -12,6 +12,7 @@ from tdcm_ros.model.accuracy import converged_tip
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
 from tdcm_ros.model.grid import build_grid, build_grids
+from tdcm_ros.model.section import notched_moment
 
 PER_CELL = ("s_nodes", "is_notch", "notch_index", "shape", "seg_start", "seg_length", "u_a", "u_b",
             "constrained", "chord_start_node", "chord_end_node", "s_q", "w_q", "xi_q", "c_q",
@@ -228,10 +229,10 @@ def test_chord_terms_in_a_notch_match_a_fine_trapezoid_integration():
     design = preset("paper-experiment")
     grid = build_grid(design, SolverSettings(routing="free"))
     for k in grid.chord_cells[grid.is_notch[grid.chord_cells]][:6]:
-        cells = np.full(20001, k)
-        u = np.linspace(grid.u_a[k], grid.u_b[k], cells.size)
-        s = grid.seg_start[k] + grid.local_sigma(cells, u)
-        c = grid.compliance(cells, u)
+        u = np.linspace(grid.u_a[k], grid.u_b[k], 20001)
+        s = grid.seg_start[k] + design.profile.sigma(u, design.w_n)
+        h1 = design.profile.h1(u, design.w_n, design.w_d)
+        c = 1.0 / (design.E * notched_moment(h1, design.R_outer, design.r_inner))
         xi = (s - s[0]) / (s[-1] - s[0])
 
         def cumulative(f, s=s):

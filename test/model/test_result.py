@@ -10,11 +10,12 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import quad
+from scipy.integrate import quad, solve_ivp
 
 from tdcm_ros.model import SolverSettings, preset, solve
 from tdcm_ros.model.batch import solve_batch
 from tdcm_ros.model.design import Design
+from tdcm_ros.model.grid_kernel import offset_section
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.section import notched_moment
 
@@ -136,3 +137,75 @@ def test_the_json_summary_lists_every_notch_base_to_tip() -> None:
                 "notch_peak_strains"):
         assert len(summary[key]) == design.N, key
         assert all(math.isfinite(v) for v in summary[key]), key
+
+
+def cell_pose_reference(result: SolveResult, s: float) -> tuple[complex, float]:
+    """Tube-axis position (z + i x, m) and tangent angle (rad) at ``s`` by scipy's ODE solver
+    from the start of its cell: the solution's end moments there taken linear along the cell
+    (about the section's centroid, less ``T dx`` where the centroid moves off the line between
+    the cell's end centroids), the section of eq. 13's half-width in s (by
+    :func:`~tdcm_ros.model.grid_kernel.offset_section`, which ``test_off_axis_notches``
+    checks against quadrature), and the axis stretching by ``x_bar kappa`` where the centroid
+    is off it."""
+    design, grid = result.design, result.grid
+    nodes = grid.s_nodes
+    cell = min(int(np.searchsorted(nodes, s, side="right")) - 1, nodes.size - 2)
+    a, b = nodes[cell], nodes[cell + 1]
+    left, right = design.notch_bounds()
+    r_outer, r_inner = design.R_outer, design.r_inner
+
+    def section(t: float) -> tuple[float, float]:
+        """Centroid offset (m) and compliance 1/(E I) (1/(N m^2)) at arc length ``t``."""
+        inside = np.flatnonzero((left <= t) & (t <= right))
+        if not inside.size:
+            return 0.0, 4.0 / (design.E * math.pi * (r_outer**4 - r_inner**4))
+        k = int(inside[0])
+        h1 = half_width(design, t - left[k])
+        _, inertia, centroid, _ = offset_section(h1, design.per_notch("w_o")[k], r_outer,
+                                                  r_inner)
+        return centroid, 1.0 / (design.E * inertia)
+
+    # a cell lies in one segment: its ends' sections are the limits from inside it
+    x_a = section(a + 1e-12 * (b - a))[0]
+    x_b = section(b - 1e-12 * (b - a))[0]
+    m_a, m_b = result.bend_moments[cell]
+    tension = result.tension_n
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        xi = (t - a) / (b - a)
+        centroid, compliance = section(t)
+        moved = centroid - ((1.0 - xi) * x_a + xi * x_b)
+        kappa = compliance * ((1.0 - xi) * m_a + xi * m_b - tension * moved)
+        stretch = 1.0 + centroid * kappa
+        return [stretch * math.cos(y[2]), stretch * math.sin(y[2]), kappa]
+
+    start = [result.positions[cell, 2], result.positions[cell, 0], result.theta[cell]]
+    end = solve_ivp(rhs, (a, s), start, method="DOP853", rtol=1e-10, atol=1e-14).y[:, -1]
+    return complex(end[0], end[1]), float(end[2])
+
+
+@pytest.mark.parametrize("design", [
+    preset("paper-experiment"),
+    # one-sided circular cuts 5.6 mm deep: the centroid moves along each notch
+    preset("paper-experiment").with_overrides(w_d=2 * 3.92e-3 - 5.6e-3, w_o=-2.8e-3)],
+    ids=["symmetric", "one-sided"])
+def test_poses_inside_cells_match_an_ode_solve_of_the_solutions_moments(design: Design
+                                                                        ) -> None:
+    """``pose_at`` between nodes: notch cells (their first, middle and last) and tube cells.
+    Measured: 2e-14 m and 1.6e-10 rad (symmetric), 8.6e-12 m and 2.9e-9 rad (one-sided), the
+    default grid's Gauss quadrature of a section that changes along the cell."""
+    result = solve(design, 6.0)
+    grid = result.grid
+    notch_cells = np.flatnonzero(grid.is_notch)
+    tube_cells = np.flatnonzero(~grid.is_notch)
+    nodes = grid.s_nodes
+    stations = np.array(
+        [nodes[k] + f * (nodes[k + 1] - nodes[k]) for k in notch_cells[[0, len(notch_cells) // 2, -1]]
+         for f in (0.37, 0.97)]
+        + [nodes[k] + 0.61 * (nodes[k + 1] - nodes[k]) for k in tube_cells[[0, -1]]])
+    positions, quaternions = result.pose_at(stations)
+    theta = 2.0 * np.arctan2(quaternions[:, 1], quaternions[:, 3])
+    for s, position, angle in zip(stations, positions, theta, strict=True):
+        reference, reference_angle = cell_pose_reference(result, float(s))
+        assert abs(complex(position[2], position[0]) - reference) <= 5e-11, s
+        assert angle == pytest.approx(reference_angle, abs=1e-8), s
