@@ -62,13 +62,16 @@ STRIP_WEIGHTS = 0.5 * _WEIGHTS
 trigonometric polynomial of degree 4 over at most pi, to rounding)."""
 
 SERIES_BELOW = 0.05
-"""Below this ``h/R`` the disc-strip moment is its series (as :mod:`tdcm_ros.model.section`)."""
+"""Below this ``h/R`` the disc-strip moment (:func:`disc_strip_moment`) is its series."""
 
 
 def disc_strip_moment(h: float, radius: float) -> float:
-    """``J(h) = int_0^h y^2 sqrt(radius^2 - y^2) dy``, ``h`` clipped to [0, radius] (m^4); the
-    scalar form of :func:`tdcm_ros.model.section.disc_strip_moment` (same formulas; at
-    ``h >= radius`` its closed form's value ``radius^4 pi / 16`` without calling libm)."""
+    """``J(h) = int_0^h y^2 sqrt(radius^2 - y^2) dy``, ``h`` clipped to [0, radius] (m^4); 0
+    where ``radius <= 0``. Closed form ``(h/8)(2h^2 - R^2) sqrt(R^2 - h^2) + (R^4/8)
+    asin(h/R)``; below ``h/R = SERIES_BELOW``, where its two terms cancel (relative error
+    ~1e-16 (R/h)^2), its Taylor series in ``t = h/R`` (``t^2 sqrt(1 - t^2)`` expanded and
+    integrated; truncation below 1e-15); at ``h >= radius`` the closed form's value
+    ``radius^4 pi / 16`` without calling libm."""
     if radius <= 0.0:
         return 0.0
     r2 = radius * radius
@@ -86,11 +89,23 @@ def disc_strip_moment(h: float, radius: float) -> float:
     return (hc / 8.0) * (2.0 * hc * hc - r2) * root + (r4 / 8.0) * math.asin(t)
 
 
+def notched_inertia(h1: float, r_outer: float, r_inner: float) -> float:
+    """Eq. 12 inside a notch: ``4 [J(h1, R_outer) - J(h2, r_inner)]``, ``h2 = min(h1,
+    r_inner)`` (m^4), the second moment of the tube's annulus where ``|x| <= h1`` (m); the
+    uncut tube's where ``h1 >= R_outer``."""
+    return 4.0 * (disc_strip_moment(h1, r_outer) - disc_strip_moment(min(h1, r_inner), r_inner))
+
+
+def notched_inertias(h1: Array, r_outer: Array, r_inner: Array, out: Array) -> None:
+    """:func:`notched_inertia` (m^4) of each ``h1[i]``, ``r_outer[i]``, ``r_inner[i]`` (m; 1-D
+    arrays of one length) into ``out[i]``."""
+    for i in range(h1.shape[0]):
+        out[i] = notched_inertia(h1[i], r_outer[i], r_inner[i])
+
+
 def notch_compliance(h1: float, r_outer: float, r_inner: float, e: float) -> float:
     """``1/(E I)`` (1/(N m^2)) of eq. 12's notched section at half-width ``h1`` (m)."""
-    inertia = 4.0 * (disc_strip_moment(h1, r_outer)
-                     - disc_strip_moment(min(h1, r_inner), r_inner))
-    return 1.0 / (e * inertia)
+    return 1.0 / (e * notched_inertia(h1, r_outer, r_inner))
 
 
 def disc_strip(lo: float, hi: float, radius: float, about: float
@@ -337,6 +352,6 @@ def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
                     out[m, f, j, q] = source[p, field, q]
 
 
-KERNELS = ("disc_strip_moment", "notch_compliance", "disc_strip", "offset_section", "geometry",
+KERNELS = ("disc_strip_moment", "notched_inertia", "notched_inertias", "notch_compliance", "disc_strip", "offset_section", "geometry",
            "point", "points", "_weights_and_chords", "cell_integrals", "gather")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -1,7 +1,8 @@
-"""The grid kernel: its scalar eq. 12 against the section module, and its builds agreeing."""
+"""The grid kernel: its scalar eq. 12 against quadrature, and its builds agreeing."""
 
 from __future__ import annotations
 
+import math
 import os
 import subprocess
 import sys
@@ -10,39 +11,35 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.integrate import quad
 
 from tdcm_ros.model import CustomProfile, SolverSettings, compiled, grid_kernel, preset
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.grid import grid_parts
-from tdcm_ros.model.section import disc_strip_moment, notched_moment
+from tdcm_ros.model.section import notched_moment
 
 E = 1.7e9
 EPS = float(np.finfo(float).eps)
 
 
-def strip_tolerance(h: float, radius: float) -> float:
-    """Rounding bound (m^4) of the closed form of J(h, radius): a few ulp of its two terms,
-    each ~h radius^3 / 8, which cancel to ~h^3 radius / 3 (section's docstring)."""
-    h = min(h, radius)
-    return 4.0 * EPS * (h * radius**3 / 8.0 + h**3 * radius / 3.0)
-
-
 @settings(max_examples=300)
 @given(r_outer=st.floats(0.5, 5.0), inner_ratio=st.floats(0.0, 0.95),
        h_ratio=st.one_of(st.floats(0.0, 1.2), st.floats(0.0, 0.06)))
-def test_notch_compliance_equals_the_section_modules_eq_12(r_outer, inner_ratio, h_ratio):
-    # Both sides of the series switch (h/R < 0.05), the h1 = r_inner clip and h1 >= R_outer;
-    # same formulas, different rounding (R^4 as (R^2)^2), so equal to their rounding bound.
+def test_the_kernels_eq_12_matches_quadrature_on_both_sides_of_its_series(
+        r_outer: float, inner_ratio: float, h_ratio: float) -> None:
+    """The strip moment J (closed form above h/R = 0.05, series below, where the closed form
+    cancels) against adaptive quadrature; the compliance the cells use is eq. 12's."""
     r_outer *= MM
     r_inner = inner_ratio * r_outer
-    h1 = max(h_ratio * r_outer, 1e-3 * r_outer)
+    h1 = h_ratio * r_outer
     for h, radius in ((h1, r_outer), (min(h1, r_inner), r_inner)):
-        assert abs(grid_kernel.disc_strip_moment(h, radius) - disc_strip_moment(h, radius)) <= \
-            strip_tolerance(h, radius)
-    inertia = float(notched_moment(h1, r_outer, r_inner))
-    bound = 4.0 * (strip_tolerance(h1, r_outer) + strip_tolerance(min(h1, r_inner), r_inner))
+        expected = quad(lambda y, radius=radius: y * y * math.sqrt(max(radius**2 - y * y, 0.0)),
+                        0.0, min(h, radius), epsabs=0.0, epsrel=1e-13, limit=200)[0]
+        assert grid_kernel.disc_strip_moment(h, radius) == pytest.approx(
+            expected, rel=1e-11, abs=1e-13 * radius**4)
+    h1 = max(h1, 1e-3 * r_outer)  # I > 0: a finite compliance
     got = 1.0 / (E * grid_kernel.notch_compliance(h1, r_outer, r_inner, E))
-    assert abs(got - inertia) <= bound + 2.0 * EPS * inertia
+    assert got == pytest.approx(float(notched_moment(h1, r_outer, r_inner)), rel=4 * EPS)
 
 
 def designs() -> list:
