@@ -171,6 +171,17 @@ def geometry(kind: float, w_n: float, w_d: float, u: float,
     return w_n * u, w_n, custom
 
 
+def profile_points(kind: float, w_n: Array, w_d: Array, u: Array, sigma: Array, h1: Array
+                   ) -> None:
+    """:func:`geometry`'s ``sigma`` and ``h1`` (m) of profile ``kind`` (not :data:`CUSTOM`)
+    at each ``u[i]`` of a notch of widths ``w_n[i]``, ``w_d[i]`` (m; 1-D arrays of one
+    length) into ``sigma[i]``, ``h1[i]``."""
+    for i in range(u.shape[0]):
+        s_i, _, h_i = geometry(kind, w_n[i], w_d[i], u[i], 0.0)
+        sigma[i] = s_i
+        h1[i] = h_i
+
+
 def point(notch: bool, d: Array, seg_length: float, u: float, custom: Array
           ) -> tuple[float, float, float, float, float]:
     """``(sigma, ds/du, 1/(E I), x_bar, fibre)`` at ``u`` in a cell's segment (m, m,
@@ -352,6 +363,7 @@ def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
                     out[m, f, j, q] = source[p, field, q]
 
 
-KERNELS = ("disc_strip_moment", "notched_inertia", "notched_inertias", "notch_compliance", "disc_strip", "offset_section", "geometry",
-           "point", "points", "_weights_and_chords", "cell_integrals", "gather")
+KERNELS = ("disc_strip_moment", "notched_inertia", "notched_inertias", "notch_compliance",
+           "disc_strip", "offset_section", "geometry", "profile_points", "point", "points",
+           "_weights_and_chords", "cell_integrals", "gather")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -38,11 +38,27 @@ class CircularProfile:
 
     def sigma(self, u: Array, w_n: Width) -> Array:
         """Local arc length (m) at reference coordinate ``u``."""
-        return 0.5 * w_n * (1.0 - np.cos(np.pi * u))
+        return _circular(u, w_n, 0.0)[0]
 
     def h1(self, u: Array, w_n: Width, w_d: Width) -> Array:
         """Backbone half-width (m) at ``u``."""
-        return 0.5 * (w_n + w_d) - 0.5 * w_n * np.sin(np.pi * u)
+        return _circular(u, w_n, w_d)[1]
+
+
+def _circular(u: Array, w_n: Width, w_d: Width) -> tuple[Array, Array]:
+    """``sigma`` and ``h1`` (m) of eq. 13 at ``u`` (widths broadcast against it): the formula
+    the cells are integrated with (:func:`tdcm_ros.model.grid_kernel.geometry`), in its
+    build."""
+    # lazily: the compiled module imports tdcm_ros.model, which imports this one
+    from tdcm_ros.model.compiled import grid_kernels
+    from tdcm_ros.model.grid_kernel import CIRCULAR
+
+    at, width, depth = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (u, w_n, w_d)))
+    sigma, h1 = np.empty(at.size), np.empty(at.size)
+    grid_kernels().profile_points(float(CIRCULAR), np.ascontiguousarray(width).ravel(),
+                                  np.ascontiguousarray(depth).ravel(),
+                                  np.ascontiguousarray(at).ravel(), sigma, h1)
+    return sigma.reshape(at.shape), h1.reshape(at.shape)
 
 
 class _StraightSlot:
