@@ -55,12 +55,12 @@ def best_time(run: Callable[[], object], repeat: int, cold: bool, clock: Callabl
               = perf_counter) -> float:
     """Best time (s, wall unless ``clock`` says otherwise) of ``run()`` over ``repeat`` calls;
     ``cold`` clears the grid cache."""
-    from tdcm_ros.model.grid import _build_grid
+    from tdcm_ros.model.grid import clear_grid_cache
 
     times = []
     for _ in range(repeat):
         if cold:
-            _build_grid.cache_clear()
+            clear_grid_cache()
         started = clock()
         run()
         times.append(clock() - started)

@@ -27,7 +27,7 @@ import numpy as np
 
 from tdcm_ros.model import SolverSettings, preset
 from tdcm_ros.model.design import MM
-from tdcm_ros.model.grid import _build_grid, build_grid, build_grids
+from tdcm_ros.model.grid import build_grid, build_grids, clear_grid_cache
 
 CASES = (("default (adaptive), paper", SolverSettings()),
          ("default (adaptive), free", SolverSettings(routing="free")),
@@ -96,7 +96,7 @@ def main() -> None:
             start = time.process_time()
             stack = build_grids(designs, settings)
             stacked.append(time.process_time() - start)
-            _build_grid.cache_clear()
+            clear_grid_cache()
             start = time.process_time()
             for design in designs:
                 build_grid(design, settings)

@@ -11,7 +11,7 @@ from tdcm_ros.model import CustomProfile, SolverSettings, preset, solve
 from tdcm_ros.model.accuracy import converged_tip
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
-from tdcm_ros.model.grid import build_grid, build_grids
+from tdcm_ros.model.grid import build_grid, build_grids, clear_grid_cache
 from tdcm_ros.model.section import notched_moment
 
 PER_CELL = ("s_nodes", "is_notch", "notch_index", "shape", "seg_start", "seg_length", "u_a", "u_b",
@@ -244,3 +244,17 @@ def test_chord_terms_in_a_notch_match_a_fine_trapezoid_integration():
             total = cumulative(c * g)
             assert c_t[k] == pytest.approx(total[-1], rel=1e-6)
             assert np.allclose(a_t[k], np.interp(grid.s_q[k], s, total), rtol=1e-5)
+
+
+def test_the_last_grid_is_kept_by_design_and_settings_and_cleared_with_the_cache() -> None:
+    design = preset("paper-experiment")
+    equal = preset("paper-experiment").with_overrides(E=design.E)   # equal, not the same object
+    settings = SolverSettings()
+    grid = build_grid(design, settings)
+    assert build_grid(design, settings) is grid and build_grid(equal, settings) is grid
+    finer = build_grid(design, SolverSettings(cells_per_notch=8))
+    assert finer is not grid and finer.n_cells > grid.n_cells
+    assert build_grid(design, settings) is grid
+    clear_grid_cache()
+    rebuilt = build_grid(design, settings)
+    assert rebuilt is not grid and np.array_equal(rebuilt.s_nodes, grid.s_nodes)

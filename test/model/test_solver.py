@@ -127,9 +127,9 @@ def linear_chord_moments(monkeypatch):
         return fc, fq, strain
 
     monkeypatch.setattr(grid_module, "_prototype_integrals", zero)
-    grid_module._build_grid.cache_clear()
+    grid_module.clear_grid_cache()
     yield
-    grid_module._build_grid.cache_clear()
+    grid_module.clear_grid_cache()
 
 
 def test_tip_converges_at_second_order_where_moments_vary_inside_cells(linear_chord_moments):
