@@ -32,15 +32,19 @@ def register(subparsers: Any) -> None:
         "inverse", help="tendon tension that puts the tip at a target",
         description="The tension (N) within [--tension-min, --tension-max] that puts the tip "
                     "at a deflection (m), an angle (rad) or a point (x, z in tdcm_base, m; "
-                    "least squares), with the achieved tip, the residual and d(tip)/dT.",
+                    "least squares), or that pulls the tendon in by a stroke (m), with the "
+                    "achieved tip, the residual and d(tip)/dT.",
         epilog="examples:\n"
                "  tdcm inverse --tip-angle 0.3\n"
                "  tdcm inverse --design fig2-wn-1.9 --tip-deflection 0.005 --json\n"
-               "  tdcm inverse --tip-point=0.006,0.0525 --set E=1.2e9 --tension-max 22")
+               "  tdcm inverse --tip-point=0.006,0.0525 --set E=1.2e9 --tension-max 22\n"
+               "  tdcm inverse --tendon-stroke 0.0005")
     target = parser.add_mutually_exclusive_group(required=True)
     add_tip_targets(target)
     target.add_argument("--tip-point", metavar="X,Z", help="tip point in tdcm_base (m); write a negative X as "
                         "--tip-point=-0.001,0.05")
+    target.add_argument("--tendon-stroke", metavar="M",
+                        help="how far the tendon is pulled in against the straight body (m)")
     parser.add_argument("--tension-min", default="0", metavar="N",
                         help="lower tension bound (N, default 0)")
     parser.add_argument("--tension-max", default=str(DEFAULT_TENSION_MAX_N), metavar="N",
@@ -64,6 +68,9 @@ def _target(args: argparse.Namespace) -> dict[str, Any]:
         return {"tip_deflection": target_number("--tip-deflection", args.tip_deflection, "[0, inf) m")}
     if args.tip_angle is not None:
         return {"tip_angle": target_number("--tip-angle", args.tip_angle, "a finite number, rad")}
+    if args.tendon_stroke is not None:
+        return {"tendon_stroke": target_number("--tendon-stroke", args.tendon_stroke,
+                                               "[0, inf) m")}
     parts = args.tip_point.split(",")
     if len(parts) != 2:
         raise InvalidTargetError(f"--tip-point = {args.tip_point!r} is not X,Z; allowed: two "
@@ -109,7 +116,8 @@ def _print(name: str, found: InverseResult) -> None:
     print(f"design {name}: {found.target_kind.replace('_', ' ')} {found.target} {unit} -> "
           f"tension {found.tension_n:.9g} N")
     print(f"achieved tip (x, z) = ({x:.9f}, {z:.9f}) m, angle {result.tip_angle_rad:.9f} rad, "
-          f"deflection {result.tip_deflection_m:.9f} m; residual {found.residual:.3g} {unit}")
+          f"deflection {result.tip_deflection_m:.9f} m, tendon stroke "
+          f"{result.tendon_strokes_m[0]:.9f} m; residual {found.residual:.3g} {unit}")
     dx, dz = sens.tip_point_m_per_n
     print(f"d(tip)/dT: (x, z) ({dx:.6g}, {dz:.6g}) m/N, angle {sens.tip_angle_rad_per_n:.6g} "
           f"rad/N ({sens.method} difference, step {sens.step_n:g} N); "

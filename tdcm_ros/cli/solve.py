@@ -9,21 +9,39 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.cli.design_args import add_design_arguments, design_and_settings
+from tdcm_ros.cli.design_args import (
+    add_design_arguments,
+    design_and_settings,
+    target_number,
+)
 from tdcm_ros.errors import TdcmError
-from tdcm_ros.model import SolveResult, TensionRangeError, one_shot, solve
+from tdcm_ros.model import (
+    DEFAULT_TENSION_MAX_N,
+    SolveResult,
+    TensionRangeError,
+    one_shot,
+    solve,
+    solve_inverse,
+)
 
 
 def register(subparsers: Any) -> None:
     """Add the ``solve`` subcommand."""
     parser = subparsers.add_parser(
         "solve", help="shape of the manipulator for one tension",
-        description="Solve Algorithm 1 for one design and tendon tension (SI units).",
+        description="Solve Algorithm 1 for one design and tendon tension, or the tension "
+                    "that pulls the tendon in by a stroke (SI units).",
         epilog="examples:\n"
                "  tdcm solve --tension 20\n"
                "  tdcm solve --design fig2-wn-1.9 --tension 20 --json\n"
-               "  tdcm solve --tension 12 --set E=1.2e9 --plot shape.png")
-    parser.add_argument("--tension", required=True, type=str, help="tendon tension (N)")
+               "  tdcm solve --tension 12 --set E=1.2e9 --plot shape.png\n"
+               "  tdcm solve --stroke 0.0005")
+    drive = parser.add_mutually_exclusive_group(required=True)
+    drive.add_argument("--tension", type=str, help="tendon tension (N)")
+    drive.add_argument("--stroke", metavar="M", help="tendon stroke (m): how far the tendon is "
+                       "pulled in against the straight body; the tension is found within "
+                       f"[0, {DEFAULT_TENSION_MAX_N:g}] N (tdcm inverse --tendon-stroke sets "
+                       "the bounds)")
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.add_argument("--plot", metavar="FILE", help="draw midline and curvature to a .png, "
@@ -50,7 +68,11 @@ def run(args: argparse.Namespace) -> int:
 
             plot_file("--plot", args.plot)
         with one_shot():  # one solve and its report: the plain-Python kernel, numba not imported
-            result = solve(design, _tension(args.tension), settings=settings)
+            if args.stroke is None:
+                result = solve(design, _tension(args.tension), settings=settings)
+            else:
+                stroke = target_number("--stroke", args.stroke, "[0, inf) m")
+                result = solve_inverse(design, tendon_stroke=stroke, settings=settings).result
             report = json.dumps(result.summary()) if args.json else _notch_line(result)
     except TdcmError as error:
         if args.json:
@@ -66,6 +88,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"tension {result.tension_n:g} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
               f"angle {result.tip_angle_rad:.5f} rad, deflection "
               f"{result.tip_deflection_m * 1e3:.4f} mm")
+        print(f"tendon: length {result.tendon_lengths_m[0] * 1e3:.6f} mm, stroke "
+              f"{result.tendon_strokes_m[0] * 1e3:.6f} mm")
         print(report)
         print(f"converged in {result.iterations} iterations ({result.strategy}), "
               f"{result.solve_time_s * 1e6:.0f} us")

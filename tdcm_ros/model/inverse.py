@@ -1,14 +1,16 @@
 """The inverse model: the tendon tension (N) that puts the tip at a target.
 
 A target is a tip deflection (m, distance from the +z axis), a tip angle (rad, from +z toward
-+x) or a tip point ``(x, z)`` in ``tdcm_base`` (m). The tension is sought within bounds
++x), a tip point ``(x, z)`` in ``tdcm_base`` (m) or a tendon stroke (m, how far the tendon is
+pulled in, :attr:`~tdcm_ros.model.result.SolveResult.tendon_strokes_m`). The tension is sought within bounds
 ``[tension_min, tension_max]`` (N; default ``[0, DEFAULT_TENSION_MAX_N]``), each trial a
 forward :func:`~tdcm_ros.model.solver.solve` warm-started from the nearest earlier one.
 
-- Deflection and angle: a root of ``tip(T) - target`` bracketed by the bounds, found with
-  Brent's method (``scipy.optimize.brentq``, imported only here). Both grow monotonically
-  with the tension while the tip angle stays below about 2.3 rad (a circular arc's deflection
-  peaks there); the reachable range is the tip at the bounds. Past that peak (bounds far above
+- Deflection, angle and stroke: a root of ``measure(T) - target`` bracketed by the bounds,
+  found with Brent's method (``scipy.optimize.brentq``, imported only here). All grow
+  monotonically with the tension while the tip angle stays below about 2.3 rad (a circular
+  arc's deflection peaks there; the stroke grows as long as the body bends further); the
+  reachable range is the measure at the bounds. Past that peak (bounds far above
   the default) a target only reached on the curled branch is reported unreachable.
 - Point: least squares over the tension (the closest tip point on the tension's path): each
   step minimises the distance to the target along a quadratic through three solves near the
@@ -64,7 +66,7 @@ MAX_POINT_STEPS = 40
 #: Largest number of safeguarded Newton steps per root of the point target's cubic.
 CUBIC_STEPS = 200
 
-TARGET_KINDS = ("tip_deflection", "tip_angle", "tip_point")
+TARGET_KINDS = ("tip_deflection", "tip_angle", "tip_point", "tendon_stroke")
 
 
 class InvalidTargetError(ModelError, InputError):
@@ -146,6 +148,7 @@ class InverseResult:
             "tip_point_m": list(self.tip_point_m),
             "tip_angle_rad": self.result.tip_angle_rad,
             "tip_deflection_m": self.result.tip_deflection_m,
+            "tendon_stroke_m": float(self.result.tendon_strokes_m[0]),
             "residual": self.residual,
             "residual_unit": "rad" if self.target_kind == "tip_angle" else "m",
             "sensitivity": self.sensitivity.to_dict(),
@@ -184,20 +187,21 @@ class _Forward:
 def solve_inverse(design: Design, *, tip_deflection: float | None = None,
                   tip_angle: float | None = None,
                   tip_point: tuple[float, float] | None = None,
+                  tendon_stroke: float | None = None,
                   tension_min: float = 0.0, tension_max: float = DEFAULT_TENSION_MAX_N,
                   settings: SolverSettings = DEFAULT_SETTINGS,
                   warm_start: SolveResult | None = None,
                   tol: float = DEFAULT_TOL) -> InverseResult:
     """The tension (N) in ``[tension_min, tension_max]`` that puts the tip of ``design`` at
-    exactly one target: ``tip_deflection`` (m), ``tip_angle`` (rad) or ``tip_point`` ``(x, z)``
-    (m, least squares). ``tol`` is the tolerance on the target (m, or rad for an angle);
+    exactly one target: ``tip_deflection`` (m), ``tip_angle`` (rad), ``tip_point`` ``(x, z)``
+    (m, least squares) or ``tendon_stroke`` (m, the tendon pulled in by it). ``tol`` is the tolerance on the target (m, or rad for an angle);
     ``warm_start`` seeds the first forward solve (a result of the same design and settings).
 
     Raises :class:`InvalidTargetError` for a bad target, bounds or ``tol``;
     :class:`UnreachableTargetError` (naming the reachable range) when the target is out of
     reach; a forward solve's own errors pass through.
     """
-    kind, target = _check_target(tip_deflection, tip_angle, tip_point)
+    kind, target = _check_target(tip_deflection, tip_angle, tip_point, tendon_stroke)
     lower, upper = _check_bounds(tension_min, tension_max)
     tolerance = _real(tol)
     if tolerance is None or not math.isfinite(tolerance) or tolerance <= 0.0:
@@ -219,8 +223,9 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
 _MEASURES: dict[str, Callable[[SolveResult], float]] = {
     "tip_deflection": lambda r: r.tip_deflection_m,
     "tip_angle": lambda r: r.tip_angle_rad,
+    "tendon_stroke": lambda r: float(r.tendon_strokes_m[0]),
 }
-_UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m"}
+_UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m", "tendon_stroke": "m"}
 
 
 def one_target(targets: dict[str, Any]) -> tuple[str, Any]:
@@ -237,10 +242,11 @@ def one_target(targets: dict[str, Any]) -> tuple[str, Any]:
 
 
 def _check_target(tip_deflection: float | None, tip_angle: float | None,
-                  tip_point: tuple[float, float] | None) -> tuple[str, Any]:
+                  tip_point: tuple[float, float] | None, tendon_stroke: float | None
+                  ) -> tuple[str, Any]:
     """The one target given, checked: ``(kind, value)``."""
-    kind, value = one_target(dict(zip(TARGET_KINDS, (tip_deflection, tip_angle, tip_point),
-                                      strict=True)))
+    kind, value = one_target(dict(zip(
+        TARGET_KINDS, (tip_deflection, tip_angle, tip_point, tendon_stroke), strict=True)))
     if kind == "tip_point":
         values = np.asarray(value, dtype=float) if _is_pair(value) else None
         if values is None or not np.all(np.isfinite(values)):
@@ -249,9 +255,9 @@ def _check_target(tip_deflection: float | None, tip_angle: float | None,
                 parameter="tip_point", value=value, allowed="(x, z), finite, m")
         return kind, (float(values[0]), float(values[1]))
     number = _real(value)
-    low = 0.0 if kind == "tip_deflection" else -math.inf
+    low = -math.inf if kind == "tip_angle" else 0.0
     if number is None or not math.isfinite(number) or number < low:
-        allowed = "[0, inf) m, finite" if kind == "tip_deflection" else "finite rad"
+        allowed = "finite rad" if kind == "tip_angle" else "[0, inf) m, finite"
         raise InvalidTargetError(f"{kind} = {value!r} is out of range; allowed: {allowed}",
                                  parameter=kind, value=value, allowed=allowed)
     return kind, number

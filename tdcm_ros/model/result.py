@@ -123,6 +123,32 @@ class SolveResult:
         np.maximum.at(out, grid.notch_index[notch], np.max(strain[notch], axis=1))
         return out
 
+    @cached_property
+    def tendon_lengths_m(self) -> Array:
+        """Length of each tendon's path from the base to the tip (m), one per tendon: along the
+        curve ``R_c`` from the tube axis where it follows the body, ``(1 - (R_c - x_bar) kappa)
+        ds`` (the axis's stretch ``x_bar kappa`` less the offset's ``R_c kappa``, integrated
+        by the cells' own quadrature), and straight across each chord."""
+        grid = self.grid
+        r_c = grid.r_c
+        moments = self.bend_moments
+        stretch = np.sum(moments[:, 0:1] * grid.K0 + moments[:, 1:2] * grid.K1
+                         - self.tension_n * grid.K2, axis=1)
+        follows = grid.constrained
+        along = np.sum((grid.length + stretch - r_c * np.diff(self.theta))[follows])
+        path = (self.positions[:, 2] + 1j * self.positions[:, 0]
+                + 1j * r_c * np.exp(1j * self.theta))
+        chords = np.unique(np.stack([grid.chord_start_node, grid.chord_end_node],
+                                    axis=1)[~follows], axis=0)
+        across = np.sum(np.abs(path[chords[:, 1]] - path[chords[:, 0]]))
+        return np.array([along + across])
+
+    @property
+    def tendon_strokes_m(self) -> Array:
+        """How far each tendon has been pulled in (m), one per tendon: its path's length on the
+        straight body (``L``) less :attr:`tendon_lengths_m`."""
+        return self.design.length - self.tendon_lengths_m
+
     @property
     def quaternions(self) -> Array:
         """Orientation of the body frame at each node, ``(x, y, z, w)``."""
@@ -209,6 +235,8 @@ class SolveResult:
             "notch_gaps_m": _finite_or_none(self.notch_gaps_m),
             "notch_stop_margins_rad": _finite_or_none(self.notch_stop_margins_rad),
             "notch_peak_strains": self.notch_peak_strains.tolist(),
+            "tendon_lengths_m": self.tendon_lengths_m.tolist(),
+            "tendon_strokes_m": self.tendon_strokes_m.tolist(),
             "solve_time_s": self.solve_time_s,
             "residual_history_m": list(self.residual_history),
             "design": self.design.to_dict(),

@@ -9,7 +9,7 @@ from tdcm_ros.model import preset, solve
 from test.support.cli import tdcm
 
 KEYS = {"target", "tension_n", "tip_point_m", "tip_angle_rad", "tip_deflection_m", "residual",
-        "residual_unit", "sensitivity", "forward_solves", "tension_bounds_n"}
+        "residual_unit", "sensitivity", "forward_solves", "tension_bounds_n", "tendon_stroke_m"}
 
 
 def test_json_tension_round_trips_through_tdcm_solve():
@@ -20,8 +20,10 @@ def test_json_tension_round_trips_through_tdcm_solve():
     assert data["tip_angle_rad"] == pytest.approx(0.25, abs=1e-9)
     again = tdcm("solve", "--design", "fig2-wn-1.9", "--tension", repr(data["tension_n"]),
                  "--json")
-    tip = json.loads(again.stdout)["tip_position_m"]
+    solved = json.loads(again.stdout)
+    tip = solved["tip_position_m"]
     assert [tip[0], tip[2]] == pytest.approx(data["tip_point_m"], abs=1e-9)
+    assert solved["tendon_strokes_m"] == pytest.approx([data["tendon_stroke_m"]], abs=1e-12)
     assert data["sensitivity"]["tip_angle_rad_per_n"] > 0.0
 
 

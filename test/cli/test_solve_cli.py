@@ -7,10 +7,11 @@ import sys
 import pytest
 
 from tdcm_ros.cli.main import main
-from tdcm_ros.model import preset, solve
+from tdcm_ros.model import SolverSettings, preset, solve
 
 KEYS = {"converged", "iterations", "tension_n", "tip_position_m", "tip_angle_rad",
-        "tip_deflection_m", "tip_displacement_m", "solve_time_s", "design"}
+        "tip_deflection_m", "tip_displacement_m", "solve_time_s", "design", "tendon_lengths_m",
+        "tendon_strokes_m"}
 
 
 def run_json(capsys, *args):
@@ -26,6 +27,19 @@ def test_json_contract_matches_library(capsys):
     assert data["tip_position_m"] == pytest.approx(expected.tip_position.tolist(), abs=1e-15)
     assert data["tip_deflection_m"] == pytest.approx(expected.tip_deflection_m)
     assert data["design"]["E"] == 1.85e9 and data["design"]["L"] == pytest.approx(0.053)
+    assert data["tendon_strokes_m"] == expected.tendon_strokes_m.tolist()
+
+
+def test_a_stroke_solves_for_the_tension_that_pulls_the_tendon_in_that_far(capsys):
+    status, data, _ = run_json(capsys, "--stroke", "0.0005", "--routing", "free")
+    assert status == 0 and data["settings"]["routing"] == "free"
+    assert data["tendon_strokes_m"] == pytest.approx([0.0005], abs=1e-9)
+    again = solve(preset("paper-experiment"), data["tension_n"],
+                  settings=SolverSettings(routing="free"))
+    assert again.tendon_strokes_m == pytest.approx([0.0005], abs=1e-9)
+    with pytest.raises(SystemExit) as exited:                              # one or the other
+        main(["solve", "--stroke", "0.0005", "--tension", "3"])
+    assert exited.value.code == 2 and "not allowed with" in capsys.readouterr().err
 
 
 def test_overrides_profile_and_routing(capsys):
@@ -48,6 +62,9 @@ def test_overrides_profile_and_routing(capsys):
     (["--tension", "20", "--set", "novalue"], 2, "input"),
     (["--tension", "5000"], 3, "tendon_singularity"),
     (["--tension", "200", "--profile", "rectangular"], 3, "notch_closure"),
+    (["--stroke", "-0.001"], 2, "invalid_target"),
+    (["--stroke", "abc"], 2, "invalid_target"),
+    (["--stroke", "0.01"], 3, "unreachable_target"),
 ])
 def test_errors_exit_codes_and_json(capsys, args, status, kind):
     code = main(["solve", *args, "--json"])

@@ -28,16 +28,20 @@ def target_of(kind, result):
     """The target of ``kind`` that ``result`` reaches."""
     if kind == "tip_point":
         return (float(result.tip_position[0]), float(result.tip_position[2]))
+    if kind == "tendon_stroke":
+        return float(result.tendon_strokes_m[0])
     return result.tip_deflection_m if kind == "tip_deflection" else result.tip_angle_rad
 
 
 @settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow])
 @given(name=st.sampled_from(sorted(PRESETS)),
        tension=st.floats(0.0, DEFAULT_TENSION_MAX_N),
-       kind=st.sampled_from(["tip_deflection", "tip_angle", "tip_point"]))
+       kind=st.sampled_from(["tip_deflection", "tip_angle", "tip_point", "tendon_stroke"]))
 def test_round_trip_reaches_targets_drawn_from_solves(name, tension, kind):
     design = preset(name)
     target = target_of(kind, solve(design, tension))
+    if kind == "tendon_stroke":  # a straight body's is 0 to rounding, of either sign
+        target = max(target, 0.0)
     found = solve_inverse(design, **{kind: target})
     assert 0.0 <= found.tension_n <= DEFAULT_TENSION_MAX_N
     assert found.residual <= 1e-9  # m or rad: the default tolerance
@@ -45,6 +49,7 @@ def test_round_trip_reaches_targets_drawn_from_solves(name, tension, kind):
     assert np.max(np.abs(np.subtract(achieved, target))) <= 1e-9
     cold = solve(design, found.tension_n)  # the round trip: no warm start, nothing shared
     assert np.max(np.abs(cold.tip_position - found.result.tip_position)) <= ROUND_TRIP_M
+    assert abs(cold.tendon_strokes_m[0] - found.result.tendon_strokes_m[0]) <= ROUND_TRIP_M
     assert found.tension_n == pytest.approx(tension, abs=1e-4)
     assert found.forward_solves <= 10
 
@@ -74,7 +79,7 @@ def test_sensitivity_is_one_sided_at_a_bound():
 
 @pytest.mark.parametrize(("kind", "target"), [
     ("tip_deflection", 0.05), ("tip_angle", 1.5), ("tip_angle", -0.1),
-    ("tip_point", (0.05, 0.02)), ("tip_point", (-0.01, 0.053)),
+    ("tip_point", (0.05, 0.02)), ("tip_point", (-0.01, 0.053)), ("tendon_stroke", 0.01),
 ])
 def test_unreachable_target_names_the_range_at_the_bounds(kind, target):
     with pytest.raises(UnreachableTargetError) as caught:
@@ -165,6 +170,8 @@ def test_warm_start_gives_the_same_answer():
     ({"tip_point": (0.01,)}, "tip_point"),
     ({"tip_point": (0.01, math.nan)}, "tip_point"),
     ({"tip_point": "0.01,0.05"}, "tip_point"),
+    ({"tendon_stroke": -1e-4}, "tendon_stroke"),
+    ({"tendon_stroke": math.nan}, "tendon_stroke"),
     ({"tip_angle": 0.1, "tension_min": -1.0}, "tension_min"),
     ({"tip_angle": 0.1, "tension_max": 0.0}, "tension_max"),
     ({"tip_angle": 0.1, "tension_max": math.inf}, "tension_max"),

@@ -209,3 +209,48 @@ def test_poses_inside_cells_match_an_ode_solve_of_the_solutions_moments(design: 
         reference, reference_angle = cell_pose_reference(result, float(s))
         assert abs(complex(position[2], position[0]) - reference) <= 5e-11, s
         assert angle == pytest.approx(reference_angle, abs=1e-8), s
+
+
+def tendon_path_length(result: SolveResult, points: int) -> float:
+    """Length (m) of the tendon drawn from ``pose_at``: a polyline of ``points`` intervals on
+    the curve ``R_c`` from the tube axis along each segment the tendon follows, a straight
+    line between the segment's ends where it is a chord (the tubes under ``paper`` routing,
+    the notches under ``free``)."""
+    design = result.design
+    left, right = design.notch_bounds()
+    bounds = np.concatenate([[0.0], np.ravel(np.column_stack([left, right])), [design.length]])
+    chords_in_notches = result.settings.routing == "free"
+
+    def tendon(s: np.ndarray) -> np.ndarray:
+        positions, quaternions = result.pose_at(s)
+        theta = 2.0 * np.arctan2(quaternions[:, 1], quaternions[:, 3])
+        return positions[:, 2] + 1j * positions[:, 0] + 1j * design.R_c * np.exp(1j * theta)
+
+    total = 0.0
+    for k, (a, b) in enumerate(itertools.pairwise(bounds)):
+        if b <= a:
+            continue
+        in_notch = k % 2 == 1
+        stations = np.array([a, b]) if in_notch == chords_in_notches else \
+            np.linspace(a, b, points + 1)
+        total += float(np.sum(np.abs(np.diff(tendon(stations)))))
+    return total
+
+
+@pytest.mark.parametrize("routing", ["paper", "free"])
+@pytest.mark.parametrize("design", [
+    preset("paper-experiment"),
+    preset("paper-experiment").with_overrides(w_d=2 * 3.92e-3 - 5.6e-3, w_o=-2.8e-3)],
+    ids=["symmetric", "one-sided"])
+def test_the_tendon_length_is_its_drawn_path_to_a_nanometre(design: Design, routing: str
+                                                            ) -> None:
+    """Against polylines of 64 and 128 intervals a segment, extrapolated (Richardson: the
+    polyline's error goes as h^2); and a straight body's tendon is as long as the body."""
+    result = solve(design, 6.0, settings=SolverSettings(routing=routing))
+    coarse, fine = tendon_path_length(result, 64), tendon_path_length(result, 128)
+    reference = (4.0 * fine - coarse) / 3.0
+    assert result.tendon_lengths_m == pytest.approx([reference], abs=1e-9)
+    assert result.tendon_strokes_m == pytest.approx([design.length - reference], abs=1e-9)
+    assert result.tendon_strokes_m[0] > 1e-4   # 0.2 mm at 6 N: pulled in, not a rounding
+    straight = solve(design, 0.0, settings=SolverSettings(routing=routing))
+    assert straight.tendon_strokes_m == pytest.approx([0.0], abs=1e-15)
