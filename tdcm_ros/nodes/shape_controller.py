@@ -87,7 +87,8 @@ FIXED_SPECS = by_name(
          kind="str"),
     Spec("roll.joint", description="joint of joint_states that is the roll", default="roll",
          kind="str"),
-    Spec("period_s", "s", "control period (setpoints are slewed at this step)", 0.05,
+    Spec("period_s", "s", "control period (setpoints are slewed by the time since the last "
+         "tick, at most 10 periods)", 0.05,
          low=0.005, high=1.0),
     Spec("keepalive_s", "s", "setpoints are sent again after this long unchanged", 1.0,
          low=0.05, high=60.0),
@@ -124,6 +125,11 @@ RELEASED_AFTER_S = 1.0
 HISTORY = 2048
 #: Marker frames kept waiting for the tension of their stamp (the oldest go first).
 WAITING_FRAMES = 1024
+#: A control tick later than its period slews by the time since the last one (late ticks are
+#: skipped, as rcl's timers do, so a fixed step would slew slower than the driver's rates), but
+#: by at most this many periods: a node stalled for seconds does not command a jump (the driver
+#: ramps its setpoint at ``setpoint_rate`` besides).
+LATE_STEPS_COUNTED = 10
 NEVER = -(1 << 62)
 
 
@@ -234,6 +240,7 @@ class ShapeControllerNode(NodeLogic):
         self.tensions, self.rolls = StampedHistory(HISTORY), RollHistory(HISTORY)
         self.waiting: deque[WaitingFrame] = deque()
         self.command: tuple[float, float] | None = None
+        self.slewed_ns: int | None = None  # the clock at the last slew
         self.sent: tuple[float, float, int] | None = None  # tension, roll, when
         self.released_since_ns: int | None = None
         self.refusal = ""
@@ -443,10 +450,13 @@ class ShapeControllerNode(NodeLogic):
         if self.command is None:
             start = self.tension_n if self._fresh("tension") else 0.0
             self.command = (min(max(start, 0.0), limits.tension_max), self.roll_rad)
-        tension = slew(self.command[0], goal[0], limits.setpoint_rate, self.period_s)
-        roll = slew(self.command[1], goal[1], limits.roll_rate, self.period_s)
-        self.command = (tension, roll)
         now = self.port.now_ns()
+        step_s = self.period_s if self.slewed_ns is None else min(
+            (now - self.slewed_ns) * 1e-9, LATE_STEPS_COUNTED * self.period_s)
+        self.slewed_ns = now
+        tension = slew(self.command[0], goal[0], limits.setpoint_rate, step_s)
+        roll = slew(self.command[1], goal[1], limits.roll_rate, step_s)
+        self.command = (tension, roll)
         if (self.sent is not None and (self.sent[0], self.sent[1]) == self.command
                 and now - self.sent[2] < self.keepalive_s * 1e9):
             return

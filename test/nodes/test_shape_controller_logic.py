@@ -156,6 +156,23 @@ def test_a_point_in_mocap_is_commanded_slewed_within_the_driver_limits(bench) ->
     assert "feed-forward with the last gain 1" in b.node.check().message
 
 
+def test_a_late_tick_slews_for_the_time_it_missed_at_most_ten_periods(bench) -> None:
+    """A tick 0.15 s after the last (two skipped on a loaded machine) slews 0.15 s worth, so
+    the command keeps the driver's rates in time; after a 2 s stall, 10 periods' worth."""
+    b = bench()
+    b.tension(0.0)
+    b.target(model_tip(10.0, 1.1))
+    b.port.advance(0.05)
+    assert b.last("roll_setpoint").data == pytest.approx(0.05)     # 1 rad/s for 0.05 s
+    b.port.clock_ns += 150_000_000   # the next tick runs 0.15 s later
+    b.node.step()
+    assert b.last("tension_setpoint").data == pytest.approx(2.0 + 40.0 * 0.15)
+    assert b.last("roll_setpoint").data == pytest.approx(0.05 + 0.15)
+    b.port.clock_ns += 2_000_000_000  # a stall of 2 s
+    b.node.step()
+    assert b.last("roll_setpoint").data == pytest.approx(0.2 + 10 * 0.05)
+
+
 def test_an_angle_keeps_the_current_roll(bench) -> None:
     b = bench()
     b.target(model_tip(8.0, -0.3))

@@ -22,6 +22,7 @@ from tdcm_ros.bagio import from_dict
 from tdcm_ros.control import rotate_z
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import MarkerLayout, preset, solve, surface_points
+from tdcm_ros.nodes.shape_controller import LATE_STEPS_COUNTED
 from tdcm_ros.runtime.port import QoS
 from test.support.waiting import eventually
 
@@ -150,8 +151,13 @@ def test_a_target_in_mocap_is_tracked_with_feedback_from_markers(runtime, contex
                     and peer.last("tension_setpoint").data == pytest.approx(10.0, abs=1e-6)
                     and peer.last("roll_setpoint").data == pytest.approx(0.4), 10.0,
                     "the feed-forward setpoints (model: 10 N, 0.4 rad)")
-    steps = np.diff([m.data for m in peer.outputs["tension_setpoint"]])
-    assert np.all(steps <= 40.0 * 0.05 + 1e-9)   # slewed at the driver's setpoint_rate
+    # Slewed at the driver's setpoint_rate (40 N/s): the first tick by one period (0.05 s) from
+    # 0 N, each later one by the time since the last, at most LATE_STEPS_COUNTED periods (the
+    # law on simulated time: test_shape_controller_logic.py); a ramp, never down.
+    setpoints = [m.data for m in peer.outputs["tension_setpoint"]]
+    assert setpoints[0] <= 40.0 * 0.05 + 1e-9
+    steps = np.diff(setpoints)
+    assert np.all(steps >= 0.0) and np.all(steps <= 40.0 * 0.05 * LATE_STEPS_COUNTED + 1e-9)
 
     def close_loop() -> None:
         peer.echo(peer.last("tension_setpoint").data, peer.last("roll_setpoint").data)
