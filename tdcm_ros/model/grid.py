@@ -232,7 +232,8 @@ class Grid(CellArrays):
         return Members.of([self.design])
 
     def u_of_s(self, cells: IntArray, s: Array) -> Array:
-        """Inverse of :meth:`local_sigma`: reference coordinate of arc length ``s`` (m)."""
+        """Reference coordinate ``u`` of each cell's segment where it reaches arc length ``s``
+        (m): the inverse of its profile's ``sigma(u)``."""
         sigma = s - self.seg_start[cells]
         u_lin = sigma / self.seg_length[cells]
         members = self.members

@@ -1,8 +1,10 @@
-"""``sensor_msgs/msg/JointState`` of the bench's one joint, ``roll`` (rad), as the device nodes
-publish it (``tension_driver``: ``joint_states``; ``device_twin``: ``sim/joint_states_true``)."""
+"""``sensor_msgs/msg/JointState`` of the bench's joints: the roll (rad), as the device nodes
+publish it (``tension_driver``: ``joint_states``; ``device_twin``: ``sim/joint_states_true``), and
+the tendons as prismatic joints, as model_node predicts them (``tendon_states``)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from tdcm_ros.bagio import from_dict
@@ -10,6 +12,7 @@ from tdcm_ros.nodes.shape_messages import header
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 ROLL_JOINT = "roll"  #: joint name of the roll servo (rotation about the base +z axis)
+TENDON_JOINT = "tendon_{}"  #: joint name of tendon k (1-based, in the body's order)
 
 
 def joint_state(stamp_ns: int, position: float, velocity: float | None = None) -> Any:
@@ -19,3 +22,14 @@ def joint_state(stamp_ns: int, position: float, velocity: float | None = None) -
                                    "position": [position],
                                    "velocity": [] if velocity is None else [velocity],
                                    "effort": []})
+
+
+def tendon_states(stamp_ns: int, strokes_m: Sequence[float], tensions_n: Sequence[float]
+                  ) -> Any:
+    """Each tendon as a prismatic joint ``tendon_<k>``: position its stroke (m, pulled in
+    against the straight body), effort its tension (N), stamped ``stamp_ns``, no frame."""
+    return from_dict(JOINT_STATE, {"header": header(stamp_ns, ""),
+                                   "name": [TENDON_JOINT.format(k + 1)
+                                            for k in range(len(strokes_m))],
+                                   "position": [float(v) for v in strokes_m], "velocity": [],
+                                   "effort": [float(v) for v in tensions_n]})

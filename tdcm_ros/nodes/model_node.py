@@ -5,7 +5,9 @@ in N, in a frame whose z axis runs along the tendon toward the actuator; or
 ``std_msgs/msg/Float64`` in N, by the ``input.tension_type`` parameter). Publishes, stamped
 with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (nav_msgs/Path),
 ``midline_poses`` (PoseArray), ``tip_pose`` (PoseStamped), ``predicted_markers`` (PoseArray),
-``body_markers`` (visualization_msgs/MarkerArray) and ``/diagnostics`` (``model_node: input``:
+``body_markers`` (visualization_msgs/MarkerArray), ``tendon_states`` (sensor_msgs/JointState:
+each tendon as a prismatic joint ``tendon_<k>``, position its stroke in m, effort its tension in
+N; not rolled, no frame) and ``/diagnostics`` (``model_node: input``:
 dropped and coalesced inputs; ``model_node: solver``: solves and failures; each WARN while a
 problem happened within the last 5 diagnostics periods, OK again after).
 
@@ -58,6 +60,7 @@ from tdcm_ros.model import (
     solve,
     warm_up,
 )
+from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_states
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import midline_messages, stamp_ns_of
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
@@ -174,7 +177,8 @@ class ModelNode(NodeLogic):
                                ("midline_poses", "geometry_msgs/msg/PoseArray"),
                                ("tip_pose", "geometry_msgs/msg/PoseStamped"),
                                ("predicted_markers", "geometry_msgs/msg/PoseArray"),
-                               ("body_markers", "visualization_msgs/msg/MarkerArray"))}
+                               ("body_markers", "visualization_msgs/msg/MarkerArray"),
+                               ("tendon_states", JOINT_STATE))}
         self.tf_static = port.create_publisher("/tf_static", TF_TYPE,
                                                QoS(depth=1, durability="transient_local"))
         self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
@@ -330,6 +334,8 @@ class ModelNode(NodeLogic):
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
                 roll=roll):
             self.publishers[topic].publish(message)  # midline first: sent before the rest is built
+        self.publishers["tendon_states"].publish(
+            tendon_states(stamp_ns, result.tendon_strokes_m.tolist(), [result.tension_n]))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=str(self.tf_names["tf.station_prefix"]),

@@ -62,6 +62,21 @@ def test_a_good_tension_is_solved_at_its_stamp_as_the_library_solves_it() -> Non
     assert n.counts() == dict.fromkeys(KEYS, 0)
 
 
+def test_each_solve_publishes_the_tendon_as_a_joint_its_stroke_and_tension() -> None:
+    n = Node()
+    for tension in (6.0, 20.0):
+        sent = n.port.now_ns() - 2 * MS
+        assert n.send(tension, sent)
+        state = n.port.messages("tendon_states")[-1]
+        expected = solve(preset("paper-experiment"), tension)
+        assert stamp(state) == sent and state.header.frame_id == ""
+        assert list(state.name) == ["tendon_1"] and len(state.velocity) == 0
+        assert list(state.position) == pytest.approx(expected.tendon_strokes_m.tolist(),
+                                                     abs=1e-12)
+        assert list(state.effort) == [tension]
+    assert len(n.port.messages("tendon_states")) == 2   # one per solve
+
+
 @pytest.mark.parametrize(("tension", "key"), [
     (float("nan"), "dropped_non_finite"), (float("inf"), "dropped_non_finite"),
     (-3.0, "dropped_negative"), (200.000001, "dropped_above_max"), (1e9, "dropped_above_max")])
