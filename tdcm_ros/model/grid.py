@@ -195,6 +195,21 @@ class Grid(CellArrays):
         """Indices of cells where the tendon follows the offset curve."""
         return np.flatnonzero(self.constrained)
 
+    @cached_property
+    def constrained_length(self) -> float:
+        """Arc length (m) of the cells where the tendon follows the offset curve."""
+        return float(np.sum(self.length[self.constrained_cells]))
+
+    @cached_property
+    def chord_nodes(self) -> IntArray:
+        """Start (row 0) and end node (row 1) of each chord the tendon crosses, base to tip,
+        shape (2, chords) (a chord's cells are consecutive and share its two nodes)."""
+        chord = ~self.constrained
+        starts, ends = self.chord_start_node[chord], self.chord_end_node[chord]
+        first = np.ones(starts.size, dtype=bool)
+        first[1:] = (starts[1:] != starts[:-1]) | (ends[1:] != ends[:-1])
+        return np.stack([starts[first], ends[first]])
+
     @property
     def r_c(self) -> float:
         """The tendon's offset from the tube axis (m)."""

@@ -131,16 +131,18 @@ class SolveResult:
         by the cells' own quadrature), and straight across each chord."""
         grid = self.grid
         r_c = grid.r_c
-        moments = self.bend_moments
-        stretch = np.sum(moments[:, 0:1] * grid.K0 + moments[:, 1:2] * grid.K1
-                         - self.tension_n * grid.K2, axis=1)
-        follows = grid.constrained
-        along = np.sum((grid.length + stretch - r_c * np.diff(self.theta))[follows])
-        path = (self.positions[:, 2] + 1j * self.positions[:, 0]
-                + 1j * r_c * np.exp(1j * self.theta))
-        chords = np.unique(np.stack([grid.chord_start_node, grid.chord_end_node],
-                                    axis=1)[~follows], axis=0)
-        across = np.sum(np.abs(path[chords[:, 1]] - path[chords[:, 0]]))
+        follows = grid.constrained_cells
+        along = grid.constrained_length - r_c * float(
+            np.sum(self.theta[follows + 1] - self.theta[follows]))
+        if grid.off_axis:  # the axis's stretch (zero where every centroid is on it)
+            m = self.bend_moments[follows]
+            along += float(np.sum(m[:, 0:1] * grid.K0[follows] + m[:, 1:2] * grid.K1[follows]
+                                  - self.tension_n * grid.K2[follows]))
+        nodes = grid.chord_nodes  # the tendon at each chord's ends: R_c along the body's +x
+        theta = self.theta[nodes]
+        x = self.positions[nodes, 0] + r_c * np.cos(theta)
+        z = self.positions[nodes, 2] - r_c * np.sin(theta)
+        across = float(np.sum(np.hypot(x[1] - x[0], z[1] - z[0])))
         return np.array([along + across])
 
     @property

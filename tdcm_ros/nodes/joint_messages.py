@@ -7,8 +7,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from tdcm_ros.bagio import from_dict
-from tdcm_ros.nodes.shape_messages import header
+import numpy as np
+
+from tdcm_ros.bagio import from_dict, msg_class
+from tdcm_ros.nodes.shape_messages import header, header_msg
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 ROLL_JOINT = "roll"  #: joint name of the roll servo (rotation about the base +z axis)
@@ -28,8 +30,9 @@ def tendon_states(stamp_ns: int, strokes_m: Sequence[float], tensions_n: Sequenc
                   ) -> Any:
     """Each tendon as a prismatic joint ``tendon_<k>``: position its stroke (m, pulled in
     against the straight body), effort its tension (N), stamped ``stamp_ns``, no frame."""
-    return from_dict(JOINT_STATE, {"header": header(stamp_ns, ""),
-                                   "name": [TENDON_JOINT.format(k + 1)
-                                            for k in range(len(strokes_m))],
-                                   "position": [float(v) for v in strokes_m], "velocity": [],
-                                   "effort": [float(v) for v in tensions_n]})
+    # from the typestore class, as the shape messages (model_node builds one per input)
+    return msg_class(JOINT_STATE)(
+        header=header_msg(stamp_ns, ""),
+        name=[TENDON_JOINT.format(k + 1) for k in range(len(strokes_m))],
+        position=np.array(strokes_m, dtype=np.float64), velocity=np.empty(0),
+        effort=np.array(tensions_n, dtype=np.float64))

@@ -34,7 +34,8 @@ def stamp_ns_of(message: Any) -> int:
     return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
 
 
-def _header_msg(stamp_ns: int, frame_id: str) -> Any:
+def header_msg(stamp_ns: int, frame_id: str) -> Any:
+    """A ``std_msgs/Header`` message object for ``stamp_ns`` (ns since the epoch)."""
     sec, nanosec = divmod(stamp_ns, 1_000_000_000)
     return msg_class("std_msgs/msg/Header")(
         stamp=msg_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec),
@@ -83,7 +84,7 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     # midline, markers and tip turned in one call: rows [0, samples), [samples, -1), -1
     positions, quats = roll_poses(np.vstack([planar, result.tip_position]),
                                   np.vstack([planar_quats, result.tip_quaternion]), roll)
-    hdr = _header_msg(stamp_ns, frame_id)
+    hdr = header_msg(stamp_ns, frame_id)
     pose_stamped = msg_class("geometry_msgs/msg/PoseStamped")
     pose_array = msg_class("geometry_msgs/msg/PoseArray")
     poses = _poses(positions[:samples], quats[:samples])
