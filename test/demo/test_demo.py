@@ -10,6 +10,7 @@ import subprocess
 import sys
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -113,6 +114,17 @@ def test_ideal_scene_demo_gives_a_readable_bag_and_near_zero_metrics(tmp_path: P
     assert (tmp_path / "ideal" / "plots" / "shapes.png").stat().st_size > 0
 
 
+def loading_levels(evaluation: dict[str, Any]) -> list[int]:
+    """The loading levels (N, rounded) of an evaluation's steps. Besides them, only the release
+    to 0 N after the schedule may be a step: the recorder stops ``SETTLE_S`` after the driver's
+    ``schedule_done`` reaches the demo (a diagnostics period or less after the schedule ends),
+    so that unloading hold lasts about ``min_hold_s`` at 1 s holds and is found in some runs."""
+    steps = evaluation["steps"]
+    release = [step for step in steps if step["phase"] != "loading"]
+    assert len(release) <= 1 and all(round(step["tension_n"]) == 0 for step in release), steps
+    return sorted(round(step["tension_n"]) for step in steps if step["phase"] == "loading")
+
+
 @pytest.mark.demo
 def test_paper_scene_demo_calibrates_into_the_papers_range_on_short_holds(tmp_path: Path) -> None:
     """``--hold 1``: the step settings follow the schedule (the defaults' 1 s shortest hold
@@ -125,14 +137,14 @@ def test_paper_scene_demo_calibrates_into_the_papers_range_on_short_holds(tmp_pa
     results = json.loads((tmp_path / "paper" / "metrics.json").read_text())
     before = results["before_calibration"]
     said = done.stdout[-3000:]  # the bench's holds and the steps found, for a failure
-    assert (before["n_trials"], before["n_steps"]) == (1, 6), said
-    assert sorted(round(step["tension_n"]) for step in before["steps"]) == [0, 4, 8, 12, 16, 20]
+    assert before["n_trials"] == 1 and 6 <= before["n_steps"] <= len(before["steps"]), said
+    assert loading_levels(before) == [0, 4, 8, 12, 16, 20], said
     assert before["details"]["mape_threshold_m"] == 0.002
     calibration, after = results["calibration"], results["after_calibration"]
     # each number once: the fit holds no evaluation; the one after it has its own step table
     assert set(results) == {"scene", "before_calibration", "calibration", "after_calibration"}
     assert not {"before", "after"} & set(calibration)
-    assert sorted(round(step["tension_n"]) for step in after["steps"]) == [0, 4, 8, 12, 16, 20]
+    assert loading_levels(after) == [0, 4, 8, 12, 16, 20]
     # Datasheet E (1.85 GPa) against a 0.70 GPa world: the tip is predicted far too stiff.
     assert before["mape_pct"] > 40.0
     # After fitting E: the paper's Table I range (MAPE 2.51 %, RMSE 0.54 mm, shape 0.85 mm),
