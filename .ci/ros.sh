@@ -271,7 +271,9 @@ fi
 rclpy_pytest() {  # rclpy_pytest PYTEST_ARGS...: one pytest run; no test collected is a failure
   phase "pytest $*"
   local status=0
-  TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider --durations=25 "$@" || status=$?
+  # --max-worker-restart=0: a crashed worker ends the run, red (see .ci/test.sh)
+  TDCM_REQUIRE_RCLPY=1 python -m pytest -q -p no:cacheprovider --durations=25 \
+    --max-worker-restart=0 "$@" || status=$?
   if [ "$status" = 5 ]; then  # none collected: a failure, unless PYTEST_ARGS selected them
     [ "$CUSTOM_ARGS" = 1 ] || fail "pytest $* collected no tests: the rclpy tests are missing"
     echo "pytest $*: no test selected"
