@@ -288,10 +288,10 @@ class Grid(CellArrays):
         docstring; ``D`` and ``K`` are 0 where the centroid is on the axis).
         """
         start = self.s_nodes[cells] - self.seg_start[cells]
-        cell = np.stack([self.is_notch[cells], np.zeros(cells.size), self.u_a[cells],
-                         self.u_of_s(cells, s), start, self.length[cells],
-                         self.seg_length[cells], self.u_b[cells], s - self.s_nodes[cells]],
-                        axis=1).astype(float)
+        cell = _cell_rows(is_notch=self.is_notch[cells], chord=np.zeros(cells.size),
+                          u_a=self.u_a[cells], u_b=self.u_of_s(cells, s), start=start,
+                          length=self.length[cells], seg_length=self.seg_length[cells],
+                          u_end=self.u_b[cells], span=s - self.s_nodes[cells])
         fc, fq, _ = _integrals(self.members, self.shape[cells], cell, self.gauss_u.size)
         fc, fq = fc[:-1], fq[:-1]
         k = grid_kernel
@@ -459,9 +459,18 @@ def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
     """:class:`GridParts`' ``proto_fc``, ``proto_fq``, ``proto_strain`` of every prototype cell
     of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row;
     ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
-    cell = np.stack([table.is_notch, table.chord, table.u_a, table.u_b, table.a, table.length,
-                     table.seg_length, table.u_b, table.length], axis=1).astype(float)
+    cell = _cell_rows(is_notch=table.is_notch, chord=table.chord, u_a=table.u_a, u_b=table.u_b,
+                      start=table.a, length=table.length, seg_length=table.seg_length,
+                      u_end=table.u_b, span=table.length)
     return _integrals(table.members, table.shape, cell, quad_order, workers)
+
+
+def _cell_rows(**columns: NDArray[Any]) -> Array:
+    """The kernel's ``cell`` input (cells, 9) from its columns by name (``is_notch``, ``chord``,
+    ``u_a``, ``u_b``, ``start``, ``length``, ``seg_length``, ``u_end``, ``span``: the module
+    docstring of :mod:`tdcm_ros.model.grid_kernel`), in the kernel's column order."""
+    order = ("is_notch", "chord", "u_a", "u_b", "start", "length", "seg_length", "u_end", "span")
+    return np.stack([columns[name] for name in order], axis=1).astype(float)
 
 
 def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
