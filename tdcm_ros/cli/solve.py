@@ -35,9 +35,12 @@ def register(subparsers: Any) -> None:
                "  tdcm solve --tension 20\n"
                "  tdcm solve --design fig2-wn-1.9 --tension 20 --json\n"
                "  tdcm solve --tension 12 --set E=1.2e9 --plot shape.png\n"
+               "  tdcm solve --design config/bodies/antagonistic_pair.yaml --tension 25,5\n"
                "  tdcm solve --stroke 0.0005")
     drive = parser.add_mutually_exclusive_group(required=True)
-    drive.add_argument("--tension", type=str, help="tendon tension (N)")
+    drive.add_argument("--tension", type=str, help="tendon tension (N); one per tendon, "
+                       "comma-separated, for a body file with several (base to tip order of "
+                       "its tendons list)")
     drive.add_argument("--stroke", metavar="M", help="tendon stroke (m): how far the tendon is "
                        "pulled in against the straight body; the tension is found within "
                        f"[0, {DEFAULT_TENSION_MAX_N:g}] N (tdcm inverse --tendon-stroke sets "
@@ -49,14 +52,17 @@ def register(subparsers: Any) -> None:
     parser.set_defaults(handler=run)
 
 
-def _tension(text: str) -> float:
-    """``--tension`` text as a number (N); the solver checks its range."""
+def _tension(text: str) -> float | list[float]:
+    """``--tension`` text as a number (N), or comma-separated numbers (one per tendon); the
+    solver checks their count and range."""
     try:
-        return float(text)
+        values = [float(item) for item in text.split(",")]
     except ValueError:
-        raise TensionRangeError(f"--tension = {text!r} is not a number; allowed: a finite "
-                                "number in [0, inf) N", parameter="--tension", value=text,
-                                allowed="[0, inf) N") from None
+        raise TensionRangeError(f"--tension = {text!r} is not a number or comma-separated "
+                                "numbers; allowed: finite numbers in [0, inf) N",
+                                parameter="--tension", value=text,
+                                allowed="[0, inf) N, one per tendon") from None
+    return values[0] if len(values) == 1 else values
 
 
 def run(args: argparse.Namespace) -> int:
@@ -85,11 +91,15 @@ def run(args: argparse.Namespace) -> int:
         x, _, z = result.tip_position * 1e3
         print(f"design {name}: L = {design.length * 1e3:.3f} mm, E = {design.E:.4g} Pa, "
               f"routing {settings.routing}, loads {settings.loads}")
-        print(f"tension {result.tension_n:g} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
+        tensions = ", ".join(f"{t:g}" for t in result.tensions_n)
+        print(f"tension {tensions} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
               f"angle {result.tip_angle_rad:.5f} rad, deflection "
               f"{result.tip_deflection_m * 1e3:.4f} mm")
-        print(f"tendon: length {result.tendon_lengths_m[0] * 1e3:.6f} mm, stroke "
-              f"{result.tendon_strokes_m[0] * 1e3:.6f} mm")
+        for name, tension, length, stroke in zip(
+                result.tendons.names, result.tensions_n, result.tendon_lengths_m,
+                result.tendon_strokes_m, strict=True):
+            print(f"{name}: {tension:g} N, length {length * 1e3:.6f} mm, stroke "
+                  f"{stroke * 1e3:.6f} mm")
         print(report)
         print(f"converged in {result.iterations} iterations ({result.strategy}), "
               f"{result.solve_time_s * 1e6:.0f} us")

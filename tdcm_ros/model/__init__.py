@@ -97,6 +97,7 @@ from tdcm_ros.model.roll import (
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
+from tdcm_ros.model.tendons import Tendon, require_paper_tendon
 
 __all__ = [
     "DEFAULT_ALLOWABLE_STRAIN",
@@ -145,6 +146,7 @@ __all__ = [
     "SolveResult",
     "SolverSettings",
     "StampedHistory",
+    "Tendon",
     "TendonSingularityError",
     "TensionProfile",
     "TensionRangeError",
@@ -166,6 +168,7 @@ __all__ = [
     "preset",
     "read_body_file",
     "report_progress",
+    "require_paper_tendon",
     "roll_loading",
     "roll_points",
     "roll_poses",

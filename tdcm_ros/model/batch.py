@@ -54,6 +54,7 @@ from tdcm_ros.model.limits import check_closure, check_tendon_singularity, check
 from tdcm_ros.model.moment_model import DIVERGENCE_GROWTH
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, SLOW_CONTRACTION, solve
+from tdcm_ros.model.tendons import require_paper_tendon
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -198,6 +199,7 @@ def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAU
             raise InvalidDesignError(
                 f"designs[{i}] = {design!r} is not a Design", parameter=f"designs[{i}]",
                 value=design, allowed="tdcm_ros.model.Design")
+        require_paper_tendon(design.tendons, "the batch solver", f"designs[{i}].tendons")
     if not isinstance(settings, SolverSettings):
         raise InvalidSettingsError(f"settings = {settings!r} is not a SolverSettings",
                                    parameter="settings", value=settings,

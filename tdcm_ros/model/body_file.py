@@ -4,7 +4,7 @@
 
     tube: {R_outer: 3.92e-3, r_inner: 1.55e-3}     # m
     material: {E: 1.85e9}                         # Pa
-    tendons:
+    tendons:                                      # one or more
       - {offset: 2.75e-3, routing: paper}         # m from the tube axis, + on the +x side
     segments:                                     # base to tip
       - tube: 5.0e-3                              # a plain tube of this length (m)
@@ -27,8 +27,16 @@ to the body file's folder), sliced into its tube and prismatic notches by
 :class:`~tdcm_ros.model.errors.InvalidDesignError` naming the key by its path in the file
 (``segments[1].segments[0].notch.cut``), the value and the allowed range.
 
+A tendon has a signed ``offset`` (m, + on the +x side, - on the -x side), a ``routing``
+(``paper``: following the body in the notches, chords across the tubes; ``free``: the
+reverse; default the solver's, ``paper``), an ``anchor`` (m from the base, at a segment
+boundary; default the tip), ``guides`` (``internal``: through the wall, ``|offset| <
+R_outer``; ``external``: through guides such as disks, any offset up to 0.5 m) and a ``name``
+(default ``tendon_1``, ``tendon_2``, ...: :mod:`tdcm_ros.model.tendons`). The solver takes one
+tension per tendon.
+
 The solver takes band, cut and polygon notches, each with its own width and section, any
-tubes between them, and one tendon: :meth:`BodySpec.design` gives that
+tubes between them, and the tendons: :meth:`BodySpec.design` gives that
 :class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ; a polygon
 notch is a :class:`~tdcm_ros.model.profiles.PolygonProfile`, prismatic along the body).
 """
@@ -36,6 +44,7 @@ notch is a :class:`~tdcm_ros.model.profiles.PolygonProfile`, prismatic along the
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -54,12 +63,15 @@ from tdcm_ros.model.profiles import (
     profile_from_name,
 )
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
+from tdcm_ros.model.settings import ROUTINGS
+from tdcm_ros.model.tendons import GUIDES, MAX_EXTERNAL_OFFSET_M, MAX_TENDONS, Tendon
 from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
 
 #: Most segments a body may expand to (``repeat`` included).
 MAX_SEGMENTS = 10_000
-ROUTINGS = ("paper", "free")
+#: A tendon's name: a ROS name token (it names its joint and topic).
+NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 SECTION_KEYS = ("band", "cut", "polygon", "section")
 #: Keys of a section given by its numbers (SI units).
 GIVEN_SECTION_KEYS = ("area", "centroid_x", "second_moment", "x_low", "x_high")
@@ -128,16 +140,28 @@ Segment = TubeSpec | NotchSpec
 
 @dataclass(frozen=True)
 class BodySpec:
-    """A body file's contents, checked (SI units): the tube, ``E`` (Pa), the tendon's offset (m)
-    and routing, and the segments base to tip (``repeat`` expanded)."""
+    """A body file's contents, checked (SI units): the tube, ``E`` (Pa), the tendons (their
+    ``routing`` None where the file gives none) and the segments base to tip (``repeat``
+    expanded)."""
 
     R_outer: float
     r_inner: float
     E: float
-    tendon_offset: float
-    routing: str
+    tendons: tuple[Tendon, ...]
     segments: tuple[Segment, ...]
     source: str
+
+    @property
+    def routing(self) -> str:
+        """The solver's routing the file asks for: its first tendon's (``paper`` if none)."""
+        return self.tendons[0].routing or "paper"
+
+    @property
+    def is_paper_tendon(self) -> bool:
+        """Whether the file has the paper's one tendon: on +x, through the wall, to the tip."""
+        only = self.tendons[0]
+        return (len(self.tendons) == 1 and only.offset > 0.0 and only.anchor is None
+                and only.guides == "internal" and only.name in ("", "tendon_1"))
 
     def design(self) -> Design:
         """The body as the solver's :class:`Design`: a base tube (or none), N band, cut or
@@ -164,11 +188,19 @@ class BodySpec:
         at = [k for k, segment in enumerate(merged) if isinstance(segment, NotchSpec)]
         gaps = tuple(after.length if isinstance(after := merged[k + 1], TubeSpec) else 0.0
                      for k in at[:-1])
-        return Design(w_base=head, w_tip=tail, w_n=tuple(n.width for n in notches), w_t=gaps,
-                      w_d=tuple(n.backbone(self.R_outer) for n in notches), N=len(notches),
-                      w_o=tuple(n.offset for n in notches), R_outer=self.R_outer,
-                      r_inner=self.r_inner, R_c=self.tendon_offset, E=self.E,
-                      profile=tuple(n.profile_object() for n in notches))
+        tendons = () if self.is_paper_tendon else self.tendons
+        try:
+            return Design(w_base=head, w_tip=tail, w_n=tuple(n.width for n in notches),
+                          w_t=gaps, w_d=tuple(n.backbone(self.R_outer) for n in notches),
+                          N=len(notches), w_o=tuple(n.offset for n in notches),
+                          R_outer=self.R_outer, r_inner=self.r_inner,
+                          R_c=abs(self.tendons[0].offset), E=self.E,
+                          profile=tuple(n.profile_object() for n in notches), tendons=tendons)
+        except InvalidDesignError as error:
+            if not (error.parameter or "").startswith("tendons"):
+                raise
+            raise InvalidDesignError(f"{self.source}: {error}", parameter=error.parameter,
+                                     value=error.value, allowed=error.allowed) from error
 
 
 def _merged_tubes(segments: Sequence[Segment]) -> list[Segment]:
@@ -219,21 +251,47 @@ def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
     material = _mapping(_required(top, "material", "", source), "material", source)
     reject_unknown("material key", material, ("E",), error=InvalidDesignError)
     modulus = _number(material, "E", "material.", source, low=0.0, high=1e12, open_low=True)
-    tendons = _required(top, "tendons", "", source)
-    if not isinstance(tendons, list) or len(tendons) != 1:
-        count = len(tendons) if isinstance(tendons, list) else tendons
-        raise out_of_range(f"{source}: tendons", count, "a list of one tendon (several "
-                           "tendons are not solvable yet)", error=InvalidDesignError)
-    tendon = _mapping(tendons[0], "tendons[0]", source)
-    reject_unknown("tendon key", tendon, ("offset", "routing"), error=InvalidDesignError)
-    offset = _number(tendon, "offset", "tendons[0].", source, low=0.0, high=r_outer,
-                     open_low=True, open_high=True)
-    routing = tendon.get("routing", "paper")
-    if routing not in ROUTINGS:
-        raise out_of_range(f"{source}: tendons[0].routing", routing, " | ".join(ROUTINGS),
+    tendons = _tendons(_required(top, "tendons", "", source), source, r_outer)
+    return BodySpec(R_outer=r_outer, r_inner=r_inner, E=modulus, tendons=tendons,
+                    segments=tuple(segments), source=source)
+
+
+def _tendons(items: Any, source: str, r_outer: float) -> tuple[Tendon, ...]:
+    """The body file's ``tendons``: each with its signed ``offset`` (m), ``routing`` (None
+    where not given), ``anchor`` (m, None: the tip), ``guides`` and ``name``; where an anchor
+    falls is checked with the segments (:class:`~tdcm_ros.model.design.Design`)."""
+    if not isinstance(items, list) or not 1 <= len(items) <= MAX_TENDONS:
+        count = len(items) if isinstance(items, list) else items
+        raise out_of_range(f"{source}: tendons", count, f"a list of 1 to {MAX_TENDONS} tendons",
                            error=InvalidDesignError)
-    return BodySpec(R_outer=r_outer, r_inner=r_inner, E=modulus, tendon_offset=offset,
-                    routing=str(routing), segments=tuple(segments), source=source)
+    out = []
+    for k, item in enumerate(items):
+        here = f"tendons[{k}]"
+        tendon = _mapping(item, here, source)
+        reject_unknown("tendon key", tendon, ("offset", "routing", "anchor", "guides", "name"),
+                       error=InvalidDesignError)
+        guides = tendon.get("guides", "internal")
+        if guides not in GUIDES:
+            raise out_of_range(f"{source}: {here}.guides", guides, " | ".join(GUIDES),
+                               error=InvalidDesignError)
+        limit = r_outer if guides == "internal" else MAX_EXTERNAL_OFFSET_M
+        offset = _number(tendon, "offset", f"{here}.", source, low=-limit, high=limit,
+                         open_low=True, open_high=True)
+        if offset == 0.0:
+            raise out_of_range(f"{source}: {here}.offset", offset, f"0 < |offset| < {limit:g} m "
+                               "(+ on the +x side, - on the -x side)", error=InvalidDesignError)
+        routing = tendon.get("routing")
+        if routing is not None and routing not in ROUTINGS:
+            raise out_of_range(f"{source}: {here}.routing", routing, " | ".join(ROUTINGS),
+                               error=InvalidDesignError)
+        anchor = (_number(tendon, "anchor", f"{here}.", source, low=0.0, high=1.0,
+                          open_low=True) if "anchor" in tendon else None)
+        name = tendon.get("name", f"tendon_{k + 1}")
+        if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
+            raise out_of_range(f"{source}: {here}.name", name, "a ROS name token: a letter, "
+                               "then letters, digits or _", error=InvalidDesignError)
+        out.append(Tendon(offset, routing, anchor, str(guides), name))
+    return tuple(out)
 
 
 def _mesh(entry: Mapping[str, Any], source: str) -> tuple[float, float, list[Segment]]:
@@ -421,7 +479,8 @@ def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low
 
 
 def body_file_text(design: Design, routing: str = "paper") -> str:
-    """The body file of ``design`` whose tendon has ``routing``: reading it back gives
+    """The body file of ``design`` whose tendons without their own routing have ``routing``
+    (the paper's one tendon: ``R_c`` on +x): reading it back gives
     ``design`` bit for bit (every number written as its shortest round-trip form). A uniform
     design is written with ``repeat``, a per-notch one segment by segment."""
     def number(value: float) -> str:
@@ -448,9 +507,19 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         at = f", offset: {number(offset)}" if offset != 0.0 else ""
         return f"{{width: {number(width)}, band: {number(band)}{at}, profile: {profile.name}}}"
 
+    def tendon(one: Tendon) -> str:
+        keys = [f"offset: {number(one.offset)}"]
+        if one.routing or not design.tendons:
+            keys.append(f"routing: {one.routing or routing}")
+        if one.anchor is not None:
+            keys.append(f"anchor: {number(one.anchor)}")
+        if one.guides != "internal":
+            keys.append(f"guides: {one.guides}")
+        return "  - {" + ", ".join([*keys, f"name: {one.name}"] if design.tendons else keys) + "}"
+
     lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
              f"material: {{E: {number(design.E)}}}", "tendons:",
-             f"  - {{offset: {number(design.R_c)}, routing: {routing}}}", "segments:"]
+             *(tendon(one) for one in design.tendon_list()), "segments:"]
     if design.w_base > 0.0:
         lines.append(f"  - tube: {number(design.w_base)}")
     if design.is_uniform:

@@ -41,6 +41,7 @@ from tdcm_ros.model.profiles import (
 )
 from tdcm_ros.model.section import tube_moment
 from tdcm_ros.model.sections import OFFSET_SLACK, keeps_wall
+from tdcm_ros.model.tendons import Tendon, check_tendons
 from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of, spelled_as
 
 MM = 1e-3
@@ -48,7 +49,7 @@ MM = 1e-3
 #: or at least this, so no cell is negligible against the arc lengths it sits between.
 MIN_SEGMENT_M = 1e-6
 #: Fields a design may derive from its notch sections (:meth:`Design.derived_fields`).
-DERIVABLE_FIELDS = frozenset({"profile", "w_d", "w_o"})
+DERIVABLE_FIELDS = frozenset({"profile", "w_d", "w_o", "R_c"})
 #: Fields that may hold one value per notch (base to tip).
 PER_NOTCH_FIELDS = ("w_n", "w_d", "w_o")
 #: Fields that may hold one value per gap between adjacent notches (base to tip).
@@ -88,6 +89,9 @@ class Design:
         "the paper's symmetric notch, -(R_outer - w_d/2): a one-sided cut from +x (per notch: "
         "a list in Python and --set, or a body file)", low=-0.5, high=0.5, kind="float")
     profile: NotchProfile | tuple[NotchProfile, ...] = field(default_factory=CircularProfile)
+    tendons: tuple[Tendon, ...] = ()
+    """Several tendons, or one off the paper's (:mod:`tdcm_ros.model.tendons`); empty: the
+    paper's one tendon at ``R_c`` on +x. With a list, ``R_c`` is the first one's ``|offset|``."""
 
     def __post_init__(self) -> None:
         check_fields(self, {k: v for k, v in FIELD_SPECS.items() if k not in _LISTABLE},
@@ -97,6 +101,17 @@ class Design:
         object.__setattr__(self, "profile", _profiles(self.profile, self.N))
         self._take_prismatic_extents()
         self._check_cross_fields()
+        if self.tendons != ():
+            object.__setattr__(self, "tendons", check_tendons(
+                self.tendons, self.R_outer, self.segment_ends()))
+            if self.R_c != abs(self.tendons[0].offset):
+                raise out_of_range("R_c", self.R_c, f"{abs(self.tendons[0].offset):g} m (the "
+                                   "first tendon's |offset| where tendons are listed)",
+                                   error=InvalidDesignError)
+
+    def tendon_list(self) -> tuple[Tendon, ...]:
+        """The design's tendons: its list, or the paper's one at ``R_c`` on +x, to the tip."""
+        return self.tendons if self.tendons else (Tendon(self.R_c, name="tendon_1"),)
 
     def _take_prismatic_extents(self) -> None:
         """Set ``w_d`` and ``w_o`` of each notch whose section is given (a polygon, a section's
@@ -134,11 +149,15 @@ class Design:
         narrower than the tube and inside it (``|w_o| <= R_outer - w_d/2``), and tube segments absent or at least ``MIN_SEGMENT_M`` long."""
         diameter = 2.0 * self.R_outer
         below = (("r_inner", self.R_outer, f"[0, R_outer = {self.R_outer:g}) m"),
-                 ("R_c", self.R_outer, f"(0, R_outer = {self.R_outer:g}) m"),
+                 ("R_c", self.R_outer if self.tendons == () else math.inf,
+                  f"(0, R_outer = {self.R_outer:g}) m"),
                  ("w_d", diameter, f"(0, 2 R_outer = {diameter:g}) m"))
+        given = [isinstance(p, GIVEN_SECTION_PROFILES) for p in self.notch_profiles()]
         for name, limit, allowed in below:
-            for where, value in _entries(name, getattr(self, name)):
-                if value >= limit:
+            for index, (where, value) in enumerate(_entries(name, getattr(self, name))):
+                # a section given whole (a rod between disks) may fill the tube's width
+                fills = name == "w_d" and (all(given) if where == name else given[index])
+                if value > limit or (value == limit and not fills):
                     raise out_of_range(where, value, allowed, error=InvalidDesignError)
         room = self.R_outer - 0.5 * self.per_notch("w_d")
         slack = OFFSET_SLACK * self.R_outer  # a cut's w_o = -(R_outer - w_d/2) to rounding
@@ -163,6 +182,8 @@ class Design:
             derived.add("profile")  # each in DERIVABLE_FIELDS
         if any(isinstance(p, GIVEN_SECTION_PROFILES) for p in profiles):
             derived |= {"w_d", "w_o"}
+        if self.tendons:
+            derived.add("R_c")
         return frozenset(derived)
 
     def require_free(self, names: Sequence[str], what: str) -> None:
@@ -171,9 +192,11 @@ class Design:
         derived = self.derived_fields()
         for name in names:
             if name in derived:
+                source = "tendons (the first one's |offset|)" if name == "R_c" else \
+                    "notch sections (a polygon or a section given whole: its extent in x)"
                 raise InvalidDesignError(
-                    f"{what}: {name} is derived from this design's notch sections (a polygon or "
-                    f"a section given whole: its extent in x); allowed: other fields",
+                    f"{what}: {name} is derived from this design's {source}; allowed: other "
+                    "fields",
                     parameter=name, value=name, allowed="a field the design takes as a value")
 
     def open_faces(self) -> NDArray[np.bool_]:
@@ -246,6 +269,12 @@ class Design:
         ends = self._ends()
         return ends[0::2], ends[1::2]
 
+    def segment_ends(self) -> NDArray[np.float64]:
+        """Arc lengths (m) where a segment ends, base to tip (no 0; the tip last)."""
+        left, right = self.notch_bounds()
+        ends = np.concatenate([left, right, [self.length]])
+        return np.unique(ends[ends > 0.0])
+
     def _ends(self) -> NDArray[np.float64]:
         """``l_1, r_1, l_2, ..., r_N`` (m) of a per-notch design, summed segment by segment
         from the base, so that a notch right after another starts exactly where it ends."""
@@ -274,7 +303,7 @@ class Design:
         """All fields in SI units (a per-notch field as a list), plus the derived length ``L``;
         the profile by name."""
         data = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()
-                if k != "profile"}
+                if k != "profile" and (k != "tendons" or v)}
         profile = self.profile
         data["profile"] = [p.name for p in profile] if isinstance(profile, tuple) else profile.name
         data["L"] = self.length

@@ -86,6 +86,7 @@ from tdcm_ros.model.grid_layout import (
 )
 from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.tendons import TendonLayout, grid_routing, tendon_layout
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -185,6 +186,8 @@ class Grid(CellArrays):
     chord_cells: IntArray
     _queries: dict[bytes, Query] = field(default_factory=dict, init=False, compare=False,
                                          repr=False)
+    _layouts: dict[str, TendonLayout] = field(default_factory=dict, init=False, compare=False,
+                                              repr=False)
 
     def member_view(self, values: NDArray[Scalar]) -> NDArray[Scalar]:
         """``values`` of the one member."""
@@ -195,20 +198,15 @@ class Grid(CellArrays):
         """Indices of cells where the tendon follows the offset curve."""
         return np.flatnonzero(self.constrained)
 
-    @cached_property
-    def constrained_length(self) -> float:
-        """Arc length (m) of the cells where the tendon follows the offset curve."""
-        return float(np.sum(self.length[self.constrained_cells]))
-
-    @cached_property
-    def chord_nodes(self) -> IntArray:
-        """Start (row 0) and end node (row 1) of each chord the tendon crosses, base to tip,
-        shape (2, chords) (a chord's cells are consecutive and share its two nodes)."""
-        chord = ~self.constrained
-        starts, ends = self.chord_start_node[chord], self.chord_end_node[chord]
-        first = np.ones(starts.size, dtype=bool)
-        first[1:] = (starts[1:] != starts[:-1]) | (ends[1:] != ends[:-1])
-        return np.stack([starts[first], ends[first]])
+    def tendons(self, routing: str) -> TendonLayout:
+        """The design's tendons on this grid (:class:`~tdcm_ros.model.tendons.TendonLayout`),
+        a tendon without its own routing taking the solver's ``routing`` (kept per routing)."""
+        found = self._layouts.get(routing)
+        if found is None:
+            found = self._layouts[routing] = tendon_layout(
+                self.design.tendon_list(), routing, self.is_notch, self.s_nodes,
+                self.chord_start_node, self.chord_end_node)
+        return found
 
     @property
     def r_c(self) -> float:
@@ -313,8 +311,9 @@ def arm_weighted(peak_c: Array, xbar_start: Array, xbar_end: Array, r_c: Array |
 def build_grid(design: Design, settings: SolverSettings) -> Grid:
     """The (cached) grid for ``design`` under ``settings``' routing and discretisation: the
     many-design build (:func:`build_grids`) with one member."""
-    key = (settings.routing, settings.grid, settings.cells_per_notch, settings.cells_per_tube,
-           settings.quad_order)
+    key = (settings.routing if design.tendons == () else grid_routing(design.tendons,
+                                                                       settings.routing),
+           settings.grid, settings.cells_per_notch, settings.cells_per_tube, settings.quad_order)
     last = _last_grid.get("grid")
     if last is not None and last[0] is design and last[1] == key:
         return last[2]

@@ -389,7 +389,8 @@ def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
     b = np.where(u_b == 1.0, length_of_segment, b)
     kind_counts = counts.sum(axis=-1)
     return Prototypes(members=members, member=member, shape=shape, is_notch=is_notch,
-                      chord=is_notch != _tendon_follows_notches(routing), u_a=u_a, u_b=u_b, a=a,
+                      chord=(is_notch != _tendon_follows_notches(routing)) | ("+" in routing),
+                      u_a=u_a, u_b=u_b, a=a,
                       length=b - a, seg_length=length_of_segment, seg_start=np.zeros(a.size),
                       first=(np.cumsum(kind_counts.ravel()) - kind_counts.ravel()
                              ).reshape(m_count, k_count),
@@ -440,8 +441,10 @@ def cell_table(proto: Prototypes, routing: str) -> CellTable:
 
 
 def _tendon_follows_notches(routing: str) -> bool:
-    """Whether the tendon follows the body in notches (``paper``) or in tubes (``free``)."""
-    return routing == "paper"
+    """Whether the (first) tendon follows the body in notches (``paper``) or in tubes
+    (``free``); ``paper+free`` and ``free+paper`` (tendons of both routings, every cell with
+    the chord terms: :func:`tdcm_ros.model.tendons.grid_routing`) as their first."""
+    return routing.split("+")[0] == "paper"
 
 
 def crossing_levels(members: Members) -> Array:

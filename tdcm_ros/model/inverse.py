@@ -48,6 +48,7 @@ from tdcm_ros.model.errors import ModelError, ModelLimitError
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
+from tdcm_ros.model.tendons import require_paper_tendon
 
 Array = NDArray[np.float64]
 
@@ -201,6 +202,7 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
     :class:`UnreachableTargetError` (naming the reachable range) when the target is out of
     reach; a forward solve's own errors pass through.
     """
+    require_paper_tendon(design.tendons, "the inverse solver")
     kind, target = _check_target(tip_deflection, tip_angle, tip_point, tendon_stroke)
     lower, upper = _check_bounds(tension_min, tension_max)
     tolerance = _real(tol)

@@ -73,13 +73,15 @@ def unit(phi: float) -> complex:
     return complex(c, s)
 
 
-def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Complex,
-                  theta: Array, tangent: Complex) -> None:
-    """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m) and each cell's
-    tendon tension ``t`` (N; on chords the moment inside the cell is ``m'' = -T c m`` to first
-    order, and off the axis the centroid's motion adds ``- T dx``; elsewhere exactly linear):
-    writes nodes ``p`` (m), ``theta`` (rad) and ``tangent`` of the tube axis (stretched by
-    ``x_bar kappa`` where the centroid is off it)."""
+def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, t_axis: Array,
+                  p: Complex, theta: Array, tangent: Complex) -> None:
+    """Shape of one member from its cell end moments ``m_a``, ``m_b`` (N m), each cell's
+    chord tension ``t`` (N: the tension of the tendons crossing it as a chord, where the
+    moment inside the cell is ``m'' = -T c m`` to first order) and axial tension ``t_axis``
+    (N: of every tendon pulling on the cell, whose centroid's motion off the axis adds
+    ``- T dx``; elsewhere the moment is exactly linear): writes nodes ``p`` (m), ``theta``
+    (rad) and ``tangent`` of the tube axis (stretched by ``x_bar kappa`` where the centroid is
+    off it). One tendon passes its tension as both."""
     n = fc.shape[1]
     nq = fq.shape[2]
     pos = 0j
@@ -100,6 +102,7 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Com
             th = th + (a * fc[0, i] + b * fc[1, i])
         else:
             tension = t[i]
+            pull = t_axis[i]
             for q in range(nq):
                 if chord:
                     phi = (a * (fq[0, i, q] + tension * fq[3, i, q])
@@ -108,15 +111,15 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Com
                     phi = a * fq[0, i, q] + b * fq[1, i, q]
                 weight = fq[2, i, q]
                 if off_axis:
-                    phi -= tension * fq[7, i, q]
-                    weight += a * fq[5, i, q] + b * fq[6, i, q] - tension * fq[8, i, q]
+                    phi -= pull * fq[7, i, q]
+                    weight += a * fq[5, i, q] + b * fq[6, i, q] - pull * fq[8, i, q]
                 local += weight * unit(phi)
             if chord:
                 bend = a * (fc[0, i] + tension * fc[2, i]) + b * (fc[1, i] + tension * fc[3, i])
             else:
                 bend = a * fc[0, i] + b * fc[1, i]
             if off_axis:
-                bend -= tension * fc[6, i]
+                bend -= pull * fc[6, i]
             th = th + bend
         pos = pos + tan * local
         tan = complex(math.cos(th), math.sin(th))
@@ -181,12 +184,13 @@ def gaps_row(r_outer: float, p: Complex, tangent: Complex, notch: Ints, out: Arr
         out[k] = smallest
 
 
-def integrate(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, p: Complex,
-              theta: Array, tangent: Complex) -> None:
-    """:func:`integrate_row` for every member (``m_a``, ``m_b``, tensions ``t`` (M, n);
-    outputs (M, n+1))."""
+def integrate(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, t_axis: Array,
+              p: Complex, theta: Array, tangent: Complex) -> None:
+    """:func:`integrate_row` for every member (``m_a``, ``m_b``, tensions ``t``, ``t_axis``
+    (M, n); outputs (M, n+1))."""
     for j in range(m_a.shape[0]):
-        integrate_row(fc[j], fq[j], m_a[j], m_b[j], t[j], p[j], theta[j], tangent[j])
+        integrate_row(fc[j], fq[j], m_a[j], m_b[j], t[j], t_axis[j], p[j], theta[j],
+                      tangent[j])
 
 
 def moments(scal: Array, p: Complex, tangent: Complex, t_a: Array, t_b: Array, ic: Ints,
@@ -233,7 +237,7 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
         t_a[:] = tension[j]
         xj = x[j]
         pj = p[j]
-        integrate_row(fc[row], fq[row], xj[:n], xj[n:], t_a, pj, theta[j], tangent[j])
+        integrate_row(fc[row], fq[row], xj[:n], xj[n:], t_a, t_a, pj, theta[j], tangent[j])
         smallest = math.inf
         status = EXHAUSTED
         steps = 0
@@ -242,7 +246,8 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
             if relaxation != 1.0:
                 for i in range(2 * n):
                     g[i] = xj[i] + relaxation * (g[i] - xj[i])
-            integrate_row(fc[row], fq[row], g[:n], g[n:], t_a, new_p, new_theta, new_tangent)
+            integrate_row(fc[row], fq[row], g[:n], g[n:], t_a, t_a, new_p, new_theta,
+                          new_tangent)
             step = 0.0
             for i in range(n + 1):
                 d = abs(new_p[i] - pj[i])

@@ -47,7 +47,8 @@ class PlanarShape:
 
 
 def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
-              tension: float | Array = 0.0) -> PlanarShape:
+              tension: float | Array = 0.0, axis_tension: float | Array | None = None
+              ) -> PlanarShape:
     """Shape from per-cell end moments ``m_a``, ``m_b`` (N m) under tendon ``tension`` (N).
 
     Each cell's tangent angle at its Gauss points is ``theta_a + m_a A0 + m_b A1``; the cell's
@@ -55,7 +56,10 @@ def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
     (:func:`tdcm_ros.model.kernel.integrate_row`). Exact for moments linear in a cell, i.e.
     where the tendon follows the body; on a chord the moment bows (``m'' = -T c m``) and the
     grid's chord terms, times ``tension`` (a scalar or one per cell, broadcast against the
-    moments; 0 treats every moment as linear), carry it. ``grid`` is one grid, whose moments
+    moments; 0 treats every moment as linear), carry it; ``axis_tension`` (N, the same
+    shapes; default ``tension``) is the tension of every tendon pulling on each cell, for the
+    centroid's motion off the axis (several tendons: only some cross a cell as a chord).
+    ``grid`` is one grid, whose moments
     may carry leading batch axes, or :class:`Cells` of ``M`` members with moments (M, cells).
     """
     cells = grid.cells if isinstance(grid, Grid) else grid
@@ -67,6 +71,8 @@ def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
     b = np.ascontiguousarray(np.asarray(m_b, dtype=float).reshape(rows, n))
     t = np.ascontiguousarray(np.broadcast_to(np.asarray(tension, dtype=float),
                                              m_a.shape).reshape(rows, n))
+    t_axis = t if axis_tension is None else np.ascontiguousarray(np.broadcast_to(
+        np.asarray(axis_tension, dtype=float), m_a.shape).reshape(rows, n))
     fc, fq = cells.fc, cells.fq
     if rows != cells.members:
         fc = np.ascontiguousarray(np.broadcast_to(fc, (rows, *fc.shape[1:])))
@@ -74,7 +80,7 @@ def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
     p = np.empty((rows, n + 1), np.complex128)
     theta = np.empty((rows, n + 1))
     tangent = np.empty((rows, n + 1), np.complex128)
-    kernels().integrate(fc, fq, a, b, t, p, theta, tangent)
+    kernels().integrate(fc, fq, a, b, t, t_axis, p, theta, tangent)
     nodes = (*lead, n + 1)
     return PlanarShape(p=p.reshape(nodes), theta=theta.reshape(nodes),
                        tangent=tangent.reshape(nodes))

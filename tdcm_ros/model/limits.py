@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Sequence
 from functools import lru_cache
 from typing import Any
 
@@ -20,6 +21,7 @@ from tdcm_ros.model.errors import (
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape, integrate
 from tdcm_ros.model.quiet import quiet_fp
+from tdcm_ros.model.tendons import TendonLayout
 
 Array = NDArray[np.float64]
 
@@ -45,23 +47,67 @@ def check_tension(tension: Any) -> float:
     return value
 
 
+def check_tensions(tension: Any, count: int) -> tuple[float, ...]:
+    """Base tensions (N) of ``count`` tendons: ``tension`` as one number (one tendon) or a
+    sequence of ``count`` numbers, each as :func:`check_tension` (named ``tension[k]``);
+    raises :class:`TensionRangeError`."""
+    if isinstance(tension, (Sequence, np.ndarray)) and not isinstance(tension, (str, bytes)):
+        values = list(np.asarray(tension, dtype=object).ravel()) if isinstance(
+            tension, np.ndarray) else list(tension)
+        if len(values) != count:
+            raise out_of_range("tension", values, f"{count} tension(s) in N, one "
+                               f"per tendon (the design has {count})", unit="N",
+                               error=TensionRangeError)
+        out = []
+        for k, value in enumerate(values):
+            try:
+                out.append(check_tension(value))
+            except TensionRangeError as error:
+                raise out_of_range(f"tension[{k}]", value, str(error.allowed),
+                                   error=TensionRangeError) from error
+        return tuple(out)
+    if count != 1:
+        raise out_of_range("tension", tension, f"{count} tensions in N, one per tendon",
+                           unit="N", error=TensionRangeError)
+    return (check_tension(tension),)
+
+
 @quiet_fp
 def check_singularity(grid: Grid, m_a: Array, m_b: Array) -> None:
     """Raise :class:`TendonSingularityError` where the tendon follows the offset curve and
     ``(R_c - x_bar) * kappa`` reaches 1 (the curve ``p + R_c x_b`` cusps; ``x_bar`` the
     centroid's offset, 0 but in notches whose backbone is off the axis). ``kappa`` uses each
     cell's peak compliance, so the check is pointwise, not a cell average."""
-    cells = grid.constrained_cells
+    _check_cusp(grid, grid.constrained_cells, grid.r_c, m_a, m_b, "")
+
+
+@quiet_fp
+def check_tendons_singularity(grid: Grid, layout: TendonLayout, m_a: Array, m_b: Array
+                              ) -> None:
+    """:func:`check_singularity` for each tendon of ``layout`` on the cells it follows before
+    its anchor, at its own signed offset (a tendon on -x cusps under a moment toward -x)."""
+    follows = layout.follows & layout.active()
+    for j in range(layout.count):
+        _check_cusp(grid, np.flatnonzero(follows[j]), float(layout.offsets[j]), m_a, m_b,
+                    f" ({layout.names[j]})")
+
+
+def _check_cusp(grid: Grid, cells: NDArray[np.int64], offset: float, m_a: Array, m_b: Array,
+                which: str) -> None:
+    """Raise :class:`TendonSingularityError` where ``(offset - x_bar) kappa`` (signed; the
+    worst of the cell's end moments and end centroids) reaches 1 on ``cells``."""
     if cells.size == 0:
         return
-    moment = np.maximum(np.abs(m_a[cells]), np.abs(m_b[cells]))
-    arm = grid.r_c - np.minimum(grid.xbar_start[cells], grid.xbar_end[cells])
-    rc_kappa = arm * moment * grid.peak_c[cells]
+    arm_a = offset - grid.xbar_start[cells]
+    arm_b = offset - grid.xbar_end[cells]
+    worst_pair = np.maximum.reduce([arm_a * m_a[cells], arm_a * m_b[cells],
+                                    arm_b * m_a[cells], arm_b * m_b[cells]])
+    rc_kappa = worst_pair * grid.peak_c[cells]
     worst = int(np.argmax(rc_kappa))
     if rc_kappa[worst] >= 1.0:
         s = float(grid.peak_s[cells[worst]])
         raise TendonSingularityError(
-            f"tendon-offset singularity: R_c*kappa = {rc_kappa[worst]:.3g} >= 1 at s = "
+            f"tendon-offset singularity{which}: R_c*kappa = {rc_kappa[worst]:.3g} >= 1 at s = "
             f"{s * 1e3:.3f} mm (the tendon path cusps); lower the tension or stiffen the notch",
             arc_length_m=s, rc_kappa=float(rc_kappa[worst]))
 

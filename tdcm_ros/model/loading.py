@@ -50,7 +50,7 @@ from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_singularity, closure_angles
-from tdcm_ros.model.moment_model import PlainRun, Plan
+from tdcm_ros.model.moment_model import PlainRun, Plan, own_moment
 from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.section import notched_area, tube_area
 from tdcm_ros.model.settings import SolverSettings
@@ -335,6 +335,14 @@ class LoadedModel:
         if self.loading.tension_profile is None or last is None or last[0] != level:
             return level
         return last[1]
+
+    def axis_tension(self, level: float) -> float | Array:
+        """Tension (N) pulling on each cell: the chord tension (one tendon)."""
+        return self.chord_tension(level)
+
+    def start(self, level: float) -> Array:
+        """The tendon's own moment ``R_c T`` (N m) everywhere at tension ``level`` (N)."""
+        return own_moment(self.grid, level)
 
     def bend_moments(self, x: Array) -> Array:
         """Moments (N m) that set the curvature: ``x`` with contact scaling applied."""

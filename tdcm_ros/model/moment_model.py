@@ -79,6 +79,16 @@ class MomentModel(Protocol):
         the shape integration: one value or one per cell."""
         ...
 
+    def axis_tension(self, level: float) -> float | Array:
+        """Tension (N) of every tendon pulling on each cell at base tension ``level`` (N),
+        for the centroid's motion off the axis: one value or one per cell."""
+        ...
+
+    def start(self, level: float) -> Array:
+        """The initial iterate ``[m_a, m_b]`` (N m) at base tension ``level`` (N): the
+        tendons' own moments on the straight body."""
+        ...
+
     def check_before(self, tension: float) -> None:
         """Raise a limit error known before iterating."""
         ...
@@ -123,6 +133,14 @@ def paper_plans(settings: SolverSettings) -> tuple[Plan, ...]:
     return tuple(plans)
 
 
+def own_moment(grid: Grid, level: float) -> Array:
+    """``[m_a, m_b]`` (N m) of the paper's tendon on the straight body, ``R_c T`` everywhere
+    at tension ``level`` (N)."""
+    x0 = np.empty(2 * grid.n_cells)
+    x0.fill(grid.r_c * level)
+    return x0
+
+
 class ClosedForm:
     """The paper's model, tendon moment in closed form; the neutral loading."""
 
@@ -141,6 +159,12 @@ class ClosedForm:
 
     def chord_tension(self, level: float) -> float:
         return level
+
+    def axis_tension(self, level: float) -> float:
+        return level
+
+    def start(self, level: float) -> Array:
+        return own_moment(self.grid, level)
 
     def check_before(self, tension: float) -> None:
         if self._r_c_squared * tension * self._peak_c >= 1.0:

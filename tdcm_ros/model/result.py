@@ -17,6 +17,7 @@ from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape, quaternions_y
 from tdcm_ros.model.limits import closure_angles, notch_gaps
 from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.tendons import TendonLayout
 
 if TYPE_CHECKING:
     from tdcm_ros.model.loading import Loading
@@ -35,7 +36,9 @@ class SolveResult:
     Under a :class:`~tdcm_ros.model.loading.Loading`: ``loading`` is it; ``tendon_tension``
     (N, per node, just past each node's kink) is set when the tension varies along ``s``;
     ``contact_scale`` (per cell) is set with notch contact: the curvature follows
-    ``cell_moments * contact_scale`` (:attr:`bend_moments`).
+    ``cell_moments * contact_scale`` (:attr:`bend_moments`). With several tendons
+    (``Design.tendons``) ``tendon_tensions_n`` holds each one's base tension (N) and
+    ``tension_n`` the largest.
     """
 
     design: Design
@@ -54,6 +57,21 @@ class SolveResult:
     loading: Loading | None = None
     contact_scale: Array | None = field(default=None, repr=False)
     tendon_tension: Array | None = field(default=None, repr=False)
+    tendon_tensions_n: tuple[float, ...] = ()
+
+    @property
+    def tensions_n(self) -> tuple[float, ...]:
+        """Each tendon's base tension (N), in the design's tendon order (one: ``tension_n``)."""
+        return self.tendon_tensions_n or (self.tension_n,)
+
+    @property
+    def tendons(self) -> TendonLayout:
+        """The design's tendons on the grid (:class:`~tdcm_ros.model.tendons.TendonLayout`)."""
+        return self.grid.tendons(self.settings.routing)
+
+    def _axis_tensions(self) -> Array:
+        """Tension (N) of every tendon pulling on each cell."""
+        return self.tendons.cell_tensions(np.array(self.tensions_n))[2]
 
     @property
     def bend_moments(self) -> Array:
@@ -125,31 +143,36 @@ class SolveResult:
 
     @cached_property
     def tendon_lengths_m(self) -> Array:
-        """Length of each tendon's path from the base to the tip (m), one per tendon: along the
-        curve ``R_c`` from the tube axis where it follows the body, ``(1 - (R_c - x_bar) kappa)
-        ds`` (the axis's stretch ``x_bar kappa`` less the offset's ``R_c kappa``, integrated
-        by the cells' own quadrature), and straight across each chord."""
-        grid = self.grid
-        r_c = grid.r_c
-        follows = grid.constrained_cells
-        along = grid.constrained_length - r_c * float(
-            np.sum(self.theta[follows + 1] - self.theta[follows]))
-        if grid.off_axis:  # the axis's stretch (zero where every centroid is on it)
-            m = self.bend_moments[follows]
-            along += float(np.sum(m[:, 0:1] * grid.K0[follows] + m[:, 1:2] * grid.K1[follows]
-                                  - self.tension_n * grid.K2[follows]))
-        nodes = grid.chord_nodes  # the tendon at each chord's ends: R_c along the body's +x
-        theta = self.theta[nodes]
-        x = self.positions[nodes, 0] + r_c * np.cos(theta)
-        z = self.positions[nodes, 2] - r_c * np.sin(theta)
-        across = float(np.sum(np.hypot(x[1] - x[0], z[1] - z[0])))
-        return np.array([along + across])
+        """Length of each tendon's path from the base to its anchor (m), one per tendon: along
+        the curve at its offset ``r`` from the tube axis where it follows the body, ``(1 - (r -
+        x_bar) kappa) ds`` (the axis's stretch ``x_bar kappa`` less the offset's ``r kappa``,
+        integrated by the cells' own quadrature), and straight across each chord."""
+        layout = self.tendons
+        out = np.empty(layout.count)
+        axis = self._axis_tensions() if self.grid.off_axis else None
+        for j in range(layout.count):
+            r_c = float(layout.offsets[j])
+            follows = layout.follow_cells[j]
+            along = layout.follow_lengths[j] - r_c * float(
+                np.sum(self.theta[follows + 1] - self.theta[follows]))
+            if axis is not None:  # the axis's stretch (zero where every centroid is on it)
+                grid = self.grid
+                m = self.bend_moments[follows]
+                along += float(np.sum(m[:, 0:1] * grid.K0[follows] + m[:, 1:2] * grid.K1[follows]
+                                      - axis[follows, None] * grid.K2[follows]))
+            nodes = layout.chord_nodes[j]  # the tendon at each chord's ends: r along +x_b
+            theta = self.theta[nodes]
+            x = self.positions[nodes, 0] + r_c * np.cos(theta)
+            z = self.positions[nodes, 2] - r_c * np.sin(theta)
+            out[j] = along + float(np.sum(np.hypot(x[1] - x[0], z[1] - z[0])))
+        return out
 
     @property
     def tendon_strokes_m(self) -> Array:
         """How far each tendon has been pulled in (m), one per tendon: its path's length on the
-        straight body (``L``) less :attr:`tendon_lengths_m`."""
-        return self.design.length - self.tendon_lengths_m
+        straight body (its anchor's arc length, ``L`` at the tip) less
+        :attr:`tendon_lengths_m`."""
+        return self.grid.s_nodes[self.tendons.anchors] - self.tendon_lengths_m
 
     @property
     def quaternions(self) -> Array:
@@ -209,10 +232,10 @@ class SolveResult:
         theta_a = self.theta[cells]
         theta = theta_a + m_a * found.a0_s + m_b * found.a1_s
         if self.grid.off_axis:  # the centroid's motion, the axis's stretch
-            pull = self.tension_n
-            phi_r = phi_r - pull * found.d_r
+            pull = self._axis_tensions()[cells]
+            phi_r = phi_r - pull[:, None] * found.d_r
             w_r = w_r + m_a[:, None] * found.k0_r + m_b[:, None] * found.k1_r \
-                - pull * found.k2_r
+                - pull[:, None] * found.k2_r
             theta = theta - pull * found.d_s
         along = np.sum(w_r * np.cos(phi_r), axis=1)
         across = np.sum(w_r * np.sin(phi_r), axis=1)
@@ -238,6 +261,8 @@ class SolveResult:
             "notch_gaps_m": _finite_or_none(self.notch_gaps_m),
             "notch_stop_margins_rad": _finite_or_none(self.notch_stop_margins_rad),
             "notch_peak_strains": self.notch_peak_strains.tolist(),
+            "tendon_names": list(self.tendons.names),
+            "tendon_tensions_n": list(self.tensions_n),
             "tendon_lengths_m": self.tendon_lengths_m.tolist(),
             "tendon_strokes_m": self.tendon_strokes_m.tolist(),
             "solve_time_s": self.solve_time_s,

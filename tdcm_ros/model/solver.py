@@ -20,6 +20,7 @@ the compiled kernel (:func:`tdcm_ros.model.kernel.iterate`).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from time import perf_counter
@@ -30,10 +31,11 @@ from numpy.typing import NDArray
 
 from tdcm_ros.model.compiled import is_compiled
 from tdcm_ros.model.design import Design, preset
+from tdcm_ros.model.errors import InvalidSettingsError
 from tdcm_ros.model.grid import Grid, build_grid
 from tdcm_ros.model.kernel import CONVERGED, DIVERGING, NON_FINITE, SLOWED
 from tdcm_ros.model.kinematics import PlanarShape, integrate
-from tdcm_ros.model.limits import check_tension, notch_gaps
+from tdcm_ros.model.limits import check_tension, check_tensions, notch_gaps
 from tdcm_ros.model.loading import InvalidLoadingError, LoadedModel, Loading
 from tdcm_ros.model.moment_model import (
     DIVERGENCE_GROWTH,
@@ -46,6 +48,7 @@ from tdcm_ros.model.moment_model import (
 from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.tendon_model import TendonSet
 
 Array = NDArray[np.float64]
 
@@ -66,7 +69,8 @@ class _Problem(NamedTuple):
         ``level`` (N; it bows the moment on chords)."""
         y = self.model.bend_moments(x)
         n = self.grid.n_cells
-        return integrate(self.grid, y[:n], y[n:], self.model.chord_tension(level))
+        return integrate(self.grid, y[:n], y[n:], self.model.chord_tension(level),
+                         self.model.axis_tension(level))
 
 
 
@@ -82,10 +86,13 @@ class _Run:
     min_gap: float | None = None
 
 
-def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_SETTINGS,
+def solve(design: Design, tension: float | Sequence[float], *,
+          settings: SolverSettings = DEFAULT_SETTINGS,
           warm_start: SolveResult | None = None, strict: bool = True,
           loading: Loading | None = None) -> SolveResult:
-    """Shape of ``design`` under tendon tension ``tension`` (N), the tension at the base.
+    """Shape of ``design`` under tendon tension ``tension`` (N), the tension at the base: one
+    number, or one per tendon of a design with several (``Design.tendons``: the paper's closed
+    form, no ``loading``; ``warm_start`` is not used).
 
     ``warm_start`` reuses a previous result of the same design and settings as the initial
     iterate (scaled by the tension ratio). With ``strict=False`` a non-converged solve returns
@@ -100,8 +107,14 @@ def solve(design: Design, tension: float, *, settings: SolverSettings = DEFAULT_
     raises none).
     """
     started = perf_counter()
-    t_base = check_tension(tension)
-    return _solve(design, t_base, settings, warm_start, strict, loading, started)
+    if design.tendons == ():
+        if isinstance(tension, (list, tuple, np.ndarray)):
+            tension = check_tensions(tension, 1)[0]
+        return _solve(design, check_tension(tension), settings, warm_start, strict, loading,
+                      started)
+    tensions = np.array(check_tensions(tension, len(design.tendons)))
+    return _solve(design, float(np.max(tensions)), settings, warm_start, strict, loading,
+                  started, tensions)
 
 
 def warm_up() -> bool:
@@ -118,10 +131,11 @@ def warm_up() -> bool:
 
 def _solve(design: Design, t_base: float, settings: SolverSettings,
            warm_start: SolveResult | None, strict: bool, loading: Loading | None,
-           started: float) -> SolveResult:
-    """:func:`solve` for a checked base tension ``t_base`` (N); ``started`` is its start time
-    (s, ``perf_counter``)."""
-    problem = _problem(design, settings, t_base, loading)
+           started: float, tensions: Array | None = None) -> SolveResult:
+    """:func:`solve` for a checked base tension ``t_base`` (N; the largest of ``tensions``,
+    one per tendon where the design lists them); ``started`` is its start time (s,
+    ``perf_counter``)."""
+    problem = _problem(design, settings, t_base, loading, tensions)
     grid, _, model = problem
     model.check_before(t_base)
     x0 = _initial_guess(grid, settings, t_base, warm_start, model)
@@ -168,11 +182,31 @@ def _last_finite(runs: list[tuple[str, _Run]]) -> tuple[str, _Run] | None:
 
 
 def _problem(design: Design, settings: SolverSettings, tension: float,
-             loading: Loading | None) -> _Problem:
+             loading: Loading | None, tensions: Array | None = None) -> _Problem:
     """The (cached) grid of ``design`` under ``settings`` and its moment model under
-    ``loading`` at ``tension`` (N)."""
+    ``loading`` at ``tension`` (N), or its tendons' at ``tensions`` (N, largest ``tension``)."""
     grid = build_grid(design, settings)
-    return _Problem(grid, settings, _model(grid, settings, tension, loading))
+    if tensions is None:
+        return _Problem(grid, settings, _model(grid, settings, tension, loading))
+    return _Problem(grid, settings, _tendon_model(grid, settings, tension, tensions, loading))
+
+
+def _tendon_model(grid: Grid, settings: SolverSettings, level: float, tensions: Array,
+                  loading: Loading | None) -> TendonSet:
+    """The moment model of the design's tendons at ``tensions`` (N; ``level`` the largest)."""
+    if loading is not None and not (isinstance(loading, Loading) and loading.is_trivial):
+        raise InvalidLoadingError(
+            "loading is not supported with several tendons (a tendon list in the design); "
+            "allowed: None", parameter="loading", value=getattr(loading, "describe",
+                                                                 lambda: loading)(),
+            allowed="None")
+    if settings.loads != "closed":
+        raise InvalidSettingsError(
+            f"loads = {settings.loads!r} is not supported with several tendons (a tendon list "
+            "in the design); allowed: closed", parameter="loads", value=settings.loads,
+            allowed="closed")
+    fractions = tensions / level if level > 0.0 else np.zeros_like(tensions)
+    return TendonSet(grid, grid.tendons(settings.routing), fractions)
 
 
 def _model(grid: Grid, settings: SolverSettings, tension: float,
@@ -202,16 +236,15 @@ def _paper_model(grid: Grid, loads: str) -> MomentModel:
 
 def _initial_guess(grid: Grid, settings: SolverSettings, tension: float,
                    warm_start: SolveResult | None, model: MomentModel) -> Array:
-    """The tendon moment ``R_c T`` everywhere, or a compatible converged result rescaled by
+    """The tendons' own moments on the straight body (the model's ``start``: ``R_c T``
+    everywhere for the paper's tendon), or a compatible converged result rescaled by
     the model's :meth:`~tdcm_ros.model.moment_model.MomentModel.warm_scale`."""
     if (warm_start is not None and warm_start.grid is grid and warm_start.settings == settings
             and warm_start.converged):
         scale = model.warm_scale(warm_start.tension_n, tension)
         if scale is not None:
             return _rescaled(warm_start.cell_moments, scale)
-    x0 = np.empty(2 * grid.n_cells)
-    x0.fill(grid.r_c * tension)
-    return x0
+    return model.start(tension)
 
 
 @quiet_fp
@@ -234,9 +267,9 @@ def _continuation(problem: _Problem, tension: float, x0: Array, budget: int, *,
     previous solution; ``adaptive`` halves a failing step (see :func:`_adaptive_continuation`)."""
     if adaptive:
         return _adaptive_continuation(problem, tension, x0, budget)
-    grid, settings = problem.grid, problem.settings
+    settings = problem.settings
     steps = settings.continuation_steps
-    x = np.full_like(x0, grid.r_c * tension / steps)
+    x = problem.model.start(tension / steps)
     history: list[float] = []
     run = _Run(x, problem.shape_of(x, tension / steps), history, False, "no steps")
     previous = tension / steps
@@ -272,8 +305,7 @@ def _adaptive_continuation(problem: _Problem, tension: float, x0: Array, budget:
     loose = max(tol, math.sqrt(tol * problem.grid.design.length))
     while lam < 1.0:
         target = 1.0 if lam + step >= 1.0 - 1e-12 else lam + step
-        guess = x * (target / lam) if lam > 0.0 else np.full_like(
-            x0, problem.grid.r_c * tension * target)
+        guess = x * (target / lam) if lam > 0.0 else problem.model.start(tension * target)
         run = _iterate(problem, tension * target, guess, budget - len(history),
                        mode="anderson", factor=target, tol=tol if target == 1.0 else loose)
         history.extend(run.history)
@@ -408,6 +440,7 @@ def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, str
     positions = np.zeros((grid.s_nodes.size, 3))
     positions[:, 0] = shape.p.imag
     positions[:, 2] = shape.p.real
+    tensions = tuple(model.tensions(tension).tolist()) if isinstance(model, TendonSet) else ()
     return SolveResult(grid.design, settings, tension, grid.s_nodes, positions, shape.theta,
                        run.x.reshape(2, -1).T, len(history), history, run.converged, strategy,
-                       elapsed, grid, loading, contact_scale, tendon_tension)
+                       elapsed, grid, loading, contact_scale, tendon_tension, tensions)

@@ -57,6 +57,7 @@ from tdcm_ros.model import (
     InvalidRollError,
     named_design,
     parameter_specs,
+    require_paper_tendon,
 )
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.runtime import (
@@ -114,11 +115,14 @@ def _stamp_s(message: Any) -> float:
     return int(message.header.stamp.sec) + int(message.header.stamp.nanosec) * 1e-9
 
 
-def declare_design_and_layout(port: NodePort) -> tuple[Design, MarkerLayout]:
+def declare_design_and_layout(port: NodePort, node: str = "metrics_node"
+                              ) -> tuple[Design, MarkerLayout]:
     """The design (``design.preset`` then ``design.*``) and the marker layout (``markers.*``)
-    as read-only parameters; bad values raise InputError."""
+    as read-only parameters of the node named ``node``; bad values, and a body with a tendon
+    list (the node takes one tension), raise InputError."""
     start = declare_specs(port, PRESET_SPECS, read_only=True)
     base = named_design(str(start["design.file"]) or str(start["design.preset"]))
+    require_paper_tendon(base.tendons, f"{node} (one tension input)", "design.file")
     design = base.with_overrides(**declare_specs(
         port, parameter_specs(base), prefix="design.", defaults=base.to_dict(), read_only=True))
     given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}

@@ -57,6 +57,7 @@ from tdcm_ros.model import (
     SolverSettings,
     named_design,
     parameter_specs,
+    require_paper_tendon,
     solve,
     warm_up,
 )
@@ -161,6 +162,8 @@ class ModelNode(NodeLogic):
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
         self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
+        require_paper_tendon(self.base.tendons, "model_node (one tension input)",
+                             "design.file")
         self.design_specs = parameter_specs(self.base)
         declare_specs(port, self.design_specs, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")

@@ -218,7 +218,7 @@ class ShapeControllerNode(NodeLogic):
         """``limits_on_timer``: read the driver's limits on the port's timer, not a thread
         (see :class:`LimitsReader`; for a :class:`MemoryPort` only)."""
         super().__init__(port)
-        design, layout = declare_design_and_layout(port)
+        design, layout = declare_design_and_layout(port, "shape_controller")
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
         declare_specs(port, TUNABLE_SPECS)
         gain = GainSettings(float(fixed["gain.initial"]), float(fixed["gain.initial_std"]),

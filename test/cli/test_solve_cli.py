@@ -3,6 +3,7 @@
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -53,7 +54,31 @@ def test_overrides_profile_and_routing(capsys):
     assert free["tip_deflection_m"] != base["tip_deflection_m"]
 
 
+PAIR = str(Path(__file__).resolve().parents[2] / "config" / "bodies" / "antagonistic_pair.yaml")
+
+
+def test_a_body_with_several_tendons_takes_one_tension_each(capsys):
+    """``--tension 25,5``: one per tendon, in the body file's order; each tendon's tension,
+    length and stroke by its name."""
+    status, data, _ = run_json(capsys, "--design", PAIR, "--tension", "25,5")
+    assert status == 0
+    assert data["tendon_names"] == ["flexor", "extensor"]
+    assert data["tendon_tensions_n"] == [25.0, 5.0] and data["tension_n"] == 25.0
+    one = solve(preset("paper-experiment"), 20.0)
+    assert data["tip_position_m"] == pytest.approx(one.tip_position.tolist(), abs=2e-8)
+    assert data["tendon_strokes_m"][0] == pytest.approx(-data["tendon_strokes_m"][1], rel=1e-5)
+    assert main(["solve", "--design", PAIR, "--tension", "25,5"]) == 0
+    text = capsys.readouterr().out
+    assert "tension 25, 5 N" in text and "flexor: 25 N, length" in text
+    assert "extensor: 5 N, length" in text
+
+
 @pytest.mark.parametrize(("args", "status", "kind"), [
+    (["--design", PAIR, "--tension", "20"], 2, "tension_out_of_range"),
+    (["--design", PAIR, "--tension", "20,x"], 2, "tension_out_of_range"),
+    (["--design", PAIR, "--tension", "20,-1"], 2, "tension_out_of_range"),
+    (["--design", PAIR, "--stroke", "0.0005"], 2, "invalid_design"),
+    (["--tension", "20,5"], 2, "tension_out_of_range"),
     (["--tension", "-1"], 2, "tension_out_of_range"),
     (["--tension", "nan"], 2, "tension_out_of_range"),
     (["--tension", "inf"], 2, "tension_out_of_range"),

@@ -291,8 +291,8 @@ def test_strict_false_never_returns_nan(monkeypatch):
 
     integrate_row = kernel.integrate_row
 
-    def poisoned(fc, fq, m_a, m_b, t, p, theta, tangent):
-        integrate_row(fc, fq, m_a, m_b, t, p, theta, tangent)
+    def poisoned(fc, fq, m_a, m_b, t, t_axis, p, theta, tangent):
+        integrate_row(fc, fq, m_a, m_b, t, t_axis, p, theta, tangent)
         p[:] = np.nan
         theta[:] = np.nan
 
@@ -303,12 +303,26 @@ def test_strict_false_never_returns_nan(monkeypatch):
     assert info.value.result is None
 
 
-@pytest.mark.parametrize("tension", ["20", True, False, None, [20.0], np.array([20.0]),
-                                     np.bool_(True), 1 + 0j])
+@pytest.mark.parametrize("tension", ["20", True, False, None, np.bool_(True), 1 + 0j])
 def test_tension_must_be_a_real_number(tension):
     with pytest.raises(TensionRangeError, match="tension") as info:
         solve(preset("paper-experiment"), tension)
     assert info.value.parameter == "tension" and info.value.allowed == "[0, inf) N"
+
+
+@pytest.mark.parametrize("tension", [[20.0], (20,), np.array([20.0])])
+def test_one_tension_per_tendon_is_the_tension_of_the_one_tendon(tension):
+    design = preset("paper-experiment")
+    assert np.array_equal(solve(design, tension).positions, solve(design, 20.0).positions)
+
+
+@pytest.mark.parametrize(("tension", "parameter"), [([20.0, 5.0], "tension"),
+                                                    (["20"], "tension[0]"),
+                                                    ([-1.0], "tension[0]")])
+def test_a_tension_list_must_have_one_real_tension_per_tendon(tension, parameter):
+    with pytest.raises(TensionRangeError) as info:
+        solve(preset("paper-experiment"), tension)
+    assert info.value.parameter == parameter
 
 
 @pytest.mark.parametrize("tension", [20, 20.0, np.float32(20.0), np.float64(20.0), np.int64(20)])

@@ -50,6 +50,16 @@ def test_a_bad_body_file_stops_the_start_naming_the_key(tmp_path: Path) -> None:
                                              name="metrics_node"))
 
 
+def test_the_nodes_refuse_a_body_with_a_tendon_list_naming_it() -> None:
+    """The nodes take one tension input: a body with several tendons stops their start."""
+    body = str(Path(__file__).resolve().parents[2] / "config" / "bodies" / "antagonistic_pair.yaml")
+    with pytest.raises(InvalidDesignError, match=r"design\.file: model_node \(one tension input\)"):
+        ModelNode(MemoryPort({"design.file": body}, name="model_node"))
+    for name in ("metrics_node", "shape_controller"):
+        with pytest.raises(InvalidDesignError, match=rf"design\.file: {name} \(one tension"):
+            declare_design_and_layout(MemoryPort({"design.file": body}, name=name), name)
+
+
 def test_metrics_node_takes_the_same_file(tmp_path: Path) -> None:
     body = tmp_path / "fig2.yaml"
     body.write_text(body_file_text(preset("fig2-wn-2.5")), encoding="utf-8")

@@ -13,6 +13,7 @@ from tdcm_ros.model.limits import check_closure
 from tdcm_ros.model.profiles import GIVEN_SECTION_PROFILES
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SolverSettings
+from tdcm_ros.model.tendons import require_paper_tendon
 
 Array = NDArray[np.float64]
 
@@ -21,7 +22,9 @@ def require_centred(design: Design, method: str) -> None:
     """Raise :class:`InvalidDesignError` naming ``w_o`` unless every notch's backbone is on the
     tube axis, or ``profile`` where a notch's section is given whole (a polygon, a section's
     numbers, a mesh's slices): the baselines model the paper's symmetric notch only (the
-    off-axis centroid's and given sections' mechanics are :func:`tdcm_ros.model.solve`'s)."""
+    off-axis centroid's and given sections' mechanics are :func:`tdcm_ros.model.solve`'s),
+    and its one tendon."""
+    require_paper_tendon(design.tendons, f"the {method} baseline")
     given = [k for k, p in enumerate(design.notch_profiles())
              if isinstance(p, GIVEN_SECTION_PROFILES)]
     if given:
