@@ -39,7 +39,7 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
                              "design.E=1.2e9, as evaluate takes it); L (the length, m) sets w_t "
                              "as tdcm design --free L does")
     parser.add_argument("--profile", choices=PROFILE_NAMES, help="notch profile")
-    for name in ("routing", "loads"):  # choices and defaults from the settings' specs
+    for name in ("routing", "loads", "axial"):  # choices and defaults from the settings' specs
         spec = SOLVER_SPECS[name]
         parser.add_argument(f"--{name}", choices=spec.choices, help=spec.description +
                             f" (default: {spec.default}" +
@@ -55,7 +55,8 @@ def design_and_settings(args: argparse.Namespace) -> tuple[str, Design, SolverSe
         design = design.with_overrides(profile=args.profile)
     routing = args.routing or (body.routing if body else SOLVER_SPECS["routing"].default)
     return name, design, SolverSettings(routing=routing,
-                                        loads=args.loads or SOLVER_SPECS["loads"].default)
+                                        loads=args.loads or SOLVER_SPECS["loads"].default,
+                                        axial=args.axial or SOLVER_SPECS["axial"].default)
 
 
 def _design(named: str | None, pairs: list[str], body: BodySpec | None = None

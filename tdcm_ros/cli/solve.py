@@ -41,8 +41,9 @@ def register(subparsers: Any) -> None:
     drive.add_argument("--tension", type=str, help="tendon tension (N); one per tendon, "
                        "comma-separated, for a body file with several (base to tip order of "
                        "its tendons list)")
-    drive.add_argument("--stroke", metavar="M", help="tendon stroke (m): how far the tendon is "
-                       "pulled in against the straight body; the tension is found within "
+    drive.add_argument("--stroke", metavar="M", help="tendon stroke (m): how far the tendon's "
+                       "actuator pulls it in against the straight body (its slack and stretch "
+                       "included where the body file gives them); the tension is found within "
                        f"[0, {DEFAULT_TENSION_MAX_N:g}] N (tdcm inverse --tendon-stroke sets "
                        "the bounds)")
     add_design_arguments(parser)
@@ -90,16 +91,18 @@ def run(args: argparse.Namespace) -> int:
     else:
         x, _, z = result.tip_position * 1e3
         print(f"design {name}: L = {design.length * 1e3:.3f} mm, E = {design.E:.4g} Pa, "
-              f"routing {settings.routing}, loads {settings.loads}")
+              f"routing {settings.routing}, loads {settings.loads}"
+              + (", axial compressible" if settings.axial == "compressible" else ""))
         tensions = ", ".join(f"{t:g}" for t in result.tensions_n)
         print(f"tension {tensions} N -> tip (x, z) = ({x:.4f}, {z:.4f}) mm, "
               f"angle {result.tip_angle_rad:.5f} rad, deflection "
               f"{result.tip_deflection_m * 1e3:.4f} mm")
-        for name, tension, length, stroke in zip(
+        for name, tension, length, stroke, actuator in zip(
                 result.tendons.names, result.tensions_n, result.tendon_lengths_m,
-                result.tendon_strokes_m, strict=True):
+                result.tendon_strokes_m, result.actuator_strokes_m, strict=True):
+            travel = "" if actuator == stroke else f", actuator {actuator * 1e3:.6f} mm"
             print(f"{name}: {tension:g} N, length {length * 1e3:.6f} mm, stroke "
-                  f"{stroke * 1e3:.6f} mm")
+                  f"{stroke * 1e3:.6f} mm{travel}")
         print(report)
         print(f"converged in {result.iterations} iterations ({result.strategy}), "
               f"{result.solve_time_s * 1e6:.0f} us")

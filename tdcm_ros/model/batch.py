@@ -204,6 +204,11 @@ def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAU
         raise InvalidSettingsError(f"settings = {settings!r} is not a SolverSettings",
                                    parameter="settings", value=settings,
                                    allowed="tdcm_ros.model.SolverSettings")
+    if settings.axial != "rigid":
+        raise InvalidSettingsError(
+            f"axial = {settings.axial!r}: the batch solver takes the rigid midline; allowed: "
+            "rigid (solve() takes compressible)", parameter="axial", value=settings.axial,
+            allowed="rigid")
     if isinstance(workers, bool) or not isinstance(workers, int) or \
             not 1 <= workers <= MAX_WORKERS:
         raise InvalidSettingsError(

@@ -64,7 +64,14 @@ from tdcm_ros.model.profiles import (
 )
 from tdcm_ros.model.sections import BandSection, OneSidedCut, PolygonSection, Section
 from tdcm_ros.model.settings import ROUTINGS
-from tdcm_ros.model.tendons import GUIDES, MAX_EXTERNAL_OFFSET_M, MAX_TENDONS, Tendon
+from tdcm_ros.model.tendons import (
+    GUIDES,
+    MAX_EXTERNAL_OFFSET_M,
+    MAX_SLACK_M,
+    MAX_STIFFNESS_N_PER_M,
+    MAX_TENDONS,
+    Tendon,
+)
 from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
 
@@ -161,7 +168,8 @@ class BodySpec:
         """Whether the file has the paper's one tendon: on +x, through the wall, to the tip."""
         only = self.tendons[0]
         return (len(self.tendons) == 1 and only.offset > 0.0 and only.anchor is None
-                and only.guides == "internal" and only.name in ("", "tendon_1"))
+                and only.guides == "internal" and only.name in ("", "tendon_1")
+                and only.stiffness is None and only.slack == 0.0)
 
     def design(self) -> Design:
         """The body as the solver's :class:`Design`: a base tube (or none), N band, cut or
@@ -268,8 +276,8 @@ def _tendons(items: Any, source: str, r_outer: float) -> tuple[Tendon, ...]:
     for k, item in enumerate(items):
         here = f"tendons[{k}]"
         tendon = _mapping(item, here, source)
-        reject_unknown("tendon key", tendon, ("offset", "routing", "anchor", "guides", "name"),
-                       error=InvalidDesignError)
+        reject_unknown("tendon key", tendon, ("offset", "routing", "anchor", "guides", "name",
+                                              "stiffness", "slack"), error=InvalidDesignError)
         guides = tendon.get("guides", "internal")
         if guides not in GUIDES:
             raise out_of_range(f"{source}: {here}.guides", guides, " | ".join(GUIDES),
@@ -290,7 +298,12 @@ def _tendons(items: Any, source: str, r_outer: float) -> tuple[Tendon, ...]:
         if not isinstance(name, str) or not NAME_PATTERN.fullmatch(name):
             raise out_of_range(f"{source}: {here}.name", name, "a ROS name token: a letter, "
                                "then letters, digits or _", error=InvalidDesignError)
-        out.append(Tendon(offset, routing, anchor, str(guides), name))
+        stiffness = (_number(tendon, "stiffness", f"{here}.", source, low=0.0,
+                             high=MAX_STIFFNESS_N_PER_M, open_low=True)
+                     if "stiffness" in tendon else None)
+        slack = _number(tendon, "slack", f"{here}.", source, low=0.0, high=MAX_SLACK_M,
+                        default=0.0)
+        out.append(Tendon(offset, routing, anchor, str(guides), name, stiffness, slack))
     return tuple(out)
 
 
@@ -515,6 +528,10 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
             keys.append(f"anchor: {number(one.anchor)}")
         if one.guides != "internal":
             keys.append(f"guides: {one.guides}")
+        if one.stiffness is not None:
+            keys.append(f"stiffness: {number(one.stiffness)}")
+        if one.slack != 0.0:
+            keys.append(f"slack: {number(one.slack)}")
         return "  - {" + ", ".join([*keys, f"name: {one.name}"] if design.tendons else keys) + "}"
 
     lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",

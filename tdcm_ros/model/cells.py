@@ -69,8 +69,11 @@ class Cells:
 
 FC_NAMES = ("C0", "C1", "C0_T", "C1_T", "xbar_start", "xbar_end", "D")
 """Rows of :attr:`Cells.fc` (members, rows, cells): per cell, :mod:`tdcm_ros.model.grid`'s names."""
-FQ_NAMES = ("A0", "A1", "w_q", "A0_T", "A1_T", "K0", "K1", "D_q", "K2")
-"""Rows of :attr:`Cells.fq` (members, rows, cells, Gauss points)."""
+FQ_NAMES = ("A0", "A1", "w_q", "A0_T", "A1_T", "K0", "K1", "D_q", "K2", "W_A")
+"""Rows of :attr:`Cells.fq` (members, rows, cells, Gauss points); the last, ``W_A``
+(``w_q / (E A)``, m/N: each Gauss point's shortening per newton of axial load), is zero
+unless the midline is compressible (:class:`~tdcm_ros.model.settings.SolverSettings`'s
+``axial``) and is not one of the grid kernel's outputs."""
 IC_NAMES = ("chord_start_node", "chord_end_node", "constrained")
 """Rows of :attr:`Cells.ic` (members, rows, cells); ``constrained`` as 0/1."""
 NOTCH_NAMES = ("notch_left_node", "notch_right_node", "notch_open")
@@ -83,6 +86,7 @@ FC_FIELDS = np.array([grid_kernel.C0, grid_kernel.C1, grid_kernel.C0_T, grid_ker
 FQ_FIELDS = np.array([grid_kernel.A0, grid_kernel.A1, grid_kernel.W_Q, grid_kernel.A0_T,
                       grid_kernel.A1_T, grid_kernel.K0, grid_kernel.K1, grid_kernel.D_Q,
                       grid_kernel.K2])
-"""The grid kernel's per-Gauss-point rows of :data:`FQ_NAMES`, in order."""
-FC_ROWS, FQ_ROWS = FC_FIELDS.size, FQ_FIELDS.size
+"""The grid kernel's per-Gauss-point rows of :data:`FQ_NAMES` but the last, in order."""
+FC_ROWS, FQ_ROWS = FC_FIELDS.size, FQ_FIELDS.size + 1
+W_A_ROW = FQ_ROWS - 1
 NOTCH_ROWS = 4

@@ -64,6 +64,7 @@ from tdcm_ros.model.cells import (
     FQ_ROWS,
     IC_NAMES,
     NOTCH_NAMES,
+    W_A_ROW,
     Cells,
 )
 from tdcm_ros.model.compiled import grid_kernels
@@ -84,7 +85,9 @@ from tdcm_ros.model.grid_layout import (
     cell_table,
     prototypes,
 )
+from tdcm_ros.model.profiles import PRISMATIC_PROFILES, SlicedProfile
 from tdcm_ros.model.quiet import quiet_fp
+from tdcm_ros.model.section import tube_area
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.tendons import TendonLayout, grid_routing, tendon_layout
 
@@ -106,6 +109,7 @@ class Query(NamedTuple):
     k0_r: Array
     k1_r: Array
     k2_r: Array
+    wa_r: Array
 
 #: Distinct query station sets a grid keeps (see :meth:`Grid.query`).
 QUERY_CACHE_SIZE = 8
@@ -165,7 +169,7 @@ class CellArrays:
 
     C0, C1, C0_T, C1_T, xbar_start, xbar_end, D = (
         _Packed[np.float64]("fc", k) for k in range(len(FC_NAMES)))
-    A0, A1, w_q, A0_T, A1_T, K0, K1, D_q, K2 = (
+    A0, A1, w_q, A0_T, A1_T, K0, K1, D_q, K2, W_A = (
         _Packed[np.float64]("fq", k) for k in range(len(FQ_NAMES)))
     chord_start_node, chord_end_node = (_Packed[np.int64]("ic", k) for k in range(2))
     constrained = _Packed[np.bool_]("ic", IC_NAMES.index("constrained"), nonzero=True)
@@ -197,6 +201,39 @@ class Grid(CellArrays):
     def constrained_cells(self) -> IntArray:
         """Indices of cells where the tendon follows the offset curve."""
         return np.flatnonzero(self.constrained)
+
+    @cached_property
+    def compressible(self) -> bool:
+        """Whether the midline shortens under the axial load (``W_A`` not zero)."""
+        return bool(np.any(self.W_A))
+
+    def areas_at(self, cells: IntArray, u: Array) -> Array:
+        """Section area (m^2) of cells ``cells`` at reference coordinates ``u`` (rows as
+        ``cells``): the tube's in tubes; in a notch its section's (a band's from eq. 12's
+        strips, on or off the axis: :func:`~tdcm_ros.model.grid_kernel.offset_section`; a
+        section given whole, its own; a mesh's slice at ``u``)."""
+        design, members = self.design, self.members
+        out = np.full(u.shape, tube_area(design.R_outer, design.r_inner))
+        notch = self.is_notch[cells]
+        shape = self.shape[cells]
+        kinds = members.profile_of[shape]
+        for k, profile in enumerate(members.profiles):
+            rows = notch & (kinds == k)
+            if not np.any(rows):
+                continue
+            if isinstance(profile, SlicedProfile):
+                out[rows] = profile.section_at(u[rows])[0]
+            elif isinstance(profile, PRISMATIC_PROFILES):
+                out[rows] = float(profile.section(design.R_outer).area)
+            else:
+                h1 = members.h1(shape[rows], u[rows])
+                offset = np.broadcast_to(members.shape_w_o[shape[rows]][:, None], h1.shape)
+                section = grid_kernels().offset_section
+                out[rows] = np.reshape([section(float(h), float(o), design.R_outer,
+                                                design.r_inner)[0]
+                                        for h, o in zip(h1.ravel(), offset.ravel(), strict=True)],
+                                       h1.shape)
+        return out
 
     def tendons(self, routing: str) -> TendonLayout:
         """The design's tendons on this grid (:class:`~tdcm_ros.model.tendons.TendonLayout`),
@@ -275,15 +312,16 @@ class Grid(CellArrays):
 
     def partial_integrals(self, cells: IntArray, s: Array
                           ) -> tuple[Array, Array, Array, Array, Array, Array, Array, Array,
-                                     Array, Array]:
+                                     Array, Array, Array]:
         """Integrals from each cell's start ``a`` to a query ``s`` inside it (SI units), by the
         kernel that integrated the cells (:func:`tdcm_ros.model.grid_kernel.cell_integrals`)
         on the part ``[a, s]`` of each, with the whole cell's ``xi`` and end centroids.
 
-        Returns ``(A0_s, A1_s, D_s, A0_r, A1_r, D_r, w_r, K0_r, K1_r, K2_r)``: ``A0``, ``A1``,
-        ``D`` at ``s`` (shape (k,)) and at the Gauss points of ``[a, s]`` (shape (k, Q)), those
-        points' ds weights (m) and their tube-axis stretch terms ``K0``, ``K1``, ``K2`` (module
-        docstring; ``D`` and ``K`` are 0 where the centroid is on the axis).
+        Returns ``(A0_s, A1_s, D_s, A0_r, A1_r, D_r, w_r, K0_r, K1_r, K2_r, W_A_r)``: ``A0``,
+        ``A1``, ``D`` at ``s`` (shape (k,)) and at the Gauss points of ``[a, s]`` (shape (k, Q)),
+        those points' ds weights (m), their tube-axis stretch terms ``K0``, ``K1``, ``K2``
+        (module docstring; ``D`` and ``K`` are 0 where the centroid is on the axis) and their
+        shortening per newton ``W_A`` (m/N; 0 on a rigid midline).
         """
         start = self.s_nodes[cells] - self.seg_start[cells]
         cell = _cell_rows(is_notch=self.is_notch[cells], chord=np.zeros(cells.size),
@@ -293,8 +331,12 @@ class Grid(CellArrays):
         fc, fq, _ = _integrals(self.members, self.shape[cells], cell, self.gauss_u.size)
         fc, fq = fc[:-1], fq[:-1]
         k = grid_kernel
+        w_r = fq[:, k.W_Q]
+        w_a = np.zeros_like(w_r) if not self.compressible else w_r / (
+            self.design.E * self.areas_at(cells, cell[:, k.U_A, None] + (
+                cell[:, k.U_B] - cell[:, k.U_A])[:, None] * self.gauss_u))
         return (fc[:, k.C0], fc[:, k.C1], fc[:, k.D_CELL], fq[:, k.A0], fq[:, k.A1],
-                fq[:, k.D_Q], fq[:, k.W_Q], fq[:, k.K0], fq[:, k.K1], fq[:, k.K2])
+                fq[:, k.D_Q], w_r, fq[:, k.K0], fq[:, k.K1], fq[:, k.K2], w_a)
 
 
 def arm_weighted(peak_c: Array, xbar_start: Array, xbar_end: Array, r_c: Array | float
@@ -313,7 +355,8 @@ def build_grid(design: Design, settings: SolverSettings) -> Grid:
     many-design build (:func:`build_grids`) with one member."""
     key = (settings.routing if design.tendons == () else grid_routing(design.tendons,
                                                                        settings.routing),
-           settings.grid, settings.cells_per_notch, settings.cells_per_tube, settings.quad_order)
+           settings.grid, settings.cells_per_notch, settings.cells_per_tube, settings.quad_order,
+           settings.axial == "compressible")
     last = _last_grid.get("grid")
     if last is not None and last[0] is design and last[1] == key:
         return last[2]
@@ -322,7 +365,7 @@ def build_grid(design: Design, settings: SolverSettings) -> Grid:
     return grid
 
 
-_last_grid: dict[str, tuple[Design, tuple[str, str, int, int, int], Grid]] = {}
+_last_grid: dict[str, tuple[Design, tuple[str, str, int, int, int, bool], Grid]] = {}
 """The last grid :func:`build_grid` returned, by the identity of its design: a node or a loop
 solves one ``Design`` object again and again, and the grid cache's lookup hashes it and, for
 an equal design that is not the cached one (e.g. read from a body file), compares it field by
@@ -338,10 +381,15 @@ def clear_grid_cache() -> None:
 @lru_cache(maxsize=512)
 @quiet_fp
 def _build_grid(design: Design, routing: str, kind: str, cells_per_notch: int,
-                cells_per_tube: int, quad_order: int) -> Grid:
+                cells_per_tube: int, quad_order: int, compressible: bool) -> Grid:
     parts = GridParts.of(Members.of([design]), routing, kind, cells_per_notch,
                          cells_per_tube, quad_order)
-    return parts.stack(np.zeros(1, np.int64)).grid(0)
+    grid = parts.stack(np.zeros(1, np.int64)).grid(0)
+    if compressible:  # each Gauss point's shortening per newton: w_q / (E A)
+        cells = np.arange(grid.n_cells)
+        grid.cells.fq[0, W_A_ROW] = grid.w_q / (design.E * grid.areas_at(
+            cells, grid.u_a[:, None] + (grid.u_b - grid.u_a)[:, None] * grid.gauss_u))
+    return grid
 
 
 @dataclass(frozen=True, eq=False)
@@ -433,6 +481,7 @@ class GridParts:
         build.gather(proto, FC_FIELDS, self.proto_fc[..., None], fc)
         fq = np.empty((rows.size, FQ_ROWS, cell.shape[1], self.gauss_u.size))
         build.gather(proto, FQ_FIELDS, self.proto_fq, fq)
+        fq[:, W_A_ROW] = 0.0  # a rigid midline (see _build_grid)
         tip = table.count[rows][:, None]
         constrained = np.where(valid, table.constrained[cell], True)
         ic = np.stack([np.where(valid, table.chord_start_node[cell], tip),

@@ -1,8 +1,10 @@
 """The inverse model: the tendon tension (N) that puts the tip at a target.
 
 A target is a tip deflection (m, distance from the +z axis), a tip angle (rad, from +z toward
-+x), a tip point ``(x, z)`` in ``tdcm_base`` (m) or a tendon stroke (m, how far the tendon is
-pulled in, :attr:`~tdcm_ros.model.result.SolveResult.tendon_strokes_m`). The tension is sought within bounds
++x), a tip point ``(x, z)`` in ``tdcm_base`` (m) or a tendon stroke (m, how far the tendon's
+actuator has pulled it in: the path's stroke plus the tendon's slack and stretch where the
+design gives them, :attr:`~tdcm_ros.model.result.SolveResult.actuator_strokes_m`). The
+tension is sought within bounds
 ``[tension_min, tension_max]`` (N; default ``[0, DEFAULT_TENSION_MAX_N]``), each trial a
 forward :func:`~tdcm_ros.model.solver.solve` warm-started from the nearest earlier one.
 
@@ -150,6 +152,7 @@ class InverseResult:
             "tip_angle_rad": self.result.tip_angle_rad,
             "tip_deflection_m": self.result.tip_deflection_m,
             "tendon_stroke_m": float(self.result.tendon_strokes_m[0]),
+            "actuator_stroke_m": float(self.result.actuator_strokes_m[0]),
             "residual": self.residual,
             "residual_unit": "rad" if self.target_kind == "tip_angle" else "m",
             "sensitivity": self.sensitivity.to_dict(),
@@ -195,7 +198,9 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
                   tol: float = DEFAULT_TOL) -> InverseResult:
     """The tension (N) in ``[tension_min, tension_max]`` that puts the tip of ``design`` at
     exactly one target: ``tip_deflection`` (m), ``tip_angle`` (rad), ``tip_point`` ``(x, z)``
-    (m, least squares) or ``tendon_stroke`` (m, the tendon pulled in by it). ``tol`` is the tolerance on the target (m, or rad for an angle);
+    (m, least squares) or ``tendon_stroke`` (m, the tendon's actuator travel: the path's
+    stroke, its slack and stretch). ``tol`` is the tolerance on the target (m, or rad for an
+    angle);
     ``warm_start`` seeds the first forward solve (a result of the same design and settings).
 
     Raises :class:`InvalidTargetError` for a bad target, bounds or ``tol``;
@@ -225,7 +230,7 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
 _MEASURES: dict[str, Callable[[SolveResult], float]] = {
     "tip_deflection": lambda r: r.tip_deflection_m,
     "tip_angle": lambda r: r.tip_angle_rad,
-    "tendon_stroke": lambda r: float(r.tendon_strokes_m[0]),
+    "tendon_stroke": lambda r: float(r.actuator_strokes_m[0]),
 }
 _UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m", "tendon_stroke": "m"}
 

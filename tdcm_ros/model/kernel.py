@@ -12,10 +12,11 @@ Member arrays (SI units; ``M`` members, ``n`` cells, ``Q`` quadrature points, ``
   notches whose backbone is off the axis: the end moments are taken about the centroid) and
   ``D`` (rad/(N m): the bend of the moment's part the centroid's motion inside the cell adds,
   per newton of tendon tension, :func:`tdcm_ros.model.grid_kernel.cell_integrals`);
-- ``fq`` (M, 9, n, Q): ``A0``, ``A1`` (rad/(N m)), ``w_q`` (m), ``A0_T``, ``A1_T``
-  (rad/(N^2 m)), ``K0``, ``K1`` (m/(N m)), ``D_q`` (rad/N) and ``K2`` (m/N) at the Gauss
-  points: off the axis a point's angle has ``- T D_q`` and the tube axis's ds weight is
-  ``w_q + m_a K0 + m_b K1 - T K2`` (its stretch ``x_bar kappa``) (:mod:`tdcm_ros.model.grid`: on a chord the moment is
+- ``fq`` (M, 10, n, Q): ``A0``, ``A1`` (rad/(N m)), ``w_q`` (m), ``A0_T``, ``A1_T``
+  (rad/(N^2 m)), ``K0``, ``K1`` (m/(N m)), ``D_q`` (rad/N), ``K2`` (m/N) and ``W_A`` (m/N) at
+  the Gauss points: off the axis a point's angle has ``- T D_q`` and the tube axis's ds weight
+  is ``w_q + m_a K0 + m_b K1 - T K2`` (its stretch ``x_bar kappa``), and a compressible
+  midline's weight has ``- T W_A`` (``W_A = w_q / (E A)``, zero when rigid) (:mod:`tdcm_ros.model.grid`: on a chord the moment is
   not linear in the cell, ``m'' = -T c m``; the integrals are then ``A0 + T A0_T`` etc. with
   ``T`` the chord's tension, and the chord terms are zero where the tendon follows the body);
 - ``ic`` (M, 3, n): each cell's chord start node, chord end node, and 1 where the tendon
@@ -96,7 +97,8 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, t_axis
         local = 0j
         chord = fc[2, i] != 0.0 or fc[3, i] != 0.0
         off_axis = fc[4, i] != 0.0 or fc[5, i] != 0.0 or fq[5, i, 0] != 0.0
-        if not (chord or off_axis):  # the tendon follows the body: linear
+        compress = fq[9, i, 0] != 0.0
+        if not (chord or off_axis or compress):  # the tendon follows the body: linear
             for q in range(nq):
                 local += fq[2, i, q] * unit(a * fq[0, i, q] + b * fq[1, i, q])
             th = th + (a * fc[0, i] + b * fc[1, i])
@@ -113,6 +115,8 @@ def integrate_row(fc: Array, fq: Array, m_a: Array, m_b: Array, t: Array, t_axis
                 if off_axis:
                     phi -= pull * fq[7, i, q]
                     weight += a * fq[5, i, q] + b * fq[6, i, q] - pull * fq[8, i, q]
+                if compress:
+                    weight -= pull * fq[9, i, q]
                 local += weight * unit(phi)
             if chord:
                 bend = a * (fc[0, i] + tension * fc[2, i]) + b * (fc[1, i] + tension * fc[3, i])

@@ -149,17 +149,19 @@ class SolveResult:
         integrated by the cells' own quadrature), and straight across each chord."""
         layout = self.tendons
         out = np.empty(layout.count)
-        axis = self._axis_tensions() if self.grid.off_axis else None
+        grid = self.grid
+        axis = self._axis_tensions() if grid.off_axis or grid.compressible else np.zeros(0)
         for j in range(layout.count):
             r_c = float(layout.offsets[j])
             follows = layout.follow_cells[j]
             along = layout.follow_lengths[j] - r_c * float(
                 np.sum(self.theta[follows + 1] - self.theta[follows]))
-            if axis is not None:  # the axis's stretch (zero where every centroid is on it)
-                grid = self.grid
+            if grid.off_axis:  # the axis's stretch (zero where every centroid is on it)
                 m = self.bend_moments[follows]
                 along += float(np.sum(m[:, 0:1] * grid.K0[follows] + m[:, 1:2] * grid.K1[follows]
                                       - axis[follows, None] * grid.K2[follows]))
+            if grid.compressible:  # the body's shortening under the axial load
+                along -= float(np.sum(axis[follows, None] * grid.W_A[follows]))
             nodes = layout.chord_nodes[j]  # the tendon at each chord's ends: r along +x_b
             theta = self.theta[nodes]
             x = self.positions[nodes, 0] + r_c * np.cos(theta)
@@ -173,6 +175,16 @@ class SolveResult:
         straight body (its anchor's arc length, ``L`` at the tip) less
         :attr:`tendon_lengths_m`."""
         return self.grid.s_nodes[self.tendons.anchors] - self.tendon_lengths_m
+
+    @property
+    def actuator_strokes_m(self) -> Array:
+        """How far each tendon's actuator has travelled (m), one per tendon: the tendon's
+        ``slack`` taken up, :attr:`tendon_strokes_m` and its stretch ``T / stiffness``
+        (:meth:`~tdcm_ros.model.tendons.Tendon.actuator_stroke`; the path stroke itself for an
+        inextensible tendon without slack). At 0 N: where the tendon just becomes taut."""
+        return np.array([tendon.actuator_stroke(float(stroke), tension) for tendon, stroke, tension
+                         in zip(self.design.tendon_list(), self.tendon_strokes_m,
+                                self.tensions_n, strict=True)])
 
     @property
     def quaternions(self) -> Array:
@@ -237,6 +249,8 @@ class SolveResult:
             w_r = w_r + m_a[:, None] * found.k0_r + m_b[:, None] * found.k1_r \
                 - pull[:, None] * found.k2_r
             theta = theta - pull * found.d_s
+        if self.grid.compressible:  # the body's shortening under the axial load
+            w_r = w_r - self._axis_tensions()[cells][:, None] * found.wa_r
         along = np.sum(w_r * np.cos(phi_r), axis=1)
         across = np.sum(w_r * np.sin(phi_r), axis=1)
         x = self.positions[cells, 0] + along * np.sin(theta_a) + across * np.cos(theta_a)
@@ -265,6 +279,7 @@ class SolveResult:
             "tendon_tensions_n": list(self.tensions_n),
             "tendon_lengths_m": self.tendon_lengths_m.tolist(),
             "tendon_strokes_m": self.tendon_strokes_m.tolist(),
+            "actuator_strokes_m": self.actuator_strokes_m.tolist(),
             "solve_time_s": self.solve_time_s,
             "residual_history_m": list(self.residual_history),
             "design": self.design.to_dict(),

@@ -13,6 +13,7 @@ ROUTINGS = ("paper", "free")
 LOAD_FORMS = ("closed", "literal")
 ACCELERATIONS = ("auto", "anderson", "relaxation", "none")
 GRID_KINDS = ("adaptive", "uniform")
+AXIAL_MODELS = ("rigid", "compressible")
 
 
 @dataclass(frozen=True)
@@ -34,6 +35,8 @@ class SolverSettings:
       two iterations. ``max_iter`` bounds the iterations over all strategies.
     - ``acceleration``: ``auto`` (Picard while it contracts, Anderson when it slows, damped
       relaxation and load continuation as fall-backs), or one strategy only.
+    - ``axial``: ``rigid`` (the paper's inextensible midline) or ``compressible`` (each
+      section shortens by ``T / (E A)`` under the tendons' resultant ``T``, ``A`` its area).
     """
 
     routing: str = spec_field("paper", choices=ROUTINGS, description="tendon routing")
@@ -53,6 +56,8 @@ class SolverSettings:
     anderson_depth: int = spec_field(5, low=1, high=50, description="iterates Anderson mixes")
     continuation_steps: int = spec_field(8, low=0, high=1024,
                                          description="load continuation steps (fall-back)")
+    axial: str = spec_field("rigid", choices=AXIAL_MODELS, description="midline under the "
+                            "tendons' axial load: rigid (the paper's) or compressible (EA)")
 
     def __post_init__(self) -> None:
         check_fields(self, SOLVER_SPECS, error=InvalidSettingsError)

@@ -49,6 +49,7 @@ from tdcm_ros.model.quiet import quiet_fp
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.tendon_model import TendonSet
+from tdcm_ros.model.tendons import is_paper_like
 
 Array = NDArray[np.float64]
 
@@ -107,7 +108,7 @@ def solve(design: Design, tension: float | Sequence[float], *,
     raises none).
     """
     started = perf_counter()
-    if design.tendons == ():
+    if is_paper_like(design.tendons):
         if isinstance(tension, (list, tuple, np.ndarray)):
             tension = check_tensions(tension, 1)[0]
         return _solve(design, check_tension(tension), settings, warm_start, strict, loading,

@@ -36,17 +36,39 @@ Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
 
+#: Largest tendon stiffness (N/m) and slack (m) a tendon may be given.
+MAX_STIFFNESS_N_PER_M = 1e12
+MAX_SLACK_M = 1.0
+
+
 @dataclass(frozen=True)
 class Tendon:
     """One tendon: its signed ``offset`` (m, + toward +x), ``routing`` (``paper`` | ``free``;
     None: the solver's), ``anchor`` (m from the base, at a segment boundary; None: the tip),
-    ``guides`` (``internal`` | ``external``) and ``name`` (its joint and topic name)."""
+    ``guides`` (``internal`` | ``external``), ``name`` (its joint and topic name), and for its
+    actuator's stroke its own axial ``stiffness`` (N/m, actuator to anchor; None: inextensible)
+    and ``slack`` (m the actuator takes up before the tendon pulls)."""
 
     offset: float
     routing: str | None = None
     anchor: float | None = None
     guides: str = "internal"
     name: str = ""
+    stiffness: float | None = None
+    slack: float = 0.0
+
+    def actuator_stroke(self, stroke: float, tension: float) -> float:
+        """The actuator's travel (m) for the tendon's path ``stroke`` (m) at ``tension`` (N):
+        the slack taken up, the path, and the tendon's stretch ``T / stiffness``."""
+        stretch = 0.0 if self.stiffness is None else tension / self.stiffness
+        return self.slack + stroke + stretch
+
+
+def is_paper_like(tendons: tuple[Tendon, ...]) -> bool:
+    """Whether ``tendons`` pull as the paper's one tendon: none listed, or one on +x to the tip
+    (its routing, guides, name, stiffness and slack change no moment)."""
+    return not tendons or (len(tendons) == 1 and tendons[0].offset > 0.0
+                           and tendons[0].anchor is None)
 
 
 def check_tendons(tendons: tuple[Tendon, ...], r_outer: float, boundaries: Array
@@ -88,8 +110,19 @@ def check_tendons(tendons: tuple[Tendon, ...], r_outer: float, boundaries: Array
                                    f"base, m ({shown}{', ...' if boundaries.size > 12 else ''})",
                                    error=InvalidDesignError)
             anchor = float(nearest)
+        stiffness = tendon.stiffness
+        if stiffness is not None and (isinstance(stiffness, bool) or not isinstance(
+                stiffness, (int, float)) or not 0.0 < stiffness <= MAX_STIFFNESS_N_PER_M):
+            raise out_of_range(f"{where}.stiffness", stiffness, f"(0, {MAX_STIFFNESS_N_PER_M:g}]"
+                               " N/m, or None (inextensible)", error=InvalidDesignError)
+        slack = tendon.slack
+        if isinstance(slack, bool) or not isinstance(slack, (int, float)) or \
+                not 0.0 <= slack <= MAX_SLACK_M:
+            raise out_of_range(f"{where}.slack", slack, f"[0, {MAX_SLACK_M:g}] m",
+                               error=InvalidDesignError)
         out.append(Tendon(float(offset), tendon.routing, anchor, tendon.guides,
-                          tendon.name or f"tendon_{k + 1}"))
+                          tendon.name or f"tendon_{k + 1}",
+                          None if stiffness is None else float(stiffness), float(slack)))
     names = [t.name for t in out]
     if len(set(names)) != len(names):
         raise out_of_range("tendons[].name", names, "distinct names", error=InvalidDesignError)
@@ -98,13 +131,14 @@ def check_tendons(tendons: tuple[Tendon, ...], r_outer: float, boundaries: Array
 
 def require_paper_tendon(tendons: tuple[Tendon, ...], what: str,
                          parameter: str = "design.tendons") -> None:
-    """Raise :class:`InvalidDesignError` if a design lists ``tendons`` (several, or one off the
-    paper's), which ``what`` does not take yet (say so, naming ``parameter``)."""
-    if tendons:
+    """Raise :class:`InvalidDesignError` if a design lists ``tendons`` that do not pull as the
+    paper's one (:func:`is_paper_like`), which ``what`` does not take yet (say so, naming
+    ``parameter``)."""
+    if not is_paper_like(tendons):
         raise InvalidDesignError(
             f"{parameter}: {what} takes the paper's one tendon (on +x, to the tip); this design "
-            f"lists {len(tendons)} tendon(s); allowed: no tendon list (solve() and "
-            "tdcm solve take tendon lists)", parameter=parameter, value=len(tendons),
+            f"lists {len(tendons)} tendon(s) that do not; allowed: one tendon on +x to the tip "
+            "(solve() and tdcm solve take any tendon list)", parameter=parameter, value=len(tendons),
             allowed="the paper's one tendon")
 
 

@@ -338,7 +338,7 @@ class ModelNode(NodeLogic):
                 roll=roll):
             self.publishers[topic].publish(message)  # midline first: sent before the rest is built
         self.publishers["tendon_states"].publish(
-            tendon_states(stamp_ns, result.tendon_strokes_m.tolist(), [result.tension_n]))
+            tendon_states(stamp_ns, result.actuator_strokes_m.tolist(), [result.tension_n]))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=str(self.tf_names["tf.station_prefix"]),

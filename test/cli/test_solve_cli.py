@@ -73,6 +73,18 @@ def test_a_body_with_several_tendons_takes_one_tension_each(capsys):
     assert "extensor: 5 N, length" in text
 
 
+def test_axial_compression_is_a_switch_that_shortens_the_body(capsys):
+    _, rigid, _ = run_json(capsys, "--tension", "20")
+    _, soft, _ = run_json(capsys, "--tension", "20", "--axial", "compressible")
+    assert rigid["settings"]["axial"] == "rigid" and soft["settings"]["axial"] == "compressible"
+    expected = solve(preset("paper-experiment"), 20.0,
+                     settings=SolverSettings(axial="compressible"))
+    assert soft["tip_position_m"] == pytest.approx(expected.tip_position.tolist(), abs=1e-15)
+    assert rigid["tip_position_m"][2] - soft["tip_position_m"][2] > 2e-5
+    assert main(["solve", "--tension", "20", "--axial", "compressible"]) == 0
+    assert "axial compressible" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(("args", "status", "kind"), [
     (["--design", PAIR, "--tension", "20"], 2, "tension_out_of_range"),
     (["--design", PAIR, "--tension", "20,x"], 2, "tension_out_of_range"),

@@ -285,3 +285,55 @@ def test_an_external_tendon_may_run_outside_the_wall() -> None:
 def test_sweeps_do_not_vary_a_listed_tendons_offset() -> None:
     assert "R_c" in PAIR.derived_fields()
     assert list(itertools.islice(PAIR.tendon_list(), 2)) == list(PAIR.tendons)
+
+
+STRETCHY = with_tendons(PAPER, Tendon(R_C, stiffness=2.0e4, slack=0.5e-3))
+
+
+def test_a_tendon_with_stiffness_and_slack_pulls_as_the_paper_tendon() -> None:
+    """Stiffness and slack move the actuator, not the body: the listed tendon is the paper's
+    model bit for bit (its compiled iteration), and the actuator's travel is the path's
+    stroke, the slack and ``T / k``."""
+    result = solve(STRETCHY, 20.0)
+    paper = solve(PAPER, 20.0)
+    assert np.array_equal(result.positions, paper.positions)
+    assert np.array_equal(result.tendon_strokes_m, paper.tendon_strokes_m)
+    assert result.actuator_strokes_m[0] == pytest.approx(
+        paper.tendon_strokes_m[0] + 0.5e-3 + 20.0 / 2.0e4, abs=1e-15)
+    assert solve(STRETCHY, 0.0).actuator_strokes_m == pytest.approx([0.5e-3], abs=1e-15)
+    assert np.array_equal(paper.actuator_strokes_m, paper.tendon_strokes_m)
+
+
+@pytest.mark.parametrize("stroke", [0.8e-3, 1.5e-3, 2.4e-3])
+def test_an_actuator_stroke_round_trips_through_the_tension(stroke: float) -> None:
+    """Issue 28's target: stroke -> tension -> stroke within 1e-9 m, the tendon's stretch and
+    slack included (the path's part of it is what is left)."""
+    found = solve_inverse(STRETCHY, tendon_stroke=stroke, tol=1e-11)
+    again = solve(STRETCHY, found.tension_n)
+    assert again.actuator_strokes_m[0] == pytest.approx(stroke, abs=1e-9)
+    path = stroke - 0.5e-3 - found.tension_n / 2.0e4
+    assert again.tendon_strokes_m[0] == pytest.approx(path, abs=1e-9)
+
+
+def test_an_actuator_stroke_within_the_slack_is_out_of_reach() -> None:
+    from tdcm_ros.model.inverse import UnreachableTargetError
+
+    with pytest.raises(UnreachableTargetError):
+        solve_inverse(STRETCHY, tendon_stroke=0.2e-3)
+
+
+@pytest.mark.parametrize(("tendon", "message"), [
+    (Tendon(R_C, stiffness=0.0), r"tendons\[0\]\.stiffness = 0\.0 .*\(0, 1e\+12\] N/m"),
+    (Tendon(R_C, stiffness=math.inf), r"tendons\[0\]\.stiffness = inf"),
+    (Tendon(R_C, slack=-1e-3), r"tendons\[0\]\.slack = -0\.001 .*\[0, 1\] m"),
+])
+def test_bad_stiffness_and_slack_name_the_tendon(tendon: Tendon, message: str) -> None:
+    with pytest.raises(InvalidDesignError, match=message):
+        dataclasses.replace(PAPER, tendons=(tendon,))
+
+
+def test_stiffness_and_slack_round_trip_through_a_body_file(tmp_path: Path) -> None:
+    path = tmp_path / "stretchy.yaml"
+    path.write_text(body_file_text(STRETCHY), encoding="utf-8")
+    assert "stiffness: 20000.0" in path.read_text(encoding="utf-8")
+    assert read_body_file(path).design() == STRETCHY
