@@ -38,7 +38,7 @@ def shape() -> SolveResult:
 def with_tendon() -> None:
     """:func:`shape` and the tendon's JointState."""
     result = shape()
-    tendon_states(1, result.tendon_strokes_m.tolist(), [result.tension_n])
+    tendon_states(1, result.tendons.names, result.tendon_strokes_m.tolist(), [result.tension_n])
 
 
 def main() -> None:

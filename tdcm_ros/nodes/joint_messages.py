@@ -14,7 +14,6 @@ from tdcm_ros.nodes.shape_messages import header, header_msg
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 ROLL_JOINT = "roll"  #: joint name of the roll servo (rotation about the base +z axis)
-TENDON_JOINT = "tendon_{}"  #: joint name of tendon k (1-based, in the body's order)
 
 
 def joint_state(stamp_ns: int, position: float, velocity: float | None = None) -> Any:
@@ -26,13 +25,14 @@ def joint_state(stamp_ns: int, position: float, velocity: float | None = None) -
                                    "effort": []})
 
 
-def tendon_states(stamp_ns: int, strokes_m: Sequence[float], tensions_n: Sequence[float]
-                  ) -> Any:
-    """Each tendon as a prismatic joint ``tendon_<k>``: position its stroke (m, pulled in
-    against the straight body), effort its tension (N), stamped ``stamp_ns``, no frame."""
+def tendon_states(stamp_ns: int, names: Sequence[str], strokes_m: Sequence[float],
+                  tensions_n: Sequence[float]) -> Any:
+    """Each tendon as a prismatic joint named as in the body (``tendon_<k>`` by default):
+    position its actuator's stroke (m, pulled in against the straight body), effort its
+    tension (N), stamped ``stamp_ns``, no frame."""
     # from the typestore class, as the shape messages (model_node builds one per input)
     return msg_class(JOINT_STATE)(
         header=header_msg(stamp_ns, ""),
-        name=[TENDON_JOINT.format(k + 1) for k in range(len(strokes_m))],
+        name=list(names),
         position=np.array(strokes_m, dtype=np.float64), velocity=np.empty(0),
         effort=np.array(tensions_n, dtype=np.float64))

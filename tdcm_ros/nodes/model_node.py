@@ -2,12 +2,15 @@
 
 Subscribes ``tension`` (``geometry_msgs/msg/WrenchStamped``: the tension is ``wrench.force.z``
 in N, in a frame whose z axis runs along the tendon toward the actuator; or
-``std_msgs/msg/Float64`` in N, by the ``input.tension_type`` parameter). Publishes, stamped
+``std_msgs/msg/Float64`` in N; or ``sensor_msgs/msg/JointState``, one effort in N per tendon
+named as in the body file (the input of a body with several tendons: ros2_control's
+convention for a set of actuators, one message for one sample of all of them), by the
+``input.tension_type`` parameter). Publishes, stamped
 with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (nav_msgs/Path),
 ``midline_poses`` (PoseArray), ``tip_pose`` (PoseStamped), ``predicted_markers`` (PoseArray),
 ``body_markers`` (visualization_msgs/MarkerArray), ``tendon_states`` (sensor_msgs/JointState:
-each tendon as a prismatic joint ``tendon_<k>``, position its stroke in m, effort its tension in
-N; not rolled, no frame) and ``/diagnostics`` (``model_node: input``:
+each tendon as a prismatic joint named as in the body (``tendon_<k>`` by default), position its
+actuator's stroke in m, effort its tension in N; not rolled, no frame) and ``/diagnostics`` (``model_node: input``:
 dropped and coalesced inputs; ``model_node: solver``: solves and failures; each WARN while a
 problem happened within the last 5 diagnostics periods, OK again after).
 
@@ -81,15 +84,17 @@ from tdcm_ros.runtime import (
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
-TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64")
+TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64", JOINT_STATE)
 #: Rolls kept to pair with tensions: over a second at the driver's telemetry rate.
 ROLL_HISTORY = 2048
 #: m: a marker arc length up to this far past the tip (a length rounded in a file) is the tip.
 TIP_TOLERANCE_M = 1e-9
 #: Parameters fixed at start, besides the design and solver groups.
 FIXED_SPECS = by_name(
-    Spec("input.tension_type", description="message type on `tension`", default=TENSION_TYPES[0],
-         kind="str", choices=TENSION_TYPES),
+    Spec("input.tension_type", description="message type on `tension`: WrenchStamped "
+         "(force.z, N), Float64 (N) or JointState (one effort per tendon in N, by the body's "
+         "tendon names: a body with several tendons)", default=TENSION_TYPES[0], kind="str",
+         choices=TENSION_TYPES),
     Spec("design.preset", description="design preset the fields start from",
          default="paper-experiment", kind="str", choices=tuple(PRESETS)),
     Spec("design.file", description="body file (.yaml) the design fields start from instead of "
@@ -162,8 +167,14 @@ class ModelNode(NodeLogic):
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
         self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
-        require_paper_tendon(self.base.tendons, "model_node (one tension input)",
-                             "design.file")
+        if self.tension_type != JOINT_STATE:
+            try:
+                require_paper_tendon(self.base.tendons, f"input.tension_type = "
+                                     f"{self.tension_type} (one tension)", "design.file")
+            except InputError as error:
+                raise InputError(f"{error}; a body with several tendons takes input.tension_type"
+                                 f" = {JOINT_STATE}", parameter="input.tension_type",
+                                 value=self.tension_type, allowed=JOINT_STATE) from error
         self.design_specs = parameter_specs(self.base)
         declare_specs(port, self.design_specs, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
@@ -191,7 +202,7 @@ class ModelNode(NodeLogic):
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
                                  self._on_joint_states, QoS(depth=100))
         self.rolls = RollHistory(ROLL_HISTORY)
-        self.pending: tuple[float, int] | None = None
+        self.pending: tuple[float | tuple[float, ...], int] | None = None
         self.previous: SolveResult | None = None
         self.counts: Counter[str] = Counter()
         self.last_problem = ""
@@ -233,16 +244,21 @@ class ModelNode(NodeLogic):
                                          child=str(self.tf_names["tf.tendon_frame_id"])))
 
     def _on_tension(self, message: Any) -> None:
-        """Store a valid tension (N) with its stamp (ns); an unstamped ``Float64`` takes the
-        node's clock."""
+        """Store a valid tension (N; a JointState's, one per tendon) with its stamp (ns); an
+        unstamped ``Float64`` takes the node's clock."""
         stamp_ns: int | None
+        tension: float | tuple[float, ...]
+        reason = ""
         if self.tension_type == TENSION_TYPES[0]:
             tension = float(message.wrench.force.z)
+            stamp_ns = stamp_ns_of(message)
+        elif self.tension_type == JOINT_STATE:
+            tension, reason = self._tendon_efforts(message)
             stamp_ns = stamp_ns_of(message)
         else:
             tension, stamp_ns = float(message.data), None
         now = self.port.now_ns()
-        reason = self._reject_reason(tension, stamp_ns, now)
+        reason = reason or self._reject_reason(tension, stamp_ns, now)
         if reason:
             self.counts[f"dropped_{reason}"] += 1
             self.last_problem = f"dropped tension {tension!r} N: {reason}"
@@ -253,6 +269,16 @@ class ModelNode(NodeLogic):
         if self.pending is not None:
             self.counts["coalesced"] += 1
         self.pending = (tension, now if stamp_ns is None else stamp_ns)
+
+    def _tendon_efforts(self, message: Any) -> tuple[tuple[float, ...], str]:
+        """Each tendon's tension (N) from a JointState's efforts by the design's tendon names,
+        in the design's order; ``missing_tendon`` where one has no effort."""
+        efforts = dict(zip(message.name, np.asarray(message.effort, dtype=float).tolist(),
+                           strict=False))
+        names = [t.name for t in self.design.tendon_list()]
+        if any(name not in efforts for name in names):
+            return tuple(efforts.get(name, math.nan) for name in names), "missing_tendon"
+        return tuple(efforts[name] for name in names), ""
 
     def _on_joint_states(self, message: Any) -> None:
         """Keep the roll (rad) of a JointState naming ``roll.joint``, with its stamp (ns; an
@@ -285,17 +311,22 @@ class ModelNode(NodeLogic):
                     f"input.max_future_s = {get('input.max_future_s'):g} s")
         if reason == "above_max":
             return f"above input.tension_max = {get('input.tension_max'):g} N"
+        if reason == "missing_tendon":
+            names = ", ".join(t.name for t in self.design.tendon_list())
+            return f"the JointState has no effort for every tendon ({names})"
         return f"{reason.replace('_', '-')} tension"
 
-    def _reject_reason(self, tension: float, stamp_ns: int | None, now_ns: int) -> str:
-        """Why a tension (N) stamped ``stamp_ns`` (ns; None: a type without a header) is
-        dropped at ``now_ns``, or ``""``. A zero header stamp was never set: its age is
-        unknown, so it is dropped as ``unstamped``."""
-        if not math.isfinite(tension):
+    def _reject_reason(self, tension: float | tuple[float, ...], stamp_ns: int | None,
+                       now_ns: int) -> str:
+        """Why a tension (N; or one per tendon, each checked) stamped ``stamp_ns`` (ns; None:
+        a type without a header) is dropped at ``now_ns``, or ``""``. A zero header stamp was
+        never set: its age is unknown, so it is dropped as ``unstamped``."""
+        values = tension if isinstance(tension, tuple) else (tension,)
+        if not all(math.isfinite(value) for value in values):
             return "non_finite"
-        if tension < 0.0:
+        if any(value < 0.0 for value in values):
             return "negative"
-        if tension > float(self.port.get_parameter("input.tension_max")):
+        if any(value > float(self.port.get_parameter("input.tension_max")) for value in values):
             return "above_max"
         if stamp_ns is None:
             return ""
@@ -319,7 +350,7 @@ class ModelNode(NodeLogic):
                            warm_start=self.previous)
         except (PhysicsError, InputError) as error:
             self.counts[f"model_{error.kind}"] += 1
-            self.last_failure = f"tension {tension:g} N: {error}"
+            self.last_failure = f"tension {_shown(tension)} N: {error}"
             return
         self.previous = result
         self.counts["solved"] += 1
@@ -338,7 +369,8 @@ class ModelNode(NodeLogic):
                 roll=roll):
             self.publishers[topic].publish(message)  # midline first: sent before the rest is built
         self.publishers["tendon_states"].publish(
-            tendon_states(stamp_ns, result.actuator_strokes_m.tolist(), [result.tension_n]))
+            tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
+                          result.tensions_n))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=str(self.tf_names["tf.station_prefix"]),
@@ -368,6 +400,11 @@ class ModelNode(NodeLogic):
         if recent:
             return Status(DiagnosticLevel.WARN, last, values)
         return Status(DiagnosticLevel.OK, "ok", values)
+
+def _shown(tension: float | tuple[float, ...]) -> str:
+    """A tension (N), or one per tendon, as text."""
+    return ", ".join(f"{t:g}" for t in tension) if isinstance(tension, tuple) else f"{tension:g}"
+
 
 def main() -> int:
     """``ros2 run tdcm_ros model_node`` / ``model_node`` console script."""

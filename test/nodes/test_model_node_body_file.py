@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
 from tdcm_ros.model import InvalidDesignError, body_file_text, preset, solve
 from tdcm_ros.nodes.metrics_node import declare_design_and_layout
 from tdcm_ros.nodes.model_node import ModelNode
@@ -51,10 +52,9 @@ def test_a_bad_body_file_stops_the_start_naming_the_key(tmp_path: Path) -> None:
 
 
 def test_the_nodes_refuse_a_body_with_a_tendon_list_naming_it() -> None:
-    """The nodes take one tension input: a body with several tendons stops their start."""
+    """metrics_node and shape_controller take one tension: a body with several tendons stops
+    their start."""
     body = str(Path(__file__).resolve().parents[2] / "config" / "bodies" / "antagonistic_pair.yaml")
-    with pytest.raises(InvalidDesignError, match=r"design\.file: model_node \(one tension input\)"):
-        ModelNode(MemoryPort({"design.file": body}, name="model_node"))
     for name in ("metrics_node", "shape_controller"):
         with pytest.raises(InvalidDesignError, match=rf"design\.file: {name} \(one tension"):
             declare_design_and_layout(MemoryPort({"design.file": body}, name=name), name)
@@ -128,3 +128,43 @@ def test_a_polygon_or_mesh_body_file_reaches_both_nodes_its_sections_not_paramet
     metrics_design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                              name="metrics_node"))
     assert metrics_design == node.design.with_overrides(E=1.85e9)
+
+
+def test_a_body_with_several_tendons_takes_a_joint_state_of_tensions_by_name() -> None:
+    """``input.tension_type: sensor_msgs/msg/JointState``: one effort per tendon by the body
+    file's names, in any order; the shape is the library's for those tensions, and
+    tendon_states names each tendon. A message without every tendon is dropped and counted."""
+    from tdcm_ros.model import read_body_file
+
+    body = Path(__file__).resolve().parents[2] / "config" / "bodies" / "antagonistic_pair.yaml"
+    port = MemoryPort({"design.file": str(body),
+                       "input.tension_type": "sensor_msgs/msg/JointState"}, name="model_node")
+    node = ModelNode(port)
+
+    def send(names: list[str], efforts: list[float]) -> None:
+        port.deliver("tension", from_dict("sensor_msgs/msg/JointState", {
+            "header": {"stamp": {"sec": port.clock_ns // 10**9,
+                                 "nanosec": port.clock_ns % 10**9}},
+            "name": names, "effort": efforts}))
+        port.advance(0.01)
+
+    send(["extensor", "flexor"], [5.0, 25.0])
+    expected = solve(read_body_file(body).design(), [25.0, 5.0])
+    tip = port.messages("tip_pose")[-1].pose.position
+    assert [tip.x, tip.z] == pytest.approx([expected.tip_position[0], expected.tip_position[2]],
+                                           abs=1e-12)
+    states = port.messages("tendon_states")[-1]
+    assert list(states.name) == ["flexor", "extensor"]
+    assert list(states.effort) == [25.0, 5.0]
+    assert list(states.position) == pytest.approx(expected.actuator_strokes_m.tolist(), abs=1e-12)
+    solved = len(port.messages("tip_pose"))
+    send(["flexor"], [25.0])
+    assert len(port.messages("tip_pose")) == solved
+    assert node.counts["dropped_missing_tendon"] == 1
+
+
+def test_a_body_with_several_tendons_needs_the_joint_state_input() -> None:
+    body = str(Path(__file__).resolve().parents[2] / "config" / "bodies" / "antagonistic_pair.yaml")
+    with pytest.raises(InputError, match=r"input\.tension_type = .*JointState") as info:
+        ModelNode(MemoryPort({"design.file": body}, name="model_node"))
+    assert info.value.parameter == "input.tension_type"
