@@ -3,7 +3,7 @@ raises the right typed error, never NaN."""
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.model import (
@@ -94,3 +94,72 @@ def test_custom_profile_is_validated_and_used():
     assert np.allclose(rect, same, atol=1e-12)
     with pytest.raises(InvalidDesignError, match=r"h1\(s\)"):
         solve(base.with_overrides(profile=CustomProfile(lambda s: s - 1.0)), 10)
+
+
+@st.composite
+def tendon_sets(draw, design):
+    """One to three tendons inside the wall on either side, each with its routing, the last
+    ones possibly anchored at a segment boundary short of the tip."""
+    import dataclasses
+
+    from tdcm_ros.model import Tendon
+
+    ends = design.segment_ends()
+    count = draw(st.integers(1, 3))
+    tendons = tuple(
+        Tendon(draw(st.floats(0.1, 0.99)) * design.R_outer * draw(st.sampled_from([1.0, -1.0])),
+               routing=draw(st.sampled_from([None, "paper", "free"])),
+               anchor=None if k == 0 else draw(st.sampled_from([None, *ends[:3].tolist()])))
+        for k in range(count))
+    return dataclasses.replace(design, R_c=abs(tendons[0].offset), tendons=tendons)
+
+
+@settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow], deadline=None)
+@given(data=st.data(), design=hard_designs(), routing=st.sampled_from(["paper", "free"]),
+       axial=st.sampled_from(["rigid", "compressible"]))
+def test_several_tendons_pulling_against_each_other_converge_or_raise_a_typed_limit(
+        data, design, routing, axial):
+    """Issue 28's stability cases: tendons on both sides at any tensions up to 5 kN (cancelling
+    ones among them), any routings and anchors, with or without axial compression."""
+    body = data.draw(tendon_sets(design))
+    tensions = data.draw(st.lists(st.floats(0.0, 5e3), min_size=len(body.tendons),
+                                  max_size=len(body.tendons)))
+    config = SolverSettings(routing=routing, axial=axial)
+    try:
+        first = solve(body, tensions, settings=config)
+    except LIMITS as error:
+        event(type(error).__name__)
+        assert str(error)
+        with pytest.raises(type(error)):
+            solve(body, tensions, settings=config)
+        return
+    event("converged")
+    assert first.converged and first.residual_history[-1] <= config.tol
+    assert np.all(np.isfinite(first.positions)) and np.all(np.isfinite(first.theta))
+    assert np.all(np.isfinite(first.tendon_lengths_m))
+    assert np.array_equal(first.positions, solve(body, tensions, settings=config).positions)
+
+
+@settings(max_examples=40, suppress_health_check=[HealthCheck.too_slow], deadline=None)
+@given(design=hard_designs(), stroke=st.floats(0.0, 2e-2),
+       stiffness=st.sampled_from([None, 1e3, 1e5]), slack=st.sampled_from([0.0, 1e-4]))
+def test_a_stroke_input_finds_its_tension_or_raises_a_typed_error(design, stroke, stiffness,
+                                                                  slack):
+    """Stroke inputs over hard designs: the tension that pulls the actuator in by ``stroke``
+    round-trips to 1e-9 m, or a typed error says why not (out of reach, a model limit)."""
+    import dataclasses
+
+    from tdcm_ros.model import Tendon, UnreachableTargetError, solve_inverse
+
+    body = dataclasses.replace(design, tendons=(Tendon(design.R_c, stiffness=stiffness,
+                                                       slack=slack),))
+    try:
+        found = solve_inverse(body, tendon_stroke=stroke, tol=1e-11)
+    except (UnreachableTargetError, *LIMITS) as error:
+        event(type(error).__name__)
+        assert str(error)
+        return
+    event("found")
+    assert 0.0 <= found.tension_n <= 50.0
+    again = solve(body, found.tension_n)
+    assert again.actuator_strokes_m[0] == pytest.approx(stroke, abs=1e-9)
