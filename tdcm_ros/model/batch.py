@@ -200,6 +200,12 @@ def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAU
                 f"designs[{i}] = {design!r} is not a Design", parameter=f"designs[{i}]",
                 value=design, allowed="tdcm_ros.model.Design")
         require_paper_tendon(design.tendons, "the batch solver", f"designs[{i}].tendons")
+        if not design.material.is_trivial:
+            raise InvalidDesignError(
+                f"designs[{i}].material: the batch solver takes the linear law without a strain "
+                "limit; allowed: Material() (solve() takes any law)",
+                parameter=f"designs[{i}].material", value=design.material.law,
+                allowed="linear")
     if not isinstance(settings, SolverSettings):
         raise InvalidSettingsError(f"settings = {settings!r} is not a SolverSettings",
                                    parameter="settings", value=settings,

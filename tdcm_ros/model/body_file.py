@@ -53,6 +53,7 @@ from typing import Any
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.design import MIN_SEGMENT_M, OFFSET_SLACK, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.material import LAWS, Material
 from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
     NotchProfile,
@@ -157,6 +158,7 @@ class BodySpec:
     tendons: tuple[Tendon, ...]
     segments: tuple[Segment, ...]
     source: str
+    material: Material
 
     @property
     def routing(self) -> str:
@@ -203,9 +205,10 @@ class BodySpec:
                           N=len(notches), w_o=tuple(n.offset for n in notches),
                           R_outer=self.R_outer, r_inner=self.r_inner,
                           R_c=abs(self.tendons[0].offset), E=self.E,
-                          profile=tuple(n.profile_object() for n in notches), tendons=tendons)
+                          profile=tuple(n.profile_object() for n in notches), tendons=tendons,
+                          material=self.material)
         except InvalidDesignError as error:
-            if not (error.parameter or "").startswith("tendons"):
+            if not (error.parameter or "").startswith(("tendons", "material")):
                 raise
             raise InvalidDesignError(f"{self.source}: {error}", parameter=error.parameter,
                                      value=error.value, allowed=error.allowed) from error
@@ -257,11 +260,33 @@ def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
         segments = _segments(_required(top, "segments", "", source), "segments", source,
                              r_outer, r_inner)
     material = _mapping(_required(top, "material", "", source), "material", source)
-    reject_unknown("material key", material, ("E",), error=InvalidDesignError)
+    reject_unknown("material key", material, ("E", "law", "plateau_strain", "E_plateau",
+                                              "recoverable_strain"), error=InvalidDesignError)
     modulus = _number(material, "E", "material.", source, low=0.0, high=1e12, open_low=True)
+    law = material.get("law", "linear")
+    if law not in LAWS:
+        raise out_of_range(f"{source}: material.law", law, " | ".join(LAWS),
+                           error=InvalidDesignError)
+    bilinear = law == "bilinear"
+    for key in ("plateau_strain", "E_plateau"):
+        if (key in material) != bilinear:
+            raise InvalidDesignError(
+                f"{source}: material.{key} {'is missing' if bilinear else 'goes with law: '}"
+                f"{'' if bilinear else 'bilinear'}; allowed: plateau_strain and E_plateau with law"
+                " bilinear only", parameter=f"material.{key}", value=material.get(key),
+                allowed="law: bilinear")
+    law_of = Material(
+        str(law),
+        _number(material, "plateau_strain", "material.", source, low=0.0, high=1.0,
+                open_low=True, open_high=True) if bilinear else math.inf,
+        _number(material, "E_plateau", "material.", source, low=0.0, high=modulus,
+                open_low=True) if bilinear else math.nan,
+        _number(material, "recoverable_strain", "material.", source, low=0.0, high=1.0,
+                open_low=True, default=math.inf) if "recoverable_strain" in material
+        else math.inf)
     tendons = _tendons(_required(top, "tendons", "", source), source, r_outer)
     return BodySpec(R_outer=r_outer, r_inner=r_inner, E=modulus, tendons=tendons,
-                    segments=tuple(segments), source=source)
+                    segments=tuple(segments), source=source, material=law_of)
 
 
 def _tendons(items: Any, source: str, r_outer: float) -> tuple[Tendon, ...]:
@@ -520,6 +545,16 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         at = f", offset: {number(offset)}" if offset != 0.0 else ""
         return f"{{width: {number(width)}, band: {number(band)}{at}, profile: {profile.name}}}"
 
+    def material() -> str:
+        law = design.material
+        keys = [f"E: {number(design.E)}"]
+        if not law.is_linear:
+            keys += ["law: bilinear", f"plateau_strain: {number(law.plateau_strain)}",
+                     f"E_plateau: {number(law.E_plateau)}"]
+        if math.isfinite(law.recoverable_strain):
+            keys.append(f"recoverable_strain: {number(law.recoverable_strain)}")
+        return ", ".join(keys)
+
     def tendon(one: Tendon) -> str:
         keys = [f"offset: {number(one.offset)}"]
         if one.routing or not design.tendons:
@@ -535,7 +570,7 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
         return "  - {" + ", ".join([*keys, f"name: {one.name}"] if design.tendons else keys) + "}"
 
     lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
-             f"material: {{E: {number(design.E)}}}", "tendons:",
+             f"material: {{{material()}}}", "tendons:",
              *(tendon(one) for one in design.tendon_list()), "segments:"]
     if design.w_base > 0.0:
         lines.append(f"  - tube: {number(design.w_base)}")

@@ -29,6 +29,7 @@ from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.material import Material
 from tdcm_ros.model.profiles import (
     GIVEN_SECTION_PROFILES,
     PRISMATIC_PROFILES,
@@ -92,6 +93,8 @@ class Design:
     tendons: tuple[Tendon, ...] = ()
     """Several tendons, or one off the paper's (:mod:`tdcm_ros.model.tendons`); empty: the
     paper's one tendon at ``R_c`` on +x. With a list, ``R_c`` is the first one's ``|offset|``."""
+    material: Material = field(default_factory=Material)
+    """The material law (:mod:`tdcm_ros.model.material`; default linear, modulus ``E``)."""
 
     def __post_init__(self) -> None:
         check_fields(self, {k: v for k, v in FIELD_SPECS.items() if k not in _LISTABLE},
@@ -101,6 +104,15 @@ class Design:
         object.__setattr__(self, "profile", _profiles(self.profile, self.N))
         self._take_prismatic_extents()
         self._check_cross_fields()
+        if not isinstance(self.material, Material):
+            raise out_of_range("material", self.material, "a Material", error=InvalidDesignError)
+        self.material.check(self.E)
+        if not self.material.is_linear and any(
+                isinstance(p, GIVEN_SECTION_PROFILES) for p in self.notch_profiles()):
+            raise InvalidDesignError(
+                "material.law = 'bilinear' takes band and cut notches (the law is integrated over "
+                "their annulus sections); allowed: law linear with polygon, section or mesh "
+                "notches", parameter="material.law", value=self.material.law, allowed="linear")
         if self.tendons != ():
             object.__setattr__(self, "tendons", check_tendons(
                 self.tendons, self.R_outer, self.segment_ends()))
@@ -301,9 +313,13 @@ class Design:
 
     def to_dict(self) -> dict[str, Any]:
         """All fields in SI units (a per-notch field as a list), plus the derived length ``L``;
-        the profile by name."""
+        the profile by name; ``tendons`` and ``material`` where they are not the paper's (a
+        material's keys that are not finite left out: JSON has no inf or nan)."""
         data = {k: list(v) if isinstance(v, tuple) else v for k, v in asdict(self).items()
-                if k != "profile" and (k != "tendons" or v)}
+                if k not in ("profile", "material") and (k != "tendons" or v)}
+        if not self.material.is_trivial:
+            data["material"] = {k: v for k, v in asdict(self.material).items()
+                                if not isinstance(v, float) or math.isfinite(v)}
         profile = self.profile
         data["profile"] = [p.name for p in profile] if isinstance(profile, tuple) else profile.name
         data["L"] = self.length

@@ -58,6 +58,7 @@ class SolveResult:
     contact_scale: Array | None = field(default=None, repr=False)
     tendon_tension: Array | None = field(default=None, repr=False)
     tendon_tensions_n: tuple[float, ...] = ()
+    material_scale: Array | None = field(default=None, repr=False)
 
     @property
     def tensions_n(self) -> tuple[float, ...]:
@@ -76,10 +77,14 @@ class SolveResult:
     @property
     def bend_moments(self) -> Array:
         """Per-cell end moments (N m) that set the curvature: ``cell_moments``, scaled in
-        closed notches when notch contact is on."""
-        if self.contact_scale is None:
-            return self.cell_moments
-        return self.cell_moments * self.contact_scale[:, None]
+        closed notches when notch contact is on, and at each cell end by a nonlinear
+        material's curvature ratio (``material_scale``, (cells, 2))."""
+        moments = self.cell_moments
+        if self.contact_scale is not None:
+            moments = moments * self.contact_scale[:, None]
+        if self.material_scale is not None:
+            moments = moments * self.material_scale
+        return moments
 
     @property
     def closed_notches(self) -> tuple[int, ...]:

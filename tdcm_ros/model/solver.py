@@ -37,6 +37,7 @@ from tdcm_ros.model.kernel import CONVERGED, DIVERGING, NON_FINITE, SLOWED
 from tdcm_ros.model.kinematics import PlanarShape, integrate
 from tdcm_ros.model.limits import check_tension, check_tensions, notch_gaps
 from tdcm_ros.model.loading import InvalidLoadingError, LoadedModel, Loading
+from tdcm_ros.model.material_model import MaterialLaw
 from tdcm_ros.model.moment_model import (
     DIVERGENCE_GROWTH,
     ClosedForm,
@@ -187,9 +188,11 @@ def _problem(design: Design, settings: SolverSettings, tension: float,
     """The (cached) grid of ``design`` under ``settings`` and its moment model under
     ``loading`` at ``tension`` (N), or its tendons' at ``tensions`` (N, largest ``tension``)."""
     grid = build_grid(design, settings)
-    if tensions is None:
-        return _Problem(grid, settings, _model(grid, settings, tension, loading))
-    return _Problem(grid, settings, _tendon_model(grid, settings, tension, tensions, loading))
+    model: MomentModel = _model(grid, settings, tension, loading) if tensions is None else \
+        _tendon_model(grid, settings, tension, tensions, loading)
+    if not design.material.is_trivial:
+        model = MaterialLaw(model, design.material)
+    return _Problem(grid, settings, model)
 
 
 def _tendon_model(grid: Grid, settings: SolverSettings, level: float, tensions: Array,
@@ -441,7 +444,13 @@ def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, str
     positions = np.zeros((grid.s_nodes.size, 3))
     positions[:, 0] = shape.p.imag
     positions[:, 2] = shape.p.real
-    tensions = tuple(model.tensions(tension).tolist()) if isinstance(model, TendonSet) else ()
+    tendons = model.inner if isinstance(model, MaterialLaw) else model
+    tensions = tuple(tendons.tensions(tension).tolist()) if isinstance(tendons, TendonSet) else ()
+    material = None
+    if isinstance(model, MaterialLaw):
+        bent = model.inner.bend_moments(run.x)
+        material = model.factors(bent).reshape(2, -1).T
     return SolveResult(grid.design, settings, tension, grid.s_nodes, positions, shape.theta,
                        run.x.reshape(2, -1).T, len(history), history, run.converged, strategy,
-                       elapsed, grid, loading, contact_scale, tendon_tension, tensions)
+                       elapsed, grid, loading, contact_scale, tendon_tension, tensions,
+                       material)

@@ -1,0 +1,183 @@
+"""The moment model of a material law (:mod:`tdcm_ros.model.material`).
+
+:class:`MaterialLaw` wraps a moment model: the moments that bend the body are the model's
+scaled, at each cell end, by the ratio of the law's curvature to the linear one (1 where the
+plateau is not reached, so such a solution is the linear model's, bit for bit): the curvature
+is exact at every cell end and linear in the moment between them, like the linear model's.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.kinematics import PlanarShape
+from tdcm_ros.model.material import Material, StrainLimitError
+from tdcm_ros.model.moment_model import MomentModel, PlainRun, Plan
+from tdcm_ros.model.settings import SolverSettings
+
+Array = NDArray[np.float64]
+
+#: Gauss-Legendre points per piece of a section's width integral.
+WIDTH_POINTS = 48
+#: Bisection steps for a curvature (the bracket is at most E / E_p wide: far below 1 ulp).
+BISECTIONS = 80
+
+
+@dataclass(frozen=True, eq=False)
+class _Ends:
+    """Every cell end's section (SI units, (2n,): starts then ends): the material's extent
+    ``lo``..``hi`` in x, the centroid ``x_bar``, the linear ``E I`` and the tube radii."""
+
+    lo: Array
+    hi: Array
+    x_bar: Array
+    stiffness: Array
+    r_outer: float
+    r_inner: float
+
+    @classmethod
+    def of(cls, grid: Grid) -> _Ends:
+        design, members = grid.design, grid.members
+        u = np.concatenate([grid.u_a, grid.u_b])
+        notch = np.concatenate([grid.is_notch, grid.is_notch])
+        shape = np.concatenate([grid.shape, grid.shape])
+        half = np.full(u.size, design.R_outer)
+        offset = np.zeros(u.size)
+        if np.any(notch):
+            half[notch] = members.h1(shape[notch], u[notch])
+            offset[notch] = members.shape_w_o[shape[notch]]
+        lo = np.maximum(offset - half, -design.R_outer)
+        hi = np.minimum(offset + half, design.R_outer)
+        compliance = np.concatenate([grid.c_start, grid.c_end])
+        return cls(lo=lo, hi=hi, x_bar=np.concatenate([grid.xbar_start, grid.xbar_end]),
+                   stiffness=1.0 / compliance, r_outer=design.R_outer, r_inner=design.r_inner)
+
+    def width(self, x: Array) -> Array:
+        """The section's width (m) at abscissa ``x`` (m): the annulus's chord, both sides."""
+        outer = np.sqrt(np.maximum(self.r_outer**2 - x * x, 0.0))
+        inner = np.sqrt(np.maximum(self.r_inner**2 - x * x, 0.0))
+        return 2.0 * (outer - inner)
+
+    def excess(self, rows: NDArray[np.int64], d: Array) -> Array:
+        """``J(d)`` (m^4) of the ends ``rows`` at plateau distances ``d`` (m): Gauss-Legendre
+        on each side beyond ``d``, split where the width has its kinks (``x = +-r_inner``)."""
+        nodes, weights = np.polynomial.legendre.leggauss(WIDTH_POINTS)
+        nodes, weights = 0.5 * (nodes + 1.0), 0.5 * weights
+        x_bar = self.x_bar[rows]
+        total = np.zeros(rows.size)
+        sides = ((x_bar + d, self.hi[rows]), (self.lo[rows], x_bar - d))
+        kinks = [k for k in (-self.r_inner, self.r_inner) if self.r_inner > 0.0]
+        for low, high in sides:
+            cuts = [low, *(np.clip(k, low, np.maximum(low, high)) for k in kinks),
+                    np.maximum(low, high)]
+            for a, b in itertools.pairwise(cuts):
+                span = b - a
+                x = a[:, None] + span[:, None] * nodes[None, :]
+                y = np.abs(x - x_bar[:, None])
+                total += span * (((y - d[:, None]) * y * self.width(x)) @ weights)
+        return total
+
+
+class MaterialLaw:
+    """A moment model (``inner``) whose bending moments follow ``material`` (module
+    docstring); everything else is the inner model's."""
+
+    def __init__(self, inner: MomentModel, material: Material) -> None:
+        self.inner = inner
+        self.grid = inner.grid
+        self.material = material
+        self.modulus = self.grid.design.E
+        self.ends = _Ends.of(self.grid) if not material.is_linear else None
+
+    def factors(self, y: Array) -> Array:
+        """Per cell end (2n,): the law's curvature over the linear one at the bending moments
+        ``y`` (N m); 1 where the plateau is not reached (and for the linear law)."""
+        out = np.ones_like(y)
+        ends, material = self.ends, self.material
+        if ends is None:
+            return out
+        linear = y / ends.stiffness
+        reach = np.maximum(ends.hi - ends.x_bar, ends.x_bar - ends.lo)
+        rows = np.flatnonzero(np.abs(linear) * reach > material.plateau_strain)
+        if rows.size == 0:
+            return out
+        target = np.abs(y[rows])
+        low = np.abs(linear[rows])
+        high = low * (self.modulus / material.E_plateau)
+        softening = self.modulus - material.E_plateau
+        for _ in range(BISECTIONS):
+            middle = 0.5 * (low + high)
+            moment = middle * (ends.stiffness[rows] - softening
+                               * ends.excess(rows, material.plateau_strain / middle))
+            above = moment > target
+            high = np.where(above, middle, high)
+            low = np.where(above, low, middle)
+        out[rows] = 0.5 * (low + high) / np.abs(linear[rows])
+        return out
+
+    def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
+        return self.inner.moments(shape, x, level, factor)
+
+    def bend_moments(self, x: Array) -> Array:
+        y = self.inner.bend_moments(x)
+        return y if self.ends is None else y * self.factors(y)
+
+    def chord_tension(self, level: float) -> float | Array:
+        return self.inner.chord_tension(level)
+
+    def axis_tension(self, level: float) -> float | Array:
+        return self.inner.axis_tension(level)
+
+    def start(self, level: float) -> Array:
+        return self.inner.start(level)
+
+    def check_before(self, tension: float) -> None:
+        self.inner.check_before(tension)
+
+    def check_after(self, x: Array, shape: PlanarShape, tension: float,
+                    min_gap: float | None = None) -> None:
+        self.inner.check_after(x, shape, tension, min_gap)
+        limit = self.material.recoverable_strain
+        if not math.isfinite(limit):
+            return
+        grid = self.grid
+        n = grid.n_cells
+        y = self.bend_moments(x)
+        strain = np.abs(y[:n, None] * grid.strain0 + y[n:, None] * grid.strain1)
+        peak = np.max(strain, axis=1)
+        cells = np.flatnonzero(grid.is_notch)
+        if cells.size == 0:
+            return
+        worst = cells[int(np.argmax(peak[cells]))]
+        if peak[worst] > limit:
+            notch = int(grid.notch_index[worst]) + 1
+            raise StrainLimitError(
+                f"notch {notch} strains {peak[worst] * 100:.3g} % at tension {tension:g} N, past "
+                f"the material's recoverable strain {limit * 100:.3g} %",
+                notch=notch, strain=float(peak[worst]))
+
+    def plans(self, settings: SolverSettings) -> Sequence[Plan]:
+        return self.inner.plans(settings)
+
+    def warm_scale(self, previous: float, tension: float) -> float | None:
+        return self.inner.warm_scale(previous, tension)
+
+    def extras(self, x: Array, shape: PlanarShape, tension: float
+               ) -> tuple[Array | None, Array | None]:
+        return self.inner.extras(x, shape, tension)
+
+    def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
+              slow: float) -> PlainRun | None:
+        """The inner model's compiled iteration where its iterate stays below the plateau
+        (the linear model's result, bit for bit); else None (the solver iterates in NumPy)."""
+        run = self.inner.plain(x, level, budget, tol, relaxation, slow)
+        if run is None or self.ends is None:
+            return run
+        return run if np.all(self.factors(self.inner.bend_moments(run.x)) == 1.0) else None
