@@ -163,3 +163,28 @@ def test_a_stroke_input_finds_its_tension_or_raises_a_typed_error(design, stroke
     assert 0.0 <= found.tension_n <= 50.0
     again = solve(body, found.tension_n)
     assert again.actuator_strokes_m[0] == pytest.approx(stroke, abs=1e-9)
+
+
+@settings(max_examples=25, suppress_health_check=[HealthCheck.too_slow], deadline=None)
+@given(design=hard_designs(), tension=st.floats(0.0, 5e3), onset=st.floats(1e-3, 0.05),
+       ratio=st.floats(0.01, 1.0), routing=st.sampled_from(["paper", "free"]))
+def test_a_superelastic_plateau_converges_or_raises_a_typed_limit(design, tension, onset,
+                                                                   ratio, routing):
+    """The plateau softens the notches up to 100x: still a finite converged shape, bent at
+    least as far as the linear law's, or a typed limit."""
+    import dataclasses
+
+    from tdcm_ros.model.material import Material
+
+    law = dataclasses.replace(design, material=Material("bilinear", onset, ratio * design.E))
+    config = SolverSettings(routing=routing)
+    try:
+        result = solve(law, tension, settings=config)
+    except LIMITS as error:
+        event(type(error).__name__)
+        assert str(error)
+        return
+    event("converged")
+    assert result.converged and result.residual_history[-1] <= config.tol
+    assert np.all(np.isfinite(result.positions)) and np.all(np.isfinite(result.theta))
+    assert np.all(result.material_scale >= 1.0)
