@@ -38,7 +38,9 @@ def register(subparsers: Any) -> None:
                "  tdcm inverse --tip-angle 0.3\n"
                "  tdcm inverse --design fig2-wn-1.9 --tip-deflection 0.005 --json\n"
                "  tdcm inverse --tip-point=0.006,0.0525 --set E=1.2e9 --tension-max 22\n"
-               "  tdcm inverse --tendon-stroke 0.0005")
+               "  tdcm inverse --tendon-stroke 0.0005\n"
+               "  tdcm inverse --design config/bodies/antagonistic_pair.yaml --tip-angle 0.2 "
+               "--tendon flexor --tensions 0,5")
     target = parser.add_mutually_exclusive_group(required=True)
     add_tip_targets(target)
     target.add_argument("--tip-point", metavar="X,Z", help="tip point in tdcm_base (m); write a negative X as "
@@ -53,6 +55,11 @@ def register(subparsers: Any) -> None:
                         help=f"largest tension the device can hold (N, default {DEVICE_MAX_N:g}: "
                              "the tension device's largest setpoint; give your driver's "
                              "tension_max): a target that needs more is said to be out of reach")
+    parser.add_argument("--tendon", metavar="NAME", help="the tendon whose tension is sought, by "
+                        "its name in the body file (a body with several tendons)")
+    parser.add_argument("--tensions", metavar="N,N,...", help="the other tendons' tensions held "
+                        "constant (N, one per tendon in the body file's order, the sought one's "
+                        "entry unused; default 0)")
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.set_defaults(handler=run)
@@ -84,8 +91,11 @@ def run(args: argparse.Namespace) -> int:
     reach, physics)."""
     try:
         name, design, settings = design_and_settings(args)
+        held = None if args.tensions is None else [
+            target_number("--tensions", part, "N, one per tendon") for part in
+            args.tensions.split(",")]
         found = solve_inverse(
-            design, **_target(args), settings=settings,
+            design, **_target(args), settings=settings, tendon=args.tendon, tensions=held,
             tension_min=target_number("--tension-min", args.tension_min, "[0, tension-max) N"),
             tension_max=target_number("--tension-max", args.tension_max, "(tension-min, inf) N"))
         device_max = target_number("--device-max", args.device_max, "> 0 N")
@@ -117,7 +127,7 @@ def _print(name: str, found: InverseResult) -> None:
           f"tension {found.tension_n:.9g} N")
     print(f"achieved tip (x, z) = ({x:.9f}, {z:.9f}) m, angle {result.tip_angle_rad:.9f} rad, "
           f"deflection {result.tip_deflection_m:.9f} m, tendon stroke "
-          f"{result.tendon_strokes_m[0]:.9f} m; residual {found.residual:.3g} {unit}")
+          f"{result.tendon_strokes_m[found.tendon]:.9f} m; residual {found.residual:.3g} {unit}")
     dx, dz = sens.tip_point_m_per_n
     print(f"d(tip)/dT: (x, z) ({dx:.6g}, {dz:.6g}) m/N, angle {sens.tip_angle_rad_per_n:.6g} "
           f"rad/N ({sens.method} difference, step {sens.step_n:g} N); "

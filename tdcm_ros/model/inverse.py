@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -47,10 +47,11 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import InputError
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import ModelError, ModelLimitError
+from tdcm_ros.model.limits import check_tensions
 from tdcm_ros.model.result import ConvergenceError, SolveResult
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
-from tdcm_ros.model.tendons import require_paper_tendon
+from tdcm_ros.model.tendons import is_paper_like
 
 Array = NDArray[np.float64]
 
@@ -121,7 +122,8 @@ class Sensitivity:
 class InverseResult:
     """The tension for a target and what it achieves.
 
-    ``tension_n`` (N) is the answer; ``result`` its forward solve (so ``result.tip_position``
+    ``tension_n`` (N) is the answer (the sought ``tendon``'s, an index); ``result`` its forward
+    solve (so ``result.tip_position``
     is the achieved tip); ``residual`` the distance from the achieved tip to the target (m for a
     deflection or point, rad for an angle); ``forward_solves`` how many solves the call made,
     the sensitivity's included.
@@ -135,6 +137,7 @@ class InverseResult:
     sensitivity: Sensitivity
     forward_solves: int
     tension_bounds: tuple[float, float]
+    tendon: int = 0
 
     @property
     def tip_point_m(self) -> tuple[float, float]:
@@ -151,8 +154,10 @@ class InverseResult:
             "tip_point_m": list(self.tip_point_m),
             "tip_angle_rad": self.result.tip_angle_rad,
             "tip_deflection_m": self.result.tip_deflection_m,
-            "tendon_stroke_m": float(self.result.tendon_strokes_m[0]),
-            "actuator_stroke_m": float(self.result.actuator_strokes_m[0]),
+            "tendon": self.result.tendons.names[self.tendon],
+            "tensions_n": list(self.result.tensions_n),
+            "tendon_stroke_m": float(self.result.tendon_strokes_m[self.tendon]),
+            "actuator_stroke_m": float(self.result.actuator_strokes_m[self.tendon]),
             "residual": self.residual,
             "residual_unit": "rad" if self.target_kind == "tip_angle" else "m",
             "sensitivity": self.sensitivity.to_dict(),
@@ -167,23 +172,32 @@ def _point(result: SolveResult) -> tuple[float, float]:
 
 
 class _Forward:
-    """Forward solves of one design, each warm-started from the nearest earlier one; counted."""
+    """Forward solves of one design at the sought tendon's tension (the others at ``held``,
+    N, one per listed tendon; None: the paper's one tendon), each warm-started from the
+    nearest earlier one; counted."""
 
     def __init__(self, design: Design, settings: SolverSettings,
-                 warm_start: SolveResult | None) -> None:
+                 warm_start: SolveResult | None, sought: int = 0,
+                 held: tuple[float, ...] | None = None) -> None:
         self.design = design
         self.settings = settings
         self.solved: dict[float, SolveResult] = {}
         self.warm = warm_start
+        self.sought = sought
+        self.held = held
         self.count = 0
 
     def __call__(self, tension: float) -> SolveResult:
         if tension in self.solved:
             return self.solved[tension]
-        warm = min(self.solved.values(), key=lambda r: abs(r.tension_n - tension),
-                   default=self.warm)
+        nearest = min(self.solved, key=lambda t: abs(t - tension), default=None)
+        warm = self.warm if nearest is None else self.solved[nearest]
         self.count += 1
-        result = solve(self.design, tension, settings=self.settings, warm_start=warm)
+        given: float | list[float] = tension
+        if self.held is not None:
+            given = list(self.held)
+            given[self.sought] = tension
+        result = solve(self.design, given, settings=self.settings, warm_start=warm)
         self.solved[tension] = result
         return result
 
@@ -195,43 +209,85 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
                   tension_min: float = 0.0, tension_max: float = DEFAULT_TENSION_MAX_N,
                   settings: SolverSettings = DEFAULT_SETTINGS,
                   warm_start: SolveResult | None = None,
-                  tol: float = DEFAULT_TOL) -> InverseResult:
+                  tol: float = DEFAULT_TOL, tendon: int | str | None = None,
+                  tensions: Sequence[float] | None = None) -> InverseResult:
     """The tension (N) in ``[tension_min, tension_max]`` that puts the tip of ``design`` at
     exactly one target: ``tip_deflection`` (m), ``tip_angle`` (rad), ``tip_point`` ``(x, z)``
     (m, least squares) or ``tendon_stroke`` (m, the tendon's actuator travel: the path's
     stroke, its slack and stretch). ``tol`` is the tolerance on the target (m, or rad for an
     angle);
     ``warm_start`` seeds the first forward solve (a result of the same design and settings).
+    A design with several tendons (``Design.tendons``) names the ``tendon`` whose tension is
+    sought (its name or index; its stroke is the stroke target's), the others held at
+    ``tensions`` (N, one per tendon, the sought one's entry unused; default 0: a preload held
+    constant).
 
     Raises :class:`InvalidTargetError` for a bad target, bounds or ``tol``;
     :class:`UnreachableTargetError` (naming the reachable range) when the target is out of
     reach; a forward solve's own errors pass through.
     """
-    require_paper_tendon(design.tendons, "the inverse solver")
+    sought, held = _sought_tendon(design, tendon, tensions)
     kind, target = _check_target(tip_deflection, tip_angle, tip_point, tendon_stroke)
     lower, upper = _check_bounds(tension_min, tension_max)
     tolerance = _real(tol)
     if tolerance is None or not math.isfinite(tolerance) or tolerance <= 0.0:
         raise InvalidTargetError(f"tol = {tol!r} is out of range; allowed: (0, inf) m or rad",
                                  parameter="tol", value=tol, allowed="(0, inf)")
-    forward = _Forward(design, settings, warm_start)
+    forward = _Forward(design, settings, warm_start, sought, held)
     top, limit = _reachable_top(forward, lower, upper)
     if kind == "tip_point":
         tension, residual = _point_tension(forward, target, lower, top, limit, tolerance)
     else:
-        measure = _MEASURES[kind]
+        measure = _measure(kind, sought)
         tension = _scalar_tension(forward, measure, kind, target, lower, top, limit, tolerance)
         residual = abs(measure(forward(tension)) - target)
     sensitivity = _sensitivity(forward, tension, lower, top)
     return InverseResult(kind, target, tension, forward(tension), residual, sensitivity,
-                         forward.count, (lower, upper))
+                         forward.count, (lower, upper), sought)
+
+
+def _measure(kind: str, sought: int) -> Callable[[SolveResult], float]:
+    """The scalar a target of ``kind`` is compared with (the stroke: the sought tendon's
+    actuator travel, m)."""
+    if kind == "tendon_stroke":
+        return lambda r: float(r.actuator_strokes_m[sought])
+    return _MEASURES[kind]
 
 
 _MEASURES: dict[str, Callable[[SolveResult], float]] = {
     "tip_deflection": lambda r: r.tip_deflection_m,
     "tip_angle": lambda r: r.tip_angle_rad,
-    "tendon_stroke": lambda r: float(r.actuator_strokes_m[0]),
 }
+
+
+def _sought_tendon(design: Design, tendon: int | str | None,
+                   tensions: Sequence[float] | None) -> tuple[int, tuple[float, ...] | None]:
+    """The sought tendon's index and the held tensions (N; None for the paper's one tendon),
+    checked: :class:`InvalidTargetError` naming ``tendon`` or ``tensions``."""
+    names = [t.name for t in design.tendon_list()]
+    if tendon is None:
+        if len(names) > 1:
+            raise InvalidTargetError(
+                f"tendon is missing: this design has {len(names)} tendons; allowed: one of "
+                f"{', '.join(names)} (or its index)", parameter="tendon", value=None,
+                allowed=" | ".join(names))
+        sought = 0
+    elif isinstance(tendon, str) and tendon in names:
+        sought = names.index(tendon)
+    elif isinstance(tendon, int) and not isinstance(tendon, bool) and 0 <= tendon < len(names):
+        sought = tendon
+    else:
+        raise InvalidTargetError(f"tendon = {tendon!r} is not one of this design's tendons; "
+                                 f"allowed: {', '.join(names)} or 0..{len(names) - 1}",
+                                 parameter="tendon", value=tendon, allowed=" | ".join(names))
+    if is_paper_like(design.tendons):
+        if tensions is not None:
+            raise InvalidTargetError("tensions go with a design of several tendons; allowed: "
+                                     "none", parameter="tensions", value=list(tensions),
+                                     allowed="none")
+        return sought, None
+    held = check_tensions([0.0] * len(names) if tensions is None else tensions, len(names))
+    return sought, held
 _UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m", "tendon_stroke": "m"}
 
 
@@ -494,12 +550,13 @@ def _sensitivity(forward: _Forward, tension: float, lower: float, top: float) ->
     step = SENSITIVITY_STEP * (top - lower)
     below, above = tension - step, tension + step
     if below >= 0.0 and above <= top:
-        method, low, high = "central", forward(below), forward(above)
+        method, (t_low, t_high) = "central", (below, above)
     elif above <= top:
-        method, low, high = "forward", forward(tension), forward(above)
+        method, (t_low, t_high) = "forward", (tension, above)
     else:
-        method, low, high = "backward", forward(below), forward(tension)
-    span = high.tension_n - low.tension_n
+        method, (t_low, t_high) = "backward", (below, tension)
+    low, high = forward(t_low), forward(t_high)
+    span = t_high - t_low  # the sought tendon's tensions (a result's tension_n is the largest)
     d_point = (np.array(_point(high)) - np.array(_point(low))) / span
     return Sensitivity(
         (float(d_point[0]), float(d_point[1])),

@@ -73,6 +73,16 @@ def test_a_body_with_several_tendons_takes_one_tension_each(capsys):
     assert "extensor: 5 N, length" in text
 
 
+def test_tdcm_inverse_seeks_the_named_tendon_with_the_others_held(capsys):
+    status = main(["inverse", "--design", PAIR, "--tip-angle", "0.2", "--tendon", "flexor",
+                   "--tensions", "0,5", "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert status == 0 and data["tendon"] == "flexor" and data["tensions_n"][1] == 5.0
+    assert data["tip_angle_rad"] == pytest.approx(0.2, abs=1e-9)
+    assert main(["inverse", "--design", PAIR, "--tip-angle", "0.2", "--tendon", "biceps"]) == 2
+    assert "tendon = 'biceps' is not one of this design's tendons" in capsys.readouterr().err
+
+
 def test_axial_compression_is_a_switch_that_shortens_the_body(capsys):
     _, rigid, _ = run_json(capsys, "--tension", "20")
     _, soft, _ = run_json(capsys, "--tension", "20", "--axial", "compressible")
@@ -89,7 +99,7 @@ def test_axial_compression_is_a_switch_that_shortens_the_body(capsys):
     (["--design", PAIR, "--tension", "20"], 2, "tension_out_of_range"),
     (["--design", PAIR, "--tension", "20,x"], 2, "tension_out_of_range"),
     (["--design", PAIR, "--tension", "20,-1"], 2, "tension_out_of_range"),
-    (["--design", PAIR, "--stroke", "0.0005"], 2, "invalid_design"),
+    (["--design", PAIR, "--stroke", "0.0005"], 2, "invalid_target"),
     (["--tension", "20,5"], 2, "tension_out_of_range"),
     (["--tension", "-1"], 2, "tension_out_of_range"),
     (["--tension", "nan"], 2, "tension_out_of_range"),

@@ -27,7 +27,7 @@ from tdcm_ros.model import (
 from tdcm_ros.model.batch import solve_batch
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidSettingsError
-from tdcm_ros.model.inverse import solve_inverse
+from tdcm_ros.model.inverse import InvalidTargetError, solve_inverse
 from tdcm_ros.model.loading import InvalidLoadingError, Loading
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.section import notched_moment
@@ -252,7 +252,7 @@ def test_a_design_with_tendons_takes_one_tension_per_tendon(tension: object, par
 def test_what_takes_the_paper_tendon_only_says_so() -> None:
     with pytest.raises(InvalidDesignError, match=r"designs\[0\]\.tendons: the batch solver"):
         solve_batch([PAIR], [1.0])
-    with pytest.raises(InvalidDesignError, match=r"the inverse solver takes the paper's one"):
+    with pytest.raises(InvalidTargetError, match=r"tendon is missing: this design has 2 "):
         solve_inverse(PAIR, tip_deflection=1e-3)
     with pytest.raises(InvalidLoadingError, match="several tendons"):
         solve(PAIR, [1.0, 0.0], loading=Loading(tip_force=(0.1, 0.0)))
@@ -337,3 +337,39 @@ def test_stiffness_and_slack_round_trip_through_a_body_file(tmp_path: Path) -> N
     path.write_text(body_file_text(STRETCHY), encoding="utf-8")
     assert "stiffness: 20000.0" in path.read_text(encoding="utf-8")
     assert read_body_file(path).design() == STRETCHY
+
+
+NAMED = with_tendons(PAPER, Tendon(R_C, name="flexor"), Tendon(-R_C, name="extensor"))
+
+
+def test_the_inverse_seeks_one_tendon_with_the_others_held() -> None:
+    """The flexor against a 5 N preload needs the single tendon's tension plus 5 N (to the
+    pair's 7 nm equivalence); the extensor against a 12 N flexor straightens the body at 12 N
+    exactly; a stroke target is the sought tendon's, round-tripped to 1e-9 m."""
+    single = solve_inverse(PAPER, tip_angle=0.2)
+    flexor = solve_inverse(NAMED, tip_angle=0.2, tendon="flexor", tensions=[0.0, 5.0])
+    assert flexor.tension_n - 5.0 == pytest.approx(single.tension_n, abs=5e-5)
+    assert flexor.result.tensions_n == (flexor.tension_n, 5.0)
+    assert flexor.summary()["tendon"] == "flexor"
+    straight = solve_inverse(NAMED, tip_angle=0.0, tendon=1, tensions=[12.0, 0.0])
+    assert straight.tension_n == pytest.approx(12.0, abs=1e-9)
+    assert straight.sensitivity.tip_angle_rad_per_n == pytest.approx(
+        -single.sensitivity.tip_angle_rad_per_n, rel=1e-3)
+    pulled = solve_inverse(NAMED, tendon_stroke=4e-4, tendon="extensor", tensions=[12.0, 0.0],
+                           tol=1e-11)
+    assert pulled.result.actuator_strokes_m[1] == pytest.approx(4e-4, abs=1e-9)
+    assert pulled.summary()["actuator_stroke_m"] == pytest.approx(4e-4, abs=1e-9)
+
+
+@pytest.mark.parametrize(("design", "keywords", "parameter"), [
+    (NAMED, {"tendon": "biceps"}, "tendon"),
+    (NAMED, {"tendon": 2}, "tendon"),
+    (NAMED, {"tendon": True}, "tendon"),
+    (NAMED, {"tendon": "flexor", "tensions": [1.0]}, "tension"),
+    (PAPER, {"tensions": [1.0]}, "tensions"),
+])
+def test_a_bad_sought_tendon_is_named(design: Design, keywords: dict[str, object],
+                                      parameter: str) -> None:
+    with pytest.raises((InvalidTargetError, TensionRangeError)) as info:
+        solve_inverse(design, tip_angle=0.1, **keywords)  # type: ignore[arg-type]
+    assert info.value.parameter == parameter
