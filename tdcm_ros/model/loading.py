@@ -20,7 +20,8 @@ the moment of the external loads on the body beyond each cut, in frame ``tdcm_ba
   each side uses its own value (profile at the wrap angle before / after the kink).
 - **Tip force and moment** act at the tip midline ``p(L)``.
 - **Body force density** ``f`` (N/m^3, e.g. ``rho g``) acts on the section area ``A(s)``
-  (:func:`tdcm_ros.model.section.notched_area`) at the cells' Gauss points, placed on each
+  (:meth:`tdcm_ros.model.grid.Grid.areas_at`: every section type's own) at the cells' Gauss
+  points, placed on each
   cell's mean-curvature arc (to 4th order in the cell's bend angle). Inside a cell the moment is linear between its end values, as for
   the tendon (the quadratic part of a distributed load is a discretisation error that
   shrinks with the cell length).
@@ -52,7 +53,6 @@ from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_singularity, closure_angles
 from tdcm_ros.model.moment_model import PlainRun, Plan, own_moment
 from tdcm_ros.model.quiet import quiet_fp
-from tdcm_ros.model.section import notched_area, tube_area
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
@@ -192,12 +192,9 @@ class _BodyCells:
 
 @lru_cache(maxsize=64)
 def _body_cells(grid: Grid) -> _BodyCells:
-    d = grid.design
     span = (grid.u_b - grid.u_a)[:, None]
     u_q = grid.u_a[:, None] + span * grid.gauss_u[None, :]
-    h1 = grid.members.h1(grid.shape, u_q)
-    area = np.where(grid.is_notch[:, None], notched_area(h1, d.R_outer, d.r_inner),
-                    tube_area(d.R_outer, d.r_inner))
+    area = grid.areas_at(np.arange(grid.n_cells), u_q)
     weights = grid.w_q * area
     sigma = grid.s_q - grid.s_nodes[:-1, None]
     moments = np.stack([np.sum(weights * sigma**j, axis=1) for j in range(5)])
