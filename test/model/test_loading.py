@@ -539,3 +539,23 @@ def test_singularity_is_checked_on_the_loaded_solution():
     # A tip moment opposing the tendon lowers the notch moments below the singular level.
     relieved = solve(design, 40.0, loading=Loading(tip_moment=-0.6 * design.R_c * 40.0))
     assert relieved.converged
+
+
+def test_the_body_force_weighs_each_section_by_its_own_area() -> None:
+    """A body of polygon (tee) notches: its volume, the sum of the body force's ``A ds``
+    weights, is the tee's polygon area (shoelace, here) times the notches' widths plus the
+    tube's annulus times the tubes' lengths."""
+    from tdcm_ros.model.loading import _body_cells
+    from tdcm_ros.model.profiles import PolygonProfile
+
+    tee = ((-3.5e-3, -1.5e-3), (-2.5e-3, -1.5e-3), (-2.5e-3, -0.3e-3), (0.5e-3, -0.3e-3),
+           (0.5e-3, 0.3e-3), (-2.5e-3, 0.3e-3), (-2.5e-3, 1.5e-3), (-3.5e-3, 1.5e-3))
+    xs, ys = np.array(tee).T
+    shoelace = 0.5 * abs(float(np.dot(xs, np.roll(ys, -1)) - np.dot(ys, np.roll(xs, -1))))
+    design = preset("paper-experiment").with_overrides(profile=PolygonProfile(tee))
+    grid = build_grid(design, SolverSettings())
+    volume = float(np.sum(_body_cells(grid).moments[0]))
+    notches = design.N * design.w_n
+    expected = shoelace * notches + tube_area(design.R_outer, design.r_inner) * (
+        design.length - notches)
+    assert volume == pytest.approx(expected, rel=1e-12)
