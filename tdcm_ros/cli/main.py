@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import signal
 import sys
 from collections.abc import Mapping, Sequence
@@ -46,6 +47,8 @@ COMMANDS: dict[str, str] = {
 
 INTERRUPTED_EXIT = 130
 """Exit status after Ctrl-C (128 + SIGINT, as shells report it)."""
+CLOSED_PIPE_EXIT = 141
+"""Exit status when the reader of stdout closed it (128 + SIGPIPE, as shells report it)."""
 
 EXIT_STATUSES: dict[int, str] = {
     0: "success",
@@ -53,6 +56,7 @@ EXIT_STATUSES: dict[int, str] = {
     InputError.exit_code: "bad input: usage, a parameter, a value or a file",
     PhysicsError.exit_code: "a physical limit of the model, or numerics that did not converge",
     INTERRUPTED_EXIT: "interrupted (Ctrl-C)",
+    CLOSED_PIPE_EXIT: "stdout closed by its reader (a pipe into head, ...)",
 }
 """Exit statuses common to every command (``--help`` epilogs, README)."""
 
@@ -133,6 +137,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return error.exit_code
     except KeyboardInterrupt:
         return INTERRUPTED_EXIT
+    except BrokenPipeError:
+        _discard_stdout()
+        return CLOSED_PIPE_EXIT
+
+
+def _discard_stdout() -> None:
+    """Point the process's stdout at the null device, so that the interpreter's last flush of a
+    pipe its reader closed raises nothing (an in-process stdout without a file is left)."""
+    try:
+        descriptor = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):
+        return
+    null = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(null, descriptor)
+    os.close(null)
 
 
 if __name__ == "__main__":

@@ -102,3 +102,21 @@ def test_evaluate_child_runs_the_plain_kernel_without_numba() -> None:
     assert "scipy" in imported  # the import list was read (evaluation needs scipy)
     assert "numba" not in imported
     assert json.loads(done.stdout)["steps"]
+
+
+def test_a_reader_that_closes_stdout_ends_the_command_quietly_with_141(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """``tdcm solve ... | head -1``: once ``head`` exits, writing raises BrokenPipeError; the
+    command ends with 141 (128 + SIGPIPE) and no traceback."""
+    import io
+
+    from tdcm_ros.cli.main import CLOSED_PIPE_EXIT, EXIT_STATUSES, main
+
+    class ClosedPipe(io.StringIO):
+        def write(self, text: str) -> int:
+            raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(sys, "stdout", ClosedPipe())
+    assert main(["solve", "--tension", "20"]) == CLOSED_PIPE_EXIT == 141
+    assert capsys.readouterr().err == ""
+    assert "stdout closed" in EXIT_STATUSES[141]
