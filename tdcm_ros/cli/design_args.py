@@ -111,6 +111,24 @@ def add_tip_targets(group: argparse._MutuallyExclusiveGroup) -> None:
     group.add_argument("--tip-angle", metavar="RAD", help="tip angle from +z toward +x (rad)")
 
 
+def add_sought_tendon(parser: argparse.ArgumentParser) -> None:
+    """Add ``--tendon NAME`` and ``--tensions N,N,...``: which tendon of a body with several
+    a stroke or tip target seeks, and the others' tensions held (:func:`sought_tendon`)."""
+    parser.add_argument("--tendon", metavar="NAME", help="the tendon whose tension is sought, by "
+                        "its name in the body file (a body with several tendons)")
+    parser.add_argument("--tensions", metavar="N,N,...", help="the other tendons' tensions held "
+                        "constant (N, one per tendon in the body file's order, the sought one's "
+                        "entry unused; default 0)")
+
+
+def sought_tendon(args: argparse.Namespace) -> dict[str, Any]:
+    """The ``tendon`` and ``tensions`` keywords of :func:`~tdcm_ros.model.solve_inverse` that
+    :func:`add_sought_tendon`'s options give."""
+    held = None if args.tensions is None else [
+        target_number("--tensions", part, "N, one per tendon") for part in args.tensions.split(",")]
+    return {"tendon": args.tendon, "tensions": held}
+
+
 def target_number(option: str, text: str, allowed: str) -> float:
     """``text`` of ``option`` (a target or a tension bound) as a float; the model checks its
     range."""

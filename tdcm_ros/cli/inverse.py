@@ -9,8 +9,10 @@ from typing import Any
 
 from tdcm_ros.cli.design_args import (
     add_design_arguments,
+    add_sought_tendon,
     add_tip_targets,
     design_and_settings,
+    sought_tendon,
     target_number,
 )
 from tdcm_ros.device import constants
@@ -55,11 +57,7 @@ def register(subparsers: Any) -> None:
                         help=f"largest tension the device can hold (N, default {DEVICE_MAX_N:g}: "
                              "the tension device's largest setpoint; give your driver's "
                              "tension_max): a target that needs more is said to be out of reach")
-    parser.add_argument("--tendon", metavar="NAME", help="the tendon whose tension is sought, by "
-                        "its name in the body file (a body with several tendons)")
-    parser.add_argument("--tensions", metavar="N,N,...", help="the other tendons' tensions held "
-                        "constant (N, one per tendon in the body file's order, the sought one's "
-                        "entry unused; default 0)")
+    add_sought_tendon(parser)
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.set_defaults(handler=run)
@@ -91,11 +89,8 @@ def run(args: argparse.Namespace) -> int:
     reach, physics)."""
     try:
         name, design, settings = design_and_settings(args)
-        held = None if args.tensions is None else [
-            target_number("--tensions", part, "N, one per tendon") for part in
-            args.tensions.split(",")]
         found = solve_inverse(
-            design, **_target(args), settings=settings, tendon=args.tendon, tensions=held,
+            design, **_target(args), settings=settings, **sought_tendon(args),
             tension_min=target_number("--tension-min", args.tension_min, "[0, tension-max) N"),
             tension_max=target_number("--tension-max", args.tension_max, "(tension-min, inf) N"))
         device_max = target_number("--device-max", args.device_max, "> 0 N")

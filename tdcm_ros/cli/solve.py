@@ -11,10 +11,12 @@ import numpy as np
 
 from tdcm_ros.cli.design_args import (
     add_design_arguments,
+    add_sought_tendon,
     design_and_settings,
+    sought_tendon,
     target_number,
 )
-from tdcm_ros.errors import TdcmError
+from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.model import (
     DEFAULT_TENSION_MAX_N,
     SolveResult,
@@ -36,7 +38,9 @@ def register(subparsers: Any) -> None:
                "  tdcm solve --design fig2-wn-1.9 --tension 20 --json\n"
                "  tdcm solve --tension 12 --set E=1.2e9 --plot shape.png\n"
                "  tdcm solve --design config/bodies/antagonistic_pair.yaml --tension 25,5\n"
-               "  tdcm solve --stroke 0.0005")
+               "  tdcm solve --stroke 0.0005\n"
+               "  tdcm solve --design config/bodies/antagonistic_pair.yaml --stroke 0.0004 "
+               "--tendon extensor --tensions 12,0")
     drive = parser.add_mutually_exclusive_group(required=True)
     drive.add_argument("--tension", type=str, help="tendon tension (N); one per tendon, "
                        "comma-separated, for a body file with several (base to tip order of "
@@ -46,6 +50,7 @@ def register(subparsers: Any) -> None:
                        "included where the body file gives them); the tension is found within "
                        f"[0, {DEFAULT_TENSION_MAX_N:g}] N (tdcm inverse --tendon-stroke sets "
                        "the bounds)")
+    add_sought_tendon(parser)
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.add_argument("--plot", metavar="FILE", help="draw midline and curvature to a .png, "
@@ -76,10 +81,16 @@ def run(args: argparse.Namespace) -> int:
             plot_file("--plot", args.plot)
         with one_shot():  # one solve and its report: the plain-Python kernel, numba not imported
             if args.stroke is None:
+                if args.tendon is not None or args.tensions is not None:
+                    raise InputError("--tendon and --tensions go with --stroke; allowed: "
+                                     "--tension N,N,... gives every tendon's tension",
+                                     parameter="--tendon", value=args.tendon,
+                                     allowed="--stroke")
                 result = solve(design, _tension(args.tension), settings=settings)
             else:
                 stroke = target_number("--stroke", args.stroke, "[0, inf) m")
-                result = solve_inverse(design, tendon_stroke=stroke, settings=settings).result
+                result = solve_inverse(design, tendon_stroke=stroke, settings=settings,
+                                       **sought_tendon(args)).result
             report = json.dumps(result.summary()) if args.json else _notch_line(result)
     except TdcmError as error:
         if args.json:

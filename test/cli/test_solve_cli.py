@@ -83,6 +83,16 @@ def test_tdcm_inverse_seeks_the_named_tendon_with_the_others_held(capsys):
     assert "tendon = 'biceps' is not one of this design's tendons" in capsys.readouterr().err
 
 
+def test_a_stroke_seeks_the_named_tendon_with_the_others_held(capsys):
+    status, data, _ = run_json(capsys, "--design", PAIR, "--stroke", "0.0004", "--tendon",
+                               "extensor", "--tensions", "12,0")
+    assert status == 0 and data["tendon_tensions_n"][0] == 12.0
+    assert data["actuator_strokes_m"][1] == pytest.approx(4e-4, abs=1e-9)
+    assert data["tip_angle_rad"] < 0.0  # the extensor wins
+    code = main(["solve", "--design", PAIR, "--tension", "20,5", "--tendon", "flexor"])
+    assert code == 2 and "--tendon and --tensions go with --stroke" in capsys.readouterr().err
+
+
 def test_axial_compression_is_a_switch_that_shortens_the_body(capsys):
     _, rigid, _ = run_json(capsys, "--tension", "20")
     _, soft, _ = run_json(capsys, "--tension", "20", "--axial", "compressible")
