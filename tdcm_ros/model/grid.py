@@ -421,8 +421,8 @@ class GridParts:
                            routing)
         fc, fq, strain = _prototype_integrals(table.prototypes, quad_order, workers)
         return cls(members=members, table=table, proto_fc=fc, proto_fq=fq,
-                   proto_strain=strain, gauss_u=_gauss(quad_order)[0],
-                   gauss_w=_gauss(quad_order)[1])
+                   proto_strain=strain, gauss_u=gauss_legendre(quad_order)[0],
+                   gauss_w=gauss_legendre(quad_order)[1])
 
     def cells_of(self, rows: IntArray) -> tuple[IntArray, IntArray, NDArray[np.bool_]]:
         """For members ``rows``, padded to the most cells among them (m, W): each slot's cell
@@ -526,7 +526,7 @@ def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
     """:func:`tdcm_ros.model.grid_kernel.cell_integrals` of the cells ``cell`` (its columns)
     of notch shapes ``shape`` (rows of ``members``), followed by a zero row: ``fc``, ``fq``,
     ``strain``; ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
-    gauss_u, gauss_w = _gauss(quad_order)
+    gauss_u, gauss_w = gauss_legendre(quad_order)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
     owner = members.shape_member
     design = np.concatenate([np.stack(
@@ -591,7 +591,7 @@ def _custom_table(members: Members, shape: IntArray, build: Any, cell: Array, de
 
 
 @lru_cache(maxsize=32)
-def _gauss(quad_order: int) -> tuple[Array, Array]:
+def gauss_legendre(quad_order: int) -> tuple[Array, Array]:
     """Gauss-Legendre points and weights of order ``quad_order`` on [0, 1]."""
     gauss_x, gauss_wt = np.polynomial.legendre.leggauss(quad_order)
     return 0.5 * (gauss_x + 1.0), 0.5 * gauss_wt

@@ -86,9 +86,8 @@ def check_tendons_singularity(grid: Grid, layout: TendonLayout, m_a: Array, m_b:
                               ) -> None:
     """:func:`check_singularity` for each tendon of ``layout`` on the cells it follows before
     its anchor, at its own signed offset (a tendon on -x cusps under a moment toward -x)."""
-    follows = layout.follows & layout.active()
     for j in range(layout.count):
-        _check_cusp(grid, np.flatnonzero(follows[j]), float(layout.offsets[j]), m_a, m_b,
+        _check_cusp(grid, layout.follow_cells[j], float(layout.offsets[j]), m_a, m_b,
                     f" ({layout.names[j]})")
 
 

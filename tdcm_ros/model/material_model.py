@@ -12,11 +12,12 @@ import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.grid import Grid, gauss_legendre
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.material import Material, StrainLimitError
 from tdcm_ros.model.moment_model import MomentModel, PlainRun, Plan
@@ -41,6 +42,11 @@ class _Ends:
     stiffness: Array
     r_outer: float
     r_inner: float
+
+    @cached_property
+    def reach(self) -> Array:
+        """Each end's farthest material from its centroid (m)."""
+        return np.maximum(self.hi - self.x_bar, self.x_bar - self.lo)
 
     @classmethod
     def of(cls, grid: Grid) -> _Ends:
@@ -68,8 +74,7 @@ class _Ends:
     def excess(self, rows: NDArray[np.int64], d: Array) -> Array:
         """``J(d)`` (m^4) of the ends ``rows`` at plateau distances ``d`` (m): Gauss-Legendre
         on each side beyond ``d``, split where the width has its kinks (``x = +-r_inner``)."""
-        nodes, weights = np.polynomial.legendre.leggauss(WIDTH_POINTS)
-        nodes, weights = 0.5 * (nodes + 1.0), 0.5 * weights
+        nodes, weights = gauss_legendre(WIDTH_POINTS)
         x_bar = self.x_bar[rows]
         total = np.zeros(rows.size)
         sides = ((x_bar + d, self.hi[rows]), (self.lo[rows], x_bar - d))
@@ -104,8 +109,7 @@ class MaterialLaw:
         if ends is None:
             return out
         linear = y / ends.stiffness
-        reach = np.maximum(ends.hi - ends.x_bar, ends.x_bar - ends.lo)
-        rows = np.flatnonzero(np.abs(linear) * reach > material.plateau_strain)
+        rows = np.flatnonzero(np.abs(linear) * ends.reach > material.plateau_strain)
         if rows.size == 0:
             return out
         target = np.abs(y[rows])

@@ -248,14 +248,15 @@ class SolveResult:
         w_r = found.w_r
         theta_a = self.theta[cells]
         theta = theta_a + m_a * found.a0_s + m_b * found.a1_s
+        pull = self._axis_tensions()[cells] if self.grid.off_axis or self.grid.compressible \
+            else np.zeros(0)
         if self.grid.off_axis:  # the centroid's motion, the axis's stretch
-            pull = self._axis_tensions()[cells]
             phi_r = phi_r - pull[:, None] * found.d_r
             w_r = w_r + m_a[:, None] * found.k0_r + m_b[:, None] * found.k1_r \
                 - pull[:, None] * found.k2_r
             theta = theta - pull * found.d_s
         if self.grid.compressible:  # the body's shortening under the axial load
-            w_r = w_r - self._axis_tensions()[cells][:, None] * found.wa_r
+            w_r = w_r - pull[:, None] * found.wa_r
         along = np.sum(w_r * np.cos(phi_r), axis=1)
         across = np.sum(w_r * np.sin(phi_r), axis=1)
         x = self.positions[cells, 0] + along * np.sin(theta_a) + across * np.cos(theta_a)

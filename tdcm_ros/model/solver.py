@@ -210,7 +210,7 @@ def _tendon_model(grid: Grid, settings: SolverSettings, level: float, tensions: 
             "in the design); allowed: closed", parameter="loads", value=settings.loads,
             allowed="closed")
     fractions = tensions / level if level > 0.0 else np.zeros_like(tensions)
-    return TendonSet(grid, grid.tendons(settings.routing), fractions)
+    return TendonSet(grid, settings.routing, fractions)
 
 
 def _model(grid: Grid, settings: SolverSettings, tension: float,

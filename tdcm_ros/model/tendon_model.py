@@ -16,6 +16,7 @@ tensions as fractions of it, so continuation scales them together.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,7 +27,6 @@ from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import check_closure, check_tendons_singularity
 from tdcm_ros.model.moment_model import PlainRun, Plan, paper_plans
 from tdcm_ros.model.settings import SolverSettings
-from tdcm_ros.model.tendons import TendonLayout
 
 Array = NDArray[np.float64]
 
@@ -35,27 +35,26 @@ class TendonSet:
     """Several tendons' closed-form moments on one grid, at tensions ``fractions`` (J,) times
     the solver's level (N)."""
 
-    def __init__(self, grid: Grid, layout: TendonLayout, fractions: Array) -> None:
+    def __init__(self, grid: Grid, routing: str, fractions: Array) -> None:
         self.grid = grid
-        self.layout = layout
+        self.layout = grid.tendons(routing)
         self.fractions = fractions
-        cells = grid.cells
-        self._scal = []
-        self._ic = []
-        for j in range(layout.count):  # each tendon's offset and cells it follows
-            scal = cells.scal.copy()
-            scal[:, 0] = layout.offsets[j]
-            ic = cells.ic.copy()
-            ic[:, 2] = layout.follows[j]
-            self._scal.append(scal)
-            self._ic.append(ic)
+        self._scal, self._ic = _tendon_cells(grid, routing)
+        self._level: tuple[float, tuple[Array, Array, Array]] | None = None
 
     def tensions(self, level: float) -> Array:
         """Each tendon's base tension (N) at ``level``."""
         return level * self.fractions
 
+    def _cell_tensions(self, level: float) -> tuple[Array, Array, Array]:
+        """:meth:`~tdcm_ros.model.tendons.TendonLayout.cell_tensions` at ``level``, kept for
+        the last level (an iteration asks for it three times)."""
+        if self._level is None or self._level[0] != level:
+            self._level = (level, self.layout.cell_tensions(self.tensions(level)))
+        return self._level[1]
+
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
-        per, _, _ = self.layout.cell_tensions(self.tensions(level))
+        per, _, _ = self._cell_tensions(level)
         n = self.grid.n_cells
         p = np.ascontiguousarray(shape.p).reshape(1, -1)
         tangent = np.ascontiguousarray(shape.tangent).reshape(1, -1)
@@ -73,13 +72,13 @@ class TendonSet:
         return x
 
     def chord_tension(self, level: float) -> Array:
-        return self.layout.cell_tensions(self.tensions(level))[1]
+        return self._cell_tensions(level)[1]
 
     def axis_tension(self, level: float) -> Array:
-        return self.layout.cell_tensions(self.tensions(level))[2]
+        return self._cell_tensions(level)[2]
 
     def start(self, level: float) -> Array:
-        per, _, _ = self.layout.cell_tensions(self.tensions(level))
+        per, _, _ = self._cell_tensions(level)
         moment = self.layout.offsets @ per
         return np.concatenate([moment, moment])
 
@@ -107,3 +106,20 @@ class TendonSet:
     def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
               slow: float) -> PlainRun | None:
         return None
+
+
+@lru_cache(maxsize=64)
+def _tendon_cells(grid: Grid, routing: str) -> tuple[tuple[Array, ...], tuple[NDArray[np.int64], ...]]:
+    """Per tendon of ``grid``'s design under ``routing``: the kernel's ``scal`` with its offset
+    and ``ic`` with the cells it follows (:func:`tdcm_ros.model.kernel.moments_row`), built
+    once per grid (cached: they hold only the grid's numbers)."""
+    layout, cells = grid.tendons(routing), grid.cells
+    scals, ics = [], []
+    for j in range(layout.count):
+        scal = cells.scal.copy()
+        scal[:, 0] = layout.offsets[j]
+        ic = cells.ic.copy()
+        ic[:, 2] = layout.follows[j]
+        scals.append(scal)
+        ics.append(ic)
+    return tuple(scals), tuple(ics)

@@ -326,7 +326,7 @@ class ModelNode(NodeLogic):
             return "non_finite"
         if any(value < 0.0 for value in values):
             return "negative"
-        if any(value > float(self.port.get_parameter("input.tension_max")) for value in values):
+        if max(values) > float(self.port.get_parameter("input.tension_max")):
             return "above_max"
         if stamp_ns is None:
             return ""
