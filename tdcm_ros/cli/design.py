@@ -12,8 +12,10 @@ from typing import Any
 
 from tdcm_ros.cli.design_args import (
     add_design_arguments,
+    add_sought_tendon,
     add_tip_targets,
     design_and_settings,
+    sought_tendon,
     target_number,
 )
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
@@ -54,7 +56,9 @@ def register(subparsers: Any) -> None:
                "  tdcm design --tip-deflection 0.012 --free w_d=0.6e-3:2.2e-3 --free w_t=1e-3:6e-3 "
                "--samples 20000 --json\n"
                "  tdcm design --design fig2-wn-1.9 --tip-angle 0.2 --free w_n=1e-3:2.5e-3 "
-               "--free L=0.04:0.06 --out design_out")
+               "--free L=0.04:0.06 --out design_out\n"
+               "  tdcm design --design config/bodies/antagonistic_pair.yaml --tendon flexor "
+               "--tensions 0,5 --tip-angle 0.2 --free w_n=1e-3:3e-3 --samples 64")
     add_tip_targets(parser.add_mutually_exclusive_group(required=True))
     parser.add_argument("--free", action="append", default=[], metavar="NAME=MIN:MAX",
                         help=f"a field to vary over [MIN, MAX] (SI units; N integers): "
@@ -75,6 +79,7 @@ def register(subparsers: Any) -> None:
                         help=f"tolerance on the target, m or rad (default {DEFAULT_TOL:g})")
     parser.add_argument("--top", default=str(DEFAULT_TOP), metavar="K",
                         help=f"Pareto rows in the table (default {DEFAULT_TOP}; all in JSON)")
+    add_sought_tendon(parser)
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.add_argument("--out", metavar="DIR",
@@ -118,10 +123,11 @@ def run(args: argparse.Namespace) -> int:
     name = ""
     try:
         name, design, settings = design_and_settings(args)
-        target = ({"tip_deflection": target_number("--tip-deflection", args.tip_deflection,
-                                                   "(0, inf) m")}
-                  if args.tip_deflection is not None else
-                  {"tip_angle": target_number("--tip-angle", args.tip_angle, "(0, inf) rad")})
+        target: dict[str, Any] = (
+            {"tip_deflection": target_number("--tip-deflection", args.tip_deflection,
+                                             "(0, inf) m")}
+            if args.tip_deflection is not None else
+            {"tip_angle": target_number("--tip-angle", args.tip_angle, "(0, inf) rad")})
         top = _number("--top", args.top, int)
         if top < 0:
             raise InputError(f"--top = {top} is out of range; allowed: an integer >= 0",
@@ -133,7 +139,8 @@ def run(args: argparse.Namespace) -> int:
                 allowable_strain=_number("--allowable-strain", args.allowable_strain),
                 samples=_number("--samples", args.samples, int), sampling=args.sampling,
                 seed=_number("--seed", args.seed, int),
-                ladder=_number("--ladder", args.ladder, int), tol=_number("--tol", args.tol))
+                ladder=_number("--ladder", args.ladder, int), tol=_number("--tol", args.tol),
+                **sought_tendon(args))
     except TdcmError as error:
         if args.json:
             print(json.dumps({"error": {"kind": error.kind, "message": str(error)}}))

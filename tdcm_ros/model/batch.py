@@ -12,6 +12,11 @@ continuation (it slowed down, diverged or ran out of budget), and every member u
 iterating, the formula of :mod:`tdcm_ros.model.limits`) and notch closure (on the solution,
 the kernel's notch gaps) are checked per member.
 
+A design the kernel does not take (tendons other than the paper's one, a material law other
+than the linear one, or ``axial="compressible"`` settings) has every member solved by ``solve``
+(``fallback`` set): the batch takes any design ``solve`` takes. Designs with ``k`` tendons take a
+tension per tendon on a last axis of length ``k`` (every design of a batch lists as many).
+
 Nothing is raised for a member: each gets a status (``STATUSES``) and a message. Numbers are
 returned only for ``ok`` members; the others hold NaN.
 
@@ -54,13 +59,14 @@ from tdcm_ros.model.limits import check_closure, check_tendon_singularity, check
 from tdcm_ros.model.moment_model import DIVERGENCE_GROWTH
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, SLOW_CONTRACTION, solve
-from tdcm_ros.model.tendons import require_paper_tendon
+from tdcm_ros.model.tendons import is_paper_like
 
 Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 STATUSES = ("ok", "singularity", "closure", "non_convergence", "invalid")
-"""Member statuses; ``kink_angle`` can also appear, under ``loads="literal"`` only."""
+"""Member statuses; ``kink_angle`` can also appear, under ``loads="literal"`` only, and
+``strain_limit`` for a material's recoverable strain."""
 
 _STATUS_OF_KIND = {"tendon_singularity": "singularity", "notch_closure": "closure",
                    "non_convergence": "non_convergence", "invalid_design": "invalid",
@@ -73,7 +79,8 @@ MAX_WORKERS = 64
 
 @dataclass(frozen=True, eq=False)
 class BatchResult:
-    """Per-member outcome of :func:`solve_batch`; arrays have the shape of ``tensions``.
+    """Per-member outcome of :func:`solve_batch`; arrays have the members' shape: that of
+    ``tensions``, less its last (tendon) axis where the designs list several tendons.
 
     ``tip_position`` (..., 3) m in frame ``tdcm_base``; ``tip_angle_rad`` (rad about +y);
     ``tip_deflection_m`` (distance of the tip from +z, m); ``max_bending_strain`` (largest
@@ -178,10 +185,13 @@ class _Stack:
 
 def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
                 settings: SolverSettings = DEFAULT_SETTINGS, workers: int = 1) -> BatchResult:
-    """Solve every design at its tensions (N); ``tensions`` has shape ``(len(designs), ...)``.
+    """Solve every design at its tensions (N); ``tensions`` has shape ``(len(designs), ...)``,
+    with a last axis of one tension per tendon where the designs list ``k > 1`` tendons
+    (``(len(designs), ..., k)``).
 
     A 1-D ``tensions`` pairs design ``i`` with tension ``i``; a 2-D one gives each design a
-    row of tensions (a design-space grid). Results have the shape of ``tensions``.
+    row of tensions (a design-space grid). Results have the members' shape (``tensions``'
+    less the tendon axis).
     ``workers`` threads build the grids and iterate chunks of members at once (the compiled
     kernels release the GIL); the answers do not depend on it. The same as
     ``prepare_batch(designs, ...).solve(tensions)``.
@@ -199,44 +209,61 @@ def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAU
             raise InvalidDesignError(
                 f"designs[{i}] = {design!r} is not a Design", parameter=f"designs[{i}]",
                 value=design, allowed="tdcm_ros.model.Design")
-        require_paper_tendon(design.tendons, "the batch solver", f"designs[{i}].tendons")
-        if not design.material.is_trivial:
-            raise InvalidDesignError(
-                f"designs[{i}].material: the batch solver takes the linear law without a strain "
-                "limit; allowed: Material() (solve() takes any law)",
-                parameter=f"designs[{i}].material", value=design.material.law,
-                allowed="linear")
+    tendons = _tendon_count(designs)
     if not isinstance(settings, SolverSettings):
         raise InvalidSettingsError(f"settings = {settings!r} is not a SolverSettings",
                                    parameter="settings", value=settings,
                                    allowed="tdcm_ros.model.SolverSettings")
-    if settings.axial != "rigid":
-        raise InvalidSettingsError(
-            f"axial = {settings.axial!r}: the batch solver takes the rigid midline; allowed: "
-            "rigid (solve() takes compressible)", parameter="axial", value=settings.axial,
-            allowed="rigid")
     if isinstance(workers, bool) or not isinstance(workers, int) or \
             not 1 <= workers <= MAX_WORKERS:
         raise InvalidSettingsError(
             f"workers = {workers!r} is out of range; allowed: integer in [1, {MAX_WORKERS}]",
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
-    valid, parts, invalid = _grids(designs, settings, workers)
-    stacks = [] if parts is None else [(valid[rows], stack)
+    compiled = np.array([d for d, design in enumerate(designs) if _kernel_takes(design, settings)],
+                        np.int64)
+    valid, parts, invalid = _grids([designs[d] for d in compiled], settings, workers)
+    stacks = [] if parts is None else [(compiled[valid[rows]], stack)
                                        for rows, stack in _Stack.split(parts, settings)]
-    return BatchGrids(tuple(designs), settings, workers, invalid, stacks)
+    single = np.setdiff1d(np.arange(len(designs)), compiled)
+    return BatchGrids(tuple(designs), settings, workers,
+                      {int(compiled[d]): error for d, error in invalid.items()}, stacks, single,
+                      tendons)
+
+
+def _kernel_takes(design: Design, settings: SolverSettings) -> bool:
+    """Whether the compiled iteration solves ``design`` (else ``solve`` does): the paper's one
+    tendon, the linear law without a strain limit, a rigid midline."""
+    return is_paper_like(design.tendons) and design.material.is_trivial and \
+        settings.axial == "rigid"
+
+
+def _tendon_count(designs: list[Design]) -> int:
+    """The number of tendons every design lists (1 for none); raises
+    :class:`InvalidDesignError` naming the first design that lists another number."""
+    counts = [len(design.tendon_list()) for design in designs]
+    for i, count in enumerate(counts):
+        if count != counts[0]:
+            raise InvalidDesignError(
+                f"designs[{i}].tendons: {count} tendon(s) where designs[0] has {counts[0]}; "
+                "allowed: as many tendons in every design of a batch (one tension each)",
+                parameter=f"designs[{i}].tendons", value=count, allowed=f"{counts[0]} tendons")
+    return counts[0] if counts else 1
 
 
 @dataclass(frozen=True, eq=False)
 class BatchGrids:
     """Grids of ``designs`` built once by :func:`prepare_batch`; ``invalid`` maps a design
     whose grid cannot be built to its error, ``stacks`` holds the others as ``(design
-    indices, stack)`` per cell count."""
+    indices, stack)`` per cell count; ``single`` lists the designs ``solve`` solves (the kernel
+    does not take them), ``tendons`` the number of tendons of every design."""
 
     designs: tuple[Design, ...]
     settings: SolverSettings
     workers: int
     invalid: dict[int, InvalidDesignError]
     stacks: list[tuple[NDArray[np.int64], _Stack]]
+    single: NDArray[np.int64]
+    tendons: int
 
     def solve(self, tensions: ArrayLike, *, subset: ArrayLike | None = None) -> BatchResult:
         """Solve the designs (or the distinct design indices ``subset``, in its order) at
@@ -250,18 +277,23 @@ class BatchGrids:
                 f"tensions = {tensions!r} are not numbers; allowed: [0, inf) N",
                 parameter="tensions", value=tensions,
                 allowed="array of numbers in [0, inf) N") from exc
-        if t_all.ndim == 0 or t_all.shape[0] != chosen.size:
+        count = self.tendons
+        axis = "" if count == 1 else f", {count}"
+        if t_all.ndim < (1 if count == 1 else 2) or t_all.shape[0] != chosen.size or \
+                (count > 1 and t_all.shape[-1] != count):
             raise TensionRangeError(
-                f"tensions of shape {t_all.shape} do not match {chosen.size} designs; allowed: "
-                "shape (len(designs), ...)", parameter="tensions", value=t_all.shape,
-                allowed=f"shape ({chosen.size}, ...)")
-        out = _Outcome(t_all.reshape(chosen.size, -1))
+                f"tensions of shape {t_all.shape} do not match {chosen.size} designs of "
+                f"{count} tendon(s); allowed: shape (len(designs), ...{axis})",
+                parameter="tensions", value=t_all.shape, allowed=f"shape ({chosen.size}, ...{axis})")
+        out = _Outcome(t_all.reshape(chosen.size, -1, count))
         k = out.per_design
         position = np.full(len(self.designs), -1, np.int64)
         position[chosen] = np.arange(chosen.size)
         for d, error in self.invalid.items():
             if position[d] >= 0:
                 out.fail(position[d] * k + np.arange(k), error)
+        for d in self.single[position[self.single] >= 0]:
+            out.pending.extend((int(m), None, 0) for m in position[d] * k + np.arange(k))
         chunks: list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]] = []
         for design_ids, stack in self.stacks:
             local = np.flatnonzero(position[design_ids] >= 0)
@@ -276,7 +308,7 @@ class BatchGrids:
                 list(pool.map(lambda c: _iterate(out, c[0], c[1], c[2], self.settings),
                               chunks))
         out.run_fallbacks([self.designs[d] for d in chosen], self.settings)
-        return out.result(t_all.shape)
+        return out.result(t_all.shape if count == 1 else t_all.shape[:-1], t_all.shape)
 
     def _subset(self, subset: ArrayLike | None) -> NDArray[np.int64]:
         """``subset`` checked: distinct indices of designs (all designs when ``None``)."""
@@ -298,8 +330,10 @@ class _Outcome:
     """Per-member outputs while a batch runs (flat member index ``d * per_design + k``)."""
 
     def __init__(self, tensions: Array) -> None:
+        """``tensions`` (designs, members per design, tendons), N."""
         self.per_design = tensions.shape[1]
-        self.tensions = tensions.ravel()
+        self.vectors = tensions.reshape(-1, tensions.shape[2])
+        self.tensions = self.vectors[:, 0]
         size = self.tensions.size
         self.status = np.full(size, "ok", dtype="<U16")
         self.message = np.full(size, "", dtype=object)
@@ -308,7 +342,7 @@ class _Outcome:
         self.strain = np.full(size, np.nan)
         self.iterations = np.zeros(size, np.int64)
         self.fallback = np.zeros(size, bool)
-        self.pending: list[tuple[int, _Stack, int]] = []
+        self.pending: list[tuple[int, _Stack | None, int]] = []
 
     def fail(self, members: NDArray[np.int64], error: ModelError) -> None:
         """Mark ``members`` with the status of ``error`` and its message."""
@@ -325,28 +359,31 @@ class _Outcome:
         self.strain[members] = strain
 
     def run_fallbacks(self, designs: list[Design], settings: SolverSettings) -> None:
-        """Solve every pending member (with its stack and design row) by the single
-        :func:`solve`."""
+        """Solve every pending member (with its stack and design row; no stack: a design the
+        kernel does not take) by the single :func:`solve`."""
         for m, stack, row in self.pending:
             self.fallback[m] = True
+            vector = self.vectors[m]
             try:
-                result = solve(designs[m // self.per_design], float(self.tensions[m]),
+                result = solve(designs[m // self.per_design],
+                               float(vector[0]) if vector.size == 1 else vector.tolist(),
                                settings=settings)
             except ModelError as error:
                 self.fail(np.array([m]), error)
                 self.iterations[m] = settings.max_iter if error.kind == "non_convergence" else 0
                 continue
-            moments = result.cell_moments
             x, _, z = result.tip_position
+            strain = np.array([result.notch_peak_strains.max(initial=0.0)]) if stack is None \
+                else stack.strain(np.array([row]), result.cell_moments.T.reshape(1, -1))
             self.store(np.array([m]), np.array([z + 1j * x]), np.array([result.tip_angle_rad]),
-                       stack.strain(np.array([row]), moments.T.reshape(1, -1)))
+                       strain)
             self.iterations[m] = result.iterations
 
-    def result(self, shape: tuple[int, ...]) -> BatchResult:
-        """The outcome in the caller's shape."""
+    def result(self, shape: tuple[int, ...], given: tuple[int, ...]) -> BatchResult:
+        """The outcome in the members' ``shape`` (the tensions in their ``given`` one)."""
         deflection = np.hypot(self.tip[:, 0], self.tip[:, 1])
         return BatchResult(
-            tensions=self.tensions.reshape(shape), status=self.status.reshape(shape),
+            tensions=self.vectors.reshape(given), status=self.status.reshape(shape),
             message=self.message.reshape(shape), tip_position=self.tip.reshape(shape + (3,)),
             tip_angle_rad=self.angle.reshape(shape), tip_deflection_m=deflection.reshape(shape),
             max_bending_strain=self.strain.reshape(shape),

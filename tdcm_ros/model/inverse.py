@@ -226,7 +226,7 @@ def solve_inverse(design: Design, *, tip_deflection: float | None = None,
     :class:`UnreachableTargetError` (naming the reachable range) when the target is out of
     reach; a forward solve's own errors pass through.
     """
-    sought, held = _sought_tendon(design, tendon, tensions)
+    sought, held = sought_tendon(design, tendon, tensions)
     kind, target = _check_target(tip_deflection, tip_angle, tip_point, tendon_stroke)
     lower, upper = _check_bounds(tension_min, tension_max)
     tolerance = _real(tol)
@@ -260,7 +260,7 @@ _MEASURES: dict[str, Callable[[SolveResult], float]] = {
 }
 
 
-def _sought_tendon(design: Design, tendon: int | str | None,
+def sought_tendon(design: Design, tendon: int | str | None,
                    tensions: Sequence[float] | None) -> tuple[int, tuple[float, ...] | None]:
     """The sought tendon's index and the held tensions (N; None for the paper's one tendon),
     checked: :class:`InvalidTargetError` naming ``tendon`` or ``tensions``."""

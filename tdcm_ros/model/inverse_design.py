@@ -23,6 +23,9 @@ Tension for the target, per design (the tip and the strain grow with the tension
    rounds find where it leaves them: the peak strain within ``STRAIN_RTOL`` below the
    allowable, or a closure or singularity bracketed to ``LIMIT_XTOL`` of the budget.
 
+A design with several tendons has its ``tendon`` sought, the others held at ``tensions`` (N),
+as :func:`~tdcm_ros.model.inverse.solve_inverse`; the batch solves it by ``solve``.
+
 The reported tension is the last solve's: its tip, strain and status are those of ``solve`` at
 that tension. It differs from ``solve_inverse``'s by at most about ``2 tol / (dtip/dT)`` (both
 stop within ``tol`` of the target).
@@ -40,7 +43,7 @@ highest rung inside the limits).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,7 +66,12 @@ from tdcm_ros.model.errors import (
     InvalidSettingsError,
     ModelLimitError,
 )
-from tdcm_ros.model.inverse import DEFAULT_TOL, InvalidTargetError, one_target
+from tdcm_ros.model.inverse import (
+    DEFAULT_TOL,
+    InvalidTargetError,
+    one_target,
+    sought_tendon,
+)
 from tdcm_ros.model.pareto import non_dominated
 from tdcm_ros.model.progress import Progress, report_progress
 from tdcm_ros.model.settings import SolverSettings
@@ -184,12 +192,15 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
                    samples: int = DEFAULT_DESIGN_SAMPLES, sampling: str = "sobol", seed: int = 0,
                    ladder: int = DEFAULT_DESIGN_LADDER, tol: float = DEFAULT_TOL,
                    settings: SolverSettings = DEFAULT_SETTINGS,
-                   progress: Progress | None = None) -> DesignSearch:
+                   progress: Progress | None = None, tendon: int | str | None = None,
+                   tensions: Sequence[float] | None = None) -> DesignSearch:
     """Sample ``samples`` designs (``base`` with the fields of ``free`` = ``{name: (low,
     high)}`` varied) and find, for each, the tension in ``[0, tension_max]`` N that puts the
     tip on the target (one of ``tip_deflection`` m, ``tip_angle`` rad, within ``tol``) inside
     every limit; return them all with the Pareto set. ``progress("design search", designs
-    done, samples)`` after each batch of designs.
+    done, samples)`` after each batch of designs. A base with several tendons names the
+    ``tendon`` whose tension is sought, the others held at ``tensions`` (N, one per tendon;
+    default 0), as :func:`~tdcm_ros.model.inverse.solve_inverse`.
 
     Raises :class:`InvalidTargetError`, :class:`InvalidDesignError` or
     :class:`InvalidSettingsError` for bad input (naming the parameter, value and range), and
@@ -199,6 +210,7 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
         raise InvalidDesignError(f"base = {base!r} is not a Design", parameter="base",
                                  value=base, allowed="tdcm_ros.model.Design")
     kind, target = _target(tip_deflection, tip_angle)
+    sought, held = sought_tendon(base, tendon, tensions)
     budget = _positive("tension_max", tension_max, "N")
     tolerance = _positive("tol", tol, UNITS[kind])
     strain_limit = _allowable(allowable_strain)
@@ -207,7 +219,8 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
                            error=InvalidSettingsError)
     ranges = free_ranges(base, free)
     values = scale(ranges, sample_unit(len(ranges), samples, sampling, seed))
-    problem = _Problem(base, kind, target, budget, strain_limit, tolerance, ladder, settings)
+    problem = _Problem(base, kind, target, budget, strain_limit, tolerance, ladder, settings,
+                       sought, held)
     found = _Found(samples)
     report_progress(progress, "design search", 0, samples)
     for start in range(0, samples, BATCH_DESIGNS):
@@ -271,6 +284,8 @@ class _Problem:
     tol: float
     ladder: int
     settings: SolverSettings
+    sought: int
+    held: tuple[float, ...] | None
 
     def measure(self, result: BatchResult) -> Array:
         """The target's quantity of a batch result (NaN where it did not solve)."""
@@ -290,7 +305,7 @@ class _Problem:
             kept.append(i)
         if not designs:
             return
-        grids = prepare_batch(designs, settings=self.settings)
+        grids = _Driven(prepare_batch(designs, settings=self.settings), self.sought, self.held)
         ids = np.asarray(kept, np.int64)
         rungs = self.budget * np.arange(1, self.ladder + 1) / self.ladder
         result = grids.solve(np.broadcast_to(rungs, (len(designs), self.ladder)))
@@ -388,13 +403,32 @@ class _Problem:
 Record = Callable[[NDArray[np.int64], Array, BatchResult, Array, NDArray[np.bool_]], None]
 
 
+@dataclass(frozen=True)
+class _Driven:
+    """Batch solves at the sought tendon's tensions (N), the others at ``held`` (None: the
+    paper's one tendon)."""
+
+    grids: BatchGrids
+    sought: int
+    held: tuple[float, ...] | None
+
+    def solve(self, tensions: Array, *, subset: NDArray[np.int64] | None = None) -> BatchResult:
+        """:meth:`BatchGrids.solve` with ``tensions`` (N) the sought tendon's."""
+        if self.held is None:
+            return self.grids.solve(tensions, subset=subset)
+        vectors = np.empty(np.shape(tensions) + (len(self.held),))
+        vectors[...] = self.held
+        vectors[..., self.sought] = tensions
+        return self.grids.solve(vectors, subset=subset)
+
+
 class _Rounds:
     """Rounds of one batch solve per bracketed design (``ids``: sample of each batch row) at
     :meth:`_Bracket.estimate`, until ``quantity`` of the solve satisfies ``hit``; a bracket
     closed at a limit (``LIMIT_XTOL`` of the budget) or still open after ``MAX_ROUNDS`` ends
     that design's search, listed in ``left`` with the reason."""
 
-    def __init__(self, grids: BatchGrids, ids: NDArray[np.int64], budget: float,
+    def __init__(self, grids: _Driven, ids: NDArray[np.int64], budget: float,
                  quantity: Callable[[BatchResult], Array],
                  hit: Callable[[Array], NDArray[np.bool_]]) -> None:
         self.grids, self.ids, self.budget = grids, ids, budget

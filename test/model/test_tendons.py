@@ -24,7 +24,6 @@ from tdcm_ros.model import (
     read_body_file,
     solve,
 )
-from tdcm_ros.model.batch import solve_batch
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidSettingsError
 from tdcm_ros.model.inverse import InvalidTargetError, solve_inverse
@@ -250,8 +249,6 @@ def test_a_design_with_tendons_takes_one_tension_per_tendon(tension: object, par
 
 
 def test_what_takes_the_paper_tendon_only_says_so() -> None:
-    with pytest.raises(InvalidDesignError, match=r"designs\[0\]\.tendons: the batch solver"):
-        solve_batch([PAIR], [1.0])
     with pytest.raises(InvalidTargetError, match=r"tendon is missing: this design has 2 "):
         solve_inverse(PAIR, tip_deflection=1e-3)
     with pytest.raises(InvalidLoadingError, match="several tendons"):
