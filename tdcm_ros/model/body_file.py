@@ -504,13 +504,18 @@ def _required(entry: Mapping[str, Any], key: str, prefix: str, source: str) -> A
     return entry[key]
 
 
+#: Units of the body file's numbers that are not lengths in m.
+_UNITS = {"E": "Pa", "E_plateau": "Pa", "area": "m^2", "second_moment": "m^4",
+          "plateau_strain": "", "recoverable_strain": "", "stiffness": "N/m"}
+
+
 def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low: float,
             high: float, open_low: bool = False, open_high: bool = False,
             default: float | None = None) -> float:
     """``entry[key]`` as a finite float in the range (SI units), else a named error."""
     if key not in entry and default is not None:
         return default
-    spec = Spec(key, unit="m" if key != "E" else "Pa", low=low, high=high, low_open=open_low,
+    spec = Spec(key, unit=_UNITS.get(key, "m"), low=low, high=high, low_open=open_low,
                 high_open=open_high)
     return float(spec.check(_required(entry, key, prefix, source), f"{source}: {prefix}{key}",
                             error=InvalidDesignError))

@@ -192,6 +192,11 @@ def test_a_section_given_by_its_numbers_is_read_and_a_mesh_body_written_back_as_
                        r"range; allowed: \(-0\.0035, 0\.0005\)"):
         body_from_mapping(with_changes(segments=[{"notch": {"width": 2e-3, "section": bad}}]),
                           "body.yaml")
+    for key, value, unit in (("area", 1.0, "m\\^2"), ("second_moment", 2.0, "m\\^4")):
+        with pytest.raises(InvalidDesignError, match=rf"section\.{key} = {value} is out of range;"
+                           rf" allowed: \(0, .*\] {unit}$"):
+            body_from_mapping(with_changes(segments=[{"notch": {"width": 2e-3, "section": dict(
+                given, **{key: value})}}]), "body.yaml")
 
 
 def test_a_polygon_outside_the_tube_is_refused_naming_its_segment() -> None:
