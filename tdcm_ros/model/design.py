@@ -37,6 +37,7 @@ from tdcm_ros.model.profiles import (
     CircularProfile,
     NotchProfile,
     PolygonProfile,
+    SectionProfile,
     SlicedProfile,
     profile_from_name,
 )
@@ -57,6 +58,8 @@ PER_NOTCH_FIELDS = ("w_n", "w_d", "w_o")
 PER_GAP_FIELDS = ("w_t",)
 #: A length (m): one value, or one per notch or gap (see the module docstring).
 Lengths = float | tuple[float, ...]
+#: Notch profiles whose section carries no width profile to integrate a material law over.
+_WIDTHLESS_PROFILES = (SectionProfile, SlicedProfile)
 
 
 @dataclass(frozen=True)
@@ -108,11 +111,12 @@ class Design:
             raise out_of_range("material", self.material, "a Material", error=InvalidDesignError)
         self.material.check(self.E)
         if not self.material.is_linear and any(
-                isinstance(p, GIVEN_SECTION_PROFILES) for p in self.notch_profiles()):
+                isinstance(p, _WIDTHLESS_PROFILES) for p in self.notch_profiles()):
             raise InvalidDesignError(
-                "material.law = 'bilinear' takes band and cut notches (the law is integrated over "
-                "their annulus sections); allowed: law linear with polygon, section or mesh "
-                "notches", parameter="material.law", value=self.material.law, allowed="linear")
+                f"material.law = {self.material.law!r} takes band, cut and polygon notches (the "
+                "law is integrated over their sections' widths; a section given by its numbers or "
+                "a mesh's slices has none); allowed: law linear with section or mesh notches",
+                parameter="material.law", value=self.material.law, allowed="linear")
         if self.tendons != ():
             object.__setattr__(self, "tendons", check_tendons(
                 self.tendons, self.R_outer, self.segment_ends()))

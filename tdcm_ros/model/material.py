@@ -8,11 +8,14 @@ model: a plateau from about 2 % strain at about 8 % of ``E``). A section's momen
     M(kappa) = kappa [E I - (E - E_p) J(eps_p / |kappa|)],
     J(d) = int_{|y| > d} (|y| - d) |y| b(y) dy,
 
-``b`` the section's width at ``y`` (an annulus cut to the band ``|x - w_o| <= h1``: its chord
-lengths). ``M`` is monotone in ``kappa`` (``E_p > 0``), so each moment has one curvature,
-found by bisection. The neutral axis stays at the centroid: exact for sections symmetric about
-it (the paper's bands, the tubes), an approximation for one-sided cuts in the plateau. Sections
-given whole (polygons, a section's numbers, mesh slices) take the linear law only.
+``b`` the section's width at ``y``: an annulus cut to the band ``|x - w_o| <= h1`` (its chord
+lengths), or a polygon notch's section (:class:`~tdcm_ros.model.profiles.PolygonProfile`,
+integrated exactly by Green's theorem: :func:`~tdcm_ros.model.sections.plateau_excess`). ``M``
+is monotone in ``kappa`` (``E_p > 0``), so each moment has one curvature, found by bisection.
+The neutral axis stays at the centroid: exact for sections symmetric about it (the paper's
+bands, the tubes, a symmetric polygon), an approximation for one-sided cuts and polygons in the
+plateau. Sections given by their numbers or by a mesh's slices carry no width profile: they
+take the linear law only.
 
 ``recoverable_strain`` (default none): the largest strain the material recovers from; a
 solution past it raises :class:`StrainLimitError`.

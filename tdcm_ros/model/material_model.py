@@ -4,6 +4,13 @@
 scaled, at each cell end, by the ratio of the law's curvature to the linear one (1 where the
 plateau is not reached, so such a solution is the linear model's, bit for bit): the curvature
 is exact at every cell end and linear in the moment between them, like the linear model's.
+
+The law is integrated over each cell end's own section: an annulus's chord widths for the
+band and cut notches and the tubes, Green's theorem over the polygon for a
+:class:`~tdcm_ros.model.profiles.PolygonProfile` notch
+(:func:`~tdcm_ros.model.sections.plateau_excess`). The neutral axis stays at the section's
+centroid: exact for sections symmetric about it, an approximation for one-sided ones in the
+plateau.
 """
 
 from __future__ import annotations
@@ -21,6 +28,8 @@ from tdcm_ros.model.grid import Grid, gauss_legendre
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.material import Material, StrainLimitError
 from tdcm_ros.model.moment_model import MomentModel, PlainRun, Plan
+from tdcm_ros.model.profiles import PolygonProfile
+from tdcm_ros.model.sections import material_edges, plateau_excess
 from tdcm_ros.model.settings import SolverSettings
 
 Array = NDArray[np.float64]
@@ -34,7 +43,11 @@ BISECTIONS = 80
 @dataclass(frozen=True, eq=False)
 class _Ends:
     """Every cell end's section (SI units, (2n,): starts then ends): the material's extent
-    ``lo``..``hi`` in x, the centroid ``x_bar``, the linear ``E I`` and the tube radii."""
+    ``lo``..``hi`` in x (a polygon's own, which its notch holds as ``w_d`` and ``w_o``), the
+    centroid ``x_bar``, the linear ``E I``, the tube radii, and
+    ``polygon``: the index in ``polygons`` (the edges of each polygon notch's section,
+    :func:`~tdcm_ros.model.sections.material_edges`) of an end in a polygon notch, -1 for an
+    annulus."""
 
     lo: Array
     hi: Array
@@ -42,6 +55,8 @@ class _Ends:
     stiffness: Array
     r_outer: float
     r_inner: float
+    polygon: NDArray[np.int64]
+    polygons: tuple[tuple[Array, Array], ...]
 
     @cached_property
     def reach(self) -> Array:
@@ -61,9 +76,19 @@ class _Ends:
             offset[notch] = members.shape_w_o[shape[notch]]
         lo = np.maximum(offset - half, -design.R_outer)
         hi = np.minimum(offset + half, design.R_outer)
+        polygon = np.full(u.size, -1, np.int64)
+        polygons: list[tuple[Array, Array]] = []
+        kinds = members.profile_of[shape]
+        for k, profile in enumerate(members.profiles):
+            rows = notch & (kinds == k)
+            if isinstance(profile, PolygonProfile) and np.any(rows):
+                polygon[rows] = len(polygons)
+                polygons.append(material_edges(np.asarray(profile.shell),
+                                               [np.asarray(hole) for hole in profile.holes]))
         compliance = np.concatenate([grid.c_start, grid.c_end])
         return cls(lo=lo, hi=hi, x_bar=np.concatenate([grid.xbar_start, grid.xbar_end]),
-                   stiffness=1.0 / compliance, r_outer=design.R_outer, r_inner=design.r_inner)
+                   stiffness=1.0 / compliance, r_outer=design.R_outer, r_inner=design.r_inner,
+                   polygon=polygon, polygons=tuple(polygons))
 
     def width(self, x: Array) -> Array:
         """The section's width (m) at abscissa ``x`` (m): the annulus's chord, both sides."""
@@ -72,8 +97,25 @@ class _Ends:
         return 2.0 * (outer - inner)
 
     def excess(self, rows: NDArray[np.int64], d: Array) -> Array:
-        """``J(d)`` (m^4) of the ends ``rows`` at plateau distances ``d`` (m): Gauss-Legendre
-        on each side beyond ``d``, split where the width has its kinks (``x = +-r_inner``)."""
+        """``J(d)`` (m^4) of the ends ``rows`` at plateau distances ``d`` (m): an annulus's
+        (:meth:`annulus_excess`) or a polygon's
+        (:func:`~tdcm_ros.model.sections.plateau_excess`)."""
+        which = self.polygon[rows]
+        total = np.empty(rows.size)
+        for k in np.unique(which):
+            chosen = np.flatnonzero(which == k)
+            ends, at = rows[chosen], d[chosen]
+            if k < 0:
+                total[chosen] = self.annulus_excess(ends, at)
+            else:
+                start, end = self.polygons[k]
+                total[chosen] = plateau_excess(start, end, self.x_bar[ends], at)
+        return total
+
+    def annulus_excess(self, rows: NDArray[np.int64], d: Array) -> Array:
+        """``J(d)`` (m^4) of the annulus ends ``rows`` at plateau distances ``d`` (m):
+        Gauss-Legendre on each side beyond ``d``, split where the width has its kinks
+        (``x = +-r_inner``)."""
         nodes, weights = gauss_legendre(WIDTH_POINTS)
         x_bar = self.x_bar[rows]
         total = np.zeros(rows.size)

@@ -20,6 +20,8 @@ parameters, e.g. the paper's half-width ``h1`` at many stations of a notch):
 Three types: :class:`BandSection` (the paper's symmetric pair of cuts, eq. 12),
 :class:`OneSidedCut` (a tube cut from +x to a depth, in closed form) and
 :class:`PolygonSection` (any simple polygon of material, exact polygon integrals).
+:func:`plateau_excess` integrates a bilinear material law over a polygon
+(:mod:`tdcm_ros.model.material`).
 """
 
 from __future__ import annotations
@@ -231,3 +233,49 @@ def edge_moments(start: Array, end: Array) -> Array:
     return np.array([np.sum(cross, axis=-1) / 2.0, np.sum((x + x1) * cross, axis=-1) / 6.0,
                      np.sum((x * x + x * x1 + x1 * x1) * cross, axis=-1) / 12.0,
                      np.sum((y + y1) * cross, axis=-1) / 6.0])
+
+
+def material_edges(shell: Array, holes: Sequence[Array]) -> tuple[Array, Array]:
+    """The directed edges ``(start, end)`` ((n, 2) each, m) of a polygon of material with the
+    material on each edge's left, whatever the rings' orientation: the shell turned
+    counter-clockwise, the holes clockwise (by the sign of each ring's area, as
+    :func:`_ring_moments` reads it)."""
+    rings = [_oriented(shell, 1.0), *(_oriented(hole, -1.0) for hole in holes)]
+    return (np.concatenate(rings),
+            np.concatenate([np.roll(ring, -1, axis=0) for ring in rings]))
+
+
+def _oriented(ring: Array, sign: float) -> Array:
+    """``ring`` ((n, 2), m) turned so its signed area has the sign ``sign``."""
+    area = edge_moments(ring, np.roll(ring, -1, axis=0))[0]
+    return ring if area * sign > 0.0 else ring[::-1]
+
+
+def plateau_excess(start: Array, end: Array, x_bar: ArrayLike, d: ArrayLike) -> Array:
+    """``J(d) = int_{|x - x_bar| > d} (|x - x_bar| - d) |x - x_bar| dA`` (m^4) of the polygon
+    bounded by the edges ``start -> end`` ((n, 2), m; material on the left:
+    :func:`material_edges`) about the axis ``x = x_bar`` (m), at plateau distances ``d >= 0``
+    (m); ``x_bar`` and ``d`` broadcast, one ``J`` per pair. ``J(0)`` is the second moment
+    about ``x_bar``.
+
+    Exact, by Green's theorem on each side: with ``w = +-(x - x_bar) - d`` the distance past
+    the line ``w = 0``, the side's integrand is ``w (w + d)``, whose antiderivative
+    ``F = w^3/3 + d w^2/2`` vanishes on that line; so the side's ``J`` is ``+-`` the sum, over
+    each edge's part with ``w >= 0``, of ``int F dy`` (a cubic in ``w``, linear along the
+    edge: in closed form), and no polygon is clipped. Edges no pair's ``w`` reaches on a side
+    are left out of it."""
+    x_bar, d = (a[..., None] for a in np.broadcast_arrays(np.asarray(x_bar, dtype=float),
+                                                          np.asarray(d, dtype=float)))
+    total = np.zeros(d.shape[:-1])
+    for side in (1.0, -1.0):
+        line = np.min(side * x_bar + d, initial=np.inf)
+        edges = np.maximum(side * start[:, 0], side * end[:, 0]) > line
+        x0, x1 = start[edges, 0], end[edges, 0]
+        rise = end[edges, 1] - start[edges, 1]
+        w0, w1 = side * (x0 - x_bar) - d, side * (x1 - x_bar) - d
+        a, b = np.maximum(w0, 0.0), np.maximum(w1, 0.0)
+        crossing = (w0 < 0.0) != (w1 < 0.0)
+        kept = np.where(crossing, (a + b) / np.where(crossing, np.abs(w1 - w0), 1.0), 1.0)
+        mean = (a + b) * (a * a + b * b) / 12.0 + d * (a * a + a * b + b * b) / 6.0
+        total += side * np.sum(kept * rise * mean, axis=-1)
+    return total

@@ -22,7 +22,6 @@ from tdcm_ros.model import (
     solve,
 )
 from tdcm_ros.model.material import Material, StrainLimitError
-from tdcm_ros.model.profiles import PolygonProfile
 
 PAPER = preset("paper-experiment")
 
@@ -116,14 +115,6 @@ def test_a_strain_past_the_recoverable_strain_is_a_typed_limit() -> None:
 def test_bad_laws_name_their_key(material: Material, message: str) -> None:
     with pytest.raises(InvalidDesignError, match=message):
         dataclasses.replace(PAPER, material=material)
-
-
-def test_what_takes_the_linear_law_only_says_so() -> None:
-    tee = PolygonProfile(((-3.5e-3, -1.5e-3), (-2.5e-3, -1.5e-3), (-2.5e-3, -0.3e-3),
-                          (0.5e-3, -0.3e-3), (0.5e-3, 0.3e-3), (-2.5e-3, 0.3e-3),
-                          (-2.5e-3, 1.5e-3), (-3.5e-3, 1.5e-3)))
-    with pytest.raises(InvalidDesignError, match=r"material\.law = 'bilinear' takes band"):
-        nitinol(PAPER.with_overrides(profile=tee))
 
 
 def test_a_law_round_trips_through_a_body_file(tmp_path: Path) -> None:
