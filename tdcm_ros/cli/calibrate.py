@@ -7,7 +7,7 @@ import json
 import sys
 from typing import Any
 
-from tdcm_ros.cli.evaluate import add_input_arguments, design_sets, fail
+from tdcm_ros.cli.evaluate import add_input_arguments, design_sets, fail, input_topics
 from tdcm_ros.cli.progress import ProgressBars
 from tdcm_ros.errors import PhysicsError, TdcmError
 
@@ -22,12 +22,14 @@ def register(subparsers: Any) -> None:
     """Add the ``calibrate`` subcommand."""
     parser = subparsers.add_parser(
         "calibrate", help="fit E (and other design fields) to bags by least squares",
-        description="Least squares on the marker position residuals of every step; reports "
+        description="Least squares on the marker position residuals of every step (the model "
+                    "at the step's mean tension, one per tendon); reports "
                     "each value with a confidence interval, Table I before and after, and warns "
                     "when a parameter is not identifiable from the data.",
         epilog="examples:\n"
                "  tdcm calibrate bags/paper_experiment\n"
-               "  tdcm calibrate run.mcap --fit E --confidence 0.9 --json")
+               "  tdcm calibrate run.mcap --fit E --confidence 0.9 --json\n"
+               "  tdcm calibrate pair_run --design config/bodies/antagonistic_pair.yaml")
     add_input_arguments(parser)
     parser.add_argument("--fit", default="E", metavar="NAME[,NAME]",
                         help="real-valued design fields to fit (default: E); start values from "
@@ -40,7 +42,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Calibrate; known errors become one line and a non-zero exit status."""
     from tdcm_ros.metrics import format_calibration, options_from_sets
-    from tdcm_ros.metrics.api import Topics, calibrate_paths
+    from tdcm_ros.metrics.api import calibrate_paths
     from tdcm_ros.metrics.calibration import parse_fit
 
     try:
@@ -48,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
         options = options_from_sets(design_sets(args))
         with ProgressBars.of(args) as bars:
             cal = calibrate_paths(args.bags, names, options, confidence=args.confidence,
-                                  topics=Topics(args.tension_topic, args.markers_topic),
+                                  topics=input_topics(args),
                                   progress=bars)
     except TdcmError as error:
         return fail("calibrate", error, args.json)

@@ -5,11 +5,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tdcm_ros.cli.deprecation import DeprecatedAlias
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
 from tdcm_ros.errors import InputError, TdcmError
+
+if TYPE_CHECKING:
+    from tdcm_ros.metrics.api import Topics
 
 SET_HELP = ("override in SI units: a design field (E=1.2e9, w_d=0.0014) or design.preset=NAME, "
             "steps.tolerance_n, steps.min_hold_s, steps.settle_s, steps.zero_n, "
@@ -22,8 +25,13 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments shared by ``evaluate`` and ``calibrate``."""
     parser.add_argument("bags", nargs="+", metavar="BAG",
                         help="rosbag2 folder or .mcap file (several: trials numbered on)")
-    parser.add_argument("--tension-topic", default="tension",
-                        help="geometry_msgs/msg/WrenchStamped topic (default: tension)")
+    parser.add_argument("--tension-topic", action="append", metavar="TOPIC|NAME=TOPIC",
+                        help="TOPIC (default: tension): a geometry_msgs/msg/WrenchStamped "
+                             "(force.z) or std_msgs/msg/Float64 for a body with one tendon, or a "
+                             "sensor_msgs/msg/JointState with an effort (N) per tendon, named as "
+                             "in the body file; or NAME=TOPIC once per tendon NAME: a "
+                             "WrenchStamped or Float64 topic each, aligned on the first one's "
+                             "stamps within align.tolerance_s")
     parser.add_argument("--markers-topic", default="markers",
                         help="mocap4r2_msgs/msg/Markers topic (default: markers)")
     parser.add_argument("--design", metavar="NAME|FILE",
@@ -46,17 +54,27 @@ def design_sets(args: argparse.Namespace) -> list[str]:
     return [f"design.preset={args.design}", *args.set]
 
 
+def input_topics(args: argparse.Namespace) -> Topics:
+    """The topics ``--tension-topic`` (default ``tension``) and ``--markers-topic`` name."""
+    from tdcm_ros.metrics.api import Topics
+
+    return Topics(tuple(args.tension_topic or ("tension",)), args.markers_topic)
+
+
 def register(subparsers: Any) -> None:
     """Add the ``evaluate`` subcommand."""
     parser = subparsers.add_parser(
         "evaluate", help="Table I metrics of bags against the model",
-        description="Detect tension steps in the bags, average the markers per step and compare "
-                    "them with the model at each step's mean tension (MAPE, RMSE, MAE, shape "
-                    "error, deflection mean).",
+        description="Detect tension steps in the bags (holds of every tendon's tension), average "
+                    "the markers per step and compare them with the model at each step's mean "
+                    "tension, one per tendon (MAPE, RMSE, MAE, shape error, deflection mean).",
         epilog="examples:\n"
                "  tdcm evaluate bags/paper_experiment\n"
                "  tdcm evaluate run.mcap --design paper-experiment --set E=0.7e9 --out plots\n"
-               "  tdcm evaluate trial1 trial2 --json > table1.json")
+               "  tdcm evaluate trial1 trial2 --json > table1.json\n"
+               "  tdcm evaluate pair_run --design config/bodies/antagonistic_pair.yaml\n"
+               "  tdcm evaluate pair_topics --design config/bodies/antagonistic_pair.yaml "
+               "--tension-topic flexor=/flexor --tension-topic extensor=/extensor")
     add_input_arguments(parser)
     parser.add_argument("--out", metavar="DIR",
                         help="write the plots shapes.png and error_vs_tension.png into DIR "
@@ -76,7 +94,7 @@ def fail(command: str, error: TdcmError, as_json: bool) -> int:
 def run(args: argparse.Namespace) -> int:
     """Evaluate; known errors become one line and a non-zero exit status."""
     from tdcm_ros.metrics import format_evaluation, options_from_sets
-    from tdcm_ros.metrics.api import Topics, evaluate_paths
+    from tdcm_ros.metrics.api import evaluate_paths
     from tdcm_ros.model import one_shot
 
     try:
@@ -84,8 +102,7 @@ def run(args: argparse.Namespace) -> int:
         # One solve per step (tens to hundreds): the plain kernel takes about as long as numba's
         # import and cache load, without its ~60 MiB (bench/bench_evaluate_memory.py).
         with one_shot(), ProgressBars.of(args) as bars:
-            ev = evaluate_paths(args.bags, options, progress=bars,
-                                topics=Topics(args.tension_topic, args.markers_topic))
+            ev = evaluate_paths(args.bags, options, progress=bars, topics=input_topics(args))
         plots = []
         out = args.out or args.plots  # --plots: the deprecated spelling
         option = "--out" if args.out else "--plots"

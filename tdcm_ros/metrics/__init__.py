@@ -13,7 +13,12 @@ Separate entry points, kept out of this face because they pull heavier libraries
   recordings and bags for tests, benchmarks and demos.
 """
 
-from tdcm_ros.metrics.errors import MarkersNotVisibleError, MetricsError, NoStepsError
+from tdcm_ros.metrics.errors import (
+    MarkersNotVisibleError,
+    MetricsError,
+    NoStepsError,
+    TensionTopicError,
+)
 from tdcm_ros.metrics.evaluation import Evaluation, StepRecord, evaluate_series
 from tdcm_ros.metrics.geometry import DEFLECTION_AXES
 from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions, options_from_sets
@@ -42,6 +47,7 @@ __all__ = [
     "StepSettings",
     "TableMetrics",
     "TensionSeries",
+    "TensionTopicError",
     "evaluate_series",
     "format_calibration",
     "format_evaluation",

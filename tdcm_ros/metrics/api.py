@@ -33,9 +33,10 @@ from tdcm_ros.model import Progress, report_progress
 
 @dataclass(frozen=True)
 class Topics:
-    """Topic names read from the bags."""
+    """Topic names read from the bags: ``tension`` one topic, or ``NAME=TOPIC`` values, one per
+    tendon of the body (:mod:`tdcm_ros.metrics.tension_topics`), and ``markers``."""
 
-    tension: str = "tension"
+    tension: str | tuple[str, ...] = "tension"
     markers: str = "markers"
 
 
@@ -47,11 +48,13 @@ def load_paths(paths: Sequence[str | Path], options: EvaluateOptions,
         raise InputError("no bag given; allowed: one or more bag folders or .mcap files",
                          parameter="BAG", value=[], allowed="one or more paths")
     names = topics or Topics()
+    tendons = [t.name for t in options.design.tendon_list()]
     sources = []
     for done, path in enumerate(paths):
         report_progress(progress, "reading bags", done, len(paths))
         sources.append(load_bag(path, labels=options.layout.labels, tension_topic=names.tension,
-                                markers_topic=names.markers))
+                                markers_topic=names.markers, tendons=tendons,
+                                align_tolerance_s=options.align_tolerance_s))
     report_progress(progress, "reading bags", len(paths), len(paths))
     return sources
 

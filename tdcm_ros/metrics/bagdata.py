@@ -1,7 +1,10 @@
 """Read the evaluation's inputs from a bag: tension, marker frames and the registration.
 
 - tension: ``geometry_msgs/msg/WrenchStamped`` (``wrench.force.z``, N) or, as model_node takes
-  it, ``std_msgs/msg/Float64`` (``data``, N; no header: stamped by the bag's log times);
+  it, ``std_msgs/msg/Float64`` (``data``, N; no header: stamped by the bag's log times) or
+  ``sensor_msgs/msg/JointState`` (an effort in N per tendon, by the body file's tendon names); a
+  body with several tendons takes the JointState, or a WrenchStamped or Float64 topic per
+  tendon, put on the first tendon's stamps (:mod:`tdcm_ros.metrics.tension_topics`);
 - markers: ``mocap4r2_msgs/msg/Markers`` (positions in the message's frame, matched to the
   layout's labels by ``marker_name``; unknown names are ignored and counted in a warning; a
   layout label never seen is an error listing the names the bag holds, with their frame counts). A
@@ -36,13 +39,21 @@ import numpy as np
 
 from tdcm_ros.bagio import BagError
 from tdcm_ros.bagio.reader import BagReader, open_bag, require_topic
-from tdcm_ros.metrics.cdr import float64_data, markers_frame, wrench_force_z
-from tdcm_ros.metrics.errors import MetricsError
+from tdcm_ros.metrics.align import on_first_stamps
+from tdcm_ros.metrics.cdr import (
+    float64_data,
+    joint_efforts,
+    markers_frame,
+    wrench_force_z,
+)
+from tdcm_ros.metrics.errors import MetricsError, TensionTopicError
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.tension_topics import OPTION, TensionTopics, tension_topics
 from tdcm_ros.mocap import Registration, visible
 
 TENSION_TYPE = "geometry_msgs/msg/WrenchStamped"
 FLOAT_TENSION_TYPE = "std_msgs/msg/Float64"
+JOINT_STATE_TYPE = "sensor_msgs/msg/JointState"
 MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 BASE_FRAME = "tdcm_base"
@@ -187,12 +198,16 @@ def _tension_series(stamps: np.ndarray, force: np.ndarray) -> TensionSeries:
     return TensionSeries.of(stamps, force)
 
 
-def _tension(reader: BagReader, topic: str, warnings: list[str]) -> TensionSeries:
+def _tension_topic(reader: BagReader, topic: str, types: Sequence[str], which: str) -> str:
+    """:func:`require_topic`, its error saying in ``which`` what ``topic`` is."""
     try:
-        name = require_topic(reader, topic, [TENSION_TYPE, FLOAT_TENSION_TYPE])
+        return require_topic(reader, topic, types)
     except BagError as error:
-        raise BagError(f"{error} (the tension topic: evaluate --tension-topic, calibrate "
-                       f"--tension-topic)", parameter="tension_topic", value=topic) from error
+        raise BagError(f"{error} ({which})", parameter="tension_topic", value=topic) from error
+
+
+def _tension(reader: BagReader, name: str, warnings: list[str]) -> TensionSeries:
+    """One tension (N) from the WrenchStamped or Float64 topic ``name`` (a stored name)."""
     floats = reader.topics[name] == FLOAT_TENSION_TYPE
     stamps_ns, from_log, unique, (force,) = _read(reader, name, float64_data if floats
                                                   else wrench_force_z)
@@ -203,6 +218,71 @@ def _tension(reader: BagReader, topic: str, warnings: list[str]) -> TensionSerie
     stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
     del stamps_ns  # free the stamps (ns) before the series is built
     return _tension_series(stamps, force if keep.all() else force[keep])
+
+
+def _joint_tensions(reader: BagReader, name: str, tendons: Sequence[str], warnings: list[str]
+                    ) -> TensionSeries:
+    """The tendons' tensions (N) from the efforts of the JointState topic ``name``, by name; a
+    tendon it never gives a finite effort for is an error, a message without one for every
+    tendon is left out (counted in a warning)."""
+    present: Counter[str] = Counter()
+    stamps_ns, from_log, unique, (efforts,) = _read(
+        reader, name, lambda payloads: joint_efforts(payloads, tendons, present))
+    if never := [t for t, column in zip(tendons, efforts.T, strict=True)
+                 if not np.isfinite(column).any()]:
+        held = ", ".join(f"{joint} ({count} messages)" for joint, count in
+                         sorted(present.items())) or "none"
+        raise TensionTopicError(
+            f"{reader.path}: {OPTION} {name} ({JOINT_STATE_TYPE}) has no effort for tendon(s) "
+            f"{', '.join(never)} in {len(efforts)} messages; its joints with efforts: {held}; "
+            f"allowed: an effort (N) for each tendon of the body (--design), by its name "
+            f"({', '.join(tendons)})", parameter=OPTION, value=never, allowed=", ".join(tendons))
+    stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
+    rows = efforts if keep.all() else efforts[keep]
+    if partial := int((~np.all(np.isfinite(rows), axis=1)).sum()):
+        warnings.append(f"{name}: {partial} messages without a finite effort for every tendon "
+                        f"({', '.join(tendons)}) left out")
+    several = len(tendons) > 1
+    return TensionSeries.of(stamps, rows if several else rows[:, 0], tendons if several else ())
+
+
+def _tensions(reader: BagReader, topics: TensionTopics, align_tolerance_s: float,
+              warnings: list[str]) -> TensionSeries:
+    """The tensions (N) of every tendon in the layout ``topics`` (see the module docstring)."""
+    one = [TENSION_TYPE, FLOAT_TENSION_TYPE]
+    tendons = topics.tendons
+    if topics.shared is None:
+        series = [_tension(reader, _tension_topic(
+            reader, topic, one, f"the tension topic of tendon {tendon}: {OPTION} {tendon}={topic}"),
+            warnings) for tendon, topic in zip(tendons, topics.per_tendon, strict=True)]
+        stamps, values = on_first_stamps([s.stamps_s for s in series],
+                                         [s.tension_n for s in series], align_tolerance_s)
+        first = topics.per_tendon[0]
+        if dropped := series[0].stamps_s.size - stamps.size:
+            warnings.append(f"{first}: {dropped} of {series[0].stamps_s.size} samples without a "
+                            f"sample of every other tendon's topic within align.tolerance_s = "
+                            f"{align_tolerance_s:g} s left out")
+        if not stamps.size:
+            raise TensionTopicError(
+                f"{reader.path}: no sample of {first} has a sample of every other tendon's topic "
+                f"({', '.join(topics.per_tendon[1:])}) within align.tolerance_s = "
+                f"{align_tolerance_s:g} s; allowed: topics sampled over the same time, within "
+                "align.tolerance_s of each other (--set align.tolerance_s=SECONDS)",
+                parameter="align.tolerance_s", value=align_tolerance_s,
+                allowed="the largest gap between the topics' samples (s)")
+        return TensionSeries(stamps, values if len(series) > 1 else values[:, 0],
+                             tendons if len(series) > 1 else ())
+    name = _tension_topic(reader, topics.shared, [*one, JOINT_STATE_TYPE],
+                          f"the tension topic: evaluate {OPTION}, calibrate {OPTION}")
+    if reader.topics[name] == JOINT_STATE_TYPE:
+        return _joint_tensions(reader, name, tendons, warnings)
+    if len(tendons) > 1:
+        raise TensionTopicError(
+            f"{reader.path}: {OPTION} {name} is a {reader.topics[name]}: one tension, but the "
+            f"body has {len(tendons)} tendons ({', '.join(tendons)}); allowed: a "
+            f"{JOINT_STATE_TYPE} topic with an effort per tendon, or NAME=TOPIC for each tendon",
+            parameter=OPTION, value=name, allowed=f"{JOINT_STATE_TYPE}, or NAME=TOPIC per tendon")
+    return _tension(reader, name, warnings)
 
 
 def _occlude(rows: np.ndarray, reported: np.ndarray, labels: Sequence[str], topic: str,
@@ -282,13 +362,19 @@ def _registration(reader: BagReader, parent: str, warnings: list[str]) -> Regist
     return found
 
 
-def load_bag(path: str | Path, *, labels: Sequence[str], tension_topic: str = "tension",
-             markers_topic: str = "markers") -> BagSource:
-    """Read one bag (rosbag2 folder or ``.mcap`` file); errors are :class:`BagError` or
+def load_bag(path: str | Path, *, labels: Sequence[str],
+             tension_topic: str | Sequence[str] = "tension", markers_topic: str = "markers",
+             tendons: Sequence[str] = ("tendon_1",), align_tolerance_s: float = 0.02
+             ) -> BagSource:
+    """Read one bag (rosbag2 folder or ``.mcap`` file) of a body whose tendons are ``tendons``
+    (names, the body file's order; default: the paper's one); ``tension_topic`` one topic or
+    ``NAME=TOPIC`` values (:func:`~tdcm_ros.metrics.tension_topics.tension_topics`), topics per
+    tendon aligned within ``align_tolerance_s`` (s). Errors are :class:`BagError` or
     :class:`~tdcm_ros.metrics.errors.MetricsError` naming the file and topic."""
+    topics = tension_topics(tension_topic, tendons)
     reader = open_bag(path)
     warnings = list(reader.warnings)
-    tension = _tension(reader, tension_topic, warnings)
+    tension = _tensions(reader, topics, align_tolerance_s, warnings)
     markers, occluded = _markers(reader, markers_topic, labels, warnings)
     registration = _registration(reader, markers.frame_id, warnings)
     return BagSource(Path(path), tension, markers, registration, tuple(warnings), occluded)

@@ -1,8 +1,8 @@
 """Least-squares calibration of design parameters (e.g. Young's modulus) from measured steps.
 
 Residuals: for every step and every marker visible in it, the model's marker point at the
-step's mean tension minus the measured mean position, all three coordinates, in ``tdcm_base``
-(m). ``scipy.optimize.least_squares`` (trust region, bounds from the design field ranges) fits
+step's mean tension (one per tendon for a body with several) minus the measured mean position,
+all three coordinates, in ``tdcm_base`` (m). ``scipy.optimize.least_squares`` (trust region, bounds from the design field ranges) fits
 the parameters relative to their start values.
 
 Uncertainty: ``cov = s^2 (J^T J)^-1`` at the optimum with ``s^2 = |r|^2 / (m - n)``; the interval
@@ -26,7 +26,7 @@ from scipy.optimize import least_squares
 from scipy.stats import t as student_t
 
 from tdcm_ros.errors import InputError, TdcmError, out_of_range
-from tdcm_ros.metrics.evaluation import Evaluation, model_tension
+from tdcm_ros.metrics.evaluation import Evaluation, model_tensions, solve_tension
 from tdcm_ros.metrics.measure import MeasuredStep
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
@@ -130,7 +130,8 @@ def parse_fit(text: str) -> tuple[str, ...]:
 
 @dataclass(frozen=True, eq=False)
 class _Data:
-    """Measured marker points in ``tdcm_base`` (steps, k, 3) with their step tensions (N)."""
+    """Measured marker points in ``tdcm_base`` (steps, k, 3) with their step tensions (steps, J)
+    N, a column per tendon."""
 
     tensions: Array
     markers: Array
@@ -141,9 +142,10 @@ class _Data:
         tensions, markers = [], []
         for steps, reg in prepared:
             for step in steps:
-                tensions.append(model_tension(step.tension_n, options))
+                tensions.append(model_tensions(step.tensions_n, options))
                 markers.append(reg.to_base(step.markers))
-        order = np.argsort(tensions, kind="stable")  # warm starts follow increasing tension
+        # warm starts follow increasing tension (the largest of a step's)
+        order = np.argsort([max(t) for t in tensions], kind="stable")
         return cls(np.asarray(tensions)[order], np.asarray(markers)[order])
 
 
@@ -152,8 +154,8 @@ def _model_markers(design: Design, data: _Data, options: EvaluateOptions) -> Arr
     radius = layout.radius(design.R_outer)
     out = np.empty_like(data.markers)
     warm: SolveResult | None = None
-    for i, tension in enumerate(data.tensions):
-        warm = solve(design, float(tension), settings=options.solver, warm_start=warm)
+    for i, tensions in enumerate(data.tensions.tolist()):
+        warm = solve(design, solve_tension(tensions), settings=options.solver, warm_start=warm)
         out[i] = surface_points(warm, layout.s, radius, layout.side_rad)[0]
     return out
 

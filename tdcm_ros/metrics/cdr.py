@@ -1,6 +1,8 @@
-"""Vectorised decoding of ``geometry_msgs/msg/WrenchStamped`` CDR payloads (1 kHz tension bags).
+"""Decoding of the evaluation's CDR payloads: ``geometry_msgs/msg/WrenchStamped`` vectorised (1 kHz
+tension bags), ``mocap4r2_msgs/msg/Markers``, ``std_msgs/msg/Float64`` and the tendon efforts of
+``sensor_msgs/msg/JointState``.
 
-Messages of equal length share one layout (same ``frame_id`` length), so each group is decoded
+WrenchStamped messages of equal length share one layout (same ``frame_id`` length), so each group is decoded
 with one NumPy view: encapsulation header (4 bytes), ``stamp.sec`` (int32), ``stamp.nanosec``
 (uint32), ``frame_id`` (uint32 length + bytes), then six float64 aligned to 8 bytes from the end
 of the encapsulation header. Big-endian payloads go through the typestore.
@@ -9,6 +11,7 @@ of the encapsulation header. Big-endian payloads go through the typestore.
 from __future__ import annotations
 
 import struct
+from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
@@ -118,3 +121,22 @@ def float64_data(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArray[
     values = np.array([float(deserialize(data, "std_msgs/msg/Float64").data)
                        for data in payloads])
     return np.zeros(len(payloads), dtype=np.int64), values
+
+
+def joint_efforts(payloads: Sequence[bytes], names: Sequence[str], present: Counter[str]
+                  ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Header stamps (ns) and the efforts (n, J) N of the joints ``names`` in
+    ``sensor_msgs/msg/JointState`` CDR payloads (NaN where a message has no effort for one);
+    each joint name a message gives an effort for is counted in ``present``."""
+    column = {name: j for j, name in enumerate(names)}
+    stamps = np.zeros(len(payloads), dtype=np.int64)
+    efforts = np.full((len(payloads), len(names)), np.nan)
+    for i, data in enumerate(payloads):
+        msg = deserialize(data, "sensor_msgs/msg/JointState")
+        stamps[i] = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        for name, effort in zip(msg.name, np.asarray(msg.effort, dtype=float).tolist(),
+                                strict=False):  # a name past the efforts has none
+            present[name] += 1
+            if (j := column.get(name)) is not None:
+                efforts[i, j] = effort
+    return stamps, efforts

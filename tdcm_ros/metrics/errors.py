@@ -15,3 +15,8 @@ class MarkersNotVisibleError(MetricsError):
 
 class NoStepsError(MetricsError):
     """No tension hold long and steady enough to count as a step."""
+
+
+class TensionTopicError(MetricsError):
+    """The tension topics given do not fit the body's tendons, or a topic carries another
+    number of tensions than it is asked for."""

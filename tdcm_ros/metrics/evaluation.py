@@ -1,4 +1,5 @@
-"""Evaluation: measured steps against the model re-run at each step's mean tension.
+"""Evaluation: measured steps against the model re-run at each step's mean tension (one per
+tendon for a body with several).
 
 Per step: the measured markers in ``tdcm_base``, the model's markers at the same surface points
 (:func:`tdcm_ros.model.surface_points`), both tip deflections and the shape error;
@@ -10,7 +11,7 @@ no solution at its tension.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -43,13 +44,21 @@ class Prediction:
     midline: Array
 
 
-def predict(design: Design, tension_n: float, options: EvaluateOptions,
+def predict(design: Design, tensions_n: Sequence[float], options: EvaluateOptions,
             warm_start: SolveResult | None = None) -> Prediction:
-    """Solve ``design`` at ``tension_n`` (N) and take the marker points and midline stations."""
-    result = solve(design, tension_n, settings=options.solver, warm_start=warm_start)
+    """Solve ``design`` at ``tensions_n`` (N, one per tendon) and take the marker points and
+    midline stations."""
+    result = solve(design, solve_tension(tensions_n), settings=options.solver,
+                   warm_start=warm_start)
     layout = options.layout
     markers, _ = surface_points(result, layout.s, layout.radius(design.R_outer), layout.side_rad)
     return Prediction(result, markers, result.pose_at(stations(options))[0])
+
+
+def solve_tension(tensions_n: Sequence[float]) -> float | list[float]:
+    """``tensions_n`` (N, one per tendon) as :func:`~tdcm_ros.model.solve` takes them: the number
+    itself for one tendon (its errors name ``tension``), else the list."""
+    return float(tensions_n[0]) if len(tensions_n) == 1 else [float(t) for t in tensions_n]
 
 
 def stations(options: EvaluateOptions) -> Array:
@@ -65,10 +74,11 @@ TABLE_KEYS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m
 @dataclass(frozen=True, eq=False)
 class StepRecord:
     """One step of the evaluation (SI units, frame ``tdcm_base``); ``trial`` counts from 1,
-    ``phase`` is ``loading`` or ``unloading``."""
+    ``phase`` is ``loading`` or ``unloading``; ``tensions_n`` the step's mean tension by tendon
+    name (N, the body file's order)."""
 
     trial: int
-    tension_n: float
+    tensions_n: dict[str, float]
     start_s: float
     end_s: float
     frames: int
@@ -88,10 +98,19 @@ class StepRecord:
         """Both tip deflections exist: the step counts in the metrics."""
         return self.measured_deflection_m is not None and self.predicted_deflection_m is not None
 
+    @property
+    def tension_n(self) -> float:
+        """The step's level: its largest tension (N), the tension itself for one tendon (Table
+        I's highest-tension step per trial)."""
+        return max(self.tensions_n.values())
+
     def to_json(self) -> dict[str, Any]:
-        """``trial``, ``phase``, ``tension_n``, ``measured_deflection_m`` and
-        ``predicted_deflection_m`` (tip), extras; units in the keys."""
-        return {"trial": self.trial, "phase": self.phase, "tension_n": self.tension_n,
+        """``trial``, ``phase``, ``tension_n`` (one tendon) or ``tensions_n`` (several: N by
+        tendon name), ``measured_deflection_m`` and ``predicted_deflection_m`` (tip), extras;
+        units in the keys."""
+        tension = {"tension_n": self.tension_n} if len(self.tensions_n) == 1 else {
+            "tensions_n": dict(self.tensions_n)}
+        return {"trial": self.trial, "phase": self.phase, **tension,
                 "measured_deflection_m": self.measured_deflection_m,
                 "predicted_deflection_m": self.predicted_deflection_m,
                 "shape_error_m": self.shape_error_m, "start_s": self.start_s,
@@ -121,19 +140,20 @@ class Evaluation:
 
     def hysteresis_m(self) -> list[float | None]:
         """Per record: for an unloading step, its measured tip deflection minus that of the
-        same trial's loading step nearest in tension within ``2 steps.tolerance_n`` (the same
-        level), in m; ``None`` for loading steps and where no such pair was measured."""
+        same trial's loading step nearest in tension (the largest difference over the tendons)
+        with every tendon within ``2 steps.tolerance_n`` (the same level), in m; ``None`` for
+        loading steps and where no such pair was measured."""
         band = 2.0 * self.options.steps.tolerance_n
         loading = [r for r in self.records
                    if r.phase == LOADING and r.measured_deflection_m is not None]
         out: list[float | None] = []
         for r in self.records:
             pairs = [p for p in loading if p.trial == r.trial
-                     and abs(p.tension_n - r.tension_n) <= band]
+                     and tension_distance(p.tensions_n, r.tensions_n) <= band]
             if r.phase != UNLOADING or r.measured_deflection_m is None or not pairs:
                 out.append(None)
                 continue
-            pair = min(pairs, key=lambda p: abs(p.tension_n - r.tension_n))
+            pair = min(pairs, key=lambda p: tension_distance(p.tensions_n, r.tensions_n))
             out.append(r.measured_deflection_m - float(pair.measured_deflection_m or 0.0))
         return out
 
@@ -156,6 +176,19 @@ class Evaluation:
                             "deflection_axis": self.options.deflection_axis,
                             "occluded_markers": dict(self.occluded),
                             "warnings": list(self.warnings)}}
+
+
+def tension_distance(a: Mapping[str, float], b: Mapping[str, float]) -> float:
+    """The largest difference (N) between two steps' tensions of the same tendons."""
+    return max(abs(a[name] - b[name]) for name in a)
+
+
+def tensions_text(tensions_n: Mapping[str, float]) -> str:
+    """A step's tensions in words: ``8.026 N`` for one tendon, else ``flexor 8.026 N, extensor
+    0.012 N``."""
+    if len(tensions_n) == 1:
+        return f"{next(iter(tensions_n.values())):.3f} N"
+    return ", ".join(f"{name} {value:.3f} N" for name, value in tensions_n.items())
 
 
 def registration_json(reg: Registration) -> dict[str, Any]:
@@ -186,16 +219,17 @@ def choose_registration(steps: Sequence[MeasuredStep], options: EvaluateOptions,
                                  side_rad=layout.side_rad, bent_markers=bent.markers)
 
 
-def model_tension(tension_n: float, options: EvaluateOptions) -> float:
-    """The tension (N) the model runs at: a mean within ``steps.tolerance_n`` below zero is
-    load-cell noise around zero and becomes 0."""
-    return 0.0 if -options.steps.tolerance_n <= tension_n < 0.0 else tension_n
+def model_tensions(tensions_n: Sequence[float], options: EvaluateOptions) -> tuple[float, ...]:
+    """The tensions (N, one per tendon) the model runs at: a mean within
+    ``steps.tolerance_n`` below zero is load-cell noise around zero and becomes 0."""
+    return tuple(0.0 if -options.steps.tolerance_n <= t < 0.0 else t for t in tensions_n)
 
 
 def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
                 options: EvaluateOptions) -> tuple[list[StepRecord], list[str]]:
     """Per-step records against the model of ``options.design``; warnings for flagged steps."""
     design = options.design
+    names = [t.name for t in design.tendon_list()]
     offset = options.layout.rest_offset(design.R_outer)
     radius = options.layout.radius(design.R_outer)
     at = stations(options)
@@ -204,9 +238,10 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
     warm: SolveResult | None = None
     for measured in steps:
         base = registration.to_base(measured.markers)
+        tensions = dict(zip(names, measured.tensions_n, strict=True))
         note, pred = "", None
         try:
-            pred = predict(design, model_tension(measured.tension_n, options), options, warm)
+            pred = predict(design, model_tensions(measured.tensions_n, options), options, warm)
             warm = pred.result
         except TdcmError as error:
             note = f"model: {error}"
@@ -216,9 +251,9 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
             note = note or f"tip marker {options.layout.labels[-1]} not visible"
         if note:
             warnings.append(f"trial {measured.step.trial + 1} step at "
-                            f"{measured.tension_n:.3f} N left out: {note}")
+                            f"{tensions_text(tensions)} left out: {note}")
         records.append(StepRecord(
-            trial=measured.step.trial + 1, tension_n=measured.tension_n,
+            trial=measured.step.trial + 1, tensions_n=tensions,
             start_s=measured.step.start_s, end_s=measured.step.end_s, frames=measured.frames,
             measured_markers=base, predicted_markers=None if pred is None else pred.markers,
             measured_deflection_m=float(deflection(base[-1], offset, options.deflection_axis))

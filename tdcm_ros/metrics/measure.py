@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tdcm_ros.metrics.align import nearest_within
-from tdcm_ros.metrics.errors import NoStepsError
+from tdcm_ros.metrics.errors import MetricsError, NoStepsError
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.steps import Step, detect_steps
@@ -25,14 +25,20 @@ Array = NDArray[np.float64]
 
 @dataclass(frozen=True, eq=False)
 class MeasuredStep:
-    """A step with its mean tension (N) and mean marker positions (k, 3) m in the markers' frame
-    (NaN rows: never visible in the step); ``frames`` marker frames fell in the step."""
+    """A step with its mean tensions (N, one per tendon in the body's order) and mean marker
+    positions (k, 3) m in the markers' frame (NaN rows: never visible in the step); ``frames``
+    marker frames fell in the step."""
 
     step: Step
-    tension_n: float
+    tensions_n: tuple[float, ...]
     markers: Array
     frames: int
     labels: tuple[str, ...]
+
+    @property
+    def tension_n(self) -> float:
+        """The largest of its tensions (N): the mean tension for one tendon."""
+        return max(self.tensions_n)
 
     @property
     def missing(self) -> tuple[str, ...]:
@@ -43,13 +49,22 @@ class MeasuredStep:
 
 def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: EvaluateOptions
                   ) -> list[MeasuredStep]:
-    """Detect the steps and average the markers over each (frame of ``markers``)."""
+    """Detect the steps and average the markers over each (frame of ``markers``); ``tension``
+    has a column per tendon of ``options.design``, named as in its body file."""
+    tendons = tuple(t.name for t in options.design.tendon_list())
+    if (tension.names or tendons[:1]) != tendons:  # an unnamed series is the one tendon's
+        raise MetricsError(
+            f"tension columns {', '.join(tension.names) or '(one, unnamed)'} do not match the "
+            f"design's tendons {', '.join(tendons)}; allowed: one column per tendon, in the "
+            "body file's order", parameter="tension", value=tension.names,
+            allowed=", ".join(tendons))
     markers.require_visible()
     steps = detect_steps(tension.stamps_s, tension.tension_n, options.steps)
     if not steps:
         cfg = options.steps
+        every = " of every tendon" if tension.names else ""
         raise NoStepsError(
-            f"no tension hold within {cfg.tolerance_n:g} N for {cfg.min_hold_s:g} s in "
+            f"no tension hold{every} within {cfg.tolerance_n:g} N for {cfg.min_hold_s:g} s in "
             f"{len(tension.stamps_s)} samples over {np.ptp(tension.stamps_s):.3g} s; adjust "
             "steps.tolerance_n / steps.min_hold_s", parameter="steps.min_hold_s",
             value=cfg.min_hold_s, allowed="a hold at least this long in the data")
@@ -75,5 +90,5 @@ def average_markers(tension: TensionSeries, markers: MarkerSeries, steps: Sequen
     np.add.at(sums, frame_step[used], filled[used])
     with np.errstate(invalid="ignore", divide="ignore"):
         means = np.where(counts[:, :, None] > 0, sums / counts[:, :, None], np.nan)
-    return [MeasuredStep(step, step.mean_n, means[k], int(frames[k]), markers.labels)
+    return [MeasuredStep(step, step.means_n, means[k], int(frames[k]), markers.labels)
             for k, step in enumerate(steps)]

@@ -48,7 +48,8 @@ class EvaluateOptions:
     layout: MarkerLayout = field(default_factory=MarkerLayout)
     align_tolerance_s: float = spec_field(
         0.02, name="align.tolerance_s", unit="s", low=0.0, high=10.0,
-        description="largest gap between a marker frame and its nearest tension sample")
+        description="largest gap between a marker frame and its nearest tension sample, and "
+                    "between the samples of a body's tension topics (one per tendon)")
     mape_threshold_m: float = spec_field(
         1e-3, unit="m", low=1e-9, high=1.0,
         description="steps measured below this tip deflection are left out of MAPE")

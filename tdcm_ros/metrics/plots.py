@@ -46,6 +46,12 @@ def shapes_caption(evaluation: Evaluation) -> str:
             "and midlines with midlines.")
 
 
+def tension_label(evaluation: Evaluation) -> str:
+    """The axis label of a step's tension: its mean, the largest tendon's for several."""
+    several = len(evaluation.options.design.tendon_list()) > 1
+    return f"step mean tension{', largest tendon' if several else ''} (N)"
+
+
 def shapes_figure(plt: Any, evaluation: Evaluation) -> Any:
     """Measured and predicted midlines and markers, x-z plane of ``tdcm_base``, one panel per
     trial, colour = the step's mean tension."""
@@ -83,7 +89,7 @@ def shapes_figure(plt: Any, evaluation: Evaluation) -> Any:
         ax.tick_params(labelsize=FONT_SIZE)
     axes[0][0].set_ylabel("z in tdcm_base (mm)", fontsize=FONT_SIZE)
     bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=list(axes[0]), shrink=0.8)
-    bar.set_label("step mean tension (N)", fontsize=FONT_SIZE)
+    bar.set_label(tension_label(evaluation), fontsize=FONT_SIZE)
     handles = [
         Line2D([], [], color="k", ls="-", lw=1.4, label="model midline"),
         Line2D([], [], color="k", ls="none", marker="x", ms=6, label="model markers"),
@@ -111,7 +117,7 @@ def error_figure(plt: Any, evaluation: Evaluation) -> Any:
                           for r in rows])
         ax.plot(tension, error * MM, "o-", label=f"trial {trial}")
     ax.axhline(0.0, color="k", lw=0.8, label="no error")
-    ax.set_xlabel("step mean tension (N)", fontsize=FONT_SIZE)
+    ax.set_xlabel(tension_label(evaluation), fontsize=FONT_SIZE)
     ax.set_ylabel("tip deflection error,\npredicted - measured (mm)", fontsize=FONT_SIZE)
     ax.set_title("model error at each step", fontsize=FONT_SIZE + 1)
     ax.tick_params(labelsize=FONT_SIZE)

@@ -27,12 +27,20 @@ def format_evaluation(ev: Evaluation) -> str:
                             f"{reg.residual_m * 1e3:.3f} mm)"}.get(reg.method, reg.method)
         lines.append(f"registration mocap -> tdcm_base of {source}: {how}")
     lines.append("")
-    lines.append(f"{'trial':>5} {'phase':>9} {'tension N':>9} {'frames':>6} {'meas mm':>8} "
-                 f"{'pred mm':>8} {'err mm':>7} {'shape mm':>8}  note")
+    tendons = [t.name for t in d.tendon_list()]
+    # one tension column per tendon, headed by its name where the body has several
+    heads = ["tension N"] if len(tendons) == 1 else [f"{name} N" for name in tendons]
+    widths = [max(9, len(head)) for head in heads]
+    lines.append(f"{'trial':>5} {'phase':>9} "
+                 + "".join(f"{head:>{w}} " for head, w in zip(heads, widths, strict=True))
+                 + f"{'frames':>6} {'meas mm':>8} {'pred mm':>8} {'err mm':>7} {'shape mm':>8}"
+                 "  note")
     for r in ev.records:
         measured, predicted = r.measured_deflection_m, r.predicted_deflection_m
         err = predicted - measured if predicted is not None and measured is not None else None
-        lines.append(f"{r.trial:>5} {r.phase:>9} {r.tension_n:>9.3f} {r.frames:>6} "
+        tensions = "".join(f"{value:>{w}.3f} " for value, w in zip(
+            r.tensions_n.values(), widths, strict=True))
+        lines.append(f"{r.trial:>5} {r.phase:>9} {tensions}{r.frames:>6} "
                      f"{_mm(r.measured_deflection_m):>8} {_mm(r.predicted_deflection_m):>8} "
                      f"{_mm(err):>7} {_mm(r.shape_error_m):>8}  {r.note}")
     m, unloading = ev.metrics, ev.unloading

@@ -25,26 +25,31 @@ def _sorted_stamps(name: str, stamps: ArrayLike) -> tuple[Array, NDArray[np.int6
 
 @dataclass(frozen=True, eq=False)
 class TensionSeries:
-    """Measured tendon tension: ``stamps_s`` (n,) s ascending, ``tension_n`` (n,) N, finite."""
+    """Measured tendon tension: ``stamps_s`` (n,) s ascending; ``tension_n`` N, finite: (n,) for
+    one unnamed tendon (``names`` empty), or (n, J) for the J tendons ``names`` (a column each,
+    in the body file's order)."""
 
     stamps_s: Array
     tension_n: Array
+    names: tuple[str, ...] = ()
 
     @classmethod
-    def of(cls, stamps_s: ArrayLike, tension_n: ArrayLike) -> TensionSeries:
-        """Validate, drop non-finite tensions and sort by stamp."""
+    def of(cls, stamps_s: ArrayLike, tension_n: ArrayLike, names: Sequence[str] = ()
+           ) -> TensionSeries:
+        """Validate, drop the samples with a non-finite tension and sort by stamp."""
         t, order = _sorted_stamps("tension stamps", stamps_s)
         x = np.asarray(tension_n, dtype=float)
-        if x.shape != (len(order),):
-            raise MetricsError(f"tension samples of shape {x.shape}; allowed: ({len(order)},), "
-                               "one per stamp", parameter="tension", value=x.shape,
-                               allowed=f"({len(order)},)")
+        shape = (len(order), len(names)) if names else (len(order),)
+        if x.shape != shape:
+            raise MetricsError(f"tension samples of shape {x.shape}; allowed: {shape}, one "
+                               f"per stamp{' and tendon' if names else ''}",
+                               parameter="tension", value=x.shape, allowed=str(shape))
         x = x[order]
-        keep = np.isfinite(x)
+        keep = np.all(np.isfinite(x.reshape(len(order), -1)), axis=1)
         if not keep.any():
             raise MetricsError("no finite tension sample; allowed: finite values (N)",
                                parameter="tension", value="all non-finite", allowed="finite (N)")
-        return cls(t[keep], x[keep])
+        return cls(t[keep], x[keep], tuple(names))
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,37 +1,42 @@
 """Step detection: holds at one tension level, grouped into trials (staircases).
 
-A *step* is a contiguous run of tension samples that stay within ``tolerance_n`` of the run's
-median for at least ``min_hold_s``, once the transients are excluded:
+The tension is one column per tendon (one column for the paper's body). A *step* is a
+contiguous run of samples in which every tendon's tension stays within ``tolerance_n`` of its
+own median over the run, for at least ``min_hold_s``, once the transients are excluded:
 
-1. the tension is despiked by a ``despike_samples`` median filter (single-sample glitches of
-   the load cell); samples are *steady* where it spans at most ``2 tolerance_n`` over a centred
-   window of ``settle_s``: ramps and ringing between levels are cut out;
-2. in each steady run, the longest contiguous stretch (of the despiked tension) within
-   ``tolerance_n`` of its median is
-   taken (the median is re-taken on the stretch until it settles); the rest of the run is
+1. each tendon's tension is despiked by a ``despike_samples`` median filter (single-sample
+   glitches of the load cell); samples are *steady* where each despiked tension spans at most
+   ``2 tolerance_n`` over a centred window of ``settle_s``: ramps and ringing between levels
+   are cut out;
+2. in each steady run, the longest contiguous stretch (of the despiked tensions) with every
+   tendon within ``tolerance_n`` of its median is
+   taken (the medians are re-taken on the stretch until it settles); the rest of the run is
    searched again, so a slow ramp through several levels can yield several steps;
 3. the first ``settle_s`` of the stretch is dropped (settling after the change); what is left
-   is a step if it lasts at least ``min_hold_s``. Its median and mean are of the measured
-   samples, the mean over those within ``tolerance_n`` of the median (glitches left out).
+   is a step if it lasts at least ``min_hold_s``. Each tendon's median and mean are of its
+   measured samples, the mean over those within ``tolerance_n`` of the median (glitches left
+   out): the step's tension is the vector of those means.
 
-A *trial* is one staircase: a new trial starts at the first step at or below ``zero_n``
-(or the first step after the tension dipped to ``zero_n``) once the current trial has risen
-above ``zero_n``. Steps at zero after the last rise stay with the last trial.
+A step's *level* is its largest tendon median (the median itself for one tendon): every tendon
+is released at a level at or below ``zero_n``. A *trial* is one staircase: a new trial starts
+at the first step at or below ``zero_n`` (or the first step after the level dipped to
+``zero_n``) once the current trial has risen above ``zero_n``. Steps at zero after the last
+rise stay with the last trial.
 
-Each step is *loading* or *unloading*: a trial's first step loads; a later step
-more than ``tolerance_n`` below the step before it unloads, more than ``tolerance_n`` above it
-loads, and within that band it keeps the phase of the step before. So the return to 0 N after a
+Each step is *loading* or *unloading*: a trial's first step loads; a later step in which some
+tendon is more than ``tolerance_n`` above its median in the step before loads, else one in
+which some tendon is more than ``tolerance_n`` below it unloads, and a step within that band on
+every tendon keeps the phase of the step before. So the return to 0 N after a
 trial's last level is that trial's unloading step; a zero hold between two trials is one hold,
 the start (loading) of the next trial. Table I uses the loading steps (the paper's protocol).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy.ndimage import maximum_filter1d, median_filter, minimum_filter1d
 
 from tdcm_ros.spec import check_fields, spec_field, specs_of
@@ -78,21 +83,32 @@ def settings_for_hold(hold_s: float) -> StepSettings:
 
 @dataclass(frozen=True)
 class Step:
-    """One hold: samples ``[start, stop)`` of the tension series, stamps in s, tensions in N."""
+    """One hold: samples ``[start, stop)`` of the tension series, stamps in s; each tendon's
+    median and mean tension (N, a tuple in the series' column order)."""
 
     trial: int
     start: int
     stop: int
     start_s: float
     end_s: float
-    median_n: float
-    mean_n: float
+    medians_n: tuple[float, ...]
+    means_n: tuple[float, ...]
     phase: str = LOADING
 
     @property
     def duration_s(self) -> float:
         """Length of the hold (s)."""
         return self.end_s - self.start_s
+
+    @property
+    def median_n(self) -> float:
+        """The step's level: its largest tendon median (N)."""
+        return max(self.medians_n)
+
+    @property
+    def mean_n(self) -> float:
+        """Its largest tendon mean (N): the mean tension for one tendon."""
+        return max(self.means_n)
 
 
 def _true_runs(mask: NDArray[np.bool_]) -> NDArray[np.int64]:
@@ -107,18 +123,20 @@ def _odd(n: int) -> int:
 
 
 def _steady(t: Array, smooth: Array, cfg: StepSettings) -> NDArray[np.bool_]:
+    """Samples where every column of ``smooth`` (n, J) spans at most ``2 tolerance_n``."""
     dt = float(np.median(np.diff(t))) if t.size > 1 else cfg.settle_s
     window = _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
-    span = maximum_filter1d(smooth, window, mode="nearest") - \
-        minimum_filter1d(smooth, window, mode="nearest")
-    return span <= 2.0 * cfg.tolerance_n
+    span = maximum_filter1d(smooth, window, axis=0, mode="nearest") - \
+        minimum_filter1d(smooth, window, axis=0, mode="nearest")
+    return np.all(span <= 2.0 * cfg.tolerance_n, axis=1)
 
 
 def _longest_band(x: Array, tol: float) -> tuple[int, int]:
-    """``[a, b)`` of the longest stretch within ``tol`` of its own median (iterated)."""
-    a, b = 0, x.size
+    """``[a, b)`` of the longest stretch of ``x`` (m, J) with every column within ``tol`` of
+    its own median (iterated)."""
+    a, b = 0, len(x)
     for _ in range(_MEDIAN_PASSES):
-        runs = _true_runs(np.abs(x - np.median(x[a:b])) <= tol)
+        runs = _true_runs(np.all(np.abs(x - np.median(x[a:b], axis=0)) <= tol, axis=1))
         if runs.size == 0:
             return 0, 0
         longest = runs[np.argmax(runs[:, 1] - runs[:, 0])]
@@ -129,7 +147,8 @@ def _longest_band(x: Array, tol: float) -> tuple[int, int]:
 
 
 def _holds(t: Array, x: Array, lo: int, hi: int, cfg: StepSettings) -> list[tuple[int, int]]:
-    """Hold index ranges inside the steady run ``[lo, hi)``."""
+    """Hold index ranges inside the steady run ``[lo, hi)`` of the despiked tensions ``x``
+    (n, J) N."""
     found: list[tuple[int, int]] = []
     pending = [(lo, hi)]
     while pending:
@@ -149,63 +168,69 @@ def _holds(t: Array, x: Array, lo: int, hi: int, cfg: StepSettings) -> list[tupl
 
 def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | None = None
                  ) -> list[Step]:
-    """Steps of a tension series (stamps ascending, s; tensions N), in time order, with trials."""
+    """Steps of a tension series (stamps ascending, s; tensions N, (n,) for one tendon or
+    (n, J) a column per tendon), in time order, with trials."""
     cfg = settings or StepSettings()
     t = np.asarray(stamps_s, dtype=float)
-    x = np.asarray(tension_n, dtype=float)
     if t.size < 2:
         return []
-    smooth = median_filter(x, size=cfg.despike_samples, mode="nearest") \
-        if cfg.despike_samples > 1 else x
+    x = np.asarray(tension_n, dtype=float).reshape(t.size, -1)
+    smooth = np.column_stack([median_filter(column, size=cfg.despike_samples, mode="nearest")
+                              for column in x.T]) if cfg.despike_samples > 1 else x
     ranges: list[tuple[int, int]] = []
     for lo, hi in _true_runs(_steady(t, smooth, cfg)):
         ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
     ranges.sort()
-    medians = [float(np.median(x[a:b])) for a, b in ranges]
+    medians = [tuple(float(np.median(column)) for column in x[a:b].T) for a, b in ranges]
+    sample_levels = x.max(axis=1)
     previous_stops = [0, *(b for _, b in ranges)][:len(ranges)]
-    dips = [float(x[prev:a].min()) if a > prev else np.inf
+    dips = [float(sample_levels[prev:a].min()) if a > prev else np.inf
             for (a, _), prev in zip(ranges, previous_stops, strict=True)]
-    trials = assign_trials(medians, dips, cfg.zero_n)
+    trials = assign_trials([max(m) for m in medians], dips, cfg.zero_n)
     steps = []
     for (start, stop), median, trial, phase in zip(
             ranges, medians, trials, assign_phases(medians, trials, cfg.tolerance_n),
             strict=True):
-        held = x[start:stop]
-        mean = float(np.mean(held[np.abs(held - median) <= cfg.tolerance_n]))
-        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median, mean,
+        means = tuple(float(np.mean(held[np.abs(held - m) <= cfg.tolerance_n]))
+                      for held, m in zip(x[start:stop].T, median, strict=True))
+        steps.append(Step(trial, start, stop, float(t[start]), float(t[stop - 1]), median, means,
                           phase))
     return steps
 
 
-def assign_trials(medians: Sequence[float], dips: Sequence[float], zero_n: float) -> list[int]:
-    """Trial (0-based) of each step from its median tension and the lowest tension between it
-    and the previous step (``dips``, N). Zero holds after the last rise stay with the last
-    staircase (its unloading); a live stream re-assigns them when the next rise comes."""
+def assign_trials(levels: ArrayLike, dips: ArrayLike, zero_n: float) -> list[int]:
+    """Trial (0-based) of each step from its level (N, see the module docstring) and the lowest
+    level between it and the previous step (``dips``, N). Zero holds after the last rise stay
+    with the last staircase (its unloading); a live stream re-assigns them when the next rise
+    comes."""
     trials: list[int] = []
     trial, risen = 0, False
-    for median, dip in zip(medians, dips, strict=True):
-        if risen and (median <= zero_n or dip <= zero_n):
+    for level, dip in zip(np.asarray(levels, dtype=float).tolist(),
+                          np.asarray(dips, dtype=float).tolist(), strict=True):
+        if risen and (level <= zero_n or dip <= zero_n):
             trial, risen = trial + 1, False
-        risen = risen or median > zero_n
+        risen = risen or level > zero_n
         trials.append(trial)
     if trial > 0 and not risen:
         trials = [k - 1 if k == trial else k for k in trials]
     return trials
 
 
-def assign_phases(medians: Sequence[float], trials: Sequence[int], tolerance_n: float
-                  ) -> list[str]:
-    """Phase (:data:`LOADING` or :data:`UNLOADING`) of each step from its median tension (N) and trial: a trial's
-    first step loads; later steps load or unload as they lie more than ``tolerance_n`` above or
-    below the step before, and keep its phase within that band."""
+def assign_phases(medians: ArrayLike, trials: ArrayLike, tolerance_n: float) -> list[str]:
+    """Phase (:data:`LOADING` or :data:`UNLOADING`) of each step from its median tensions (N:
+    (steps,) for one tendon, (steps, J) a column per tendon) and trial: a trial's first step
+    loads; a later step loads where some tendon lies more than ``tolerance_n`` above the step
+    before, else unloads where some tendon lies more than ``tolerance_n`` below it, and keeps
+    its phase within that band."""
+    rows = np.asarray(medians, dtype=float)
+    rows = rows.reshape(len(rows), -1) if rows.size else rows.reshape(0, 1)
+    trial = np.asarray(trials, dtype=int).tolist()
     phases: list[str] = []
-    for k, (median, trial) in enumerate(zip(medians, trials, strict=True)):
-        if k == 0 or trials[k - 1] != trial:
+    for k, (row, current) in enumerate(zip(rows, trial, strict=True)):
+        if k == 0 or trial[k - 1] != current or np.any(row > rows[k - 1] + tolerance_n):
             phases.append(LOADING)
-        elif median < medians[k - 1] - tolerance_n:
+        elif np.any(row < rows[k - 1] - tolerance_n):
             phases.append(UNLOADING)
-        elif median > medians[k - 1] + tolerance_n:
-            phases.append(LOADING)
         else:
             phases.append(phases[-1])
     return phases

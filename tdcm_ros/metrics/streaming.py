@@ -126,7 +126,7 @@ class RunningEvaluation:
             new = average_markers(tension, markers, done, self.options)
         else:
             empty = np.full((len(self.options.layout.labels), 3), np.nan)
-            new = [MeasuredStep(s, s.mean_n, empty, 0, self.options.layout.labels) for s in done]
+            new = [MeasuredStep(s, s.means_n, empty, 0, self.options.layout.labels) for s in done]
         previous_stop = 0
         for step in done:
             between = x[previous_stop:step.start]
@@ -165,7 +165,7 @@ class RunningEvaluation:
         records, warnings = score_steps(self.measured, reg, self.options)
         tensions = [m.tension_n for m in self.measured]
         trials = assign_trials(tensions, self._dips, self.options.steps.zero_n)
-        phases = assign_phases([m.step.median_n for m in self.measured], trials,
+        phases = assign_phases([m.step.medians_n for m in self.measured], trials,
                                self.options.steps.tolerance_n)
         self.records = [replace(r, trial=k + 1, phase=phase)
                         for r, k, phase in zip(records, trials, phases, strict=True)]

@@ -1,10 +1,13 @@
 """Write a simulated :class:`~tdcm_ros.metrics.synthetic.Recording` as a rosbag2 MCAP bag with the
-contract topics: ``/tension`` (WrenchStamped, force.z), ``/markers`` (mocap4r2_msgs/Markers in
-``mocap``, occluded markers omitted) and, optionally, ``/tf_static`` (``mocap`` -> ``tdcm_base``).
+contract topics: ``/tension`` (WrenchStamped, force.z; for several tendons a JointState with an
+effort per tendon, by name, or a WrenchStamped topic per tendon), ``/markers``
+(mocap4r2_msgs/Markers in ``mocap``, occluded markers omitted) and, optionally, ``/tf_static``
+(``mocap`` -> ``tdcm_base``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +18,7 @@ from tdcm_ros.metrics.synthetic import Recording
 
 EPOCH_NS = 1_700_000_000 * 1_000_000_000
 """Stamp (ns) of ``t = 0`` of a recording."""
+WRENCH, JOINT_STATE = "geometry_msgs/msg/WrenchStamped", "sensor_msgs/msg/JointState"
 
 
 def _header(stamp_ns: int, frame_id: str) -> object:
@@ -24,29 +28,64 @@ def _header(stamp_ns: int, frame_id: str) -> object:
         frame_id=frame_id)
 
 
-def write_recording(recording: Recording, path: str | Path, *, tf_static: bool = True,
-                    tension_topic: str = "tension", markers_topic: str = "markers") -> Path:
-    """Write ``recording`` to the new bag folder ``path``; returns ``path``."""
+def _wrenches(stamps_s: np.ndarray, tension_n: np.ndarray, topic: str
+              ) -> list[tuple[int, str, bytes]]:
+    """WrenchStamped messages (log time ns, topic, CDR) of tensions (N) at stamps (s)."""
     vector = msg_class("geometry_msgs/msg/Vector3")
-    wrench, stamped = msg_class("geometry_msgs/msg/Wrench"), msg_class(
-        "geometry_msgs/msg/WrenchStamped")
+    wrench, stamped = msg_class("geometry_msgs/msg/Wrench"), msg_class(WRENCH)
+    zero = vector(x=0.0, y=0.0, z=0.0)
+    messages = []
+    for t, value in zip(stamps_s.tolist(), tension_n.tolist(), strict=True):
+        ns = EPOCH_NS + round(t * 1e9)
+        msg = stamped(header=_header(ns, "tdcm_tendon"),
+                      wrench=wrench(force=vector(x=0.0, y=0.0, z=value), torque=zero))
+        messages.append((ns, topic, serialize(msg)))
+    return messages
+
+
+def _joint_states(stamps_s: np.ndarray, tensions_n: np.ndarray, names: tuple[str, ...],
+                  topic: str) -> list[tuple[int, str, bytes]]:
+    """JointState messages (log time ns, topic, CDR): an effort (N) per tendon ``names``."""
+    joints = msg_class(JOINT_STATE)
+    messages = []
+    for t, row in zip(stamps_s.tolist(), tensions_n, strict=True):
+        ns = EPOCH_NS + round(t * 1e9)
+        msg = joints(header=_header(ns, ""), name=list(names), position=np.empty(0),
+                     velocity=np.empty(0), effort=np.array(row, dtype=np.float64))
+        messages.append((ns, topic, serialize(msg)))
+    return messages
+
+
+def write_recording(recording: Recording, path: str | Path, *, tf_static: bool = True,
+                    tension_topic: str = "tension", markers_topic: str = "markers",
+                    tendon_topics: Mapping[str, str] | None = None) -> Path:
+    """Write ``recording`` to the new bag folder ``path``; returns ``path``. A recording of
+    several tendons goes to ``tension_topic`` as one JointState, or with ``tendon_topics``
+    (tendon name -> topic) to a WrenchStamped topic per tendon."""
     marker, markers = msg_class("mocap4r2_msgs/msg/Marker"), msg_class("mocap4r2_msgs/msg/Markers")
     point = msg_class("geometry_msgs/msg/Point")
-    zero = vector(x=0.0, y=0.0, z=0.0)
+    tension = recording.tension
+    if tendon_topics is not None:
+        columns = dict(zip(tension.names, tension.tension_n.T, strict=True))
+        kind, series = WRENCH, {topic: _wrenches(tension.stamps_s, columns[name], topic)
+                                for name, topic in tendon_topics.items()}
+    elif tension.names:
+        kind, series = JOINT_STATE, {tension_topic: _joint_states(
+            tension.stamps_s, tension.tension_n, tension.names, tension_topic)}
+    else:
+        kind, series = WRENCH, {tension_topic: _wrenches(tension.stamps_s, tension.tension_n,
+                                                         tension_topic)}
     with BagWriter(path) as bag:
-        bag.add_topic(tension_topic, "geometry_msgs/msg/WrenchStamped")
+        for topic in series:
+            bag.add_topic(topic, kind)
         bag.add_topic(markers_topic, "mocap4r2_msgs/msg/Markers")
         messages: list[tuple[int, str, bytes]] = []
         if tf_static:
             bag.add_topic("/tf_static", "tf2_msgs/msg/TFMessage",
                           OfferedQos(depth=1, durability="transient_local"))
             messages.append((EPOCH_NS, "/tf_static", serialize(_tf(recording))))
-        tension = recording.tension
-        for t, value in zip(tension.stamps_s.tolist(), tension.tension_n.tolist(), strict=True):
-            ns = EPOCH_NS + round(t * 1e9)
-            msg = stamped(header=_header(ns, "tdcm_tendon"),
-                          wrench=wrench(force=vector(x=0.0, y=0.0, z=value), torque=zero))
-            messages.append((ns, tension_topic, serialize(msg)))
+        for part in series.values():
+            messages.extend(part)
         frames = recording.markers
         labels = frames.labels
         for n, (t, rows) in enumerate(zip(frames.stamps_s.tolist(), frames.positions,

@@ -58,11 +58,14 @@ def test_every_example_parses_and_is_of_a_known_kind(example: Example) -> None:
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A folder holding every file the offline examples name, as a checkout does: the sample
-    bag (also as ``run.mcap``, ``trial1``, ``trial2``), ``config/``, ``bench/``, a scene file and
-    a bag from another lab."""
+    bag (also as ``run.mcap``, ``trial1``, ``trial2``), ``config/``, ``bench/``, a scene file, a
+    bag from another lab and bags of the antagonistic pair (``pair_run``: one JointState;
+    ``pair_topics``: a WrenchStamped topic per tendon, ``/flexor`` and ``/extensor``)."""
     from tdcm_ros.metrics.synthetic import simulate
+    from tdcm_ros.metrics.synthetic_bag import write_recording
     from tdcm_ros.model import MarkerLayout
     from test.cli.test_foreign_bags_cli import DESIGN, LEVELS, VICON, write_foreign_bag
+    from test.metrics.metrics_samples import pair_recording
 
     folder = tmp_path_factory.mktemp("examples")
     sample = REPO / "bags" / "paper_experiment"
@@ -76,6 +79,10 @@ def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     lab = simulate(DESIGN, layout=MarkerLayout(labels=VICON, radial_offset=0.0), levels=LEVELS,
                    hold_s=2.0, trials=1, tension_hz=200.0, mocap_hz=50.0, seed=8)
     write_foreign_bag(lab, folder / "lab_bag")
+    pair = pair_recording(trials=1, tension_noise_n=0.03, marker_noise_m=5e-5, lag_s=0.1)
+    write_recording(pair, folder / "pair_run")
+    write_recording(pair, folder / "pair_topics",
+                    tendon_topics={"flexor": "/flexor", "extensor": "/extensor"})
     return folder
 
 

@@ -2,11 +2,20 @@
 
 from __future__ import annotations
 
-from tdcm_ros.metrics.synthetic import simulate
-from tdcm_ros.model import preset
+from pathlib import Path
+
+from tdcm_ros.metrics.synthetic import Recording, simulate
+from tdcm_ros.model import Design, named_design, preset
 
 TRUE_E = 0.7e9  #: Pa, the simulated robot's modulus
 DESIGN = preset("paper-experiment").with_overrides(E=TRUE_E)
+#: The antagonistic pair's body file (tendons flexor, extensor), as ``--design`` takes it.
+PAIR_BODY = str(Path(__file__).resolve().parents[2] / "config" / "bodies" /
+                "antagonistic_pair.yaml")
+PAIR = named_design(PAIR_BODY)
+#: Each trial's holds, N (flexor, extensor): bend to +x, balanced, bend to -x; the last hold
+#: is the final return to (0, 0).
+PAIR_LEVELS = ((0.0, 0.0), (8.0, 0.0), (16.0, 0.0), (8.0, 8.0), (0.0, 12.0))
 
 
 def small_recording(**kw: object) -> object:
@@ -15,3 +24,14 @@ def small_recording(**kw: object) -> object:
             "mocap_hz": 50.0, "marker_noise_m": 5e-5, "seed": 1}
     args.update(kw)
     return simulate(DESIGN, **args)
+
+
+def pair_recording(design: Design = PAIR, **kw: object) -> Recording:
+    """The antagonistic pair (``design``: its E is the truth), 2 trials of :data:`PAIR_LEVELS`
+    held 2 s; tension 250 Hz, mocap 50 Hz; by default noise-free with no lag, so each hold's
+    markers are the model's own at the hold's true tension vector; ``kw`` overrides."""
+    args = {"levels": PAIR_LEVELS, "hold_s": 2.0, "trials": 2, "tension_hz": 250.0,
+            "mocap_hz": 50.0, "tension_noise_n": 0.0, "marker_noise_m": 0.0, "lag_s": 0.0,
+            "seed": 1}
+    args.update(kw)
+    return simulate(design, **args)
