@@ -1,13 +1,19 @@
 """Streaming form of the evaluation for the live node: samples in, finished steps and running
 Table I out, with the same definitions as the offline evaluation.
 
+A tension sample is one tension (N) per tendon of the design (one for the paper's body).
 Tension samples and marker frames are buffered; :meth:`RunningEvaluation.update` runs step
 detection on the buffer. A step is *finished* once the buffer reaches ``settle_s`` past its end
 (the tension left the band); finished steps are averaged, scored against the model and dropped
 from the buffer. Trials and phases are assigned over all finished steps at each update, as the
-offline evaluation does: a zero hold after a rise is the trial's unloading until the next rise
-makes it the start of the next trial (the running Table I then counts it as loading). The buffer keeps at most
+offline evaluation does (from the steps' median levels and the lowest level between steps):
+a zero hold after a rise is the trial's unloading until the next rise makes it the start of the
+next trial (the running Table I then counts it as loading). The buffer keeps at most
 ``max_buffer_s`` of data (older samples are dropped when no step finishes, e.g. a long ramp).
+
+Per-frame errors (:meth:`RunningEvaluation.sample_errors`) take the model at the tension
+nearest the frame's stamp from a :class:`~tdcm_ros.metrics.lookup.MarkerTable` (one tendon) or
+a :class:`~tdcm_ros.metrics.lookup.MarkerLattice` (several tendons).
 
 Roll (issue 18): the per-frame errors (:meth:`RunningEvaluation.sample_errors`) compare with
 the model rolled by the roll current at the frame's stamp (:meth:`RunningEvaluation.add_roll`,
@@ -17,6 +23,7 @@ it assumes the body at roll 0.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -29,7 +36,7 @@ from tdcm_ros.metrics.evaluation import (
     metrics_of,
     score_steps,
 )
-from tdcm_ros.metrics.lookup import MarkerTable
+from tdcm_ros.metrics.lookup import MarkerLattice, MarkerTable
 from tdcm_ros.metrics.measure import MeasuredStep, average_markers
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
@@ -53,9 +60,13 @@ class RunningEvaluation:
         self.registration = registration
         self.max_buffer_s = float(max_buffer_s)
         self.estimate = estimate
-        self.table = MarkerTable(options.design, options.layout, settings=options.solver)
+        self.tendons = tuple(t.name for t in options.design.tendon_list())
+        self.table: MarkerTable | MarkerLattice = (
+            MarkerTable(options.design, options.layout, settings=options.solver)
+            if len(self.tendons) == 1 else
+            MarkerLattice(options.design, options.layout, settings=options.solver))
         self._t: list[float] = []
-        self._x: list[float] = []
+        self._x: list[tuple[float, ...]] = []
         self._frame_t: list[float] = []
         self._frames: list[Array] = []
         self.rolls = RollHistory()
@@ -72,12 +83,17 @@ class RunningEvaluation:
         self.registration = self.used_registration = registration
         self._rescore()
 
-    def add_tension(self, stamp_s: float, tension_n: float) -> None:
-        """One tension sample (s, N); out-of-order samples are ignored."""
+    def add_tension(self, stamp_s: float, tension_n: float | Sequence[float]) -> None:
+        """One tension sample: stamp (s) and the tension (N), one per tendon of the design in
+        its order (a number for one tendon); out-of-order samples are ignored."""
+        row = tuple(np.atleast_1d(np.asarray(tension_n, dtype=float)).tolist())
+        if len(row) != len(self.tendons):
+            raise out_of_range("tension_n", row, f"{len(self.tendons)} values (N): one per "
+                               f"tendon ({', '.join(self.tendons)})")
         if self._t and stamp_s <= self._t[-1]:
             return
         self._t.append(float(stamp_s))
-        self._x.append(float(tension_n))
+        self._x.append(row)
 
     def add_roll(self, stamp_s: float, roll_rad: float) -> bool:
         """One roll sample (s; rad about the base +z axis); False when out of order (ignored).
@@ -89,24 +105,31 @@ class RunningEvaluation:
         self._frame_t.append(float(stamp_s))
         self._frames.append(np.asarray(positions, dtype=float))
 
-    def tension_at(self, stamp_s: float) -> float | None:
-        """The buffered tension nearest ``stamp_s`` within the alignment tolerance (N)."""
+    def tension_at(self, stamp_s: float) -> tuple[float, ...] | None:
+        """The buffered tension nearest ``stamp_s`` within the alignment tolerance (N, one per
+        tendon)."""
         if not self._t:
             return None
         t = np.asarray(self._t)
         i = int(np.argmin(np.abs(t - stamp_s)))
         return self._x[i] if abs(t[i] - stamp_s) <= self.options.align_tolerance_s else None
 
+    def model_markers(self, tension_n: Sequence[float]) -> Array:
+        """The model's marker points (k, 3) m in ``tdcm_base`` at ``tension_n`` (N, one per
+        tendon; a negative one is taken as 0), from :attr:`table`."""
+        at = np.maximum(np.asarray(tension_n, dtype=float), 0.0)
+        return self.table.markers(at[0] if isinstance(self.table, MarkerTable) else at)
+
     def sample_errors(self, stamp_s: float, positions: ArrayLike) -> Array | None:
         """Measured minus predicted marker points (k, 3) m in ``tdcm_base`` for one frame, the
-        model at the aligned tension (:class:`MarkerTable`) rolled by the roll at the frame's
+        model at the aligned tension (:meth:`model_markers`) rolled by the roll at the frame's
         stamp (0 without any); ``None`` without a registration (given or estimated yet) or an
         aligned tension."""
         tension = self.tension_at(stamp_s)
         if tension is None or self.used_registration is None:
             return None
         measured = self.used_registration.to_base(np.asarray(positions, dtype=float))
-        predicted = roll_points(self.table.markers(max(tension, 0.0)), self.rolls.at(stamp_s))
+        predicted = roll_points(self.model_markers(tension), self.rolls.at(stamp_s))
         return measured - predicted
 
     def update(self) -> list[StepRecord]:
@@ -114,12 +137,15 @@ class RunningEvaluation:
         if len(self._t) < 2:
             return []
         t, x = np.asarray(self._t), np.asarray(self._x)
+        several = len(self.tendons) > 1
+        tension = TensionSeries(t, x if several else x[:, 0], self.tendons if several else ())
         cfg = self.options.steps
-        done = [s for s in detect_steps(t, x, cfg) if s.end_s < t[-1] - cfg.settle_s]
+        done = [s for s in detect_steps(t, tension.tension_n, cfg)
+                if s.end_s < t[-1] - cfg.settle_s]
         if not done:
             self._trim(t[-1] - self.max_buffer_s)
             return []
-        tension = TensionSeries(t, x)
+        levels = x.max(axis=1)  # the steps' module docstring: every tendon at or below zero_n
         if self._frames:
             markers = MarkerSeries.of(self._frame_t, self.options.layout.labels,
                                       np.asarray(self._frames))
@@ -129,12 +155,12 @@ class RunningEvaluation:
             new = [MeasuredStep(s, s.means_n, empty, 0, self.options.layout.labels) for s in done]
         previous_stop = 0
         for step in done:
-            between = x[previous_stop:step.start]
+            between = levels[previous_stop:step.start]
             self._dips.append(min(self._low_since_step,
                                   float(between.min()) if between.size else np.inf))
             self._low_since_step = np.inf
             previous_stop = step.stop
-        tail = x[done[-1].stop:]
+        tail = levels[done[-1].stop:]
         self._low_since_step = float(tail.min()) if tail.size else np.inf
         self.measured.extend(new)
         self._trim(done[-1].end_s, keep_low=True)
@@ -145,7 +171,8 @@ class RunningEvaluation:
     def _trim(self, until_s: float, keep_low: bool = False) -> None:
         keep = int(np.searchsorted(np.asarray(self._t), until_s, side="right"))
         if not keep_low and keep:
-            self._low_since_step = min(self._low_since_step, float(np.min(self._x[:keep])))
+            self._low_since_step = min(self._low_since_step,
+                                       float(np.max(self._x[:keep], axis=1).min()))
         del self._t[:keep], self._x[:keep]
         first = int(np.searchsorted(np.asarray(self._frame_t),
                                     until_s - self.options.align_tolerance_s, side="right"))
@@ -163,8 +190,8 @@ class RunningEvaluation:
             self.problem = f"waiting for a registration: {error}"
             return
         records, warnings = score_steps(self.measured, reg, self.options)
-        tensions = [m.tension_n for m in self.measured]
-        trials = assign_trials(tensions, self._dips, self.options.steps.zero_n)
+        trials = assign_trials([m.step.median_n for m in self.measured], self._dips,
+                               self.options.steps.zero_n)
         phases = assign_phases([m.step.medians_n for m in self.measured], trials,
                                self.options.steps.tolerance_n)
         self.records = [replace(r, trial=k + 1, phase=phase)

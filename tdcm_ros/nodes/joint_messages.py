@@ -1,9 +1,12 @@
 """``sensor_msgs/msg/JointState`` of the bench's joints: the roll (rad), as the device nodes
 publish it (``tension_driver``: ``joint_states``; ``device_twin``: ``sim/joint_states_true``), and
-the tendons as prismatic joints, as model_node predicts them (``tendon_states``)."""
+the tendons as prismatic joints, as model_node predicts them (``tendon_states``), and the
+tendons' tensions as efforts, as model_node and metrics_node take them
+(:func:`tendon_efforts`)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -36,3 +39,14 @@ def tendon_states(stamp_ns: int, names: Sequence[str], strokes_m: Sequence[float
         name=list(names),
         position=np.array(strokes_m, dtype=np.float64), velocity=np.empty(0),
         effort=np.array(tensions_n, dtype=np.float64))
+
+
+def tendon_efforts(message: Any, tendons: Sequence[str]
+                   ) -> tuple[tuple[float, ...], tuple[str, ...]]:
+    """Each tendon's tension (N) in the order of ``tendons`` (names) from the efforts of a
+    JointState, matched by joint name (NaN where missing; not validated otherwise), and the
+    tendons it has no effort for."""
+    efforts = dict(zip(message.name, np.asarray(message.effort, dtype=float).tolist(),
+                       strict=False))
+    return (tuple(efforts.get(name, math.nan) for name in tendons),
+            tuple(name for name in tendons if name not in efforts))

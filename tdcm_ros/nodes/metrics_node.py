@@ -1,6 +1,10 @@
 """``metrics_node``: live Table I metrics of the model against motion capture.
 
-Subscribes ``tension`` (geometry_msgs/msg/WrenchStamped, ``wrench.force.z`` in N), ``markers``
+Subscribes ``tension`` (type ``input.tension_type``: geometry_msgs/msg/WrenchStamped,
+``wrench.force.z`` in N, for a body with one tendon; or sensor_msgs/msg/JointState, one effort
+in N per tendon named as in the body file, as model_node takes it: required for a body with
+several tendons, e.g. ``design.file: config/bodies/antagonistic_pair.yaml``; a JointState
+without a finite effort for every tendon is dropped and counted), ``markers``
 (mocap4r2_msgs/msg/Markers, frame ``mocap``, labels ``markers.labels``), ``/tf_static``
 (tf2_msgs/msg/TFMessage, transient local: the ``mocap`` -> ``tdcm_base`` transform) and
 ``joint_states`` (sensor_msgs/msg/JointState: the roll, joint ``roll.joint``, rad; 0 until one
@@ -10,11 +14,13 @@ roll 0 (see :mod:`tdcm_ros.metrics.streaming`).
 Publishes (frame ``tdcm_base``, SI units):
 
 - ``metrics/marker_errors`` (mocap4r2_msgs/msg/Markers): per marker frame, each visible
-  marker's measured minus predicted position (m; the model at the tension nearest the frame's
-  stamp within ``align.tolerance_s``), same labels and stamp as the input;
+  marker's measured minus predicted position (m; the model at the tension, or tension vector,
+  nearest the frame's stamp within ``align.tolerance_s``: interpolated on a grid of 0.1 N per
+  tendon, :mod:`tdcm_ros.metrics.lookup`), same labels and stamp as the input;
 - ``metrics/tip_error`` (geometry_msgs/msg/Vector3Stamped): the same vector for the tip marker;
 - ``metrics/table`` (std_msgs/msg/String): JSON of the running Table I and the finished steps,
-  the ``tdcm evaluate --json`` layout, after each finished step;
+  the ``tdcm evaluate --json`` layout (a step's ``tensions_n`` by tendon name), after each
+  finished step;
 - ``metrics/mape_pct``, ``metrics/rmse_m``, ``metrics/mae_m``, ``metrics/shape_error_m``,
   ``metrics/deflection_mean_m`` (std_msgs/msg/Float64): the running values, once defined;
 - ``/diagnostics``: WARN when no tension or no markers arrived for ``stale_s``, or no
@@ -38,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from tdcm_ros.bagio import from_dict, msg_class
-from tdcm_ros.errors import InputError
+from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.metrics import (
     MARKER_SPECS,
     OPTION_SPECS,
@@ -59,6 +65,7 @@ from tdcm_ros.model import (
     parameter_specs,
     require_paper_tendon,
 )
+from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_efforts
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.runtime import (
     DiagnosticLevel,
@@ -74,6 +81,7 @@ from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
+TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", JOINT_STATE)
 TABLE_TOPICS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m")
 BASE_FRAME = "tdcm_base"
 SCORED_DEPTH = 10_000
@@ -94,6 +102,10 @@ LAYOUT_SPECS = {**MARKER_SPECS,
                 "ball_radius": replace(MARKER_SPECS["ball_radius"], formerly=("radius",))}
 #: Parameters fixed at start, besides the evaluation options.
 FIXED_SPECS = by_name(
+    Spec("input.tension_type", description="message type on `tension`: WrenchStamped "
+         "(force.z, N; a body with one tendon) or JointState (one effort per tendon in N, by "
+         "the body's tendon names: required for a body with several tendons)",
+         default=TENSION_TYPES[0], kind="str", choices=TENSION_TYPES),
     Spec("registration.source", description="auto, tf_static, parameter or estimate",
          default="auto", kind="str", choices=REGISTRATION_SOURCES),
     Spec("registration.translation", "m", "tdcm_base origin in mocap, source=parameter",
@@ -115,14 +127,16 @@ def _stamp_s(message: Any) -> float:
     return int(message.header.stamp.sec) + int(message.header.stamp.nanosec) * 1e-9
 
 
-def declare_design_and_layout(port: NodePort, node: str = "metrics_node"
-                              ) -> tuple[Design, MarkerLayout]:
+def declare_design_and_layout(port: NodePort, node: str = "metrics_node", *,
+                              tendon_list: bool = False) -> tuple[Design, MarkerLayout]:
     """The design (``design.preset`` then ``design.*``) and the marker layout (``markers.*``)
-    as read-only parameters of the node named ``node``; bad values, and a body with a tendon
-    list (the node takes one tension), raise InputError."""
+    as read-only parameters of the node named ``node``; bad values raise InputError, and so
+    does a body with a tendon list unless ``tendon_list`` (the node takes a tension per
+    tendon)."""
     start = declare_specs(port, PRESET_SPECS, read_only=True)
     base = named_design(str(start["design.file"]) or str(start["design.preset"]))
-    require_paper_tendon(base.tendons, f"{node} (one tension input)", "design.file")
+    if not tendon_list:
+        require_paper_tendon(base.tendons, f"{node} (one tension input)", "design.file")
     design = base.with_overrides(**declare_specs(
         port, parameter_specs(base), prefix="design.", defaults=base.to_dict(), read_only=True))
     given = {k: s for k, s in LAYOUT_SPECS.items() if k != "radial_offset"}
@@ -168,6 +182,14 @@ class MetricsNode(NodeLogic):
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
         declare_specs(port, TUNABLE_SPECS)
         self.source = str(fixed["registration.source"])
+        self.tension_type = str(fixed["input.tension_type"])
+        self.tendons = tuple(t.name for t in self.options.design.tendon_list())
+        if len(self.tendons) > 1 and self.tension_type != JOINT_STATE:
+            raise InputError(
+                f"input.tension_type = {self.tension_type} carries one tension, but the body "
+                f"has {len(self.tendons)} tendons ({', '.join(self.tendons)}); allowed: "
+                f"{JOINT_STATE} (an effort in N per tendon, by name)",
+                parameter="input.tension_type", value=self.tension_type, allowed=JOINT_STATE)
         self.roll_joint = str(fixed["roll.joint"])
         translation, rotation = fixed["registration.translation"], fixed["registration.rotation"]
         update_s = float(fixed["update_period_s"])
@@ -189,8 +211,7 @@ class MetricsNode(NodeLogic):
                                                    qos) for name in TABLE_TOPICS}
         # what it scores is queued, not dropped, while it is busy (see SCORED_DEPTH)
         scored = QoS(depth=SCORED_DEPTH, reliability="reliable")
-        port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", self._on_tension,
-                                 scored)
+        port.create_subscription("tension", self.tension_type, self._on_tension, scored)
         port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", self._on_markers,
                                  scored)
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
@@ -208,19 +229,27 @@ class MetricsNode(NodeLogic):
     def _options(self) -> EvaluateOptions:
         """Evaluation options from the (read-only) parameters; bad values raise InputError."""
         port = self.port
-        design, layout = declare_design_and_layout(port)
+        design, layout = declare_design_and_layout(port, tendon_list=True)
         steps = StepSettings(**declare_specs(port, STEP_SPECS, prefix="steps.", read_only=True))
         return EvaluateOptions(design=design, steps=steps, layout=layout,
                                **declare_specs(port, OPTION_SPECS, read_only=True))
 
     def _on_tension(self, message: Any) -> None:
-        value = float(message.wrench.force.z)
-        if not math.isfinite(value):
+        """Buffer a tension sample (N, one per tendon); one without a finite tension for every
+        tendon is counted (``tension_missing_tendon``, ``tension_non_finite``) and dropped."""
+        if self.tension_type == JOINT_STATE:
+            values, missing = tendon_efforts(message, self.tendons)
+            if missing:
+                self.counts["tension_missing_tendon"] += 1
+                return
+        else:
+            values = (float(message.wrench.force.z),)
+        if not all(math.isfinite(value) for value in values):
             self.counts["tension_non_finite"] += 1
             return
         self.counts["tension"] += 1
         self.last_ns["tension"] = self.port.now_ns()
-        self.running.add_tension(_stamp_s(message), value)
+        self.running.add_tension(_stamp_s(message), values)
 
     def _on_joint_states(self, message: Any) -> None:
         roll = joint_position(message, self.roll_joint)
@@ -241,7 +270,11 @@ class MetricsNode(NodeLogic):
             self.counts["markers_ignored"] += ignored
         stamp = _stamp_s(message)
         self.running.add_markers(stamp, rows)
-        errors = self.running.sample_errors(stamp, rows)
+        try:
+            errors = self.running.sample_errors(stamp, rows)
+        except TdcmError:  # no model at that tension: as offline, the frame is not scored
+            self.counts["frames_model_failed"] += 1
+            return
         if errors is None:
             self.counts["frames_without_error"] += 1
             return

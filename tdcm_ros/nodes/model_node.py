@@ -64,7 +64,7 @@ from tdcm_ros.model import (
     solve,
     warm_up,
 )
-from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_states
+from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_efforts, tendon_states
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import midline_messages, stamp_ns_of
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
@@ -253,7 +253,9 @@ class ModelNode(NodeLogic):
             tension = float(message.wrench.force.z)
             stamp_ns = stamp_ns_of(message)
         elif self.tension_type == JOINT_STATE:
-            tension, reason = self._tendon_efforts(message)
+            tension, missing = tendon_efforts(message,
+                                              [t.name for t in self.design.tendon_list()])
+            reason = "missing_tendon" if missing else ""
             stamp_ns = stamp_ns_of(message)
         else:
             tension, stamp_ns = float(message.data), None
@@ -269,16 +271,6 @@ class ModelNode(NodeLogic):
         if self.pending is not None:
             self.counts["coalesced"] += 1
         self.pending = (tension, now if stamp_ns is None else stamp_ns)
-
-    def _tendon_efforts(self, message: Any) -> tuple[tuple[float, ...], str]:
-        """Each tendon's tension (N) from a JointState's efforts by the design's tendon names,
-        in the design's order; ``missing_tendon`` where one has no effort."""
-        efforts = dict(zip(message.name, np.asarray(message.effort, dtype=float).tolist(),
-                           strict=False))
-        names = [t.name for t in self.design.tendon_list()]
-        if any(name not in efforts for name in names):
-            return tuple(efforts.get(name, math.nan) for name in names), "missing_tendon"
-        return tuple(efforts[name] for name in names), ""
 
     def _on_joint_states(self, message: Any) -> None:
         """Keep the roll (rad) of a JointState naming ``roll.joint``, with its stamp (ns; an

@@ -51,13 +51,16 @@ def test_a_bad_body_file_stops_the_start_naming_the_key(tmp_path: Path) -> None:
                                              name="metrics_node"))
 
 
-def test_the_nodes_refuse_a_body_with_a_tendon_list_naming_it() -> None:
-    """metrics_node and shape_controller take one tension: a body with several tendons stops
-    their start."""
+def test_shape_controller_refuses_a_body_with_a_tendon_list_naming_it() -> None:
+    """shape_controller takes one tension: a body with several tendons stops its start;
+    metrics_node takes it (a tension per tendon: test_metrics_node_tendons.py)."""
     body = str(Path(__file__).resolve().parents[2] / "config" / "bodies" / "antagonistic_pair.yaml")
-    for name in ("metrics_node", "shape_controller"):
-        with pytest.raises(InvalidDesignError, match=rf"design\.file: {name} \(one tension"):
-            declare_design_and_layout(MemoryPort({"design.file": body}, name=name), name)
+    name = "shape_controller"
+    with pytest.raises(InvalidDesignError, match=rf"design\.file: {name} \(one tension"):
+        declare_design_and_layout(MemoryPort({"design.file": body}, name=name), name)
+    design, _ = declare_design_and_layout(MemoryPort({"design.file": body}, name="metrics_node"),
+                                          tendon_list=True)
+    assert [t.name for t in design.tendon_list()] == ["flexor", "extensor"]
 
 
 def test_metrics_node_takes_the_same_file(tmp_path: Path) -> None:
