@@ -11,7 +11,8 @@ model: a plateau from about 2 % strain at about 8 % of ``E``). A section's momen
 ``b`` the section's width at ``y``: an annulus cut to the band ``|x - w_o| <= h1`` (its chord
 lengths), or a polygon notch's section (:class:`~tdcm_ros.model.profiles.PolygonProfile`,
 integrated exactly by Green's theorem: :func:`~tdcm_ros.model.sections.plateau_excess`). ``M``
-is monotone in ``kappa`` (``E_p > 0``), so each moment has one curvature, found by bisection.
+is monotone in ``kappa`` (``E_p > 0``), so each moment has one curvature, found by false
+position (Illinois's rule) in its bracket.
 The neutral axis stays at the centroid: exact for sections symmetric about it (the paper's
 bands, the tubes, a symmetric polygon), an approximation for one-sided cuts and polygons in the
 plateau. Sections given by their numbers or by a mesh's slices carry no width profile: they

@@ -36,8 +36,13 @@ Array = NDArray[np.float64]
 
 #: Gauss-Legendre points per piece of a section's width integral.
 WIDTH_POINTS = 48
-#: Bisection steps for a curvature (the bracket is at most E / E_p wide: far below 1 ulp).
-BISECTIONS = 80
+#: Largest number of false-position steps for a curvature (each row stops once converged:
+#: about ten; bisection to the same precision took 80).
+MAX_STEPS = 100
+#: A curvature is found once its moment is within this fraction of the target, or its bracket
+#: within ``BRACKET_RTOL`` of it (relative error of the curvature <= about 1e-14 E / E_p).
+MOMENT_RTOL = 1e-14
+BRACKET_RTOL = 4.0 * np.finfo(float).eps
 
 
 @dataclass(frozen=True, eq=False)
@@ -132,6 +137,22 @@ class _Ends:
         return total
 
 
+def _false_position(low: Array, high: Array, f_low: Array, f_high: Array) -> Array:
+    """The secant's zero between ``low`` and ``high`` (values ``f_low <= 0 <= f_high``); the
+    midpoint where it falls outside (rounding)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        guess = high - f_high * (high - low) / (f_high - f_low)
+    return np.where((guess > low) & (guess < high), guess, 0.5 * (low + high))
+
+
+def _illinois(rows: NDArray[np.int64], end: int, moved: NDArray[np.int8], other: Array) -> None:
+    """Illinois's rule: where the same end (``end``: +1 high, -1 low) of ``rows``' brackets moves
+    twice running, halve the other end's value ``other`` (so it moves too); record the move."""
+    again = rows[moved[rows] == end]
+    other[again] *= 0.5
+    moved[rows] = end
+
+
 class MaterialLaw:
     """A moment model (``inner``) whose bending moments follow ``material`` (module
     docstring); everything else is the inner model's."""
@@ -155,17 +176,37 @@ class MaterialLaw:
         if rows.size == 0:
             return out
         target = np.abs(y[rows])
+        stiffness = ends.stiffness[rows]
+        softening = self.modulus - material.E_plateau
+
+        def excess_moment(curvature: Array, at: NDArray[np.int64]) -> Array:
+            """``M(kappa) - |m|`` (N m) of rows ``at`` of ``rows``."""
+            return curvature * (stiffness[at] - softening * ends.excess(
+                rows[at], material.plateau_strain / curvature)) - target[at]
+
+        every = np.arange(rows.size)
+        # M(kappa) <= E I kappa and >= E_p I kappa: the root lies in [linear, linear E / E_p]
         low = np.abs(linear[rows])
         high = low * (self.modulus / material.E_plateau)
-        softening = self.modulus - material.E_plateau
-        for _ in range(BISECTIONS):
-            middle = 0.5 * (low + high)
-            moment = middle * (ends.stiffness[rows] - softening
-                               * ends.excess(rows, material.plateau_strain / middle))
-            above = moment > target
-            high = np.where(above, middle, high)
-            low = np.where(above, low, middle)
-        out[rows] = 0.5 * (low + high) / np.abs(linear[rows])
+        root = 0.5 * (low + high)
+        f_low, f_high = excess_moment(low, every), excess_moment(high, every)
+        moved = np.zeros(rows.size, np.int8)  # the end moved last: +1 high, -1 low
+        active = every
+        for _ in range(MAX_STEPS):
+            if active.size == 0:
+                break
+            root[active] = _false_position(low[active], high[active], f_low[active],
+                                           f_high[active])
+            value = excess_moment(root[active], active)
+            above = value > 0.0
+            _illinois(active[above], 1, moved, f_low)
+            high[active[above]], f_high[active[above]] = root[active[above]], value[above]
+            _illinois(active[~above], -1, moved, f_high)
+            low[active[~above]], f_low[active[~above]] = root[active[~above]], value[~above]
+            done = (np.abs(value) <= MOMENT_RTOL * target[active]) | (
+                high[active] - low[active] <= BRACKET_RTOL * high[active])
+            active = active[~done]
+        out[rows] = root / np.abs(linear[rows])
         return out
 
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
