@@ -166,6 +166,13 @@ def _holds(t: Array, x: Array, lo: int, hi: int, cfg: StepSettings) -> list[tupl
     return found
 
 
+def sample_levels(tension_n: ArrayLike) -> Array:
+    """Each sample's level (N): its largest tendon tension (``tension_n`` (n,) for one tendon or
+    (n, J)); see the module docstring."""
+    x = np.asarray(tension_n, dtype=float)
+    return x if x.ndim == 1 else x.max(axis=1)
+
+
 def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | None = None
                  ) -> list[Step]:
     """Steps of a tension series (stamps ascending, s; tensions N, (n,) for one tendon or
@@ -182,9 +189,9 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
         ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
     ranges.sort()
     medians = [tuple(float(np.median(column)) for column in x[a:b].T) for a, b in ranges]
-    sample_levels = x.max(axis=1)
+    levels = sample_levels(x)
     previous_stops = [0, *(b for _, b in ranges)][:len(ranges)]
-    dips = [float(sample_levels[prev:a].min()) if a > prev else np.inf
+    dips = [float(levels[prev:a].min()) if a > prev else np.inf
             for (a, _), prev in zip(ranges, previous_stops, strict=True)]
     trials = assign_trials([max(m) for m in medians], dips, cfg.zero_n)
     steps = []

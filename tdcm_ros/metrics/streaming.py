@@ -40,7 +40,12 @@ from tdcm_ros.metrics.lookup import MarkerLattice, MarkerTable
 from tdcm_ros.metrics.measure import MeasuredStep, average_markers
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
-from tdcm_ros.metrics.steps import assign_phases, assign_trials, detect_steps
+from tdcm_ros.metrics.steps import (
+    assign_phases,
+    assign_trials,
+    detect_steps,
+    sample_levels,
+)
 from tdcm_ros.metrics.table import TableMetrics
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import RollHistory, roll_points
@@ -145,7 +150,7 @@ class RunningEvaluation:
         if not done:
             self._trim(t[-1] - self.max_buffer_s)
             return []
-        levels = x.max(axis=1)  # the steps' module docstring: every tendon at or below zero_n
+        levels = sample_levels(x)
         if self._frames:
             markers = MarkerSeries.of(self._frame_t, self.options.layout.labels,
                                       np.asarray(self._frames))
@@ -172,7 +177,7 @@ class RunningEvaluation:
         keep = int(np.searchsorted(np.asarray(self._t), until_s, side="right"))
         if not keep_low and keep:
             self._low_since_step = min(self._low_since_step,
-                                       float(np.max(self._x[:keep], axis=1).min()))
+                                       float(sample_levels(self._x[:keep]).min()))
         del self._t[:keep], self._x[:keep]
         first = int(np.searchsorted(np.asarray(self._frame_t),
                                     until_s - self.options.align_tolerance_s, side="right"))

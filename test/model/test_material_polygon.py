@@ -36,6 +36,7 @@ from tdcm_ros.model.sections import (
     material_edges,
     plateau_excess,
 )
+from test.model.test_material import nitinol
 
 MM = 1e-3
 BODIES = Path(__file__).resolve().parents[2] / "config" / "bodies"
@@ -158,11 +159,6 @@ def test_random_polygons_with_a_hole_match_their_widths(
     many = plateau_excess(start, end, np.full(d.size, x_bar), d)
     assert many == pytest.approx([excess(outer, [inner], x_bar, one) for one in d], rel=1e-14,
                                  abs=1e-15 * inertia)
-
-
-def nitinol(design: Design, onset: float, ratio: float = 0.08, **more: float) -> Design:
-    return dataclasses.replace(design, material=Material("bilinear", onset, ratio * design.E,
-                                                         **more))
 
 
 def band_polygon(h1: float, r_outer: float, r_inner: float, arc: int, lumen: int
