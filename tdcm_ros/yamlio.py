@@ -21,6 +21,7 @@ Every failure, including plain syntax errors and scalars Python cannot build (e.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import Any
 
 import yaml
@@ -126,18 +127,54 @@ def load_yaml(text: str, source: str, *, parameter: str | None = None,
     """The value of one YAML document ``text`` read from ``source`` (a file or parameter
     name, shown in messages); ``error(message, parameter=parameter or source, value=source,
     allowed=...)`` on any problem (see the module docstring)."""
+    return _guarded(text, source, parameter, error, _load)
+
+
+def _guarded(text: str, source: str, parameter: str | None, error: type[InputError],
+             read: Callable[[str], Any]) -> Any:
+    """``read(text)`` with the size bound first and every YAML failure as ``error``."""
     name = parameter or source
     if too_big := _oversize(text, source):
         raise error(too_big, parameter=name, value=source,
                     allowed=f"at most {MAX_INPUT_BYTES} bytes")
     try:
-        return _load(text)
+        return read(text)
     except _LimitError as problem:
         raise error(_describe(source, problem), parameter=name, value=source,
                     allowed=problem.allowed) from problem
     except yaml.YAMLError as problem:
         raise error(_describe(source, problem, "not valid YAML: "), parameter=name,
                     value=source, allowed="valid YAML") from problem
+
+
+#: the tag :func:`compose_yaml` gives a node whose tag was not written (YAML's resolvers skipped)
+UNTAGGED = ""
+
+
+class _UntaggedLoader(_BoundedLoader):
+    """The bounded composer that leaves a node's tag as written (``UNTAGGED`` when none was),
+    for readers with their own typing rules (rcl's, for parameter files)."""
+
+    def resolve(self, kind: type[Node], value: Any, implicit: Any) -> str:
+        """No implicit resolution: the written tag, or ``UNTAGGED``."""
+        return UNTAGGED
+
+
+def compose_yaml(text: str, source: str, *, parameter: str | None = None,
+                 error: type[InputError] = YamlInputError) -> Node | None:
+    """The node tree of one YAML document ``text`` (``None`` if empty) under the same bounds as
+    :func:`load_yaml`, with scalars left as written (value, style, explicit tag or
+    ``UNTAGGED``); duplicate keys are the reader's to handle."""
+    return _guarded(text, source, parameter, error, _compose)
+
+
+def _compose(text: str) -> Node | None:
+    loader = _UntaggedLoader(text)
+    try:
+        node: Node | None = loader.get_single_node()
+        return node
+    finally:
+        loader.dispose()
 
 
 def _load(text: str) -> Any:

@@ -40,7 +40,7 @@ def test_config_files_are_ros_parameter_yaml_and_load_for_the_embedded_runtime()
         data = yaml.safe_load(path.read_text())
         for node, body in data.items():
             assert "ros__parameters" in body, (path, node)
-            values = node_parameters(str(path), f"/{node}")
+            values = node_parameters([path], f"/{node}")
             assert values, (path, node)
 
 
@@ -57,7 +57,7 @@ def _effective_parameters(node: launch_fakes.Node, arguments: dict[str, str]) ->
             values.update(entry)
         else:
             assert Path(entry).is_file(), entry
-            values.update(node_parameters(entry, f"/{node.name}"))
+            values.update(node_parameters([entry], f"/{node.name}"))
     return values
 
 

@@ -132,23 +132,12 @@ def run_describe(args: argparse.Namespace) -> int:
     return 0
 
 
-def _yaml_value(value: Any) -> str:
-    """YAML flow text of a value; floats keep a dot (``1.0e-05``), so every YAML reader,
-    1.1 or 1.2, reads them as floats."""
-    if isinstance(value, list):
-        return "[" + ", ".join(_yaml_value(v) for v in value) + "]"
-    if isinstance(value, float):
-        text = repr(value)
-        return text if "." in text else text.replace("e", ".0e", 1)
-    return json.dumps(value)
-
-
 def run_dump(args: argparse.Namespace) -> int:
     """Print the node's values as a parameter file (``tdcm up --params`` and ROS read it)."""
+    from tdcm_ros.runtime.params import param_file_text
+
     values, _ = _with_client(args, _listing)
-    print(f"{'/' + args.node.strip('/')}:\n  ros__parameters:")
-    for name, value in values.items():
-        print(f"    {name}: {_yaml_value(value)}")
+    print(param_file_text({"/" + args.node.strip("/"): values}), end="")
     return 0
 
 

@@ -27,11 +27,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-import yaml
-
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.names import fully_qualified_node_name
-from tdcm_ros.runtime.params import ROS_PARAMETERS, node_parameters
+from tdcm_ros.runtime.params import node_parameters, param_file_text
 from tdcm_ros.runtime.registry import node_target
 
 log = logging.getLogger("tdcm.graph")
@@ -62,9 +60,9 @@ def merged_params(folder: Path, name: str, params_file: str | None,
                   overrides: Mapping[str, Any]) -> str:
     """Write node ``name``'s parameters from ``params_file`` with ``overrides`` on top; the path."""
     fqn = fully_qualified_node_name("/", name)
-    values = {**node_parameters(params_file, fqn), **overrides}
+    values = {**node_parameters([params_file] if params_file else [], fqn), **overrides}
     path = folder / f"{name}.yaml"
-    path.write_text(yaml.safe_dump({fqn: {ROS_PARAMETERS: values}}), encoding="utf-8")
+    path.write_text(param_file_text({fqn: values}), encoding="utf-8")
     return str(path)
 
 

@@ -46,7 +46,7 @@ from tdcm_ros.runtime.parameters import (
     SetCallback,
     Validator,
 )
-from tdcm_ros.runtime.params import node_parameters, parse_cli_param
+from tdcm_ros.runtime.params import node_parameters, sources_in_order
 from tdcm_ros.runtime.port import DEFAULT_QOS, SERVICE_TIMEOUT_S, NodePort, QoS
 from tdcm_ros.runtime.wire import RawSample
 
@@ -93,11 +93,6 @@ def to_native(message: Any, type_name: str, native_class: Any) -> Any:
     from rclpy.serialization import deserialize_message
 
     return deserialize_message(serialize(message, type_name), native_class)
-
-
-def _flag_values(args: Sequence[str], flags: tuple[str, ...]) -> list[str]:
-    """The value after each occurrence of one of ``flags`` in ``args``."""
-    return [args[i + 1] for i in range(len(args) - 1) if args[i] in flags]
 
 
 def plain_value(value: Any) -> Any:
@@ -392,11 +387,10 @@ class RclpyContext:
     """An rclpy context with one executor for the nodes it creates; see the module docstring.
 
     ``args`` are rclpy command-line arguments (``--ros-args ...``), applied to every node.
-    Each port's overrides are read by the package's own reader (so an ``int`` widens to a
-    ``float`` parameter and mixed ``[0.1, 0, 0.5]`` lists load, which rcl's parser refuses), looked
-    up by the node's final (remapped) name, later sources winning: ``params_files`` (never handed
-    to rcl), then the ``--params-file`` files in ``args`` (as ``ros2 launch`` passes them), then
-    ``-p [node:]name:=value`` in ``args``.
+    Each port's overrides are read by the package's own reader, which reads as rcl does
+    (:mod:`tdcm_ros.runtime.params`; the port then widens an ``int`` to a ``float`` parameter),
+    looked up by the node's final (remapped) name, from ``params_files`` (never handed to rcl),
+    then the ``--params-file`` files and ``-p [node:]name:=value`` items of ``args`` in order.
     """
 
     def __init__(self, args: Sequence[str] = (), params_files: Sequence[str] = ()) -> None:
@@ -419,8 +413,7 @@ class RclpyContext:
         # or timer starved the ones after it.
         self._timeout = TimeoutObject(0.0)
         self.domain_id = int(self.context.get_domain_id())
-        self.params_files = [*params_files, *_flag_values(args, ("--params-file",))]
-        self.cli_params = _flag_values(args, ("-p", "--param"))
+        self.param_sources = sources_in_order(params_files, args)
         self._stop = threading.Event()
         self._nodes: list[Any] = []
         self._client_node: Any = None
@@ -435,17 +428,8 @@ class RclpyContext:
         node's values from the parameter files and ``-p`` arguments (see the class docstring)."""
         node = self.create_node(name, namespace)
         if overrides is None:
-            overrides = self.file_overrides(node.get_fully_qualified_name(), node.get_name())
+            overrides = node_parameters(self.param_sources, node.get_fully_qualified_name())
         return RclpyNodePort(node, overrides)
-
-    def file_overrides(self, fqn: str, name: str) -> dict[str, Any]:
-        """Values for node ``fqn`` from the parameter files, then the ``-p`` arguments."""
-        values = {k: v for path in self.params_files for k, v in node_parameters(path, fqn).items()}
-        for item in self.cli_params:
-            node, parameter, value = parse_cli_param(item)
-            if node in ("", name, fqn):
-                values[parameter] = value
-        return values
 
     def create_node(self, name: str, namespace: str = "/") -> Any:
         """A plain ``rclpy.node.Node`` spun by this context's executor."""

@@ -24,7 +24,14 @@ from typing import Any
 
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.runtime.names import fully_qualified_node_name
-from tdcm_ros.runtime.params import node_entries, node_parameters
+from tdcm_ros.runtime.params import (
+    CliParam,
+    Source,
+    node_entries,
+    node_parameters,
+    ros_arguments,
+    sources_in_order,
+)
 from tdcm_ros.runtime.port import NodeLogic, NodePort
 
 RUNTIMES = ("auto", "zenoh", "rclpy")
@@ -106,16 +113,32 @@ def open_context(runtime: str, ros_args: Sequence[str] = (),
     return context
 
 
-def warn_unused_overrides(port: NodePort, params_file: str | None) -> None:
-    """Warn of each name an entry of the parameter file that names this node sets and the
-    node does not declare: it has no effect (a typo, or a parameter of another node). Wildcard
-    entries (``/**``) are meant for many nodes, so their extra names are not warned of."""
+def warn_unused_overrides(port: NodePort, sources: Sequence[Source]) -> None:
+    """Warn of each name an entry that names this node sets and the node does not declare: it
+    has no effect (a typo, or a parameter of another node). Wildcard entries (``/**``) are meant
+    for many nodes, so their extra names are not warned of."""
     fqn = fully_qualified_node_name(port.namespace, port.node_name)
-    _, exact = node_entries(params_file, fqn)
+    exact = {name for key, values in node_entries(sources, fqn) if "*" not in key
+             for name in values}
+    origin = " or ".join(f"-p {source.item}" if isinstance(source, CliParam)
+                         else f"parameter file {source}" for source in sources)
     for name in port.unused_overrides():
         if name in exact:
-            port.logger.warning("parameter file %s sets %s for %s, which does not declare it: "
-                                "ignored", params_file, name, fqn)
+            port.logger.warning("%s sets %s for %s, which does not declare it: ignored",
+                                origin, name, fqn)
+
+
+def embedded_sources(params_file: str | None, ros_args: Sequence[str]) -> list[Source]:
+    """The parameter sources of a node on the embedded runtime: ``params_file`` and the
+    ``--params-file``/``-p`` items of ``ros_args``; any other ROS argument (a remap, an
+    enclave) is refused by name, since this runtime would not apply it."""
+    for flag, _ in ros_arguments(ros_args):
+        if flag not in ("--params-file", "-p", "--param"):
+            raise InputError(f"ROS argument {flag!r} is not supported by the embedded runtime "
+                             "(it would be ignored); use --runtime rclpy, or the node's own "
+                             "options", parameter="--ros-args", value=" ".join(ros_args),
+                             allowed="--params-file FILE, -p [NODE:]NAME:=VALUE")
+    return sources_in_order([params_file] if params_file else [], ros_args)
 
 
 def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file: str | None = None,
@@ -135,8 +158,10 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
     node_name = name or node_class.default_name
     chosen = resolve_runtime(runtime)
     overrides: dict[str, Any] | None = None  # rclpy: by the node's final name, in create_port
+    sources: list[Source] = []
     if chosen == "zenoh":
-        overrides = node_parameters(params_file, fully_qualified_node_name(namespace, node_name))
+        sources = embedded_sources(params_file, ros_args)
+        overrides = node_parameters(sources, fully_qualified_node_name(namespace, node_name))
 
     interrupted: list[str] = []
 
@@ -163,7 +188,7 @@ def run_node(node_class: type[NodeLogic], *, runtime: str = "auto", params_file:
         try:
             if interrupted:  # a library the build called ran the handler and dropped its error
                 raise KeyboardInterrupt(interrupted[0])
-            warn_unused_overrides(port, params_file)
+            warn_unused_overrides(port, sources if chosen == "zenoh" else context.param_sources)
             port.logger.info("running on %s (domain %d)", chosen, context.domain_id)
             context.spin()
         except Exception as error:  # noqa: BLE001 - the loop died: close, then exit non-zero

@@ -179,6 +179,6 @@ def test_merged_parameter_file_keeps_the_users_values_under_the_overrides(tmp_pa
         "tension_driver": {"ros__parameters": {"tension_max": 12.0, "port": "/dev/ttyUSB0",
                                                "schedule": {"hold_s": 2.0}}}}))
     written = merged_params(tmp_path, "tension_driver", str(user), {"port": "/tmp/x"})
-    assert node_parameters(written, "/tension_driver") == {
+    assert node_parameters([written], "/tension_driver") == {
         "frame_id": "from_wildcard", "tension_max": 12.0, "port": "/tmp/x",
         "schedule.hold_s": 2.0}

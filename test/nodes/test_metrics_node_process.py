@@ -21,6 +21,7 @@ import pytest
 import yaml
 
 from tdcm_ros.bagio import from_dict
+from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.evaluation import evaluate_series, metrics_of
 from tdcm_ros.metrics.lookup import MarkerTable
 from tdcm_ros.metrics.options import EvaluateOptions
@@ -257,12 +258,14 @@ def test_stale_inputs_warn_and_stale_s_changes_at_runtime(runtime, context, spaw
     assert node.get("design.E") == preset("paper-experiment").E
 
 
-def test_a_float_list_with_integer_entries_is_read(runtime, context, spawn, params, tmp_path):
-    peer = Peer(context)
+def test_a_float_list_with_an_integer_entry_is_refused_as_rcl_refuses_it(runtime, spawn,
+                                                                         tmp_path):
+    """``[0.1, 0, 0.5]`` mixes a double and an integer: rcl refuses such a file, and so does
+    this node on either runtime, at start, naming the parameter (``[0.1, 0.0, 0.5]`` loads)."""
     node = spawn("tdcm_ros.runtime.run_node", METRICS, "--params", params_file(tmp_path, {
-        "registration": {"source": "parameter", "translation": [0.1, 0, 0.5]},
-        "diagnostics_period_s": 0.2}))
-    peer.spin_until(lambda: peer.status() is not None or node.poll() is not None, 20.0,
-                    "diagnostics or the node's exit")
-    assert node.poll() is None, node.stderr.read().decode()
-    assert params("/metrics_node").get("registration.translation") == [0.1, 0.0, 0.5]
+        "registration": {"source": "parameter", "translation": [0.1, 0, 0.5]}}))
+    assert node.wait(timeout=60) == InputError.exit_code
+    assert ("parameter registration.translation mixes double and integer items"
+            in node.stderr.read().decode())
+
+

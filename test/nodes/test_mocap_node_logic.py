@@ -388,7 +388,7 @@ def test_shipped_config_file_starts_the_node():
     from tdcm_ros.runtime.params import node_parameters
 
     config = Path(__file__).resolve().parents[2] / "config" / "mocap_node.yaml"
-    values = node_parameters(str(config), "/mocap_node")
+    values = node_parameters([config], "/mocap_node")
     port = mocap_port(values)
     MocapNode(port)
     port.advance(0.05)

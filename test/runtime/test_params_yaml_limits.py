@@ -12,14 +12,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime.params import read_param_file
+from tdcm_ros.runtime.params import CliParam, node_parameters, read_param_file
+from test.conftest import HOSTILE_YAML
 
 Stopwatch = Callable[[str], AbstractContextManager[None]]
+#: the hostile texts that exceed a bound (a repeated key is not one for rcl: it merges)
+BOUNDS = sorted(name for name in HOSTILE_YAML if not name.startswith("duplicate"))
 
 
+@pytest.mark.parametrize("name", BOUNDS)
 def test_hostile_parameter_file_is_an_input_error_naming_file_and_limit(
-        tmp_path: Path, hostile_yaml: tuple[str, str, str], stopwatch: Stopwatch) -> None:
-    name, text, phrase = hostile_yaml
+        tmp_path: Path, name: str, stopwatch: Stopwatch) -> None:
+    text, phrase = HOSTILE_YAML[name]
     path = tmp_path / f"{name}.yaml"
     path.write_text(text)
     with stopwatch(f"read_param_file {name}"), pytest.raises(InputError, match=phrase) as caught:
@@ -27,11 +31,18 @@ def test_hostile_parameter_file_is_an_input_error_naming_file_and_limit(
     assert str(caught.value).startswith(f"{path}: ") and caught.value.parameter == "params_file"
 
 
-def test_duplicate_parameter_names_the_line(tmp_path: Path) -> None:
+@pytest.mark.parametrize("name", BOUNDS)
+def test_hostile_dash_p_value_is_an_input_error_naming_it(name: str, stopwatch: Stopwatch) -> None:
+    text, phrase = HOSTILE_YAML[name]
+    with stopwatch(f"-p talker:rate:= {name}"), pytest.raises(InputError, match=phrase) as caught:
+        node_parameters([CliParam(f"talker:rate:={text}")], "/talker")
+    assert str(caught.value).startswith("-p talker:rate: ")
+
+
+def test_a_repeated_parameter_takes_the_later_value_as_rcl_does(tmp_path: Path) -> None:
     path = tmp_path / "params.yaml"
     path.write_text("talker:\n  ros__parameters:\n    rate: 1.0\n    rate: 2.0\n")
-    with pytest.raises(InputError, match="line 4: duplicate key 'rate'"):
-        read_param_file(path)
+    assert read_param_file(path) == [("talker", {"rate": 2.0})]
 
 
 def test_non_utf8_parameter_file_is_an_input_error(tmp_path: Path) -> None:

@@ -119,7 +119,7 @@ def test_tdcm_param_describes_and_dumps(runtime: str, graph_env: dict[str, str],
     dump = tdcm_param(graph_env, "dump", "talker")
     assert dump.returncode == 0 and dump.stdout.startswith("/talker:\n  ros__parameters:\n")
     (tmp_path / "dump.yaml").write_text(dump.stdout)
-    values = node_parameters(tmp_path / "dump.yaml", "/talker")
+    values = node_parameters([tmp_path / "dump.yaml"], "/talker")
     assert (values["period"], values["prefix"], values["use_sim_time"]) == (0.5, "dumped", False)
 
 

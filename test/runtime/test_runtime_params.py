@@ -2,17 +2,22 @@
 
 from __future__ import annotations
 
+import math
+import tempfile
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.parameters import ParameterStore, ParamSpec
-from tdcm_ros.runtime.params import node_parameters, read_param_file
+from tdcm_ros.runtime.params import node_parameters, param_file_text, read_param_file
 from tdcm_ros.runtime.run_node import resolve_runtime
+from test.runtime.test_params_rcl_table import same
 
 YAML = """
 /**:
@@ -41,12 +46,12 @@ def param_file(tmp_path: Path) -> Path:
 
 def test_yaml_wildcards_exact_and_nested(param_file: Path) -> None:
     assert [key for key, _ in read_param_file(param_file)] == [
-        "/**", "/talker", "/robot1/talker", "/*/model"]
-    assert node_parameters(param_file, "/talker") == {"rate": 2.0, "solver.tol": 1e-6}
-    assert node_parameters(param_file, "/robot1/talker") == {"rate": 5.0}
-    assert node_parameters(param_file, "/a/model")["arc_lengths"] == [0.015, 0.033, 0.053]
-    assert node_parameters(param_file, "/model") == {"rate": 1.0}
-    assert node_parameters(None, "/talker") == {}
+        "/**", "talker", "robot1/talker", "/*/model"]
+    assert node_parameters([param_file], "/talker") == {"rate": 2.0, "solver.tol": 1e-6}
+    assert node_parameters([param_file], "/robot1/talker") == {"rate": 5.0}
+    assert node_parameters([param_file], "/a/model")["arc_lengths"] == [0.015, 0.033, 0.053]
+    assert node_parameters([param_file], "/model") == {"rate": 1.0}
+    assert node_parameters([], "/talker") == {}
 
 
 def test_bad_yaml_is_an_input_error(tmp_path: Path) -> None:
@@ -161,10 +166,57 @@ def test_a_node_warns_of_names_its_own_entry_sets_but_not_of_wildcard_ones(
     path = tmp_path / "params.yaml"
     path.write_text("/**:\n  ros__parameters:\n    shared_by_others: 1\n"
                     "talker:\n  ros__parameters:\n    rate: 2.0\n    rtae: 3.0\n")
-    port = MemoryPort(node_parameters(path, "/talker"), name="talker")
+    port = MemoryPort(node_parameters([path], "/talker"), name="talker")
     port.declare_parameter("rate", 1.0)
     with caplog.at_level("WARNING"):
-        warn_unused_overrides(port, str(path))
+        warn_unused_overrides(port, [str(path)])
     warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
     assert warned == [(f"parameter file {path} sets rtae for /talker, which does not declare "
                       "it: ignored")]
+
+
+_SCALARS = st.one_of(st.booleans(), st.integers(-(2**63), 2**63 - 1), st.floats(),
+                     st.text(max_size=12), st.sampled_from(["y", "n", "1e9", "~", "0x1F", "", "null"]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.dictionaries(st.from_regex(r"[a-z][a-z0-9_]{0,8}(\.[a-z][a-z0-9_]{0,8})?", fullmatch=True),
+                       st.one_of(_SCALARS, st.lists(st.booleans(), min_size=1, max_size=4),
+                                 st.lists(st.floats(), min_size=1, max_size=4),
+                                 st.lists(st.text(max_size=6), min_size=1, max_size=4)),
+                       max_size=6))
+@example({"tiny": 5e-324, "tinies": [-2.2e-308, 1e-310], "nan": math.nan, "inf": [-math.inf],
+          "words": ["y", "~", "1e9", "0x1F", "", "\x85", "a\nb", " lead", "'\"\\"],
+          "big": 2**63 - 1, "true": False})
+def test_a_written_parameter_file_reads_back_to_the_same_values(values: dict[str, Any]) -> None:
+    if any(a.startswith(b + ".") for a in values for b in values):
+        return  # a name and a dotted child of it cannot both be parameters of one node
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "params.yaml"
+        path.write_text(param_file_text({"/lab/talker": values}), encoding="utf-8")
+        read = node_parameters([path], "/lab/talker")
+    assert same(read, values)
+
+
+@pytest.mark.parametrize("value", [None, [], [1, 2.5], [[1]], {"a": 1}])
+def test_a_value_rcl_cannot_hold_is_not_written(value: Any) -> None:
+    with pytest.raises(InputError, match="cannot be written as an rcl parameter"):
+        param_file_text({"/talker": {"x": value}})
+
+
+def test_the_embedded_runtime_takes_params_files_and_p_but_refuses_other_ros_arguments(
+        tmp_path: Path) -> None:
+    from tdcm_ros.runtime.run_node import embedded_sources
+
+    path = tmp_path / "p.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    rate: 1.0\n    period: 2.0\n")
+    sources = embedded_sources(None, ["--ros-args", "--params-file", str(path), "-p", "rate:=3.0"])
+    assert node_parameters(sources, "/talker") == {"rate": 3.0, "period": 2.0}
+    for flag, value in [("-r", "chatter:=talk"), ("--remap", "__ns:=/x"), ("--log-level", "debug"),
+                        ("--enclave", "/e")]:
+        with pytest.raises(InputError, match=f"ROS argument '{flag}' is not supported by the "
+                                             "embedded runtime") as caught:
+            embedded_sources(str(path), ["--ros-args", flag, value])
+        assert caught.value.parameter == "--ros-args"
+    with pytest.raises(InputError, match="-p has no value"):
+        embedded_sources(None, ["--ros-args", "-p"])
