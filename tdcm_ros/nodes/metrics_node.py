@@ -77,6 +77,7 @@ from tdcm_ros.runtime import (
     declare_specs,
     grouped,
 )
+from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -211,11 +212,12 @@ class MetricsNode(NodeLogic):
                                                    qos) for name in TABLE_TOPICS}
         # what it scores is queued, not dropped, while it is busy (see SCORED_DEPTH)
         scored = QoS(depth=SCORED_DEPTH, reliability="reliable")
-        port.create_subscription("tension", self.tension_type, self._on_tension, scored)
+        port.create_subscription("tension", self.tension_type, self._on_tension,
+                                 overridable_qos(port, "tension", scored))
         port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", self._on_markers,
-                                 scored)
+                                 overridable_qos(port, "markers", scored))
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
-                                 self._on_joint_states, scored)
+                                 self._on_joint_states, overridable_qos(port, "joint_states", scored))
         if self.source in ("auto", "tf_static"):
             port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
                                      QoS(depth=10, durability="transient_local"))

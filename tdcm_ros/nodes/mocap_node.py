@@ -71,6 +71,7 @@ from tdcm_ros.runtime import (
     grouped,
     resolve_topic,
 )
+from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -268,7 +269,8 @@ class MocapNode(NodeLogic):
                 "in a namespace", parameter="relabel.input_topic", value=topic,
                 allowed="a topic other than the output")
         self.input_scale = float(get("relabel.input_scale"))
-        self.port.create_subscription(topic, MARKERS_TYPE, self._on_markers, QoS(depth=100))
+        self.port.create_subscription(topic, MARKERS_TYPE, self._on_markers,
+                                      overridable_qos(self.port, topic, QoS(depth=100)))
         self.state = f"waiting for {resolve_topic(topic, ns, name)}"
         return self._given_registration()
 

@@ -81,6 +81,7 @@ from tdcm_ros.runtime import (
     grouped,
     read_specs,
 )
+from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -198,9 +199,11 @@ class ModelNode(NodeLogic):
         self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
         self._publish_tendon_tf(str(port.get_parameter("frame_id")))
         # A deep queue so every input is seen (and counted); the callback only stores the newest.
-        port.create_subscription("tension", self.tension_type, self._on_tension, QoS(depth=100))
+        port.create_subscription("tension", self.tension_type, self._on_tension,
+                                 overridable_qos(port, "tension", QoS(depth=100)))
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
-                                 self._on_joint_states, QoS(depth=100))
+                                 self._on_joint_states,
+                                 overridable_qos(port, "joint_states", QoS(depth=100)))
         self.rolls = RollHistory(ROLL_HISTORY)
         self.pending: tuple[float | tuple[float, ...], int] | None = None
         self.previous: SolveResult | None = None

@@ -75,6 +75,7 @@ from tdcm_ros.runtime import (
     grouped,
 )
 from tdcm_ros.runtime.param_client import ParameterClient
+from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -260,11 +261,12 @@ class ShapeControllerNode(NodeLogic):
         port.create_subscription("target_angle", "std_msgs/msg/Float64", self._on_target_angle,
                                  qos)
         port.create_subscription("markers", "mocap4r2_msgs/msg/Markers", self._on_markers,
-                                 QoS(depth=10))
+                                 overridable_qos(port, "markers", QoS(depth=10)))
         port.create_subscription("tension", "geometry_msgs/msg/WrenchStamped", self._on_tension,
-                                 QoS(depth=100))
+                                 overridable_qos(port, "tension", QoS(depth=100)))
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
-                                 self._on_joint_states, QoS(depth=10))
+                                 self._on_joint_states,
+                                 overridable_qos(port, "joint_states", QoS(depth=10)))
         port.create_subscription("/tf", "tf2_msgs/msg/TFMessage", self._on_tf, QoS(depth=100))
         port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
                                  QoS(depth=10, durability="transient_local"))

@@ -16,6 +16,11 @@ from tdcm_ros.runtime.registry import NODES
 #: Overrides a node needs to start in-process (no device, no Vicon, no pty link of its own).
 START = {"mocap_node": {"source": "relabel", "relabel.input_topic": "/vicon/markers"},
          "tension_driver": {"port": "loop://"}}
+#: the sensor inputs whose QoS a parameter file may override (``qos_overrides.<topic>...``)
+SENSOR_INPUTS = {"metrics_node": ("/tension", "/markers", "/joint_states"),
+                 "model_node": ("/tension", "/joint_states"),
+                 "shape_controller": ("/markers", "/tension", "/joint_states"),
+                 "mocap_node": ("/vicon/markers",)}
 
 
 @pytest.mark.parametrize("node", sorted(NODES))
@@ -29,7 +34,11 @@ def test_declared_parameters_are_the_table(node: str, tmp_path: Path) -> None:
     logic = getattr(module, class_name)(port)
     try:
         declared = port.store.specs
-        assert list(declared) and set(declared) == set(module.PARAMETERS)
+        qos = {name for name in declared if name.startswith("qos_overrides.")}
+        assert list(declared) and set(declared) - qos == set(module.PARAMETERS)
+        assert qos == {f"qos_overrides.{topic}.subscription.{policy}"
+                       for topic in SENSOR_INPUTS.get(node, ())
+                       for policy in ("reliability", "durability", "depth")}
         for name, spec in module.PARAMETERS.items():
             assert declared[name].range == spec.bounds, name
             assert declared[name].description.startswith(spec.description), name
