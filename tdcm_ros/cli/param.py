@@ -134,7 +134,7 @@ def run_describe(args: argparse.Namespace) -> int:
 
 def run_dump(args: argparse.Namespace) -> int:
     """Print the node's values as a parameter file (``tdcm up --params`` and ROS read it)."""
-    from tdcm_ros.runtime.params import param_file_text
+    from tdcm_ros.runtime import param_file_text
 
     values, _ = _with_client(args, _listing)
     print(param_file_text({"/" + args.node.strip("/"): values}), end="")

@@ -76,8 +76,8 @@ from tdcm_ros.runtime import (
     Status,
     declare_specs,
     grouped,
+    overridable_qos,
 )
-from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 

@@ -79,9 +79,9 @@ from tdcm_ros.runtime import (
     Throttled,
     declare_specs,
     grouped,
+    overridable_qos,
     read_specs,
 )
-from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 

@@ -73,9 +73,9 @@ from tdcm_ros.runtime import (
     Timer,
     declare_specs,
     grouped,
+    overridable_qos,
 )
 from tdcm_ros.runtime.param_client import ParameterClient
-from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 

@@ -22,7 +22,7 @@ from tdcm_ros.runtime.graph import NodeGraph
 from tdcm_ros.runtime.launcher import launch
 from tdcm_ros.runtime.names import resolve_topic
 from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
-from tdcm_ros.runtime.params import parse_cli_param
+from tdcm_ros.runtime.params import param_file_text, parse_cli_param
 from tdcm_ros.runtime.port import (
     CLOCK_QOS,
     CLOCK_TOPIC,
@@ -34,6 +34,7 @@ from tdcm_ros.runtime.port import (
     QoS,
     Timer,
 )
+from tdcm_ros.runtime.qos_overrides import overridable_qos
 from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
 from tdcm_ros.runtime.shutdown import close_within, exit_now
 from tdcm_ros.runtime.spec_params import NODE_COMMON, declare_specs, grouped, read_specs
@@ -68,6 +69,8 @@ __all__ = [
     "grouped",
     "launch",
     "node_target",
+    "overridable_qos",
+    "param_file_text",
     "parse_cli_param",
     "read_specs",
     "resolve_topic",
