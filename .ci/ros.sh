@@ -70,18 +70,21 @@ ROS_PACKAGES=(
   ros-jazzy-ament-cmake-gmock ros-jazzy-ament-cmake-gtest ros-jazzy-ament-cmake-pytest
   ros-jazzy-domain-coordinator
 )
-# The package's own dependencies (setup.py install_requires, plot and test extras). tdcm_ros itself
-# is NOT installed with pip: it must come from the colcon install space.
-PROJECT_PACKAGES=(numpy scipy "numba>=0.60" "rosbags>=0.10.4" "mcap>=1.1" PyYAML pyserial "xxhash>=3.0" "tqdm>=4.60"
-                  "lz4>=4" "zstandard>=0.19" "shapely>=2.0" "trimesh>=4" "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9" matplotlib pytest
-                  "pytest-xdist>=3.5" hypothesis)
+# The package's own dependencies, as the README's ROS route gives them: the pip names of
+# package.xml's python3-* keys (what rosdep installs from apt there), then the README's pip line;
+# read from those two files, so a library missing from them is missing here (phase 3 then fails).
+# tdcm_ros itself is NOT installed with pip: it must come from the colcon install space.
+mapfile -t PROJECT_PACKAGES < <("$BASE_PYTHON" "$REPO/.ci/deps.py" ros-route)
+if [ "${#PROJECT_PACKAGES[@]}" -lt 5 ]; then
+  echo "ros.sh: FAIL: .ci/deps.py ros-route gave ${#PROJECT_PACKAGES[@]} packages" >&2
+  exit 1
+fi
 # Bump when the venv's fix-ups change, so that an old venv is not taken for complete.
 VENV_RECIPE_VERSION=3
-# What `ros2 run tdcm_ros <exe>` starts: the nodes' ROS names (colcon only, see setup.py) and the
+# What `ros2 run tdcm_ros <exe>` starts: the nodes' ROS names (colcon only, see setup.py; the names come from dependencies.toml) and the
 # prefixed names a pip install puts on PATH.
-EXECUTABLES=(tdcm model_node metrics_node mocap_node tension_driver device_twin shape_controller tdcm_node
-             tdcm_model_node tdcm_metrics_node tdcm_mocap_node tdcm_tension_driver tdcm_device_twin
-             tdcm_shape_controller)
+mapfile -t NODE_NAMES < <("$BASE_PYTHON" "$REPO/.ci/deps.py" nodes)
+EXECUTABLES=(tdcm tdcm_node "${NODE_NAMES[@]}" "${NODE_NAMES[@]/#/tdcm_}")
 
 now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
@@ -224,10 +227,38 @@ for exe in "${EXECUTABLES[@]}"; do
   fi
   echo "$exe --help: ok ($(head -1 "$LIB/$exe"))"
 done
+# Every third-party module the package imports (anywhere, also inside a function) is installed.
+missing="$("$BASE_PYTHON" "$REPO/.ci/deps.py" imports | python -c 'import importlib.util, sys
+print(" ".join(m for m in sys.stdin.read().split() if importlib.util.find_spec(m) is None))')"
+[ -z "$missing" ] || fail "the README's ROS route does not install: $missing (add it to dependencies.toml)"
+echo "every module the package imports is installed: ok"
 # From a directory outside the checkout, so that tdcm_ros comes from the install space.
 (cd /tmp && nice -n "$BUILD_NICE" python -c 'from tdcm_ros.model import preset, solve
 print("one solve from the install space: tip", solve(preset("paper-experiment"), 20.0).tip_position)') \
   || fail "a solve from the install space failed"
+# One command on the embedded runtime: tdcm up brings model_node up, tdcm topic list sees it.
+UP_DIR="$(mktemp -d)"
+UP_PORT="$(python -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
+export TDCM_ZENOH_ENDPOINT="tcp/127.0.0.1:$UP_PORT"
+(cd "$UP_DIR" && exec nice -n "$BUILD_NICE" "$LIB/tdcm" up --runtime zenoh --nodes model_node) \
+  >"$UP_DIR/up.log" 2>&1 &
+UP_PID=$!
+deadline=$((SECONDS + 180))
+until (cd "$UP_DIR" && "$LIB/tdcm" topic list 2>/dev/null) | grep -qx /tip_pose; do
+  if [ "$SECONDS" -ge "$deadline" ] || ! kill -0 "$UP_PID" 2>/dev/null; then
+    cat "$UP_DIR/up.log" >&2
+    kill -KILL "$UP_PID" 2>/dev/null || true
+    fail "tdcm up --nodes model_node: /tip_pose not listed by tdcm topic list within 180 s"
+  fi
+  sleep 0.5
+done
+kill -INT "$UP_PID"
+up_status=0
+wait "$UP_PID" || up_status=$?
+unset TDCM_ZENOH_ENDPOINT
+rm -rf "$UP_DIR"
+[ "$up_status" = 0 ] || [ "$up_status" = 130 ] || fail "tdcm up exited $up_status after SIGINT"
+echo "tdcm up on the embedded runtime from the install space: /tip_pose listed, stopped (exit $up_status)"
 fi
 
 if [ "$PREPARE_ONLY" = 0 ]; then

@@ -5,7 +5,7 @@
 # What it installs on this machine before any test runs:
 #   - into the `python3` first on PATH (the active virtual environment's, if any): this checkout in
 #     editable mode with its `test` extra (pytest, pytest-xdist, hypothesis, ruff, mypy, stubs) and
-#     the highest eclipse-zenoh that setup.py allows;
+#     the highest eclipse-zenoh that dependencies.toml allows;
 #   - .ros/venv, a virtual environment of ROS 2 Jazzy pip wheels (rclpy, the message packages,
 #     colcon; ~600 MB), and .ros/ws, a colcon workspace, both inside the checkout (.ci/ros.sh);
 #   - nothing with apt (.ci/run's firmware step installs the AVR toolchain and simavr).
@@ -65,7 +65,7 @@ step() {  # step NAME COMMAND...: run it, say how long it took (wall, CPU), reme
 
 set -e
 python3 -m pip install -q -e '.[test]'
-# The highest eclipse-zenoh that setup.py allows (pip keeps an older one that satisfies it otherwise).
+# The highest eclipse-zenoh that dependencies.toml allows (pip keeps an older one that satisfies it otherwise).
 python3 -m pip install -q --upgrade --only-binary :all: "eclipse-zenoh>=1.5.0,!=1.8.0,<1.9"
 set +e
 

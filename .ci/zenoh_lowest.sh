@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CI step: the embedded runtime on the LOWEST eclipse-zenoh that setup.py allows (the main run,
+# CI step: the embedded runtime on the LOWEST eclipse-zenoh that dependencies.toml allows (the main run,
 # .ci/test.sh, has the highest). Only eclipse-zenoh at the lower bound is installed, into a
 # throwaway folder (pip --target) put first on PYTHONPATH: it shadows the installed one for this
 # run and its children, inside a virtual environment or outside one alike. A small interop
@@ -12,7 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source .ci/pip_env.sh
 
-REQUIREMENT="$(python3 -c 'import re, sys; sys.stdout.write(re.search(r"ZENOH_REQUIREMENT = \"([^\"]+)\"", open("setup.py").read()).group(1))')"
+REQUIREMENT="$(python3 .ci/deps.py requirement eclipse-zenoh)"
 LOWEST="$(sed -n 's/.*>=\([0-9.]*\).*/\1/p' <<<"$REQUIREMENT")"
 [ -n "$LOWEST" ] || { echo "zenoh_lowest.sh: no lower bound in $REQUIREMENT" >&2; exit 1; }
 

@@ -3,26 +3,15 @@ same eclipse-zenoh range as setup.py."""
 
 from __future__ import annotations
 
-import ast
-import re
-import sys
+import importlib.util
 from importlib.metadata import packages_distributions
+from typing import Any
 
+from tdcm_ros.runtime import NODES
 from test.setup_info import REPO, requirement_name, setup_kwargs
 
 #: Imported only on a ROS 2 machine (rclpy runtime), where they come from ROS, not pip.
 ROS_MODULES = {"rclpy", "rcl_interfaces", "ament_index_python"}
-
-
-def imported_top_level_modules() -> set[str]:
-    names: set[str] = set()
-    for path in (REPO / "tdcm_ros").rglob("*.py"):
-        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
-            if isinstance(node, ast.Import):
-                names |= {alias.name.split(".")[0] for alias in node.names}
-            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-                names.add(node.module.split(".")[0])
-    return names - set(sys.stdlib_module_names) - {"tdcm_ros"} - ROS_MODULES
 
 
 def declared() -> set[str]:
@@ -36,7 +25,7 @@ def declared() -> set[str]:
 def test_every_imported_third_party_module_is_declared_in_setup_py() -> None:
     distributions = packages_distributions()
     missing = {}
-    for module in sorted(imported_top_level_modules()):
+    for module in sorted(set(_deps_script().imported_modules()) - ROS_MODULES):
         names = {d.lower().replace("_", "-") for d in distributions.get(module, [module])}
         if not names & declared():
             missing[module] = sorted(names)
@@ -48,19 +37,54 @@ def test_bag_decompressors_are_runtime_requirements() -> None:
     assert {"lz4", "zstandard"} <= runtime
 
 
-def _ros_sh_project_packages() -> list[str]:
-    text = (REPO / ".ci" / "ros.sh").read_text()
-    block = re.search(r"PROJECT_PACKAGES=\((.*?)\)", text, re.DOTALL)
-    assert block, "PROJECT_PACKAGES=(...) not found in .ci/ros.sh"
-    return [word.strip('"') for word in re.findall(r'"[^"]*"|\S+', block.group(1))]
+def _deps_script() -> Any:
+    """``.ci/deps.py`` as a module (it is a script, run by CI before any install)."""
+    spec = importlib.util.spec_from_file_location("ci_deps", REPO / ".ci" / "deps.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def test_ci_installs_what_setup_py_requires() -> None:
-    packages = _ros_sh_project_packages()
-    runtime = setup_kwargs()["install_requires"]
-    assert {requirement_name(r) for r in runtime} <= {requirement_name(p) for p in packages}
-    zenoh = next(r for r in runtime if requirement_name(r) == "eclipse-zenoh")
-    assert zenoh in packages, (zenoh, packages)
+def test_package_xml_the_readme_and_the_version_are_generated_from_the_declaration() -> None:
+    deps = _deps_script()
+    decl = deps.declaration()
+    for name, expected in deps.FILES.items():
+        text = (REPO / name).read_text(encoding="utf-8")
+        assert expected(text, decl) == text, f"{name}: run python3 .ci/deps.py write"
+
+
+def test_the_ros_route_installs_every_module_the_package_imports() -> None:
+    """What package.xml's keys and the README's pip line give covers every import (the CI
+    step imports them all in a venv built from that route alone)."""
+    deps = _deps_script()
+    route = {requirement_name(r) for r in deps.ros_route(deps.declaration())}
+    distributions = packages_distributions()
+    missing = {}
+    for module in sorted(set(deps.imported_modules()) - ROS_MODULES):
+        names = {d.lower().replace("_", "-") for d in distributions.get(module, [module])}
+        if not names & route:
+            missing[module] = sorted(names)
+    assert not missing, f"imported but not installed by the README's ROS route: {missing}"
+
+
+def test_the_node_table_is_declared_once() -> None:
+    declared_nodes = _deps_script().declaration()["nodes"]
+    assert set(NODES) - {"talker"} == set(declared_nodes)
+    assert {name: f"tdcm_ros.nodes.{name}:main" for name in declared_nodes} == declared_nodes
+
+
+def test_numba_is_an_extra() -> None:
+    kwargs = setup_kwargs()
+    assert "numba" not in {requirement_name(r) for r in kwargs["install_requires"]}
+    assert "numba" in {requirement_name(r) for r in kwargs["extras_require"]["fast"]}
+    assert "numba" in {requirement_name(r) for r in kwargs["extras_require"]["test"]}
+
+
+def test_ci_installs_the_zenoh_range_of_setup_py() -> None:
+    zenoh = next(r for r in setup_kwargs()["install_requires"]
+                 if requirement_name(r) == "eclipse-zenoh")
+    assert zenoh in _deps_script().ros_route(_deps_script().declaration())
     assert f'"{zenoh}"' in (REPO / ".ci" / "test.sh").read_text()
 
 

@@ -98,9 +98,12 @@ def _select() -> types.SimpleNamespace:
         return PLAIN
     try:
         import numba
-    except ImportError:
+    except ImportError as missing:
         if wanted:
-            raise
+            raise InvalidSettingsError(
+                f"{ENVIRONMENT}=1 needs numba, which is not installed: pip install "
+                "'tdcm_ros[fast]' (or python3-numba on a ROS machine)", parameter=ENVIRONMENT,
+                value="1", allowed="numba installed, or 0 (plain Python)") from missing
         return PLAIN
     return _compile(numba)
 

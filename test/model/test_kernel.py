@@ -78,6 +78,18 @@ def test_plain_build_iterates_like_the_compiled_one(monkeypatch):
     assert slow.residual_history == pytest.approx(fast.residual_history, rel=1e-6, abs=1e-15)
 
 
+def test_asking_for_numba_without_it_is_a_typed_error_naming_the_extra(monkeypatch):
+    monkeypatch.setitem(compiled._state, "build", None)
+    monkeypatch.setitem(compiled._state, "chosen", False)
+    monkeypatch.setenv(compiled.ENVIRONMENT, "1")
+    monkeypatch.setitem(sys.modules, "numba", None)  # import numba now raises ImportError
+    with pytest.raises(compiled.InvalidSettingsError, match=r"tdcm_ros\[fast\]") as caught:
+        compiled.kernels()
+    assert caught.value.parameter == "TDCM_JIT"
+    monkeypatch.setenv(compiled.ENVIRONMENT, "")  # unset: the plain build, no error
+    assert compiled.kernels() is compiled.PLAIN
+
+
 def test_bad_switch_value_is_a_typed_error(monkeypatch):
     monkeypatch.setitem(compiled._state, "build", None)
     monkeypatch.setitem(compiled._state, "chosen", False)
