@@ -17,6 +17,9 @@ from tdcm_ros.nodes.shape_messages import header, header_msg
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
 ROLL_JOINT = "roll"  #: joint name of the roll servo (rotation about the base +z axis)
+#: joint name of the driven tendon on the tension driver's ``joint_states`` and ``joint_commands``
+#: (effort = tension, N), as ros2_control's topic-based hardware interfaces name joints
+TENDON_JOINT = "tendon"
 
 
 def joint_state(stamp_ns: int, position: float, velocity: float | None = None) -> Any:
@@ -26,6 +29,24 @@ def joint_state(stamp_ns: int, position: float, velocity: float | None = None) -
                                    "position": [position],
                                    "velocity": [] if velocity is None else [velocity],
                                    "effort": []})
+
+
+def tendon_effort(stamp_ns: int, tension_n: float) -> Any:
+    """The driven tendon as a joint whose effort is its measured tension (N), stamped
+    ``stamp_ns``, no frame, no position (the driver measures no stroke)."""
+    return from_dict(JOINT_STATE, {"header": header(stamp_ns, ""), "name": [TENDON_JOINT],
+                                   "position": [], "velocity": [], "effort": [tension_n]})
+
+
+def commanded(message: Any) -> dict[str, tuple[float | None, float | None]]:
+    """``{joint: (position or None, effort or None)}`` of a JointState command, by index in
+    ``name``: a missing entry (a shorter array) or NaN is ``None``, no command (ros2_control
+    leaves what it does not command empty or NaN); an infinity stays, to be refused."""
+    def field(values: Any, i: int) -> float | None:
+        array = np.asarray(values, dtype=float)
+        return None if i >= array.size or math.isnan(array[i]) else float(array[i])
+    return {str(name): (field(message.position, i), field(message.effort, i))
+            for i, name in enumerate(message.name)}
 
 
 def tendon_states(stamp_ns: int, names: Sequence[str], strokes_m: Sequence[float],

@@ -10,14 +10,19 @@ carries one status per component (:mod:`tdcm_ros.nodes.driver_diagnostics`): ``s
 ``schedule_done``, the roll). ``joint_states`` (``sensor_msgs/msg/JointState``, name ``["roll"]``)
 carries the roll servo's position (rad, from the device's telemetry: where its slew-limited pulse
 points; 0 rad, its boot position, until a roll is commanded) once per telemetry frame, stamped like
-``tension``. ``device_state`` (``diagnostic_msgs/msg/DiagnosticStatus``, every
+``tension``; and, for every telemetry frame, the driven tendon as joint ``tendon`` whose effort is
+the measured tension (N; no position), so a ros2_control topic-based hardware interface reads
+both joints from ``joint_states``. ``device_state`` (``diagnostic_msgs/msg/DiagnosticStatus``, every
 ``state_period_s``) is deprecated: those statuses rolled into one.
 
 Inputs: ``tension_setpoint`` (``std_msgs/msg/Float64``, N: clamped to ``[0, tension_max]`` with a
 warning, ramped at ``setpoint_rate``; cancels a running schedule), ``roll_setpoint``
 (``std_msgs/msg/Float64``, rad: clamped to ``[-roll_max, roll_max]`` with a warning, slewed at
 ``roll_rate``; refused while disarmed or with a trip fault latched, the servo holding where it is)
-and ``estop``
+``joint_commands`` (``sensor_msgs/msg/JointState``, as ros2_control's topic-based hardware
+interfaces send commands: joint ``tendon``'s effort is a tension setpoint, joint ``roll``'s position
+a roll setpoint, each handled exactly as on the two topics above; other joints, missing or
+non-finite fields are counted and ignored) and ``estop``
 (``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable; a topic so any
 node can fire it without waiting). Commands are ``std_srvs/srv/Trigger`` services whose response
 says whether they were carried out and why not: ``~/start_schedule`` ((re)start the
@@ -63,7 +68,14 @@ from tdcm_ros.device import (
 )
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.driver_diagnostics import actuator, load_cell, serial_link
-from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
+from tdcm_ros.nodes.joint_messages import (
+    JOINT_STATE,
+    ROLL_JOINT,
+    TENDON_JOINT,
+    commanded,
+    joint_state,
+    tendon_effort,
+)
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
     Diagnostics,
@@ -179,6 +191,8 @@ class TensionDriverNode(NodeLogic):
                                  QoS(depth=10))
         port.create_subscription("roll_setpoint", "std_msgs/msg/Float64", self._on_roll,
                                  QoS(depth=10))
+        port.create_subscription("joint_commands", JOINT_STATE, self._on_joint_commands,
+                                 QoS(depth=10))
         port.create_subscription(ESTOP_TOPIC, ESTOP_TYPE, self._on_estop, QoS(depth=10))
         for name, command in (("start_schedule", self.start_schedule),
                               ("clear_faults", self.clear_faults), ("release", self.release),
@@ -250,10 +264,12 @@ class TensionDriverNode(NodeLogic):
             self.counts["clamped_setpoints"] += 1
 
     def _on_setpoint(self, message: Any) -> None:
-        newtons = float(message.data)
+        self._tension_command(float(message.data), "tension_setpoint")
+
+    def _tension_command(self, newtons: float, source: str) -> None:
         if not math.isfinite(newtons):
             self.counts["rejected_setpoints"] += 1
-            self._warn(f"tension_setpoint = {newtons!r} N is not finite; ignored")
+            self._warn(f"{source} = {newtons!r} N is not finite; ignored")
             return
         self._cancel_schedule()
         if not self.driver.armed:
@@ -261,10 +277,26 @@ class TensionDriverNode(NodeLogic):
         self._request(newtons)
 
     def _on_roll(self, message: Any) -> None:
-        radians = float(message.data)
+        self._roll_command(float(message.data), "roll_setpoint")
+
+    def _on_joint_commands(self, message: Any) -> None:
+        """ros2_control's command: ``tendon`` effort (N) and ``roll`` position (rad)."""
+        for joint, (position, effort) in commanded(message).items():
+            if joint == TENDON_JOINT and effort is not None:
+                self._tension_command(effort, f"joint_commands {TENDON_JOINT} effort")
+            elif joint == ROLL_JOINT and position is not None:
+                self._roll_command(position, f"joint_commands {ROLL_JOINT} position")
+            else:
+                self.counts["ignored_joint_commands"] += 1
+                what = (f"no {_COMMAND_FIELD[joint]}" if joint in _COMMAND_FIELD
+                        else "not a joint of this driver")
+                self._warn(f"joint_commands: {joint!r}: {what}; ignored (commands: "
+                           f"{TENDON_JOINT} effort in N, {ROLL_JOINT} position in rad)")
+
+    def _roll_command(self, radians: float, source: str) -> None:
         if not math.isfinite(radians):
             self.counts["rejected_rolls"] += 1
-            self._warn(f"roll_setpoint = {radians!r} rad is not finite; ignored")
+            self._warn(f"{source} = {radians!r} rad is not finite; ignored")
             return
         held = self.driver.set_roll(radians)
         if held is None:
@@ -402,9 +434,12 @@ class TensionDriverNode(NodeLogic):
             self.tension.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
                 "header": header(self._stamp("tension", now, frame.time), frame_id),
                 "wrench": {"force": {"z": frame.tension}}}))
-        for joint in joints:
-            self.joints.publish(joint_state(self._stamp("joint_states", now, joint.time),
-                                            joint.position))
+        # both joints on joint_states in device-time order (a stamp never goes back)
+        samples = sorted([(frame.time, 0, frame.tension) for frame in frames]
+                         + [(joint.time, 1, joint.position) for joint in joints])
+        for device_s, is_roll, value in samples:
+            stamp = self._stamp("joint_states", now, device_s)
+            self.joints.publish(joint_state(stamp, value) if is_roll else tendon_effort(stamp, value))
         self.counts["telemetry_frames"] += len(frames)
 
     def _stamp(self, topic: str, now: int, device_s: float) -> int:
@@ -432,6 +467,10 @@ class TensionDriverNode(NodeLogic):
         """Release the tendon and close the port."""
         self.driver.close()
         self.port.logger.info("tendon released, port closed")
+
+
+#: the field of each commanded joint this driver acts on
+_COMMAND_FIELD = {TENDON_JOINT: "effort", ROLL_JOINT: "position"}
 
 
 def _answering(command: Callable[[], tuple[bool, str]]) -> Callable[[Any], Any]:

@@ -8,9 +8,11 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Callable, Iterator
+from typing import Any
 
 import pytest
 
+from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.protocol import Fault, Mode
 from tdcm_ros.errors import InputError
@@ -523,22 +525,25 @@ def roll_bench() -> Iterator[DriverBench]:
     made.close()
 
 
+def roll_states(bench: DriverBench) -> list[Any]:
+    """The roll joint's messages on joint_states (the tendon joint's are the others)."""
+    return [m for m in bench.port.messages("joint_states") if list(m.name) == ["roll"]]
+
+
 def joint_positions(bench: DriverBench, first: int = 0) -> list[tuple[float, float]]:
-    return [(stamp_ns(m) / 1e9, float(m.position[0]))
-            for m in bench.port.messages("joint_states")[first:]]
+    return [(stamp_ns(m) / 1e9, float(m.position[0])) for m in roll_states(bench)[first:]]
 
 
 def test_roll_setpoint_is_slewed_clamped_and_published_as_joint_states(roll_bench) -> None:
     bench = roll_bench
     bench.connected()
     bench.advance(0.5)
-    joints = bench.port.messages("joint_states")
+    joints = roll_states(bench)
     assert len(joints) > 20
-    assert all(list(m.name) == ["roll"] and list(m.position) == [0.0] for m in joints)
-    assert all(len(m.velocity) == 0 for m in joints)
+    assert all(list(m.position) == [0.0] and len(m.velocity) == 0 for m in joints)
     first = len(joints)
     bench.roll(0.9)
-    bench.until(lambda: float(bench.port.messages("joint_states")[-1].position[0]) == 0.9, 2.0,
+    bench.until(lambda: float(roll_states(bench)[-1].position[0]) == 0.9, 2.0,
                 "roll 0.9 rad on joint_states")
     moving = [p for p in joint_positions(bench, first) if 0.0 < p[1] < 0.9]
     assert len(moving) >= 54  # 1.125 s at 0.8 rad/s of 50 Hz frames on the way
@@ -569,11 +574,11 @@ def test_estop_holds_the_roll_and_refuses_it_until_clear_faults(roll_bench) -> N
     assert -1200 < held <= -400 and core.roll_target_mrad == held  # stopped on the way
     bench.roll(1.0)
     assert bench.state()["rejected_rolls"] == "1"
-    count = len(bench.port.messages("joint_states"))
+    count = len(roll_states(bench))
     for _ in range(100):  # 1 s
         bench.advance(0.01)
         assert core.roll_mrad == held, "the servo moved while disarmed"
-    joints = bench.port.messages("joint_states")[count:]
+    joints = roll_states(bench)[count:]
     assert len(joints) == 50  # joint_states go on at 50 Hz: the held position
     assert {float(m.position[0]) for m in joints} == {held / 1000}
     assert plant.roll == pytest.approx(held / 1000, abs=2e-3)
@@ -616,3 +621,51 @@ def test_a_lost_graph_releases_after_the_timeout_and_stays_released_until_armed(
     bench.advance(0.2)
     assert "graph back; the tendon stays released until clear_faults" in bench.log.text
     released_until_armed(bench, "graph lost")
+
+
+# --- ros2_control reach: the tendon joint on joint_states, joint_commands in -----------------------
+def joint_command(names: list[str], positions: list[float], efforts: list[float]) -> Any:
+    return from_dict("sensor_msgs/msg/JointState", {
+        "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}, "name": names,
+        "position": positions, "velocity": [], "effort": efforts})
+
+
+def test_joint_states_carry_the_tendon_joint_with_the_measured_tension_as_effort(bench) -> None:
+    bench.connected()
+    bench.setpoint(8.0)
+    bench.advance(2.0)
+    tendon = [m for m in bench.port.messages("joint_states") if list(m.name) == ["tendon"]]
+    tension = bench.port.messages("tension")
+    assert len(tendon) == len(tension) > 90  # one per telemetry frame
+    assert [float(m.effort[0]) for m in tendon] == [m.wrench.force.z for m in tension]
+    assert [stamp_ns(m) for m in tendon] == [stamp_ns(m) for m in tension]
+    assert all(len(m.position) == 0 for m in tendon)
+    stamps = [stamp_ns(m) for m in bench.port.messages("joint_states")]
+    assert stamps == sorted(stamps)  # both joints, in time order
+
+
+def test_joint_commands_set_tension_and_roll_as_ros2_control_sends_them(roll_bench) -> None:
+    bench = roll_bench
+    bench.connected()
+    bench.port.deliver("joint_commands", joint_command(["tendon"], [], [12.0]))
+    bench.advance(0.005)
+    assert bench.state()["target"] == "12.000"
+    bench.port.deliver("joint_commands", joint_command(["roll", "tendon"], [0.4, math.nan],
+                                                       [math.nan, 6.0]))
+    bench.advance(0.005)
+    assert bench.state()["target"] == "6.000" and bench.state()["roll_target"] == "0.400"
+    bench.port.deliver("joint_commands", joint_command(["tendon"], [], [99.0]))
+    bench.advance(0.005)
+    assert bench.state()["target"] == "20.000" and bench.state()["clamped_setpoints"] == "1"
+    for bad in (joint_command(["tendon"], [], [math.inf]), joint_command(["tendon"], [], [math.nan]),
+                joint_command(["wrist"], [1.0], [1.0])):
+        bench.port.deliver("joint_commands", bad)
+    bench.advance(0.005)
+    assert bench.state()["target"] == "20.000"
+    assert bench.node.counts["rejected_setpoints"] == 1      # inf N
+    assert bench.node.counts["ignored_joint_commands"] == 2  # tendon with no effort; wrist
+    assert "'wrist': not a joint of this driver" in bench.log.text
+    bench.node.estop()
+    bench.port.deliver("joint_commands", joint_command(["tendon"], [], [5.0]))
+    bench.advance(0.005)
+    assert bench.state()["target"] == "0.000"  # disarmed: refused, the tendon stays released
