@@ -26,7 +26,12 @@ import tempfile
 from typing import Any
 
 from tdcm_ros.errors import InputError
-from tdcm_ros.runtime import DEFAULT_NODE_SET, NODES, parse_cli_param
+from tdcm_ros.runtime import (
+    DEFAULT_NODE_SET,
+    NODES,
+    normalize_namespace,
+    parse_cli_param,
+)
 
 TWIN_NODES = ("device_twin", "tension_driver")
 
@@ -48,6 +53,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help=f"comma-separated node names from: {', '.join(sorted(NODES))}")
     parser.add_argument("--runtime", default="zenoh", choices=("zenoh", "rclpy"),
                         help="runtime of every node (default zenoh)")
+    parser.add_argument("--namespace", default="/",
+                        help="namespace of every node (default /): a second robot on the same "
+                             "graph runs with another, e.g. --namespace /robot2 --connect "
+                             "ENDPOINT")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--endpoint", default=None,
                        help="zenoh router endpoint, started here unless one answers (default "
@@ -82,6 +91,11 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
                                                       dict[str, str]]:
     """Node names, per-node parameter overrides and ready paths for ``launch``."""
     nodes = [n.strip() for n in args.nodes.split(",") if n.strip()]
+    try:
+        args.namespace = normalize_namespace(args.namespace)
+    except InputError as error:
+        raise InputError(f"--namespace = {args.namespace!r} is invalid", parameter="--namespace",
+                         value=args.namespace, allowed=error.allowed) from error
     overrides: dict[str, dict[str, Any]] = {}
     ready: dict[str, str] = {}
     for option in ("endpoint", "connect", "zenoh_config", "router_config"):
@@ -160,4 +174,4 @@ def run(args: argparse.Namespace) -> int:
         export_zenoh_configs(args, endpoint)
     return launch(nodes, params_file=args.params, runtime=args.runtime, endpoint=endpoint,
                   overrides=overrides, ready_paths=ready, start_router=not args.connect,
-                  on_router_exit=args.on_router_exit)
+                  on_router_exit=args.on_router_exit, namespace=args.namespace)

@@ -20,7 +20,7 @@ from tdcm_ros.runtime.diagnostics import (
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.graph import NodeGraph
 from tdcm_ros.runtime.launcher import launch
-from tdcm_ros.runtime.names import resolve_topic
+from tdcm_ros.runtime.names import normalize_namespace, resolve_topic
 from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
 from tdcm_ros.runtime.params import param_file_text, parse_cli_param
 from tdcm_ros.runtime.port import (
@@ -69,6 +69,7 @@ __all__ = [
     "grouped",
     "launch",
     "node_target",
+    "normalize_namespace",
     "overridable_qos",
     "param_file_text",
     "parse_cli_param",

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from tdcm_ros.runtime.errors import RuntimePortError
-from tdcm_ros.runtime.names import fully_qualified_node_name
+from tdcm_ros.runtime.names import fully_qualified_node_name, normalize_namespace
 from tdcm_ros.runtime.params import node_parameters, param_file_text
 from tdcm_ros.runtime.registry import node_target
 
@@ -57,9 +57,10 @@ class Child:
 
 
 def merged_params(folder: Path, name: str, params_file: str | None,
-                  overrides: Mapping[str, Any]) -> str:
-    """Write node ``name``'s parameters from ``params_file`` with ``overrides`` on top; the path."""
-    fqn = fully_qualified_node_name("/", name)
+                  overrides: Mapping[str, Any], namespace: str = "/") -> str:
+    """Write node ``namespace/name``'s parameters from ``params_file`` with ``overrides`` on
+    top; the path."""
+    fqn = fully_qualified_node_name(namespace, name)
     values = {**node_parameters([params_file] if params_file else [], fqn), **overrides}
     path = folder / f"{name}.yaml"
     path.write_text(param_file_text({fqn: values}), encoding="utf-8")
@@ -71,14 +72,17 @@ class NodeGraph:
 
     ``log_dir``, when set, receives each child's stdout and stderr as ``<name>.log``; otherwise
     children share the terminal. ``stop_event`` aborts waits for ready paths. ``endpoint`` is the
-    zenoh router's (``None`` on rclpy).
+    zenoh router's (``None`` on rclpy). Every node starts in ``namespace`` (its relative topics
+    and private services resolve there; its parameter file entries are looked up by
+    ``namespace/name``).
     """
 
     def __init__(self, *, endpoint: str | None = None, runtime: str = "zenoh",
                  params_file: str | None = None, grace: float = 5.0, log_dir: Path | None = None,
-                 stop_event: threading.Event | None = None) -> None:
+                 stop_event: threading.Event | None = None, namespace: str = "/") -> None:
         self.endpoint = endpoint
         self.runtime = runtime
+        self.namespace = normalize_namespace(namespace)
         self.params_file = params_file
         self.grace = grace
         self.log_dir = log_dir
@@ -172,9 +176,9 @@ class NodeGraph:
                    ready_path: str | None = None, ready_timeout: float = 30.0) -> Child:
         """Start registered node ``name``; with ``ready_path``, wait until the node creates it."""
         argv = [sys.executable, "-m", "tdcm_ros.runtime.run_node", node_target(name), "--name",
-                name, "--runtime", self.runtime]
-        params = (merged_params(Path(self._folder.name), name, self.params_file, overrides)
-                  if overrides else self.params_file)
+                name, "--namespace", self.namespace, "--runtime", self.runtime]
+        params = (merged_params(Path(self._folder.name), name, self.params_file, overrides,
+                                self.namespace) if overrides else self.params_file)
         if params:
             argv += ["--params", params]
         child = self.start(name, argv)

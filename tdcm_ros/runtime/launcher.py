@@ -70,7 +70,7 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
            endpoint: str | None = None, grace: float = 5.0,
            overrides: Mapping[str, Mapping[str, Any]] | None = None,
            ready_paths: Mapping[str, str] | None = None, ready_timeout: float = 30.0,
-           start_router: bool = True, on_router_exit: str = "restart") -> int:
+           start_router: bool = True, on_router_exit: str = "restart", namespace: str = "/") -> int:
     """Run ``nodes`` (registry names) until SIGINT/SIGTERM or until every node has exited.
 
     ``endpoint``: the zenoh router's (``None`` on rclpy); ``grace``: s from SIGINT to SIGTERM
@@ -79,7 +79,8 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
     ``ready_paths``: node name -> path it creates when ready (waited for, ``ready_timeout`` s,
     before the next node); ``start_router``: False to use only an existing router at
     ``endpoint`` (fails if none answers within 10 s); ``on_router_exit``: ``restart`` or
-    ``stop`` (see the module).
+    ``stop`` (see the module); ``namespace``: every node's (two robots share one graph, each
+    in its own).
     """
     if on_router_exit not in ROUTER_EXIT_ACTIONS:
         raise InputError(f"on_router_exit = {on_router_exit!r} is not one of "
@@ -97,7 +98,7 @@ def launch(nodes: Sequence[str], *, params_file: str | None = None, runtime: str
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     overrides, ready_paths = overrides or {}, ready_paths or {}
     graph = NodeGraph(endpoint=endpoint, runtime=runtime, params_file=params_file, grace=grace,
-                      stop_event=stop)
+                      stop_event=stop, namespace=namespace)
     try:
         graph.ensure_router(start=start_router)
         graph.check_peers_connect()

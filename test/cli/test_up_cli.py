@@ -12,6 +12,7 @@ import pytest
 from tdcm_ros.cli.up import plan, register
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime.graph import merged_params
+from tdcm_ros.runtime.params import node_parameters
 
 
 def up_args(*argv: str) -> argparse.Namespace:
@@ -45,3 +46,16 @@ def test_a_bad_p_is_an_input_error_naming_it(item: str, message: str) -> None:
     with pytest.raises(InputError, match=re.escape(message)) as error:
         plan(up_args("-p", item), 1)
     assert error.value.parameter == "-p"
+
+
+def test_namespace_is_checked_and_reaches_the_merged_parameter_file(tmp_path) -> None:
+    args = up_args("--namespace", "robot2/", "-p", "model_node:input.max_age_s:=2.0")
+    nodes, overrides, _ = plan(args, 1)
+    assert nodes == ["model_node"]
+    assert args.namespace == "/robot2"
+    written = merged_params(tmp_path, "model_node", None, overrides["model_node"], args.namespace)
+    assert node_parameters([written], "/robot2/model_node") == {"input.max_age_s": 2.0}
+    assert node_parameters([written], "/model_node") == {}
+    with pytest.raises(InputError, match="--namespace") as error:
+        plan(up_args("--namespace", "/2nd"), 1)
+    assert error.value.parameter == "--namespace"
