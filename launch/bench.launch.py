@@ -24,7 +24,10 @@ def generate_launch_description() -> LaunchDescription:
     def params(name: str) -> PathJoinSubstitution:
         return PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config", f"{name}.yaml"])
 
+    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
     return LaunchDescription([
+        DeclareLaunchArgument("use_sim_time", default_value="false",
+                              description="true: every node takes its time from /clock"),
         DeclareLaunchArgument("port", default_value="/dev/ttyACM0",
                               description="serial port of the tension device"),
         DeclareLaunchArgument("driver_markers", default_value="/vicon/markers",
@@ -32,13 +35,13 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
         Node(package="tdcm_ros", executable="tension_driver", name="tension_driver",
              namespace=namespace, output="screen",
-             parameters=[params("tension_driver"), {"port": LaunchConfiguration("port")}]),
+             parameters=[params("tension_driver"), {"port": LaunchConfiguration("port")}, sim_time]),
         Node(package="tdcm_ros", executable="model_node", name="model_node",
-             namespace=namespace, output="screen", parameters=[params("model_node")]),
+             namespace=namespace, output="screen", parameters=[params("model_node"), sim_time]),
         Node(package="tdcm_ros", executable="mocap_node", name="mocap_node",
              namespace=namespace, output="screen",
-             parameters=[params("mocap_node"), {"source": "relabel"}],
+             parameters=[params("mocap_node"), {"source": "relabel"}, sim_time],
              remappings=[("/vicon/markers", LaunchConfiguration("driver_markers"))]),
         Node(package="tdcm_ros", executable="metrics_node", name="metrics_node",
-             namespace=namespace, output="screen", parameters=[params("metrics_node")]),
+             namespace=namespace, output="screen", parameters=[params("metrics_node"), sim_time]),
     ])

@@ -19,12 +19,15 @@ def generate_launch_description() -> LaunchDescription:
     """shape_controller with the package's config and the chosen mode."""
     params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
                                    "shape_controller.yaml"])
+    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
     return LaunchDescription([
+        DeclareLaunchArgument("use_sim_time", default_value="false",
+                              description="true: every node takes its time from /clock"),
         DeclareLaunchArgument("mode", default_value="feedback",
                               choices=["feedforward", "feedback"],
                               description="feedforward, or feedback from motion capture"),
         DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
         Node(package="tdcm_ros", executable="shape_controller", name="shape_controller",
              namespace=LaunchConfiguration("namespace"), output="screen",
-             parameters=[params, {"mode": LaunchConfiguration("mode")}]),
+             parameters=[params, {"mode": LaunchConfiguration("mode")}, sim_time]),
     ])

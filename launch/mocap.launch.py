@@ -26,7 +26,10 @@ def generate_launch_description() -> LaunchDescription:
     """The mocap node with ``source`` over ``params_file``, in ``namespace``."""
     default_params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
                                            "mocap_node.yaml"])
+    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
     return LaunchDescription([
+        DeclareLaunchArgument("use_sim_time", default_value="false",
+                              description="true: every node takes its time from /clock"),
         DeclareLaunchArgument("source", default_value=SOURCES[0], choices=SOURCES,
                               description="relabel: the live driver's markers (real bench); "
                                           "csv: a Nexus CSV replay; sim: simulated markers"),
@@ -40,7 +43,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package="tdcm_ros", executable="mocap_node", name="mocap_node",
              namespace=LaunchConfiguration("namespace"),
              parameters=[LaunchConfiguration("params_file"),
-                         {"source": LaunchConfiguration("source")}],
+                         {"source": LaunchConfiguration("source")}, sim_time],
              remappings=[("/vicon/markers", LaunchConfiguration("driver_markers"))],
              output="screen"),
     ])

@@ -1,6 +1,7 @@
 """ROS 2 launch: the model node with the package's parameter file.
 
-``ros2 launch tdcm_ros model.launch.py [params_file:=/path/to/params.yaml] [tension:=/bench/tension]``
+``ros2 launch tdcm_ros model.launch.py [params_file:=/path/to/params.yaml] [tension:=/bench/tension]
+[namespace:=/robot1] [use_sim_time:=true]``
 
 ``tension`` remaps the node's input (a relative name, ``tension`` by default) to another topic.
 """
@@ -17,12 +18,17 @@ def generate_launch_description() -> LaunchDescription:
     """The model node, parameters from ``params_file``, input remapped to ``tension``."""
     default_params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
                                            "model_node.yaml"])
+    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
     return LaunchDescription([
+        DeclareLaunchArgument("use_sim_time", default_value="false",
+                              description="true: every node takes its time from /clock"),
+        DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
         DeclareLaunchArgument("params_file", default_value=default_params,
                               description="ROS 2 parameter YAML for model_node"),
         DeclareLaunchArgument("tension", default_value="tension",
                               description="topic of the tendon tension (WrenchStamped)"),
         Node(package="tdcm_ros", executable="model_node", name="model_node",
-             parameters=[LaunchConfiguration("params_file")],
+             namespace=LaunchConfiguration("namespace"),
+             parameters=[LaunchConfiguration("params_file"), sim_time],
              remappings=[("tension", LaunchConfiguration("tension"))], output="screen"),
     ])

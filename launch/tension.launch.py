@@ -1,7 +1,7 @@
 """ROS 2 launch: the tension driver on a real serial port, and the model node fed by it.
 
 ``ros2 launch tdcm_ros tension.launch.py [port:=/dev/ttyACM0] [params_file:=...]
-[model_params_file:=...]``
+[model_params_file:=...] [namespace:=/robot1] [use_sim_time:=true]``
 
 This opens the real device (an Arduino UNO running ``firmware/tdcm_tension``). Without hardware
 use ``tdcm up --twin`` (embedded runtime) or run the ``device_twin`` node and point ``port`` at
@@ -19,7 +19,11 @@ from launch import LaunchDescription
 def generate_launch_description() -> LaunchDescription:
     """tension_driver (``port`` overrides the file) and model_node."""
     config = [FindPackageShare("tdcm_ros"), "config"]
+    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
     return LaunchDescription([
+        DeclareLaunchArgument("use_sim_time", default_value="false",
+                              description="true: every node takes its time from /clock"),
+        DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
         DeclareLaunchArgument("port", default_value="/dev/ttyACM0",
                               description="serial device, pty path or pyserial URL"),
         DeclareLaunchArgument("params_file",
@@ -29,9 +33,11 @@ def generate_launch_description() -> LaunchDescription:
                               default_value=PathJoinSubstitution([*config, "model_node.yaml"]),
                               description="ROS 2 parameter YAML for model_node"),
         Node(package="tdcm_ros", executable="tension_driver", name="tension_driver",
+             namespace=LaunchConfiguration("namespace"),
              parameters=[LaunchConfiguration("params_file"),
-                         {"port": LaunchConfiguration("port")}],
+                         {"port": LaunchConfiguration("port")}, sim_time],
              output="screen"),
         Node(package="tdcm_ros", executable="model_node", name="model_node",
-             parameters=[LaunchConfiguration("model_params_file")], output="screen"),
+             namespace=LaunchConfiguration("namespace"),
+             parameters=[LaunchConfiguration("model_params_file"), sim_time], output="screen"),
     ])

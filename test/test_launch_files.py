@@ -40,8 +40,11 @@ def test_config_files_are_ros_parameter_yaml_and_load_for_the_embedded_runtime()
         data = yaml.safe_load(path.read_text())
         for node, body in data.items():
             assert "ros__parameters" in body, (path, node)
-            values = node_parameters([path], f"/{node}")
+            assert node.startswith("/**/"), (path, node)  # applies in any namespace
+            name = node.split("/")[-1]
+            values = node_parameters([path], f"/{name}")
             assert values, (path, node)
+            assert node_parameters([path], f"/robot1/{name}") == values
 
 
 # -- the launch files run on stand-ins of launch/launch_ros (test/launch_fakes.py) -------------
@@ -52,12 +55,15 @@ def _effective_parameters(node: launch_fakes.Node, arguments: dict[str, str]) ->
     from tdcm_ros.runtime.params import node_parameters
 
     values: dict[str, Any] = {}
+    namespace = str(launch_fakes.resolve(node.namespace, arguments) or "").strip("/")
+    fqn = f"/{namespace}/{node.name}" if namespace else f"/{node.name}"
     for entry in launch_fakes.resolve(node.parameters, arguments):
-        if isinstance(entry, dict):
-            values.update(entry)
+        if isinstance(entry, dict):  # launch_ros reads a substituted value as YAML
+            values.update({k: yaml.safe_load(v) if isinstance(v, str) else v
+                           for k, v in entry.items()})
         else:
             assert Path(entry).is_file(), entry
-            values.update(node_parameters([entry], f"/{node.name}"))
+            values.update(node_parameters([entry], fqn))
     return values
 
 
@@ -107,11 +113,13 @@ def test_launch_files_find_configs_with_find_package_share_and_pass_valid_parame
         shape_controller,
         tension_driver,
     )
+    from tdcm_ros.runtime import NODE_COMMON
 
     specs = {"model_node": model_node.PARAMETERS, "metrics_node": metrics_node.PARAMETERS,
              "mocap_node": mocap_node.PARAMETERS, "tension_driver": tension_driver.PARAMETERS,
              "device_twin": device_twin.PARAMETERS,
              "shape_controller": shape_controller.PARAMETERS}
+    specs = {node: {**table, **NODE_COMMON} for node, table in specs.items()}
     tree = ast.parse(path.read_text())
     imported = {n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)}
     assert "ament_index_python.packages" not in imported, "use FindPackageShare"
@@ -123,3 +131,19 @@ def test_launch_files_find_configs_with_find_package_share_and_pass_valid_parame
         for name, value in values.items():
             assert name in specs[node.executable], (path.name, node.name, name)
             specs[node.executable][name].check(value, name)
+
+
+@pytest.mark.parametrize("path", sorted((REPO / "launch").glob("*.launch.py")), ids=lambda p: p.name)
+def test_every_launch_file_takes_namespace_and_use_sim_time_for_every_node(path: Path) -> None:
+    """namespace:=/robot1 moves every node there, and the shipped parameter files still apply
+    (their keys are /**/NODE); use_sim_time:=true reaches every node as a bool."""
+    description = launch_fakes.load(path)
+    plain = {node.name: _effective_parameters(node, launch_fakes.launch_arguments(description, {}))
+             for node in launch_fakes.nodes(description)}
+    arguments = launch_fakes.launch_arguments(description, {"namespace": "/robot1",
+                                                            "use_sim_time": "true"})
+    for node in launch_fakes.nodes(description):
+        assert launch_fakes.resolve(node.namespace, arguments) == "/robot1", node.name
+        values = _effective_parameters(node, arguments)
+        assert values.pop("use_sim_time") is True and plain[node.name].pop("use_sim_time") is False
+        assert values == plain[node.name], node.name

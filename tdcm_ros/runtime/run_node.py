@@ -114,12 +114,13 @@ def open_context(runtime: str, ros_args: Sequence[str] = (),
 
 
 def warn_unused_overrides(port: NodePort, sources: Sequence[Source]) -> None:
-    """Warn of each name an entry that names this node sets and the node does not declare: it
-    has no effect (a typo, or a parameter of another node). Wildcard entries (``/**``) are meant
-    for many nodes, so their extra names are not warned of."""
+    """Warn of each name an entry that names this node (``/ns/node``, ``node``, ``/**/node``)
+    sets and the node does not declare: it has no effect (a typo, or a parameter of another
+    node). Entries for any node (``/**``, ``/ns/*``) are meant for many nodes, so their extra
+    names are not warned of."""
     fqn = fully_qualified_node_name(port.namespace, port.node_name)
-    exact = {name for key, values in node_entries(sources, fqn) if "*" not in key
-             for name in values}
+    exact = {name for key, values in node_entries(sources, fqn)
+             if key.rpartition("/")[2] not in ("*", "**") for name in values}
     origin = " or ".join(f"-p {source.item}" if isinstance(source, CliParam)
                          else f"parameter file {source}" for source in sources)
     for name in port.unused_overrides():

@@ -39,7 +39,8 @@ def values(status: Any) -> dict[str, str]:
 def driver_params(path: Path, **changes: Any) -> str:
     """``config/tension_driver.yaml`` with ``changes`` (dotted names) applied, written to ``path``."""
     data = yaml.safe_load((REPO / "config" / "tension_driver.yaml").read_text())
-    params = data["tension_driver"]["ros__parameters"]
+    (node_key,) = data  # /**/tension_driver: the node in any namespace
+    params = data[node_key]["ros__parameters"]
     for name, value in changes.items():
         *parents, leaf = name.split(".")
         node = params

@@ -165,14 +165,15 @@ def test_a_node_warns_of_names_its_own_entry_sets_but_not_of_wildcard_ones(
 
     path = tmp_path / "params.yaml"
     path.write_text("/**:\n  ros__parameters:\n    shared_by_others: 1\n"
-                    "talker:\n  ros__parameters:\n    rate: 2.0\n    rtae: 3.0\n")
+                    "talker:\n  ros__parameters:\n    rate: 2.0\n    rtae: 3.0\n"
+                    "/**/talker:\n  ros__parameters:\n    prefx: x\n")
     port = MemoryPort(node_parameters([path], "/talker"), name="talker")
     port.declare_parameter("rate", 1.0)
     with caplog.at_level("WARNING"):
         warn_unused_overrides(port, [str(path)])
     warned = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
-    assert warned == [(f"parameter file {path} sets rtae for /talker, which does not declare "
-                      "it: ignored")]
+    assert warned == [f"parameter file {path} sets {name} for /talker, which does not declare "
+                      "it: ignored" for name in ("prefx", "rtae")]
 
 
 _SCALARS = st.one_of(st.booleans(), st.integers(-(2**63), 2**63 - 1), st.floats(),
