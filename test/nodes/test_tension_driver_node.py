@@ -23,6 +23,7 @@ from typing import Any
 
 import pytest
 
+from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import constants as c
 from tdcm_ros.device.plant import PlantConfig
 from tdcm_ros.device.protocol import Fault, Mode
@@ -109,6 +110,35 @@ def test_a_setpoint_reaches_the_tendon_and_sigint_releases_it(runtime, spawn, pr
     assert level(probe.states[-1]) == 0 and probe.state()["faults"] == ""
     stop_driver(node, twin)
     eventually(lambda: twin.twin.plant.tension == 0.0, 5.0, "a slack tendon")
+
+
+def test_joint_commands_drive_the_tendon_and_joint_states_report_it(runtime, spawn, probe,
+                                                                  twin, tmp_path) -> None:
+    """As a ros2_control topic-based hardware interface drives it, over the wire: a JointState
+    on ``joint_commands`` (tendon effort 6 N) reaches the tendon, and ``joint_states`` carries
+    the tendon joint with the measured tension as its effort."""
+    start_driver(spawn, tmp_path, twin)
+    probe.connected()
+    port = probe.ctx.create_port("ros2_control")
+    commands = port.create_publisher("joint_commands", "sensor_msgs/msg/JointState")
+    states: list[Any] = []
+    port.create_subscription("joint_states", "sensor_msgs/msg/JointState", states.append)
+    command = from_dict("sensor_msgs/msg/JointState", {
+        "header": {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}, "name": ["tendon"],
+        "position": [], "velocity": [], "effort": [6.0]})
+
+    def tendon_at_6_n() -> bool:
+        tendon = [m for m in states if list(m.name) == ["tendon"]]
+        return bool(tendon) and abs(float(tendon[-1].effort[0]) - 6.0) < BAND
+
+    def command_6_n() -> None:  # clearing a watchdog trip first, as Probe.hold does
+        if probe.state().get("faults"):
+            probe.clear_faults()
+        commands.publish(command)
+
+    probe.until(tendon_at_6_n, 20.0, "6 N as the tendon joint's effort on joint_states",
+                action=command_6_n)
+    probe.until(lambda: abs(twin.twin.plant.tension - 6.0) < BAND, 10.0, "6 N on the tendon")
 
 
 def test_device_releases_within_its_watchdog_when_heartbeats_stop(runtime, spawn, probe, twin,
