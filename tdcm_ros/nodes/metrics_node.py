@@ -6,12 +6,15 @@ in N per tendon named as in the body file, as model_node takes it: required for 
 several tendons, e.g. ``design.file: config/bodies/antagonistic_pair.yaml``; a JointState
 without a finite effort for every tendon is dropped and counted), ``markers``
 (mocap4r2_msgs/msg/Markers, frame ``mocap``, labels ``markers.labels``), ``/tf_static``
-(tf2_msgs/msg/TFMessage, transient local: the ``mocap`` -> ``tdcm_base`` transform) and
+(tf2_msgs/msg/TFMessage, transient local: the ``mocap_frame_id`` -> ``base_frame_id`` transform,
+default ``mocap`` -> ``tdcm_base``; an edge into the base from another parent, e.g. a robot's
+``tool0`` -> ``tdcm_base`` when the body is mounted on a robot, is not a mocap registration: it is
+counted (``tf_other_parent``), reported and ignored) and
 ``joint_states`` (sensor_msgs/msg/JointState: the roll, joint ``roll.joint``, rad; 0 until one
 arrives). The per-frame errors compare at the roll current at the frame's stamp; Table I assumes
 roll 0 (see :mod:`tdcm_ros.metrics.streaming`).
 
-Publishes (frame ``tdcm_base``, SI units):
+Publishes (frame ``base_frame_id``, SI units):
 
 - ``metrics/marker_errors`` (mocap4r2_msgs/msg/Markers): per marker frame, each visible
   marker's measured minus predicted position (m; the model at the tension, or tension vector,
@@ -84,7 +87,6 @@ from tdcm_ros.spec import Spec, by_name
 REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", JOINT_STATE)
 TABLE_TOPICS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m")
-BASE_FRAME = "tdcm_base"
 SCORED_DEPTH = 10_000
 """History depth (messages) of the scored inputs (tension, markers, joint_states): an evaluator
 must not lose data it scores, so a backlog that builds while the node is busy (an update, a
@@ -115,6 +117,10 @@ FIXED_SPECS = by_name(
          (0.0, 0.0, 0.0, 1.0), kind="vector", size=4),
     Spec("roll.joint", description="joint of `joint_states` the body rolls by (rad about "
          "the base +z axis)", default="roll", kind="str"),
+    Spec("base_frame_id", description="the body's base frame: the registration's child "
+         "frame and the outputs' frame", default="tdcm_base", kind="str"),
+    Spec("mocap_frame_id", description="the motion-capture frame: the registration's parent "
+         "frame on /tf_static", default="mocap", kind="str"),
     Spec("update_period_s", "s", "period of step detection", 0.5, low=0.01, high=60.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0),
     Spec("max_buffer_s", "s", "longest buffered stretch without a step", 120.0, low=1.0,
@@ -192,6 +198,8 @@ class MetricsNode(NodeLogic):
                 f"{JOINT_STATE} (an effort in N per tendon, by name)",
                 parameter="input.tension_type", value=self.tension_type, allowed=JOINT_STATE)
         self.roll_joint = str(fixed["roll.joint"])
+        self.base_frame = str(fixed["base_frame_id"]).lstrip("/")
+        self.mocap_frame = str(fixed["mocap_frame_id"]).lstrip("/")
         translation, rotation = fixed["registration.translation"], fixed["registration.rotation"]
         update_s = float(fixed["update_period_s"])
         diag_s = float(fixed["diagnostics_period_s"])
@@ -283,7 +291,7 @@ class MetricsNode(NodeLogic):
         self._publish_errors(message, errors)
 
     def _publish_errors(self, message: Any, errors: np.ndarray) -> None:
-        hdr = msg_class("std_msgs/msg/Header")(stamp=message.header.stamp, frame_id=BASE_FRAME)
+        hdr = msg_class("std_msgs/msg/Header")(stamp=message.header.stamp, frame_id=self.base_frame)
         point, marker = msg_class("geometry_msgs/msg/Point"), msg_class(
             "mocap4r2_msgs/msg/Marker")
         labels = self.options.layout.labels
@@ -300,7 +308,14 @@ class MetricsNode(NodeLogic):
 
     def _on_tf(self, message: Any) -> None:
         for tf in message.transforms:
-            if tf.child_frame_id.lstrip("/") != BASE_FRAME:
+            if tf.child_frame_id.lstrip("/") != self.base_frame:
+                continue
+            parent = tf.header.frame_id.lstrip("/")
+            if parent != self.mocap_frame:
+                self.counts["tf_other_parent"] += 1
+                self.running.problem = (f"/tf_static: {parent!r} -> {self.base_frame!r} is not "
+                                        f"the registration (parent {self.mocap_frame!r}, "
+                                        "mocap_frame_id): ignored")
                 continue
             t, q = tf.transform.translation, tf.transform.rotation
             try:

@@ -112,6 +112,32 @@ def test_node_publishes_errors_and_the_running_table(recording: Recording) -> No
     assert values["registration"] == "tf_static"
 
 
+def _tf_static(parent: str, child: str, rec: Recording) -> Any:
+    return from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
+        "header": _hdr(0.0, parent), "child_frame_id": child,
+        "transform": {"translation": dict(zip("xyz", rec.registration.translation, strict=True)),
+                      "rotation": dict(zip("xyzw", rec.registration.quaternion, strict=True))}}]})
+
+
+def test_only_the_mocap_edge_into_the_base_is_the_registration(recording: Recording) -> None:
+    """Mounted on a robot, /tf_static also holds tool0 -> tdcm_base: not a mocap registration,
+    so it is counted and ignored (before, it was taken and the metrics were silently wrong);
+    the frames are parameters."""
+    port = metrics_port({"registration.source": "tf_static", "base_frame_id": "r1_base",
+                         "mocap_frame_id": "vicon"})
+    node = MetricsNode(port)
+    for parent in ("tool0", "mocap"):
+        port.deliver("/tf_static", _tf_static(parent, "r1_base", recording))
+        assert (f"{parent!r} -> 'r1_base' is not the registration (parent 'vicon'"
+                in node.running.problem)
+    assert node.counts["tf_other_parent"] == 2 and node.counts["tf_static"] == 0
+    port.deliver("/tf_static", _tf_static("vicon", "r1_base", recording))
+    assert node.counts["tf_static"] == 1
+    feed(port, node, recording)
+    assert port.published["metrics/marker_errors"][0].header.frame_id == "r1_base"
+    assert json.loads(port.published["metrics/table"][-1].data)["n_steps"] == 6
+
+
 def test_node_estimates_the_registration_without_tf(recording: Recording) -> None:
     port = metrics_port({"registration.source": "estimate"})
     node = MetricsNode(port)

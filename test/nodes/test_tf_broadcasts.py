@@ -16,9 +16,9 @@ import yaml
 
 from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
+from tdcm_ros.metrics.bagdata import BASE_FRAME
 from tdcm_ros.model import preset, solve
 from tdcm_ros.nodes import device_twin, mocap_node, tension_driver
-from tdcm_ros.nodes.metrics_node import BASE_FRAME
 from tdcm_ros.nodes.model_node import ModelNode
 from tdcm_ros.nodes.tf_messages import station_lengths
 from tdcm_ros.runtime.memory_port import MemoryPort
