@@ -88,6 +88,8 @@ class _Damaged(Exception):
 
 #: Largest uncompressed chunk (bytes) believed from a file; writers use chunks of a few MB.
 MAX_CHUNK_BYTES = 1 << 30
+#: Bytes decompressed per step from a zstd frame that does not declare its size.
+_ZSTD_PIECE = 1 << 20
 # What record parsers and decompressors raise on damaged bytes (lz4 raises RuntimeError).
 _DAMAGE = (_Damaged, McapError, struct.error, ValueError, KeyError, IndexError, EOFError,
            RuntimeError, OverflowError, zstandard.ZstdError)
@@ -118,13 +120,35 @@ class _FileBytes:
         return layout.unpack(self[pos:pos + layout.size])
 
 
+def _zstd(data: bytes, size: int) -> bytes:
+    """The zstd frame ``data`` holding the chunk's ``size`` bytes. Memory follows what the data
+    holds, never what a damaged field claims: a frame that declares its size (every writer's)
+    must declare ``size`` and is decompressed at once; one that does not is read in pieces of
+    :data:`_ZSTD_PIECE` bytes, up to ``size``. (Trusting the claim allocated up to
+    :data:`MAX_CHUNK_BYTES` for a flipped byte: a MemoryError on a busy machine.)"""
+    declared = zstandard.frame_content_size(data)
+    if declared >= 0:
+        if declared != size:
+            raise _Damaged(f"chunk claims {size} bytes; its zstd frame holds {declared}")
+        return zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
+    reader = zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True)
+    parts: list[bytes] = []
+    total = 0
+    while piece := reader.read(_ZSTD_PIECE):
+        total += len(piece)
+        if total > size:
+            raise _Damaged(f"chunk claims {size} bytes; its zstd data holds more")
+        parts.append(piece)
+    return b"".join(parts)
+
+
 def _decompress(compression: str, data: bytes, size: int) -> bytes:
     if not compression:
         return data
     if not 0 <= size <= MAX_CHUNK_BYTES:
         raise _Damaged(f"chunk claims {size} bytes uncompressed; allowed: 0..{MAX_CHUNK_BYTES}")
     if compression == "zstd":
-        return zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
+        return _zstd(data, size)
     if compression == "lz4":
         return bytes(lz4.frame.decompress(data))
     raise _Damaged(f"unsupported chunk compression {compression!r}")

@@ -112,3 +112,29 @@ def test_a_chunk_claiming_an_absurd_uncompressed_size_is_skipped_with_a_warning(
     assert any(f"corrupt chunk at byte {chunk.chunk_start_offset}" in w for w in reader.warnings)
     assert got == [e for e in expected
                    if not chunk.message_start_time <= e[1] <= chunk.message_end_time]
+
+
+def test_a_zstd_chunk_allocates_what_its_data_holds_not_what_a_field_claims() -> None:
+    """A damaged size field used to be trusted as the output buffer (up to 1 GiB: a
+    MemoryError on a busy machine, found by the flip test above)."""
+    import tracemalloc
+
+    import zstandard
+
+    from tdcm_ros.bagio.reader import MAX_CHUNK_BYTES, _Damaged, _zstd
+
+    content = bytes(range(256)) * 4096  # 1 MiB
+    sized = zstandard.ZstdCompressor().compress(content)
+    unsized = zstandard.ZstdCompressor(write_content_size=False).compress(content)
+    assert _zstd(sized, len(content)) == content == _zstd(unsized, len(content))
+    tracemalloc.start()
+    try:
+        with pytest.raises(_Damaged, match="its zstd frame holds 1048576"):
+            _zstd(sized, MAX_CHUNK_BYTES)
+        assert _zstd(unsized, MAX_CHUNK_BYTES) == content  # the caller then sees the size differ
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 8 * len(content)
+    with pytest.raises(_Damaged, match="holds more"):
+        _zstd(unsized, len(content) - 1)
