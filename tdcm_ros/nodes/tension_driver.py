@@ -21,8 +21,9 @@ warning, ramped at ``setpoint_rate``; cancels a running schedule), ``roll_setpoi
 ``roll_rate``; refused while disarmed or with a trip fault latched, the servo holding where it is)
 ``joint_commands`` (``sensor_msgs/msg/JointState``, as ros2_control's topic-based hardware
 interfaces send commands: joint ``tendon``'s effort is a tension setpoint, joint ``roll``'s position
-a roll setpoint, each handled exactly as on the two topics above; other joints, missing or
-non-finite fields are counted and ignored) and ``estop``
+a roll setpoint, each handled exactly as on the two topics above; an empty or NaN field is no
+command, an infinite one is refused as on those topics, other joints are counted and ignored)
+and ``estop``
 (``std_msgs/msg/Empty``: release at once, latch the device's ESTOP fault, disable; a topic so any
 node can fire it without waiting). Commands are ``std_srvs/srv/Trigger`` services whose response
 says whether they were carried out and why not: ``~/start_schedule`` ((re)start the
@@ -280,18 +281,18 @@ class TensionDriverNode(NodeLogic):
         self._roll_command(float(message.data), "roll_setpoint")
 
     def _on_joint_commands(self, message: Any) -> None:
-        """ros2_control's command: ``tendon`` effort (N) and ``roll`` position (rad)."""
+        """ros2_control's command: ``tendon`` effort (N) and ``roll`` position (rad); either
+        joint without its field (empty or NaN, as ros2_control leaves what it does not command)
+        is no command; another joint is counted and ignored."""
         for joint, (position, effort) in commanded(message).items():
             if joint == TENDON_JOINT and effort is not None:
                 self._tension_command(effort, f"joint_commands {TENDON_JOINT} effort")
             elif joint == ROLL_JOINT and position is not None:
                 self._roll_command(position, f"joint_commands {ROLL_JOINT} position")
-            else:
+            elif joint not in (TENDON_JOINT, ROLL_JOINT):  # theirs with no field: no command
                 self.counts["ignored_joint_commands"] += 1
-                what = (f"no {_COMMAND_FIELD[joint]}" if joint in _COMMAND_FIELD
-                        else "not a joint of this driver")
-                self._warn(f"joint_commands: {joint!r}: {what}; ignored (commands: "
-                           f"{TENDON_JOINT} effort in N, {ROLL_JOINT} position in rad)")
+                self._warn(f"joint_commands: {joint!r} is not a joint of this driver; ignored "
+                           f"(commands: {TENDON_JOINT} effort in N, {ROLL_JOINT} position in rad)")
 
     def _roll_command(self, radians: float, source: str) -> None:
         if not math.isfinite(radians):
@@ -467,10 +468,6 @@ class TensionDriverNode(NodeLogic):
         """Release the tendon and close the port."""
         self.driver.close()
         self.port.logger.info("tendon released, port closed")
-
-
-#: the field of each commanded joint this driver acts on
-_COMMAND_FIELD = {TENDON_JOINT: "effort", ROLL_JOINT: "position"}
 
 
 def _answering(command: Callable[[], tuple[bool, str]]) -> Callable[[Any], Any]:
