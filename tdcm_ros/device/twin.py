@@ -468,8 +468,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     server = PtyTwin(DeviceTwin(plant, roll_speed=args.roll_speed), speed=args.speed,
                      link=args.link)
     done = threading.Event()
+
+    def on_signal(signum: int, frame: object) -> None:
+        # set from another thread: Event.set in the handler waits for the Event's lock, which
+        # this (main) thread may hold inside done.wait() when the signal lands there: a
+        # deadlock that left the twin running after SIGTERM (seen in CI at cbea303)
+        threading.Thread(target=done.set, daemon=True).start()
+
     for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, lambda *_: done.set())
+        signal.signal(signum, on_signal)
     server.start()
     if args.print_port:
         print(server.port, flush=True)

@@ -63,7 +63,13 @@ def test_twin_cli_serves_a_pty_and_stops_cleanly(tmp_path: Path) -> None:
                 got.extend(decoder.feed(line))
     finally:
         process.send_signal(signal.SIGTERM)
-        assert process.wait(timeout=10) == 0
+        try:
+            status = process.wait(timeout=10)
+        finally:
+            if process.poll() is None:  # never leave it running past the test
+                process.kill()
+                process.wait()
+    assert status == 0
     assert not os.path.lexists(link)
 
 
