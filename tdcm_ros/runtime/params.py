@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -241,7 +242,7 @@ def _quoted(dumper: yaml.SafeDumper, value: str) -> yaml.ScalarNode:
 
 
 def _double(dumper: yaml.SafeDumper, value: float) -> yaml.ScalarNode:
-    if value != 0.0 and math.isfinite(value) and abs(value) < 2.2250738585072014e-308:
+    if value != 0.0 and math.isfinite(value) and abs(value) < sys.float_info.min:
         return yaml.ScalarNode(_STR_TAG, value.hex())  # plain: no tag, no quotes
     return dumper.represent_float(value)
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from collections.abc import Callable
 from fractions import Fraction
 
@@ -34,7 +35,6 @@ _DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _HEX_FLOAT = re.compile(r"(?P<sign>[+-]?)0[xX](?P<int>[0-9a-fA-F]*)\.?(?P<frac>[0-9a-fA-F]*)"
                         r"(?:[pP](?P<exp>[+-]?[0-9]+))?")
 _INF_NAN = re.compile(r"[+-]?(?:inf(?:inity)?|nan(?:\([0-9A-Za-z_]*\))?)", re.IGNORECASE)
-_SMALLEST_NORMAL = 2.2250738585072014e-308
 
 
 def strtoll(text: str) -> int | None:
@@ -87,7 +87,7 @@ def _in_range(value: float, *, written_zero: bool, exact: Callable[[], Fraction]
     below the smallest normal double that differs from the written number ``exact()``."""
     if math.isinf(value):
         return None
-    if abs(value) < _SMALLEST_NORMAL and not written_zero and Fraction(value) != exact():
+    if abs(value) < sys.float_info.min and not written_zero and Fraction(value) != exact():
         return None
     return value
 
