@@ -83,6 +83,23 @@ class RunningEvaluation:
         self.used_registration: Registration | None = registration
         self.problem = ""
 
+    @property
+    def has_markers(self) -> bool:
+        """Whether any marker frame or finished step is held."""
+        return bool(self._frames or self.measured)
+
+    def restart_markers(self, registration: Registration | None) -> None:
+        """Drop the marker frames, the finished steps and the table (markers of another frame)
+        and use ``registration`` from now on; the tension and roll samples stay."""
+        self._frame_t.clear()
+        self._frames.clear()
+        self.measured.clear()
+        self._dips.clear()
+        self.records = []
+        self.metrics = None
+        self.registration = self.used_registration = registration
+        self.problem = ""
+
     def set_registration(self, registration: Registration) -> None:
         """Use ``registration`` from now on (finished steps are re-scored)."""
         self.registration = self.used_registration = registration

@@ -1,5 +1,6 @@
 """ROS-free motion capture: Vicon Nexus CSV reading, labelling, occlusion, sources, and the
-registration of the ``mocap`` frame to ``tdcm_base``.
+registration of the ``mocap`` frame to ``tdcm_base``, and a TF buffer (lookups between frames
+at a stamp).
 
 Never imports rclpy; ``tdcm_ros.nodes.mocap_node`` puts it on a runtime.
 """
@@ -23,12 +24,18 @@ from tdcm_ros.mocap.registration import (
     estimate_registration,
 )
 from tdcm_ros.mocap.sources import CsvReplay, RawFrame, SimSource, SourceError
+from tdcm_ros.mocap.tf_buffer import (
+    ExtrapolationError,
+    TransformBuffer,
+    TransformLookupError,
+)
 from tdcm_ros.mocap.truth import FrameClock, TruthTrack
 
 __all__ = [
     "ArcLengthLabeller",
     "CsvFormatError",
     "CsvReplay",
+    "ExtrapolationError",
     "FrameClock",
     "LabelError",
     "LabelledFrame",
@@ -42,6 +49,8 @@ __all__ = [
     "SimSource",
     "SourceError",
     "Trajectories",
+    "TransformBuffer",
+    "TransformLookupError",
     "TruthTrack",
     "estimate_from_recordings",
     "estimate_registration",

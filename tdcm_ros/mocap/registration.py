@@ -67,9 +67,9 @@ class Registration:
         object.__setattr__(self, "quaternion", tuple(float(v) for v in q / norm))
 
     @classmethod
-    def identity(cls) -> Registration:
+    def identity(cls, method: str = "given") -> Registration:
         """``tdcm_base`` coincides with ``mocap``."""
-        return cls((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+        return cls((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), method)
 
     @classmethod
     def from_matrix(cls, rotation: ArrayLike, translation: ArrayLike, *, method: str = "given",
