@@ -1,7 +1,7 @@
 """ROS-free core of the ``shape_controller`` node (never imports rclpy or zenoh): targets in
 ``tdcm_base`` resolved to a roll and an in-plane target, the inverse model's feed-forward, the
 measured tip from motion capture, an on-line estimate of the effective stiffness, the driver's
-limits, and a small TF buffer.
+limits (its TF buffer is :class:`tdcm_ros.mocap.TransformBuffer`).
 """
 
 from tdcm_ros.control.controller import (
@@ -14,7 +14,6 @@ from tdcm_ros.control.controller import (
 )
 from tdcm_ros.control.errors import TargetRefusedError
 from tdcm_ros.control.estimator import GainEstimator, GainSettings, ModelTip
-from tdcm_ros.control.frames import TransformBuffer
 from tdcm_ros.control.limits import DRIVER_LIMIT_NAMES, DriverLimits, clamp, slew
 from tdcm_ros.control.measured import marker_to_tip, measured_tip
 from tdcm_ros.control.simulation import TrackingRun, simulate_tracking
@@ -44,7 +43,6 @@ __all__ = [
     "ShapeController",
     "TargetRefusedError",
     "TrackingRun",
-    "TransformBuffer",
     "angle_target",
     "check_roll",
     "clamp",

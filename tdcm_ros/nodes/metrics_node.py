@@ -5,11 +5,10 @@ Subscribes ``tension`` (type ``input.tension_type``: geometry_msgs/msg/WrenchSta
 in N per tendon named as in the body file, as model_node takes it: required for a body with
 several tendons, e.g. ``design.file: config/bodies/antagonistic_pair.yaml``; a JointState
 without a finite effort for every tendon is dropped and counted), ``markers``
-(mocap4r2_msgs/msg/Markers, frame ``mocap``, labels ``markers.labels``), ``/tf_static``
-(tf2_msgs/msg/TFMessage, transient local: the ``mocap_frame_id`` -> ``base_frame_id`` transform,
-default ``mocap`` -> ``tdcm_base``; an edge into the base from another parent, e.g. a robot's
-``tool0`` -> ``tdcm_base`` when the body is mounted on a robot, is not a mocap registration: it is
-counted (``tf_other_parent``), reported and ignored) and
+(mocap4r2_msgs/msg/Markers, frame ``mocap_frame_id``, labels ``markers.labels``), ``/tf_static``
+(tf2_msgs/msg/TFMessage, transient local) and ``/tf`` (volatile): the TF tree that relates
+``mocap_frame_id`` (``mocap``) to ``base_frame_id`` (``tdcm_base``), directly or through other
+frames (a base mounted on a robot: ``mocap -> world -> ... -> tool0 -> tdcm_base``), and
 ``joint_states`` (sensor_msgs/msg/JointState: the roll, joint ``roll.joint``, rad; 0 until one
 arrives). The per-frame errors compare at the roll current at the frame's stamp; Table I assumes
 roll 0 (see :mod:`tdcm_ros.metrics.streaming`).
@@ -29,10 +28,22 @@ Publishes (frame ``base_frame_id``, SI units):
 - ``/diagnostics``: WARN when no tension or no markers arrived for ``stale_s``, or no
   registration is known yet; counters.
 
-Registration (``registration.source``): ``auto`` (``/tf_static`` when it arrives, else estimated
-from a zero-tension and the largest-tension step), ``tf_static``, ``parameter``
-(``registration.translation`` m, ``registration.rotation`` quaternion x, y, z, w) or
-``estimate``.
+Registration (``registration.source``):
+
+- ``tf``: each marker frame is placed by TF, the pose of ``base_frame_id`` in ``mocap_frame_id``
+  at the frame's stamp (:class:`~tdcm_ros.mocap.TransformBuffer`: ``/tf`` edges interpolated,
+  kept ``tf.cache_s``). A frame waits up to ``tf.wait_s`` (node time) for TF to cover its stamp,
+  in arrival order; then it is counted (``frames_without_transform``) and not scored. When every
+  edge between the two frames is static the pose is one registration (method ``tf_static``):
+  frames are kept in ``mocap`` and finished steps are re-scored when it changes, as offline.
+  When an edge moves (a base on a moving robot), each frame is moved into the base at its own
+  stamp before it is averaged or scored (method ``tf``; the table reports the identity). A
+  change between the two cases restarts the running evaluation (counted, ``restarts``).
+- ``tf_static``: the same from ``/tf_static`` alone.
+- ``auto``: ``tf`` once TF relates the two frames; until then frames are kept in ``mocap`` and
+  the registration is estimated from a zero-tension and the largest-tension step.
+- ``parameter``: ``registration.translation`` m, ``registration.rotation`` quaternion
+  (x, y, z, w); ``estimate``: always estimated.
 """
 
 from __future__ import annotations
@@ -40,8 +51,8 @@ from __future__ import annotations
 import json
 import math
 import sys
-from collections import Counter
-from dataclasses import replace
+from collections import Counter, deque
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -58,7 +69,12 @@ from tdcm_ros.metrics import (
     RunningEvaluation,
     StepSettings,
 )
-from tdcm_ros.mocap import Registration
+from tdcm_ros.mocap import (
+    ExtrapolationError,
+    Registration,
+    TransformBuffer,
+    TransformLookupError,
+)
 from tdcm_ros.model import (
     PARAMETER_SPECS,
     PRESETS,
@@ -70,6 +86,7 @@ from tdcm_ros.model import (
 )
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_efforts
 from tdcm_ros.nodes.joint_states import joint_position
+from tdcm_ros.nodes.tf_messages import TF_TYPE
 from tdcm_ros.runtime import (
     DiagnosticLevel,
     Diagnostics,
@@ -84,7 +101,8 @@ from tdcm_ros.runtime import (
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
-REGISTRATION_SOURCES = ("auto", "tf_static", "parameter", "estimate")
+REGISTRATION_SOURCES = ("auto", "tf", "tf_static", "parameter", "estimate")
+TF_SOURCES = ("auto", "tf", "tf_static")
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", JOINT_STATE)
 TABLE_TOPICS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m")
 SCORED_DEPTH = 10_000
@@ -109,7 +127,7 @@ FIXED_SPECS = by_name(
          "(force.z, N; a body with one tendon) or JointState (one effort per tendon in N, by "
          "the body's tendon names: required for a body with several tendons)",
          default=TENSION_TYPES[0], kind="str", choices=TENSION_TYPES),
-    Spec("registration.source", description="auto, tf_static, parameter or estimate",
+    Spec("registration.source", description="auto, tf, tf_static, parameter or estimate",
          default="auto", kind="str", choices=REGISTRATION_SOURCES),
     Spec("registration.translation", "m", "tdcm_base origin in mocap, source=parameter",
          (0.0, 0.0, 0.0), kind="vector"),
@@ -119,8 +137,12 @@ FIXED_SPECS = by_name(
          "the base +z axis)", default="roll", kind="str"),
     Spec("base_frame_id", description="the body's base frame: the registration's child "
          "frame and the outputs' frame", default="tdcm_base", kind="str"),
-    Spec("mocap_frame_id", description="the motion-capture frame: the registration's parent "
-         "frame on /tf_static", default="mocap", kind="str"),
+    Spec("mocap_frame_id", description="the motion-capture frame: the markers' frame, the "
+         "registration's parent", default="mocap", kind="str"),
+    Spec("tf.cache_s", "s", "how long a /tf edge's samples are kept", 10.0, low=0.1,
+         high=3600.0),
+    Spec("tf.wait_s", "s", "how long a marker frame waits for TF to cover its stamp (node "
+         "time)", 1.0, low=0.0, high=60.0),
     Spec("update_period_s", "s", "period of step detection", 0.5, low=0.01, high=60.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0),
     Spec("max_buffer_s", "s", "longest buffered stretch without a step", 120.0, low=1.0,
@@ -128,6 +150,17 @@ FIXED_SPECS = by_name(
 #: Parameters a client may change at run time.
 TUNABLE_SPECS = by_name(Spec("stale_s", "s", "inputs older than this are stale; changeable at run "
                              "time", 1.0, low=0.01, high=3600.0))
+
+
+@dataclass(frozen=True)
+class _Frame:
+    """A marker frame: the message, its stamp (s), its rows (k, 3) m in ``mocap`` and when it
+    arrived (node time, ns)."""
+
+    message: Any
+    stamp_s: float
+    rows: np.ndarray
+    received_ns: int
 
 
 def _stamp_s(message: Any) -> float:
@@ -209,6 +242,12 @@ class MetricsNode(NodeLogic):
             given = Registration(tuple(translation), tuple(rotation), method="parameter")
         self.running = RunningEvaluation(self.options, given, max_buffer_s=buffer_s,
                                          estimate=self.source in ("auto", "estimate"))
+        self.tf = (TransformBuffer(float(fixed["tf.cache_s"])) if self.source in TF_SOURCES
+                   else None)
+        self.wait_ns = round(float(fixed["tf.wait_s"]) * 1e9)
+        self.pending: deque[_Frame] = deque()
+        self.moving = False  # frames are moved into the base one by one (a moving TF edge)
+        self.tf_problem = ""  # why TF did not place the last frame, or rejected an edge
         qos = QoS(depth=10)
         self.marker_errors = port.create_publisher("metrics/marker_errors",
                                                    "mocap4r2_msgs/msg/Markers", qos)
@@ -226,9 +265,11 @@ class MetricsNode(NodeLogic):
                                  overridable_qos(port, "markers", scored))
         port.create_subscription("joint_states", "sensor_msgs/msg/JointState",
                                  self._on_joint_states, overridable_qos(port, "joint_states", scored))
-        if self.source in ("auto", "tf_static"):
-            port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
-                                     QoS(depth=10, durability="transient_local"))
+        if self.tf is not None:  # tf2's listener QoS
+            port.create_subscription("/tf_static", TF_TYPE, self._on_tf_static,
+                                     QoS(depth=100, durability="transient_local"))
+            if self.source != "tf_static":
+                port.create_subscription("/tf", TF_TYPE, self._on_tf, QoS(depth=100))
         self.counts: Counter[str] = Counter()
         self.last_ns: dict[str, int] = {}
         self.index = {label: i for i, label in enumerate(self.options.layout.labels)}
@@ -278,7 +319,72 @@ class MetricsNode(NodeLogic):
         rows, ignored = marker_rows(message, self.index)
         if ignored:
             self.counts["markers_ignored"] += ignored
-        stamp = _stamp_s(message)
+        frame = _Frame(message, _stamp_s(message), rows, self.port.now_ns())
+        if self.tf is None:
+            self._score(frame, rows)
+            return
+        self.pending.append(frame)
+        self._release()
+
+    def _release(self) -> None:
+        """Place the waiting marker frames, in arrival order, as TF covers their stamps; a
+        frame TF cannot place within ``tf.wait_s`` is counted and dropped (``auto`` before TF
+        ever placed one: kept in ``mocap`` for the estimate)."""
+        assert self.tf is not None
+        while self.pending:
+            frame = self.pending[0]
+            try:
+                pose = self.tf.lookup(self.mocap_frame, self.base_frame, frame.stamp_s)
+            except TransformLookupError as error:
+                estimating = self.source == "auto" and self.running.registration is None
+                not_yet = isinstance(error, ExtrapolationError) and error.future
+                waited = self.port.now_ns() - frame.received_ns > self.wait_ns
+                if not waited and (not_yet or not estimating):
+                    return
+                self.pending.popleft()
+                if estimating:
+                    self._score(frame, frame.rows)
+                    continue
+                self.counts["frames_without_transform"] += 1
+                self.tf_problem = f"markers at {frame.stamp_s:.3f} s not placed by TF: {error}"
+                continue
+            self.pending.popleft()
+            self.tf_problem = ""
+            self._place(frame, pose)
+
+    def _place(self, frame: _Frame, pose: Registration) -> None:
+        """Score a frame TF placed: by one registration on a static path, else moved into the
+        base at its stamp (see the module docstring)."""
+        assert self.tf is not None
+        moving = not self.tf.is_static(self.mocap_frame, self.base_frame)
+        if moving != self.moving or (moving and self.running.registration is None):
+            self._restart(moving)
+        if moving:
+            self._score(frame, pose.to_base(frame.rows))
+            return
+        self._use_static(pose)
+        self._score(frame, frame.rows)
+
+    def _use_static(self, pose: Registration) -> None:
+        """Use the pose of a static path as the registration (finished steps re-scored when it
+        changes)."""
+        registration = replace(pose, method="tf_static")
+        if self.running.registration != registration:
+            self.counts["registrations"] += 1
+            self.running.set_registration(registration)
+
+    def _restart(self, moving: bool) -> None:
+        """Restart the running evaluation's markers: frames in the base (``moving``) or in
+        ``mocap``; tension and roll samples stay."""
+        if self.running.has_markers:
+            self.counts["restarts"] += 1
+        self.moving = moving
+        self.running.restart_markers(Registration.identity("tf") if moving else None)
+
+    def _score(self, frame: _Frame, rows: np.ndarray) -> None:
+        """Buffer one marker frame (rows in ``mocap``, or in the base when moving) and publish
+        its errors."""
+        message, stamp = frame.message, frame.stamp_s
         self.running.add_markers(stamp, rows)
         try:
             errors = self.running.sample_errors(stamp, rows)
@@ -306,29 +412,32 @@ class MetricsNode(NodeLogic):
                 header=hdr, vector=msg_class("geometry_msgs/msg/Vector3")(
                     x=float(tip[0]), y=float(tip[1]), z=float(tip[2]))))
 
+    def _on_tf_static(self, message: Any) -> None:
+        self._add_transforms(message, static=True)
+
     def _on_tf(self, message: Any) -> None:
-        for tf in message.transforms:
-            if tf.child_frame_id.lstrip("/") != self.base_frame:
-                continue
-            parent = tf.header.frame_id.lstrip("/")
-            if parent != self.mocap_frame:
-                self.counts["tf_other_parent"] += 1
-                self.running.problem = (f"/tf_static: {parent!r} -> {self.base_frame!r} is not "
-                                        f"the registration (parent {self.mocap_frame!r}, "
-                                        "mocap_frame_id): ignored")
-                continue
-            t, q = tf.transform.translation, tf.transform.rotation
-            try:
-                reg = Registration((t.x, t.y, t.z), (q.x, q.y, q.z, q.w), method="tf_static")
-            except InputError as error:
-                self.counts["tf_rejected"] += 1
-                self.running.problem = f"/tf_static: {error}"
-                continue
-            self.counts["tf_static"] += 1
-            self.running.set_registration(reg)
+        self._add_transforms(message, static=False)
+
+    def _add_transforms(self, message: Any, *, static: bool) -> None:
+        """Put a TFMessage's edges in the buffer (a bad edge is counted, ``tf_rejected``, and
+        reported) and place the marker frames waiting for them."""
+        assert self.tf is not None
+        topic = "/tf_static" if static else "/tf"
+        problems = self.tf.add_message(message, static=static)
+        self.counts[topic.lstrip("/")] += len(message.transforms) - len(problems)
+        if problems:
+            self.counts["tf_rejected"] += len(problems)
+            self.tf_problem = f"{topic}: {problems[-1]}"
+        if self.tf.is_static(self.mocap_frame, self.base_frame) and not self.moving:
+            # a static path holds at every time: the registration is known before any frame
+            self._use_static(self.tf.lookup(self.mocap_frame, self.base_frame, None))
+        self._release()
 
     def update(self) -> None:
-        """Finish ended steps; publish the running table when a step finished."""
+        """Place marker frames that waited too long for TF; finish ended steps; publish the
+        running table when a step finished."""
+        if self.tf is not None:
+            self._release()
         finished = self.running.update()
         if not finished or self.running.metrics is None:
             return
@@ -352,8 +461,10 @@ class MetricsNode(NodeLogic):
                     if now - self.last_ns.get(name, -(1 << 62)) > stale_s * 1e9]
         reg = self.running.used_registration
         if reg is None:
-            problems.append("no registration yet (waiting for /tf_static or a zero-tension and "
-                            "a bent step)")
+            problems.append(f"no registration yet (waiting for TF {self.mocap_frame} -> "
+                            f"{self.base_frame} or a zero-tension and a bent step)")
+        if self.tf_problem:
+            problems.append(self.tf_problem)
         message = "; ".join(problems) or self.running.problem or "ok"
         values = {**dict(sorted(self.counts.items())),
                   "registration": reg.method if reg else "none"}

@@ -49,12 +49,12 @@ from tdcm_ros.control import (
     GainSettings,
     PlaneTarget,
     ShapeController,
-    TransformBuffer,
     angle_target,
     point_target,
     slew,
 )
 from tdcm_ros.errors import TdcmError
+from tdcm_ros.mocap import TransformBuffer
 from tdcm_ros.model import PARAMETER_SPECS, RollHistory, StampedHistory
 from tdcm_ros.nodes.metrics_node import (
     LAYOUT_SPECS,
@@ -268,7 +268,7 @@ class ShapeControllerNode(NodeLogic):
                                  self._on_joint_states,
                                  overridable_qos(port, "joint_states", QoS(depth=10)))
         port.create_subscription("/tf", "tf2_msgs/msg/TFMessage", self._on_tf, QoS(depth=100))
-        port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf,
+        port.create_subscription("/tf_static", "tf2_msgs/msg/TFMessage", self._on_tf_static,
                                  QoS(depth=10, durability="transient_local"))
         self.limits = LimitsReader(port, driver_name(port.namespace, str(fixed["driver"])),
                                    float(fixed["limits_period_s"]), on_timer=limits_on_timer)
@@ -305,7 +305,13 @@ class ShapeControllerNode(NodeLogic):
         self._pair_waiting()
 
     def _on_tf(self, message: Any) -> None:
-        for problem in self.tf.add_message(message):
+        self._add_transforms(message, static=False)
+
+    def _on_tf_static(self, message: Any) -> None:
+        self._add_transforms(message, static=True)
+
+    def _add_transforms(self, message: Any, *, static: bool) -> None:
+        for problem in self.tf.add_message(message, static=static):
             self.counts["tf_rejected"] += 1
             self.port.logger.warning("transform ignored: %s", problem)
 
@@ -340,7 +346,8 @@ class ShapeControllerNode(NodeLogic):
         shown = f"target_point ({p.x:g}, {p.y:g}, {p.z:g}) m in {message.header.frame_id!r}"
 
         def make(limits: DriverLimits) -> PlaneTarget:
-            to_base = self.tf.lookup(self.base_frame, message.header.frame_id or self.base_frame)
+            to_base = self.tf.lookup(message.header.frame_id or self.base_frame, self.base_frame,
+                                     None)
             x, y, z = (float(v) for v in to_base.to_base([p.x, p.y, p.z]))
             return point_target((x, y, z), self._current_roll(), limits.roll_max)
 
@@ -357,7 +364,7 @@ class ShapeControllerNode(NodeLogic):
             self.counts["markers_without_tension"] += 1
             return
         try:
-            registration = self.tf.lookup(self.base_frame, message.header.frame_id)
+            registration = self.tf.lookup(message.header.frame_id, self.base_frame, None)
         except TdcmError:
             self.counts["markers_without_registration"] += 1
             return

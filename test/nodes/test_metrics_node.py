@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import math
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -33,8 +35,10 @@ def _hdr(stamp_s: float, frame: str) -> dict[str, Any]:
     return {"stamp": {"sec": ns // 10**9, "nanosec": ns % 10**9}, "frame_id": frame}
 
 
-def feed(port: MemoryPort, node: MetricsNode, rec: Recording, every_s: float = 0.5) -> None:
-    """Deliver the recording in stamp order, running the update timer every ``every_s``."""
+def feed(port: MemoryPort, node: MetricsNode, rec: Recording, every_s: float = 0.5, *,
+         before_frame: Callable[[float], None] | None = None) -> None:
+    """Deliver the recording in stamp order, running the update timer every ``every_s``;
+    ``before_frame(stamp_s)`` runs before each marker frame is delivered."""
     tension, markers = rec.tension, rec.markers
     labels = markers.labels
     fi, next_update = 0, every_s
@@ -44,6 +48,8 @@ def feed(port: MemoryPort, node: MetricsNode, rec: Recording, every_s: float = 0
             "header": _hdr(t, "tdcm_tendon"), "wrench": {"force": {"z": float(x)}}}))
         while fi < markers.stamps_s.size and markers.stamps_s[fi] <= t:
             rows = markers.positions[fi]
+            if before_frame is not None:
+                before_frame(float(markers.stamps_s[fi]))
             port.deliver("markers", from_dict("mocap4r2_msgs/msg/Markers", {
                 "header": _hdr(markers.stamps_s[fi], "mocap"), "frame_number": fi,
                 "markers": [{"marker_name": labels[i], "marker_index": i,
@@ -119,22 +125,208 @@ def _tf_static(parent: str, child: str, rec: Recording) -> Any:
                       "rotation": dict(zip("xyzw", rec.registration.quaternion, strict=True))}}]})
 
 
-def test_only_the_mocap_edge_into_the_base_is_the_registration(recording: Recording) -> None:
-    """Mounted on a robot, /tf_static also holds tool0 -> tdcm_base: not a mocap registration,
-    so it is counted and ignored (before, it was taken and the metrics were silently wrong);
-    the frames are parameters."""
+def _tf(stamp_s: float, parent: str, child: str, translation: Any, quaternion: Any) -> Any:
+    return from_dict("tf2_msgs/msg/TFMessage", {"transforms": [{
+        "header": _hdr(stamp_s, parent), "child_frame_id": child,
+        "transform": {"translation": dict(zip("xyz", map(float, translation), strict=True)),
+                      "rotation": dict(zip("xyzw", map(float, quaternion), strict=True))}}]})
+
+
+def _pose(translation: Any, axis: Any, angle: float) -> np.ndarray:
+    """4x4 pose: a rotation by ``angle`` about the unit ``axis`` (Rodrigues), then a shift."""
+    k = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    cross = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    m = np.eye(4)
+    m[:3, :3] = np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
+    m[:3, 3] = translation
+    return m
+
+
+def _quaternion(axis: Any, angle: float) -> tuple[float, ...]:
+    k = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    return (*(math.sin(angle / 2) * k), math.cos(angle / 2))
+
+
+#: A bench mounted on a robot: mocap -> world and tool0 -> r1_base static, world -> tool0 a
+#: rotation about ARM_AXIS by ARM_ANGLE(t) plus ARM_SHIFT(t), sampled on /tf every TF_PERIOD_S.
+WORLD = ((0.3, -1.0, 0.2), (0.2, 0.1, 1.0), 0.7)
+MOUNT = ((0.0, 0.05, 0.12), (1.0, 0.0, 0.0), math.pi)
+ARM_AXIS = (0.3, 1.0, -0.2)
+TF_PERIOD_S = 0.01
+
+
+def _arm(t: float) -> tuple[np.ndarray, float]:
+    return np.array([0.4 + 0.1 * math.sin(t), 0.2 * math.cos(0.7 * t), 0.5]), 0.6 * math.sin(0.4 * t)
+
+
+def _moved(rows: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """Points (k, 3) m moved by a 4x4 pose."""
+    return rows @ pose[:3, :3].T + pose[:3, 3]
+
+
+def _mounted(rec: Recording) -> Recording:
+    """The recording's markers as a bench on the moving arm sees them in ``mocap``: each frame
+    moved from the base by mocap<-world<-tool0(t)<-base, tool0(t) interpolated between the /tf
+    samples as the angle and the shift, linearly (a rotation about one axis: its slerp)."""
+    reg = rec.registration
+    base_rows = [reg.to_base(rows) for rows in rec.markers.positions]
+    world, mount = _pose(*WORLD), _pose(*MOUNT)
+    moved = []
+    for t, rows in zip(rec.markers.stamps_s, base_rows, strict=True):
+        k = math.floor(t / TF_PERIOD_S + 1e-9)
+        (s0, a0), (s1, a1) = _arm(k * TF_PERIOD_S), _arm((k + 1) * TF_PERIOD_S)
+        f = t / TF_PERIOD_S - k
+        arm = _pose(s0 + f * (s1 - s0), ARM_AXIS, a0 + f * (a1 - a0))
+        moved.append(_moved(rows, world @ arm @ mount))
+    return replace(rec, markers=replace(rec.markers, positions=np.asarray(moved)))
+
+
+def _deliver_arm(port: MemoryPort, sent: list[float], until_s: float) -> None:
+    """The arm's /tf samples up to one past ``until_s`` (s)."""
+    while not sent or sent[-1] < until_s:
+        t = len(sent) * TF_PERIOD_S
+        shift, angle = _arm(t)
+        port.deliver("/tf", _tf(t, "world", "tool0", shift, _quaternion(ARM_AXIS, angle)))
+        sent.append(t)
+
+
+def _mount_statics(port: MemoryPort) -> None:
+    port.deliver("/tf_static", _tf(0.0, "vicon", "world", WORLD[0],
+                                   _quaternion(WORLD[1], WORLD[2])))
+    port.deliver("/tf_static", _tf(0.0, "tool0", "r1_base", MOUNT[0],
+                                   _quaternion(MOUNT[1], MOUNT[2])))
+
+
+def _between(rec: Recording, start_s: float, stop_s: float) -> Recording:
+    """The part of a recording stamped in [start_s, stop_s) s."""
+    t, m = rec.tension.stamps_s, rec.markers.stamps_s
+    keep, frames = (t >= start_s) & (t < stop_s), (m >= start_s) & (m < stop_s)
+    return replace(rec, tension=replace(rec.tension, stamps_s=t[keep],
+                                        tension_n=rec.tension.tension_n[keep]),
+                   markers=replace(rec.markers, stamps_s=m[frames],
+                                   positions=rec.markers.positions[frames]))
+
+
+def _run_fixed_and_mounted(recording: Recording, overrides: dict[str, Any]
+                           ) -> tuple[MemoryPort, MemoryPort, MetricsNode]:
+    frames = {"base_frame_id": "r1_base", "mocap_frame_id": "vicon", **overrides}
+    fixed = metrics_port(frames)
+    fixed_node = MetricsNode(fixed)
+    fixed.deliver("/tf_static", _tf(0.0, "vicon", "r1_base", recording.registration.translation,
+                                    recording.registration.quaternion))
+    feed(fixed, fixed_node, recording)
+    mounted = metrics_port(frames)
+    node = MetricsNode(mounted)
+    _mount_statics(mounted)
+    sent: list[float] = []
+    feed(mounted, node, _mounted(recording),
+         before_frame=lambda stamp: _deliver_arm(mounted, sent, stamp))
+    return fixed, mounted, node
+
+
+@pytest.mark.parametrize("source", ["tf", "auto"])
+def test_a_bench_on_a_moving_robot_scores_as_a_fixed_one(recording: Recording,
+                                                         source: str) -> None:
+    """Issue 29: mounted under a moving tool frame (vicon -> world -> tool0(t) -> r1_base), each
+    marker frame is placed by TF at its stamp, and every error and Table I figure equals the
+    fixed bench's (which the steps average in mocap, the mounted one in the base)."""
+    fixed, mounted, node = _run_fixed_and_mounted(recording, {"registration.source": source})
+    assert node.moving and node.counts["frames_without_transform"] == 0
+    got, want = (port.published["metrics/marker_errors"] for port in (mounted, fixed))
+    assert len(got) == len(want) > 0.9 * recording.markers.stamps_s.size
+    for a, b in zip(got, want, strict=True):
+        assert [m.marker_name for m in a.markers] == [m.marker_name for m in b.markers]
+        assert a.header.frame_id == "r1_base"
+        np.testing.assert_allclose([[m.translation.x, m.translation.y, m.translation.z]
+                                    for m in a.markers],
+                                   [[m.translation.x, m.translation.y, m.translation.z]
+                                    for m in b.markers], atol=1e-12)
+    moving, still = (json.loads(port.published["metrics/table"][-1].data)
+                     for port in (mounted, fixed))
+    assert moving["n_steps"] == still["n_steps"] == 6
+    for key in ("rmse_m", "mae_m", "mape_pct", "shape_error_m"):
+        assert moving[key] == pytest.approx(still[key], rel=1e-9, abs=1e-15), key
+    assert moving["details"]["sources"][0]["registration"]["method"] == "tf"
+    assert still["details"]["sources"][0]["registration"]["method"] == "tf_static"
+
+
+def test_a_frame_waits_for_late_tf_and_one_tf_never_covers_is_counted(
+        recording: Recording) -> None:
+    """/tf lagging 0.3 s behind the markers: each frame waits (tf.wait_s 1 s) and is scored;
+    after /tf stops, frames wait 1 s of node time, then are counted and not scored."""
+    port = metrics_port({"base_frame_id": "r1_base", "mocap_frame_id": "vicon",
+                         "registration.source": "tf"})
+    node = MetricsNode(port)
+    _mount_statics(port)
+    sent: list[float] = []
+    stop_s = 10.0
+    mounted = _mounted(recording)
+    feed(port, node, mounted, before_frame=lambda stamp: _deliver_arm(
+        port, sent, min(stamp - 0.3, stop_s)) if stamp > 0.3 else None)
+    after = mounted.markers.stamps_s > stop_s
+    last_s = float(recording.tension.stamps_s[-1])
+    # frames stamped in (stop_s, last_s - wait] waited their second and were dropped; the rest
+    # still wait at the end of the stream
+    dropped = int(np.count_nonzero(after & (mounted.markers.stamps_s < last_s - 1.0)))
+    assert node.counts["frames_without_transform"] == pytest.approx(dropped, abs=1)
+    assert "after the last sample" in node.tf_problem
+    errors = port.published["metrics/marker_errors"]
+    assert max(m.header.stamp.sec + m.header.stamp.nanosec * 1e-9 for m in errors) <= stop_s
+    assert len(errors) > 0.9 * np.count_nonzero(~after)
+
+
+def test_a_static_path_that_starts_moving_restarts_the_markers_and_keeps_the_tension(
+        recording: Recording) -> None:
+    """Steps scored by one static registration, then the arm starts moving on /tf: the frames
+    change frame, so the finished steps go (counted, ``restarts``) and the evaluation goes on
+    in the base; the tension samples stay."""
+    port = metrics_port({"base_frame_id": "r1_base", "mocap_frame_id": "vicon",
+                         "registration.source": "tf"})
+    node = MetricsNode(port)
+    _mount_statics(port)
+    shift, angle = _arm(0.0)
+    port.deliver("/tf_static", _tf(0.0, "world", "tool0", shift, _quaternion(ARM_AXIS, angle)))
+    held = _pose(*WORLD) @ _pose(shift, ARM_AXIS, angle) @ _pose(*MOUNT)
+    still = _between(recording, 0.0, 8.0)
+    still = replace(still, markers=replace(still.markers, positions=np.asarray(
+        [_moved(recording.registration.to_base(rows), held)
+         for rows in still.markers.positions])))
+    feed(port, node, still)
+    before = json.loads(port.published["metrics/table"][-1].data)
+    assert not node.moving and before["n_steps"] >= 2
+    assert before["details"]["sources"][0]["registration"]["method"] == "tf_static"
+    sent: list[float] = [t * TF_PERIOD_S for t in range(round(8.0 / TF_PERIOD_S))]
+    feed(port, node, _between(_mounted(recording), 8.0, np.inf),
+         before_frame=lambda stamp: _deliver_arm(port, sent, stamp))
+    assert node.moving and node.counts["restarts"] == 1
+    after = json.loads(port.published["metrics/table"][-1].data)
+    assert after["details"]["sources"][0]["registration"]["method"] == "tf"
+    assert 1 <= after["n_steps"] < 6 and after["rmse_m"] < 2e-5
+
+
+def test_a_base_under_a_tool_frame_waits_for_the_path_to_mocap(recording: Recording) -> None:
+    """Mounted on a robot, /tf_static holds tool0 -> r1_base: with no path from tool0 to the
+    mocap frame the frames cannot be placed; the problem says so, the frames are counted and
+    not scored, until the path arrives."""
     port = metrics_port({"registration.source": "tf_static", "base_frame_id": "r1_base",
                          "mocap_frame_id": "vicon"})
     node = MetricsNode(port)
-    for parent in ("tool0", "mocap"):
-        port.deliver("/tf_static", _tf_static(parent, "r1_base", recording))
-        assert (f"{parent!r} -> 'r1_base' is not the registration (parent 'vicon'"
-                in node.running.problem)
-    assert node.counts["tf_other_parent"] == 2 and node.counts["tf_static"] == 0
-    port.deliver("/tf_static", _tf_static("vicon", "r1_base", recording))
-    assert node.counts["tf_static"] == 1
-    feed(port, node, recording)
-    assert port.published["metrics/marker_errors"][0].header.frame_id == "r1_base"
+    assert "/tf" not in port.subscriptions
+    port.deliver("/tf_static", _tf(0.0, "tool0", "r1_base", MOUNT[0],
+                                   _quaternion(MOUNT[1], MOUNT[2])))
+    feed(port, node, _between(recording, 0.0, 2.0))
+    assert node.counts["frames_without_transform"] > 0
+    assert "metrics/marker_errors" not in port.published
+    node.diagnostics.publish()
+    status = port.published["/diagnostics"][-1].status[0]
+    assert "no registration yet (waiting for TF vicon -> r1_base" in status.message
+    assert "not placed by TF: frame 'vicon' is in no TF edge" in status.message
+    # the direct registration replaces tool0 as r1_base's parent: frames are placed again
+    port.deliver("/tf_static", _tf(0.0, "vicon", "r1_base", recording.registration.translation,
+                                   recording.registration.quaternion))
+    feed(port, node, _between(recording, 2.0, np.inf))
+    assert node.tf_problem == ""
+    # the first 2 s are the first zero hold: its frames were lost, its tension was not
     assert json.loads(port.published["metrics/table"][-1].data)["n_steps"] == 6
 
 

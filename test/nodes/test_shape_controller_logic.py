@@ -189,7 +189,7 @@ def test_bad_targets_are_refused_naming_value_and_range_and_the_old_one_stays(be
     b.target(model_tip(6.0, 0.2))
     refusals = [
         ((math.nan, 0.0, 0.05), "tdcm_base", "target x = nan"),
-        ((0.003, 0.0, 0.05), "camera", "frame 'camera' has no transform to 'tdcm_base'"),
+        ((0.003, 0.0, 0.05), "camera", "frame 'camera' is in no TF edge \\(frames known: mocap, tdcm_base\\)"),
         (model_tip(6.0, 1.4), "mocap", r"target roll = 1.4.* allowed: \[-1.2, 1.2\] rad"),
         (model_tip(40.0, 0.0), "mocap", "reach"),
     ]
