@@ -12,6 +12,7 @@ for ``metrics_node``; the driver's topic is remapped onto the node's input ``/vi
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
+from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
 
 from launch import LaunchDescription
@@ -24,10 +25,14 @@ def generate_launch_description() -> LaunchDescription:
     def params(name: str) -> PathJoinSubstitution:
         return PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config", f"{name}.yaml"])
 
-    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
+    # launch_ros reads use_sim_time as YAML; frame_prefix stays a string ('' included)
+    common = {"use_sim_time": LaunchConfiguration("use_sim_time"),
+              "frame_prefix": ParameterValue(LaunchConfiguration("frame_prefix"), value_type=str)}
     return LaunchDescription([
         DeclareLaunchArgument("use_sim_time", default_value="false",
                               description="true: every node takes its time from /clock"),
+        DeclareLaunchArgument("frame_prefix", default_value="",
+                              description="put before every TF frame of this robot, e.g. robot1/"),
         DeclareLaunchArgument("port", default_value="/dev/ttyACM0",
                               description="serial port of the tension device"),
         DeclareLaunchArgument("driver_markers", default_value="/vicon/markers",
@@ -35,13 +40,13 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
         Node(package="tdcm_ros", executable="tension_driver", name="tension_driver",
              namespace=namespace, output="screen",
-             parameters=[params("tension_driver"), {"port": LaunchConfiguration("port")}, sim_time]),
+             parameters=[params("tension_driver"), {"port": LaunchConfiguration("port")}, common]),
         Node(package="tdcm_ros", executable="model_node", name="model_node",
-             namespace=namespace, output="screen", parameters=[params("model_node"), sim_time]),
+             namespace=namespace, output="screen", parameters=[params("model_node"), common]),
         Node(package="tdcm_ros", executable="mocap_node", name="mocap_node",
              namespace=namespace, output="screen",
-             parameters=[params("mocap_node"), {"source": "relabel"}, sim_time],
+             parameters=[params("mocap_node"), {"source": "relabel"}, common],
              remappings=[("/vicon/markers", LaunchConfiguration("driver_markers"))]),
         Node(package="tdcm_ros", executable="metrics_node", name="metrics_node",
-             namespace=namespace, output="screen", parameters=[params("metrics_node"), sim_time]),
+             namespace=namespace, output="screen", parameters=[params("metrics_node"), common]),
     ])

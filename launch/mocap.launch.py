@@ -14,6 +14,7 @@ so that its own ``markers`` output does not land on ``/markers`` too).
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
+from launch_ros.parameter_descriptions import ParameterValue
 from launch_ros.substitutions import FindPackageShare
 
 from launch import LaunchDescription
@@ -26,10 +27,14 @@ def generate_launch_description() -> LaunchDescription:
     """The mocap node with ``source`` over ``params_file``, in ``namespace``."""
     default_params = PathJoinSubstitution([FindPackageShare("tdcm_ros"), "config",
                                            "mocap_node.yaml"])
-    sim_time = {"use_sim_time": LaunchConfiguration("use_sim_time")}  # launch_ros reads it as YAML
+    # launch_ros reads use_sim_time as YAML; frame_prefix stays a string ('' included)
+    common = {"use_sim_time": LaunchConfiguration("use_sim_time"),
+              "frame_prefix": ParameterValue(LaunchConfiguration("frame_prefix"), value_type=str)}
     return LaunchDescription([
         DeclareLaunchArgument("use_sim_time", default_value="false",
                               description="true: every node takes its time from /clock"),
+        DeclareLaunchArgument("frame_prefix", default_value="",
+                              description="put before every TF frame of this robot, e.g. robot1/"),
         DeclareLaunchArgument("source", default_value=SOURCES[0], choices=SOURCES,
                               description="relabel: the live driver's markers (real bench); "
                                           "csv: a Nexus CSV replay; sim: simulated markers"),
@@ -43,7 +48,7 @@ def generate_launch_description() -> LaunchDescription:
         Node(package="tdcm_ros", executable="mocap_node", name="mocap_node",
              namespace=LaunchConfiguration("namespace"),
              parameters=[LaunchConfiguration("params_file"),
-                         {"source": LaunchConfiguration("source")}, sim_time],
+                         {"source": LaunchConfiguration("source")}, common],
              remappings=[("/vicon/markers", LaunchConfiguration("driver_markers"))],
              output="screen"),
     ])

@@ -48,6 +48,14 @@ class FindPackageShare:
         self.package = package
 
 
+class ParameterValue:
+    """launch_ros's typed parameter value: ``value_type=str`` keeps the substituted text as it
+    is (no YAML reading), the way the launch files pass ``frame_prefix``."""
+
+    def __init__(self, value: Any, *, value_type: Any = None) -> None:
+        self.value, self.value_type = value, value_type
+
+
 class Node:
     def __init__(self, *, executable: str, package: str | None = None, name: str | None = None,
                  namespace: Any = None, exec_name: str | None = None,
@@ -73,6 +81,8 @@ def resolve(value: Any, arguments: Mapping[str, str]) -> Any:
         return os.path.join(*(str(resolve(part, arguments)) for part in value.substitutions))
     if isinstance(value, FindPackageShare):
         return _share(value.package)
+    if isinstance(value, ParameterValue):
+        return ParameterValue(resolve(value.value, arguments), value_type=value.value_type)
     if isinstance(value, (list, tuple)):
         return type(value)(resolve(item, arguments) for item in value)
     if isinstance(value, dict):
@@ -94,6 +104,8 @@ def _modules() -> dict[str, types.ModuleType]:
                                        PathJoinSubstitution=PathJoinSubstitution),
         "launch_ros": module("launch_ros"),
         "launch_ros.actions": module("launch_ros.actions", Node=Node),
+        "launch_ros.parameter_descriptions": module("launch_ros.parameter_descriptions",
+                                                    ParameterValue=ParameterValue),
         "launch_ros.substitutions": module("launch_ros.substitutions",
                                            FindPackageShare=FindPackageShare),
         # the older style (os.path.join over the share directory) still loads, to be judged

@@ -49,6 +49,15 @@ def test_config_files_are_ros_parameter_yaml_and_load_for_the_embedded_runtime()
 
 # -- the launch files run on stand-ins of launch/launch_ros (test/launch_fakes.py) -------------
 
+def _launch_value(value: Any) -> Any:
+    """An inline parameter as launch_ros passes it: a ``ParameterValue`` of ``value_type=str``
+    as its text, other text read as YAML."""
+    if isinstance(value, launch_fakes.ParameterValue):
+        assert value.value_type is str, value.value_type
+        return str(value.value)
+    return yaml.safe_load(value) if isinstance(value, str) else value
+
+
 def _effective_parameters(node: launch_fakes.Node, arguments: dict[str, str]) -> dict[str, Any]:
     """What the node starts with: its parameter files (``ros__parameters`` of ``/<name>``), then
     the inline dicts, later entries winning, as launch_ros passes them."""
@@ -59,8 +68,7 @@ def _effective_parameters(node: launch_fakes.Node, arguments: dict[str, str]) ->
     fqn = f"/{namespace}/{node.name}" if namespace else f"/{node.name}"
     for entry in launch_fakes.resolve(node.parameters, arguments):
         if isinstance(entry, dict):  # launch_ros reads a substituted value as YAML
-            values.update({k: yaml.safe_load(v) if isinstance(v, str) else v
-                           for k, v in entry.items()})
+            values.update({k: _launch_value(v) for k, v in entry.items()})
         else:
             assert Path(entry).is_file(), entry
             values.update(node_parameters([entry], fqn))
@@ -136,14 +144,17 @@ def test_launch_files_find_configs_with_find_package_share_and_pass_valid_parame
 @pytest.mark.parametrize("path", sorted((REPO / "launch").glob("*.launch.py")), ids=lambda p: p.name)
 def test_every_launch_file_takes_namespace_and_use_sim_time_for_every_node(path: Path) -> None:
     """namespace:=/robot1 moves every node there, and the shipped parameter files still apply
-    (their keys are /**/NODE); use_sim_time:=true reaches every node as a bool."""
+    (their keys are /**/NODE); use_sim_time:=true reaches every node as a bool, and
+    frame_prefix:=robot1/ as text ('' by default, not YAML's null)."""
     description = launch_fakes.load(path)
     plain = {node.name: _effective_parameters(node, launch_fakes.launch_arguments(description, {}))
              for node in launch_fakes.nodes(description)}
     arguments = launch_fakes.launch_arguments(description, {"namespace": "/robot1",
-                                                            "use_sim_time": "true"})
+                                                            "use_sim_time": "true",
+                                                            "frame_prefix": "robot1/"})
     for node in launch_fakes.nodes(description):
         assert launch_fakes.resolve(node.namespace, arguments) == "/robot1", node.name
         values = _effective_parameters(node, arguments)
         assert values.pop("use_sim_time") is True and plain[node.name].pop("use_sim_time") is False
+        assert values.pop("frame_prefix") == "robot1/" and plain[node.name].pop("frame_prefix") == ""
         assert values == plain[node.name], node.name

@@ -28,9 +28,11 @@ from typing import Any
 from tdcm_ros.errors import InputError
 from tdcm_ros.runtime import (
     DEFAULT_NODE_SET,
+    FRAMED_NODES,
     NODES,
     normalize_namespace,
     parse_cli_param,
+    validate_frame_prefix,
 )
 
 TWIN_NODES = ("device_twin", "tension_driver")
@@ -57,6 +59,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="namespace of every node (default /): a second robot on the same "
                              "graph runs with another, e.g. --namespace /robot2 --connect "
                              "ENDPOINT")
+    parser.add_argument("--frame-prefix", default="", metavar="PREFIX",
+                        help="put before every TF frame of this robot (frame_prefix of every "
+                             "node that names one), e.g. --frame-prefix robot2/ with "
+                             "--namespace /robot2: robot2/tdcm_base; the mocap frame is shared")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--endpoint", default=None,
                        help="zenoh router endpoint, started here unless one answers (default "
@@ -124,6 +130,11 @@ def plan(args: argparse.Namespace, pid: int) -> tuple[list[str], dict[str, dict[
                              f"{', '.join(nodes)}", parameter="-p", value=item,
                              allowed=", ".join(nodes))
         overrides.setdefault(node, {})[name] = value
+    if args.frame_prefix:
+        validate_frame_prefix(args.frame_prefix, "--frame-prefix")
+        for node in nodes:
+            if node in FRAMED_NODES:
+                overrides.setdefault(node, {}).setdefault("frame_prefix", args.frame_prefix)
     if args.use_sim_time:
         for node in nodes:
             overrides.setdefault(node, {})["use_sim_time"] = True

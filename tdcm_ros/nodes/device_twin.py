@@ -8,7 +8,7 @@ with ``scene`` set (a shipped scene name or a YAML path) their defaults come fro
 scene's ``latency`` effect delays every line the device sends by its ``tension`` delay.
 
 Publishes ``sim/tension_true`` (``geometry_msgs/msg/WrenchStamped``): the true tendon tension
-(N, ``wrench.force.z``, frame ``frame_id``) at every load-cell sample, stamped with the host time
+(N, ``wrench.force.z``, frame ``frame_id`` after ``frame_prefix``) at every load-cell sample, stamped with the host time
 of the sample; ``sim/joint_states_true`` (``sensor_msgs/msg/JointState``, name ``["roll"]``): the
 simulated roll servo's true angle (rad) at the same samples and stamps; and ``/diagnostics``
 (port, simulated time, device mode, faults, roll, and how the simulation kept up: ``sim_late_turns``
@@ -29,6 +29,7 @@ from tdcm_ros.bagio import from_dict
 from tdcm_ros.device import PLANT_SPECS, ROLL_SPEED, PlantConfig, fault_names
 from tdcm_ros.device.twin import LATE_TURN_S, TRUTH_DEPTH, DeviceTwin, PtyTwin
 from tdcm_ros.errors import InputError
+from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix, robot_frame
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, joint_state
 from tdcm_ros.nodes.shape_messages import header
 from tdcm_ros.runtime import (
@@ -59,7 +60,8 @@ TWIN_SPECS = by_name(
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(TWIN_SPECS), **grouped(PLANT_SPECS, "plant.")}
+PARAMETERS = {**grouped(TWIN_SPECS), **grouped(FRAME_PREFIX_SPECS),
+              **grouped(PLANT_SPECS, "plant.")}
 
 
 def scene_bench(scene: str) -> tuple[PlantConfig, Callable[[], float]]:
@@ -116,7 +118,7 @@ class DeviceTwinNode(NodeLogic):
         link = str(own["link"]).strip() or default_link()
         check_link(link)
         speed = float(own["speed"])
-        self.frame_id = str(own["frame_id"])
+        self.frame_id = robot_frame(declare_frame_prefix(port), str(own["frame_id"]))
         period = float(own["publish_period_s"])
         diag_period = float(own["diagnostics_period_s"])
         # every sample counts (tdcm_ros.mocap.truth): a reader behind keeps them all

@@ -13,7 +13,8 @@ frames (a base mounted on a robot: ``mocap -> world -> ... -> tool0 -> tdcm_base
 arrives). The per-frame errors compare at the roll current at the frame's stamp; Table I assumes
 roll 0 (see :mod:`tdcm_ros.metrics.streaming`).
 
-Publishes (frame ``base_frame_id``, SI units):
+Publishes (frame ``base_frame_id`` after ``frame_prefix``, :mod:`tdcm_ros.nodes.frames`; SI
+units):
 
 - ``metrics/marker_errors`` (mocap4r2_msgs/msg/Markers): per marker frame, each visible
   marker's measured minus predicted position (m; the model at the tension, or tension vector,
@@ -84,6 +85,7 @@ from tdcm_ros.model import (
     parameter_specs,
     require_paper_tendon,
 )
+from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix, robot_frame
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_efforts
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.tf_messages import TF_TYPE
@@ -206,7 +208,8 @@ def marker_rows(message: Any, index: dict[str, int]) -> tuple[np.ndarray, int]:
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(PRESET_SPECS), **grouped(PARAMETER_SPECS, "design."),
+PARAMETERS = {**grouped(FRAME_PREFIX_SPECS), **grouped(PRESET_SPECS),
+              **grouped(PARAMETER_SPECS, "design."),
               **grouped(LAYOUT_SPECS, "markers."), **grouped(STEP_SPECS, "steps."),
               **grouped(OPTION_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS)}
 
@@ -220,6 +223,7 @@ class MetricsNode(NodeLogic):
         super().__init__(port)
         self.options = self._options()
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
+        prefix = declare_frame_prefix(port)
         declare_specs(port, TUNABLE_SPECS)
         self.source = str(fixed["registration.source"])
         self.tension_type = str(fixed["input.tension_type"])
@@ -231,7 +235,7 @@ class MetricsNode(NodeLogic):
                 f"{JOINT_STATE} (an effort in N per tendon, by name)",
                 parameter="input.tension_type", value=self.tension_type, allowed=JOINT_STATE)
         self.roll_joint = str(fixed["roll.joint"])
-        self.base_frame = str(fixed["base_frame_id"]).lstrip("/")
+        self.base_frame = robot_frame(prefix, str(fixed["base_frame_id"]))
         self.mocap_frame = str(fixed["mocap_frame_id"]).lstrip("/")
         translation, rotation = fixed["registration.translation"], fixed["registration.rotation"]
         update_s = float(fixed["update_period_s"])

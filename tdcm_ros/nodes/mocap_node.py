@@ -4,7 +4,8 @@ Publishes ``markers`` (``mocap4r2_msgs/msg/Markers``, the MOCAP4ROS2 Vicon drive
 ``markers_poses`` (``geometry_msgs/msg/PoseArray``, same order, identity orientations), both in
 ``frame_id`` (``mocap``), positions in m; marker_name = label (``m1``...), marker_index = the
 label's index. Occluded markers (NaN or exactly zero) and unlabelled ones are left out and
-counted. The static transform ``mocap`` -> ``tdcm_base`` goes to ``/tf_static``
+counted. The static transform ``mocap`` -> ``tdcm_base`` (``base_frame_id`` after ``frame_prefix``,
+:mod:`tdcm_ros.nodes.frames`; ``frame_id`` is the room's and not prefixed) goes to ``/tf_static``
 (``tf2_msgs/msg/TFMessage``, transient local) once at start. ``/diagnostics``
 (``mocap_node: <source> source``) carries the counters and the source state; WARN while a source
 error or rejected axis message happened within the last 5 periods, or a live source waits.
@@ -58,6 +59,7 @@ from tdcm_ros.mocap import (
     read_nexus_csv,
     straight_axis,
 )
+from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix, robot_frame
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import header, stamp_ns_of
 from tdcm_ros.runtime import (
@@ -143,7 +145,7 @@ TRUTH_STALE_NS = 2_000_000_000
 #: reads 1970), not a backlog still to be covered: such truth is held too.
 TRUTH_OTHER_CLOCK_NS = 60_000_000_000
 #: Every parameter of the node by full name (parameter files are checked against it).
-PARAMETERS = grouped(MOCAP_SPECS)
+PARAMETERS = {**grouped(MOCAP_SPECS), **grouped(FRAME_PREFIX_SPECS)}
 
 
 class MocapNode(NodeLogic):
@@ -154,10 +156,11 @@ class MocapNode(NodeLogic):
     def __init__(self, port: NodePort) -> None:
         super().__init__(port)
         declare_specs(port, MOCAP_SPECS, read_only=True)
+        prefix = declare_frame_prefix(port)
         get = port.get_parameter
         self.source_name = str(get("source"))
         self.frame_id = str(get("frame_id"))
-        self.base_frame_id = str(get("base_frame_id"))
+        self.base_frame_id = robot_frame(prefix, str(get("base_frame_id")))
         self.counts: Counter[str] = Counter()
         self.state = "starting"
         self.last_problem = ""

@@ -27,7 +27,9 @@ TF (``tf2_msgs/msg/TFMessage``, see :mod:`tdcm_ros.nodes.tf_messages`): on ``/tf
 (transient local, depth 1, as tf2's StaticTransformBroadcaster) ``frame_id -> tf.tendon_frame_id``,
 the frame ``tension`` is stamped in, sent at start and again when ``frame_id`` or the design
 changes (``tf.tendon: false`` leaves it to a URDF or another node); on ``/tf`` (depth 100, as tf2's TransformBroadcaster) ``frame_id -> tf.tip_frame_id``
-for every solve, stamped with the input's stamp, plus ``tf.stations`` midline frames.
+for every solve, stamped with the input's stamp, plus ``tf.stations`` midline frames. Every
+frame named here (``frame_id``, ``tf.*``) is put after ``frame_prefix`` (read-only, ``''``;
+:mod:`tdcm_ros.nodes.frames`), so two robots' frames differ on the shared ``/tf``.
 
 Keep-latest: the subscription only stores the newest valid tension; a timer solves it, warm
 started from the previous shape, so a burst never builds a queue (skipped inputs are counted
@@ -64,6 +66,7 @@ from tdcm_ros.model import (
     solve,
     warm_up,
 )
+from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix
 from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_efforts, tendon_states
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import midline_messages, stamp_ns_of
@@ -137,7 +140,8 @@ TF_SPECS = by_name(
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(FIXED_SPECS), **grouped(TF_SPECS), **grouped(PARAMETER_SPECS, "design."),
+PARAMETERS = {**grouped(FIXED_SPECS), **grouped(FRAME_PREFIX_SPECS), **grouped(TF_SPECS),
+              **grouped(PARAMETER_SPECS, "design."),
               **grouped(SOLVER_SPECS, "solver."), **grouped(TUNABLE_SPECS)}
 
 
@@ -165,6 +169,7 @@ class ModelNode(NodeLogic):
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
         self.tf_names = declare_specs(port, TF_SPECS, read_only=True)
         _check_frame_names(self.tf_names)
+        self.prefix = declare_frame_prefix(port)
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
         self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
@@ -243,8 +248,9 @@ class ModelNode(NodeLogic):
         (unless ``tf.tendon`` is off)."""
         if not self.tf_names["tf.tendon"]:
             return
-        self.tf_static.publish(tendon_tf(self.design, stamp_ns=self.port.now_ns(), parent=frame_id,
-                                         child=str(self.tf_names["tf.tendon_frame_id"])))
+        self.tf_static.publish(tendon_tf(
+            self.design, stamp_ns=self.port.now_ns(), parent=self.prefix + frame_id,
+            child=self.prefix + str(self.tf_names["tf.tendon_frame_id"])))
 
     def _on_tension(self, message: Any) -> None:
         """Store a valid tension (N; a JointState's, one per tendon) with its stamp (ns); an
@@ -352,7 +358,7 @@ class ModelNode(NodeLogic):
         placement = self.port.get_parameter("markers.placement")
         radius = (self.design.R_outer + float(self.port.get_parameter("markers.ball_radius"))
                   if placement == "surface" else 0.0)
-        frame_id = str(self.port.get_parameter("frame_id"))
+        frame_id = self.prefix + str(self.port.get_parameter("frame_id"))
         roll = self.rolls.at(stamp_ns)
         for topic, message in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
@@ -367,8 +373,9 @@ class ModelNode(NodeLogic):
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
-                                tip=str(self.tf_names["tf.tip_frame_id"]),
-                                station_prefix=str(self.tf_names["tf.station_prefix"]),
+                                tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
+                                station_prefix=self.prefix
+                                + str(self.tf_names["tf.station_prefix"]),
                                 stations=int(self.tf_names["tf.stations"]), roll=roll))
 
     def check_input(self) -> Status:

@@ -56,6 +56,7 @@ from tdcm_ros.control import (
 from tdcm_ros.errors import TdcmError
 from tdcm_ros.mocap import TransformBuffer
 from tdcm_ros.model import PARAMETER_SPECS, RollHistory, StampedHistory
+from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix, robot_frame
 from tdcm_ros.nodes.metrics_node import (
     LAYOUT_SPECS,
     PRESET_SPECS,
@@ -119,7 +120,7 @@ TUNABLE_SPECS = by_name(
 #: Every parameter of the node by full name, as declared below.
 PARAMETERS = {**grouped(PRESET_SPECS), **grouped(PARAMETER_SPECS, "design."),
               **grouped(LAYOUT_SPECS, "markers."), **grouped(FIXED_SPECS),
-              **grouped(TUNABLE_SPECS)}
+              **grouped(FRAME_PREFIX_SPECS), **grouped(TUNABLE_SPECS)}
 #: How long the tendon must read released while commanded before diagnostics say so (s).
 RELEASED_AFTER_S = 1.0
 #: Tension and roll samples kept by stamp for the marker frames (seconds at 500 Hz).
@@ -228,7 +229,7 @@ class ShapeControllerNode(NodeLogic):
         self.core = ShapeController(design, layout, gain=gain,
                                     tolerance_m=float(fixed["target_tolerance_m"]),
                                     adapt_min_n=float(fixed["adapt_min_n"]))
-        self.base_frame = str(fixed["base_frame"])
+        self.base_frame = robot_frame(declare_frame_prefix(port), str(fixed["base_frame"]))
         self.roll_joint = str(fixed["roll.joint"])
         self.period_s, self.keepalive_s = float(fixed["period_s"]), float(fixed["keepalive_s"])
         self.index = {label: i for i, label in enumerate(layout.labels)}

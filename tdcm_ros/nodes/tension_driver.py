@@ -3,7 +3,7 @@
 Wraps :class:`tdcm_ros.device.driver.TensionDriver` (handshake, heartbeats, setpoint ramp and
 clamp, reconnect with backoff, stale detection). A timer (``step_period_s``) steps the driver and
 publishes every telemetry frame as ``tension`` (``geometry_msgs/msg/WrenchStamped``,
-``wrench.force.z`` = measured tension in N, frame ``frame_id``; stamp = the host time the device
+``wrench.force.z`` = measured tension in N, frame ``frame_id`` (after ``frame_prefix``); stamp = the host time the device
 took it, :class:`~tdcm_ros.device.clock_map.DeviceClockMap`: a burst keeps its device spacing). ``/diagnostics`` (every ``diagnostics_period_s``)
 carries one status per component (:mod:`tdcm_ros.nodes.driver_diagnostics`): ``serial link``,
 ``load cell`` and ``actuator`` (mode, faults, setpoints, armed, the schedule state and
@@ -69,6 +69,7 @@ from tdcm_ros.device import (
 )
 from tdcm_ros.errors import InputError
 from tdcm_ros.nodes.driver_diagnostics import actuator, load_cell, serial_link
+from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix, robot_frame
 from tdcm_ros.nodes.joint_messages import (
     JOINT_STATE,
     ROLL_JOINT,
@@ -128,7 +129,8 @@ TUNABLE_SPECS = by_name(
 
 #: Every parameter of the node by full name, as declared below (parameter files are checked
 #: against it).
-PARAMETERS = {**grouped(DRIVER_SPECS), **grouped(FIXED_SPECS), **grouped(TUNABLE_SPECS),
+PARAMETERS = {**grouped(DRIVER_SPECS), **grouped(FIXED_SPECS), **grouped(FRAME_PREFIX_SPECS),
+              **grouped(TUNABLE_SPECS),
               **grouped(SCHEDULE_SPECS, "schedule.")}
 
 
@@ -148,6 +150,7 @@ class TensionDriverNode(NodeLogic):
         url = str(link["port"])
         _non_empty("port")(url)
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
+        self.frame_prefix = declare_frame_prefix(port)
         self.limits_writable = bool(fixed[LIMITS_WRITABLE])
         self.driver_specs = {name: self._noted(spec) for name, spec in DRIVER_SPECS.items()
                              if name not in LINK_FIELDS}
@@ -430,7 +433,7 @@ class TensionDriverNode(NodeLogic):
         now = self.port.now_ns()
         self.clock_map.observe(max([frame.time for frame in frames]
                                    + [joint.time for joint in joints]), now)
-        frame_id = str(self.port.get_parameter("frame_id"))
+        frame_id = robot_frame(self.frame_prefix, str(self.port.get_parameter("frame_id")))
         for frame in frames:
             self.tension.publish(from_dict("geometry_msgs/msg/WrenchStamped", {
                 "header": header(self._stamp("tension", now, frame.time), frame_id),

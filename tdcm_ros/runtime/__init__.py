@@ -20,7 +20,11 @@ from tdcm_ros.runtime.diagnostics import (
 from tdcm_ros.runtime.errors import RuntimePortError
 from tdcm_ros.runtime.graph import NodeGraph
 from tdcm_ros.runtime.launcher import launch
-from tdcm_ros.runtime.names import normalize_namespace, resolve_topic
+from tdcm_ros.runtime.names import (
+    normalize_namespace,
+    resolve_topic,
+    validate_frame_prefix,
+)
 from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
 from tdcm_ros.runtime.params import param_file_text, parse_cli_param
 from tdcm_ros.runtime.port import (
@@ -35,7 +39,7 @@ from tdcm_ros.runtime.port import (
     Timer,
 )
 from tdcm_ros.runtime.qos_overrides import overridable_qos
-from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, NODES, node_target
+from tdcm_ros.runtime.registry import DEFAULT_NODE_SET, FRAMED_NODES, NODES, node_target
 from tdcm_ros.runtime.shutdown import close_within, exit_now
 from tdcm_ros.runtime.spec_params import NODE_COMMON, declare_specs, grouped, read_specs
 from tdcm_ros.runtime.throttle import Throttled, template
@@ -46,6 +50,7 @@ __all__ = [
     "CLOCK_TYPE",
     "DEFAULT_NODE_SET",
     "DEFAULT_QOS",
+    "FRAMED_NODES",
     "NODES",
     "NODE_COMMON",
     "DiagnosticLevel",
@@ -77,4 +82,5 @@ __all__ = [
     "resolve_topic",
     "summary",
     "template",
+    "validate_frame_prefix",
 ]

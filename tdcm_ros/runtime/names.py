@@ -1,6 +1,7 @@
 """ROS 2 name rules: validation and resolution of node names, namespaces and topic names.
 
-Follows https://design.ros2.org/articles/topic_and_service_names.html (no remapping).
+Follows https://design.ros2.org/articles/topic_and_service_names.html (no remapping); and the
+prefix of a robot's TF frame ids.
 """
 
 from __future__ import annotations
@@ -19,6 +20,20 @@ def validate_node_name(name: str) -> str:
         raise InputError(f"node name {name!r} is invalid; allowed: [A-Za-z_][A-Za-z0-9_]*",
                          parameter="node_name", value=name, allowed="[A-Za-z_][A-Za-z0-9_]*")
     return name
+
+
+#: What a ``frame_prefix`` may be (tf2 frame ids have no leading ``/``).
+FRAME_PREFIX_ALLOWED = "'' or a tf2 frame-id start: no leading '/', no white space"
+
+
+def validate_frame_prefix(prefix: str, parameter: str = "frame_prefix") -> str:
+    """Return ``prefix`` if it can start tf2 frame ids (robot_state_publisher's
+    ``frame_prefix``, e.g. ``robot1/``); else an InputError naming ``parameter``."""
+    if prefix.startswith("/") or any(c.isspace() for c in prefix):
+        raise InputError(f"{parameter} = {prefix!r} is not a frame prefix; allowed: "
+                         f"{FRAME_PREFIX_ALLOWED}", parameter=parameter, value=prefix,
+                         allowed=FRAME_PREFIX_ALLOWED)
+    return prefix
 
 
 def normalize_namespace(namespace: str) -> str:

@@ -15,6 +15,8 @@ NODES: dict[str, str] = {
 }
 
 DEFAULT_NODE_SET: tuple[str, ...] = ("model_node",)
+#: The nodes that name frames of the robot and take ``frame_prefix`` (``tdcm up --frame-prefix``).
+FRAMED_NODES: frozenset[str] = frozenset(NODES) - {"talker"}
 
 
 def node_target(name: str) -> str:

@@ -59,3 +59,16 @@ def test_namespace_is_checked_and_reaches_the_merged_parameter_file(tmp_path) ->
     with pytest.raises(InputError, match="--namespace") as error:
         plan(up_args("--namespace", "/2nd"), 1)
     assert error.value.parameter == "--namespace"
+
+
+def test_frame_prefix_reaches_every_node_that_names_a_frame_and_p_wins() -> None:
+    nodes, overrides, _ = plan(up_args(
+        "--twin", "--nodes", "model_node,talker,metrics_node", "--frame-prefix", "robot2/",
+        "-p", "metrics_node:frame_prefix:=bench/"), 1)
+    assert {n: overrides.get(n, {}).get("frame_prefix") for n in nodes} == {
+        "device_twin": "robot2/", "tension_driver": "robot2/", "model_node": "robot2/",
+        "talker": None, "metrics_node": "bench/"}
+    with pytest.raises(InputError, match=re.escape("--frame-prefix = '/robot2/' is not a frame "
+                                                   "prefix")) as error:
+        plan(up_args("--frame-prefix", "/robot2/"), 1)
+    assert error.value.parameter == "--frame-prefix"
