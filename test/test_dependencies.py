@@ -4,6 +4,7 @@ same eclipse-zenoh range as setup.py."""
 from __future__ import annotations
 
 import importlib.util
+import re
 from importlib.metadata import packages_distributions
 from typing import Any
 
@@ -66,6 +67,19 @@ def test_the_ros_route_installs_every_module_the_package_imports() -> None:
         if not names & route:
             missing[module] = sorted(names)
     assert not missing, f"imported but not installed by the README's ROS route: {missing}"
+
+
+def test_the_ros_venv_installs_package_xml_s_ros_packages_or_names_the_gap() -> None:
+    """.ci/ros.sh's wheels come from [ros] exec: each one is a wheel or a gap with a reason."""
+    deps = _deps_script()
+    decl = deps.declaration()
+    gaps = decl["ros"]["registry_gaps"]
+    wheels = {re.sub(r"\[.*\]$", "", w).removeprefix("ros-jazzy-").replace("-", "_")
+              for w in deps.ros_wheels(decl)}
+    assert wheels | set(gaps) == set(decl["ros"]["exec"]) and not wheels & set(gaps)
+    assert all(reason.startswith("no wheel: ") for reason in gaps.values())
+    assert "ros-jazzy-rclpy[fastrtps]" in deps.ros_wheels(decl)
+    assert '"$REPO/.ci/deps.py" ros-wheels' in (REPO / ".ci" / "ros.sh").read_text()
 
 
 def test_the_node_table_is_declared_once() -> None:
