@@ -88,8 +88,8 @@ class _Damaged(Exception):
 
 #: Largest uncompressed chunk (bytes) believed from a file; writers use chunks of a few MB.
 MAX_CHUNK_BYTES = 1 << 30
-#: Bytes decompressed per step from a zstd frame that does not declare its size.
-_ZSTD_PIECE = 1 << 20
+#: Bytes decompressed per step from a zstd or lz4 frame that does not declare its size.
+_PIECE = 1 << 20
 # What record parsers and decompressors raise on damaged bytes (lz4 raises RuntimeError).
 _DAMAGE = (_Damaged, McapError, struct.error, ValueError, KeyError, IndexError, EOFError,
            RuntimeError, OverflowError, zstandard.ZstdError)
@@ -124,7 +124,7 @@ def _zstd(data: bytes, size: int) -> bytes:
     """The zstd frame ``data`` holding the chunk's ``size`` bytes. Memory follows what the data
     holds, never what a damaged field claims: a frame that declares its size (every writer's)
     must declare ``size`` and is decompressed at once; one that does not is read in pieces of
-    :data:`_ZSTD_PIECE` bytes, up to ``size``. (Trusting the claim allocated up to
+    :data:`_PIECE` bytes, up to ``size``. (Trusting the claim allocated up to
     :data:`MAX_CHUNK_BYTES` for a flipped byte: a MemoryError on a busy machine.)"""
     declared = zstandard.frame_content_size(data)
     if declared >= 0:
@@ -134,11 +134,31 @@ def _zstd(data: bytes, size: int) -> bytes:
     reader = zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True)
     parts: list[bytes] = []
     total = 0
-    while piece := reader.read(_ZSTD_PIECE):
+    while piece := reader.read(_PIECE):
         total += len(piece)
         if total > size:
             raise _Damaged(f"chunk claims {size} bytes; its zstd data holds more")
         parts.append(piece)
+    return b"".join(parts)
+
+
+def _lz4(data: bytes, size: int) -> bytes:
+    """The lz4 frame ``data`` holding the chunk's ``size`` bytes, by the rule of :func:`_zstd`:
+    a frame that declares its content size must declare ``size``; one that does not is read in
+    pieces of :data:`_PIECE` bytes, up to ``size``."""
+    declared = int(lz4.frame.get_frame_info(data)["content_size"])  # 0: not declared
+    if declared and declared != size:
+        raise _Damaged(f"chunk claims {size} bytes; its lz4 frame holds {declared}")
+    decompressor = lz4.frame.LZ4FrameDecompressor()
+    parts = [decompressor.decompress(data, max_length=_PIECE)]
+    total = len(parts[0])
+    while not (decompressor.eof or decompressor.needs_input) and total <= size:
+        parts.append(decompressor.decompress(b"", max_length=_PIECE))
+        total += len(parts[-1])
+    if total > size:
+        raise _Damaged(f"chunk claims {size} bytes; its lz4 data holds more")
+    if not decompressor.eof:
+        raise _Damaged("the chunk's lz4 frame is cut short")
     return b"".join(parts)
 
 
@@ -150,7 +170,7 @@ def _decompress(compression: str, data: bytes, size: int) -> bytes:
     if compression == "zstd":
         return _zstd(data, size)
     if compression == "lz4":
-        return bytes(lz4.frame.decompress(data))
+        return _lz4(data, size)
     raise _Damaged(f"unsupported chunk compression {compression!r}")
 
 

@@ -138,3 +138,32 @@ def test_a_zstd_chunk_allocates_what_its_data_holds_not_what_a_field_claims() ->
     assert peak < 8 * len(content)
     with pytest.raises(_Damaged, match="holds more"):
         _zstd(unsized, len(content) - 1)
+
+
+def test_an_lz4_chunk_allocates_what_its_data_holds_not_what_a_field_claims() -> None:
+    """As for zstd: the frame's declared content size must be the chunk's, and a frame that
+    declares none is read in pieces, never past the chunk's claim."""
+    import tracemalloc
+
+    import lz4.frame
+
+    from tdcm_ros.bagio.reader import MAX_CHUNK_BYTES, _Damaged, _lz4
+
+    content = bytes(range(256)) * 4096  # 1 MiB
+    sized = lz4.frame.compress(content, store_size=True)
+    unsized = lz4.frame.compress(content, store_size=False)
+    assert _lz4(sized, len(content)) == content == _lz4(unsized, len(content))
+    tracemalloc.start()
+    try:
+        with pytest.raises(_Damaged, match="its lz4 frame holds 1048576"):
+            _lz4(sized, MAX_CHUNK_BYTES)
+        assert _lz4(unsized, MAX_CHUNK_BYTES) == content  # the caller then sees the size differ
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 8 * len(content)
+    with pytest.raises(_Damaged, match="holds more"):
+        _lz4(unsized, len(content) - 1)
+    with pytest.raises(_Damaged, match="cut short"):
+        _lz4(unsized[:len(unsized) // 2], len(content))
+    assert _lz4(lz4.frame.compress(b""), 0) == b""
