@@ -2,7 +2,8 @@
 
     python3 .ci/deps.py check      # exit 1 naming each file that differs (CI, tests)
     python3 .ci/deps.py write      # rewrite them: package.xml's version and depends, the README's
-                                   # ROS-route rosdep and pip lines, tdcm_ros/__init__.py's version
+                                   # ROS-route rosdep and pip lines and executables table,
+                                   # tdcm_ros/__init__.py's version
     python3 .ci/deps.py ros-route  # the pip requirements that route gives, one per line: the pip
                                    # names of package.xml's python3-* keys, then the README's pip
                                    # line (read from the files, so a key missing there is missing)
@@ -31,6 +32,8 @@ END = "  <!-- END generated -->\n"
 PIP_LINE = re.compile(r'python3 -m pip install --user --break-system-packages (?:"[^"]+"\s*(?:\\\n\s*)?)+')
 ROSDEP_LINE = re.compile(r'rosdep install --from-paths src -y --ignore-src --skip-keys (?:"[^"]*"|\S+)')
 VERSION_LINE = re.compile(r'^__version__ = "[^"]*"$', re.MULTILINE)
+NODE_TABLE_HEAD = "| node | on a ROS 2 machine (colcon) | after `pip install` (on PATH) |\n|---|---|---|\n"
+NODE_ROWS = re.compile(r"(?:\| [^|\n]+ \| `ros2 run tdcm_ros \w+` \| `tdcm_\w+` \|\n)*")
 
 
 def declaration() -> dict[str, Any]:
@@ -83,6 +86,15 @@ def expected_package_xml(text: str, decl: dict[str, Any]) -> str:
     return re.sub(r"<version>[^<]*</version>", f"<version>{decl['version']}</version>", text, count=1)
 
 
+def node_rows(decl: dict[str, Any]) -> str:
+    """The README's executables table, a row per node of the declaration."""
+    rows = []
+    for name in decl["nodes"]:
+        label = name.removesuffix("_node").replace("_", " ")
+        rows.append(f"| {label} | `ros2 run tdcm_ros {name}` | `tdcm_{name}` |\n")
+    return "".join(rows)
+
+
 def expected_readme(text: str, decl: dict[str, Any]) -> str:
     words = [f'"{r}"' for r in pip_line_requirements(decl)]
     head = "python3 -m pip install --user --break-system-packages"
@@ -95,6 +107,10 @@ def expected_readme(text: str, decl: dict[str, Any]) -> str:
     pip = "\n".join([*lines, line])
     skipped = " ".join(e["rosdep"] for e in runtime_entries(decl) if e.get("pip_key"))
     text = PIP_LINE.sub(lambda _: pip + "\n", text, count=1)
+    at = text.index(NODE_TABLE_HEAD) + len(NODE_TABLE_HEAD)
+    rows = NODE_ROWS.match(text, at)
+    assert rows is not None  # the pattern matches the empty string too
+    text = text[:at] + node_rows(decl) + text[rows.end():]
     return ROSDEP_LINE.sub(f'rosdep install --from-paths src -y --ignore-src --skip-keys "{skipped}"',
                            text, count=1)
 

@@ -55,6 +55,19 @@ def test_package_xml_the_readme_and_the_version_are_generated_from_the_declarati
         assert expected(text, decl) == text, f"{name}: run python3 .ci/deps.py write"
 
 
+def test_the_readme_s_executables_table_follows_the_node_table() -> None:
+    """A node added to dependencies.toml gets its row; a row of no node goes."""
+    deps = _deps_script()
+    decl = deps.declaration()
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    grown = {**decl, "nodes": {**decl["nodes"], "gripper_node": "tdcm_ros.nodes.gripper_node:main"}}
+    row = "| gripper | `ros2 run tdcm_ros gripper_node` | `tdcm_gripper_node` |\n"
+    assert row not in text and row in deps.expected_readme(text, grown)
+    shrunk = {**decl, "nodes": {k: v for k, v in decl["nodes"].items() if k != "device_twin"}}
+    assert "`tdcm_device_twin`" not in deps.expected_readme(text, shrunk)
+    assert "`tdcm_node`, `tdcm`" in deps.expected_readme(text, shrunk)  # the last row stays
+
+
 def test_the_ros_route_installs_every_module_the_package_imports() -> None:
     """What package.xml's keys and the README's pip line give covers every import (the CI
     step imports them all in a venv built from that route alone)."""
