@@ -36,6 +36,7 @@ ENTRY_POINTS = frozenset(f"tdcm_ros.{name}" for name in (  # besides scripts (py
     "runtime.zenoh_runtime", "runtime.zenoh_config", "runtime.zenoh_query",  # transports
     "runtime.rclpy_runtime",
     "runtime.param_client", "runtime.param_services",  # rcl_interfaces messages (rosbags)
+    "runtime.lifecycle",  # lifecycle_msgs messages (rosbags)
     "runtime.wire", "device.constants",  # used as namespaces: wire.parse_token, c.TRIP_MN
 ))
 BUDGETS = {unit: frozenset() for layer in LAYERS for unit in layer} | {

@@ -34,6 +34,12 @@ SERVICE_DEFINITIONS: dict[str, str] = {
                                         "SetParametersResult[] results\n",
     "rcl_interfaces/srv/SetParametersAtomically": "Parameter[] parameters\n---\n"
                                                   "SetParametersResult result\n",
+    # The services of a managed (lifecycle) node (lifecycle_msgs, Jazzy), comments cut.
+    "lifecycle_msgs/srv/ChangeState": "Transition transition\n---\nbool success\n",
+    "lifecycle_msgs/srv/GetState": "---\nState current_state\n",
+    "lifecycle_msgs/srv/GetAvailableStates": "---\nState[] available_states\n",
+    "lifecycle_msgs/srv/GetAvailableTransitions": "---\n"
+                                                  "TransitionDescription[] available_transitions\n",
 }
 EVENT_INFO = "service_msgs/msg/ServiceEventInfo"
 _PLACEHOLDER = ("structure_needs_at_least_one_member", (Nodetype.BASE, ("uint8", 0)))

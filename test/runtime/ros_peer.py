@@ -87,6 +87,18 @@ SERVICES: dict[str, tuple[str, str, str]] = {
     "rcl_interfaces/srv/SetParametersAtomically": (
         "rcl_interfaces/Parameter[] parameters", "rcl_interfaces/SetParametersResult result",
         "RIHS01_0e192ef259c07fc3c07a13191d27002222e65e00ccec653ca05e856f79285fcd"),
+    "lifecycle_msgs/srv/ChangeState": (
+        "lifecycle_msgs/Transition transition", "bool success",
+        "RIHS01_356fe34f0475a43acf54542013af4167b0e729f77ea22ffb045c6ad8e20668e5"),
+    "lifecycle_msgs/srv/GetState": (
+        _EMPTY, "lifecycle_msgs/State current_state",
+        "RIHS01_800a0a5aae599782b02932de0caf563f6dc4e7e94b794eadde075ba2cbef9795"),
+    "lifecycle_msgs/srv/GetAvailableStates": (
+        _EMPTY, "lifecycle_msgs/State[] available_states",
+        "RIHS01_00a07d79d2207d71e81a8cbc1880e5d924cc16d4688ea8e8e06e443dc8f8aa1d"),
+    "lifecycle_msgs/srv/GetAvailableTransitions": (
+        _EMPTY, "lifecycle_msgs/TransitionDescription[] available_transitions",
+        "RIHS01_59b7ecefce0982a8a844b9f2c4f14764c1c4543cc55e72924e2aa4adad83e9bc"),
 }
 
 

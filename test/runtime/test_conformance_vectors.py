@@ -122,6 +122,13 @@ def test_the_gid_matches_an_independent_xxh3_reading(token: str) -> None:
 
 
 @pytest.mark.parametrize("service", sorted(SERVICES))
+def test_the_package_s_service_hash_is_the_peer_s_pinned_one(service: str) -> None:
+    """bagio's service types (the .srv text of tdcm_ros/bagio/services.py) hash as the
+    independent peer's pinned Jazzy hashes (checked against Jazzy's files in the rclpy half)."""
+    assert service_type_hash(service) == peer_hash(service)
+
+
+@pytest.mark.parametrize("service", sorted(SERVICES))
 def test_the_peer_s_service_types_round_trip(service: str) -> None:
     for half in ("Request", "Response"):
         name = f"{service}_{half}"
