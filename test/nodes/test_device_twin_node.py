@@ -45,10 +45,18 @@ def test_twin_node_serves_its_plant_and_publishes_the_true_tension(runtime, spaw
         driver.enable()
         driver.set_setpoint(8.0)
         results: list[Any] = []
+        cleared = [0.0]  # when faults were last cleared (s, monotonic)
 
         def step() -> None:  # the driver's loop; the probe spins 5 ms between steps
             results.append(driver.step())
             measured.extend(frame.tension for frame in results[-1].telemetry)
+            latest = results[-1].status.telemetry
+            if latest is not None and latest.faults and time.monotonic() > cleared[0] + 0.2:
+                # this process not scheduled for 0.5 s (a loaded machine) trips the device's
+                # watchdog, which then holds the tendon released: clear it, as an operator
+                # would (Probe.hold does the same); the watchdog itself is tested elsewhere
+                driver.clear_faults()
+                cleared[0] = time.monotonic()
 
         eventually(lambda: results and measured and abs(measured[-1] - 8.0) < 0.02
                    and len(probe.truth) > 10 and abs(probe.truth[-1].wrench.force.z - 7.0) < 0.05,
