@@ -313,6 +313,11 @@ class TensionDriver:
         return True
 
     @property
+    def link(self) -> LinkState:
+        """The link's state now."""
+        return self._link
+
+    @property
     def armed(self) -> bool:
         """False while the driver holds the device released until :meth:`clear_faults`."""
         return self._armed
@@ -379,6 +384,13 @@ class TensionDriver:
                 self._send(SetMode(Mode.RELEASE))
             except PortError:
                 pass  # the next read or write drops the link
+
+    def open_link(self) -> None:
+        """Open the port and start the handshake now, whatever the backoff (a managed node's
+        configure); raises :class:`PortError` naming why the port did not open."""
+        self._connect(self._clock())
+        if self._transport is None:
+            raise PortError(self._link_error)
 
     def close(self) -> None:
         """Release the tendon (best effort) and close the port."""

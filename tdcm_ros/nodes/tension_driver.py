@@ -39,6 +39,12 @@ status reports ``armed`` and ``disarm_reason``.
 
 The force and roll limits :data:`SAFETY_LIMITS` are read-only at run time unless the node is started with
 ``safety.limits_writable: true`` (itself read-only).
+
+``managed: true`` (read-only) makes it a managed (lifecycle) node, :mod:`tdcm_ros.runtime.lifecycle`:
+it starts ``unconfigured`` with the port closed; ``configure`` opens the port and starts the
+handshake; ``activate`` is the arm command (as ``clear_faults``, which is refused while not
+active); ``deactivate`` releases the tendon and disarms; ``cleanup``, ``shutdown`` and an error
+release and close the port. Its safety rules are those above in every state.
 """
 
 from __future__ import annotations
@@ -59,6 +65,7 @@ from tdcm_ros.device import (
     DriverConfig,
     DriverStatus,
     LinkState,
+    PortError,
     ProtocolVersionError,
     RollState,
     StepSchedule,
@@ -92,6 +99,7 @@ from tdcm_ros.runtime import (
     summary,
     template,
 )
+from tdcm_ros.runtime.lifecycle import ACTIVE, INACTIVE, Lifecycle, TransitionFailed
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
@@ -120,7 +128,12 @@ FIXED_SPECS = by_name(
          high=0.02),
     Spec("state_period_s", "s", "device_state period (deprecated topic)", 0.1, low=0.01,
          high=10.0),
-    Spec("diagnostics_period_s", "s", "/diagnostics period", 0.5, low=0.05, high=60.0))
+    Spec("diagnostics_period_s", "s", "/diagnostics period", 0.5, low=0.05, high=60.0),
+    Spec("managed", description="a managed (lifecycle) node: starts unconfigured; configure "
+         "opens the port, activate arms, deactivate releases, cleanup closes", default=False,
+         kind="bool"))
+#: Why a managed driver is disarmed outside ``active``.
+NOT_ACTIVE = "managed node not active: activate arms"
 #: Parameters of the node a client may change at run time, besides the driver and schedule.
 TUNABLE_SPECS = by_name(
     Spec("frame_id", description="frame of `tension`", default="tdcm_tendon", kind="str"),
@@ -179,6 +192,13 @@ class TensionDriverNode(NodeLogic):
         self._graph_lost = False
         if bool(port.get_parameter("enabled")):
             self.driver.enable()
+        self.lifecycle: Lifecycle | None = None
+        if bool(fixed["managed"]):
+            self.lifecycle = Lifecycle(port, {
+                "on_configure": self._configure, "on_activate": self._activate,
+                "on_deactivate": self._deactivate, "on_cleanup": self._close,
+                "on_shutdown": self._close, "on_error": self._close})
+            self.driver.disarm(NOT_ACTIVE)
 
         self.tension = port.create_publisher("tension", "geometry_msgs/msg/WrenchStamped",
                                              QoS(depth=100))
@@ -330,10 +350,17 @@ class TensionDriverNode(NodeLogic):
         return True, "released: tendon slack; call clear_faults to hold tension again"
 
     def clear_faults(self) -> tuple[bool, str]:
-        """The operator's arm command: clear faults, arm, re-enable if ``enabled``."""
-        link = self.status.link if self.status else LinkState.DISCONNECTED
+        """The operator's arm command: clear faults, arm, re-enable if ``enabled``; a managed
+        node arms only when active (``activate`` is its arm command)."""
+        if self.lifecycle is not None and self.lifecycle.state != ACTIVE:
+            return False, (f"refused: lifecycle state {self.lifecycle.label}; activate arms "
+                           "(it clears the faults)")
+        return self._arm()
+
+    def _arm(self) -> tuple[bool, str]:
         if not self.driver.clear_faults():
-            return False, f"refused: link {link.value}; clear_faults needs the device connected"
+            return False, (f"refused: link {self.driver.link.value}; clear_faults needs the "
+                           "device connected")
         if bool(self.port.get_parameter("enabled")):
             self.driver.enable()
         target = self.status.target if self.status else 0.0
@@ -374,8 +401,34 @@ class TensionDriverNode(NodeLogic):
         return True, text
 
     # --- the step ---------------------------------------------------------------------------
+    # --- lifecycle (managed: true) ---------------------------------------------------------
+    def _configure(self) -> None:
+        try:
+            self.driver.open_link()
+        except PortError as error:
+            raise TransitionFailed(f"port {self.driver.config.port}: {error}") from error
+
+    def _activate(self) -> None:
+        armed, message = self._arm()
+        if not armed:
+            raise TransitionFailed(message)
+
+    def _deactivate(self) -> None:
+        self.driver.release()
+        self._cancel_schedule()
+        self.driver.disarm(NOT_ACTIVE)
+
+    def _close(self) -> None:
+        self._cancel_schedule()
+        self.driver.disarm(NOT_ACTIVE)
+        self.driver.close()
+        self.status = None
+
     def step(self) -> None:
-        """Step the driver; publish every telemetry frame received."""
+        """Step the driver; publish every telemetry frame received (a managed node: only while
+        configured)."""
+        if self.lifecycle is not None and self.lifecycle.state not in (INACTIVE, ACTIVE):
+            return
         self._watch_graph()
         try:
             result = self.driver.step()

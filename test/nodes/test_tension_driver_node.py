@@ -141,6 +141,36 @@ def test_joint_commands_drive_the_tendon_and_joint_states_report_it(runtime, spa
     probe.until(lambda: abs(twin.twin.plant.tension - 6.0) < BAND, 10.0, "6 N on the tendon")
 
 
+def test_a_managed_driver_goes_through_its_lifecycle_over_the_wire(runtime, spawn, probe, twin,
+                                                                  tmp_path) -> None:
+    """``managed: true``, driven through lifecycle_msgs services as ``ros2 lifecycle set`` or a
+    lifecycle manager drives it: unconfigured the port stays closed; configure brings the link
+    up with the tendon slack; activate arms (a setpoint reaches the tendon); deactivate
+    releases it. (That the port stays closed until configure: test_tension_driver_lifecycle.)"""
+    start_driver(spawn, tmp_path, twin, managed=True)
+
+    def change(label: str) -> bool:
+        request = from_dict("lifecycle_msgs/srv/ChangeState_Request",
+                            {"transition": {"id": 0, "label": label}})
+        return bool(probe.ctx.call_service("/tension_driver/change_state",
+                                           "lifecycle_msgs/srv/ChangeState", request,
+                                           timeout=20.0).success)
+
+    def state() -> str:
+        return str(probe.ctx.call_service("/tension_driver/get_state",
+                                          "lifecycle_msgs/srv/GetState",
+                                          timeout=20.0).current_state.label)
+
+    assert state() == "unconfigured"
+    assert change("configure") and state() == "inactive"
+    probe.connected(mode="release")
+    assert change("activate") and state() == "active"
+    probe.hold(lambda: abs(twin.twin.plant.tension - 5.0) < BAND, 5.0)
+    assert change("deactivate") and state() == "inactive"
+    eventually(lambda: twin.twin.core.mode is Mode.RELEASE and twin.twin.plant.tension == 0.0,
+               5.0, "the tendon released on deactivate")
+
+
 def test_device_releases_within_its_watchdog_when_heartbeats_stop(runtime, spawn, probe, twin,
                                                                   tmp_path) -> None:
     """The driver process is frozen (SIGSTOP: a hung host); the device releases by itself."""
