@@ -10,6 +10,7 @@ from __future__ import annotations
 import struct
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -114,56 +115,56 @@ def test_a_chunk_claiming_an_absurd_uncompressed_size_is_skipped_with_a_warning(
                    if not chunk.message_start_time <= e[1] <= chunk.message_end_time]
 
 
-def test_a_zstd_chunk_allocates_what_its_data_holds_not_what_a_field_claims() -> None:
-    """A damaged size field used to be trusted as the output buffer (up to 1 GiB: a
-    MemoryError on a busy machine, found by the flip test above)."""
-    import tracemalloc
+CONTENT = bytes(range(256)) * 4096  #: 1 MiB of chunk content
 
+
+def _frames(compression: str) -> tuple[bytes, bytes, Any]:
+    """:data:`CONTENT` compressed into a frame that declares its size and one that does not, and the
+    reader's decompressor of that kind."""
+    import lz4.frame
     import zstandard
 
-    from tdcm_ros.bagio.reader import MAX_CHUNK_BYTES, _Damaged, _zstd
+    from tdcm_ros.bagio.reader import _lz4, _zstd
 
-    content = bytes(range(256)) * 4096  # 1 MiB
-    sized = zstandard.ZstdCompressor().compress(content)
-    unsized = zstandard.ZstdCompressor(write_content_size=False).compress(content)
-    assert _zstd(sized, len(content)) == content == _zstd(unsized, len(content))
-    tracemalloc.start()
-    try:
-        with pytest.raises(_Damaged, match="its zstd frame holds 1048576"):
-            _zstd(sized, MAX_CHUNK_BYTES)
-        assert _zstd(unsized, MAX_CHUNK_BYTES) == content  # the caller then sees the size differ
-        _, peak = tracemalloc.get_traced_memory()
-    finally:
-        tracemalloc.stop()
-    assert peak < 8 * len(content)
-    with pytest.raises(_Damaged, match="holds more"):
-        _zstd(unsized, len(content) - 1)
+    if compression == "zstd":
+        return (zstandard.ZstdCompressor().compress(CONTENT),
+                zstandard.ZstdCompressor(write_content_size=False).compress(CONTENT), _zstd)
+    return (lz4.frame.compress(CONTENT, store_size=True),
+            lz4.frame.compress(CONTENT, store_size=False), _lz4)
 
 
-def test_an_lz4_chunk_allocates_what_its_data_holds_not_what_a_field_claims() -> None:
-    """As for zstd: the frame's declared content size must be the chunk's, and a frame that
-    declares none is read in pieces, never past the chunk's claim."""
+@pytest.mark.parametrize("compression", ["zstd", "lz4"])
+def test_a_chunk_allocates_what_its_data_holds_not_what_a_field_claims(compression: str) -> None:
+    """A damaged size field used to be trusted as the output buffer (zstd: up to 1 GiB, a
+    MemoryError on a busy machine, found by the flip test above; lz4: its frame header's size,
+    guarded by a one-byte checksum). A declared size must be the chunk's; an undeclared one is
+    read in pieces, never past the chunk's claim."""
     import tracemalloc
 
-    import lz4.frame
+    from tdcm_ros.bagio.reader import MAX_CHUNK_BYTES, _Damaged
 
-    from tdcm_ros.bagio.reader import MAX_CHUNK_BYTES, _Damaged, _lz4
-
-    content = bytes(range(256)) * 4096  # 1 MiB
-    sized = lz4.frame.compress(content, store_size=True)
-    unsized = lz4.frame.compress(content, store_size=False)
-    assert _lz4(sized, len(content)) == content == _lz4(unsized, len(content))
+    sized, unsized, decompress = _frames(compression)
+    content = CONTENT
+    assert decompress(sized, len(content)) == content == decompress(unsized, len(content))
     tracemalloc.start()
     try:
-        with pytest.raises(_Damaged, match="its lz4 frame holds 1048576"):
-            _lz4(sized, MAX_CHUNK_BYTES)
-        assert _lz4(unsized, MAX_CHUNK_BYTES) == content  # the caller then sees the size differ
+        with pytest.raises(_Damaged, match=f"its {compression} frame holds 1048576"):
+            decompress(sized, MAX_CHUNK_BYTES)
+        assert decompress(unsized, MAX_CHUNK_BYTES) == content  # the caller sees the size differ
         _, peak = tracemalloc.get_traced_memory()
     finally:
         tracemalloc.stop()
     assert peak < 8 * len(content)
     with pytest.raises(_Damaged, match="holds more"):
-        _lz4(unsized, len(content) - 1)
+        decompress(unsized, len(content) - 1)
+
+
+def test_a_cut_or_empty_lz4_frame() -> None:
+    import lz4.frame
+
+    from tdcm_ros.bagio.reader import _Damaged, _lz4
+
+    _, unsized, _ = _frames("lz4")
     with pytest.raises(_Damaged, match="cut short"):
-        _lz4(unsized[:len(unsized) // 2], len(content))
+        _lz4(unsized[:len(unsized) // 2], 1 << 20)
     assert _lz4(lz4.frame.compress(b""), 0) == b""
