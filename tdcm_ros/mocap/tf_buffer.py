@@ -222,12 +222,12 @@ class TransformBuffer:
         target, source = _frame(target, "target frame"), _frame(source, "source frame")
         if target == source:
             return Registration.identity("tf")
-        self._require_known(target)
-        self._require_known(source)
         of_source, source_error = self._walk(source, stamp_s, {target: _Pose.identity()})
         of_target, target_error = self._walk(target, stamp_s, of_source)
         common = next((name for name in of_target if name in of_source), None)
-        if common is None:
+        if common is None:  # the frames are checked here, off the path of a found pose
+            self._require_known(target)
+            self._require_known(source)
             error = source_error or target_error
             if error is not None:
                 raise error
