@@ -1,13 +1,21 @@
 """Plots of model results (need matplotlib): one solution (midline in the x-z plane and
-curvature along s), and an inverse-design search (the designs that meet the target and their
-Pareto set)."""
+curvature along s), an inverse-design search (the designs that meet the target and their
+Pareto set) and a shape design (target against achieved shape)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Any
 
-from tdcm_ros.model import DesignSearch, SolveResult, body_outline
+from tdcm_ros.model import (
+    CurveTarget,
+    DesignSearch,
+    NotchAngleTarget,
+    ShapeDesign,
+    SolveResult,
+    TipTarget,
+    body_outline,
+)
 from tdcm_ros.plot_backend import load_pyplot
 
 FONT_SIZE = 10
@@ -104,7 +112,70 @@ def plot_search(search: DesignSearch, path: str | Path) -> Path:
     target = search.target * reach_scale
     fig.suptitle(f"{search.target_kind.replace('_', ' ')} {target:g} {unit}: "
                  f"{search.outcome.size} candidates", fontsize=FONT_SIZE + 1)
-    for ax in (ax_strain, ax_reach):
+    return _save(plt, fig, (ax_strain, ax_reach), path)
+
+
+def plot_shape_design(found: ShapeDesign, path: str | Path) -> Path:
+    """Write two panels to ``path``: the achieved midline at each load with the target tip
+    poses and curves, and each notch's bend (deg) at each load with a notch-angle target's
+    mean or angles."""
+    import numpy as np
+
+    plt = load_pyplot("--out", path)
+    fig, (ax_shape, ax_notch) = plt.subplots(1, 2, figsize=(11, 4.8))
+    results = found.evaluation.results
+    loads = list(results)
+    width = 0.8 / max(1, len(loads))
+    for k, load in enumerate(loads):
+        result = results[load]
+        ax_shape.plot(result.positions[:, 0] * 1e3, result.positions[:, 2] * 1e3, lw=2,
+                      color=f"C{k}", label=f"achieved at {load.label}")
+        phi = np.degrees(result.notch_angles_rad)
+        ax_notch.bar(np.arange(phi.size) + 1 + (k - (len(loads) - 1) / 2) * width, phi, width,
+                     color=f"C{k}", label=f"achieved at {load.label}")
+    for goal in found.problem.goals:
+        colour = f"C{loads.index(goal.load)}"
+        target = goal.target
+        if isinstance(target, CurveTarget):
+            ax_shape.plot(target.points[:, 0] * 1e3, target.points[:, 1] * 1e3, "x", ms=6,
+                          color="k", label=f"target curve at {goal.load.label}")
+        elif isinstance(target, TipTarget):
+            result = results[goal.load]
+            x = result.tip_position[0] if target.x is None else target.x
+            z = result.tip_position[2] if target.z is None else target.z
+            angle = result.tip_angle_rad if target.angle is None else target.angle
+            reach = 0.15 * float(result.s[-1]) * 1e3  # a tangent 15 % of the body long (mm)
+            ax_shape.plot([x * 1e3, x * 1e3 + reach * np.sin(angle)],
+                          [z * 1e3, z * 1e3 + reach * np.cos(angle)], "k--", lw=1)
+            ax_shape.plot([x * 1e3], [z * 1e3], "ko", mfc="none", ms=8,
+                          label=f"target tip (and its tangent) at {goal.load.label}")
+        elif isinstance(target, NotchAngleTarget):
+            phi = np.degrees(results[goal.load].notch_angles_rad)
+            if target.kind == "angles":
+                ax_notch.plot(np.arange(phi.size) + 1, np.degrees(target.angles), "k_", ms=18,
+                              mew=2, label="target angles")
+            elif target.kind == "equal":
+                ax_notch.axhline(phi.mean(), color=colour, ls="--", lw=0.8,
+                                 label=f"mean; target within {target.tol:.0%}")
+            else:
+                ax_notch.axhline(phi[0] * target.ratio, color=colour, ls="--", lw=0.8,
+                                 label=f"{target.ratio:g} x the first notch")
+    ax_shape.set_aspect("equal", adjustable="datalim")
+    ax_shape.set_xlabel("x (mm, toward the tendon)", fontsize=FONT_SIZE)
+    ax_shape.set_ylabel("z (mm, along the unbent body)", fontsize=FONT_SIZE)
+    ax_shape.legend(loc="best", fontsize=FONT_SIZE - 1)
+    ax_notch.set_xlabel("notch (1 at the base)", fontsize=FONT_SIZE)
+    ax_notch.xaxis.get_major_locator().set_params(integer=True)
+    ax_notch.set_ylabel("bend across the notch (deg)", fontsize=FONT_SIZE)
+    ax_notch.legend(loc="best", fontsize=FONT_SIZE - 1)
+    verdict = "every target met" if found.evaluation.met else "closest design (not met)"
+    fig.suptitle(f"shape design: {verdict}", fontsize=FONT_SIZE + 1)
+    return _save(plt, fig, (ax_shape, ax_notch), path)
+
+
+def _save(plt: Any, fig: Any, axes: tuple[Any, ...], path: str | Path) -> Path:
+    """Label sizes, layout, and ``fig`` written to ``path`` (its folder made) and closed."""
+    for ax in axes:
         ax.tick_params(labelsize=FONT_SIZE)
     fig.tight_layout()
     out = Path(path)

@@ -18,6 +18,9 @@ from tdcm_ros.cli.design_args import (
     sought_tendon,
     target_number,
 )
+from tdcm_ros.cli.design_shape import FILES as SHAPE_FILES
+from tdcm_ros.cli.design_shape import HELP as PROBLEM_HELP
+from tdcm_ros.cli.design_shape import add_problem_arguments, run_problem
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
 from tdcm_ros.errors import InputError, TdcmError
 from tdcm_ros.model import (
@@ -44,13 +47,18 @@ FILES = ("design.json", "pareto.csv", "pareto.png")
 def register(subparsers: Any) -> None:
     """Add the ``design`` subcommand."""
     parser = subparsers.add_parser(
-        "design", help="inverse design: designs that reach a tip target within a tension budget",
-        description="Sample designs (the base design with --free fields varied) and find for "
+        "design", help="inverse design: designs that reach a tip target within a tension "
+                       "budget, or a pattern for a shape (--problem)",
+        description="Uniform search (--tip-deflection or --tip-angle): sample designs (the base design with --free fields varied) and find for "
                     "each the tension within 0..--tension-max N that puts the tip at the target "
                     "deflection (m) or angle (rad), without exceeding --allowable-strain, "
                     "closing a notch or meeting the tendon singularity; print the Pareto set "
                     "(reach within the budget, peak strain at the target, tension needed). "
-                    "--free L=MIN:MAX frees the total length (m), which then sets w_t.",
+                    "--free L=MIN:MAX frees the total length (m), which then sets w_t. "
+                    "Shape design (--problem FILE): per-notch variables and laws, shape "
+                    "targets each at a tension or stroke, strain, hard-stop and fabrication "
+                    "limits; differential evolution then least squares (scipy); --out writes "
+                    "the body file, an STL of the body and the target-against-achieved plot.",
         epilog="examples:\n"
                "  tdcm design --tip-angle 0.45 --free w_n=0.5e-3:3e-3 --free N=3:12\n"
                "  tdcm design --tip-deflection 0.012 --free w_d=0.6e-3:2.2e-3 --free w_t=1e-3:6e-3 "
@@ -58,32 +66,38 @@ def register(subparsers: Any) -> None:
                "  tdcm design --design fig2-wn-1.9 --tip-angle 0.2 --free w_n=1e-3:2.5e-3 "
                "--free L=0.04:0.06 --out design_out\n"
                "  tdcm design --design config/bodies/antagonistic_pair.yaml --tendon flexor "
-               "--tensions 0,5 --tip-angle 0.2 --free w_n=1e-3:3e-3 --samples 64")
-    add_tip_targets(parser.add_mutually_exclusive_group(required=True))
+               "--tensions 0,5 --tip-angle 0.2 --free w_n=1e-3:3e-3 --samples 64\n"
+               "  tdcm design --problem config/design/constant_curvature.yaml --out cc_out\n"
+               "  tdcm design --problem config/design/tip_first_wrist.yaml --workers 1 --json\n"
+               "\n" + PROBLEM_HELP)
+    targets = parser.add_mutually_exclusive_group(required=True)
+    add_tip_targets(targets)
+    add_problem_arguments(parser, targets)
     parser.add_argument("--free", action="append", default=[], metavar="NAME=MIN:MAX",
                         help=f"a field to vary over [MIN, MAX] (SI units; N integers): "
                              f"{', '.join(FREE_FIELDS)}; repeat for more")
-    parser.add_argument("--tension-max", default=str(DEFAULT_TENSION_BUDGET_N), metavar="N",
+    parser.add_argument("--tension-max", metavar="N",
                         help=f"tension budget 0..N (default {DEFAULT_TENSION_BUDGET_N:g} N)")
-    parser.add_argument("--allowable-strain", default=str(DEFAULT_ALLOWABLE_STRAIN),
+    parser.add_argument("--allowable-strain",
                         metavar="S", help="largest peak notch bending strain (default "
                                           f"{DEFAULT_ALLOWABLE_STRAIN:g})")
-    parser.add_argument("--samples", default=str(DEFAULT_DESIGN_SAMPLES), metavar="K",
+    parser.add_argument("--samples", metavar="K",
                         help=f"candidate designs (default {DEFAULT_DESIGN_SAMPLES})")
-    parser.add_argument("--sampling", choices=SAMPLINGS, default=SAMPLINGS[0],
+    parser.add_argument("--sampling", choices=SAMPLINGS,
                         help="scrambled Sobol' (default) or Latin hypercube")
-    parser.add_argument("--seed", default="0", help="sampling seed (default 0)")
-    parser.add_argument("--ladder", default=str(DEFAULT_DESIGN_LADDER), metavar="K",
+    parser.add_argument("--seed", help="sampling or search seed (default 0; --problem: the file's)")
+    parser.add_argument("--ladder", metavar="K",
                         help=f"tension rungs before refining (default {DEFAULT_DESIGN_LADDER})")
-    parser.add_argument("--tol", default=str(DEFAULT_TOL),
+    parser.add_argument("--tol",
                         help=f"tolerance on the target, m or rad (default {DEFAULT_TOL:g})")
-    parser.add_argument("--top", default=str(DEFAULT_TOP), metavar="K",
+    parser.add_argument("--top", metavar="K",
                         help=f"Pareto rows in the table (default {DEFAULT_TOP}; all in JSON)")
     add_sought_tendon(parser)
     add_design_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     parser.add_argument("--out", metavar="DIR",
-                        help=f"write {', '.join(FILES)} into DIR (created if missing)")
+                        help=f"write {', '.join(FILES)} into DIR (created if missing); with "
+                             f"--problem: {', '.join(SHAPE_FILES)}")
     add_quiet_argument(parser)
     parser.set_defaults(handler=run)
 
@@ -96,6 +110,11 @@ def _number(option: str, text: str, kind: type = float) -> Any:
         noun = "an integer" if kind is int else "a number"
         raise InputError(f"{option} = {text!r} is not {noun}", parameter=option, value=text,
                          allowed=noun) from None
+
+
+def _or(text: str | None, default: float) -> str:
+    """An option's text, or its default's where it was not given."""
+    return str(default) if text is None else text
 
 
 def _free(pairs: list[str]) -> dict[str, tuple[float, float]]:
@@ -119,6 +138,8 @@ def _free(pairs: list[str]) -> dict[str, tuple[float, float]]:
 
 def run(args: argparse.Namespace) -> int:
     """Search and report; typed errors become exit status 2 (input) or 3 (no design)."""
+    if args.problem is not None:
+        return run_problem(args)
     started = perf_counter()
     name = ""
     try:
@@ -128,18 +149,22 @@ def run(args: argparse.Namespace) -> int:
                                              "(0, inf) m")}
             if args.tip_deflection is not None else
             {"tip_angle": target_number("--tip-angle", args.tip_angle, "(0, inf) rad")})
-        top = _number("--top", args.top, int)
+        top = _number("--top", _or(args.top, DEFAULT_TOP), int)
         if top < 0:
             raise InputError(f"--top = {top} is out of range; allowed: an integer >= 0",
                              parameter="--top", value=top, allowed="an integer >= 0")
         with ProgressBars.of(args) as bars:
             search = search_designs(
                 design, _free(args.free), **target, settings=settings, progress=bars,
-                tension_max=_number("--tension-max", args.tension_max),
-                allowable_strain=_number("--allowable-strain", args.allowable_strain),
-                samples=_number("--samples", args.samples, int), sampling=args.sampling,
-                seed=_number("--seed", args.seed, int),
-                ladder=_number("--ladder", args.ladder, int), tol=_number("--tol", args.tol),
+                tension_max=_number("--tension-max", _or(args.tension_max,
+                                                          DEFAULT_TENSION_BUDGET_N)),
+                allowable_strain=_number("--allowable-strain", _or(
+                    args.allowable_strain, DEFAULT_ALLOWABLE_STRAIN)),
+                samples=_number("--samples", _or(args.samples, DEFAULT_DESIGN_SAMPLES), int),
+                sampling=args.sampling or SAMPLINGS[0],
+                seed=_number("--seed", _or(args.seed, 0), int),
+                ladder=_number("--ladder", _or(args.ladder, DEFAULT_DESIGN_LADDER), int),
+                tol=_number("--tol", _or(args.tol, DEFAULT_TOL)),
                 **sought_tendon(args))
     except TdcmError as error:
         if args.json:

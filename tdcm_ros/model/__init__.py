@@ -38,6 +38,7 @@ from tdcm_ros.model.design_space import (
     design_curves,
     sweep,
 )
+from tdcm_ros.model.design_variables import Variable, VariableSet
 from tdcm_ros.model.errors import (
     InvalidDesignError,
     InvalidSettingsError,
@@ -95,6 +96,20 @@ from tdcm_ros.model.roll import (
     roll_quaternions,
 )
 from tdcm_ros.model.settings import SOLVER_SPECS, SolverSettings
+from tdcm_ros.model.shape_file import ShapeFile, problem_from_mapping, read_problem_file
+from tdcm_ros.model.shape_problem import Evaluation, Goal, Load, ShapeProblem
+from tdcm_ros.model.shape_search import (
+    NoShapeDesignError,
+    ShapeDesign,
+    design_for_shape,
+)
+from tdcm_ros.model.shape_targets import (
+    CurveTarget,
+    Limits,
+    NotchAngleTarget,
+    StopAngleTarget,
+    TipTarget,
+)
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
 from tdcm_ros.model.tendons import Tendon, require_paper_tendon
@@ -121,21 +136,28 @@ __all__ = [
     "Capstan",
     "CircularProfile",
     "ConvergenceError",
+    "CurveTarget",
     "CustomProfile",
     "Design",
     "DesignSearch",
     "DesignSpace",
+    "Evaluation",
+    "Goal",
     "InvalidDesignError",
     "InvalidLoadingError",
     "InvalidRollError",
     "InvalidSettingsError",
     "InvalidTargetError",
     "InverseResult",
+    "Limits",
+    "Load",
     "Loading",
     "MarkerLayout",
     "ModelError",
     "ModelLimitError",
     "NoDesignMeetsTargetError",
+    "NoShapeDesignError",
+    "NotchAngleTarget",
     "NotchClosureError",
     "NotchContact",
     "PolygonProfile",
@@ -143,14 +165,21 @@ __all__ = [
     "RectangularProfile",
     "RollHistory",
     "Sensitivity",
+    "ShapeDesign",
+    "ShapeFile",
+    "ShapeProblem",
     "SolveResult",
     "SolverSettings",
     "StampedHistory",
+    "StopAngleTarget",
     "Tendon",
     "TendonSingularityError",
     "TensionProfile",
     "TensionRangeError",
+    "TipTarget",
     "UnreachableTargetError",
+    "Variable",
+    "VariableSet",
     "body_file_text",
     "body_from_mapping",
     "body_outline",
@@ -159,6 +188,7 @@ __all__ = [
     "check_tension",
     "depends_on_roll",
     "design_curves",
+    "design_for_shape",
     "is_body_file",
     "named_design",
     "offset_points",
@@ -166,7 +196,9 @@ __all__ = [
     "parameter_specs",
     "parse_field",
     "preset",
+    "problem_from_mapping",
     "read_body_file",
+    "read_problem_file",
     "report_progress",
     "require_paper_tendon",
     "roll_loading",

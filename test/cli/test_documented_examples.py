@@ -106,7 +106,10 @@ def test_every_offline_example_runs(example: Example, workdir: Path,
     for name, value in example.env.items():
         monkeypatch.setenv(name, value)
     argv = list(example.argv)
-    if example.verb == "design" and "--samples" not in argv:
+    if example.verb == "design" and "--problem" in argv:
+        if "--workers" not in argv:  # no process pool inside a test worker
+            argv += ["--workers", "1"]
+    elif example.verb == "design" and "--samples" not in argv:
         argv += ["--samples", DESIGN_SAMPLES]
     done = tdcm(*argv, cwd=workdir)
     assert done.returncode == 0, f"{_id(example)}: exit {done.returncode}\n{done.stderr[-2000:]}"

@@ -1,0 +1,82 @@
+"""Shape-design benchmark (issue 30): each problem file of ``config/design`` searched on one
+core, with several seeds.
+
+Run: ``python bench/bench_shape_design.py [--seeds 5] [--workers 1] [FILE ...]``.
+
+Printed per problem and seed: CPU seconds of the process (``process_time``) and wall seconds
+of the search, generations, evaluations, whether every target is met, and what the design
+achieves (tip angle in degrees, each notch-angle target's spread from the mean and
+distal/proximal ratio, the peak strain); then the median and range over the seeds. Warm: the
+kernels are compiled and loaded before timing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import statistics
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np
+
+from tdcm_ros.model import warm_up
+from tdcm_ros.model.shape_file import read_problem_file
+from tdcm_ros.model.shape_search import NoShapeDesignError, ShapeDesign, design_for_shape
+from tdcm_ros.model.shape_targets import NotchAngleTarget
+
+PROBLEMS = sorted((Path(__file__).resolve().parents[1] / "config" / "design").glob("*.yaml"))
+
+
+def describe(found: ShapeDesign) -> str:
+    parts = []
+    for goal in found.problem.goals:
+        result = found.evaluation.results.get(goal.load)
+        if result is None:
+            continue
+        if isinstance(goal.target, NotchAngleTarget):
+            phi = result.notch_angles_rad
+            spread = float(np.max(np.abs(phi / phi.mean() - 1.0)))
+            parts.append(f"notch spread {spread * 100:.3f} %, ratio {phi[-1] / phi[0]:.3f}")
+        else:
+            parts.append(f"tip {math.degrees(result.tip_angle_rad):.4f} deg")
+    strains = [float(np.max(r.notch_peak_strains)) for r in found.evaluation.results.values()]
+    if strains:
+        parts.append(f"peak strain {max(strains) * 100:.3f} %")
+    return "; ".join(parts)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("files", nargs="*", type=Path, default=PROBLEMS)
+    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--workers", type=int, default=1)
+    args = parser.parse_args()
+    warm_up()
+    for path in args.files:
+        problem = read_problem_file(path)
+        cpu, wall = [], []
+        print(f"{path.name}: {problem.problem.variables.size} variables")
+        for seed in range(args.seeds):
+            started_cpu, started = time.process_time(), time.perf_counter()
+            try:
+                found = design_for_shape(problem.problem, seed=seed,
+                                         popsize=problem.search.popsize,
+                                         maxiter=problem.search.maxiter, workers=args.workers)
+            except NoShapeDesignError as error:
+                found = error.found
+            cpu.append(time.process_time() - started_cpu)
+            wall.append(time.perf_counter() - started)
+            print(f"  seed {seed}: {cpu[-1]:.2f} CPU s, {wall[-1]:.2f} s wall, "
+                  f"{found.generations} generations, {found.evaluations} evaluations, "
+                  f"met {found.evaluation.met}; {describe(found)}")
+        print(f"  median {statistics.median(cpu):.2f} CPU s (range {min(cpu):.2f}-{max(cpu):.2f}),"
+              f" wall {statistics.median(wall):.2f} s (range {min(wall):.2f}-{max(wall):.2f})")
+
+
+if __name__ == "__main__":
+    main()
