@@ -6,8 +6,11 @@ Run: ``python bench/bench_shape_design.py [--seeds 5] [--workers 1] [FILE ...]``
 Printed per problem and seed: CPU seconds of the process (``process_time``) and wall seconds
 of the search, generations, evaluations, whether every target is met, and what the design
 achieves (tip angle in degrees, each notch-angle target's spread from the mean and
-distal/proximal ratio, the peak strain); then the median and range over the seeds. Warm: the
-kernels are compiled and loaded before timing.
+distal/proximal ratio, the peak strain); then the median and range over the seeds. Then the
+STL round trip of each problem's design and of the paper's preset: the design exported
+(``write_body_stl``, mm), read back through its body file (the mesh path), solved at the
+problem's first load, and the tip's distance from the design's own tip over the tip's
+displacement. Warm: the kernels are compiled and loaded before timing.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import argparse
 import math
 import os
 import statistics
+import tempfile
 import time
 from pathlib import Path
 
@@ -24,10 +28,22 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 
-from tdcm_ros.model import warm_up
-from tdcm_ros.model.shape_file import read_problem_file
-from tdcm_ros.model.shape_search import NoShapeDesignError, ShapeDesign, design_for_shape
-from tdcm_ros.model.shape_targets import NotchAngleTarget
+from tdcm_ros.model import (
+    Capstan,
+    Design,
+    Loading,
+    NoShapeDesignError,
+    NotchAngleTarget,
+    ShapeDesign,
+    design_for_shape,
+    mesh_body_file_text,
+    named_design,
+    preset,
+    read_problem_file,
+    solve,
+    warm_up,
+    write_body_stl,
+)
 
 PROBLEMS = sorted((Path(__file__).resolve().parents[1] / "config" / "design").glob("*.yaml"))
 
@@ -48,6 +64,19 @@ def describe(found: ShapeDesign) -> str:
     if strains:
         parts.append(f"peak strain {max(strains) * 100:.3f} %")
     return "; ".join(parts)
+
+
+def round_trip(design: Design, tension: float, mu: float = 0.0) -> float:
+    """The exported STL's tip error over the tip displacement (see the module docstring)."""
+    loading = Loading(tension_profile=Capstan(mu)) if mu else None
+    with tempfile.TemporaryDirectory() as folder:
+        write_body_stl(design, Path(folder) / "body.stl")
+        body = Path(folder) / "body.yaml"
+        body.write_text(mesh_body_file_text(design, "body.stl"))
+        meshed = solve(named_design(str(body)), tension, loading=loading)
+    own = solve(design, tension, loading=loading)
+    return float(np.linalg.norm(meshed.tip_position - own.tip_position)
+                 / np.linalg.norm(own.tip_position - [0.0, 0.0, design.length]))
 
 
 def main() -> None:
@@ -76,6 +105,12 @@ def main() -> None:
                   f"met {found.evaluation.met}; {describe(found)}")
         print(f"  median {statistics.median(cpu):.2f} CPU s (range {min(cpu):.2f}-{max(cpu):.2f}),"
               f" wall {statistics.median(wall):.2f} s (range {min(wall):.2f}-{max(wall):.2f})")
+        load = problem.problem.loads[0]
+        if found.design is not None and load.tension is not None:
+            print(f"  STL round trip of the last design at {load.label}: tip error "
+                  f"{round_trip(found.design, load.tension, load.mu):.2e} of its displacement")
+    print("STL round trip of paper-experiment at 20 N: tip error "
+          f"{round_trip(preset('paper-experiment'), 20.0):.2e} of its displacement")
 
 
 if __name__ == "__main__":

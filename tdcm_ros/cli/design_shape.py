@@ -16,11 +16,13 @@ from tdcm_ros.model import (
     ShapeDesign,
     body_file_text,
     design_for_shape,
+    mesh_body_file_text,
     read_problem_file,
+    write_body_stl,
 )
 
-#: What ``--out DIR`` writes (``body.stl`` where the body has a mesh form).
-FILES = ("design.json", "body.yaml", "body.stl", "shape.png", "state.json")
+#: What ``--out DIR`` writes (``body.stl`` and ``body_mesh.yaml`` where the body has a mesh form).
+FILES = ("design.json", "body.yaml", "body.stl", "body_mesh.yaml", "shape.png", "state.json")
 #: Options of the uniform search that a problem file replaces.
 UNIFORM_ONLY = ("free", "tension_max", "allowable_strain", "samples", "sampling", "ladder", "tol",
                 "top", "tendon", "tensions", "design", "set", "profile", "routing", "loads",
@@ -116,8 +118,9 @@ def _seed(text: str) -> int:
 
 
 def write_answer(found: ShapeDesign, summary: dict[str, Any], out: Path) -> list[Path]:
-    """``design.json``, and where a design was found ``body.yaml``, ``body.stl`` (where the
-    body has a mesh form) and ``shape.png`` in ``out``."""
+    """``design.json``, and where a design was found ``body.yaml``, ``body.stl`` with the body
+    file that names it, ``body_mesh.yaml`` (where the body has a mesh form: shaped sections, a
+    linear material), and ``shape.png`` in ``out``."""
     from tdcm_ros.plotting import plot_shape_design
 
     paths = [out / "design.json"]
@@ -127,6 +130,15 @@ def write_answer(found: ShapeDesign, summary: dict[str, Any], out: Path) -> list
         return paths
     paths.append(out / "body.yaml")
     paths[-1].write_text(body_file_text(design), encoding="utf-8")
+    try:
+        stl = write_body_stl(design, out / "body.stl")
+        paths.append(stl)
+        text = mesh_body_file_text(design, stl.name)
+    except TdcmError as error:  # a section without a shape, a non-linear law, no manifold3d
+        print(f"tdcm design: {error}; the body file {paths[1]} holds the design", file=sys.stderr)
+    else:
+        paths.append(out / "body_mesh.yaml")
+        paths[-1].write_text(text, encoding="utf-8")
     if found.evaluation.results:
         paths.append(plot_shape_design(found, out / "shape.png"))
     return paths

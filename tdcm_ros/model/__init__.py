@@ -74,6 +74,11 @@ from tdcm_ros.model.loading import (
     TensionProfile,
 )
 from tdcm_ros.model.markers import MARKER_SPECS, MarkerLayout
+from tdcm_ros.model.mesh_export import (
+    InvalidExportError,
+    mesh_body_file_text,
+    write_body_stl,
+)
 from tdcm_ros.model.outline import BodyOutline, body_outline
 from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
@@ -144,6 +149,7 @@ __all__ = [
     "Evaluation",
     "Goal",
     "InvalidDesignError",
+    "InvalidExportError",
     "InvalidLoadingError",
     "InvalidRollError",
     "InvalidSettingsError",
@@ -190,6 +196,7 @@ __all__ = [
     "design_curves",
     "design_for_shape",
     "is_body_file",
+    "mesh_body_file_text",
     "named_design",
     "offset_points",
     "one_shot",
@@ -213,4 +220,5 @@ __all__ = [
     "use_compiled",
     "warm_up",
     "within",
+    "write_body_stl",
 ]

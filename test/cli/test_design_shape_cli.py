@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from tdcm_ros.model import read_body_file, solve
+from tdcm_ros.model import named_design, read_body_file, solve
 from test.support.cli import tdcm
 from test.support.examples import REPO
 
@@ -28,6 +28,8 @@ def test_a_problem_writes_the_design_its_body_file_and_plot(tmp_path: Path) -> N
     assert tip == pytest.approx(summary["targets"][0]["achieved"]["angle"], rel=1e-12)
     assert (out / "shape.png").stat().st_size > 10_000
     assert json.loads((out / "state.json").read_text())["generations"] == summary["generations"]
+    meshed = solve(named_design(str(out / "body_mesh.yaml")), 2.0)  # the STL, read back
+    assert meshed.tip_angle_rad == pytest.approx(tip, rel=1e-4)
 
 
 def test_json_and_an_unreachable_problem_exits_3_with_the_closest(tmp_path: Path) -> None:
