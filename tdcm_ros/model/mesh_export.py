@@ -200,8 +200,9 @@ def write_body_stl(design: Design, path: str | Path, *, unit: str = "mm",
     (:func:`mesh_body_file_text`) carries the material and the tendons."""
     target = Path(path)
     if target.suffix.lower() != ".stl" or not target.parent.is_dir():
-        raise out_of_range("path", str(path), "a file name ending in .stl in an existing folder",
-                           error=InvalidExportError)
+        allowed = "a file name ending in .stl in an existing folder"
+        raise InvalidExportError(f"path = {str(path)!r} is out of range; allowed: {allowed}",
+                                 parameter="path", value=str(path), allowed=allowed)  # whole
     from trimesh.exchange.stl import export_stl
 
     data = export_stl(design_mesh(design, unit=unit, sides=sides, slabs=slabs))
