@@ -14,9 +14,13 @@ The global stage stops early once its best candidate meets every target
 (:attr:`~tdcm_ros.model.shape_problem.Evaluation.met`), at ``maxiter`` generations, or when
 DE's population has converged.
 
-``workers``: an int runs that many processes (``multiprocessing``; -1: every core);
-a map-like callable ``workers(function, candidates)`` runs the evaluations wherever it sends
-them, e.g. a Dask cluster's ``lambda f, xs: client.gather(client.map(f, list(xs)))``.
+Candidates are scored one ``solve`` each, or, where every target is a tip target at a
+tension without friction (:attr:`~tdcm_ros.model.shape_problem.ShapeProblem.batchable`), a
+generation at once by the batch solver (the same scores bit for bit, 2-3x faster).
+``workers``: an int runs that many processes (``multiprocessing``; -1: every core), or that
+many threads of the batch solver; a map-like callable ``workers(function, candidates)`` runs
+the evaluations one by one wherever it sends them, e.g. a Dask cluster's
+``lambda f, xs: client.gather(client.map(f, list(xs)))``.
 
 A ``state`` file (JSON) holds the population after every generation; ``resume=True`` starts
 from it (its variables must be the problem's), so an interrupted search goes on from where it
@@ -238,10 +242,16 @@ def design_for_shape(problem: ShapeProblem, *, seed: int = 0, popsize: int = DEF
         if local.met:
             raise StopIteration  # DE's way to stop from a callback
 
+    batch = problem.batchable and isinstance(pool, int)
+
+    def scores(columns: Array) -> Array:  # DE's vectorised call: one candidate per column
+        return problem.scores(columns.T, workers=pool if isinstance(pool, int) else 1)
+
+    objective: Any = scores if batch else problem  # the stubs know no vectorised objective
     found = differential_evolution(
-        problem, Bounds(bounds[:, 0], bounds[:, 1]), popsize=popsize, maxiter=maxiter,
-        init=init, rng=seed, callback=generation, polish=False, updating="deferred",
-        workers=pool, tol=1e-6)
+        objective, Bounds(bounds[:, 0], bounds[:, 1]), popsize=popsize,
+        maxiter=maxiter, init=init, rng=seed, callback=generation, polish=False,
+        updating="deferred", workers=1 if batch else pool, vectorized=batch, tol=1e-6)
     x, _ = local.best if local.met and local.best is not None else local.run(
         np.asarray(found.x, dtype=float))
     evaluation = problem.evaluate(x)

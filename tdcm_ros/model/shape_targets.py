@@ -83,15 +83,19 @@ class TipTarget:
         _finite("targets.tip.angle_tol", self.angle_tol, positive=True, unit="rad")
 
     def residuals(self, result: SolveResult) -> Array:
-        tip = result.tip_position
+        return self.tip_residuals(result.tip_position, np.asarray(result.tip_angle_rad))
+
+    def tip_residuals(self, tip: Array, angle: Array) -> Array:
+        """Residuals of tips ``tip`` (..., 3) (m) at angles ``angle`` (...) (rad): shape
+        (..., k), ``k`` the target's given quantities (x, z, angle in that order)."""
         out = []
         if self.x is not None:
-            out.append((tip[0] - self.x) / self.position_tol)
+            out.append((tip[..., 0] - self.x) / self.position_tol)
         if self.z is not None:
-            out.append((tip[2] - self.z) / self.position_tol)
+            out.append((tip[..., 2] - self.z) / self.position_tol)
         if self.angle is not None:
-            out.append((result.tip_angle_rad - self.angle) / self.angle_tol)
-        return np.array(out)
+            out.append((angle - self.angle) / self.angle_tol)
+        return np.stack(out, axis=-1)
 
     def achieved(self, result: SolveResult) -> dict[str, float]:
         tip = result.tip_position

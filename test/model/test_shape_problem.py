@@ -86,3 +86,26 @@ def test_a_bad_load_names_its_key(load: dict, parameter: str) -> None:
 def test_a_problem_needs_targets() -> None:
     with pytest.raises(InvalidTargetError, match="targets lists none"):
         ShapeProblem(WD, (), Limits(0.06))
+
+
+def test_the_batch_solver_scores_tip_problems_as_evaluate_does_bit_for_bit() -> None:
+    variables = VariableSet(PAPER, (Variable("w_n", 0.5e-3, 3e-3, "uniform"),
+                                    Variable("w_d", 0.3e-3, 2.2e-3, "linear"),
+                                    Variable("R_c", 1e-3, 3.5e-3)))
+    problem = ShapeProblem(variables, (
+        Goal(TipTarget(angle=0.8), Load(tension=10.0)),
+        Goal(TipTarget(x=0.01, z=0.045, position_tol=1e-3), Load(tension=15.0))),
+        Limits(0.04, min_backbone=0.4e-3))
+    assert problem.batchable
+    bounds = variables.bounds()
+    xs = np.random.default_rng(0).uniform(bounds[:, 0], bounds[:, 1], (120, variables.size))
+    singles = np.array([problem.evaluate(x).score for x in xs])
+    assert np.array_equal(problem.scores(xs), singles)
+    assert np.array_equal(problem.scores(xs, workers=2), singles)
+    classes = set(np.floor(singles / PENALTY).astype(int).tolist())
+    assert classes >= {0, 1, 2, 3}  # feasible, strained, failed, short of the backbone
+    assert not problem_with_friction().batchable
+
+
+def problem_with_friction() -> ShapeProblem:
+    return ShapeProblem(WD, (Goal(TIP, Load(tension=20.0, mu=0.2)),), LIMITS)

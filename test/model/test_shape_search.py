@@ -103,6 +103,20 @@ def test_a_search_is_its_seeds_whatever_map_evaluates_it() -> None:
     assert np.array_equal(one.x, again.x) and one.history == again.history
 
 
+def test_the_batch_solvers_search_is_the_one_candidate_by_candidate() -> None:
+    """A tip-only problem is scored a generation at a time by the batch solver: same search."""
+    variables = VariableSet(PAPER, (Variable("w_n", 0.5e-3, 3e-3, "uniform"),
+                                    Variable("w_d", 0.3e-3, 2.2e-3, "linear")))
+    problem = ShapeProblem(variables, (Goal(TipTarget(angle=0.8), Load(tension=10.0)),),
+                           Limits(0.04))
+    assert problem.batchable
+    batch = design_for_shape(problem, seed=2, popsize=5, maxiter=20)
+    one_by_one = design_for_shape(problem, seed=2, popsize=5, maxiter=20,
+                                  workers=lambda f, xs: [f(x) for x in xs])
+    assert batch.evaluation.met
+    assert np.array_equal(batch.x, one_by_one.x) and batch.history == one_by_one.history
+
+
 def test_a_search_resumes_from_its_state(tmp_path: Path) -> None:
     state = tmp_path / "state.json"
     reached: list[int] = []
