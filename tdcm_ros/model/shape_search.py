@@ -163,7 +163,7 @@ class _Local:
 
             fit = least_squares(residuals, x0, bounds=(self.bounds[:, 0], self.bounds[:, 1]),
                                 x_scale="jac", diff_step=np.full(x0.size, 1e-6),
-                                max_nfev=40 * (x0.size + 1))
+                                max_nfev=10 * (x0.size + 1))
             self.evaluations += int(fit.nfev) + int(fit.njev or 0) * x0.size
             score = self.problem(fit.x)
             if self.best is None or score < self.best[1]:

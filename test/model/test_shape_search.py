@@ -32,6 +32,7 @@ from tdcm_ros.model.shape_targets import (
     CurveTarget,
     Limits,
     NotchAngleTarget,
+    StopAngleTarget,
     TipTarget,
 )
 from tdcm_ros.yamlio import load_yaml
@@ -84,6 +85,15 @@ def test_a_tip_first_nitinol_wrist_the_issue_target(tmp_path: Path) -> None:
     assert meshed.notch_angles_rad == pytest.approx(phi, rel=0.01)
     assert meshed.tip_angle_rad == pytest.approx(result.tip_angle_rad, rel=0.01)
     assert np.max(meshed.notch_peak_strains) <= 0.08
+
+
+def test_a_hard_stop_target_finds_the_notch_width_of_its_closed_form() -> None:
+    """Prismatic notches close at ``N w_n / R_outer`` of total bend: the width for 1.2 rad."""
+    base = PAPER.with_overrides(profile="rectangular")
+    variables = VariableSet(base, (Variable("w_n", 0.5e-3, 3e-3, "uniform"),))
+    goal = Goal(StopAngleTarget(1.2, tol=1e-4), Load(tension=5.0))
+    found = design_for_shape(ShapeProblem(variables, (goal,), Limits(0.2)), seed=0, popsize=5)
+    assert found.x[0] == pytest.approx(1.2 * base.R_outer / base.N, rel=1e-4)
 
 
 def curve_problem() -> ShapeProblem:
