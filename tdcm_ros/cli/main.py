@@ -31,6 +31,7 @@ COMMANDS: dict[str, str] = {
     "solve": "tdcm_ros.cli.solve",
     "inverse": "tdcm_ros.cli.inverse",
     "design": "tdcm_ros.cli.design",
+    "urdf": "tdcm_ros.cli.urdf",
     "up": "tdcm_ros.cli.up",
     "topic": "tdcm_ros.cli.topic",
     "record": "tdcm_ros.cli.record",

@@ -118,6 +118,7 @@ from tdcm_ros.model.shape_targets import (
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
 from tdcm_ros.model.tendons import Tendon, require_paper_tendon
+from tdcm_ros.model.urdf import body_urdf, joint_names, joint_positions
 
 __all__ = [
     "DEFAULT_ALLOWABLE_STRAIN",
@@ -189,6 +190,7 @@ __all__ = [
     "body_file_text",
     "body_from_mapping",
     "body_outline",
+    "body_urdf",
     "candidate",
     "check_roll",
     "check_tension",
@@ -196,6 +198,8 @@ __all__ = [
     "design_curves",
     "design_for_shape",
     "is_body_file",
+    "joint_names",
+    "joint_positions",
     "mesh_body_file_text",
     "named_design",
     "offset_points",

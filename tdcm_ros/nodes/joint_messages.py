@@ -49,6 +49,15 @@ def commanded(message: Any) -> dict[str, tuple[float | None, float | None]]:
             for i, name in enumerate(message.name)}
 
 
+def body_joint_states(stamp_ns: int, names: Sequence[str], positions: Sequence[float]) -> Any:
+    """The body's URDF joints (:func:`~tdcm_ros.model.urdf.joint_names`, the roll left to the
+    driver) at ``positions`` (rad, m), stamped ``stamp_ns``, no frame."""
+    return msg_class(JOINT_STATE)(
+        header=header_msg(stamp_ns, ""), name=list(names),
+        position=np.array(positions, dtype=np.float64), velocity=np.empty(0),
+        effort=np.empty(0))
+
+
 def tendon_states(stamp_ns: int, names: Sequence[str], strokes_m: Sequence[float],
                   tensions_n: Sequence[float]) -> Any:
     """Each tendon as a prismatic joint named as in the body (``tendon_<k>`` by default):

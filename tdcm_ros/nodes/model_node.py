@@ -8,7 +8,9 @@ convention for a set of actuators, one message for one sample of all of them), b
 ``input.tension_type`` parameter). Publishes, stamped
 with the input's stamp, in ``frame_id`` (default ``tdcm_base``): ``midline`` (nav_msgs/Path),
 ``midline_poses`` (PoseArray), ``tip_pose`` (PoseStamped), ``predicted_markers`` (PoseArray),
-``body_markers`` (visualization_msgs/MarkerArray), ``tendon_states`` (sensor_msgs/JointState:
+``body_markers`` (visualization_msgs/MarkerArray), ``joint_states`` (sensor_msgs/JointState: the body's URDF joints, ``tdcm urdf``, by
+:func:`~tdcm_ros.model.urdf.joint_positions`, rad and m; the roll joint is the driver's),
+``tendon_states`` (sensor_msgs/JointState:
 each tendon as a prismatic joint named as in the body (``tendon_<k>`` by default), position its
 actuator's stroke in m, effort its tension in N; not rolled, no frame) and ``/diagnostics`` (``model_node: input``:
 dropped and coalesced inputs; ``model_node: solver``: solves and failures; each WARN while a
@@ -60,6 +62,8 @@ from tdcm_ros.model import (
     RollHistory,
     SolveResult,
     SolverSettings,
+    joint_names,
+    joint_positions,
     named_design,
     parameter_specs,
     require_paper_tendon,
@@ -67,7 +71,12 @@ from tdcm_ros.model import (
     warm_up,
 )
 from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix
-from tdcm_ros.nodes.joint_messages import JOINT_STATE, tendon_efforts, tendon_states
+from tdcm_ros.nodes.joint_messages import (
+    JOINT_STATE,
+    body_joint_states,
+    tendon_efforts,
+    tendon_states,
+)
 from tdcm_ros.nodes.joint_states import joint_position
 from tdcm_ros.nodes.shape_messages import midline_messages, stamp_ns_of
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
@@ -202,6 +211,7 @@ class ModelNode(NodeLogic):
         self.tf_static = port.create_publisher("/tf_static", TF_TYPE,
                                                QoS(depth=1, durability="transient_local"))
         self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
+        self.joint_states = port.create_publisher("joint_states", JOINT_STATE, qos)
         self._publish_tendon_tf(str(port.get_parameter("frame_id")))
         # A deep queue so every input is seen (and counted); the callback only stores the newest.
         port.create_subscription("tension", self.tension_type, self._on_tension,
@@ -372,6 +382,8 @@ class ModelNode(NodeLogic):
         self.publishers["tendon_states"].publish(
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
+        self.joint_states.publish(body_joint_states(
+            stamp_ns, joint_names(self.design)[1:], joint_positions(result)[1:].tolist()))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=self.prefix

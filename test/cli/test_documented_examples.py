@@ -17,7 +17,7 @@ from test.support.cli import tdcm
 from test.support.examples import REPO, Example, epilog_examples, readme_examples
 
 #: Subcommands that need nothing but files: run here.
-OFFLINE = {"solve", "inverse", "design", "figures", "bench", "evaluate", "calibrate",
+OFFLINE = {"solve", "inverse", "design", "urdf", "figures", "bench", "evaluate", "calibrate",
            "scene list", "scene validate", "scene explain", "scene effects", "bag info",
            "param specs"}
 #: Subcommands that talk to a graph (or start one): run by the graph examples' test.

@@ -139,8 +139,8 @@ def test_every_frame_a_node_stamps_is_in_one_tf_tree() -> None:
         for topic, messages in port.published.items():
             for message in messages:
                 header = getattr(message, "header", None)
-                # diagnostics and joint states (tendon_states) name no frame
-                if header is not None and topic != "tendon_states" \
+                # diagnostics and joint states (tendon_states, joint_states) name no frame
+                if header is not None and topic not in ("tendon_states", "joint_states") \
                         and not topic.endswith("diagnostics"):
                     stamped.add(header.frame_id)
     assert {"tdcm_base", "tdcm_tendon", "tdcm_tip", "mocap"} <= stamped | set(parents)

@@ -1,0 +1,139 @@
+"""The body as a URDF kinematic chain, and the joint values that put it in a solved shape.
+
+The chain starts at ``base_link`` (the model's ``tdcm_base``: +z along the unbent body, +x
+toward the tendon), turns by the ``roll`` joint (revolute about +z, rad: the joint the tension
+driver publishes on ``joint_states``) and then runs through the body's segments base to tip
+(tubes and notches, :meth:`~tdcm_ros.model.design.Design.segment_ends`). Segment ``k`` is three
+joints, so that any bent segment's end pose is reached exactly, whatever its curvature along
+it: ``{name}_seg{k}_turn`` (revolute about +y by ``a``, the direction of the segment's chord
+from its start tangent), ``{name}_seg{k}_chord`` (prismatic along +z, the chord's length, m)
+and ``{name}_seg{k}_bend`` (revolute about +y by ``phi - a``, ``phi`` the segment's bend), into
+the link ``{name}_seg{k}``, whose frame is the midline's frame at the segment's end; the last
+is ``{name}_tip``. A straight segment is ``a = 0``, chord = its length, ``phi = 0``; a notch's
+bend is its ``phi`` (:attr:`~tdcm_ros.model.result.SolveResult.notch_angles_rad`).
+
+Each segment's visual hangs on its turn link (the chord's direction): a tube is a cylinder of
+``R_outer`` (a lumen is not drawn), a notch is a box of its backbone (``w_d`` across x at
+``w_o``, the tube's diameter across y, ``w_n`` long), so the notches show as waists. Every
+link and joint name is put after ``prefix`` (a robot's ``frame_prefix``).
+"""
+
+from __future__ import annotations
+
+import math
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.errors import out_of_range
+from tdcm_ros.model.design import Design
+from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.result import SolveResult
+
+Array = NDArray[np.float64]
+
+DEFAULT_NAME = "tdcm_body"
+ROLL_JOINT = "roll"
+#: Joint limits written into the URDF: bend (rad) and chord (m, up to the segment's length).
+BEND_LIMIT_RAD = math.pi
+#: URDF needs an effort and a velocity limit on every revolute or prismatic joint; the body's
+#: joints are driven by the model, not by motors: nominal values.
+NOMINAL_EFFORT = 1.0
+NOMINAL_VELOCITY = 10.0
+
+
+def _segments(design: Design) -> list[tuple[float, float, int | None]]:
+    """``(start, end, notch index or None)`` of each segment (m), base to tip."""
+    ends = design.segment_ends()
+    starts = np.concatenate([[0.0], ends[:-1]])
+    left, _ = design.notch_bounds()
+    out = []
+    for start, end in zip(starts, ends, strict=True):
+        hit = np.flatnonzero(np.isclose(left, start, rtol=0.0, atol=1e-12))
+        out.append((float(start), float(end), int(hit[0]) if hit.size else None))
+    return out
+
+
+def joint_names(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "") -> list[str]:
+    """The chain's joint names, roll first, then each segment's turn, chord and bend."""
+    out = [prefix + ROLL_JOINT]
+    for k in range(len(_segments(design))):
+        out += [f"{prefix}{name}_seg{k}_{part}" for part in ("turn", "chord", "bend")]
+    return out
+
+
+def joint_positions(result: SolveResult, roll: float = 0.0) -> Array:
+    """The positions (rad, m) of :func:`joint_names`' joints that put the chain in
+    ``result``'s shape, rolled by ``roll`` (rad)."""
+    design = result.design
+    out = [roll]
+    for start, end, _ in _segments(design):
+        i = int(np.argmin(np.abs(result.s - start)))
+        j = int(np.argmin(np.abs(result.s - end)))
+        dx, dz = result.positions[j, 0] - result.positions[i, 0], \
+            result.positions[j, 2] - result.positions[i, 2]
+        theta = float(result.theta[i])
+        # the chord in the segment's start frame (+z along the tangent, +x toward the tendon)
+        along = dz * math.cos(theta) + dx * math.sin(theta)
+        across = dx * math.cos(theta) - dz * math.sin(theta)
+        turn = math.atan2(across, along)
+        out += [turn, math.hypot(dx, dz), float(result.theta[j]) - theta - turn]
+    return np.array(out)
+
+
+def body_urdf(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "",
+              base_link: str = "tdcm_base") -> str:
+    """The URDF of ``design`` (see the module docstring) as text, its root ``base_link``."""
+    for what, value in (("name", name), ("base_link", base_link)):
+        if not value or any(c.isspace() or c in "<>&\"'" for c in value):
+            raise out_of_range(what, value, "a non-empty name without spaces or XML markup",
+                               error=InvalidDesignError)
+    segments = _segments(design)
+    lines = ['<?xml version="1.0"?>',
+             (f"<!-- {name}: tdcm_ros body, {design.N} notches, {design.length * 1e3:.6g} mm; "
+              "joints set by model_node on joint_states -->"),
+             f"<robot name={quoteattr(prefix + name)}>",
+             f"  <link name={quoteattr(prefix + base_link)}/>",
+             f"  <link name={quoteattr(f'{prefix}{name}_rolled')}/>",
+             _joint(prefix + ROLL_JOINT, "revolute", prefix + base_link, f"{prefix}{name}_rolled",
+                    "0 0 1", -math.pi, math.pi)]
+    parent = f"{prefix}{name}_rolled"
+    for k, (start, end, notch) in enumerate(segments):
+        length = end - start
+        turn, chord = f"{prefix}{name}_seg{k}_turned", f"{prefix}{name}_seg{k}_along"
+        link = f"{prefix}{name}_tip" if k == len(segments) - 1 else f"{prefix}{name}_seg{k}"
+        lines += [f"  <link name={quoteattr(turn)}>", _visual(design, length, notch),
+                  "  </link>", f"  <link name={quoteattr(chord)}/>",
+                  f"  <link name={quoteattr(link)}/>",
+                  _joint(f"{prefix}{name}_seg{k}_turn", "revolute", parent, turn, "0 1 0",
+                         -BEND_LIMIT_RAD, BEND_LIMIT_RAD),
+                  _joint(f"{prefix}{name}_seg{k}_chord", "prismatic", turn, chord, "0 0 1", 0.0,
+                         length),
+                  _joint(f"{prefix}{name}_seg{k}_bend", "revolute", chord, link, "0 1 0",
+                         -BEND_LIMIT_RAD, BEND_LIMIT_RAD)]
+        parent = link
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n"
+
+
+def _joint(name: str, kind: str, parent: str, child: str, axis: str, low: float,
+           high: float) -> str:
+    return (f"  <joint name={quoteattr(name)} type=\"{kind}\">\n"
+            f"    <parent link={quoteattr(parent)}/>\n    <child link={quoteattr(child)}/>\n"
+            f"    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n    <axis xyz=\"{axis}\"/>\n"
+            f"    <limit lower=\"{low!r}\" upper=\"{high!r}\" effort=\"{NOMINAL_EFFORT!r}\" "
+            f"velocity=\"{NOMINAL_VELOCITY!r}\"/>\n  </joint>")
+
+
+def _visual(design: Design, length: float, notch: int | None) -> str:
+    """A tube's cylinder or a notch's backbone box along the segment's chord (m)."""
+    if notch is None:
+        shape = f"<cylinder radius=\"{design.R_outer!r}\" length=\"{length!r}\"/>"
+        x = 0.0
+    else:
+        width = float(design.per_notch("w_d")[notch])
+        x = float(design.per_notch("w_o")[notch])
+        shape = f"<box size=\"{width!r} {2.0 * design.R_outer!r} {length!r}\"/>"
+    return (f"    <visual>\n      <origin xyz=\"{x!r} 0 {length / 2.0!r}\" rpy=\"0 0 0\"/>\n"
+            f"      <geometry>{shape}</geometry>\n    </visual>")
