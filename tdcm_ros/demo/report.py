@@ -48,7 +48,12 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
     """Print Table I and the per-step table of the bag evaluated with ``options`` (see
     :func:`scene_options`), write ``plots/`` and ``metrics.json``; calibrate. ``progress``
     follows the reading, the fit and the evaluations (see ``calibrate_paths``)."""
-    from tdcm_ros.metrics import format_calibration, format_evaluation, write_plots
+    from tdcm_ros.metrics import (
+        format_calibration,
+        format_evaluation,
+        write_calibration_plots,
+        write_plots,
+    )
     from tdcm_ros.metrics.api import evaluate_paths
 
     fit = None
@@ -71,6 +76,8 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
         print(format_calibration(fit))
         results["calibration"] = fit.fit_json()
         results["after_calibration"] = fit.after.to_json()
+        for path in write_calibration_plots(fit, plan.out / "plots"):
+            print(f"plot written to {path}")
     path = plan.out / "metrics.json"
     path.write_text(json.dumps(results, indent=2), encoding="utf-8")
     print(f"metrics written to {path}")

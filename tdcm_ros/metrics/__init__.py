@@ -22,7 +22,7 @@ from tdcm_ros.metrics.errors import (
 from tdcm_ros.metrics.evaluation import Evaluation, StepRecord, evaluate_series
 from tdcm_ros.metrics.geometry import DEFLECTION_AXES
 from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions, options_from_sets
-from tdcm_ros.metrics.plots import write_plots
+from tdcm_ros.metrics.plots import write_calibration_plots, write_plots
 from tdcm_ros.metrics.report import format_calibration, format_evaluation
 from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
 from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings, settings_for_hold
@@ -53,5 +53,6 @@ __all__ = [
     "format_evaluation",
     "options_from_sets",
     "settings_for_hold",
+    "write_calibration_plots",
     "write_plots",
 ]

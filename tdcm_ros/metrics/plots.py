@@ -1,4 +1,5 @@
-"""Evaluation plots (needs matplotlib, the ``plot`` extra): shapes per step, error vs tension.
+"""Evaluation plots (needs matplotlib, the ``plot`` extra): shapes per step, error vs tension,
+and a calibration's error before and after it with the calibrated shapes.
 
 Every figure explains itself: a legend entry for each kind of line and marker, axis labels with
 units, and (``shapes.png``) a caption saying why the markers are not on the measured midline:
@@ -15,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from tdcm_ros.figures import output_folder
+from tdcm_ros.metrics.calibration import Calibration
 from tdcm_ros.metrics.evaluation import Evaluation
 from tdcm_ros.plot_backend import load_pyplot
 
@@ -52,9 +54,10 @@ def tension_label(evaluation: Evaluation) -> str:
     return f"step mean tension{', largest tendon' if several else ''} (N)"
 
 
-def shapes_figure(plt: Any, evaluation: Evaluation) -> Any:
+def shapes_figure(plt: Any, evaluation: Evaluation,
+                  heading: str = "Measured and model shapes at each step") -> Any:
     """Measured and predicted midlines and markers, x-z plane of ``tdcm_base``, one panel per
-    trial, colour = the step's mean tension."""
+    trial, colour = the step's mean tension; ``heading`` above the caption."""
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
     from matplotlib.lines import Line2D
@@ -101,20 +104,64 @@ def shapes_figure(plt: Any, evaluation: Evaluation) -> Any:
     ]
     fig.legend(handles=handles, loc="outside lower center", ncol=2, fontsize=FONT_SIZE)
     width = int(12 * fig.get_figwidth())  # characters of FONT_SIZE - 1 per line
-    fig.suptitle("Measured and model shapes at each step\n" + textwrap.fill(
+    fig.suptitle(heading + "\n" + textwrap.fill(
         shapes_caption(evaluation), width), fontsize=FONT_SIZE - 1)
     return fig
+
+
+def step_errors(evaluation: Evaluation, trial: int) -> tuple[np.ndarray, np.ndarray]:
+    """A trial's usable steps: mean tension (N) and tip deflection error, predicted - measured
+    (m)."""
+    rows = [r for r in evaluation.records if r.usable and r.trial == trial]
+    return (np.array([r.tension_n for r in rows]),
+            np.array([(r.predicted_deflection_m or 0.0) - (r.measured_deflection_m or 0.0)
+                      for r in rows]))
+
+
+def calibration_figure(plt: Any, fit: Calibration) -> Any:
+    """Tip deflection error per step before calibration (the nominal design) and after (the
+    fitted one), per trial, with a sentence on what calibration did."""
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    fitted = ", ".join(f"{p.name} {p.initial:.4g} -> {p.value:.4g} {p.unit}"
+                       for p in fit.parameters)
+    for k, trial in enumerate(sorted({r.trial for r in fit.before.records})):
+        for evaluation, style, when in ((fit.before, "o--", "before"), (fit.after, "s-", "after")):
+            tension, error = step_errors(evaluation, trial)
+            ax.plot(tension, error * MM, style, color=f"C{k}", mfc="none" if when == "before"
+                    else None, label=f"trial {trial}, {when} calibration")
+    ax.axhline(0.0, color="k", lw=0.8, label="no error")
+    ax.set_xlabel(tension_label(fit.before), fontsize=FONT_SIZE)
+    ax.set_ylabel("tip deflection error,\npredicted - measured (mm)", fontsize=FONT_SIZE)
+    ax.set_title("Calibration fits " + fitted + "; what error is left after it is what the fitted "
+                 "model cannot explain (friction, noise)", fontsize=FONT_SIZE, wrap=True)
+    ax.tick_params(labelsize=FONT_SIZE)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=FONT_SIZE - 1)
+    fig.tight_layout()
+    return fig
+
+
+def write_calibration_plots(fit: Calibration, directory: str | Path, *, option: str = "--out"
+                            ) -> list[Path]:
+    """Write ``calibration.png`` (:func:`calibration_figure`) and ``shapes_calibrated.png``
+    (:func:`shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
+    plt = load_pyplot(option, Path(directory))
+    out = output_folder(option, directory)
+    fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
+    figures = (("calibration.png", calibration_figure(plt, fit)),
+               ("shapes_calibrated.png", shapes_figure(
+                   plt, fit.after, f"Measured and calibrated-model shapes ({fitted})")))
+    for name, fig in figures:
+        fig.savefig(out / name, dpi=120)
+        plt.close(fig)
+    return [out / name for name, _ in figures]
 
 
 def error_figure(plt: Any, evaluation: Evaluation) -> Any:
     """Tip deflection error (predicted - measured) against the step's mean tension, per trial."""
     fig, ax = plt.subplots(figsize=(7.0, 4.5))
-    usable = [r for r in evaluation.records if r.usable]
     for trial in sorted({r.trial for r in evaluation.records}):
-        rows = [r for r in usable if r.trial == trial]
-        tension = np.array([r.tension_n for r in rows])
-        error = np.array([(r.predicted_deflection_m or 0.0) - (r.measured_deflection_m or 0.0)
-                          for r in rows])
+        tension, error = step_errors(evaluation, trial)
         ax.plot(tension, error * MM, "o-", label=f"trial {trial}")
     ax.axhline(0.0, color="k", lw=0.8, label="no error")
     ax.set_xlabel(tension_label(evaluation), fontsize=FONT_SIZE)

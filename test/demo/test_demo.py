@@ -156,6 +156,9 @@ def test_paper_scene_demo_calibrates_into_the_papers_range_on_short_holds(tmp_pa
     assert fitted["ci_low"] <= fitted["value"] <= fitted["ci_high"]
     assert 0.6e9 < fitted["value"] < 0.9e9
     assert "Table I" in done.stdout
+    plots = sorted(p.name for p in (tmp_path / "paper" / "plots").iterdir())
+    assert plots == ["calibration.png", "error_vs_tension.png", "shapes.png",
+                     "shapes_calibrated.png"]
 
 
 def test_demo_never_overwrites_a_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

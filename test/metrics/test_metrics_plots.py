@@ -28,11 +28,16 @@ plt = pytest.importorskip("matplotlib.pyplot")
 
 
 @pytest.fixture(scope="module")
-def evaluation(tmp_path_factory: pytest.TempPathFactory) -> Evaluation:
+def bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     rec = simulate(preset("paper-experiment").with_overrides(E=0.8e9),
                    levels=(0.0, 8.0, 16.0), hold_s=2.0, trials=2, tension_hz=200.0,
                    mocap_hz=40.0, seed=3)
-    return evaluate_paths([write_recording(rec, tmp_path_factory.mktemp("plots") / "bag")])
+    return write_recording(rec, tmp_path_factory.mktemp("plots") / "bag")
+
+
+@pytest.fixture(scope="module")
+def evaluation(bag: Path) -> Evaluation:
+    return evaluate_paths([bag])
 
 
 def _legend_texts(fig: Any) -> list[str]:
@@ -111,3 +116,32 @@ def test_the_caption_follows_markers_radial_offset(evaluation: Evaluation) -> No
 
     assert "2.50 mm from the midline (markers.radial_offset)" in shapes_caption(with_offset(2.5e-3))
     assert shapes_caption(with_offset(0.0)).startswith("Markers are on the midline")
+
+
+def test_the_calibration_plot_shows_each_trials_error_before_and_after(
+        tmp_path: Path, bag: Path) -> None:
+    """The world's E is 0.8 GPa, the estimator starts from the preset's 1.85: the fit moves
+    the errors toward zero, and the figure says which field moved from where to where."""
+    from tdcm_ros.metrics.api import calibrate_paths
+    from tdcm_ros.metrics.plots import (
+        calibration_figure,
+        step_errors,
+        write_calibration_plots,
+    )
+
+    fit = calibrate_paths([bag], ("E",))
+    fig = calibration_figure(plt, fit)
+    try:
+        texts = _legend_texts(fig)
+        assert {"trial 1, before calibration", "trial 1, after calibration"} <= set(texts)
+        assert "E 1.85e+09 -> " in fig.axes[0].get_title()
+        lines = {line.get_label(): line for line in fig.axes[0].get_lines()}
+        before = lines["trial 1, before calibration"].get_ydata()
+        after = lines["trial 1, after calibration"].get_ydata()
+        assert np.array_equal(before, step_errors(fit.before, 1)[1] * 1e3)
+        assert np.mean(np.abs(after)) < 0.5 * np.mean(np.abs(before))
+    finally:
+        plt.close(fig)
+    paths = write_calibration_plots(fit, tmp_path / "plots")
+    assert [p.name for p in paths] == ["calibration.png", "shapes_calibrated.png"]
+    assert all(p.stat().st_size > 10_000 for p in paths)
