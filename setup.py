@@ -42,6 +42,7 @@ setup(
         (f"share/{PACKAGE}/config/bodies", glob("config/bodies/*.yaml") + glob("config/bodies/*.stl")),
         (f"share/{PACKAGE}/config/design", glob("config/design/*.yaml")),
         (f"share/{PACKAGE}/config/rviz", glob("config/rviz/*.rviz")),
+        (f"share/{PACKAGE}/config/foxglove", glob("config/foxglove/*.json")),
         (f"share/{PACKAGE}/config/zenoh", glob("config/zenoh/*")),
         *[(f"share/{PACKAGE}/{folder}", glob(f"{folder}/*.msg"))
           for folder in sorted({str(Path(p).parent) for p in glob("msg_defs/*/msg/*.msg")})],

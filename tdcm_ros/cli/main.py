@@ -32,6 +32,7 @@ COMMANDS: dict[str, str] = {
     "inverse": "tdcm_ros.cli.inverse",
     "design": "tdcm_ros.cli.design",
     "urdf": "tdcm_ros.cli.urdf",
+    "foxglove": "tdcm_ros.cli.foxglove",
     "up": "tdcm_ros.cli.up",
     "topic": "tdcm_ros.cli.topic",
     "record": "tdcm_ros.cli.record",

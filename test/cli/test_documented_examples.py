@@ -21,7 +21,7 @@ OFFLINE = {"solve", "inverse", "design", "urdf", "figures", "bench", "evaluate",
            "scene list", "scene validate", "scene explain", "scene effects", "bag info",
            "param specs"}
 #: Subcommands that talk to a graph (or start one): run by the graph examples' test.
-GRAPH = {"up", "demo", "record", "bag play", "topic list", "topic echo", "topic pub", "topic hz",
+GRAPH = {"up", "demo", "record", "bag play", "foxglove", "topic list", "topic echo", "topic pub", "topic hz",
          "param list", "param get", "param set", "param describe", "param dump", "service list",
          "service call"}
 EXAMPLES = readme_examples() + epilog_examples(build_parser())

@@ -48,7 +48,7 @@ GRAPH_NODES = ("/device_twin", "/tension_driver", "/model_node", "/shape_control
 #: The verbs run against the graph, in the order a reader meets them.
 AGAINST_GRAPH = {"topic list", "topic echo", "topic pub", "topic hz", "param list", "param get",
                  "param set", "param describe", "param dump", "service list", "service call",
-                 "record", "bag play"}
+                 "record", "bag play", "foxglove"}
 
 
 def _runs_here(example: Example) -> bool:
@@ -203,6 +203,8 @@ def _evidence(example: Example, folder: Path, bag_stamped: Callable[[int, int], 
         return lambda out: out.has("---")
     if example.verb == "topic pub" and not {"-1", "--once"} & set(argv):
         return lambda out: out.has("publishing #2")
+    if example.verb == "foxglove":
+        return lambda out: out.has("serving")
     if example.verb == "bag play":
         from tdcm_ros.bagio.reader import open_bag
 
