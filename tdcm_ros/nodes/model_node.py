@@ -97,6 +97,8 @@ from tdcm_ros.runtime import (
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
+#: Outputs of every solve whatever ``output.visual_rate_hz``: the state, not the drawing.
+EVERY_SOLVE = frozenset({"tip_pose"})
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64", JOINT_STATE)
 #: Rolls kept to pair with tensions: over a second at the driver's telemetry rate.
 ROLL_HISTORY = 2048
@@ -121,6 +123,10 @@ TUNABLE_SPECS = by_name(
     Spec("frame_id", description="frame of all outputs", default="tdcm_base", kind="str"),
     Spec("output.samples", description="poses along the midline", default=54, kind="int",
          low=2, high=10_000),
+    Spec("output.visual_rate_hz", "Hz", "most solves a second whose shape is drawn: midline, "
+         "midline_poses, predicted_markers, body_markers and joint_states follow it (by the "
+         "input's stamp), tip_pose, tendon_states and /tf every solve; 0: every solve",
+         default=30.0, kind="float", low=0.0, high=1e6),
     Spec("markers.arc_lengths", "m", "arc lengths of the predicted markers",
          MARKER_SPECS["arc_lengths"].default, kind="list"),
     Spec("markers.placement", description="surface or midline", default="surface", kind="str",
@@ -222,6 +228,7 @@ class ModelNode(NodeLogic):
         self.rolls = RollHistory(ROLL_HISTORY)
         self.pending: tuple[float | tuple[float, ...], int] | None = None
         self.previous: SolveResult | None = None
+        self.drawn_ns: int | None = None  # stamp of the last solve whose shape was drawn
         self.counts: Counter[str] = Counter()
         self.last_problem = ""
         self.last_failure = ""
@@ -350,6 +357,16 @@ class ModelNode(NodeLogic):
             return "stale"
         return ""
 
+    def _draw_due(self, stamp_ns: int) -> bool:
+        """Whether the solve stamped ``stamp_ns`` is drawn (``output.visual_rate_hz``): the first,
+        one ``1 / rate`` s of stamps after the last drawn, or one stamped before it."""
+        rate = float(self.port.get_parameter("output.visual_rate_hz"))
+        last = self.drawn_ns
+        if rate > 0.0 and last is not None and 0 <= stamp_ns - last < round(1e9 / rate):
+            return False
+        self.drawn_ns = stamp_ns
+        return True
+
     def process(self) -> None:
         """Solve the newest pending tension and publish the shape."""
         if self.pending is None:
@@ -370,6 +387,7 @@ class ModelNode(NodeLogic):
                   if placement == "surface" else 0.0)
         frame_id = self.prefix + str(self.port.get_parameter("frame_id"))
         roll = self.rolls.at(stamp_ns)
+        drawn = self._draw_due(stamp_ns)
         for topic, message in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),
@@ -378,12 +396,16 @@ class ModelNode(NodeLogic):
                 marker_radius=radius,
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
                 roll=roll):
-            self.publishers[topic].publish(message)  # midline first: sent before the rest is built
+            if drawn or topic in EVERY_SOLVE:
+                self.publishers[topic].publish(message)  # midline first: sent before the rest
+            if not drawn and topic == "tip_pose":
+                break  # the drawn ones after it are not built
         self.publishers["tendon_states"].publish(
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
-        self.joint_states.publish(body_joint_states(
-            stamp_ns, joint_names(self.design)[1:], joint_positions(result)[1:].tolist()))
+        if drawn:
+            self.joint_states.publish(body_joint_states(
+                stamp_ns, joint_names(self.design)[1:], joint_positions(result)[1:].tolist()))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=self.prefix

@@ -38,13 +38,14 @@ class Node:
         self.node = ModelNode(self.port)
 
     def send(self, tension: float, stamp_ns: int) -> bool:
-        """Deliver ``tension`` stamped ``stamp_ns``; True if a midline with that stamp came."""
-        before = len(self.port.messages("midline"))
+        """Deliver ``tension`` stamped ``stamp_ns``; True if a tip pose with that stamp came
+        (every solve publishes one; the midline is drawn at ``output.visual_rate_hz``)."""
+        before = len(self.port.messages("tip_pose"))
         self.port.deliver("tension", wrench(tension, stamp_ns))
         self.port.advance(0.001)  # one process_period_s
-        paths = self.port.messages("midline")[before:]
-        assert len(paths) <= 1
-        return bool(paths) and stamp(paths[0]) == stamp_ns
+        tips = self.port.messages("tip_pose")[before:]
+        assert len(tips) <= 1
+        return bool(tips) and stamp(tips[0]) == stamp_ns
 
     def counts(self) -> dict[str, int]:
         return {k: self.node.counts[k] for k in KEYS}
@@ -197,3 +198,23 @@ def test_a_marker_rounded_past_the_tip_is_the_tip_and_a_refused_bound_is_printed
     with pytest.raises(InputError) as error:
         n.node._config({"markers.arc_lengths": [0.02, base.length + 1e-6]})
     assert f"[0, {length!r}] m" in str(error.value)
+
+
+@pytest.mark.parametrize("rate", [30.0, 0.0])
+def test_the_shape_is_drawn_at_the_visual_rate_and_the_tip_every_solve(rate: float) -> None:
+    """1 kHz of inputs for 0.2 s: the tip and tendon state of each, the drawn topics at most
+    ``output.visual_rate_hz`` by the inputs' stamps (0: each), the first one drawn."""
+    n = Node({"output.visual_rate_hz": rate, "input.max_age_s": 0.0})
+    first = n.port.now_ns()
+    for k in range(200):
+        assert n.send(10.0 + 0.01 * k, first + k * MS)
+    drawn = [stamp(m) for m in n.port.messages("midline")]
+    assert len(n.port.messages("tip_pose")) == len(n.port.messages("tendon_states")) == 200
+    if rate == 0.0:
+        assert len(drawn) == 200
+    else:
+        assert drawn[0] == first and np.all(np.diff(drawn) >= 1e9 / rate)
+        assert len(drawn) == 6  # 0, 34, 68, 102, 136, 170 ms: every 34th of 1 ms stamps
+    for topic in ("midline_poses", "predicted_markers", "body_markers", "joint_states"):
+        assert [stamp(m) if hasattr(m, "header") else stamp(m.markers[0])
+                for m in n.port.messages(topic)] == drawn, topic
