@@ -155,7 +155,8 @@ def _paper_figure(plt: Any, spec: FigureSpec, tensions: np.ndarray, points: int,
     ax_b.set_xlabel("arc length s (mm)")
     ax_b.set_ylabel("curvature κ (1/m)")
     ax_b.set_title(f"(b) curvature along s at T = {T_BASE:g} N")
-    ax_b.legend(fontsize=9)
+    ax_b.set_ylim(top=1.3 * ax_b.get_ylim()[1])  # room above the peaks for the legend
+    ax_b.legend(fontsize=9, loc="upper center", ncol=len(curves))
     _surface(ax_c, space, spec, curves, colours)
     fig.suptitle(f"{spec.name}: {spec.symbol} varied, E = {base.E / 1e9:g} GPa, "
                  f"L = {base.length / MM:g} mm", fontsize=10)
