@@ -80,7 +80,7 @@ def plot_solution(result: SolveResult, path: str | Path) -> Path:
 def plot_search(search: DesignSearch, path: str | Path) -> Path:
     """Write two panels to ``path`` (.png, .pdf or .svg): tension needed against peak strain at
     the target, and reach against tension needed; every design that meets the target in grey,
-    the Pareto set coloured by reach."""
+    the Pareto set coloured by reach (one Pareto design: its reach in the legend)."""
     import numpy as np
 
     plt = load_pyplot("--out", path)
@@ -91,15 +91,21 @@ def plot_search(search: DesignSearch, path: str | Path) -> Path:
     fig, (ax_strain, ax_reach) = plt.subplots(1, 2, figsize=(11, 4.6))
     ax_strain.scatter(search.peak_strain[shown] * 100, search.tension_n[shown], s=3, c="0.75",
                       lw=0, label=f"meet the target ({meets.size})")
-    dots = ax_strain.scatter(search.peak_strain[front] * 100, search.tension_n[front], s=28,
-                             c=search.reach[front] * reach_scale, cmap="viridis",
-                             edgecolors="k", lw=0.5, label=f"Pareto set ({front.size})")
+    if front.size > 1:  # coloured by reach; one design has no range to colour
+        dots = ax_strain.scatter(search.peak_strain[front] * 100, search.tension_n[front],
+                                 s=28, c=search.reach[front] * reach_scale, cmap="viridis",
+                                 edgecolors="k", lw=0.5, label=f"Pareto set ({front.size})")
+        fig.colorbar(dots, ax=ax_strain).set_label(f"reach ({unit})", fontsize=FONT_SIZE)
+    else:
+        reach = ", ".join(f"reach {v * reach_scale:.3g} {unit}" for v in search.reach[front])
+        ax_strain.scatter(search.peak_strain[front] * 100, search.tension_n[front], s=28,
+                          c="C1", edgecolors="k", lw=0.5,
+                          label=f"Pareto set ({front.size}{': ' + reach if reach else ''})")
     ax_strain.axvline(search.allowable_strain * 100, color="r", lw=0.8, ls="--",
                       label="allowable strain")
     ax_strain.set_xlabel("peak notch strain at the target (%)", fontsize=FONT_SIZE)
     ax_strain.set_ylabel("tension needed (N)", fontsize=FONT_SIZE)
     ax_strain.legend(loc="best", fontsize=FONT_SIZE - 1)
-    fig.colorbar(dots, ax=ax_strain).set_label(f"reach ({unit})", fontsize=FONT_SIZE)
     ax_reach.scatter(search.tension_n[shown], search.reach[shown] * reach_scale, s=3, c="0.75",
                      lw=0)
     ax_reach.scatter(search.tension_n[front], search.reach[front] * reach_scale, s=28,
