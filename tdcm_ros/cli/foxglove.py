@@ -88,7 +88,6 @@ def run(args: argparse.Namespace) -> int:
     context = open_context("zenoh", require_graph=True)
     server = None
     try:
-        server = foxglove.start_server(host=args.host, port=args.port, name="tdcm_ros")
         port = context.create_port(TOOL_NODE)
         for topic, type_name in topics.items():
             schema = foxglove.Schema(name=type_name, encoding="ros2msg",
@@ -97,6 +96,8 @@ def run(args: argparse.Namespace) -> int:
             qos = QoS(depth=1, durability="transient_local") if topic in LATCHED else \
                 QoS(depth=10)
             port.create_raw_subscription(topic, type_name, _forward(channel), qos)
+        # every channel exists before the server listens: a client's first advertise has them all
+        server = foxglove.start_server(host=args.host, port=args.port, name="tdcm_ros")
         print(f"serving {len(topics)} topics on ws://{args.host}:{server.port} (Ctrl-C stops)",
               flush=True)
         context.spin()
