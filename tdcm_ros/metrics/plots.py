@@ -10,6 +10,7 @@ the measured midline is the spline through the markers moved back by that offset
 from __future__ import annotations
 
 import textwrap
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -145,13 +146,21 @@ def write_calibration_plots(fit: Calibration, directory: str | Path, *, option: 
                             ) -> list[Path]:
     """Write ``calibration.png`` (:func:`calibration_figure`) and ``shapes_calibrated.png``
     (:func:`shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
+    fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
+    return _write(directory, option, (
+        ("calibration.png", lambda plt: calibration_figure(plt, fit)),
+        ("shapes_calibrated.png", lambda plt: shapes_figure(
+            plt, fit.after, f"Measured and calibrated-model shapes ({fitted})"))))
+
+
+def _write(directory: str | Path, option: str,
+           figures: tuple[tuple[str, Callable[[Any], Any]], ...]) -> list[Path]:
+    """Each ``(name, make)`` of ``figures``: ``make(pyplot)`` saved as ``directory/name`` (the
+    folder created if missing; ``option`` names it in errors) and closed."""
     plt = load_pyplot(option, Path(directory))
     out = output_folder(option, directory)
-    fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
-    figures = (("calibration.png", calibration_figure(plt, fit)),
-               ("shapes_calibrated.png", shapes_figure(
-                   plt, fit.after, f"Measured and calibrated-model shapes ({fitted})")))
-    for name, fig in figures:
+    for name, make in figures:
+        fig = make(plt)
         fig.savefig(out / name, dpi=120)
         plt.close(fig)
     return [out / name for name, _ in figures]
@@ -179,12 +188,6 @@ def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = 
     """Write ``shapes.png`` (:func:`shapes_figure`) and ``error_vs_tension.png``
     (:func:`error_figure`) into ``directory`` (created if missing; its parent must exist;
     ``option`` names it in errors)."""
-    plt = load_pyplot(option, Path(directory))
-    out = output_folder(option, directory)
-    paths = []
-    for name, make in (("shapes.png", shapes_figure), ("error_vs_tension.png", error_figure)):
-        fig = make(plt, evaluation)
-        fig.savefig(out / name, dpi=120)
-        plt.close(fig)
-        paths.append(out / name)
-    return paths
+    return _write(directory, option, (
+        ("shapes.png", lambda plt: shapes_figure(plt, evaluation)),
+        ("error_vs_tension.png", lambda plt: error_figure(plt, evaluation))))

@@ -141,6 +141,7 @@ class _Local:
     def __init__(self, problem: ShapeProblem, bounds: Array) -> None:
         self.problem, self.bounds = problem, bounds
         self.best: tuple[Array, float] | None = None
+        self.met = False  # whether ``best`` meets every target
         self.started_at = math.inf
         self.evaluations = 0
 
@@ -165,16 +166,15 @@ class _Local:
                                 x_scale="jac", diff_step=np.full(x0.size, 1e-6),
                                 max_nfev=10 * (x0.size + 1))
             self.evaluations += int(fit.nfev) + int(fit.njev or 0) * x0.size
-            score = self.problem(fit.x)
-            if self.best is None or score < self.best[1]:
-                self.best = (np.asarray(fit.x, dtype=float), score)
-        if self.best is None or start.score < self.best[1]:
-            self.best = (np.asarray(x0, dtype=float), start.score)
+            self._keep(np.asarray(fit.x, dtype=float), self.problem.evaluate(fit.x))
+        self._keep(np.asarray(x0, dtype=float), start)
+        assert self.best is not None  # kept just now
         return self.best
 
-    @property
-    def met(self) -> bool:
-        return self.best is not None and self.problem.evaluate(self.best[0]).met
+    def _keep(self, x: Array, evaluation: Evaluation) -> None:
+        """``x`` as ``best`` if it scores lower (the first always)."""
+        if self.best is None or evaluation.score < self.best[1]:
+            self.best, self.met = (x, evaluation.score), evaluation.met
 
 
 def _read_state(path: Path, problem: ShapeProblem) -> tuple[Array, int, list[float]]:

@@ -97,8 +97,6 @@ from tdcm_ros.runtime import (
 from tdcm_ros.runtime.run_node import main_for
 from tdcm_ros.spec import Spec, by_name
 
-#: Outputs of every solve whatever ``output.visual_rate_hz``: the state, not the drawing.
-EVERY_SOLVE = frozenset({"tip_pose"})
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64", JOINT_STATE)
 #: Rolls kept to pair with tensions: over a second at the driver's telemetry rate.
 ROLL_HISTORY = 2048
@@ -203,6 +201,7 @@ class ModelNode(NodeLogic):
         period = float(fixed["process_period_s"])
         diag_period = float(fixed["diagnostics_period_s"])
         self.design, self.settings = self._config({})
+        self.joint_names = joint_names(self.design)[1:]  # the URDF's, less the driver's roll
         port.add_on_set_parameters(self._on_set)
         warm_up()  # compile the solver's kernel now, not on the first message
 
@@ -257,6 +256,7 @@ class ModelNode(NodeLogic):
     def _on_set(self, changes: Mapping[str, Any]) -> None:
         """Validate a runtime change as a whole; raising keeps the old values."""
         self.design, self.settings = self._config(changes)
+        self.joint_names = joint_names(self.design)[1:]
         self.previous = None
         self._publish_tendon_tf(str(changes.get("frame_id", self.port.get_parameter("frame_id"))))
 
@@ -395,17 +395,14 @@ class ModelNode(NodeLogic):
                                                dtype=float), self.design.length),
                 marker_radius=radius,
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
-                roll=roll):
-            if drawn or topic in EVERY_SOLVE:
-                self.publishers[topic].publish(message)  # midline first: sent before the rest
-            if not drawn and topic == "tip_pose":
-                break  # the drawn ones after it are not built
+                roll=roll, drawn=drawn):
+            self.publishers[topic].publish(message)  # midline first: sent before the rest is built
         self.publishers["tendon_states"].publish(
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
         if drawn:
             self.joint_states.publish(body_joint_states(
-                stamp_ns, joint_names(self.design)[1:], joint_positions(result)[1:].tolist()))
+                stamp_ns, self.joint_names, joint_positions(result)[1:].tolist()))
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=self.prefix

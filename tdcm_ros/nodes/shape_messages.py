@@ -71,12 +71,17 @@ def _marker(hdr: Any, ns: str, marker_id: int, marker_type: int,
 
 def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, samples: int,
                      marker_s: Array, marker_radius: float, marker_side_rad: float,
-                     roll: float = 0.0) -> Iterator[tuple[str, Any]]:
+                     roll: float = 0.0, drawn: bool = True) -> Iterator[tuple[str, Any]]:
     """``(topic, message)`` for ``midline``, ``midline_poses``, ``tip_pose``,
     ``predicted_markers`` and ``body_markers``, in that order, each built when the previous one
     has been taken (so ``midline`` can be sent before the rest exist), the shape rolled by
-    ``roll`` (rad). The messages share sub-objects (header, poses): serialise them, do not
-    modify them."""
+    ``roll`` (rad); ``drawn=False``: ``tip_pose`` alone (nothing else is built). The messages
+    share sub-objects (header, poses): serialise them, do not modify them."""
+    if not drawn:
+        position, quat = roll_poses(result.tip_position[None], result.tip_quaternion[None], roll)
+        yield "tip_pose", msg_class("geometry_msgs/msg/PoseStamped")(
+            header=header_msg(stamp_ns, frame_id), pose=_poses(position, quat)[0])
+        return
     s = np.linspace(0.0, result.design.length, samples)
     planar, planar_quats = result.pose_at(np.concatenate([s, np.asarray(marker_s, dtype=float)]))
     planar[samples:] = offset_points(planar[samples:], planar_quats[samples:], marker_radius,
