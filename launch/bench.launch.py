@@ -1,15 +1,18 @@
 """ROS 2 launch: the real bench: tension driver, model, mocap relabelling and live metrics.
 
 ``ros2 launch tdcm_ros bench.launch.py port:=/dev/ttyACM0 [driver_markers:=/vicon/markers]
-[namespace:=/tdcm]``
+[namespace:=/tdcm] [rviz:=true]``
 
 Every source is real: the tension device on ``port`` and the motion-capture driver's markers
 (e.g. MOCAP4ROS2's), which ``mocap_node`` relabels (``config/mocap_node.yaml``) into ``markers``
 for ``metrics_node``; the driver's topic is remapped onto the node's input ``/vicon/markers`` by
-``driver_markers``. For a simulated bench use ``mocap.launch.py source:=sim`` or ``tdcm up``.
+``driver_markers``. ``rviz:=true`` also starts ``view.launch.py`` (robot_state_publisher with
+the body's URDF, and RViz). For a simulated bench use ``mocap.launch.py source:=sim`` or ``tdcm up``.
 """
 
-from launch.actions import DeclareLaunchArgument
+from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription
+from launch.conditions import IfCondition
+from launch.launch_description_sources import PythonLaunchDescriptionSource
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution
 from launch_ros.actions import Node
 from launch_ros.parameter_descriptions import ParameterValue
@@ -38,6 +41,9 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument("driver_markers", default_value="/vicon/markers",
                               description="the motion-capture driver's Markers topic"),
         DeclareLaunchArgument("namespace", default_value="", description="node namespace"),
+        DeclareLaunchArgument("rviz", default_value="false", choices=["true", "false"],
+                              description="true: also view.launch.py (robot_state_publisher "
+                                          "with the body's URDF, and RViz)"),
         Node(package="tdcm_ros", executable="tension_driver", name="tension_driver",
              namespace=namespace, output="screen",
              parameters=[params("tension_driver"), {"port": LaunchConfiguration("port")}, common]),
@@ -49,4 +55,11 @@ def generate_launch_description() -> LaunchDescription:
              remappings=[("/vicon/markers", LaunchConfiguration("driver_markers"))]),
         Node(package="tdcm_ros", executable="metrics_node", name="metrics_node",
              namespace=namespace, output="screen", parameters=[params("metrics_node"), common]),
+        IncludeLaunchDescription(
+            PythonLaunchDescriptionSource(PathJoinSubstitution(
+                [FindPackageShare("tdcm_ros"), "launch", "view.launch.py"])),
+            launch_arguments={"params_file": params("model_node"), "namespace": namespace,
+                              "frame_prefix": LaunchConfiguration("frame_prefix"),
+                              "use_sim_time": LaunchConfiguration("use_sim_time")}.items(),
+            condition=IfCondition(LaunchConfiguration("rviz"))),
     ])

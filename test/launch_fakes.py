@@ -48,6 +48,46 @@ class FindPackageShare:
         self.package = package
 
 
+class IfCondition:
+    """launch's condition: true for ``true``/``1``, false for ``false``/``0`` (any case); other
+    text is an error, as in launch."""
+
+    def __init__(self, predicate_expression: Any) -> None:
+        self.predicate_expression = predicate_expression
+
+    def evaluate(self, arguments: Mapping[str, str]) -> bool:
+        text = str(resolve(self.predicate_expression, arguments)).lower()
+        if text not in ("true", "1", "false", "0"):
+            raise ValueError(f"IfCondition: {text!r} is no boolean")
+        return text in ("true", "1")
+
+
+class OpaqueFunction:
+    def __init__(self, *, function: Any, args: list[Any] | None = None,
+                 kwargs: dict[str, Any] | None = None, condition: IfCondition | None = None) -> None:
+        self.function, self.condition = function, condition
+        self.args, self.kwargs = list(args or []), dict(kwargs or {})
+
+
+class PythonLaunchDescriptionSource:
+    def __init__(self, launch_file_path: Any) -> None:
+        self.launch_file_path = launch_file_path
+
+
+class IncludeLaunchDescription:
+    def __init__(self, launch_description_source: PythonLaunchDescriptionSource, *,
+                 launch_arguments: Any = None, condition: IfCondition | None = None) -> None:
+        self.source, self.condition = launch_description_source, condition
+        self.launch_arguments = list(launch_arguments or [])
+
+
+class LaunchContext:
+    """What an ``OpaqueFunction`` gets: the launch configurations, all resolved to text."""
+
+    def __init__(self, launch_configurations: Mapping[str, str]) -> None:
+        self.launch_configurations = dict(launch_configurations)
+
+
 class ParameterValue:
     """launch_ros's typed parameter value: ``value_type=str`` keeps the substituted text as it
     is (no YAML reading), the way the launch files pass ``frame_prefix``."""
@@ -61,10 +101,12 @@ class Node:
                  namespace: Any = None, exec_name: str | None = None,
                  parameters: list[Any] | None = None, remappings: list[Any] | None = None,
                  ros_arguments: list[Any] | None = None, arguments: list[Any] | None = None,
-                 output: str = "log", **_other: Any) -> None:
+                 output: str = "log", condition: IfCondition | None = None,
+                 **_other: Any) -> None:
         self.executable, self.package, self.name, self.namespace = executable, package, name, namespace
         self.parameters = list(parameters or [])
         self.remappings = list(remappings or [])
+        self.arguments, self.condition = list(arguments or []), condition
 
 
 def _share(package: str) -> str:
@@ -98,7 +140,13 @@ def _modules() -> dict[str, types.ModuleType]:
 
     return {
         "launch": module("launch", LaunchDescription=LaunchDescription),
-        "launch.actions": module("launch.actions", DeclareLaunchArgument=DeclareLaunchArgument),
+        "launch.actions": module("launch.actions", DeclareLaunchArgument=DeclareLaunchArgument,
+                                 IncludeLaunchDescription=IncludeLaunchDescription,
+                                 OpaqueFunction=OpaqueFunction),
+        "launch.conditions": module("launch.conditions", IfCondition=IfCondition),
+        "launch.launch_description_sources": module(
+            "launch.launch_description_sources",
+            PythonLaunchDescriptionSource=PythonLaunchDescriptionSource),
         "launch.substitutions": module("launch.substitutions",
                                        LaunchConfiguration=LaunchConfiguration,
                                        PathJoinSubstitution=PathJoinSubstitution),
@@ -128,9 +176,11 @@ def load(path: Path) -> LaunchDescription:
         return runpy.run_path(str(path))["generate_launch_description"]()
 
 
-def launch_arguments(description: LaunchDescription, given: Mapping[str, str]) -> dict[str, str]:
-    """Declared arguments with their defaults, overridden by ``given``; an undeclared or an
-    off-``choices`` argument raises as ``ros2 launch`` refuses it."""
+def launch_arguments(description: LaunchDescription, given: Mapping[str, str],
+                     inherited: Mapping[str, str] | None = None) -> dict[str, str]:
+    """Declared arguments with their defaults, overridden by what an including file set
+    (``inherited``), then by ``given``; an undeclared or an off-``choices`` argument raises as
+    ``ros2 launch`` refuses it."""
     declared = [e for e in description.entities if isinstance(e, DeclareLaunchArgument)]
     names = {d.name for d in declared}
     unknown = set(given) - names
@@ -138,6 +188,7 @@ def launch_arguments(description: LaunchDescription, given: Mapping[str, str]) -
         raise KeyError(f"undeclared launch arguments {sorted(unknown)}")
     values = {d.name: str(resolve(d.default_value, {})) for d in declared
               if d.default_value is not None}
+    values.update(inherited or {})
     values.update(given)
     for d in declared:
         if d.choices is not None and values.get(d.name) not in d.choices:
@@ -147,3 +198,30 @@ def launch_arguments(description: LaunchDescription, given: Mapping[str, str]) -
 
 def nodes(description: LaunchDescription) -> list[Node]:
     return [e for e in description.entities if isinstance(e, Node)]
+
+
+def launched(path: Path, given: Mapping[str, str],
+             inherited: Mapping[str, str] | None = None) -> list[tuple[Node, dict[str, str]]]:
+    """The nodes ``ros2 launch PATH given...`` starts, each with the launch configurations its
+    substitutions see: conditions evaluated, opaque functions run, included files expanded (an
+    included file sees the including file's configurations and its ``launch_arguments``)."""
+    description = load(path)
+    arguments = launch_arguments(description, given, inherited)
+    out: list[tuple[Node, dict[str, str]]] = []
+    entities = list(description.entities)
+    while entities:
+        entity = entities.pop(0)
+        if getattr(entity, "condition", None) is not None \
+                and not entity.condition.evaluate(arguments):
+            continue
+        if isinstance(entity, Node):
+            out.append((entity, arguments))
+        elif isinstance(entity, OpaqueFunction):
+            made = entity.function(LaunchContext(arguments), *entity.args, **entity.kwargs)
+            entities[:0] = list(made or [])
+        elif isinstance(entity, IncludeLaunchDescription):
+            included = {str(resolve(key, arguments)): str(resolve(value, arguments))
+                        for key, value in entity.launch_arguments}
+            out += launched(Path(resolve(entity.source.launch_file_path, arguments)), included,
+                            arguments)
+    return out

@@ -118,7 +118,7 @@ from tdcm_ros.model.shape_targets import (
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
 from tdcm_ros.model.tendons import Tendon, require_paper_tendon
-from tdcm_ros.model.urdf import body_urdf, joint_names, joint_positions
+from tdcm_ros.model.urdf import body_urdf, body_xacro, joint_names, joint_positions
 
 __all__ = [
     "DEFAULT_ALLOWABLE_STRAIN",
@@ -191,6 +191,7 @@ __all__ = [
     "body_from_mapping",
     "body_outline",
     "body_urdf",
+    "body_xacro",
     "candidate",
     "check_roll",
     "check_tension",

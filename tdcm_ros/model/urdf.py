@@ -16,6 +16,10 @@ Each segment's visual hangs on its turn link (the chord's direction): a tube is 
 ``R_outer`` (a lumen is not drawn), a notch is a box of its backbone (``w_d`` across x at
 ``w_o``, the tube's diameter across y, ``w_n`` long), so the notches show as waists. Every
 link and joint name is put after ``prefix`` (a robot's ``frame_prefix``).
+
+:func:`body_urdf` writes the chain as a robot of its own (robot_state_publisher's
+``robot_description``); :func:`body_xacro` as a xacro macro that a larger robot's description
+includes under its tool link.
 """
 
 from __future__ import annotations
@@ -85,16 +89,49 @@ def joint_positions(result: SolveResult, roll: float = 0.0) -> Array:
 def body_urdf(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "",
               base_link: str = "tdcm_base") -> str:
     """The URDF of ``design`` (see the module docstring) as text, its root ``base_link``."""
+    _check_names(name, base_link)
+    return "\n".join([
+        '<?xml version="1.0"?>', _comment(design, name),
+        f"<robot name={quoteattr(prefix + name)}>",
+        *_chain(design, name, prefix, base_link), "</robot>"]) + "\n"
+
+
+def body_xacro(design: Design, *, name: str = DEFAULT_NAME, base_link: str = "tdcm_base") -> str:
+    """A xacro file defining the macro ``name`` that puts ``design``'s chain under a larger
+    robot's link: ``<xacro:NAME parent="tool0" [prefix="left_"] [xyz="0 0 0"] [rpy="0 0 0"]/>``
+    adds a fixed joint ``{prefix}{name}_mount`` from ``parent`` to ``{prefix}{base_link}`` at
+    ``xyz`` (m) and ``rpy`` (rad), then the chain of :func:`body_urdf`, every name after
+    ``prefix``."""
+    _check_names(name, base_link)
+    prefix = "${prefix}"
+    mount = (f"  <joint name={quoteattr(f'{prefix}{name}_mount')} type=\"fixed\">\n"
+             "    <parent link=\"${parent}\"/>\n"
+             f"    <child link={quoteattr(prefix + base_link)}/>\n"
+             "    <origin xyz=\"${xyz}\" rpy=\"${rpy}\"/>\n  </joint>")
+    return "\n".join([
+        '<?xml version="1.0"?>', _comment(design, name),
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">',
+        (f"  <xacro:macro name={quoteattr(name)} "
+         "params=\"parent prefix:='' xyz:='0 0 0' rpy:='0 0 0'\">"),
+        *_chain(design, name, prefix, base_link), mount, "  </xacro:macro>", "</robot>"]) + "\n"
+
+
+def _check_names(name: str, base_link: str) -> None:
     for what, value in (("name", name), ("base_link", base_link)):
-        if not value or any(c.isspace() or c in "<>&\"'" for c in value):
-            raise out_of_range(what, value, "a non-empty name without spaces or XML markup",
+        if not value or any(c.isspace() or c in "<>&\"'$" for c in value):
+            raise out_of_range(what, value, "a non-empty name without spaces, $ or XML markup",
                                error=InvalidDesignError)
+
+
+def _comment(design: Design, name: str) -> str:
+    return (f"<!-- {name}: tdcm_ros body, {design.N} notches, {design.length * 1e3:.6g} mm; "
+            "joints set by model_node on joint_states -->")
+
+
+def _chain(design: Design, name: str, prefix: str, base_link: str) -> list[str]:
+    """The links and joints from ``base_link`` through the roll joint to the tip."""
     segments = _segments(design)
-    lines = ['<?xml version="1.0"?>',
-             (f"<!-- {name}: tdcm_ros body, {design.N} notches, {design.length * 1e3:.6g} mm; "
-              "joints set by model_node on joint_states -->"),
-             f"<robot name={quoteattr(prefix + name)}>",
-             f"  <link name={quoteattr(prefix + base_link)}/>",
+    lines = [f"  <link name={quoteattr(prefix + base_link)}/>",
              f"  <link name={quoteattr(f'{prefix}{name}_rolled')}/>",
              _joint(prefix + ROLL_JOINT, "revolute", prefix + base_link, f"{prefix}{name}_rolled",
                     "0 0 1", -math.pi, math.pi)]
@@ -113,8 +150,7 @@ def body_urdf(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "",
                   _joint(f"{prefix}{name}_seg{k}_bend", "revolute", chord, link, "0 1 0",
                          -BEND_LIMIT_RAD, BEND_LIMIT_RAD)]
         parent = link
-    lines.append("</robot>")
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def _joint(name: str, kind: str, parent: str, child: str, axis: str, low: float,

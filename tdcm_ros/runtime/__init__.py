@@ -26,7 +26,7 @@ from tdcm_ros.runtime.names import (
     validate_frame_prefix,
 )
 from tdcm_ros.runtime.parameters import ParamSpec, ParamValue, SetResult
-from tdcm_ros.runtime.params import param_file_text, parse_cli_param
+from tdcm_ros.runtime.params import node_parameters, param_file_text, parse_cli_param
 from tdcm_ros.runtime.port import (
     CLOCK_QOS,
     CLOCK_TOPIC,
@@ -73,6 +73,7 @@ __all__ = [
     "exit_now",
     "grouped",
     "launch",
+    "node_parameters",
     "node_target",
     "normalize_namespace",
     "overridable_qos",

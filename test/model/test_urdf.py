@@ -3,14 +3,16 @@ with 4x4 matrices, puts its tip link on the model's tip for the joint values of 
 
 from __future__ import annotations
 
+import io
 import math
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from tdcm_ros.model import InvalidDesignError, named_design, preset, solve
-from tdcm_ros.model.urdf import body_urdf, joint_names, joint_positions
+from tdcm_ros.model.urdf import body_urdf, body_xacro, joint_names, joint_positions
 from test.support.examples import REPO
 
 WRIST = str(REPO / "config" / "bodies" / "tip_first_wrist.yaml")
@@ -79,3 +81,70 @@ def test_every_joint_and_link_is_named_once_and_notches_are_waists() -> None:
 def test_a_bad_name_is_refused() -> None:
     with pytest.raises(InvalidDesignError, match="name"):
         body_urdf(preset("paper-experiment"), name="my body")
+
+
+# -- a larger robot includes the body: real xacro expands it, yourdfpy walks it ----------------
+
+ARM = """<?xml version="1.0"?>
+<robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:include filename="{body}"/>
+  <link name="world"/><link name="upper"/><link name="fore"/><link name="tool0"/>
+  <joint name="shoulder" type="revolute">
+    <parent link="world"/><child link="upper"/><origin xyz="0 0 0.1" rpy="0 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="elbow" type="revolute">
+    <parent link="upper"/><child link="fore"/><origin xyz="0 0 0.3" rpy="0 0.2 0"/>
+    <axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="flange" type="fixed">
+    <parent link="fore"/><child link="tool0"/><origin xyz="0.05 0 0.25" rpy="0.1 -0.3 0.5"/>
+  </joint>
+  <xacro:tdcm_body parent="tool0" xyz="0 0 0.01" rpy="0 0 {quarter}"/>
+  <xacro:tdcm_body parent="upper" prefix="left_"/>
+</robot>
+"""
+
+
+def rpy_pose(xyz: list[float], rpy: list[float]) -> np.ndarray:
+    """URDF's origin: rotations about the fixed x, y, z axes (roll, pitch, yaw), then ``xyz``."""
+    pose = np.eye(4)
+    pose[:3, :3] = (axis_rotation(np.array([0.0, 0.0, 1.0]), rpy[2])
+                    @ axis_rotation(np.array([0.0, 1.0, 0.0]), rpy[1])
+                    @ axis_rotation(np.array([1.0, 0.0, 0.0]), rpy[0]))
+    pose[:3, 3] = xyz
+    return pose
+
+
+@pytest.mark.parametrize(("design", "tension"), [(preset("paper-experiment"), 20.0),
+                                                 (named_design(WRIST), 2.0)])
+def test_a_larger_robot_includes_the_body_under_its_tool_link(
+        tmp_path: Path, design: object, tension: float) -> None:
+    import xacro  # the test extra's: the real xacro, and a URDF library of its own
+    import yourdfpy
+    (tmp_path / "body.urdf.xacro").write_text(body_xacro(design))
+    (tmp_path / "arm.urdf.xacro").write_text(ARM.format(body=tmp_path / "body.urdf.xacro",
+                                                        quarter=math.pi / 2))
+    expanded = xacro.process_file(str(tmp_path / "arm.urdf.xacro")).toxml()
+    robot = yourdfpy.URDF.load(io.StringIO(expanded), load_meshes=False,
+                               build_collision_scene_graph=False)
+    assert robot.validate()
+    result = solve(design, tension)
+    shoulder, elbow, roll = 0.4, -0.6, 0.3
+    body = dict(zip(joint_names(design), joint_positions(result, roll), strict=True))
+    left = dict(zip(joint_names(design, prefix="left_"), joint_positions(result), strict=True))
+    robot.update_cfg({"shoulder": shoulder, "elbow": elbow, **body, **left})
+
+    tool = (rpy_pose([0, 0, 0.1], [0, 0, shoulder]) @ rpy_pose([0, 0, 0.3], [0, 0.2 + elbow, 0])
+            @ rpy_pose([0.05, 0, 0.25], [0.1, -0.3, 0.5]))
+    tip = np.eye(4)
+    tip[:3, :3] = axis_rotation(np.array([0.0, 1.0, 0.0]), result.tip_angle_rad)
+    tip[:3, 3] = result.tip_position
+    expected = (tool @ rpy_pose([0, 0, 0.01], [0, 0, math.pi / 2])
+                @ rpy_pose([0, 0, 0], [0, 0, roll]) @ tip)
+    found = robot.get_transform("tdcm_body_tip", "world")
+    assert found[:3, 3] == pytest.approx(expected[:3, 3], abs=1e-8)  # 10 nm: far under 10 um
+    assert found[:3, :3] == pytest.approx(expected[:3, :3], abs=1e-9)
+    upper = rpy_pose([0, 0, 0.1], [0, 0, shoulder])
+    assert robot.get_transform("left_tdcm_body_tip", "world")[:3, 3] == pytest.approx(
+        (upper @ tip)[:3, 3], abs=1e-8)
