@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -39,9 +40,38 @@ def _phases(record: TrackingRecord, circle: CircleTrajectory) -> np.ndarray:
     return np.array([circle.phase_of_lap(int(lap)) if lap > 0 else "" for lap in laps])
 
 
-def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory) -> Any:
-    """Two panels: x-y (top view) and r-z of the target, measured and predicted tips."""
-    fig, (top, side) = plt.subplots(1, 2, figsize=(11.5, 5.2))
+CAPTION_WIDTH = 150
+"""Characters per caption line."""
+
+
+def paths_caption(world_gain: float | None) -> str:
+    """What the paths figure shows, for a newcomer; ``world_gain`` = E_model / E_world."""
+    if world_gain is None or world_gain == 1.0:
+        miss = "misses it by the model's error"
+    else:
+        more = world_gain > 1.0
+        miss = (f"bends {'further' if more else 'less'} than planned: the model is "
+                f"{'stiffer' if more else 'softer'} than this world (E_model / E_world = "
+                f"{world_gain:.4f})")
+    return ("The tip should follow the black circle. Feed-forward alone (orange: the tension the "
+            f"model asks for) {miss}; feedback (green) measures the tip and learns the model's "
+            "error, and feed-forward with that learned gain (pink) stays on the circle without "
+            "feedback.")
+
+
+def error_caption() -> str:
+    """What the error figure shows, for a newcomer."""
+    return ("Top: how far the measured tip is from where it should be, per phase (the settle time "
+            "after a phase starts is left out of its RMSE). Bottom: the controller's estimate of "
+            "how much too stiff the model is, against this simulated world's truth (dashed); its "
+            "band is the estimate's standard deviation, the prior's until feedback starts.")
+
+
+def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory,
+                 world_gain: float | None = None) -> Any:
+    """Two panels: x-y (top view) and r-z of the target, measured and predicted tips, under
+    :func:`paths_caption`."""
+    fig, (top, side) = plt.subplots(1, 2, figsize=(11.5, 5.6))
     target = record.targets.points * MM
     phases = _phases(record, circle)
     measured = record.measured.points * MM
@@ -67,6 +97,7 @@ def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory) -> 
     side.set_ylabel("z in tdcm_base (mm)", fontsize=FONT_SIZE)
     side.set_title("in the bending plane (the bend sets r and z)", fontsize=FONT_SIZE + 1)
     side.legend(loc="best", fontsize=FONT_SIZE - 1, markerscale=4)
+    fig.suptitle(textwrap.fill(paths_caption(world_gain), CAPTION_WIDTH), fontsize=FONT_SIZE)
     fig.tight_layout()
     return fig
 
@@ -74,10 +105,12 @@ def paths_figure(plt: Any, record: TrackingRecord, circle: CircleTrajectory) -> 
 def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
                  circle: CircleTrajectory, world_gain: float | None = None) -> Any:
     """The tip's distance from its target over time (the approach's larger error off the
-    scale), and the controller's estimate with the scene's ``world_gain`` if given."""
+    scale), and the controller's estimate with the scene's ``world_gain`` if given, under
+    :func:`error_caption`."""
     gain = record.gain
     rows = 2 if gain is not None else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(10.0, 3.6 * rows), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(rows, 1, figsize=(10.0, 3.6 * rows + 0.6), sharex=True,
+                             squeeze=False)
     ax = axes[0][0]
     measured = record.measured
     distance = np.linalg.norm(measured.points - points_at(record.targets, measured.stamps_s),
@@ -104,7 +137,8 @@ def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
         if record.gain_std is not None and len(record.gain_std[1]) == len(gain[1]):
             spread = record.gain_std[1]
             gax.fill_between(times, gain[1] - spread, gain[1] + spread, color="#7570b3",
-                             alpha=0.2, lw=0, label="± controller/gain_std")
+                             alpha=0.2, lw=0, label="± controller/gain_std (the prior's before "
+                                                    "feedback)")
         if world_gain is not None:
             gax.axhline(world_gain, color="k", ls="--", lw=1.0,
                         label=f"the scene's E_model / E_world = {world_gain:.4f}")
@@ -114,6 +148,7 @@ def error_figure(plt: Any, record: TrackingRecord, errors: list[PhaseError],
         row[0].grid(True, alpha=0.3)
         row[0].tick_params(labelsize=FONT_SIZE)
     axes[-1][0].set_xlabel("time from the first target (s)", fontsize=FONT_SIZE)
+    fig.suptitle(textwrap.fill(error_caption(), CAPTION_WIDTH * 10 // 12), fontsize=FONT_SIZE)
     fig.tight_layout()
     return fig
 
@@ -126,7 +161,7 @@ def write_tracking_plots(record: TrackingRecord, errors: list[PhaseError],
     plt = load_pyplot("--out", directory)
     out = output_folder("--out", directory)
     paths = []
-    for name, fig in (("tracking_paths.png", paths_figure(plt, record, circle)),
+    for name, fig in (("tracking_paths.png", paths_figure(plt, record, circle, world_gain)),
                       ("tracking_error.png", error_figure(plt, record, errors, circle,
                                                           world_gain))):
         fig.savefig(out / name, dpi=120)
