@@ -75,8 +75,8 @@ ROS_PACKAGES=(
   ros-jazzy-ament-cmake-gmock ros-jazzy-ament-cmake-gtest ros-jazzy-ament-cmake-pytest
   ros-jazzy-domain-coordinator
 )
-# The package's own dependencies, as the README's ROS route gives them: the pip names of
-# package.xml's python3-* keys (what rosdep installs from apt there), then the README's pip line;
+# The package's own dependencies, as the ROS route (doc/howto/ros_by_apt.md) gives them: the pip names of
+# package.xml's python3-* keys (what rosdep installs from apt there), then that page's pip line;
 # read from those two files, so a library missing from them is missing here (phase 3 then fails).
 # tdcm_ros itself is NOT installed with pip: it must come from the colcon install space.
 mapfile -t PROJECT_PACKAGES < <("$BASE_PYTHON" "$REPO/.ci/deps.py" ros-route)
@@ -235,7 +235,7 @@ done
 # Every third-party module the package imports (anywhere, also inside a function) is installed.
 missing="$("$BASE_PYTHON" "$REPO/.ci/deps.py" imports | python -c 'import importlib.util, sys
 print(" ".join(m for m in sys.stdin.read().split() if importlib.util.find_spec(m) is None))')"
-[ -z "$missing" ] || fail "the README's ROS route does not install: $missing (add it to dependencies.toml)"
+[ -z "$missing" ] || fail "the ROS route does not install: $missing (add it to dependencies.toml)"
 echo "every module the package imports is installed: ok"
 # From a directory outside the checkout, so that tdcm_ros comes from the install space.
 (cd /tmp && nice -n "$BUILD_NICE" python -c 'from tdcm_ros.model import preset, solve

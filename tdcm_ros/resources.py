@@ -29,6 +29,9 @@ def _ament_share(relative: str) -> list[Path]:
     except ImportError:
         return []
     try:
-        return [Path(get_package_share_directory(PACKAGE)) / relative]
+        share = get_package_share_directory(PACKAGE)
     except (LookupError, OSError):  # not installed with colcon, or AMENT_PREFIX_PATH unset
         return []
+    if not isinstance(share, (str, os.PathLike)):  # a stand-in: Sphinx's mock under rosdoc2
+        return []
+    return [Path(share) / relative]

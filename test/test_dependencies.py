@@ -47,7 +47,7 @@ def _deps_script() -> Any:
     return module
 
 
-def test_package_xml_the_readme_and_the_version_are_generated_from_the_declaration() -> None:
+def test_package_xml_the_route_page_and_the_version_are_generated_from_the_declaration() -> None:
     deps = _deps_script()
     decl = deps.declaration()
     for name, expected in deps.FILES.items():
@@ -55,21 +55,21 @@ def test_package_xml_the_readme_and_the_version_are_generated_from_the_declarati
         assert expected(text, decl) == text, f"{name}: run python3 .ci/deps.py write"
 
 
-def test_the_readme_s_executables_table_follows_the_node_table() -> None:
+def test_the_route_page_s_executables_table_follows_the_node_table() -> None:
     """A node added to dependencies.toml gets its row; a row of no node goes."""
     deps = _deps_script()
     decl = deps.declaration()
-    text = (REPO / "README.md").read_text(encoding="utf-8")
+    text = (REPO / deps.ROUTE_PAGE).read_text(encoding="utf-8")
     grown = {**decl, "nodes": {**decl["nodes"], "gripper_node": "tdcm_ros.nodes.gripper_node:main"}}
     row = "| gripper | `ros2 run tdcm_ros gripper_node` | `tdcm_gripper_node` |\n"
-    assert row not in text and row in deps.expected_readme(text, grown)
+    assert row not in text and row in deps.expected_route_page(text, grown)
     shrunk = {**decl, "nodes": {k: v for k, v in decl["nodes"].items() if k != "device_twin"}}
-    assert "`tdcm_device_twin`" not in deps.expected_readme(text, shrunk)
-    assert "`tdcm_node`, `tdcm`" in deps.expected_readme(text, shrunk)  # the last row stays
+    assert "`tdcm_device_twin`" not in deps.expected_route_page(text, shrunk)
+    assert "`tdcm_node`, `tdcm`" in deps.expected_route_page(text, shrunk)  # the last row stays
 
 
 def test_the_ros_route_installs_every_module_the_package_imports() -> None:
-    """What package.xml's keys and the README's pip line give covers every import (the CI
+    """What package.xml's keys and the route page's pip line give covers every import (the CI
     step imports them all in a venv built from that route alone)."""
     deps = _deps_script()
     route = {requirement_name(r) for r in deps.ros_route(deps.declaration())}
@@ -79,7 +79,7 @@ def test_the_ros_route_installs_every_module_the_package_imports() -> None:
         names = {d.lower().replace("_", "-") for d in distributions.get(module, [module])}
         if not names & route:
             missing[module] = sorted(names)
-    assert not missing, f"imported but not installed by the README's ROS route: {missing}"
+    assert not missing, f"imported but not installed by the ROS route: {missing}"
 
 
 def test_the_ros_venv_installs_package_xml_s_ros_packages_or_names_the_gap() -> None:

@@ -14,7 +14,7 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "bench", help="benchmarks that print measured figures",
         description="Benchmarks that print measured figures (the timing scripts behind the "
-                    "README's numbers are under bench/ in the source tree).",
+                    "docs' numbers are under bench/ in the source tree).",
         epilog="examples:\n"
                "  tdcm bench accuracy --quick\n"
                "  tdcm bench accuracy --markdown --plot accuracy_pareto.png")
@@ -29,7 +29,7 @@ def register(subparsers: Any) -> None:
                "  tdcm bench accuracy --json -q > accuracy.json")
     accuracy.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     accuracy.add_argument("--markdown", action="store_true",
-                          help="also print the table as Markdown (the README's), first")
+                          help="also print the table as Markdown (the docs'), first")
     accuracy.add_argument("--plot", metavar="FILE", help="write the Pareto plot to a .png, .pdf "
                           "or .svg file in an existing folder")
     accuracy.add_argument("--quick", action="store_true",

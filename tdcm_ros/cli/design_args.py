@@ -33,7 +33,7 @@ def add_design_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--design", metavar="NAME|FILE",
                         help=f"design preset: {', '.join(PRESETS)} (default: {DEFAULT_DESIGN}); "
                              "the same as --set design.preset=NAME; or a body file (.yaml, "
-                             "see the README's Body files), whose tendon routing is the default")
+                             "see doc/reference/body_file.md), whose tendon routing is the default")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override a design field in SI units, e.g. --set E=1.2e9 (or "
                              "design.E=1.2e9, as evaluate takes it); L (the length, m) sets w_t "

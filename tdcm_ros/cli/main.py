@@ -60,7 +60,7 @@ EXIT_STATUSES: dict[int, str] = {
     INTERRUPTED_EXIT: "interrupted (Ctrl-C)",
     CLOSED_PIPE_EXIT: "stdout closed by its reader (a pipe into head, ...)",
 }
-"""Exit statuses common to every command (``--help`` epilogs, README)."""
+"""Exit statuses common to every command (``--help`` epilogs, doc/reference/cli.md)."""
 
 
 def exit_status_epilog(meanings: Mapping[int, str]) -> str:

@@ -1,21 +1,21 @@
 """Transport-free logic of the ``tension_driver`` node.
 
 :class:`TensionDriver` owns one device link. The caller supplies the clock (s) and, optionally,
-the port opener, then calls :meth:`TensionDriver.step` periodically (every 5-10 ms); each call
+the port opener, then calls :meth:`.TensionDriver.step` periodically (every 5-10 ms); each call
 reads what the device sent, runs the link state machine and returns a :class:`StepResult`: the
 telemetry frames received (publish each as ``tension``) and a :class:`DriverStatus` (device
 state and a diagnostics level + message). Nothing blocks and nothing sleeps.
 
 Link: open -> send ``I`` (repeated every 0.5 s) until a banner arrives (``handshake_timeout``);
-a banner of another protocol version raises :class:`ProtocolVersionError`. While connected the
+a banner of another protocol version raises :class:`.ProtocolVersionError`. While connected the
 driver sends a heartbeat every ``heartbeat_period``, ramps the commanded setpoint toward the
 target at ``setpoint_rate`` N/s, and asks for mode T while enabled and the device is released
 without faults. Port failures, a missing banner or ``link_timeout`` s without telemetry close
 the port and retry after an exponential backoff (``backoff_initial`` doubling to
 ``backoff_max``). Device faults (watchdog, over-tension, e-stop, sensor) are never cleared
-automatically: call :meth:`TensionDriver.clear_faults`.
+automatically: call :meth:`.TensionDriver.clear_faults`.
 
-Roll: :meth:`TensionDriver.set_roll` clamps a roll target to ``[-roll_max, roll_max]`` (with a
+Roll: :meth:`.TensionDriver.set_roll` clamps a roll target to ``[-roll_max, roll_max]`` (with a
 warning) and the driver slews the roll it sends (``R``) at ``roll_rate`` rad/s from the roll the
 device reports (a request waits until that is known). Nothing is sent for the roll before a first
 request, so the servo stays where it is; a trip fault on the device (it stops the servo and
@@ -35,7 +35,7 @@ and a freeze (no telemetry for the device's own watchdog time while the host kep
 the device's clock ran that long between its frames: a step counts at most ``heartbeat_period`` s
 of silence, so a stall of this host -- the device's frames not read -- is not taken for one, nor
 frames delayed while the device's clock stood still -- a stalled line, a twin not scheduled).
-Disarmed, it commands mode R whatever the device reports. Only :meth:`TensionDriver.clear_faults`
+Disarmed, it commands mode R whatever the device reports. Only :meth:`.TensionDriver.clear_faults`
 (the operator's arm command, accepted while connected) arms it again, at a target of 0 N: a new
 setpoint is needed before any tension.
 """
@@ -173,7 +173,7 @@ class DriverStatus:
 
 @dataclass(frozen=True)
 class StepResult:
-    """What one :meth:`TensionDriver.step` produced."""
+    """What one :meth:`.TensionDriver.step` produced."""
 
     telemetry: tuple[Telemetry, ...]
     status: DriverStatus
@@ -189,7 +189,7 @@ class TensionDriver:
     """Link to one tension device; see the module docstring for the behaviour.
 
     ``clock`` returns the time in s (monotonic); ``open_port`` opens a :class:`Transport` for
-    ``config.port`` (default: :func:`open_transport`); ``warn`` receives warnings (clamped
+    ``config.port`` (default: :func:`.open_transport`); ``warn`` receives warnings (clamped
     setpoints, refused commands, lost links; default: this module's logger).
     """
 
@@ -400,7 +400,7 @@ class TensionDriver:
 
     # --- the step ---------------------------------------------------------------------------
     def step(self) -> StepResult:
-        """Do everything due now; raises :class:`ProtocolVersionError` on a version mismatch."""
+        """Do everything due now; raises :class:`.ProtocolVersionError` on a version mismatch."""
         now = self._clock()
         gap, self._last_step = now - self._last_step, now
         received: list[Telemetry] = []

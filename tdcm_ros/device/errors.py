@@ -26,7 +26,7 @@ class Reject(enum.Enum):
     PARTIAL = "PARTIAL"    #: a frame cut short by the next '$'
     LONG = "LONG"          #: longer than MAX_LINE
     CHARS = "CHARS"        #: a byte outside printable ASCII
-    FRAME = "FRAME"        #: '*HH' missing or misplaced, or no version field
+    FRAME = "FRAME"        #: ``*HH`` missing or misplaced, or no version field
     CKSUM = "CKSUM"        #: checksum mismatch
     VER = "VER"            #: unsupported protocol version
     TYPE = "TYPE"          #: unknown message type (or wrong direction)

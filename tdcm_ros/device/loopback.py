@@ -1,7 +1,7 @@
 """An in-process cable between a host (the driver) and a :class:`~tdcm_ros.device.twin.DeviceTwin`.
 
-No I/O, no threads: bytes the host writes reach :meth:`DeviceTwin.receive` at once and
-:meth:`LoopbackLink.read` returns what the twin has sent since (:meth:`DeviceTwin.take_output`).
+No I/O, no threads: bytes the host writes reach :meth:`.DeviceTwin.receive` at once and
+:meth:`LoopbackLink.read` returns what the twin has sent since (:meth:`.DeviceTwin.take_output`).
 Whoever advances the twin owns the time (:meth:`Loopback.pump`), so a driver stepped on the same
 simulated clock runs in lock step with the device, deterministically::
 
@@ -12,8 +12,8 @@ A pty cannot give that lock step: the bytes written at one end reach the other t
 worker, asynchronously (:class:`~tdcm_ros.device.transport.SerialTransport`).
 
 :meth:`Loopback.unplug` pulls the cable (the open link's reads and writes raise
-:class:`PortError`, opening fails) until :meth:`Loopback.plug`; :meth:`Loopback.reopen` pulls and
-plugs it back at once (like :meth:`PtyTwin.reopen`), optionally rebooting the device. Bytes the
+:class:`.PortError`, opening fails) until :meth:`Loopback.plug`; :meth:`Loopback.reopen` pulls and
+plugs it back at once (like :meth:`.PtyTwin.reopen`), optionally rebooting the device. Bytes the
 device sends while no link is open are lost, as on a UART nobody reads.
 """
 
@@ -78,7 +78,7 @@ class Loopback:
 
     def open(self, url: str) -> LoopbackLink:
         """Open a new link (the device's earlier output is discarded, as a host flushes its
-        input when it opens a port); :class:`PortError` while unplugged."""
+        input when it opens a port); :class:`.PortError` while unplugged."""
         if not self.plugged:
             raise PortError(f"port {url!r}: cannot open: cable pulled")
         if self.link is not None:
@@ -106,14 +106,14 @@ class Loopback:
         self.plug(reboot=reboot)
 
     def pump(self, seconds: float) -> None:
-        """Lock-step use (as :meth:`PtyTwin.pump`): run ``seconds`` of simulated time; what the
+        """Lock-step use (as :meth:`.PtyTwin.pump`): run ``seconds`` of simulated time; what the
         device sends waits for the open link's next read."""
         self.twin.advance(seconds)
         self.tick()
 
     @contextmanager
     def hung(self) -> Iterator[None]:
-        """Inside this block the firmware's loop is stalled (as :meth:`PtyTwin.hung`)."""
+        """Inside this block the firmware's loop is stalled (as :meth:`.PtyTwin.hung`)."""
         self.twin.hung = True
         try:
             yield

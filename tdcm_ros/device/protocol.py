@@ -34,7 +34,7 @@ B     TDCM, firmware version, load cell, control period ms, watchdog ms, setpoin
       N, trip N -- sent at boot and on ``I``
 T     time ms (u32), raw counts (i32), tension N, pulse us, mode R|T, faults (2 hex)
 A     command letter -- command accepted (heartbeats are not acknowledged)
-N     command letter or ``?``, reason -- command rejected (see :class:`Reject`)
+N     command letter or ``?``, reason -- command rejected (see :class:`.Reject`)
 J     time ms (u32), roll target rad, roll rad, roll pulse us -- after every T once an R
       was accepted since boot (before that the servo holds 0 rad, its boot position)
 ====  ===============================================================================
@@ -45,7 +45,7 @@ device without a roll servo, so the version stays 1.
 Fault bits (the trip faults 01-08 also stop the roll servo where it is and refuse R until C):
 01 over-tension, 02 watchdog, 04 e-stop, 08 sensor, 10 calibration invalid.
 A decoded line is either a complete frame or a :class:`~tdcm_ros.device.errors.FrameError`
-naming the :class:`Reject` reason; nothing is ever half-applied. :class:`LineDecoder` frames an
+naming the :class:`.Reject` reason; nothing is ever half-applied. :class:`LineDecoder` frames an
 arbitrary byte stream: a ``$`` always starts a new frame, so garbage never hides a valid frame
 that follows it.
 """
@@ -410,6 +410,7 @@ class LineDecoder:
                  on_reject: Callable[[FrameError], None] | None = None) -> None:
         self.accept = accept
         self.on_reject = on_reject
+        #: Rejected frames counted by reason (:class:`.Reject`).
         self.rejects: Counter[Reject] = Counter()
         self.frames = 0
         self._buffer = bytearray()

@@ -4,7 +4,7 @@ Everything goes through :func:`serial.serial_for_url`, so ``/dev/ttyACM0``, ``/d
 a symlink to either, ``loop://`` and ``socket://host:port`` all work. Neither reads nor writes
 wait on the port (:class:`SerialTransport`).
 Failures (port missing, cable pulled, pty closed, the port held by another driver) raise
-:class:`PortError`.
+:class:`.PortError`.
 """
 
 from __future__ import annotations
@@ -99,7 +99,7 @@ class SerialTransport:
 
     def read(self) -> bytes:
         """The bytes read since the last call; after them, the reader's error as a
-        :class:`PortError`."""
+        :class:`.PortError`."""
         with self._lock:
             data, error = bytes(self._received), self._error
             self._received.clear()
@@ -109,7 +109,7 @@ class SerialTransport:
 
     def write(self, data: bytes) -> None:
         """Send ``data`` now; a port that takes no more bytes (its output buffer full: nothing
-        reads at the other end) is a :class:`PortError`."""
+        reads at the other end) is a :class:`.PortError`."""
         try:
             if self._fd is None:
                 self._port.write(data)
@@ -154,7 +154,7 @@ def lock_holders(path: str) -> list[str]:
 
 def open_transport(url: str, *, baudrate: int = c.BAUD_RATE) -> SerialTransport:
     """Open ``url`` (device path, pty path or pyserial URL) 8N1, non-blocking reads, locked
-    (``flock``) against a second driver on the same device: that one gets a :class:`PortError`
+    (``flock``) against a second driver on the same device: that one gets a :class:`.PortError`
     naming the process that holds the port."""
     try:
         port = serial.serial_for_url(url, baudrate=baudrate, timeout=0, write_timeout=1.0,

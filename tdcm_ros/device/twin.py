@@ -81,6 +81,8 @@ class DeviceTwin:
         self.core = TensionCore(self.storage, cell=cell, send=self.output.extend)
         self.now_ms = 0
         self._next_sample_ms = 0.0
+        #: While true the firmware's loop is stalled; time and the bench go on (see
+        #: :meth:`advance`).
         self.hung = False
         self.rx_buffer = rx_buffer
         self._held = bytearray()

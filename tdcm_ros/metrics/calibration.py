@@ -97,7 +97,7 @@ class Calibration:
 
     def to_json(self) -> dict[str, Any]:
         """The ``tdcm calibrate --json`` document: :meth:`fit_json` with the evaluations
-        ``before`` and ``after`` the fit (each :meth:`Evaluation.to_json`, per step too)."""
+        ``before`` and ``after`` the fit (each :meth:`.Evaluation.to_json`, per step too)."""
         return {**self.fit_json(), "before": self.before.to_json(),
                 "after": self.after.to_json()}
 

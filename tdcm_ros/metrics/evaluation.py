@@ -285,7 +285,7 @@ def evaluate_series(tension: TensionSeries, markers: MarkerSeries,
                     options: EvaluateOptions | None = None,
                     registration: Registration | None = None) -> Evaluation:
     """Evaluate one recording given as arrays. ``registration`` maps the markers' frame to
-    ``tdcm_base``; ``None`` estimates it from the data (see :func:`choose_registration`)."""
+    ``tdcm_base``; ``None`` estimates it from the data (see :func:`.choose_registration`)."""
     opts = options or EvaluateOptions()
     steps = measure_steps(tension, markers, opts)
     return evaluate_steps(steps, choose_registration(steps, opts, registration), opts)

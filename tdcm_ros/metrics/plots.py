@@ -144,8 +144,8 @@ def calibration_figure(plt: Any, fit: Calibration) -> Any:
 
 def write_calibration_plots(fit: Calibration, directory: str | Path, *, option: str = "--out"
                             ) -> list[Path]:
-    """Write ``calibration.png`` (:func:`calibration_figure`) and ``shapes_calibrated.png``
-    (:func:`shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
+    """Write ``calibration.png`` (:func:`.calibration_figure`) and ``shapes_calibrated.png``
+    (:func:`.shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
     fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
     return _write(directory, option, (
         ("calibration.png", lambda plt: calibration_figure(plt, fit)),
@@ -185,8 +185,8 @@ def error_figure(plt: Any, evaluation: Evaluation) -> Any:
 
 def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = "--out"
                 ) -> list[Path]:
-    """Write ``shapes.png`` (:func:`shapes_figure`) and ``error_vs_tension.png``
-    (:func:`error_figure`) into ``directory`` (created if missing; its parent must exist;
+    """Write ``shapes.png`` (:func:`.shapes_figure`) and ``error_vs_tension.png``
+    (:func:`.error_figure`) into ``directory`` (created if missing; its parent must exist;
     ``option`` names it in errors)."""
     return _write(directory, option, (
         ("shapes.png", lambda plt: shapes_figure(plt, evaluation)),

@@ -21,7 +21,7 @@ from tdcm_ros.mocap.nexus_csv import Trajectories
 
 Array = NDArray[np.float64]
 MAX_BURST = 1000
-"""Most frames one :meth:`due` call returns; a longer backlog is handed out on later calls."""
+"""Most frames one :meth:`.CsvReplay.due` call returns; a longer backlog is handed out on later calls."""
 
 
 class SourceError(MocapError, InputError):
@@ -70,7 +70,7 @@ class CsvReplay:
         return self.start_ns + self.passes * self._pass_ns + int(self._offsets_ns[self.next_row])
 
     def due(self, now_ns: int) -> list[RawFrame]:
-        """Rows due at ``now_ns``, in order (at most :data:`MAX_BURST`)."""
+        """Rows due at ``now_ns``, in order (at most :data:`.MAX_BURST`)."""
         frames: list[RawFrame] = []
         names = self.trajectories.names
         while not self.finished and len(frames) < MAX_BURST and self._due_ns() <= now_ns:

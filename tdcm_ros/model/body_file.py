@@ -36,7 +36,7 @@ R_outer``; ``external``: through guides such as disks, any offset up to 0.5 m) a
 tension per tendon.
 
 The solver takes band, cut and polygon notches, each with its own width and section, any
-tubes between them, and the tendons: :meth:`BodySpec.design` gives that
+tubes between them, and the tendons: :meth:`.BodySpec.design` gives that
 :class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ; a polygon
 notch is a :class:`~tdcm_ros.model.profiles.PolygonProfile`, prismatic along the body).
 """

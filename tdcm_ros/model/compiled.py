@@ -7,7 +7,7 @@ else numba's user-wide cache or ``NUMBA_CACHE_DIR``; without any writable place 
 are compiled uncached, never refused).
 
 The switch: environment variable ``TDCM_JIT`` (read once, at the first kernel call) or
-:func:`use_compiled`. ``TDCM_JIT=0`` runs the plain-Python build (no numba import: right for
+:func:`.use_compiled`. ``TDCM_JIT=0`` runs the plain-Python build (no numba import: right for
 a one-shot command that solves once); ``1`` requires numba; unset (default) compiles when
 numba is importable and otherwise runs the plain build.
 """
@@ -48,7 +48,7 @@ def use_compiled(flag: bool | None) -> None:
 @contextmanager
 def one_shot() -> Iterator[None]:
     """Inside, for a command that solves once: the plain build, unless ``TDCM_JIT`` or
-    :func:`use_compiled` chose or a build is already loaded (compiling would cost ~1 s of
+    :func:`.use_compiled` chose or a build is already loaded (compiling would cost ~1 s of
     numba import and cache loading, far more than it saves). The choice ends with the block."""
     if _state["chosen"] or _state["build"] is not None or \
             os.environ.get(ENVIRONMENT, "").strip():

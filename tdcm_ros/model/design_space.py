@@ -127,8 +127,8 @@ def sweep(base: Design, axes: Mapping[str, ArrayLike], tensions: ArrayLike, *,
     """Tip response of ``base`` with one or two fields varied (``{name: SI values}``) at every
     tension (N). Invalid axis values raise :class:`InvalidDesignError`.
 
-    With ``progress`` the designs are solved in chunks (at most :data:`PROGRESS_UPDATES`, at
-    least :data:`PROGRESS_CHUNK_DESIGNS` designs each), each reported as ``progress("design
+    With ``progress`` the designs are solved in chunks (at most :data:`.PROGRESS_UPDATES`, at
+    least :data:`.PROGRESS_CHUNK_DESIGNS` designs each), each reported as ``progress("design
     sweep", designs solved, designs)``; the answers are the same."""
     if not isinstance(base, Design):
         raise InvalidDesignError(f"base = {base!r} is not a Design", parameter="base",

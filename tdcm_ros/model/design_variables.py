@@ -50,7 +50,7 @@ MAX_E_PA = 1e12
 
 @dataclass(frozen=True)
 class Variable:
-    """One freed field: ``field`` (:data:`FIELDS`), its ``law`` (:data:`LAWS`; ``uniform`` for a
+    """One freed field: ``field`` (:data:`.FIELDS`), its ``law`` (:data:`.LAWS`; ``uniform`` for a
     scalar field) and its range ``[low, high]`` (m, or Pa for ``E``)."""
 
     field: str

@@ -278,7 +278,7 @@ class Grid(CellArrays):
 
     @cached_property
     def members(self) -> Members:
-        """The design as a one-member :class:`Members`."""
+        """The design as a one-member :class:`.Members`."""
         return Members.of([self.design])
 
     def u_of_s(self, cells: IntArray, s: Array) -> Array:

@@ -10,7 +10,7 @@ notch bending strain (:attr:`~tdcm_ros.model.batch.BatchResult.max_bending_strai
 the single ``solve``'s, bit for bit.
 
 Tension for the target, per design (the tip and the strain grow with the tension, as
-:func:`~tdcm_ros.model.inverse.solve_inverse` assumes):
+:func:`~tdcm_ros.model.solve_inverse` assumes):
 
 1. a ladder of ``ladder`` tensions ``tension_max k / ladder`` (plus ``T = 0``, where the tip
    is on the axis) brackets the target by the first rung at or past it, or by the first rung
@@ -24,7 +24,7 @@ Tension for the target, per design (the tip and the strain grow with the tension
    allowable, or a closure or singularity bracketed to ``LIMIT_XTOL`` of the budget.
 
 A design with several tendons has its ``tendon`` sought, the others held at ``tensions`` (N),
-as :func:`~tdcm_ros.model.inverse.solve_inverse`; the batch solves it by ``solve``.
+as :func:`~tdcm_ros.model.solve_inverse`; the batch solves it by ``solve``.
 
 The reported tension is the last solve's: its tip, strain and status are those of ``solve`` at
 that tension. It differs from ``solve_inverse``'s by at most about ``2 tol / (dtip/dT)`` (both
@@ -117,7 +117,7 @@ class DesignSearch:
     """The candidates of a search and what each achieves; arrays have one entry per sample.
 
     ``values`` holds each free field's sampled values (SI units); ``outcome`` names from
-    :data:`OUTCOMES` and ``message`` the limit or error met (empty otherwise).
+    :data:`.OUTCOMES` and ``message`` the limit or error met (empty otherwise).
     ``tension_n`` (N) is the tension that puts the tip on the target, ``tip_value`` the tip
     there (m or rad), ``peak_strain`` the peak notch strain there (NaN where the target is not
     reached: ``short``, ``limit``, ``invalid``, some ``strain``). ``reach`` (m or rad) and
@@ -200,7 +200,7 @@ def search_designs(base: Design, free: Mapping[str, Any], *,
     every limit; return them all with the Pareto set. ``progress("design search", designs
     done, samples)`` after each batch of designs. A base with several tendons names the
     ``tendon`` whose tension is sought, the others held at ``tensions`` (N, one per tendon;
-    default 0), as :func:`~tdcm_ros.model.inverse.solve_inverse`.
+    default 0), as :func:`~tdcm_ros.model.solve_inverse`.
 
     Raises :class:`InvalidTargetError`, :class:`InvalidDesignError` or
     :class:`InvalidSettingsError` for bad input (naming the parameter, value and range), and

@@ -3,7 +3,7 @@
 ``Material(law="bilinear", plateau_strain=eps_p, E_plateau=E_p)``: the stress is ``E eps`` up to
 ``|eps| = eps_p`` and grows with ``E_p`` beyond (nitinol's loading branch; the usual first
 model: a plateau from about 2 % strain at about 8 % of ``E``). A section's moment at curvature
-``kappa`` is the law integrated over it, strain ``kappa y`` at ``y`` from the centroid:
+``kappa`` is the law integrated over it, strain ``kappa y`` at ``y`` from the centroid::
 
     M(kappa) = kappa [E I - (E - E_p) J(eps_p / |kappa|)],
     J(d) = int_{|y| > d} (|y| - d) |y| b(y) dy,
@@ -68,7 +68,7 @@ class Material:
         return self.law == "linear"
 
     def check(self, modulus: float) -> None:
-        """Raise :class:`InvalidDesignError` naming the bad key (``material.<key>``) for a
+        """Raise :class:`.InvalidDesignError` naming the bad key (``material.<key>``) for a
         material of elastic modulus ``modulus`` (Pa)."""
         if self.law not in LAWS:
             raise out_of_range("material.law", self.law, " | ".join(LAWS),
@@ -94,7 +94,7 @@ class Material:
 
 
 def _positive(name: str, value: object, allowed: str, allow_inf: bool = False) -> None:
-    """Raise :class:`InvalidDesignError` unless ``value`` is a positive number (finite unless
+    """Raise :class:`.InvalidDesignError` unless ``value`` is a positive number (finite unless
     ``allow_inf``)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0.0 or (
             not allow_inf and not math.isfinite(value)):

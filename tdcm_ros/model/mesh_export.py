@@ -32,7 +32,7 @@ The mesh is geometry only: the body file that names it (:func:`mesh_body_file_te
 the material and the tendons. The mesh path takes a linear material only (a non-linear law is
 integrated over a section's widths, which a mesh's slices do not give). It takes as the tube
 the section most of the body's length has, so a body of more notch than tube does not read
-back (:func:`design_mesh` warns).
+back (:func:`.design_mesh` warns).
 """
 
 from __future__ import annotations
@@ -195,7 +195,7 @@ def _warn_unreadable(pieces: list[tuple[float, float]], tube_area: float) -> Non
 
 def write_body_stl(design: Design, path: str | Path, *, unit: str = "mm",
                    sides: int = DEFAULT_SIDES, slabs: int = DEFAULT_SLABS) -> Path:
-    """Write ``design``'s mesh (:func:`design_mesh`) to ``path`` (``.stl``, in an existing
+    """Write ``design``'s mesh (:func:`.design_mesh`) to ``path`` (``.stl``, in an existing
     folder) as a binary STL in ``unit``; returns the path. The body file naming it
     (:func:`mesh_body_file_text`) carries the material and the tendons."""
     target = Path(path)

@@ -185,7 +185,7 @@ class SolveResult:
     def actuator_strokes_m(self) -> Array:
         """How far each tendon's actuator has travelled (m), one per tendon: the tendon's
         ``slack`` taken up, :attr:`tendon_strokes_m` and its stretch ``T / stiffness``
-        (:meth:`~tdcm_ros.model.tendons.Tendon.actuator_stroke`; the path stroke itself for an
+        (:meth:`~tdcm_ros.model.Tendon.actuator_stroke`; the path stroke itself for an
         inextensible tendon without slack). At 0 N: where the tendon just becomes taut."""
         return np.array([tendon.actuator_stroke(float(stroke), tension) for tendon, stroke, tension
                          in zip(self.design.tendon_list(), self.tendon_strokes_m,

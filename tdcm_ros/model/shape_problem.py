@@ -105,6 +105,8 @@ class Evaluation:
     violations: dict[str, float]
     results: dict[Load, SolveResult]
     failure: str = ""
+    #: Deb's feasibility rules as one number; orders candidates for a search (see the module
+    #: docstring).
     score: float = field(init=False)
 
     def __post_init__(self) -> None:

@@ -1,6 +1,6 @@
 """Points on the body surface: markers (or any point) a fixed distance off the midline.
 
-Frame ``tdcm_base`` (see README Frames), SI units. A point sits ``radius`` (m) from the midline
+Frame ``tdcm_base`` (see doc/explanation/frames.md), SI units. A point sits ``radius`` (m) from the midline
 at ``side_rad`` (rad) around the body z axis, measured from the body x axis (0 = tendon side).
 """
 

@@ -132,7 +132,7 @@ def check_tendons(tendons: tuple[Tendon, ...], r_outer: float, boundaries: Array
 def require_paper_tendon(tendons: tuple[Tendon, ...], what: str,
                          parameter: str = "design.tendons") -> None:
     """Raise :class:`InvalidDesignError` if a design lists ``tendons`` that do not pull as the
-    paper's one (:func:`is_paper_like`), which ``what`` does not take yet (say so, naming
+    paper's one (:func:`.is_paper_like`), which ``what`` does not take yet (say so, naming
     ``parameter``)."""
     if not is_paper_like(tendons):
         raise InvalidDesignError(

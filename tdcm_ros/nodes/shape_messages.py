@@ -1,6 +1,6 @@
 """Build the model node's ROS messages (rosbags objects) from a :class:`SolveResult`.
 
-All poses are in the frame given as ``frame_id`` (``tdcm_base`` by default, see README Frames),
+All poses are in the frame given as ``frame_id`` (``tdcm_base`` by default, see doc/explanation/frames.md),
 positions in m, orientations as quaternions of the body frame (z axis = midline tangent), the
 planar shape turned by the roll (rad) about the base +z axis (:mod:`tdcm_ros.model.roll`).
 Messages are built from the typestore classes directly (not through ``from_dict``), one

@@ -1,6 +1,6 @@
 """``tf2_msgs/msg/TFMessage`` builders (rosbags objects) for the model node's TF tree.
 
-The tree under ``base`` (``tdcm_base`` by default, REP 103, SI units; see README Frames):
+The tree under ``base`` (``tdcm_base`` by default, REP 103, SI units; see doc/explanation/frames.md):
 
 - ``base -> tendon`` (static): where the tendon leaves the base, ``R_c`` (m) from the midline on
   +x, its z axis along the tendon toward the actuator (``-z`` of the base), x kept: a rotation by

@@ -67,7 +67,7 @@ def message_class(type_name: str) -> Any:
     except (ImportError, AttributeError) as error:
         raise RuntimePortError(
             f"message type {type_name} is not importable for rclpy ({error}); build and source "
-            f"its interface package (see README, 'On a ROS 2 machine')") from error
+            f"its interface package (see doc/howto/ros_by_apt.md)") from error
 
 
 def service_class(type_name: str) -> Any:

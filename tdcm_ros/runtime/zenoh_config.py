@@ -5,8 +5,8 @@ session, ``TDCM_ZENOH_ROUTER_CONFIG`` first for the router): the file, with the 
 on top: ``mode``; the router listens on the endpoint, a peer connects to it and, where the file
 leaves ``listen/endpoints`` at zenoh's default (every interface), listens on loopback only. The
 file brings TLS (``transport/link/tls``), user/password authentication (``transport/auth/usrpwd``)
-and the access-control list (``access_control``); see README "Several hosts: TLS, authentication,
-access control" and ``config/zenoh/``.
+and the access-control list (``access_control``); see ``doc/howto/several_hosts.md`` and
+``config/zenoh/``.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ LOOPBACK_LISTEN = "tcp/127.0.0.1:0"
 NETWORK_PROTOCOLS = ("tcp", "tls", "udp", "quic", "ws")
 #: Protocols that authenticate the connecting side with ``enable_mtls``.
 MTLS_PROTOCOLS = ("tls", "quic")
-README_SECTION = 'README "Several hosts: TLS, authentication, access control"'
+DOCS_SECTION = 'doc/howto/several_hosts.md "Several hosts: TLS, authentication, access control"'
 
 log = logging.getLogger("tdcm.zenoh")
 
@@ -132,5 +132,5 @@ def warn_if_exposed(config: zenoh.Config, mode: str) -> list[str]:
         log.warning("zenoh %s listens on %s beyond loopback without authentication (no "
                     "transport/auth/usrpwd dictionary_file, no TLS with enable_mtls): any host "
                     "that reaches it can command the nodes; see %s", mode, endpoint,
-                    README_SECTION)
+                    DOCS_SECTION)
     return exposed

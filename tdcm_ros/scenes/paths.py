@@ -18,7 +18,7 @@ def scene_dirs() -> list[Path]:
 
 
 def shipped_scenes() -> dict[str, Path]:
-    """Scene name -> file, over :func:`scene_dirs` (first directory wins), sorted by name."""
+    """Scene name -> file, over :func:`.scene_dirs` (first directory wins), sorted by name."""
     found: dict[str, Path] = {}
     for root in scene_dirs():
         for path in sorted(root.iterdir()):

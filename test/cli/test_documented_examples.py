@@ -1,6 +1,6 @@
-"""Every command example the docs give (the README's shell blocks, each ``--help`` epilog's
-``examples:``) is one tdcm takes: each parses, and each that needs no running graph runs to
-exit status 0 from a folder holding the files it names. The full benchmarks are parsed only
+"""Every command example the docs give (the shell blocks of the README and the docs site, each
+``--help`` epilog's ``examples:``) is one tdcm takes: each parses, and each that needs no running
+graph runs to exit status 0 from a folder holding the files it names. The full benchmarks are parsed only
 (minutes of timed solves; their ``--quick`` forms run); the graph's examples run in
 test_graph_examples.py (all but the ``--runtime rclpy`` ones and the demos, which test/demo runs
 in shortened forms)."""
@@ -14,7 +14,7 @@ import pytest
 
 from tdcm_ros.cli.main import build_parser
 from test.support.cli import tdcm
-from test.support.examples import REPO, Example, epilog_examples, readme_examples
+from test.support.examples import REPO, Example, documented_examples
 
 #: Subcommands that need nothing but files: run here.
 OFFLINE = {"solve", "inverse", "design", "urdf", "figures", "bench", "evaluate", "calibrate",
@@ -24,7 +24,7 @@ OFFLINE = {"solve", "inverse", "design", "urdf", "figures", "bench", "evaluate",
 GRAPH = {"up", "demo", "record", "bag play", "foxglove", "topic list", "topic echo", "topic pub", "topic hz",
          "param list", "param get", "param set", "param describe", "param dump", "service list",
          "service call"}
-EXAMPLES = readme_examples() + epilog_examples(build_parser())
+EXAMPLES = documented_examples(build_parser())
 #: Examples that are benchmarks, minutes of timed solves (``bench/`` measures, tests do not):
 #: parsed here, not run; their ``--quick`` forms run.
 BENCHMARKS = {("bench", "accuracy", "--markdown", "--plot", "accuracy_pareto.png"),
@@ -40,9 +40,11 @@ def _id(example: Example) -> str:
 
 
 def test_the_docs_have_examples_of_every_kind() -> None:
-    """The collector finds the README's and the epilogs' examples (a broken one finds none)."""
+    """The collector finds the README's, the docs pages' and the epilogs' examples (a broken
+    one finds none)."""
     wheres = {e.where.split(":")[0] for e in EXAMPLES}
-    assert "README.md" in wheres and "tdcm solve --help" in wheres
+    assert "README.md" in wheres and "doc/reference/cli.md" in wheres  # cli.md: the epilogs'
+    assert any(where.startswith("doc/tutorials/") for where in wheres)
     assert {e.verb for e in EXAMPLES} >= {"solve", "evaluate", "topic pub", "param set", "up"}
 
 
@@ -71,7 +73,7 @@ def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     sample = REPO / "bags" / "paper_experiment"
     (folder / "bags").symlink_to(REPO / "bags")
     (folder / "config").symlink_to(REPO / "config")
-    (folder / "bench").mkdir()  # figures write there, as from a checkout
+    (folder / "doc").mkdir()  # figures write to doc/figures, as from a checkout
     for name in ("trial1", "trial2"):
         shutil.copytree(sample, folder / name)
     shutil.copy(sample / "paper_experiment_0.mcap", folder / "run.mcap")

@@ -31,14 +31,14 @@ import pytest
 
 from tdcm_ros.cli.main import build_parser
 from test.support.cli import tdcm
-from test.support.examples import Example, epilog_examples, readme_examples
+from test.support.examples import Example, documented_examples
 from test.support.graph import start_router
 from test.support.processes import REPO, Lines, child_env, free_port, listening, stop
 from test.support.waiting import eventually
 
 pytestmark = pytest.mark.process
 
-EXAMPLES = readme_examples() + epilog_examples(build_parser())
+EXAMPLES = documented_examples(build_parser())
 #: The graph every other example talks to (README, "tdcm up --twin --nodes ...").
 GRAPH_ARGV = ["up", "--twin", "--nodes", "model_node,shape_controller"]
 #: The lab's motion capture beside it, joining its router: markers for the record/play examples.

@@ -6,16 +6,13 @@ from __future__ import annotations
 
 import importlib
 from pathlib import Path
-from typing import Any
 
 import pytest
 
 from tdcm_ros.runtime.memory_port import MemoryPort
 from tdcm_ros.runtime.registry import NODES
+from test.support.nodes import START, built_node
 
-#: Overrides a node needs to start in-process (no device, no Vicon, no pty link of its own).
-START = {"mocap_node": {"source": "relabel", "relabel.input_topic": "/vicon/markers"},
-         "tension_driver": {"port": "loop://"}}
 #: the sensor inputs whose QoS a parameter file may override (``qos_overrides.<topic>...``)
 SENSOR_INPUTS = {"metrics_node": ("/tension", "/markers", "/joint_states"),
                  "model_node": ("/tension", "/joint_states"),
@@ -25,13 +22,7 @@ SENSOR_INPUTS = {"metrics_node": ("/tension", "/markers", "/joint_states"),
 
 @pytest.mark.parametrize("node", sorted(NODES))
 def test_declared_parameters_are_the_table(node: str, tmp_path: Path) -> None:
-    module_name, _, class_name = NODES[node].partition(":")
-    module = importlib.import_module(module_name)
-    overrides: dict[str, Any] = dict(START.get(node, {}))
-    if node == "device_twin":
-        overrides["link"] = str(tmp_path / "twin")
-    port = MemoryPort(overrides, name=node)
-    logic = getattr(module, class_name)(port)
+    module, port, logic = built_node(node, tmp_path)
     try:
         declared = port.store.specs
         qos = {name for name in declared if name.startswith("qos_overrides.")}
@@ -61,7 +52,7 @@ def test_a_former_parameter_name_sets_the_new_one_and_warns(
     module_name, _, class_name = NODES[node].partition(":")
     module = importlib.import_module(module_name)
     assert old not in module.PARAMETERS and new in module.PARAMETERS
-    port = MemoryPort({**START.get(node, {}), old: value}, name=node)
+    port = MemoryPort({old: value, **START.get(node, {})}, name=node)
     with caplog.at_level("WARNING"):
         logic = getattr(module, class_name)(port)
     try:

@@ -1,5 +1,6 @@
-"""The command examples the docs give: every ``tdcm`` / ``python3 -m tdcm_ros`` line of the
-README's shell blocks and of each ``--help`` epilog's ``examples:``, as argument lists."""
+"""The command examples the docs give: every ``tdcm`` / ``python3 -m tdcm_ros`` line of the shell
+blocks of the README and of every page of the docs site (``doc/**/*.md``), and of each ``--help``
+epilog's ``examples:``, as argument lists."""
 
 from __future__ import annotations
 
@@ -47,8 +48,20 @@ def _parse(line: str, where: str) -> Example | None:
     return Example(where, env, words)
 
 
-def readme_examples(path: Path = REPO / "README.md") -> list[Example]:
-    """The commands of the README's ``bash`` blocks (a ``\\`` continuation joined)."""
+def documented_examples(parser: argparse.ArgumentParser) -> list[Example]:
+    """Every command the docs give, each once (where it is first written): :func:`shell_examples`
+    of the README and of every page of the docs site, then ``parser``'s :func:`epilog_examples`."""
+    pages = [REPO / "README.md", *sorted((REPO / "doc").rglob("*.md"))]
+    found: dict[tuple[str, ...], Example] = {}
+    candidates = [e for page in pages if "_build" not in page.parts for e in shell_examples(page)]
+    for example in [*candidates, *epilog_examples(parser)]:
+        key = (*sorted(f"{k}={v}" for k, v in example.env.items()), "--", *example.argv)
+        found.setdefault(key, example)
+    return list(found.values())
+
+
+def shell_examples(path: Path) -> list[Example]:
+    """The commands of a Markdown file's ``bash`` blocks (a ``\\`` continuation joined)."""
     found: list[Example] = []
     fenced, shell, pending, start = False, False, "", 0
     for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
@@ -63,7 +76,7 @@ def readme_examples(path: Path = REPO / "README.md") -> list[Example]:
         if line.rstrip().endswith("\\"):
             pending += line.rstrip()[:-1] + " "
             continue
-        example = _parse(pending + line, f"README.md:{start}")
+        example = _parse(pending + line, f"{path.relative_to(REPO)}:{start}")
         pending = ""
         if example is not None:
             found.append(example)

@@ -1,4 +1,4 @@
-"""Baseline models with the same input (:class:`Design`) and output (:class:`SolveResult`).
+"""Baseline models with the same input (:class:`.Design`) and output (:class:`.SolveResult`).
 
 Registered by name in :data:`METHODS`:
 
@@ -8,7 +8,7 @@ Registered by name in :data:`METHODS`:
 - ``shooting-whole`` / ``shooting-segmented``: Cosserat BVP by shooting, over the whole
   length or restarted at every stiffness jump.
 
-Use :func:`get_method` (unknown names raise :class:`InvalidSettingsError` listing the valid
+Use :func:`get_method` (unknown names raise :class:`.InvalidSettingsError` listing the valid
 ones) or :func:`solve_with`.
 """
 
@@ -51,7 +51,7 @@ METHODS: dict[str, Method] = {
 
 
 def get_method(name: str) -> Method:
-    """The registered method ``name``; raises :class:`InvalidSettingsError` listing valid names."""
+    """The registered method ``name``; raises :class:`.InvalidSettingsError` listing valid names."""
     try:
         return METHODS[name]
     except KeyError:
