@@ -16,6 +16,12 @@ cd "$(dirname "$0")/.."
 source .ci/pip_env.sh
 
 python3 .ci/docs_reference.py check
+# Graphviz's dot draws the node graph (sphinx.ext.graphviz); from Debian, as firmware.sh does.
+if ! command -v dot >/dev/null; then
+  echo "docs: installing graphviz"
+  apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends graphviz >/dev/null
+fi
 OUT="$(mktemp -d)"
 trap 'rm -rf "$OUT"' EXIT
 echo "=== sphinx-build -W -n doc"

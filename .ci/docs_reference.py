@@ -744,7 +744,7 @@ def node_page(node: str, tmp: str) -> str:
     return page(node, intro, *body)
 
 
-def nodes_page() -> str:
+def nodes_page(tmp: str) -> str:
     from tdcm_ros.runtime.param_services import (
         PARAMETER_EVENT_TYPE,
         PARAMETER_EVENTS_QOS,
@@ -774,18 +774,63 @@ def nodes_page() -> str:
                       _qos_text(PARAMETER_SERVICES_QOS), "always")
                      for name, type_ in SERVICES.items()]
     toctree = "```{toctree}\n:maxdepth: 1\n\n" + "\n".join(f"nodes/{n}" for n in nodes) + "\n```\n"
+    graph = graph_dot(tmp)
     return page(
         "Nodes",
         "The ROS 2 nodes of `dependencies.toml` `[nodes]`: for each, every parameter with its "
         "default, unit and range, and the topics and services it creates, read from the node "
         f"itself. What the topics mean in the whole graph: [the graph]({GRAPH_PAGE[3:]}).",
         table(("node", "class", "what it does"), rows),
+        "## The graph\n",
+        "Every node built with its defaults (mocap_node simulating its markers, as in the demo), "
+        "joined by the topics one publishes and another subscribes; a topic no node subscribes "
+        "is an output for you, RViz or a recorder. Topics under a namespace are drawn as one "
+        "(`metrics/*`); `/diagnostics`, which every node publishes, is left out; the dashed "
+        "link is the serial line from the driver to the device or its twin, not a topic.\n",
+        fenced("{graphviz}", graph),
         "## Every node\n",
         "The runtime (either one) gives every node these besides its own, as rclpy does "
         "(`tdcm_ros.runtime.param_services`, `tdcm_ros.runtime.rosout`), and the parameter "
         "`use_sim_time` (`tdcm_ros.runtime.NODE_COMMON`):\n",
         table(("name", "direction", "type", "QoS", "when"), runtime_rows),
         toctree)
+
+
+#: How the graph picture builds a node besides BUILD_OVERRIDES: the simulated bench of the demo.
+GRAPH_OVERRIDES = {"mocap_node": {"source": "sim"}}
+#: Topics every node has, left out of the picture (the table above lists them).
+GRAPH_HIDDEN = ("/diagnostics",)
+
+
+def graph_dot(tmp: str) -> str:
+    """The node graph (Graphviz): each node built with its defaults (mocap_node simulating its
+    markers), an arrow from a publisher to a topic and from the topic to a subscriber; topics
+    under a namespace (``metrics/...``) drawn as one; the driver's serial link to the device
+    (or its twin) dashed."""
+    edges: set[tuple[str, str]] = set()
+    topics: set[str] = set()
+    nodes = declared_nodes()
+    for node in nodes:
+        built = build_node(node, {**BUILD_OVERRIDES.get(node, {}),
+                                  **GRAPH_OVERRIDES.get(node, {})}, tmp)
+        for kind, name, _, _ in built.endpoints:
+            topic = "/" + name.lstrip("/")
+            if kind == "serves" or name.startswith("~/") or topic in GRAPH_HIDDEN:
+                continue
+            if topic.count("/") > 1:
+                topic = topic.rsplit("/", 1)[0] + "/*"
+            topics.add(topic)
+            edges.add((node, topic) if kind == "publishes" else (topic, node))
+    lines = ["digraph nodes {", "  rankdir=LR;",
+             '  node [fontname="sans-serif", fontsize=10];',
+             '  edge [color="#555555"];']
+    lines += [f'  "{n}" [shape=box, style="rounded,filled", fillcolor="#dbe9f6"];' for n in nodes]
+    lines += [f'  "{t}" [shape=ellipse, fontsize=9];' for t in sorted(topics)]
+    lines += [f'  "{a}" -> "{b}";' for a, b in sorted(edges)]
+    lines.append('  "tension_driver" -> "device_twin" [style=dashed, dir=both, '
+                 'label="serial", fontsize=9];')
+    lines.append("}")
+    return "\n".join(lines) + "\n"
 
 
 # --- 3. the body file -----------------------------------------------------------------------------
@@ -1702,7 +1747,7 @@ def api_index() -> str:
 def pages() -> dict[str, str]:
     """Every generated page by its path under doc/reference."""
     with tempfile.TemporaryDirectory(prefix="tdcm_docs_") as tmp:
-        out = {"cli.md": cli_page(), "nodes.md": nodes_page()}
+        out = {"cli.md": cli_page(), "nodes.md": nodes_page(tmp)}
         for node in declared_nodes():
             out[f"nodes/{node}.md"] = node_page(node, tmp)
     out["body_file.md"] = body_page()

@@ -20,7 +20,8 @@ author = "tdcm_ros developers"
 copyright = "2026, tdcm_ros developers"
 
 # No napoleon: the docstrings are reST, and napoleon reads a property's "Tension (N): ..." as a type.
-extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.viewcode"]
+extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.viewcode", "sphinx.ext.graphviz"]
+graphviz_output_format = "svg"  # the node graph (reference/nodes.md); needs Graphviz's dot
 source_suffix = {".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build"]
