@@ -1,7 +1,7 @@
 """Batch solver throughput on one core for paper-like designs, and its tip error.
 
 Run: ``python bench/bench_batch.py [--designs 40] [--tensions 250] [--many 2000]
-[--repeat 5] [--baseline /work/main] [--rounds 3]``.
+[--repeat 5] [--baseline /work/main] [--rounds 3] [--results FILE]``.
 
 Workloads (default solver settings, whose tip error against a converged reference is printed):
 
@@ -21,7 +21,8 @@ time of the many-design case's steps.
 
 Tip error: the batch against single solves at the same settings (should be ~1e-17 m), and
 against converged single solves (128 cells per notch, 16 per tube, 12-point quadrature,
-tol 1e-14 m) on a sample of points. Timings are best of ``repeat``.
+tol 1e-14 m) on a sample of points. Timings are best of ``repeat``. ``--results FILE`` also
+writes the printed figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -34,6 +35,8 @@ from collections.abc import Callable
 from pathlib import Path
 from time import perf_counter, process_time
 from typing import Any
+
+from results import BenchResults, Column, add_results_argument
 
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "NUMEXPR_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
@@ -65,6 +68,12 @@ def best_time(run: Callable[[], object], repeat: int, cold: bool, clock: Callabl
         run()
         times.append(clock() - started)
     return min(times)
+
+
+def stats(values: list[float]) -> list[float]:
+    """``[median, min, max]`` of ``values`` (the median as :func:`spread` takes it)."""
+    ordered = sorted(values)
+    return [ordered[len(ordered) // 2], ordered[0], ordered[-1]]
 
 
 def spread(values: list[float]) -> str:
@@ -123,8 +132,9 @@ def throughputs(args: argparse.Namespace, names: list[str], rounds: int
     return out
 
 
-def run(args: argparse.Namespace) -> None:
-    """Measure and print (NumPy is imported here, after the thread variables are set)."""
+def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
+    """Measure and print (NumPy is imported here, after the thread variables are set); the
+    figures also go to ``results``."""
     import numpy as np
 
     from tdcm_ros.model import SolverSettings, solve
@@ -185,6 +195,45 @@ def run(args: argparse.Namespace) -> None:
     print(f"tip error vs single solve, same settings ({len(picks)} points): {same:.2e} m")
     print(f"tip error vs converged reference: max {max(converged) * 1e6:.3f} um, "
           f"median {np.median(converged) * 1e6:.3f} um (target <= 1 um)")
+    if results is None:
+        return
+    space = f"design space {args.designs} designs × {args.tensions} tensions"
+    many = f"many designs {args.many} × 1 tension"
+    rate = ",.0f"
+    results.table(
+        f"Batch throughput: median (min–max) of {args.rounds} interleaved rounds, each best of "
+        f"{args.repeat}",
+        [Column("workload"), Column("workers"), Column("solves/s", format=rate),
+         Column("min", format=rate), Column("max", format=rate),
+         Column("per CPU second", format=rate), Column("min", format=rate),
+         Column("max", format=rate)],
+        [[f"{space}, grids built", 1, *stats(measured["space"]), *stats(measured["space cpu"])],
+         [f"{space}, grids built", 2, *stats(measured["space2"]), None, None, None],
+         [f"{space}, incl. grids", 1, *stats(measured["cold"]), *stats(measured["cold cpu"])],
+         [f"{many}, incl. grids", 1, *stats(measured["many"]), *stats(measured["many cpu"])],
+         [f"{many}, incl. grids", 2, *stats(measured["many2"]), None, None, None],
+         [f"single solve() loop, {single_n} solves", 1, single_n / single_time, None, None, None,
+          None, None]],
+        note=f"settings: cells_per_notch={settings.cells_per_notch}, quad_order="
+             f"{settings.quad_order}, tol={settings.tol:g} m; thread pools pinned to 1; "
+             "statuses " + ", ".join(f"{k} {int(v)}" for k, v in zip(
+                 *np.unique(result.status, return_counts=True), strict=True)) + "; "
+             f"fallback to single solve: {int(result.fallback.sum())}. Per CPU second: solves "
+             "per second of the process's CPU time (process_time), steadier on shared cores. "
+             "The single solve() loop is best of 2.")
+    results.table(
+        "Two workers against one, per round (wall)",
+        [Column("workload"), Column("two workers / one", format=".2f"),
+         Column("min", format=".2f"), Column("max", format=".2f")],
+        [[space, *stats(per_round("space2", "space"))],
+         [many, *stats(per_round("many2", "many"))]])
+    results.table(
+        "Tip error of the batch",
+        [Column("against"), Column("points"), Column("max", "m", ".2e"),
+         Column("median", "m", ".2e")],
+        [["single solves, same settings", len(picks), same, None],
+         [("converged single solves (128 cells per notch, 16 per tube, quadrature order 12, "
+           "tol 1e-14 m)"), len(picks), max(converged), float(np.median(converged))]])
 
 
 def throughput_in(checkout: Path, args: argparse.Namespace
@@ -200,7 +249,7 @@ def throughput_in(checkout: Path, args: argparse.Namespace
     return space, many, space_cpu, many_cpu
 
 
-def breakdown(args: argparse.Namespace) -> None:
+def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
     """CPU time (best of ``repeat``) of the steps of the many-design case, and of the grid
     kernel per compliance evaluation point."""
     import numpy as np
@@ -236,19 +285,28 @@ def breakdown(args: argparse.Namespace) -> None:
         ("kernel arrays + strain per chunk (gathers)", lambda: gathers(parts))]
     print(f"many designs {args.many} x 1: CPU time (process_time), best of {args.repeat}")
     kernel_ms = 0.0
+    rows = []
     for label, call in steps:
         call()
         ms = best_time(call, args.repeat, False, process_time) * 1e3
         kernel_ms = ms if label.startswith("grid kernel") else kernel_ms
         print(f"  {label:<44} {ms:7.1f} ms")
+        rows.append([label, ms])
     q = settings.quad_order
     points = int(np.sum(proto.is_notch)) * (q + q * q + PEAK_SAMPLES + 2)
     print(f"  grid kernel: {points / args.many:.0f} notch compliance points per design, "
           f"{kernel_ms * 1e6 / points:.1f} ns each (tube cells included in the time), "
           f"{kernel_ms * 1e3 / args.many:.1f} us per design")
+    results.table(f"Many designs ({args.many} × 1 tension): CPU time per step, best of "
+                  f"{args.repeat}", [Column("step"), Column("CPU time", "ms", ".1f")], rows)
+    results.table("Grid kernel per design",
+                  [Column("notch compliance points per design", format=".0f"),
+                   Column("per point", "ns", ".1f"), Column("per design", "µs", ".1f")],
+                  [[points / args.many, kernel_ms * 1e6 / points, kernel_ms * 1e3 / args.many]],
+                  note="tube cells included in the time")
 
 
-def compare(args: argparse.Namespace) -> None:
+def compare(args: argparse.Namespace, results: BenchResults) -> None:
     """Alternate the baseline checkout and this one; print throughputs and their ratios."""
     here = Path(__file__).resolve().parents[1]
     base: list[tuple[float, float, float, float]] = []
@@ -258,6 +316,7 @@ def compare(args: argparse.Namespace) -> None:
         mine.append(throughput_in(here, args))
     print(f"same-run comparison, one core, {args.rounds} alternating rounds (fresh processes), "
           "solves/s median (min-max)")
+    rows = []
     for k, (label, target) in enumerate(
             ((f"design space {args.designs} x {args.tensions}, grids built", "250,000"),
              (f"many designs {args.many} x 1, grids included", "100,000"))):
@@ -269,6 +328,18 @@ def compare(args: argparse.Namespace) -> None:
         print(f"    speed-up per round: {ratio_spread([y / x for x, y in zip(b, m, strict=True)])}"
               f"; per CPU second "
               f"{ratio_spread([y / x for x, y in zip(b_cpu, m_cpu, strict=True)])}")
+        rows.append([label, stats(b)[0], stats(b_cpu)[0], stats(m)[0], stats(m_cpu)[0],
+                     *stats([y / x for x, y in zip(b, m, strict=True)]),
+                     stats([y / x for x, y in zip(b_cpu, m_cpu, strict=True)])[0]])
+    rate = ",.0f"
+    results.table(
+        f"Same-run comparison with {args.baseline}, one core, {args.rounds} alternating rounds "
+        "(fresh processes), medians",
+        [Column("workload"), Column("baseline solves/s", format=rate),
+         Column("per CPU s", format=rate), Column("this checkout solves/s", format=rate),
+         Column("per CPU s", format=rate), Column("speed-up per round", format=".2f"),
+         Column("min", format=".2f"), Column("max", format=".2f"),
+         Column("speed-up per CPU s", format=".2f")], rows)
 
 
 def main() -> None:
@@ -284,14 +355,21 @@ def main() -> None:
     parser.add_argument("--breakdown", action="store_true",
                         help="only the CPU-time breakdown of the many-design case")
     parser.add_argument("--throughput-only", action="store_true", help=argparse.SUPPRESS)
+    add_results_argument(parser, "bench_batch")
     args = parser.parse_args()
     os.environ.update({name: "1" for name in THREAD_VARIABLES})
-    if args.breakdown:
-        breakdown(args)
+    if args.throughput_only:
+        run(args)
         return
-    if args.baseline is not None:
-        compare(args)
-    run(args)
+    results = BenchResults("bench_batch")
+    if args.breakdown:
+        breakdown(args, results)
+    else:
+        if args.baseline is not None:
+            compare(args, results)
+        run(args, results)
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

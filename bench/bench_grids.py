@@ -3,12 +3,13 @@ every design's prototype cells) against one ``build_grid`` per design, in the sa
 (issue 15, item 3).
 
 Run: ``python bench/bench_grids.py [--designs 2000] [--repeat 3] [--baseline CHECKOUT]
-[--rounds 3]``. Designs are paper-like (``w_n``, ``w_d`` drawn around the paper's), every one
+[--rounds 3] [--results FILE]``. Designs are paper-like (``w_n``, ``w_d`` drawn around the paper's), every one
 different, so no cache helps; the grid cache is cleared before each single-design pass.
 Single-threaded; times are CPU time of the process (``time.process_time``), which other jobs
 on shared cores disturb far less than wall time. ``--baseline`` times ``build_grids`` of another checkout (e.g. main) in the
 same run: it and this checkout alternate in fresh processes for ``--rounds`` rounds and the
-per-round ratios are printed (median and range).
+per-round ratios are printed (median and range). ``--results FILE`` also writes the printed
+figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import SolverSettings, preset
 from tdcm_ros.model.design import MM
@@ -49,7 +51,7 @@ def stacked_rates(designs: list, repeat: int) -> list[float]:
     return rates
 
 
-def compare(args: argparse.Namespace) -> None:
+def compare(args: argparse.Namespace, results: BenchResults) -> None:
     """Alternate the baseline checkout and this one in fresh processes; print the ratios."""
     here = Path(__file__).resolve().parents[1]
     runs: dict[Path, list[list[float]]] = {args.baseline: [], here: []}
@@ -62,6 +64,7 @@ def compare(args: argparse.Namespace) -> None:
             rates.append([float(v) for v in out.stdout.split()[-len(CASES):]])
     print(f"build_grids, grids per CPU second, {args.rounds} alternating rounds (fresh processes), "
           f"median (min-max); baseline {args.baseline}")
+    rows: list[list[object]] = []
     for k, (label, _) in enumerate(CASES):
         base = [r[k] for r in runs[args.baseline]]
         mine = [r[k] for r in runs[here]]
@@ -69,6 +72,17 @@ def compare(args: argparse.Namespace) -> None:
         print(f"  {label:<28} baseline {np.median(base):8.0f} ({min(base):.0f}-{max(base):.0f})"
               f"  this {np.median(mine):8.0f} ({min(mine):.0f}-{max(mine):.0f})  ratio "
               f"{ratios[len(ratios) // 2]:.2f}x ({ratios[0]:.2f}-{ratios[-1]:.2f})")
+        rows.append([label, float(np.median(base)), min(base), max(base), float(np.median(mine)),
+                     min(mine), max(mine), ratios[len(ratios) // 2], ratios[0], ratios[-1]])
+    rate = ",.0f"
+    results.table(
+        f"build_grids, grids per CPU second, {args.rounds} alternating rounds (fresh processes) "
+        f"against {args.baseline}",
+        [Column("grid"), Column("baseline", format=rate), Column("min", format=rate),
+         Column("max", format=rate), Column("this checkout", format=rate),
+         Column("min", format=rate), Column("max", format=rate),
+         Column("ratio", format=".2f"), Column("min", format=".2f"),
+         Column("max", format=".2f")], rows)
 
 
 def main() -> None:
@@ -78,6 +92,7 @@ def main() -> None:
     parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. main")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--rates-only", action="store_true", help=argparse.SUPPRESS)
+    add_results_argument(parser, "bench_grids")
     args = parser.parse_args()
     rng = np.random.default_rng(0)
     base = preset("paper-experiment")
@@ -87,8 +102,10 @@ def main() -> None:
     if args.rates_only:
         print(*stacked_rates(designs, args.repeat))
         return
+    results = BenchResults("bench_grids")
     if args.baseline is not None:
-        compare(args)
+        compare(args, results)
+    rows: list[list[object]] = []
     for label, settings in CASES:
         stacked, single = [], []
         stack = build_grids(designs, settings)
@@ -105,6 +122,20 @@ def main() -> None:
         print(f"{label:<28} cells/design {stack.n_cells.mean():6.1f}  build_grids "
               f"{args.designs / fast:9.0f} grids per CPU s ({fast / args.designs * 1e6:6.1f} us)  "
               f"build_grid loop {args.designs / slow:7.0f} grids/s  ratio {slow / fast:5.1f}x")
+        rows.append([label, float(stack.n_cells.mean()), args.designs / fast,
+                     fast / args.designs * 1e6, args.designs / slow, slow / fast])
+    rate = ",.0f"
+    results.table(
+        f"Grid building for {args.designs:,} different paper-like designs, in one process",
+        [Column("grid"), Column("cells per design", format=".1f"),
+         Column("build_grids, grids per CPU s", format=rate),
+         Column("per design", "µs", ".1f"),
+         Column("one build_grid per design, grids per CPU s", format=rate),
+         Column("ratio", format=".1f")], rows,
+        note=f"CPU time of the process (process_time), best of {args.repeat}; the grid cache is "
+             "cleared before each single-design pass")
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Inverse-model benchmark (issue 18, item 1): round trip to ``solve``, forward solves and time
 per call against one solve in the same run, and the sensitivity's error.
 
-Run: ``python bench/bench_inverse.py [--targets 20] [--seed 1]``.
+Run: ``python bench/bench_inverse.py [--targets 20] [--seed 1] [--results FILE]``.
 For every preset, ``--targets`` tensions drawn uniformly from ``[0.5, 49.5]`` N give a tip
 deflection, a tip angle and a tip point (the tip of ``solve`` there); ``solve_inverse`` finds
 each (default bounds ``[0, 50]`` N). Printed per target kind, on ``paper-experiment`` (the
@@ -19,6 +19,8 @@ issue's target row) and over all presets:
   ``ridder`` need for the deflection and angle targets, under the tolerances the model uses.
 
 Warm means after :func:`warm_up` and a first call (compiled kernels, cached grid). Single-threaded.
+``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import (
     PRESETS,
@@ -138,20 +141,42 @@ def finder_solves(finder: str, design, kind: str, target: float) -> int:
     return len(solved)
 
 
-def compare_finders(tensions: dict[str, np.ndarray]) -> None:
-    """Print the mean and max solves of each scalar root finder over the targets."""
+def compare_finders(tensions: dict[str, np.ndarray]) -> list[list[object]]:
+    """Print the mean and max solves of each scalar root finder over the targets; returns the
+    rows printed."""
+    rows: list[list[object]] = []
     for finder in ("brentq", "toms748", "ridder"):
         counts = [finder_solves(finder, preset(name), kind, target_of(kind, solve(preset(name), t)))
                   for name in PRESETS for t in tensions[name] for kind in KINDS[:2]]
         print(f"root finder {finder:8s}: {np.mean(counts):.2f} solves mean, {max(counts)} max "
               f"(deflection and angle targets, bounds included, sensitivity not)")
+        rows.append([finder, float(np.mean(counts)), max(counts)])
+    return rows
+
+
+UNITS = {"tip_deflection": "m", "tip_angle": "rad", "tip_point": "m"}
+ROW_COLUMNS = [Column("kind"), Column("designs"), Column("round trip to solve", "m", ".1e"),
+               Column("target error", format=".1e"), Column("target unit"),
+               Column("|T*−T|", "N", ".1e"), Column("forward solves, mean", format=".2f"),
+               Column("max"), Column("time per call", "µs", ".0f"),
+               Column("× one solve", format=".1f"), Column("sensitivity rel. error", format=".1e")]
+"""The columns of :func:`_cells`: what :func:`_row` prints."""
+
+
+def _cells(kind: str, designs: str, f: dict[str, float], ratio: float, *, sens: bool = True
+           ) -> list[object]:
+    return [kind, designs, f["round_trip_m"], f["target_err"], UNITS[kind], f["tension_err_n"],
+            f["solves_mean"], int(f["solves_max"]), f["call_s"] * 1e6, ratio,
+            f["sens_rel_err"] if sens else None]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--targets", type=int, default=20, help="tensions per preset")
     parser.add_argument("--seed", type=int, default=1)
+    add_results_argument(parser, "bench_inverse")
     args = parser.parse_args()
+    results = BenchResults("bench_inverse")
     warm_up()
     rng = np.random.default_rng(args.seed)
     tensions = {name: rng.uniform(0.5, 49.5, args.targets) for name in PRESETS}
@@ -162,23 +187,48 @@ def main() -> None:
     print(f"{'kind':15s} {'designs':17s} {'round trip m':>12s} {'target err':>10s} "
           f"{'|T*-T| N':>9s} {'solves':>11s} {'call us':>8s} {'x solve':>7s} "
           f"{'sens rel err':>12s}")
+    rows: list[list[object]] = []
     for kind in KINDS:
         figures = {name: measure(name, kind, tensions[name]) for name in PRESETS}
         paper = figures["paper-experiment"]
         _row(kind, "paper-experiment", paper, paper["call_s"] / solve_s["paper-experiment"])
+        rows.append(_cells(kind, "paper-experiment", paper,
+                           paper["call_s"] / solve_s["paper-experiment"]))
         ratios = [figures[n]["call_s"] / solve_s[n] for n in PRESETS]
         every = {key: max(f[key] for f in figures.values()) for key in paper}
         every["solves_mean"] = float(np.mean([f["solves_mean"] for f in figures.values()]))
         every["call_s"] = float(np.median([f["call_s"] for f in figures.values()]))
         every["sens_rel_err"] = paper["sens_rel_err"]
         _row(kind, f"all {len(PRESETS)} presets", every, float(np.median(ratios)), sens=False)
+        rows.append(_cells(kind, f"all {len(PRESETS)} presets", every, float(np.median(ratios)),
+                           sens=False))
+    results.table(
+        "Inverse model per target kind", ROW_COLUMNS, rows,
+        note=f"{args.targets} targets per kind and preset, tensions U(0.5, 49.5) N, seed "
+             f"{args.seed}; bounds [0, 50] N; one solve "
+             f"{solve_s['paper-experiment'] * 1e6:.1f} µs median on paper-experiment in this "
+             f"run. Over all presets: the largest of each figure, the mean of the mean solves, "
+             f"the median of the times and of the ratios to one solve")
+    off_rows: list[list[object]] = []
     for name in ("paper-experiment", *(n for n in PRESETS if n != "paper-experiment")):
         f = measure_off_path(name, tensions[name])
         print(f"tip_point 1 mm off the path, {name:16s}: |T*-T| {f['tension_err_n']:.2e} N, "
               f"|residual - 1 mm| {f['residual_err_m']:.2e} m, solves {f['solves_mean']:.2f} / "
               f"{int(f['solves_max'])}, {f['call_s'] * 1e6:.1f} us per call "
               f"({f['call_s'] / solve_s[name]:.1f} x solve)")
-    compare_finders(tensions)
+        off_rows.append([name, f["tension_err_n"], f["residual_err_m"], f["solves_mean"],
+                         int(f["solves_max"]), f["call_s"] * 1e6, f["call_s"] / solve_s[name]])
+    results.table(
+        "tip_point 1 mm off the path",
+        [Column("design"), Column("|T*−T|", "N", ".1e"), Column("|residual − 1 mm|", "m", ".1e"),
+         Column("forward solves, mean", format=".2f"), Column("max"),
+         Column("time per call", "µs", ".0f"), Column("× one solve", format=".1f")], off_rows)
+    results.table(
+        "Scalar root finders on the deflection and angle targets",
+        [Column("finder"), Column("solves, mean", format=".2f"), Column("max")],
+        compare_finders(tensions), note="bounds included, sensitivity not")
+    if args.results:
+        results.write(args.results)
 
 
 def _row(kind: str, designs: str, f: dict[str, float], ratio: float, *, sens: bool = True) -> None:

@@ -1,7 +1,8 @@
 """Tension -> ``midline`` end-to-end latency of ``model_node`` across processes (issue 4).
 
 Run: ``python bench/bench_latency.py [--runtime zenoh|rclpy|both] [--rates 100 500 1000]
-[--duration 10]`` or ``python bench/bench_latency.py --soak [--soak-duration 60] [--soak-rate 1000]``.
+[--duration 10] [--results FILE]`` or ``python bench/bench_latency.py --soak [--soak-duration 60]
+[--soak-rate 1000] [--results FILE]``.
 ``--runtime`` defaults to ``both`` when rclpy is importable, else ``zenoh``; with ``both`` the
 runtimes are interleaved per rate (zenoh 100, rclpy 100, zenoh 500, ...) in the same run, and a
 table of rclpy/zenoh ratios of p50 and p99 per rate follows.
@@ -26,6 +27,7 @@ publisher -> this process's listener on ``tension``, the same measurement withou
 model_node's CPU (all its threads, so above 100 % is possible) and the 1-min load average (the
 figures are only as good as an idle machine). ``--soak`` also samples model_node's RSS
 (``VmRSS``) once a second and prints start, end and max RSS and the least-squares slope, per runtime.
+``--results FILE`` also writes the printed figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.bagio import from_dict, serialize, type_hash
 
@@ -319,12 +322,15 @@ class Bench:
 
 @contextmanager
 def bench(runtime: str, period: float | None) -> Iterator[Bench]:
-    """A running :class:`Bench`, with ``process_period_s`` overridden when given."""
+    """A running :class:`Bench`: model_node draws its midline for every solve
+    (``output.visual_rate_hz`` 0, so each input has an output to time), with
+    ``process_period_s`` overridden when given."""
     with tempfile.TemporaryDirectory() as tmp:
-        params = None
+        params = Path(tmp) / "model_node.yaml"
+        lines = ["model_node:", "  ros__parameters:", "    output:", "      visual_rate_hz: 0.0"]
         if period is not None:
-            params = Path(tmp) / "model_node.yaml"
-            params.write_text(f"model_node:\n  ros__parameters:\n    process_period_s: {period}\n")
+            lines.append(f"    process_period_s: {period}")
+        params.write_text("\n".join(lines) + "\n")
         runner = Bench(runtime, params)
         try:
             yield runner
@@ -354,17 +360,40 @@ def row(phase: Phase) -> str:
             f"{phase.load[0]:5.2f}->{phase.load[1]:.2f}")
 
 
+PHASE_COLUMNS = [Column("runtime"), Column("rate", "Hz", ",.0f"), Column("p50", "ms", ".2f"),
+                 Column("p99", "ms", ".2f"), Column("max", "ms", ".2f"), Column("delivered"),
+                 Column("sent"), Column("coalesced"), Column("lost"),
+                 Column("hop p50", "ms", ".2f"), Column("hop p99", "ms", ".2f"),
+                 Column("node CPU", "% of a core", ".0f"), Column("load average", format=".2f"),
+                 Column("→ at the end", format=".2f")]
+"""The columns of :func:`phase_row`: the figures :func:`row` prints."""
+
+
+def phase_row(phase: Phase) -> list[object]:
+    """The figures of :func:`row` as cells of :data:`PHASE_COLUMNS` (``None``: none measured)."""
+    lat, hop = phase.latencies_ms, phase.hop_ms
+    return [phase.runtime, phase.rate,
+            *((phase.percentile(50), phase.percentile(99), float(lat.max())) if len(lat)
+              else (None, None, None)),
+            len(lat), phase.sent, phase.coalesced, phase.lost,
+            *((float(np.percentile(hop, 50)), float(np.percentile(hop, 99))) if len(hop)
+              else (None, None)),
+            phase.cpu_node / phase.elapsed_s * 100, phase.load[0], phase.load[1]]
+
+
 HEADER = (f"{'runtime':>7} {'rate Hz':>7} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>8} "
           f"{'delivered/sent':>15} {'coalesced':>9} {'lost':>5} {'hop p50':>5} {'p99':>5} "
           f"{'node CPU':>8} load1")
 
 
-def ratio_table(phases: list[Phase]) -> None:
-    """rclpy/zenoh ratios of p50 and p99 (and of the one-hop p99) per rate."""
+def ratio_table(phases: list[Phase]) -> list[list[object]]:
+    """rclpy/zenoh ratios of p50 and p99 (and of the one-hop p99) per rate; returns the rows
+    printed."""
     by_key = {(p.runtime, p.rate): p for p in phases}
     print("\nrclpy/zenoh ratio (same run, interleaved per rate)")
     print(f"{'rate Hz':>7} {'p50 zenoh':>9} {'p50 rclpy':>9} {'ratio':>6} "
           f"{'p99 zenoh':>9} {'p99 rclpy':>9} {'ratio':>6} {'hop p99 ratio':>13}")
+    rows: list[list[object]] = []
     for rate in dict.fromkeys(p.rate for p in phases):
         zenoh, rclpy = by_key.get(("zenoh", rate)), by_key.get(("rclpy", rate))
         if zenoh is None or rclpy is None:
@@ -375,9 +404,17 @@ def ratio_table(phases: list[Phase]) -> None:
                if len(rclpy.hop_ms) and len(zenoh.hop_ms) else np.nan)
         print(f"{rate:7.0f} {z50:9.2f} {r50:9.2f} {r50 / z50:6.2f} "
               f"{z99:9.2f} {r99:9.2f} {r99 / z99:6.2f} {hop:13.2f}", flush=True)
+        rows.append([rate, z50, r50, r50 / z50, z99, r99, r99 / z99, hop])
+    return rows
 
 
-def soak_report(phase: Phase) -> None:
+RATIO_COLUMNS = [Column("rate", "Hz", ",.0f"), Column("p50 zenoh", "ms", ".2f"),
+                 Column("p50 rclpy", "ms", ".2f"), Column("ratio", format=".2f"),
+                 Column("p99 zenoh", "ms", ".2f"), Column("p99 rclpy", "ms", ".2f"),
+                 Column("ratio", format=".2f"), Column("hop p99 ratio", format=".2f")]
+
+
+def soak_report(phase: Phase, results: BenchResults) -> None:
     times = np.array([t for t, _ in phase.rss_kib])
     kib = np.array([k for _, k in phase.rss_kib], dtype=float)
     slope = np.polyfit(times, kib, 1)[0] if len(times) > 1 else 0.0
@@ -391,6 +428,14 @@ def soak_report(phase: Phase) -> None:
     print(f"RSS (MiB) every ~{every} s: {series}")
     print(f"coalesced inputs (from /diagnostics): {phase.coalesced} of {phase.sent} sent; "
           f"solved {phase.solved}; lost {phase.lost}")
+    results.table(
+        f"model_node ({phase.runtime}) RSS over the soak",
+        [Column("start", "MiB", ".1f"), Column("end", "MiB", ".1f"), Column("max", "MiB", ".1f"),
+         Column("slope", "KiB/s", "+.2f"), Column("slope, second half", "KiB/s", "+.2f"),
+         Column("samples"), Column("solved"), Column("coalesced"), Column("lost")],
+        [[kib[0] / 1024, kib[-1] / 1024, kib.max() / 1024, slope, late, len(kib), phase.solved,
+          phase.coalesced, phase.lost]],
+        note=f"RSS (MiB) every ~{every} s: {series}")
 
 
 def fmt_load() -> str:
@@ -409,7 +454,8 @@ def describe(runtimes: list[str], period: float | None) -> str:
                      f"{os.environ.get('ROS_DOMAIN_ID', '(unset: 0)')}, "
                      f"ROS_AUTOMATIC_DISCOVERY_RANGE "
                      f"{os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', '(unset)')}")
-    parts.append(f"tension {TENSION_N} N, paper-experiment, default model_node parameters"
+    parts.append(f"tension {TENSION_N} N, paper-experiment, model_node's defaults but "
+                 "output.visual_rate_hz 0 (a midline per solve)"
                  + (f", process_period_s {period}" if period else ""))
     return "; ".join(parts)
 
@@ -431,6 +477,7 @@ def main() -> None:
                         help="override model_node's process_period_s (s)")
     parser.add_argument("--publish", nargs=2, type=float, metavar=("RATE", "DURATION"),
                         help=argparse.SUPPRESS)
+    add_results_argument(parser, "bench_latency")
     args = parser.parse_args()
     if args.publish:
         publish(args.runtime or "zenoh", *args.publish, wait=20.0)
@@ -441,7 +488,9 @@ def main() -> None:
         parser.error("--runtime rclpy/both needs rclpy (source ROS 2 or use its Python)")
     if min([*args.rates, args.soak_rate]) <= 0 or min(args.duration, args.soak_duration) <= 0:
         parser.error("rates and durations must be > 0")
-    print(describe(runtimes, args.period), flush=True)
+    results = BenchResults("bench_latency")
+    described = describe(runtimes, args.period)
+    print(described, flush=True)
     if args.soak:
         for runtime in runtimes:
             phase = measure(runtime, args.soak_rate, args.soak_duration, args.warmup,
@@ -449,7 +498,11 @@ def main() -> None:
             print(f"soak ({runtime}): {args.soak_rate:g} Hz for {args.soak_duration:g} s")
             print(HEADER)
             print(row(phase))
-            soak_report(phase)
+            results.table(f"Soak ({runtime}): {args.soak_rate:g} Hz for {args.soak_duration:g} s",
+                          PHASE_COLUMNS, [phase_row(phase)], note=described)
+            soak_report(phase, results)
+        if args.results:
+            results.write(args.results)
         return
     print(HEADER, flush=True)
     phases = []
@@ -457,9 +510,21 @@ def main() -> None:
         for runtime in runtimes:
             phases.append(measure(runtime, rate, args.duration, args.warmup, args.period))
             print(row(phases[-1]), flush=True)
-    if len(runtimes) > 1:
-        ratio_table(phases)
-    print(f"load average at the end {fmt_load()}")
+    ratios = ratio_table(phases) if len(runtimes) > 1 else []
+    end = fmt_load()
+    print(f"load average at the end {end}")
+    results.table(
+        f"Tension → midline latency, {args.duration:g} s per rate",
+        PHASE_COLUMNS, [phase_row(phase) for phase in phases],
+        note=f"{described}; load average at the end {end}. Delivered: inputs that produced a "
+             "midline; coalesced: inputs the keep-latest node replaced (its /diagnostics); "
+             "lost: sent minus every input its counters account for; hop: publisher → this "
+             "bench's own listener on tension (the machine's own stalls); node CPU: all of "
+             "model_node's threads; load average: 1 min, at the start and end of the phase.")
+    if ratios:
+        results.table("rclpy/zenoh ratio (same run, interleaved per rate)", RATIO_COLUMNS, ratios)
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

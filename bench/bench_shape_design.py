@@ -1,7 +1,7 @@
 """Shape-design benchmark (issue 30): each problem file of ``config/design`` searched on one
 core, with several seeds.
 
-Run: ``python bench/bench_shape_design.py [--seeds 5] [--workers 1] [FILE ...]``.
+Run: ``python bench/bench_shape_design.py [--seeds 5] [--workers 1] [--results FILE] [FILE ...]``.
 
 Printed per problem and seed: CPU seconds of the process (``process_time``) and wall seconds
 of the search, generations, evaluations, whether every target is met, and what the design
@@ -10,7 +10,8 @@ distal/proximal ratio, the peak strain); then the median and range over the seed
 STL round trip of each problem's design and of the paper's preset: the design exported
 (``write_body_stl``, mm), read back through its body file (the mesh path), solved at the
 problem's first load, and the tip's distance from the design's own tip over the tip's
-displacement. Warm: the kernels are compiled and loaded before timing.
+displacement. Warm: the kernels are compiled and loaded before timing. ``--results FILE`` also
+writes the printed figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import (
     Capstan,
@@ -84,8 +86,13 @@ def main() -> None:
     parser.add_argument("files", nargs="*", type=Path, default=PROBLEMS)
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--workers", type=int, default=1)
+    add_results_argument(parser, "bench_shape_design")
     args = parser.parse_args()
+    results = BenchResults("bench_shape_design")
     warm_up()
+    seeds: list[list[object]] = []
+    medians: list[list[object]] = []
+    trips: list[list[object]] = []
     for path in args.files:
         problem = read_problem_file(path)
         cpu, wall = [], []
@@ -103,14 +110,40 @@ def main() -> None:
             print(f"  seed {seed}: {cpu[-1]:.2f} CPU s, {wall[-1]:.2f} s wall, "
                   f"{found.generations} generations, {found.evaluations} evaluations, "
                   f"met {found.evaluation.met}; {describe(found)}")
+            seeds.append([path.name, seed, cpu[-1], wall[-1], found.generations,
+                          found.evaluations, found.evaluation.met, describe(found)])
         print(f"  median {statistics.median(cpu):.2f} CPU s (range {min(cpu):.2f}-{max(cpu):.2f}),"
               f" wall {statistics.median(wall):.2f} s (range {min(wall):.2f}-{max(wall):.2f})")
+        medians.append([path.name, problem.problem.variables.size, statistics.median(cpu),
+                        min(cpu), max(cpu), statistics.median(wall), min(wall), max(wall)])
         load = problem.problem.loads[0]
         if found.design is not None and load.tension is not None:
+            error = round_trip(found.design, load.tension, load.mu)
             print(f"  STL round trip of the last design at {load.label}: tip error "
-                  f"{round_trip(found.design, load.tension, load.mu):.2e} of its displacement")
+                  f"{error:.2e} of its displacement")
+            trips.append([f"{path.name}, the last seed's design", load.label, error])
+    error = round_trip(preset("paper-experiment"), 20.0)
     print("STL round trip of paper-experiment at 20 N: tip error "
-          f"{round_trip(preset('paper-experiment'), 20.0):.2e} of its displacement")
+          f"{error:.2e} of its displacement")
+    trips.append(["paper-experiment (preset)", "20 N", error])
+    seconds = [Column("CPU", "s", ".2f"), Column("wall", "s", ".2f")]
+    results.table(
+        "Each problem and seed",
+        [Column("problem"), Column("seed"), *seconds, Column("generations"),
+         Column("evaluations"), Column("met"), Column("achieved")], seeds,
+        note="achieved: the tip angle, each notch-angle target's spread from the mean and "
+             "distal/proximal ratio, the peak strain")
+    results.table(
+        f"Median over {args.seeds} seeds",
+        [Column("problem"), Column("variables"), Column("CPU", "s", ".2f"),
+         Column("min", "s", ".2f"), Column("max", "s", ".2f"), Column("wall", "s", ".2f"),
+         Column("min", "s", ".2f"), Column("max", "s", ".2f")], medians)
+    results.table(
+        "STL round trip: exported, read back through its body file, solved",
+        [Column("design"), Column("load"),
+         Column("tip error / tip displacement", format=".1e")], trips)
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """Single-solve benchmark (issue 2): median time of one solve and iterations to converge.
 
-Run: ``python bench/bench_solve.py [--repeats 2000] [--baseline /work/main] [--rounds 3]``.
+Run: ``python bench/bench_solve.py [--repeats 2000] [--baseline /work/main] [--rounds 3]
+[--results FILE]``.
 Prints the median and p90 time per solve on ``paper-experiment`` at 20 N with the default
 settings (compiled kernel, and the plain-Python build of the same kernel, ``TDCM_JIT=0``),
 the tip error of that solve against a converged reference, and the iterations across presets
@@ -10,7 +11,8 @@ paper's tube with 8 polygon (tee) notches, timed
 interleaved in this process, as ratios to the preset. ``--baseline`` times another checkout of the package (e.g. main's NumPy
 path) in the same run: baseline and this checkout alternate in fresh processes for
 ``--rounds`` rounds and the ratio of their medians is printed.
-Single-threaded: BLAS threads are pinned to one before NumPy loads.
+Single-threaded: BLAS threads are pinned to one before NumPy loads. ``--results FILE`` also
+writes the printed figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import PRESETS, SolverSettings, preset, read_body_file, solve
 from tdcm_ros.model.design import Design
@@ -101,7 +104,7 @@ def median_in(checkout: Path, repeats: int, jit: str = "1") -> float:
     return float(out.stdout.split()[-1])
 
 
-def compare(baseline: Path, repeats: int, rounds: int) -> None:
+def compare(baseline: Path, repeats: int, rounds: int, results: BenchResults) -> None:
     """Alternate baseline and this checkout; print medians and their ratio."""
     here = Path(__file__).resolve().parents[1]
     base, mine = [], []
@@ -115,6 +118,12 @@ def compare(baseline: Path, repeats: int, rounds: int) -> None:
     print(f"  this checkout      : median {m * 1e6:8.1f} us  (rounds: "
           + ", ".join(f"{t * 1e6:.1f}" for t in mine) + ")")
     print(f"  speed-up           : {b / m:8.1f}x  (target >= 10x, <= 10 us)")
+    results.table(
+        f"Same-run comparison, {rounds} alternating rounds of {repeats} solves",
+        [Column("checkout"), Column("median solve", "µs", ".1f"), Column("rounds", "µs")],
+        [[f"baseline {baseline}", b * 1e6, ", ".join(f"{t * 1e6:.1f}" for t in base)],
+         ["this checkout", m * 1e6, ", ".join(f"{t * 1e6:.1f}" for t in mine)]],
+        note=f"speed-up (baseline median / this checkout's): {b / m:.1f}x")
 
 
 def main() -> None:
@@ -123,12 +132,14 @@ def main() -> None:
     parser.add_argument("--baseline", type=Path, help="checkout to compare with, e.g. /work/main")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--median-only", action="store_true", help=argparse.SUPPRESS)
+    add_results_argument(parser, "bench_solve")
     args = parser.parse_args()
     if args.median_only:
         print(float(np.median(time_solves(args.repeats))))
         return
+    results = BenchResults("bench_solve")
     if args.baseline is not None:
-        compare(args.baseline, args.repeats, args.rounds)
+        compare(args.baseline, args.repeats, args.rounds, results)
     plain = median_in(Path(__file__).resolve().parents[1], max(args.repeats // 10, 20), "0")
     design = preset("paper-experiment")
     reference = solve(design, 20.0, settings=REFERENCE).tip_position
@@ -147,6 +158,19 @@ def main() -> None:
           " nm  (target <= 1000 nm)")
     print(f"  reference self-check   {np.linalg.norm(finer - reference) * 1e9:8.3f} nm "
           "(256 vs 512 cells/notch)")
+    results.table(
+        "Single solve: paper-experiment at 20 N, default settings",
+        [Column("figure"), Column("measured"), Column("unit")],
+        [["median solve time", np.median(times) * 1e6, "µs"],
+         ["p90 solve time", np.percentile(times, 90) * 1e6, "µs"],
+         ["plain-Python build (TDCM_JIT=0), median", plain * 1e6, "µs"],
+         ["first solve of a new design (grid build)", first * 1e3, "ms"],
+         ["tip error vs the converged reference",
+          np.linalg.norm(default.tip_position - reference) * 1e9, "nm"],
+         ["reference self-check (256 vs 512 cells per notch)",
+          np.linalg.norm(finer - reference) * 1e9, "nm"]],
+        note=f"{args.repeats} timed solves (the plain-Python build: "
+             f"{max(args.repeats // 10, 20)}, in a fresh process)")
     bodies = interleaved({"preset": design, "body file": read_body_file(BODY_FILE).design(),
                           "8 notches all different": all_different(),
                           "8 one-sided cuts": all_different_cuts(),
@@ -157,16 +181,36 @@ def main() -> None:
         print(f"  {name:24s} {median * 1e6:8.1f} us  {median / bodies['preset']:5.2f}x the preset"
               + ("   (target <= 1.2x)" if name.startswith("8 notches") else
                  "   (target: no slower)" if name == "body file" else ""))
+    results.table(
+        "Body path: interleaved median solve at 20 N",
+        [Column("body"), Column("median solve", "µs", ".1f"), Column("× the preset", format=".2f")],
+        [[name, median * 1e6, median / bodies["preset"]] for name, median in bodies.items()],
+        note="preset: paper-experiment; body file: config/bodies/paper_experiment.yaml; "
+             "8 polygon notches: config/bodies/tee_notches.yaml")
     print("iterations to converge (tol 1e-10 m), strategy")
+    iterations = []
     for name in PRESETS:
         row = [solve(preset(name), t) for t in (4.0, 12.0, 20.0)]
         print(f"  {name:22s} " + "  ".join(f"{t:4.0f} N: {r.iterations:2d} ({r.strategy})"
                                            for t, r in zip((4, 12, 20), row, strict=True)))
+        iterations.append([name, *(r.iterations for r in row),
+                           ", ".join(dict.fromkeys(r.strategy for r in row))])
+    results.table("Iterations to converge (tol 1e-10 m), presets",
+                  ["preset", "at 4 N", "at 12 N", "at 20 N", "strategy"], iterations)
+    hard_rows = []
     for name, hard in HARD.items():
         for routing in ("paper", "free"):
             r = solve(hard, HARD_TENSION[name], settings=SolverSettings(routing=routing))
             print(f"  {name:22s} {routing:5s} {HARD_TENSION[name]:4g} N: {r.iterations:3d} "
                   f"({r.strategy}), tip angle {np.degrees(r.tip_angle_rad):7.1f} deg")
+            hard_rows.append([name, routing, HARD_TENSION[name], r.iterations, r.strategy,
+                              np.degrees(r.tip_angle_rad)])
+    results.table("Iterations to converge (tol 1e-10 m), hard designs",
+                  [Column("design"), Column("routing"), Column("tension", "N", "g"),
+                   Column("iterations"), Column("strategy"), Column("tip angle", "deg", ".1f")],
+                  hard_rows)
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

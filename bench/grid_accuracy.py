@@ -1,7 +1,7 @@
 """Tip error of the default grid against a converged reference, and its time per solve
 against today's (``grid=uniform``) default, in the same run (issue 15, item 4).
 
-Run: ``python bench/grid_accuracy.py [--quick] [--settings k=v,k=v ...]``.
+Run: ``python bench/grid_accuracy.py [--quick] [--settings k=v,k=v ...] [--results FILE]``.
 
 Cases: every preset with ``N`` in ``--notches`` (default 1, 8, 64; ``paper-experiment`` also
 2, 4, 16, 32) and the accuracy bench's hard designs, at 4 and 20 N, both routings, both load
@@ -10,7 +10,8 @@ fine adaptive grids; its own uncertainty is printed). Cases the model refuses at
 (notch closure, the tendon singularity, eq. 7's 45 degree kink limit) are counted, not hidden.
 An independent check of the references' compliance integration: the constrained tendon's
 tip from the reference grid against ``shooting-segmented`` at rtol 1e-11.
-Single-threaded: BLAS threads are pinned to one before NumPy loads.
+Single-threaded: BLAS threads are pinned to one before NumPy loads. ``--results FILE`` also
+writes the printed figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import PRESETS, SolverSettings, solve
 from tdcm_ros.model.accuracy import (
@@ -86,7 +88,9 @@ def main() -> None:
                         help="also list the cases whose error exceeds this (m)")
     parser.add_argument("--settings", nargs="*", default=[""],
                         help="candidate grids as k=v,k=v overrides of the default ('' = it)")
+    add_results_argument(parser, "grid_accuracy")
     args = parser.parse_args()
+    results = BenchResults("grid_accuracy")
     candidates = {text or "default": parse_settings(text) for text in args.settings}
     designs = cases([int(n) for n in args.notches.split(",")], args.quick)
     models = MODELS[:2] if args.quick else MODELS
@@ -97,6 +101,8 @@ def main() -> None:
                       for label in candidates)
     print(header)
     worst_case: dict[str, tuple[float, str]] = {label: (0.0, "") for label in candidates}
+    rows: list[list[object]] = []
+    over: list[list[object]] = []
     for routing, loads in models:
         unc = today_err = 0.0
         today_t: list[float] = []
@@ -127,6 +133,7 @@ def main() -> None:
                     ratios[label].append(elapsed / t_today)
                     if args.over is not None and err > args.over:
                         print(f"  {label}: {err:.2e} m {routing}/{loads} {name} @ {tension:g} N")
+                        over.append([label, f"{routing}/{loads}", name, tension, err])
                     if err > worst_case[label][0]:
                         worst_case[label] = (err, f"{routing}/{loads} {name} @ {tension:g} N")
         line = (f"{routing + '/' + loads:<15}{count:>6}{refused:>8}{unc:>12.1e}"
@@ -134,11 +141,36 @@ def main() -> None:
         line += "".join(f"{errs[label]:>19.2e}{within[label]:>8}{np.median(ratios[label]):>11.2f}"
                         for label in candidates)
         print(line, flush=True)
+        rows.append([f"{routing}/{loads}", count, refused, unc, today_err,
+                     float(np.median(today_t)) * 1e3,
+                     *(cell for label in candidates for cell in (
+                         errs[label], within[label], float(np.median(ratios[label]))))])
+    results.table(
+        "Tip error against the converged reference, and time against the uniform grid",
+        [Column("model"), Column("cases"), Column("refused"),
+         Column("reference uncertainty", "m", ".1e"), Column("uniform grid: worst", "m", ".2e"),
+         Column("uniform grid: median time", "ms", ".3f"),
+         *(column for label in candidates for column in (
+             Column(f"{label}: worst", "m", ".2e"), Column(f"{label}: cases ≤ 0.1 µm"),
+             Column(f"{label}: time / uniform", format=".2f")))], rows,
+        note=f"uniform grid: grid=uniform, 4 cells per notch, 1 per tube, quadrature order 4 "
+             f"(the previous default); cases at {' and '.join(f'{t:g}' for t in TENSIONS)} N; "
+             f"times: median of {args.repeats} solves per case, then the median over the cases; "
+             "refused: cases the model refuses at that load (closure, the tendon singularity, "
+             "eq. 7's kink limit)")
+    if over:
+        results.table(f"Cases over {args.over:g} m",
+                      [Column("grid"), Column("model"), Column("case"),
+                       Column("tension", "N", "g"), Column("error", "m", ".2e")], over)
     for label, (err, where) in worst_case.items():
         print(f"\nworst case of {label}: {err:.2e} m, {where}")
+    results.table("Worst case of each grid",
+                  [Column("grid"), Column("error", "m", ".2e"), Column("case")],
+                  [[label, err, where] for label, (err, where) in worst_case.items()])
     print("\nindependent check (constrained tendon, reference grid vs shooting-segmented "
           "rtol 1e-11):")
     options = ShootingOptions(rtol=1e-11, atol=1e-14)
+    checks: list[list[object]] = []
     for name in ("paper-experiment N=8", "fig3-wd-1.2 N=8", "paper-experiment N=1"):
         if name not in designs:
             continue
@@ -148,9 +180,17 @@ def main() -> None:
                               strict=False).tip_position
         except ModelError as exc:
             print(f"  {name}: shooting failed ({exc})")
+            checks.append([name, None, f"shooting failed ({exc})"])
             continue
         grid_tip = constrained_tip(design, 20.0, REFERENCE)
         print(f"  {name} @ 20 N: |grid - shooting| = {np.linalg.norm(grid_tip - shot):.2e} m")
+        checks.append([name, float(np.linalg.norm(grid_tip - shot)), ""])
+    results.table(
+        "Independent check at 20 N: constrained tendon, reference grid against "
+        "shooting-segmented at rtol 1e-11",
+        [Column("design"), Column("|grid − shooting|", "m", ".2e"), Column("note")], checks)
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

@@ -8,6 +8,10 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from sphinx.application import Sphinx
 
 # autodoc imports the checkout's package; rosdoc2 runs this file from a copy elsewhere (then its
 # own sys.path entry finds the package)
@@ -49,3 +53,14 @@ html_theme = "sphinx_rtd_theme"  # rosdoc2's, as on docs.ros.org
 html_title = "tdcm_ros"
 html_static_path = ["_static"]
 html_css_files = ["tdcm.css"]  # wider pages, wrapping table cells
+
+
+def setup(app: Sphinx) -> None:
+    """Load the docs' own extensions from ``_ext`` of the source folder Sphinx reads: found from
+    the app's ``srcdir``, not from this file's path, because rosdoc2 runs this file from a
+    wrapping configuration in another folder. ``bench_results``: the ``bench-results`` directive
+    (tables of a benchmark's results file, ``doc/results/*.json``)."""
+    ext = str(Path(app.srcdir) / "_ext")
+    if ext not in sys.path:
+        sys.path.insert(0, ext)
+    app.setup_extension("bench_results")

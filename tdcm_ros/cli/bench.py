@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tdcm_ros.cli.progress import ProgressBars, add_quiet_argument
+
+if TYPE_CHECKING:
+    from tdcm_ros.model.accuracy import Report
 
 
 def register(subparsers: Any) -> None:
@@ -40,13 +43,15 @@ def register(subparsers: Any) -> None:
 
 def run_accuracy(args: argparse.Namespace) -> int:
     """Run the accuracy bench; the table (or JSON) on stdout, progress on stderr."""
+    print_accuracy(args, measure_accuracy(args))
+    return 0
+
+
+def measure_accuracy(args: argparse.Namespace) -> Report:
+    """The accuracy bench's report for ``args`` (progress on stderr; the plot written when
+    ``args.plot`` names a file). bench/accuracy.py also records it in a results file."""
     from tdcm_ros.figures import plot_file
-    from tdcm_ros.model.accuracy import (
-        format_markdown,
-        format_table,
-        plot_pareto,
-        run_bench,
-    )
+    from tdcm_ros.model.accuracy import plot_pareto, run_bench
 
     if args.plot:
         plot_file("--plot", args.plot)  # before the bench: a bad path fails at once
@@ -54,6 +59,13 @@ def run_accuracy(args: argparse.Namespace) -> int:
         report = run_bench(quick=args.quick, progress=bars)
     if args.plot:
         plot_pareto(report, args.plot)
+    return report
+
+
+def print_accuracy(args: argparse.Namespace, report: Report) -> None:
+    """Print ``report`` as ``args`` ask: JSON, or the table (after the Markdown one)."""
+    from tdcm_ros.model.accuracy import format_markdown, format_table
+
     if args.json:
         print(json.dumps(report.to_json(), default=float))
     else:
@@ -62,4 +74,3 @@ def run_accuracy(args: argparse.Namespace) -> int:
         print(format_table(report))
         if args.plot:
             print(f"Pareto plot written to {args.plot}")
-    return 0
