@@ -20,7 +20,8 @@ from test.support.examples import REPO
 
 #: Snippets that need a real device (a serial port): parsed, not run.
 HARDWARE = ("import serial",)
-_FENCE = re.compile(r"^```(\w*)\s*$")
+#: A fence opener: three or more backticks, then the language or a MyST directive (``{toctree}``).
+_FENCE = re.compile(r"^(`{3,})\s*(\S*)")
 _HEREDOC = re.compile(r"^python3? - <<'?(\w+)'?\s*$")
 
 
@@ -39,21 +40,21 @@ def doc_snippets() -> list[Snippet]:
             continue
         lines = page.read_text(encoding="utf-8").splitlines()
         where = str(page.relative_to(REPO))
-        language, start, block = None, 0, []
+        fence, language, start, block = "", "", 0, []
         for number, line in enumerate(lines, 1):
-            fence = _FENCE.match(line)
-            if fence and language is None:
-                language, start, block = fence.group(1), number, []
+            if not fence:
+                opener = _FENCE.match(line)
+                if opener:
+                    fence, language, start, block = opener.group(1), opener.group(2), number, []
                 continue
-            if line.startswith("```") and language is not None:
+            if line.strip() == fence:
                 if language == "python":
                     found.append(Snippet(f"{where}:{start}", "\n".join(block)))
                 elif language in ("bash", "sh", ""):
                     found.extend(_heredocs(block, where, start))
-                language = None
+                fence = ""
                 continue
-            if language is not None:
-                block.append(line)
+            block.append(line)
     return found
 
 
