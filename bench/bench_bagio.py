@@ -1,6 +1,6 @@
 """Bag I/O benchmark (issue 6): write/read throughput of a 10-minute trial and recording loss.
 
-Run: ``python bench/bench_bagio.py [--minutes 10] [--kills 3]``. Prints
+Run: ``python bench/bench_bagio.py [--minutes 10] [--kills 3] [--results FILE]``. Prints
 
 - write throughput of :class:`BagWriter` (messages/s) for a trial at 1 kHz tension
   (WrenchStamped) + 100 Hz markers (Markers, 3 markers): 660k messages for 10 minutes;
@@ -8,6 +8,9 @@ Run: ``python bench/bench_bagio.py [--minutes 10] [--kills 3]``. Prints
 - how many messages ``tdcm record`` loses when it is stopped by SIGINT or SIGKILL while a
   publisher sends the same mix live (1 kHz + 100 Hz) over the embedded zenoh runtime
   (a private router on a free port). "Lost" = published before the signal, absent from the bag.
+
+``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -22,6 +25,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.bagio import from_dict, serialize
 from tdcm_ros.bagio.reader import open_bag
@@ -75,7 +80,7 @@ def trial_messages(minutes: float) -> list[tuple[str, int, bytes]]:
     return out
 
 
-def bench_files(minutes: float, folder: Path) -> None:
+def bench_files(minutes: float, folder: Path, results: BenchResults) -> None:
     messages = trial_messages(minutes)
     bag = folder / "trial"
     start = time.perf_counter()
@@ -100,6 +105,15 @@ def bench_files(minutes: float, folder: Path) -> None:
     decoded_s = time.perf_counter() - start
     print(f"read decoded:   {decoded_s:6.2f} s  {count / decoded_s:9.0f} messages/s (messages(), "
           f"rosbags objects)")
+    results.table(
+        f"Bag write and read: a {minutes:g} min trial",
+        [Column("step"), Column("time", "s", ".2f"), Column("throughput", "messages/s", ",.0f")],
+        [["write (BagWriter)", write_s, len(messages) / write_s],
+         ["read raw CDR (open_bag + raw_messages)", raw_s, count / raw_s],
+         ["read decoded (messages(), rosbags objects)", decoded_s, count / decoded_s]],
+        note=f"{len(messages)} messages ({TENSION_HZ} Hz tension + {MARKERS_HZ} Hz markers), bag "
+             f"{size / 1e6:.1f} MB (chunk {DEFAULT_CHUNK_SIZE // 1024} KiB, flush period "
+             f"{DEFAULT_FLUSH_PERIOD_S} s, zstd)")
 
 
 def _free_port() -> int:
@@ -154,7 +168,7 @@ def record_once(folder: Path, env: dict[str, str], stop: signal.Signals, seconds
     return len(expected), sum(1 for item in expected if item not in recorded)
 
 
-def bench_recording(kills: int, seconds: float, folder: Path) -> None:
+def bench_recording(kills: int, seconds: float, folder: Path, results: BenchResults) -> None:
     port = _free_port()
     env = {**os.environ, "TDCM_ZENOH_ENDPOINT": f"tcp/127.0.0.1:{port}", "ROS_DOMAIN_ID": "0",
            "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
@@ -163,13 +177,23 @@ def bench_recording(kills: int, seconds: float, folder: Path) -> None:
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         _wait(lambda: _connectable(port), 15.0)
+        rows = []
         for stop in (signal.SIGINT, signal.SIGKILL):
-            results = [record_once(folder, env, stop, seconds) for _ in range(kills)]
-            lost = [lost for _, lost in results]
+            runs = [record_once(folder, env, stop, seconds) for _ in range(kills)]
+            lost = [lost for _, lost in runs]
             print(f"tdcm record stopped by {stop.name} after {seconds:g} s at "
                   f"{TENSION_HZ} Hz + {MARKERS_HZ} Hz, {kills} runs: published before the "
-                  f"signal {statistics.mean(p for p, _ in results):.0f}, lost min/mean/max "
+                  f"signal {statistics.mean(p for p, _ in runs):.0f}, lost min/mean/max "
                   f"{min(lost)}/{statistics.mean(lost):.1f}/{max(lost)}")
+            rows.append([stop.name, kills, statistics.mean(p for p, _ in runs), min(lost),
+                         statistics.mean(lost), max(lost)])
+        results.table(
+            f"tdcm record stopped by a signal after {seconds:g} s",
+            [Column("signal"), Column("runs"), Column("published before the signal", format=".0f"),
+             Column("lost, min"), Column("lost, mean", format=".1f"), Column("lost, max")], rows,
+            note=f"a live publisher at {TENSION_HZ} Hz + {MARKERS_HZ} Hz over the embedded zenoh "
+                 "runtime (a private router); published before the signal: mean over the runs; "
+                 "lost: published before the signal, absent from the bag")
     finally:
         router.send_signal(signal.SIGINT)
         router.wait(10)
@@ -188,11 +212,15 @@ def main() -> None:
     parser.add_argument("--minutes", type=float, default=10.0, help="trial length (min)")
     parser.add_argument("--kills", type=int, default=3, help="recordings per stop signal")
     parser.add_argument("--seconds", type=float, default=3.0, help="recording length (s)")
+    add_results_argument(parser, "bench_bagio")
     args = parser.parse_args()
+    results = BenchResults("bench_bagio")
     with tempfile.TemporaryDirectory() as tmp:
-        bench_files(args.minutes, Path(tmp))
+        bench_files(args.minutes, Path(tmp), results)
         if args.kills > 0:
-            bench_recording(args.kills, args.seconds, Path(tmp))
+            bench_recording(args.kills, args.seconds, Path(tmp), results)
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

@@ -1,12 +1,15 @@
 """How often a liveliness query of the graph completes short: N tokens on a private router, Q queries.
 
-Run: ``PYTHONPATH=. python3 bench/bench_liveliness_query.py [--tokens 50] [--queries 40] [--hogs 0 1]``.
+Run: ``PYTHONPATH=. python3 bench/bench_liveliness_query.py [--tokens 50] [--queries 40]
+[--hogs 0 1] [--results FILE]``.
 
 A peer session declares ``--tokens`` rmw_zenoh publisher tokens; a second peer asks for them
 ``--queries`` times with :func:`tdcm_ros.runtime.zenoh_query.gather` (what every graph query of the
 package uses), with ``--hogs`` CPU-bound processes running beside it. Prints, per hog count, how
 many queries completed (zenoh's final reply came) with fewer tokens than were declared, the
 fewest seen, and the median time a query took. Every query should return all of them.
+``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+from results import BenchResults, Column, add_results_argument
 
 REPO = Path(__file__).resolve().parents[1]
 HOG = "while True: pass"
@@ -73,7 +78,9 @@ def main() -> None:
     parser.add_argument("--tokens", type=int, default=50)
     parser.add_argument("--queries", type=int, default=40)
     parser.add_argument("--hogs", type=int, nargs="+", default=[0, 1])
+    add_results_argument(parser, "bench_liveliness_query")
     args = parser.parse_args()
+    results = BenchResults("bench_liveliness_query")
     port = free_port()
     endpoint = f"tcp/127.0.0.1:{port}"
     os.environ.update(TDCM_ZENOH_ENDPOINT=endpoint, ROS_DOMAIN_ID=os.environ.get("ROS_DOMAIN_ID",
@@ -85,6 +92,7 @@ def main() -> None:
         if router.poll() is not None:
             raise SystemExit("the router did not start")
     print(f"{'hogs':>4} {'queries':>8} {'short':>6} {'fewest':>7} {'median s':>9}")
+    rows = []
     try:
         for hogs in args.hogs:
             load = [subprocess.Popen([sys.executable, "-c", HOG]) for _ in range(hogs)]
@@ -95,9 +103,18 @@ def main() -> None:
                     hog.kill()
                     hog.wait()
             print(f"{hogs:>4} {args.queries:>8} {short:>6} {fewest:>7} {median:>9.4f}")
+            rows.append([hogs, args.queries, short, fewest, median])
     finally:
         router.terminate()
         router.wait()
+    results.table(
+        f"Liveliness queries of {args.tokens} tokens on a private router",
+        [Column("CPU hogs"), Column("queries"), Column("short"), Column("fewest tokens"),
+         Column("median query", "s", ".4f")], rows,
+        note="short: queries that did not return every declared token (one that did not "
+             "complete counts as -1 tokens); fewest: the fewest tokens one query returned")
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

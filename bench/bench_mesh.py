@@ -1,6 +1,6 @@
 """Mesh-body benchmark (issue 27): a body file naming an STL -> the first solve.
 
-Run: ``python bench/bench_mesh.py [--notches 30] [--sides 200] [--repeats 3]``.
+Run: ``python bench/bench_mesh.py [--notches 30] [--sides 200] [--repeats 3] [--results FILE]``.
 Builds (manifold3d, the test extra) the paper's tube with ``--notches`` tee notches, each the
 polygon of ``config/bodies/tee_notches.yaml``, its circles ``--sides``-gons (200: ~50 k
 faces at 30 notches), writes it as a binary STL with a body file naming it, and times, in a
@@ -12,6 +12,8 @@ floor: imports, kernels, grid). Prints the face count, the medians and the targe
 -> first solve <= 2 s). ``--write FILE``
 only writes the STL (e.g. the shipped ``config/bodies/tee_notches.stl``); ``--slanted`` makes
 the notches slanted cuts deepening toward the tip (``config/bodies/slanted_wrist.stl``).
+``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``; not with ``--write``, which measures nothing).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 from shapely.geometry import Polygon
 
 REPO = Path(__file__).resolve().parents[1]
@@ -72,7 +75,9 @@ def main() -> int:
     parser.add_argument("--write", type=Path, help="only write the STL to this file")
     parser.add_argument("--slanted", action="store_true",
                         help="slanted cuts deepening toward the tip instead of tee notches")
+    add_results_argument(parser, "bench_mesh")
     args = parser.parse_args()
+    results = BenchResults("bench_mesh")
     mesh = (slanted_body if args.slanted else tee_body)(args.notches, args.sides)
     if args.write:
         mesh.export(str(args.write))
@@ -112,6 +117,23 @@ def main() -> int:
           "(paper-experiment: imports, kernels, grid)")
     print(f"  tip x at 5 N                      {runs['cold'][0]['tip_x_m'] * 1e3:.4f} mm "
           f"(cached: {runs['warm'][0]['tip_x_m'] * 1e3:.4f} mm)")
+    results.table(
+        f"Mesh body: {len(mesh.faces)} faces, {runs['cold'][0]['N']} notches",
+        [Column("figure"), Column("measured"), Column("unit")],
+        [["read body file, mesh not seen (imports, reading the STL, slicing)",
+          median("cold", "read_s"), "s"],
+         ["body file → first solve, mesh not seen", median("cold", "total_s"), "s"],
+         ["read body file, slices cached", median("warm", "read_s"), "s"],
+         ["body file → first solve, slices cached (target ≤ 2 s)", median("warm", "total_s"),
+          "s"],
+         ["the preset paper-experiment, the same way (imports, kernels, grid)",
+          median("preset", "total_s"), "s"],
+         ["tip x at 5 N", runs["cold"][0]["tip_x_m"] * 1e3, "mm"],
+         ["tip x at 5 N, slices cached", runs["warm"][0]["tip_x_m"] * 1e3, "mm"]],
+        note=f"{'slanted cuts' if args.slanted else 'tee notches'}, {args.sides}-gon circles, "
+             f"STL {size} bytes; medians of {args.repeats}, a fresh process each")
+    if args.results:
+        results.write(args.results)
     return 0
 
 

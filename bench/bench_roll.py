@@ -1,11 +1,12 @@
 """What the roll costs model_node per solve (issue 18, item 2): building its outputs (the five
 shape messages and the ``/tf`` message) at a roll against at roll 0, in one run.
 
-Run: ``python bench/bench_roll.py [--repeats 2000] [--stations 0] [--roll 0.7]``.
+Run: ``python bench/bench_roll.py [--repeats 2000] [--stations 0] [--roll 0.7] [--results FILE]``.
 One solve of paper-experiment at 12 N, then ``--repeats`` builds of every output at roll 0 and at
 ``--roll`` rad, interleaved (so machine noise hits both alike); prints the median time per build
 of each and their ratio, and the median time of one solve of the same design (warm) for scale.
-Single-threaded.
+Single-threaded. ``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import SolveResult, preset, solve, warm_up
 from tdcm_ros.nodes.shape_messages import midline_messages
@@ -44,7 +46,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=2000)
     parser.add_argument("--stations", type=int, default=0)
     parser.add_argument("--roll", type=float, default=0.7)
+    add_results_argument(parser, "bench_roll")
     args = parser.parse_args()
+    results = BenchResults("bench_roll")
     warm_up()
     design = preset("paper-experiment")
     result = solve(design, 12.0)
@@ -65,6 +69,19 @@ def main() -> None:
           f"(extra {p_rolled - p_flat:.1f} us per solve)")
     print(f"one solve of paper-experiment at 12 N, warm (median of 200): "
           f"{np.median(solves) * 1e6:.1f} us")
+    results.table(
+        f"Outputs of one solve ({args.stations} stations), median of {args.repeats}",
+        [Column("figure"), Column("measured"), Column("unit")],
+        [["outputs at roll 0", p_flat, "µs"],
+         [f"outputs at roll {args.roll:g} rad", p_rolled, "µs"],
+         ["ratio rolled / roll 0", p_rolled / p_flat, ""],
+         ["extra per solve", p_rolled - p_flat, "µs"],
+         ["one solve of paper-experiment at 12 N, warm (median of 200)",
+          np.median(solves) * 1e6, "µs"]],
+        note="outputs: the five shape messages and the /tf message of one solve of "
+             "paper-experiment at 12 N; both rolls interleaved")
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

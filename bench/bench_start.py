@@ -1,6 +1,7 @@
 """Start benchmark (issue 15 item 5): ``tdcm solve`` from process start to its JSON.
 
-Run: ``python bench/bench_start.py [--runs 15] [--tension 20] [--baseline /work/main]``.
+Run: ``python bench/bench_start.py [--runs 15] [--tension 20] [--baseline /work/main]
+[--results FILE]``.
 Times whole child processes
 (wall clock from spawn to exit, JSON on stdout) and reads each child's peak RSS from
 ``os.wait4``, interleaving in every round:
@@ -14,7 +15,8 @@ Times whole child processes
 
 Children run in the checkout this script belongs to (working directory and ``PYTHONPATH``).
 Prints medians, minima, peak RSS and the ratios to the library run. Target: ``cli`` median
-<= 0.3 s.
+<= 0.3 s. ``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ import sys
 import time
 from pathlib import Path
 from typing import IO
+
+from results import BenchResults, Column, add_results_argument
 
 TARGET_S = 0.3
 LIBRARY = ("import json; from tdcm_ros.model import preset, solve; "
@@ -58,7 +62,9 @@ def main() -> None:
     parser.add_argument("--tension", type=float, default=20.0, help="tension of the solve (N)")
     parser.add_argument("--baseline", type=Path, metavar="DIR",
                         help="another checkout whose cli start is timed in the same rounds")
+    add_results_argument(parser, "bench_start")
     args = parser.parse_args()
+    results = BenchResults("bench_start")
     cli = [sys.executable, "-m", "tdcm_ros", "solve", "--tension", f"{args.tension:g}", "--json"]
     commands = {
         "cli": (cli, ROOT),
@@ -79,13 +85,27 @@ def main() -> None:
     print(f"tdcm solve start, {args.runs} interleaved runs each ({sys.executable}, "
           f"checkout {ROOT}{f', baseline {args.baseline}' if args.baseline else ''})")
     library = statistics.median(times["library"])
+    rows = []
     for name in commands:
         median = statistics.median(times[name])
         print(f"  {name:<8} median {median:.3f} s  min {min(times[name]):.3f} s  "
               f"peak RSS {max(peaks[name]):6.1f} MiB  ({median / library:.2f}x library)")
+        rows.append([name, median, min(times[name]), max(peaks[name]), median / library])
     cli = statistics.median(times["cli"])
     print(f"cli over library: +{cli - library:.3f} s; target cli <= {TARGET_S:g} s: "
           f"{'met' if cli <= TARGET_S else 'NOT met'}")
+    results.table(
+        f"tdcm solve start, {args.runs} interleaved runs each",
+        [Column("command"), Column("median", "s", ".3f"), Column("min", "s", ".3f"),
+         Column("peak RSS", "MiB", ".1f"), Column("× library", format=".2f")], rows,
+        note=f"wall clock from spawn to exit, tension {args.tension:g} N; cli: python -m "
+             "tdcm_ros solve --json; library: python -c importing tdcm_ros.model and solving; "
+             "python: python -c pass"
+             + (f"; baseline: the cli on {args.baseline}" if args.baseline else "")
+             + f". cli over library: +{cli - library:.3f} s; target cli <= {TARGET_S:g} s: "
+             f"{'met' if cli <= TARGET_S else 'NOT met'}")
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

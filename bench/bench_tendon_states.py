@@ -2,9 +2,11 @@
 messages (:func:`tdcm_ros.nodes.shape_messages.midline_messages`) against the same plus the
 tendon's stroke and its ``sensor_msgs/JointState``, interleaved in one run.
 
-Run: ``python bench/bench_tendon_states.py [--rounds 15] [--number 100]``. paper-experiment at
-20 N, 50 midline samples, three markers; per round the best of three timings of ``--number``
-calls of each; prints the medians over rounds (us) and their difference. Single-threaded.
+Run: ``python bench/bench_tendon_states.py [--rounds 15] [--number 100] [--results FILE]``.
+paper-experiment at 20 N, 50 midline samples, three markers; per round the best of three timings
+of ``--number`` calls of each; prints the medians over rounds (us) and their difference.
+Single-threaded. ``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import SolveResult, preset, solve, warm_up
 from tdcm_ros.nodes.joint_messages import tendon_states
@@ -46,7 +49,9 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=15)
     parser.add_argument("--number", type=int, default=100)
+    add_results_argument(parser, "bench_tendon_states")
     args = parser.parse_args()
+    results = BenchResults("bench_tendon_states")
     warm_up()
     times: dict[str, list[float]] = {"shape": [], "tendon": []}
     for _ in range(args.rounds):
@@ -56,6 +61,15 @@ def main() -> None:
     base, more = float(np.median(times["shape"])), float(np.median(times["tendon"]))
     print(f"solve + shape messages {base:.0f} us; with tendon_states {more:.0f} us: "
           f"+{more - base:.0f} us ({(more / base - 1.0) * 100:.0f} %) per input")
+    results.table(
+        "tendon_states: cost per input (paper-experiment at 20 N)",
+        [Column("solve + shape messages", "µs", ".0f"), Column("with tendon_states", "µs", ".0f"),
+         Column("extra", "µs", "+.0f"), Column("extra", "%", ".0f")],
+        [[base, more, more - base, (more / base - 1.0) * 100]],
+        note=f"medians over {args.rounds} interleaved rounds, each the best of three timings of "
+             f"{args.number} calls; 50 midline samples, three markers")
+    if args.results:
+        results.write(args.results)
 
 
 if __name__ == "__main__":

@@ -1,11 +1,14 @@
 """Fault campaign of issue 13: hostile and unlucky inputs against every external input path.
 
-Run: ``python bench/fault_campaign.py [--tries N] [--only CLASS ...] [--seed S]``.
+Run: ``python bench/fault_campaign.py [--tries N] [--only CLASS ...] [--seed S]
+[--results FILE]``.
 
 Bounded (every class has a fixed number of tries and every wait a timeout) and loopback only
 (a private zenoh router on 127.0.0.1; the device on the in-process cable for ``reconnect``, a pty
 for the others). Each class prints one row
 ``class | tries | failures | what a failure is``; the exit status is 1 if any try failed.
+``--results FILE`` also writes the printed figures as tables to a results file
+(``bench/results.py``).
 
 Classes:
 - ``reconnect``: the twin holds 10 N; unplug/replug, reboot on reopen, reboot with the port open,
@@ -62,6 +65,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.errors import TdcmError
 
@@ -418,7 +422,7 @@ def campaign_yaml(tries: int, rng: random.Random, tmp: Path) -> Failures:
         text = hostile_yaml(rng)
         path.write_text(text)
         for what, load in (("scene", lambda text=text: scene_from_text(text)),
-                           ("params", lambda: node_parameters(path, "/model_node"))):
+                           ("params", lambda: node_parameters([path], "/model_node"))):
             failures += typed_within(f"{what} {text[:40]!r}", load, 1.0)
     return failures
 
@@ -824,10 +828,13 @@ def main() -> int:
                         help="scale every class's number of tries (default 1.0)")
     parser.add_argument("--only", nargs="+", choices=sorted(CAMPAIGNS), help="classes to run")
     parser.add_argument("--seed", type=int, default=13)
+    add_results_argument(parser, "fault_campaign")
     args = parser.parse_args()
+    results = BenchResults("fault_campaign")
     names = args.only or list(CAMPAIGNS)
     print(f"{'class':14s} {'tries':>6s} {'failures':>9s} {'s':>7s}  failure means")
     total = 0
+    rows = []
     with tempfile.TemporaryDirectory(prefix="tdcm_faults_") as folder:
         for name in names:
             run, tries, meaning = CAMPAIGNS[name]
@@ -839,13 +846,24 @@ def main() -> int:
             except Exception as error:  # noqa: BLE001 - the campaign itself must report, not die
                 failures = [f"campaign error: {type(error).__name__}: {error}"]
             total += len(failures)
-            print(f"{name:14s} {tries:6d} {len(failures):9d} {time.monotonic() - start:7.1f}  "
+            took = time.monotonic() - start
+            print(f"{name:14s} {tries:6d} {len(failures):9d} {took:7.1f}  "
                   f"{meaning}", flush=True)
             if name in NOTES:
                 print(f"    ({NOTES[name]})")
             for failure in failures[:5]:
                 print(f"    {failure}")
+            rows.append([name, tries, len(failures), took, meaning,
+                         NOTES.get(name), "; ".join(failures[:5]) or None])
     print(f"total failures: {total}")
+    results.table(
+        "Fault campaign", [Column("class"), Column("tries"), Column("failures"),
+                           Column("time", "s", ".1f"), Column("failure means"), Column("note"),
+                           Column("first failures")], rows,
+        note=f"total failures: {total}; seed {args.seed}, tries scaled by {args.tries:g}; "
+             "first failures: up to five, as printed")
+    if args.results:
+        results.write(args.results)
     return 1 if total else 0
 
 
