@@ -157,11 +157,18 @@ CLI_NOTES = """\
 
 Errors exit with one line on stderr, never a traceback (the statuses are below). Only the named
 command's module is imported, and each command imports its heavy modules (scipy, the bag reader,
-the runtimes, matplotlib) when it runs, so `tdcm solve` starts like the library call:
-`python3 bench/bench_start.py --baseline DIR` times `python -m tdcm_ros solve --tension 20 --json`
-from spawn to exit (15 interleaved runs, shared 2-core machine) at a median 0.157 s, 31.6 MiB peak
-RSS, against 0.143 s / 31.0 MiB for importing `tdcm_ros.model` and printing the same JSON. A
-`tdcm` on PATH that is a pyenv shim adds ~0.1 s of its own. `test/cli/test_main_cli.py` checks
+the runtimes, matplotlib) when it runs, so `tdcm solve` starts at least as fast as the library call.
+`python3 bench/bench_start.py [--baseline DIR]` times `python -m tdcm_ros solve --tension 20 --json`
+from spawn to exit (15 interleaved runs) against importing `tdcm_ros.model`, solving and printing the
+same JSON, and a bare interpreter (`--baseline DIR` adds another checkout's `cli`); one run without
+a baseline on the shared 2-core machine:
+
+:::{{bench-results}} /results/bench_start.json
+:::
+
+The library run pays numba's import and cache load (`TDCM_JIT` unset), which a one-shot `tdcm solve`
+skips (it runs the plain build, see [accuracy and cost](../explanation/accuracy_cost.md#the-compiled-kernel)).
+A `tdcm` on PATH that is a pyenv shim adds ~0.1 s of its own. `test/cli/test_main_cli.py` checks
 that `tdcm solve` and `tdcm COMMAND -h` import none of scipy, matplotlib, zenoh, mcap, rosbags,
 numba or rclpy.
 
