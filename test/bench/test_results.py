@@ -42,7 +42,7 @@ CONVERTED = ("accuracy", "bench_batch", "bench_controller", "bench_design", "ben
              "bench_evaluate", "bench_evaluate_memory", "bench_grids", "bench_inverse",
              "bench_latency", "bench_loading", "bench_material", "bench_mesh", "bench_pose",
              "bench_progress", "bench_roll", "bench_shape_design", "bench_solve", "bench_start",
-             "bench_tendon_states", "bench_tendons", "grid_accuracy")
+             "bench_tendon_states", "bench_tendons", "fault_campaign", "grid_accuracy")
 
 
 def fixed_provenance() -> results.Provenance:
