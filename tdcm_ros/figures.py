@@ -15,6 +15,7 @@ Also the checks of every plot output option (``--plot FILE``, ``--out DIR``):
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -81,6 +82,20 @@ def output_folder(option: str, path: str | Path) -> Path:
                             parameter=option, value=str(out), allowed="a writable folder"
                             ) from error
     return out
+
+
+def save_figures(directory: str | Path, option: str,
+                 figures: Sequence[tuple[str, Callable[[Any], Any]]]) -> list[Path]:
+    """Each ``(name, make)`` of ``figures``: ``make(pyplot)`` saved as ``directory/name`` at 120
+    dpi and closed; the folder created if missing (:func:`output_folder`, ``option`` names it in
+    errors). Returns the files written."""
+    plt = load_pyplot(option, Path(directory))
+    out = output_folder(option, directory)
+    for name, make in figures:
+        fig = make(plt)
+        fig.savefig(out / name, dpi=120)
+        plt.close(fig)
+    return [out / name for name, _ in figures]
 
 
 @dataclass(frozen=True)

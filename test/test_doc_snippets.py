@@ -16,12 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from test.support.examples import REPO
+from test.support.examples import REPO, SHELL, doc_pages, fenced_blocks
 
 #: Snippets that need a real device (a serial port): parsed, not run.
 HARDWARE = ("import serial",)
-#: A fence opener: three or more backticks, then the language or a MyST directive (``{toctree}``).
-_FENCE = re.compile(r"^(`{3,})\s*(\S*)")
 _HEREDOC = re.compile(r"^python3? - <<'?(\w+)'?\s*$")
 
 
@@ -33,28 +31,14 @@ class Snippet:
 
 def doc_snippets() -> list[Snippet]:
     """The Python snippets of the README and of every page of the docs site, in page order."""
-    pages = [REPO / "README.md", *sorted((REPO / "doc").rglob("*.md"))]
     found: list[Snippet] = []
-    for page in pages:
-        if "_build" in page.parts:
-            continue
-        lines = page.read_text(encoding="utf-8").splitlines()
+    for page in doc_pages():
         where = str(page.relative_to(REPO))
-        fence, language, start, block = "", "", 0, []
-        for number, line in enumerate(lines, 1):
-            if not fence:
-                opener = _FENCE.match(line)
-                if opener:
-                    fence, language, start, block = opener.group(1), opener.group(2), number, []
-                continue
-            if line.strip() == fence:
-                if language == "python":
-                    found.append(Snippet(f"{where}:{start}", "\n".join(block)))
-                elif language in ("bash", "sh", ""):
-                    found.extend(_heredocs(block, where, start))
-                fence = ""
-                continue
-            block.append(line)
+        for block in fenced_blocks(page):
+            if block.language == "python":
+                found.append(Snippet(f"{where}:{block.first_line - 1}", "\n".join(block.lines)))
+            elif block.language in SHELL:
+                found.extend(_heredocs(block.lines, where, block.first_line - 1))
     return found
 
 

@@ -17,8 +17,7 @@ from typing import Any
 import numpy as np
 
 from tdcm_ros.demo.tracking_report import PhaseError, TrackingRecord, lap_of, points_at
-from tdcm_ros.figures import output_folder
-from tdcm_ros.plot_backend import load_pyplot
+from tdcm_ros.figures import save_figures
 from tdcm_ros.plotting import FONT_SIZE
 from tdcm_ros.scenes import (
     FEEDBACK,
@@ -158,13 +157,7 @@ def write_tracking_plots(record: TrackingRecord, errors: list[PhaseError],
                          world_gain: float | None = None) -> list[Path]:
     """Write ``tracking_paths.png`` and ``tracking_error.png`` into ``directory`` (created if
     missing; its parent must exist); ``world_gain`` as in :func:`error_figure`."""
-    plt = load_pyplot("--out", directory)
-    out = output_folder("--out", directory)
-    paths = []
-    for name, fig in (("tracking_paths.png", paths_figure(plt, record, circle, world_gain)),
-                      ("tracking_error.png", error_figure(plt, record, errors, circle,
-                                                          world_gain))):
-        fig.savefig(out / name, dpi=120)
-        plt.close(fig)
-        paths.append(out / name)
-    return paths
+    return save_figures(directory, "--out", (
+        ("tracking_paths.png", lambda plt: paths_figure(plt, record, circle, world_gain)),
+        ("tracking_error.png", lambda plt: error_figure(plt, record, errors, circle,
+                                                        world_gain))))

@@ -10,16 +10,14 @@ the measured midline is the spline through the markers moved back by that offset
 from __future__ import annotations
 
 import textwrap
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from tdcm_ros.figures import output_folder
+from tdcm_ros.figures import save_figures
 from tdcm_ros.metrics.calibration import Calibration
 from tdcm_ros.metrics.evaluation import Evaluation
-from tdcm_ros.plot_backend import load_pyplot
 
 MM = 1e3
 """Metres to millimetres (plots are in mm)."""
@@ -130,14 +128,9 @@ def calibration_figure(plt: Any, fit: Calibration) -> Any:
             tension, error = step_errors(evaluation, trial)
             ax.plot(tension, error * MM, style, color=f"C{k}", mfc="none" if when == "before"
                     else None, label=f"trial {trial}, {when} calibration")
-    ax.axhline(0.0, color="k", lw=0.8, label="no error")
-    ax.set_xlabel(tension_label(fit.before), fontsize=FONT_SIZE)
-    ax.set_ylabel("tip deflection error,\npredicted - measured (mm)", fontsize=FONT_SIZE)
+    _error_axes(ax, fit.before)
     ax.set_title("Calibration fits " + fitted + "; what error is left after it is what the fitted "
                  "model cannot explain (friction, noise)", fontsize=FONT_SIZE, wrap=True)
-    ax.tick_params(labelsize=FONT_SIZE)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=FONT_SIZE - 1)
     fig.tight_layout()
     return fig
 
@@ -147,23 +140,10 @@ def write_calibration_plots(fit: Calibration, directory: str | Path, *, option: 
     """Write ``calibration.png`` (:func:`.calibration_figure`) and ``shapes_calibrated.png``
     (:func:`.shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
     fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
-    return _write(directory, option, (
+    return save_figures(directory, option, (
         ("calibration.png", lambda plt: calibration_figure(plt, fit)),
         ("shapes_calibrated.png", lambda plt: shapes_figure(
             plt, fit.after, f"Measured and calibrated-model shapes ({fitted})"))))
-
-
-def _write(directory: str | Path, option: str,
-           figures: tuple[tuple[str, Callable[[Any], Any]], ...]) -> list[Path]:
-    """Each ``(name, make)`` of ``figures``: ``make(pyplot)`` saved as ``directory/name`` (the
-    folder created if missing; ``option`` names it in errors) and closed."""
-    plt = load_pyplot(option, Path(directory))
-    out = output_folder(option, directory)
-    for name, make in figures:
-        fig = make(plt)
-        fig.savefig(out / name, dpi=120)
-        plt.close(fig)
-    return [out / name for name, _ in figures]
 
 
 def error_figure(plt: Any, evaluation: Evaluation) -> Any:
@@ -172,15 +152,21 @@ def error_figure(plt: Any, evaluation: Evaluation) -> Any:
     for trial in sorted({r.trial for r in evaluation.records}):
         tension, error = step_errors(evaluation, trial)
         ax.plot(tension, error * MM, "o-", label=f"trial {trial}")
+    _error_axes(ax, evaluation)
+    ax.set_title("model error at each step", fontsize=FONT_SIZE + 1)
+    fig.tight_layout()
+    return fig
+
+
+def _error_axes(ax: Any, evaluation: Evaluation) -> None:
+    """The zero line, labels (tension in ``evaluation``'s terms, error in mm), grid and legend
+    of a tip-error-per-step plot."""
     ax.axhline(0.0, color="k", lw=0.8, label="no error")
     ax.set_xlabel(tension_label(evaluation), fontsize=FONT_SIZE)
     ax.set_ylabel("tip deflection error,\npredicted - measured (mm)", fontsize=FONT_SIZE)
-    ax.set_title("model error at each step", fontsize=FONT_SIZE + 1)
     ax.tick_params(labelsize=FONT_SIZE)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=FONT_SIZE - 1)
-    fig.tight_layout()
-    return fig
 
 
 def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = "--out"
@@ -188,6 +174,6 @@ def write_plots(evaluation: Evaluation, directory: str | Path, *, option: str = 
     """Write ``shapes.png`` (:func:`.shapes_figure`) and ``error_vs_tension.png``
     (:func:`.error_figure`) into ``directory`` (created if missing; its parent must exist;
     ``option`` names it in errors)."""
-    return _write(directory, option, (
+    return save_figures(directory, option, (
         ("shapes.png", lambda plt: shapes_figure(plt, evaluation)),
         ("error_vs_tension.png", lambda plt: error_figure(plt, evaluation))))

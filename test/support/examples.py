@@ -48,12 +48,51 @@ def _parse(line: str, where: str) -> Example | None:
     return Example(where, env, words)
 
 
+#: A fence opener: three or more backticks, then the language or a MyST directive (``{toctree}``).
+_FENCE = re.compile(r"^(`{3,})\s*(\S*)")
+#: The languages of a shell block.
+SHELL = ("bash", "sh", "")
+
+
+@dataclass(frozen=True)
+class Block:
+    """One fenced block of a Markdown file: its language, the number of its first line inside
+    the fence (1-based) and its lines."""
+
+    language: str
+    first_line: int
+    lines: list[str]
+
+
+def doc_pages() -> list[Path]:
+    """The README and every page of the docs site (not a build's output)."""
+    return [REPO / "README.md",
+            *(p for p in sorted((REPO / "doc").rglob("*.md")) if "_build" not in p.parts)]
+
+
+def fenced_blocks(path: Path) -> list[Block]:
+    """The fenced blocks of a Markdown file, as MyST reads them: a fence closes only on a line of
+    its own backticks, so a longer fence may hold shorter ones."""
+    found: list[Block] = []
+    fence, language, first, lines = "", "", 0, []
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        if not fence:
+            opener = _FENCE.match(line)
+            if opener:
+                fence, language, first, lines = opener.group(1), opener.group(2), number + 1, []
+        elif line.strip() == fence:
+            found.append(Block(language, first, lines))
+            fence = ""
+        else:
+            lines.append(line)
+    return found
+
+
 def documented_examples(parser: argparse.ArgumentParser) -> list[Example]:
     """Every command the docs give, each once (where it is first written): :func:`shell_examples`
     of the README and of every page of the docs site, then ``parser``'s :func:`epilog_examples`."""
-    pages = [REPO / "README.md", *sorted((REPO / "doc").rglob("*.md"))]
     found: dict[tuple[str, ...], Example] = {}
-    candidates = [e for page in pages if "_build" not in page.parts for e in shell_examples(page)]
+    candidates = [e for page in doc_pages() for e in shell_examples(page)]
     for example in [*candidates, *epilog_examples(parser)]:
         key = (*sorted(f"{k}={v}" for k, v in example.env.items()), "--", *example.argv)
         found.setdefault(key, example)
@@ -61,25 +100,23 @@ def documented_examples(parser: argparse.ArgumentParser) -> list[Example]:
 
 
 def shell_examples(path: Path) -> list[Example]:
-    """The commands of a Markdown file's ``bash`` blocks (a ``\\`` continuation joined)."""
+    """The commands of a Markdown file's shell blocks (a ``\\`` continuation joined)."""
     found: list[Example] = []
-    fenced, shell, pending, start = False, False, "", 0
-    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
-        if line.startswith("```"):
-            fenced = not fenced
-            shell = fenced and line[3:].strip() in ("bash", "sh", "")
+    where = path.relative_to(REPO)
+    for block in fenced_blocks(path):
+        if block.language not in SHELL:
             continue
-        if not shell:
-            continue
-        if not pending:
-            start = number
-        if line.rstrip().endswith("\\"):
-            pending += line.rstrip()[:-1] + " "
-            continue
-        example = _parse(pending + line, f"{path.relative_to(REPO)}:{start}")
-        pending = ""
-        if example is not None:
-            found.append(example)
+        pending, start = "", 0
+        for number, line in enumerate(block.lines, block.first_line):
+            if not pending:
+                start = number
+            if line.rstrip().endswith("\\"):
+                pending += line.rstrip()[:-1] + " "
+                continue
+            example = _parse(pending + line, f"{where}:{start}")
+            pending = ""
+            if example is not None:
+                found.append(example)
     return found
 
 
