@@ -48,6 +48,12 @@ from tdcm_ros.model.errors import (
     TendonSingularityError,
     TensionRangeError,
 )
+from tdcm_ros.model.friction import (
+    FrictionState,
+    FrictionTrack,
+    StickSlipTension,
+    check_mu,
+)
 from tdcm_ros.model.inverse import (
     DEFAULT_TENSION_MAX_N,
     DEFAULT_TOL,
@@ -79,6 +85,7 @@ from tdcm_ros.model.mesh_export import (
     mesh_body_file_text,
     write_body_stl,
 )
+from tdcm_ros.model.model_file import ModelSpec, read_model
 from tdcm_ros.model.outline import BodyOutline, body_outline
 from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
@@ -118,6 +125,15 @@ from tdcm_ros.model.shape_targets import (
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve, warm_up
 from tdcm_ros.model.surface import offset_points, surface_points
 from tdcm_ros.model.tendons import Tendon, require_paper_tendon
+from tdcm_ros.model.uncertainty import (
+    MU,
+    InvalidUncertaintyError,
+    ParameterCovariance,
+    fittable_names,
+    inside_band,
+    linearised_covariances,
+    prediction_covariances,
+)
 from tdcm_ros.model.urdf import body_urdf, body_xacro, joint_names, joint_positions
 
 __all__ = [
@@ -131,6 +147,7 @@ __all__ = [
     "FIELD_SPECS",
     "FREE_FIELDS",
     "MARKER_SPECS",
+    "MU",
     "PARAMETER_SPECS",
     "PRESETS",
     "PROFILE_NAMES",
@@ -148,6 +165,8 @@ __all__ = [
     "DesignSearch",
     "DesignSpace",
     "Evaluation",
+    "FrictionState",
+    "FrictionTrack",
     "Goal",
     "InvalidDesignError",
     "InvalidExportError",
@@ -155,6 +174,7 @@ __all__ = [
     "InvalidRollError",
     "InvalidSettingsError",
     "InvalidTargetError",
+    "InvalidUncertaintyError",
     "InverseResult",
     "Limits",
     "Load",
@@ -162,11 +182,13 @@ __all__ = [
     "MarkerLayout",
     "ModelError",
     "ModelLimitError",
+    "ModelSpec",
     "NoDesignMeetsTargetError",
     "NoShapeDesignError",
     "NotchAngleTarget",
     "NotchClosureError",
     "NotchContact",
+    "ParameterCovariance",
     "PolygonProfile",
     "Progress",
     "RectangularProfile",
@@ -178,6 +200,7 @@ __all__ = [
     "SolveResult",
     "SolverSettings",
     "StampedHistory",
+    "StickSlipTension",
     "StopAngleTarget",
     "Tendon",
     "TendonSingularityError",
@@ -193,23 +216,29 @@ __all__ = [
     "body_urdf",
     "body_xacro",
     "candidate",
+    "check_mu",
     "check_roll",
     "check_tension",
     "depends_on_roll",
     "design_curves",
     "design_for_shape",
+    "fittable_names",
+    "inside_band",
     "is_body_file",
     "joint_names",
     "joint_positions",
+    "linearised_covariances",
     "mesh_body_file_text",
     "named_design",
     "offset_points",
     "one_shot",
     "parameter_specs",
     "parse_field",
+    "prediction_covariances",
     "preset",
     "problem_from_mapping",
     "read_body_file",
+    "read_model",
     "read_problem_file",
     "report_progress",
     "require_paper_tendon",

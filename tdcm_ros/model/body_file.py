@@ -76,6 +76,8 @@ from tdcm_ros.model.tendons import (
 from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
 
+#: A model file's keys besides the body's (:mod:`tdcm_ros.model.model_file` reads them).
+MODEL_KEYS = ("friction", "uncertainty")
 #: Most segments a body may expand to (``repeat`` included).
 MAX_SEGMENTS = 10_000
 #: A tendon's name: a ROS name token (it names its joint and topic).
@@ -241,8 +243,8 @@ def read_body_file(path: str | Path) -> BodySpec:
 def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
     """The checked :class:`BodySpec` of a body file's parsed YAML ``data``."""
     top = _mapping(data, "the body file", source)
-    reject_unknown("body file key", top, ("tube", "material", "tendons", "segments", "mesh"),
-                   error=InvalidDesignError)
+    reject_unknown("body file key", top, ("tube", "material", "tendons", "segments", "mesh",
+                                          *MODEL_KEYS), error=InvalidDesignError)
     if "mesh" in top:
         for key in ("tube", "segments"):
             if key in top:

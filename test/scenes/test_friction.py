@@ -9,8 +9,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tdcm_ros.errors import PhysicsError
+from tdcm_ros.model.friction import FrictionState, StickSlipTension
 from tdcm_ros.scenes import load_scene
-from tdcm_ros.scenes.effects.friction import FrictionState, StickSlipTension
 from test.scenes.scene_helpers import make_scene
 
 S = np.linspace(0.0, 0.05, 11)

@@ -12,8 +12,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from tdcm_ros.model import NotchContact as NotchContactLaw
+from tdcm_ros.model.friction import FrictionState, StickSlipTension
 from tdcm_ros.scenes.effects.base import Effect, EffectContext, register
-from tdcm_ros.scenes.effects.friction import FrictionState, StickSlipTension
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param
 from tdcm_ros.scenes.parts import LoadingPart
@@ -49,7 +49,7 @@ class MechanicsEffect(Effect):
 @register
 class TendonFriction(MechanicsEffect):
     """Capstan friction between tendon and channel, stick-slip with loading/unloading
-    hysteresis (see :mod:`tdcm_ros.scenes.effects.friction`): its ``history`` is the
+    hysteresis (see :mod:`tdcm_ros.model.friction`): its ``history`` is the
     :class:`FrictionState`, the profile it hands the model a :class:`StickSlipTension` over it."""
 
     name = "tendon_friction"
