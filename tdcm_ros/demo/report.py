@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -43,6 +44,15 @@ def missed_holds(plan: DemoPlan, evaluation: Evaluation) -> str:
             f"= {steps.tolerance_n:g} N); adjust them with --set steps.<name>=VALUE")
 
 
+def fitted_names(plan: DemoPlan) -> tuple[str, ...]:
+    """What the demo calibrates: E, and the tendon's friction ``mu`` where the scene has
+    friction and its schedule unloads (the unloading steps' hysteresis is what tells ``mu``
+    from ``E``; on loading steps alone the fit cannot, see :mod:`tdcm_ros.metrics.calibration`)."""
+    levels = list(plan.schedule.levels)
+    unloads = any(later < earlier for earlier, later in pairwise(levels))
+    return ("E", "mu") if unloads and "tendon_friction" in plan.scene.effect_names() else ("E",)
+
+
 def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
            progress: Progress | None = None) -> None:
     """Print Table I and the per-step table of the bag evaluated with ``options`` (see
@@ -57,10 +67,11 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
     from tdcm_ros.metrics.api import evaluate_paths
 
     fit = None
+    names = fitted_names(plan)
     if calibrate:
         from tdcm_ros.metrics.api import calibrate_paths
 
-        fit = calibrate_paths([plan.bag], ("E",), options,  # its `before` is the evaluation
+        fit = calibrate_paths([plan.bag], names, options,  # its `before` is the evaluation
                               progress=progress)
     evaluation = fit.before if fit is not None else evaluate_paths([plan.bag], options,
                                                                    progress=progress)
@@ -72,7 +83,8 @@ def report(plan: DemoPlan, options: EvaluateOptions, *, calibrate: bool,
         print(f"plot written to {path}")
     results = {"scene": plan.scene.name, "before_calibration": evaluation.to_json()}
     if fit is not None:
-        print(f"\n== calibration of E on {plan.bag} (start: the scene's nominal E) ==")
+        print(f"\n== calibration of {' and '.join(names)} on {plan.bag} (start: the scene's "
+              f"nominal E{', no friction' if 'mu' in names else ''}) ==")
         print(format_calibration(fit))
         results["calibration"] = fit.fit_json()
         results["after_calibration"] = fit.after.to_json()

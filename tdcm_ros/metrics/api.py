@@ -30,6 +30,12 @@ from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import Progress, report_progress
 
+ESTIMATED_REGISTRATION_NOTE = (
+    "the intervals leave out the registration's error: it was estimated from the markers, so "
+    "its error is shared by every step rather than independent (a bag with /tf_static mocap -> "
+    "tdcm_base, or a given registration, gives intervals that hold)")
+"""Said with a calibration whose registration was estimated (the intervals assume it exact)."""
+
 
 @dataclass(frozen=True)
 class Topics:
@@ -104,19 +110,49 @@ def evaluate_paths(paths: Sequence[str | Path], options: EvaluateOptions | None 
 def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
                     options: EvaluateOptions | None = None, *, topics: Topics | None = None,
                     registration: Registration | None = None, confidence: float = 0.95,
-                    progress: Progress | None = None) -> Calibration:
-    """Fit the design fields ``fit`` (start: ``options.design``) to the bags' marker positions
-    by least squares; see :mod:`tdcm_ros.metrics.calibration`. ``progress``: stages ``reading
-    bags``, ``fitting NAMES`` (model evaluations) and ``Table I before and after`` (2)."""
+                    hold_out: int = 0, progress: Progress | None = None) -> Calibration:
+    """Fit the design fields and friction ``fit`` (start: ``options.design`` and
+    ``options.friction_mu``) to the bags' marker positions by least squares; see
+    :mod:`tdcm_ros.metrics.calibration`. ``hold_out``: the last so many trials of each bag are
+    not fitted but evaluated with the fitted model (:attr:`.Calibration.held_out`: Table I and
+    the band's coverage on steps the fit never saw). ``progress``: stages ``reading bags``,
+    ``fitting NAMES`` (model evaluations) and ``Table I before and after`` (2)."""
     opts = options or EvaluateOptions()
     sources = load_paths(paths, opts, topics, progress)
-    prepared = prepare(sources, opts, registration)
-    design, params, corr, condition, rms, count, warnings = calibrate_steps(
+    prepared, held = split_trials(sources, prepare(sources, opts, registration), hold_out)
+    fitted, params, corr, condition, rms, count, warnings = calibrate_steps(
         prepared, fit, opts, confidence=confidence, progress=progress)
+    notes = [ESTIMATED_REGISTRATION_NOTE] if any(
+        reg.method == "estimated" for _, reg in prepared) else []
     report_progress(progress, "Table I before and after", 0, 2)
     before = _evaluate(sources, prepared, opts)
     report_progress(progress, "Table I before and after", 1, 2)
-    after = _evaluate(sources, prepared, opts.with_design(design))
+    after = _evaluate(sources, prepared, fitted)
     report_progress(progress, "Table I before and after", 2, 2)
     return Calibration(tuple(params), confidence, corr, condition, rms, count, not warnings,
-                       before, after, tuple(warnings))
+                       before, after, tuple(warnings),
+                       _evaluate(sources, held, fitted) if hold_out else None, tuple(notes))
+
+
+def split_trials(sources: Sequence[BagSource],
+                 prepared: Sequence[tuple[list[MeasuredStep], Registration]], hold_out: int
+                 ) -> tuple[list[tuple[list[MeasuredStep], Registration]],
+                            list[tuple[list[MeasuredStep], Registration]]]:
+    """Each bag's steps split into those fitted and those of its last ``hold_out`` trials."""
+    if hold_out < 0:
+        raise InputError(f"--hold-out {hold_out}; allowed: 0 or more trials",
+                         parameter="--hold-out", value=hold_out, allowed="[0, inf)")
+    if not hold_out:
+        return list(prepared), []
+    fitted, held = [], []
+    for source, (steps, reg) in zip(sources, prepared, strict=True):
+        trials = sorted({m.step.trial for m in steps})
+        if len(trials) <= hold_out:
+            raise InputError(f"--hold-out {hold_out} leaves no trial to fit in {source.path} "
+                             f"({len(trials)} trials); allowed: fewer than {len(trials)}",
+                             parameter="--hold-out", value=hold_out,
+                             allowed=f"[0, {len(trials) - 1}]")
+        first_held = trials[-hold_out]
+        fitted.append(([m for m in steps if m.step.trial < first_held], reg))
+        held.append(([m for m in steps if m.step.trial >= first_held], reg))
+    return fitted, held

@@ -1,9 +1,15 @@
-"""Least-squares calibration of design parameters (e.g. Young's modulus) from measured steps.
+"""Least-squares calibration of design parameters (e.g. Young's modulus) and the tendon's
+friction from measured steps.
 
 Residuals: for every step and every marker visible in it, the model's marker point at the
 step's mean tension (one per tendon for a body with several) minus the measured mean position,
-all three coordinates, in ``tdcm_base`` (m). ``scipy.optimize.least_squares`` (trust region, bounds from the design field ranges) fits
-the parameters relative to their start values.
+all three coordinates, in ``tdcm_base`` (m). ``scipy.optimize.least_squares`` (trust region,
+bounds from the design field ranges) fits the design fields relative to their start values and
+``mu`` (the capstan friction coefficient, :class:`~tdcm_ros.model.FrictionTrack`) as it is.
+With friction (fitted, or ``options.friction_mu`` above 0) each recording's steps are solved
+in the order they happened, so loading and unloading steps at one level differ by the
+stick-slip hysteresis: that difference is what tells ``mu`` from ``E`` (with loading steps
+alone the two trade against each other; the correlation check below reports it).
 
 Uncertainty: ``cov = s^2 (J^T J)^-1`` at the optimum with ``s^2 = |r|^2 / (m - n)``; the interval
 is ``value +- t_{(1+confidence)/2, m-n} sqrt(cov_ii)``. It assumes independent residuals of
@@ -17,7 +23,7 @@ the bias). A parameter is reported *not identifiable* when ``J^T J`` is near-sin
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -26,19 +32,28 @@ from scipy.optimize import least_squares
 from scipy.stats import t as student_t
 
 from tdcm_ros.errors import InputError, TdcmError, out_of_range
-from tdcm_ros.metrics.evaluation import Evaluation, model_tensions, solve_tension
+from tdcm_ros.metrics.evaluation import (
+    Evaluation,
+    marker_points,
+    model_tensions,
+    solve_tension,
+)
 from tdcm_ros.metrics.measure import MeasuredStep
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import (
     FIELD_SPECS,
+    MU,
     Design,
+    FrictionTrack,
+    ModelSpec,
+    ParameterCovariance,
     Progress,
     SolveResult,
+    fittable_names,
     report_progress,
-    solve,
-    surface_points,
 )
+from tdcm_ros.model.friction import MAX_MU
 
 Array = NDArray[np.float64]
 MAX_CONDITION = 1e10
@@ -89,17 +104,34 @@ class Calibration:
     before: Evaluation
     after: Evaluation
     warnings: tuple[str, ...]
+    held_out: Evaluation | None = None
+    """The held-out trials (not fitted) evaluated with the fitted model, if any were."""
+    notes: tuple[str, ...] = ()
+    """What the numbers assume and do not show (not a reason to reject the fit)."""
 
     @property
     def design(self) -> Design:
         """The design with the fitted values."""
         return self.after.options.design
 
+    @property
+    def friction_mu(self) -> float:
+        """The friction coefficient after the fit (fitted, or as given)."""
+        return self.after.options.friction_mu
+
+    @property
+    def model(self) -> ModelSpec:
+        """The fitted model: design, friction and the parameters' covariance (``tdcm calibrate
+        --out``; None where the fit has no finite covariance)."""
+        return ModelSpec(self.design, self.friction_mu, self.after.options.uncertainty)
+
     def to_json(self) -> dict[str, Any]:
         """The ``tdcm calibrate --json`` document: :meth:`fit_json` with the evaluations
-        ``before`` and ``after`` the fit (each :meth:`.Evaluation.to_json`, per step too)."""
+        ``before`` and ``after`` the fit and of the ``held_out`` trials (null if none; each
+        :meth:`.Evaluation.to_json`, per step too)."""
         return {**self.fit_json(), "before": self.before.to_json(),
-                "after": self.after.to_json()}
+                "after": self.after.to_json(),
+                "held_out": None if self.held_out is None else self.held_out.to_json()}
 
     def fit_json(self) -> dict[str, Any]:
         """The fit alone: parameters, confidence, correlation, conditioning, residuals,
@@ -110,16 +142,18 @@ class Calibration:
                                 for row in self.correlation],
                 "condition_number": self.condition if np.isfinite(self.condition) else None,
                 "residual_rms_m": self.residual_rms_m, "n_residuals": self.n_residuals,
-                "warnings": list(self.warnings)}
+                "friction_mu": self.friction_mu, "warnings": list(self.warnings),
+                "notes": list(self.notes)}
 
 
 def parse_fit(text: str) -> tuple[str, ...]:
-    """``E`` or ``E,w_d``: names of real-valued design fields, without repeats."""
+    """``E``, ``E,mu`` or ``E,w_d``: real-valued design fields and ``mu``, without repeats."""
     names = tuple(n.strip() for n in text.split(",") if n.strip())
-    allowed = [n for n, spec in FIELD_SPECS.items() if not spec.integer]
+    allowed = fittable_names()
     for name in names:
         if name not in allowed:
-            raise CalibrationError(f"--fit {name!r} is not a real-valued design field; allowed: "
+            raise CalibrationError(f"--fit {name!r} is neither a real-valued design field nor mu; "
+                                   "allowed: "
                                    f"{', '.join(allowed)}", parameter="--fit", value=name,
                                    allowed=", ".join(allowed))
     if not names or len(set(names)) != len(names):
@@ -131,49 +165,60 @@ def parse_fit(text: str) -> tuple[str, ...]:
 @dataclass(frozen=True, eq=False)
 class _Data:
     """Measured marker points in ``tdcm_base`` (steps, k, 3) with their step tensions (steps, J)
-    N, a column per tendon."""
+    N, a column per tendon, and the recording each step belongs to (steps,)."""
 
     tensions: Array
     markers: Array
+    sources: NDArray[np.int64]
 
     @classmethod
     def of(cls, prepared: Sequence[tuple[Sequence[MeasuredStep], Registration]],
-           options: EvaluateOptions) -> _Data:
-        tensions, markers = [], []
-        for steps, reg in prepared:
+           options: EvaluateOptions, in_order: bool) -> _Data:
+        """``in_order``: keep each recording's steps as they happened (friction); else warm
+        starts follow increasing tension (the largest of a step's)."""
+        tensions, markers, sources = [], [], []
+        for k, (steps, reg) in enumerate(prepared):
             for step in steps:
                 tensions.append(model_tensions(step.tensions_n, options))
                 markers.append(reg.to_base(step.markers))
-        # warm starts follow increasing tension (the largest of a step's)
-        order = np.argsort([max(t) for t in tensions], kind="stable")
-        return cls(np.asarray(tensions)[order], np.asarray(markers)[order])
+                sources.append(k)
+        order = (np.arange(len(tensions)) if in_order
+                 else np.argsort([max(t) for t in tensions], kind="stable"))
+        return cls(np.asarray(tensions)[order], np.asarray(markers)[order],
+                   np.asarray(sources, dtype=np.int64)[order])
 
 
-def _model_markers(design: Design, data: _Data, options: EvaluateOptions) -> Array:
-    layout = options.layout
-    radius = layout.radius(design.R_outer)
+def _model_markers(design: Design, mu: float, data: _Data, options: EvaluateOptions) -> Array:
+    """The model's markers (steps, k, 3) m; a fresh friction track per recording."""
     out = np.empty_like(data.markers)
     warm: SolveResult | None = None
+    track = FrictionTrack(mu)
     for i, tensions in enumerate(data.tensions.tolist()):
-        warm = solve(design, solve_tension(tensions), settings=options.solver, warm_start=warm)
-        out[i] = surface_points(warm, layout.s, radius, layout.side_rad)[0]
+        if i and data.sources[i] != data.sources[i - 1]:
+            track = FrictionTrack(mu)
+        warm = track.solve(design, solve_tension(tensions), settings=options.solver,
+                           warm_start=warm)
+        out[i] = marker_points(warm, design, options)
     return out
 
 
 def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registration]],
                     names: Sequence[str], options: EvaluateOptions, *,
                     confidence: float = 0.95, progress: Progress | None = None
-                    ) -> tuple[Design, list[FittedParameter], Array, float, float, int,
+                    ) -> tuple[EvaluateOptions, list[FittedParameter], Array, float, float, int,
                                list[str]]:
     """Fit ``names`` on measured steps with their registrations; see the module docstring.
     ``progress`` counts the model evaluations (stage ``fitting NAMES``; no total known).
 
-    Returns the fitted design, the parameters, their correlation matrix, the condition number
-    of ``J^T J``, the residual RMS (m), the residual count and the identifiability warnings.
+    Returns the options with the fitted design and friction (and, where the fit has a finite
+    covariance, its :class:`~tdcm_ros.model.ParameterCovariance`), the parameters, their
+    correlation matrix, the condition number of ``J^T J``, the residual RMS (m), the residual
+    count and the identifiability warnings.
     """
     if not (np.isfinite(confidence) and 0.0 < confidence < 1.0):
         raise out_of_range("confidence", confidence, "(0, 1)")
-    data = _Data.of(prepared, options)
+    friction = MU in names or options.friction_mu > 0.0
+    data = _Data.of(prepared, options, in_order=friction)
     seen = ~np.isnan(data.markers)
     n = len(names)
     m = int(seen.sum())
@@ -181,14 +226,20 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
         raise CalibrationError(f"{m} marker coordinates for {n} parameters; allowed: more "
                                "residuals than parameters", parameter="--fit", value=list(names))
     start = options.design
-    x0 = np.array([float(getattr(start, name)) for name in names])
-    specs = [FIELD_SPECS[name] for name in names]
-    low = np.array([max(s.low, 0.0) / v + 1e-6 for s, v in zip(specs, x0, strict=True)])
-    high = np.array([s.high / v for s, v in zip(specs, x0, strict=True)])
+    starts = np.array([options.friction_mu if name == MU else float(getattr(start, name))
+                       for name in names])
+    # design fields relative to their start values; mu as it is (its start may be 0)
+    x0 = np.array([1.0 if name == MU else v for name, v in zip(names, starts, strict=True)])
+    low = np.array([0.0 if name == MU else max(FIELD_SPECS[name].low, 0.0) / v + 1e-6
+                    for name, v in zip(names, x0, strict=True)])
+    high = np.array([MAX_MU if name == MU else FIELD_SPECS[name].high / v
+                     for name, v in zip(names, x0, strict=True)])
+    units = [FIELD_SPECS[name].unit if name != MU else "" for name in names]
 
-    def design_at(scaled: Array) -> Design:
-        return start.with_overrides(**{nm: float(v) for nm, v in zip(names, scaled * x0,
-                                                                      strict=True)})
+    def model_at(scaled: Array) -> tuple[Design, float]:
+        values = dict(zip(names, (scaled * x0).tolist(), strict=True))
+        mu = values.pop(MU, options.friction_mu)
+        return start.with_overrides(**values), mu
 
     stage = f"fitting {', '.join(names)}"
     evaluations = 0
@@ -198,15 +249,16 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
         evaluations += 1
         report_progress(progress, stage, evaluations, None)
         try:
-            predicted = _model_markers(design_at(scaled), data, options)
+            predicted = _model_markers(*model_at(scaled), data, options)
         except TdcmError:
             return np.full(m, FAILED_RESIDUAL_M)
         return (predicted - data.markers)[seen]
 
-    first = residuals(np.ones(n))
+    begin = starts / x0
+    first = residuals(begin)
     if np.all(first == FAILED_RESIDUAL_M):
-        _model_markers(design_at(np.ones(n)), data, options)  # raises the model's own error
-    fit = least_squares(residuals, np.ones(n), bounds=(low, high), x_scale="jac",
+        _model_markers(*model_at(begin), data, options)  # raises the model's own error
+    fit = least_squares(residuals, begin, bounds=(low, high), x_scale="jac",
                         diff_step=1e-4,  # type: ignore[arg-type]  # scipy-stubs gap: scalar is array_like
                         xtol=1e-10, ftol=1e-12)
     dof = m - n
@@ -214,6 +266,7 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
     jtj = np.asarray(fit.jac).T @ np.asarray(fit.jac)  # relative units: parameter / start
     eig = np.linalg.eigvalsh(jtj)
     condition = float(eig[-1] / eig[0]) if eig[0] > 0 else float("inf")
+    cov: Array | None = None
     if condition < SINGULAR_CONDITION:
         cov = s2 * np.linalg.inv(jtj) * np.outer(x0, x0)
         std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
@@ -224,14 +277,20 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
         np.fill_diagonal(corr, 1.0)
     half = float(student_t.ppf(0.5 + confidence / 2.0, dof)) * std
     values = fit.x * x0
-    params = [FittedParameter(nm, spec.unit, float(v0), float(v), float(sd), float(v - h),
+    params = [FittedParameter(nm, unit, float(v0), float(v), float(sd), float(v - h),
                               float(v + h))
-              for nm, spec, v0, v, sd, h in zip(names, specs, x0, values, std, half, strict=True)]
+              for nm, unit, v0, v, sd, h in zip(names, units, starts, values, std, half,
+                                                strict=True)]
     warnings = _identifiability(params, corr, condition)
     if fit.status <= 0:
         warnings.append(f"least squares stopped without converging: {fit.message}")
     rms = float(np.sqrt(np.mean(fit.fun**2)))
-    return design_at(fit.x), params, corr, condition, rms, m, warnings
+    design, mu = model_at(fit.x)
+    # a band needs a finite covariance and a residual to widen it by
+    uncertainty = (ParameterCovariance(tuple(names), values, cov, float(np.sqrt(s2)))
+                   if cov is not None and s2 > 0.0 else None)
+    fitted = replace(options, design=design, friction_mu=mu, uncertainty=uncertainty)
+    return fitted, params, corr, condition, rms, m, warnings
 
 
 def _identifiability(params: Sequence[FittedParameter], corr: Array, condition: float

@@ -7,6 +7,15 @@ then Table I (:mod:`tdcm_ros.metrics.table`) over the loading steps; the unloadi
 (:mod:`tdcm_ros.metrics.steps`) get the same metrics separately. A step is *flagged* (left out of every metric,
 kept in the per-step table with a note) when its tip marker was never visible or the model has
 no solution at its tension.
+
+Friction (``options.friction_mu`` above 0): a recording's steps are solved in the order they
+happened, each after the ones before it (:class:`~tdcm_ros.model.FrictionTrack`: stick-slip
+capstan friction, so an unloading step is predicted above the loading one at the same level).
+
+Band (``options.uncertainty``, a calibration's covariance): each predicted marker gets its
+prediction covariance (:mod:`tdcm_ros.model.uncertainty`, linearised through the solver, plus
+the fit's residual variance); :attr:`Evaluation.band` counts the measured markers inside their
+95 % ellipsoid (the band's calibration: about 95 % when the model and its covariance hold).
 """
 
 from __future__ import annotations
@@ -30,7 +39,15 @@ from tdcm_ros.mocap import (
     RegistrationError,
     estimate_registration,
 )
-from tdcm_ros.model import Design, SolveResult, solve, surface_points
+from tdcm_ros.model import (
+    Design,
+    FrictionTrack,
+    SolveResult,
+    inside_band,
+    linearised_covariances,
+    prediction_covariances,
+    surface_points,
+)
 
 Array = NDArray[np.float64]
 
@@ -44,15 +61,49 @@ class Prediction:
     midline: Array
 
 
+#: Confidence of the band whose coverage an evaluation reports.
+BAND_CONFIDENCE = 0.95
+
+
 def predict(design: Design, tensions_n: Sequence[float], options: EvaluateOptions,
-            warm_start: SolveResult | None = None) -> Prediction:
-    """Solve ``design`` at ``tensions_n`` (N, one per tendon) and take the marker points and
-    midline stations."""
-    result = solve(design, solve_tension(tensions_n), settings=options.solver,
-                   warm_start=warm_start)
+            warm_start: SolveResult | None = None, track: FrictionTrack | None = None
+            ) -> Prediction:
+    """Solve ``design`` at ``tensions_n`` (N, one per tendon) after ``track``'s history (none:
+    a fresh track of ``options.friction_mu``; the caller advances it) and take the marker
+    points and midline stations."""
+    track = track or FrictionTrack(options.friction_mu)
+    result = track.solve_at(design, solve_tension(tensions_n), settings=options.solver,
+                            warm_start=warm_start)
+    return Prediction(result, marker_points(result, design, options),
+                      result.pose_at(stations(options))[0])
+
+
+def marker_points(result: SolveResult, design: Design, options: EvaluateOptions) -> Array:
+    """The marker points (k, 3) m of ``result`` (of ``design``) in ``tdcm_base``."""
     layout = options.layout
-    markers, _ = surface_points(result, layout.s, layout.radius(design.R_outer), layout.side_rad)
-    return Prediction(result, markers, result.pose_at(stations(options))[0])
+    return surface_points(result, layout.s, layout.radius(design.R_outer), layout.side_rad)[0]
+
+
+def band_inside(measured: Array, tensions_n: Sequence[float], prediction: Prediction,
+                track: FrictionTrack, options: EvaluateOptions) -> NDArray[np.bool_]:
+    """Per visible marker of ``measured`` (k, 3) m: inside the prediction's
+    :data:`BAND_CONFIDENCE` band (``options.uncertainty`` carried through the solver after
+    ``track``'s history, the prediction's)."""
+    uncertainty = options.uncertainty
+    assert uncertainty is not None
+    tension = solve_tension(tensions_n)
+
+    def markers_at(design: Design, mu: float) -> Array:
+        moved = track.solve_at(design, tension, mu=mu, settings=options.solver,
+                               warm_start=prediction.result)
+        return marker_points(moved, design, options)
+
+    covariances = prediction_covariances(linearised_covariances(
+        markers_at, options.design, track.mu, uncertainty, prediction.markers),
+        uncertainty.residual_m)
+    seen = ~np.isnan(measured[:, 0])
+    return inside_band(measured[seen] - prediction.markers[seen], covariances[seen],
+                       BAND_CONFIDENCE)
 
 
 def solve_tension(tensions_n: Sequence[float]) -> float | list[float]:
@@ -92,6 +143,8 @@ class StepRecord:
     missing: tuple[str, ...]
     note: str
     phase: str = LOADING
+    inside_band: NDArray[np.bool_] | None = None
+    """Per visible marker: inside the predicted 95 % band (None: no band)."""
 
     @property
     def usable(self) -> bool:
@@ -132,6 +185,15 @@ class Evaluation:
     occluded: dict[str, int] = field(default_factory=dict)
 
     @property
+    def band(self) -> tuple[int, int] | None:
+        """Measured markers inside their predicted 95 % band, and markers compared (steps
+        with a prediction); None without an uncertainty."""
+        flags = [r.inside_band for r in self.records if r.inside_band is not None]
+        if self.options.uncertainty is None or not flags:
+            return None
+        return int(sum(int(f.sum()) for f in flags)), int(sum(f.size for f in flags))
+
+    @property
     def unloading(self) -> TableMetrics | None:
         """The Table I metrics of the unloading steps (``None`` if there is none)."""
         if not any(r.phase == UNLOADING for r in self.records):
@@ -169,6 +231,7 @@ class Evaluation:
                 "steps": [{**r.to_json(), "hysteresis_m": h}
                           for r, h in zip(self.records, self.hysteresis_m(), strict=True)],
                 "unloading": None if unloading is None else unloading.to_dict(),
+                "band": self.band_json(),
                 "details": {**table, "sources": [
                     {"source": name, "registration": registration_json(reg)}
                     for name, reg in zip(self.sources, self.registrations, strict=True)],
@@ -176,6 +239,16 @@ class Evaluation:
                             "deflection_axis": self.options.deflection_axis,
                             "occluded_markers": dict(self.occluded),
                             "warnings": list(self.warnings)}}
+
+
+    def band_json(self) -> dict[str, Any] | None:
+        """``confidence``, ``inside``, ``markers`` and ``coverage`` of :attr:`band`, or None."""
+        band = self.band
+        if band is None:
+            return None
+        inside, markers = band
+        return {"confidence": BAND_CONFIDENCE, "inside": inside, "markers": markers,
+                "coverage": inside / markers if markers else None}
 
 
 def tension_distance(a: Mapping[str, float], b: Mapping[str, float]) -> float:
@@ -236,13 +309,18 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
     records: list[StepRecord] = []
     warnings: list[str] = []
     warm: SolveResult | None = None
+    track = FrictionTrack(options.friction_mu)
     for measured in steps:
         base = registration.to_base(measured.markers)
         tensions = dict(zip(names, measured.tensions_n, strict=True))
-        note, pred = "", None
+        note, pred, inside = "", None, None
         try:
-            pred = predict(design, model_tensions(measured.tensions_n, options), options, warm)
+            level = model_tensions(measured.tensions_n, options)
+            pred = predict(design, level, options, warm, track)
             warm = pred.result
+            if options.uncertainty is not None:
+                inside = band_inside(base, level, pred, track, options)
+            track.state.advance(pred.result)
         except TdcmError as error:
             note = f"model: {error}"
         midline = measured_midline(base, options.layout, radius, at)
@@ -263,8 +341,10 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
             shape_error_m=None if pred is None or midline is None else station_distance(
                 midline, pred.midline),
             measured_midline=midline, predicted_midline=None if pred is None else pred.midline,
-            missing=measured.missing, note=note, phase=measured.step.phase))
+            missing=measured.missing, note=note, phase=measured.step.phase,
+            inside_band=inside))
     return records, warnings
+
 
 
 def metrics_of(records: Sequence[StepRecord], options: EvaluateOptions, *,

@@ -9,7 +9,9 @@ Names (SI units):
 - ``steps.<field>``: a :class:`~tdcm_ros.metrics.steps.StepSettings` field;
 - ``markers.labels`` / ``markers.arc_lengths`` (comma lists), ``markers.ball_radius`` (m),
   ``markers.side_deg``;
-- ``align.tolerance_s``, ``mape_threshold_m``, ``stations``, ``deflection_axis``.
+- ``align.tolerance_s``, ``mape_threshold_m``, ``stations``, ``deflection_axis``;
+- ``friction.mu``: the tendon's capstan friction (a model file's ``friction`` section sets it
+  with its design; :mod:`tdcm_ros.model.model_file`).
 """
 
 from __future__ import annotations
@@ -28,10 +30,11 @@ from tdcm_ros.model import (
     Design,
     InvalidSettingsError,
     MarkerLayout,
+    ParameterCovariance,
     SolverSettings,
-    named_design,
     parse_field,
     preset,
+    read_model,
 )
 from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of
 
@@ -57,6 +60,12 @@ class EvaluateOptions:
         "arc-length stations (from the base to the tip marker) of the shape error"))
     deflection_axis: str = spec_field("marker", choices=DEFLECTION_AXES, description=(
         "marker: distance from the tip marker's rest line; body: from the body axis"))
+    friction_mu: float = spec_field(0.0, name="friction.mu", low=0.0, high=10.0, description=(
+        "capstan friction coefficient tendon/channel; above 0 each recording's steps are "
+        "solved in the order they happened, with stick-slip friction"))
+    uncertainty: ParameterCovariance | None = None
+    """The fitted parameters' covariance (a model file's ``uncertainty``): the predicted 95 %
+    band whose coverage the evaluation reports; None: no band."""
 
     def __post_init__(self) -> None:
         check_fields(self, OPTION_SPECS)
@@ -107,7 +116,9 @@ def options_from_sets(pairs: Sequence[str], base: EvaluateOptions | None = None
     design = opts.design
     for name, text in parsed:  # the preset first, whatever the order given
         if name == "design.preset":
-            design = named_design(text)
+            model = read_model(text)
+            design = model.design
+            opts = replace(opts, friction_mu=model.friction_mu, uncertainty=model.uncertainty)
     design_over = {n[7:]: parse_field(n[7:], t) for n, t in parsed if n.startswith("design.")
                    and n != "design.preset"}
     groups: dict[str, dict[str, Any]] = {prefix: {} for prefix in _GROUPS}

@@ -64,8 +64,17 @@ def format_evaluation(ev: Evaluation) -> str:
     if any(ev.occluded.values()):
         lines.append("occluded marker positions left out (NaN or exactly 0): " + ", ".join(
             f"{label} {count}" for label, count in ev.occluded.items()))
+    if (band := ev.band) is not None:
+        lines.append(band_line(*band))
     lines += [f"warning: {w}" for w in ev.warnings]
     return "\n".join(lines)
+
+
+def band_line(inside: int, markers: int) -> str:
+    """How many measured markers fall in their predicted 95 % band."""
+    share = f"{inside / markers:.1%}" if markers else "-"
+    return (f"95 % band (the fit's covariance and residual): {inside} of {markers} measured "
+            f"markers inside ({share})")
 
 
 def _metric(value: float | None, scale: float, unit: str) -> str:
@@ -77,6 +86,7 @@ def format_calibration(cal: Calibration) -> str:
     values with intervals, residuals and Table I before/after."""
     steps = len(cal.before.records)  # loading and unloading steps are fitted alike
     lines = [f"warning: {w}" for w in (*cal.warnings, *cal.after.warnings)]
+    lines += [f"note: {n}" for n in cal.notes]
     lines += [(f"least squares over {steps} steps ({cal.n_residuals} marker coordinates), "
              f"residual RMS {cal.residual_rms_m * 1e3:.4f} mm")]
     level = f"{cal.confidence:.0%}"
@@ -92,4 +102,14 @@ def format_calibration(cal: Calibration) -> str:
     lines += ["", f"{'Table I':<16} {'before':>12} {'after':>12}"]
     lines += [f"{name:<16} {_metric(x, k, u):>12} {_metric(y, k, u):>12}"
               for name, x, y, k, u in rows]
+    if (band := cal.after.band) is not None:
+        lines += ["", f"fitted steps: {band_line(*band)}"]
+    if (held := cal.held_out) is not None:
+        h = held.metrics
+        lines += ["", (f"held out ({h.n_trials} trials, {len(held.records)} steps, not "
+                       f"fitted): MAPE {_metric(h.mape_pct, 1.0, '%')}, RMSE "
+                       f"{_metric(h.rmse_m, 1e3, 'mm')}, shape error "
+                       f"{_metric(h.shape_error_m, 1e3, 'mm')}")]
+        if (band := held.band) is not None:
+            lines.append(f"held out: {band_line(*band)}")
     return "\n".join(lines)

@@ -49,8 +49,8 @@ def test_text_output_and_bad_fit_names(bag: Path, capsys: pytest.CaptureFixture[
     assert main(["calibrate", str(bag), "--set", "E=1e9"]) == 0
     out = capsys.readouterr().out
     assert "E = " in out and "95% interval" in out and "before" in out
-    for fit, message in (("N", "not a real-valued design field"), ("E,E", "distinct names"),
-                         ("Young", "not a real-valued design field")):
+    for fit, message in (("N", "neither a real-valued design field nor mu"), ("E,E", "distinct names"),
+                         ("Young", "neither a real-valued design field nor mu")):
         assert main(["calibrate", str(bag), "--fit", fit]) == 2
         err = capsys.readouterr().err
         assert message in err and "Traceback" not in err
