@@ -33,6 +33,20 @@ for every solve, stamped with the input's stamp, plus ``tf.stations`` midline fr
 frame named here (``frame_id``, ``tf.*``) is put after ``frame_prefix`` (read-only, ``''``;
 :mod:`tdcm_ros.nodes.frames`), so two robots' frames differ on the shared ``/tf``.
 
+Friction (``friction.mu``, default a model file's ``friction`` section, else 0): above 0 each
+tension is solved after the ones before it under stick-slip capstan friction
+(:class:`~tdcm_ros.model.FrictionTrack`), so the shape follows the direction of the tension's
+change (loading or unloading); coalesced inputs are skipped by the history too (a reversal
+within one processing period is missed), and a change of the design or of ``friction.mu``
+restarts it from a slack tendon.
+
+Uncertainty (a model file's ``uncertainty`` section, written by ``tdcm calibrate --out``): on
+every solve that is drawn (``output.visual_rate_hz``) the node carries the fit's covariance to
+the shape (:mod:`tdcm_ros.nodes.band_messages`: one extra solve per fitted parameter) and
+publishes ``tip_pose_with_covariance`` (``geometry_msgs/msg/PoseWithCovarianceStamped``) and
+``shape_band`` (``visualization_msgs/msg/Marker``, the ``band.confidence`` band of the midline).
+Without the section neither topic is advertised.
+
 Keep-latest: the subscription only stores the newest valid tension; a timer solves it, warm
 started from the previous shape, so a burst never builds a queue (skipped inputs are counted
 as coalesced). Bad inputs (non-finite, negative, above ``input.tension_max``, older than
@@ -58,18 +72,20 @@ from tdcm_ros.model import (
     PRESETS,
     SOLVER_SPECS,
     Design,
+    FrictionTrack,
     InvalidRollError,
     RollHistory,
     SolveResult,
     SolverSettings,
     joint_names,
     joint_positions,
-    named_design,
     parameter_specs,
+    read_model,
     require_paper_tendon,
-    solve,
     warm_up,
 )
+from tdcm_ros.model.friction import MAX_MU
+from tdcm_ros.nodes.band_messages import shape_spread, uncertainty_messages
 from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix
 from tdcm_ros.nodes.joint_messages import (
     JOINT_STATE,
@@ -110,8 +126,9 @@ FIXED_SPECS = by_name(
          choices=TENSION_TYPES),
     Spec("design.preset", description="design preset the fields start from",
          default="paper-experiment", kind="str", choices=tuple(PRESETS)),
-    Spec("design.file", description="body file (.yaml) the design fields start from instead of "
-         "design.preset, read at start ('': none)", default="", kind="str"),
+    Spec("design.file", description="body or model file (.yaml) the design fields start from "
+         "instead of design.preset, read at start ('': none); a model file's friction sets "
+         "friction.mu's default and its uncertainty turns on the band", default="", kind="str"),
     Spec("roll.joint", description="joint of `joint_states` the body rolls by (rad about "
          "the base +z axis)", default="roll", kind="str"),
     Spec("process_period_s", "s", "solver timer period", 0.001, low=1e-4, high=1.0),
@@ -136,7 +153,12 @@ TUNABLE_SPECS = by_name(
     Spec("input.max_age_s", "s", "inputs older than this are stale; 0 disables", 0.5, low=0.0,
          high=3600.0),
     Spec("input.max_future_s", "s", "inputs stamped further ahead of the clock are dropped", 0.5,
-         low=0.0, high=3600.0))
+         low=0.0, high=3600.0),
+    Spec("friction.mu", description="capstan friction coefficient tendon/channel; above 0 each "
+         "tension is solved after the previous ones with stick-slip friction (default: the "
+         "model file's friction.mu, else 0)", default=0.0, low=0.0, high=MAX_MU),
+    Spec("band.confidence", description="confidence of shape_band (with a model file's "
+         "uncertainty)", default=0.95, low=0.5, high=0.999))
 
 #: TF frames, fixed at start (the parent is ``frame_id``).
 TF_SPECS = by_name(
@@ -185,7 +207,8 @@ class ModelNode(NodeLogic):
         self.prefix = declare_frame_prefix(port)
         self.tension_type = str(fixed["input.tension_type"])
         self.roll_joint = str(fixed["roll.joint"])
-        self.base = named_design(str(fixed["design.file"]) or str(fixed["design.preset"]))
+        model = read_model(str(fixed["design.file"]) or str(fixed["design.preset"]))
+        self.base, self.uncertainty = model.design, model.uncertainty
         if self.tension_type != JOINT_STATE:
             try:
                 require_paper_tendon(self.base.tendons, f"input.tension_type = "
@@ -197,10 +220,11 @@ class ModelNode(NodeLogic):
         self.design_specs = parameter_specs(self.base)
         declare_specs(port, self.design_specs, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
-        declare_specs(port, TUNABLE_SPECS)
+        declare_specs(port, TUNABLE_SPECS, defaults={"friction.mu": model.friction_mu})
         period = float(fixed["process_period_s"])
         diag_period = float(fixed["diagnostics_period_s"])
         self.design, self.settings = self._config({})
+        self.track = FrictionTrack(float(port.get_parameter("friction.mu")))
         self.joint_names = joint_names(self.design)[1:]  # the URDF's, less the driver's roll
         port.add_on_set_parameters(self._on_set)
         warm_up()  # compile the solver's kernel now, not on the first message
@@ -212,7 +236,11 @@ class ModelNode(NodeLogic):
                                ("tip_pose", "geometry_msgs/msg/PoseStamped"),
                                ("predicted_markers", "geometry_msgs/msg/PoseArray"),
                                ("body_markers", "visualization_msgs/msg/MarkerArray"),
-                               ("tendon_states", JOINT_STATE))}
+                               ("tendon_states", JOINT_STATE),
+                               *((("tip_pose_with_covariance",
+                                   "geometry_msgs/msg/PoseWithCovarianceStamped"),
+                                  ("shape_band", "visualization_msgs/msg/Marker"))
+                                 if self.uncertainty is not None else ()))}
         self.tf_static = port.create_publisher("/tf_static", TF_TYPE,
                                                QoS(depth=1, durability="transient_local"))
         self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
@@ -257,6 +285,8 @@ class ModelNode(NodeLogic):
         """Validate a runtime change as a whole; raising keeps the old values."""
         self.design, self.settings = self._config(changes)
         self.joint_names = joint_names(self.design)[1:]
+        self.track = FrictionTrack(float(changes.get("friction.mu",
+                                                     self.port.get_parameter("friction.mu"))))
         self.previous = None
         self._publish_tendon_tf(str(changes.get("frame_id", self.port.get_parameter("frame_id"))))
 
@@ -374,8 +404,8 @@ class ModelNode(NodeLogic):
         tension, stamp_ns = self.pending
         self.pending = None
         try:
-            result = solve(self.design, tension, settings=self.settings,
-                           warm_start=self.previous)
+            result = self.track.solve_at(self.design, tension, settings=self.settings,
+                                         warm_start=self.previous)
         except (PhysicsError, InputError) as error:
             self.counts[f"model_{error.kind}"] += 1
             self.last_failure = f"tension {_shown(tension)} N: {error}"
@@ -403,11 +433,37 @@ class ModelNode(NodeLogic):
         if drawn:
             self.joint_states.publish(body_joint_states(
                 stamp_ns, self.joint_names, joint_positions(result)[1:].tolist()))
+            self._publish_uncertainty(result, tension, stamp_ns, frame_id, roll)
+        self.track.state.advance(result)  # after the band: it moves the parameters on this history
         self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=self.prefix
                                 + str(self.tf_names["tf.station_prefix"]),
                                 stations=int(self.tf_names["tf.stations"]), roll=roll))
+
+    def _publish_uncertainty(self, result: SolveResult, tension: float | tuple[float, ...],
+                             stamp_ns: int, frame_id: str, roll: float) -> None:
+        """The tip with covariance and the band of ``result`` (a model file's uncertainty);
+        a moved parameter the model cannot solve skips them, counted as a solver failure."""
+        if self.uncertainty is None:
+            return
+        samples = int(self.port.get_parameter("output.samples"))
+
+        def resolve(design: Design, mu: float) -> SolveResult:
+            return self.track.solve_at(design, tension, mu=mu, settings=self.settings,
+                                       warm_start=result)
+
+        try:
+            spread = shape_spread(result, self.track.mu, self.uncertainty,
+                                  np.linspace(0.0, self.design.length, samples), resolve)
+        except (PhysicsError, InputError) as error:
+            self.counts[f"model_band_{error.kind}"] += 1
+            self.last_failure = f"band at tension {_shown(tension)} N: {error}"
+            return
+        for topic, message in uncertainty_messages(
+                spread, result, stamp_ns=stamp_ns, frame_id=frame_id, roll=roll,
+                confidence=float(self.port.get_parameter("band.confidence"))):
+            self.publishers[topic].publish(message)
 
     def check_input(self) -> Status:
         """WARN while a tension was dropped within the window (it recovers), else OK; the

@@ -61,7 +61,7 @@ def _marker_template(ns: str, marker_id: int, marker_type: int, scale: tuple[flo
         "color": dict(zip("rgba", color, strict=True)), "frame_locked": True})
 
 
-def _marker(hdr: Any, ns: str, marker_id: int, marker_type: int,
+def marker_msg(hdr: Any, ns: str, marker_id: int, marker_type: int,
             scale: tuple[float, float, float], color: tuple[float, float, float, float],
             points: list[Any]) -> Any:
     """A ``visualization_msgs/Marker``: a cached template with this header and points."""
@@ -100,9 +100,9 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     yield "tip_pose", pose_stamped(header=hdr, pose=tip)
     markers = _poses(positions[samples:-1], quats[samples:-1])
     yield "predicted_markers", pose_array(header=hdr, poses=markers)
-    body = _marker(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
+    body = marker_msg(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
                    (0.85, 0.85, 0.9, 0.8), [p.position for p in poses])
-    spheres = _marker(hdr, "tdcm_predicted_markers", 1, 7, (0.002, 0.002, 0.002),
+    spheres = marker_msg(hdr, "tdcm_predicted_markers", 1, 7, (0.002, 0.002, 0.002),
                       (1.0, 0.2, 0.8, 1.0), [p.position for p in markers])
     yield "body_markers", msg_class("visualization_msgs/msg/MarkerArray")(
         markers=[body, spheres])

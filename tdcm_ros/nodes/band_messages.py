@@ -1,0 +1,119 @@
+"""The model node's uncertainty outputs: the tip with its covariance and the shape's band.
+
+From a calibration's :class:`~tdcm_ros.model.ParameterCovariance` (a model file's
+``uncertainty``), :func:`shape_spread` carries the parameters' covariance to the midline points
+and the tip angle through the solver (:mod:`tdcm_ros.model.uncertainty`, forward differences:
+one extra solve per fitted parameter) and adds the fit's residual variance to each point: the
+*prediction* covariance, where a marker on the body would be measured. Then
+:func:`uncertainty_messages` builds, in ``frame_id`` and turned by the roll:
+
+- ``tip_pose_with_covariance`` (``geometry_msgs/msg/PoseWithCovarianceStamped``): the tip pose;
+  covariance row-major 6 x 6 over (x, y, z, rotation about x, y, z): the position block the
+  tip's prediction covariance (m^2), the rotation block the tip angle's variance (rad^2) about
+  the bending plane's normal (the planar model's other rotations are exact: 0);
+- ``shape_band`` (``visualization_msgs/msg/Marker``, a ``TRIANGLE_LIST`` in namespace
+  ``tdcm_band``): the ``confidence`` band of the midline in the bending plane, each sample
+  widened by its interval along the in-plane normal.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tdcm_ros.bagio import msg_class
+from tdcm_ros.model import (
+    Design,
+    ParameterCovariance,
+    SolveResult,
+    linearised_covariances,
+    prediction_covariances,
+    roll_points,
+    roll_quaternions,
+)
+from tdcm_ros.model.uncertainty import band_half_widths
+from tdcm_ros.nodes.shape_messages import header_msg, marker_msg
+
+Array = NDArray[np.float64]
+BAND_NAMESPACE = "tdcm_band"
+#: RGBA of the band (translucent blue).
+BAND_COLOR = (0.2, 0.5, 1.0, 0.35)
+TRIANGLE_LIST = 11  #: visualization_msgs/Marker type
+
+
+@dataclass(frozen=True, eq=False)
+class ShapeSpread:
+    """The planar midline ``points`` (k, 3) m at arc lengths ``s`` with their prediction
+    covariances (k, 3, 3) m^2, and the tip angle's variance (rad^2, parameters only)."""
+
+    s: Array
+    points: Array
+    covariances: Array
+    tip_angle_variance: float
+
+
+def shape_spread(result: SolveResult, mu: float, uncertainty: ParameterCovariance, s: Array,
+                 resolve: Callable[[Design, float], SolveResult]) -> ShapeSpread:
+    """The spread of ``result`` (solved with friction ``mu``) at arc lengths ``s`` (m):
+    ``resolve(design, mu)`` solves the same input for moved parameters."""
+    def rows(solved: SolveResult) -> Array:
+        # the midline points, and the tip angle (rad) carried as one more row's x
+        angle = np.array([[solved.tip_angle_rad, 0.0, 0.0]])
+        return np.vstack([solved.pose_at(s)[0], angle])
+
+    def rows_at(design: Design, moved_mu: float) -> Array:
+        return rows(resolve(design, moved_mu))
+
+    centre = rows(result)
+    spread = linearised_covariances(rows_at, result.design, mu, uncertainty, centre)
+    return ShapeSpread(s, centre[:-1], prediction_covariances(spread[:-1], uncertainty.residual_m),
+                       float(spread[-1, 0, 0]))
+
+
+def uncertainty_messages(spread: ShapeSpread, result: SolveResult, *, stamp_ns: int,
+                         frame_id: str, roll: float, confidence: float
+                         ) -> Iterator[tuple[str, Any]]:
+    """``(topic, message)`` for ``tip_pose_with_covariance`` and ``shape_band`` (see the
+    module docstring), turned by ``roll`` (rad about +z)."""
+    hdr = header_msg(stamp_ns, frame_id)
+    turn = roll_points(np.eye(3), roll).T  # R: a point p turns to R p
+    tip = roll_points(result.tip_position, roll)
+    quat = roll_quaternions(result.tip_quaternion, roll)
+    covariance = np.zeros((6, 6))
+    covariance[:3, :3] = turn @ spread.covariances[-1] @ turn.T
+    normal_axis = turn @ np.array([0.0, 1.0, 0.0])  # the bending plane's normal: the tip bends about it
+    covariance[3:, 3:] = spread.tip_angle_variance * np.outer(normal_axis, normal_axis)
+    point, quaternion = msg_class("geometry_msgs/msg/Point"), msg_class(
+        "geometry_msgs/msg/Quaternion")
+    pose = msg_class("geometry_msgs/msg/Pose")(
+        position=point(x=tip[0], y=tip[1], z=tip[2]),
+        orientation=quaternion(x=quat[0], y=quat[1], z=quat[2], w=quat[3]))
+    yield "tip_pose_with_covariance", msg_class("geometry_msgs/msg/PoseWithCovarianceStamped")(
+        header=hdr, pose=msg_class("geometry_msgs/msg/PoseWithCovariance")(
+            pose=pose, covariance=covariance.ravel()))
+    yield "shape_band", _band_marker(hdr, band_edges(spread, confidence), roll)
+
+
+def band_edges(spread: ShapeSpread, confidence: float) -> tuple[Array, Array]:
+    """The band's two edges (k, 3) m in the bending plane: each point moved by its
+    ``confidence`` half-width along the in-plane normal (toward +x and away)."""
+    tangent = np.gradient(spread.points, spread.s, axis=0)
+    tangent /= np.linalg.norm(tangent, axis=1, keepdims=True)
+    normal = np.column_stack([tangent[:, 2], np.zeros(len(tangent)), -tangent[:, 0]])
+    half = band_half_widths(spread.covariances, normal, confidence)[:, None]
+    return spread.points + half * normal, spread.points - half * normal
+
+
+def _band_marker(hdr: Any, edges: tuple[Array, Array], roll: float) -> Any:
+    """The band as a ``TRIANGLE_LIST`` marker: two triangles per pair of samples."""
+    outer, inner = (roll_points(edge, roll) for edge in edges)
+    corners = []
+    for i in range(len(outer) - 1):
+        corners += [outer[i], inner[i], outer[i + 1], inner[i], inner[i + 1], outer[i + 1]]
+    point = msg_class("geometry_msgs/msg/Point")
+    return marker_msg(hdr, BAND_NAMESPACE, 0, TRIANGLE_LIST, (1.0, 1.0, 1.0), BAND_COLOR,
+                      [point(x=p[0], y=p[1], z=p[2]) for p in np.asarray(corners).tolist()])
