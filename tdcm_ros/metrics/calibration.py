@@ -2,8 +2,11 @@
 
 Residuals: for every step and every marker visible in it, the model's marker point at the
 step's mean tension (one per tendon for a body with several) minus the measured mean position,
-all three coordinates, in ``tdcm_base`` (m). ``scipy.optimize.least_squares`` (trust region, bounds from the design field ranges) fits
-the parameters relative to their start values.
+all three coordinates, in the step's bending plane (m; ``tdcm_base`` at roll 0, else turned by
+the step's roll, :func:`~tdcm_ros.metrics.evaluation.plane_markers`); a step whose roll moved
+(:func:`~tdcm_ros.metrics.evaluation.roll_note`) is left out. ``scipy.optimize.least_squares``
+(trust region, bounds from the design field ranges) fits the parameters relative to their start
+values.
 
 Uncertainty: ``cov = s^2 (J^T J)^-1`` at the optimum with ``s^2 = |r|^2 / (m - n)``; the interval
 is ``value +- t_{(1+confidence)/2, m-n} sqrt(cov_ii)``. It assumes independent residuals of
@@ -26,7 +29,13 @@ from scipy.optimize import least_squares
 from scipy.stats import t as student_t
 
 from tdcm_ros.errors import InputError, TdcmError, out_of_range
-from tdcm_ros.metrics.evaluation import Evaluation, model_tensions, solve_tension
+from tdcm_ros.metrics.evaluation import (
+    Evaluation,
+    model_tensions,
+    plane_markers,
+    roll_note,
+    solve_tension,
+)
 from tdcm_ros.metrics.measure import MeasuredStep
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
@@ -130,8 +139,8 @@ def parse_fit(text: str) -> tuple[str, ...]:
 
 @dataclass(frozen=True, eq=False)
 class _Data:
-    """Measured marker points in ``tdcm_base`` (steps, k, 3) with their step tensions (steps, J)
-    N, a column per tendon."""
+    """Measured marker points in each step's bending plane (steps, k, 3) m with their step
+    tensions (steps, J) N, a column per tendon; steps whose roll moved left out."""
 
     tensions: Array
     markers: Array
@@ -142,8 +151,10 @@ class _Data:
         tensions, markers = [], []
         for steps, reg in prepared:
             for step in steps:
+                if roll_note(step, options):
+                    continue
                 tensions.append(model_tensions(step.tensions_n, options))
-                markers.append(reg.to_base(step.markers))
+                markers.append(plane_markers(step, reg))
         # warm starts follow increasing tension (the largest of a step's)
         order = np.argsort([max(t) for t in tensions], kind="stable")
         return cls(np.asarray(tensions)[order], np.asarray(markers)[order])
