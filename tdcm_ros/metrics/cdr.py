@@ -145,7 +145,8 @@ def joint_efforts(payloads: Sequence[bytes], names: Sequence[str], present: Coun
 def joint_positions(payloads: Sequence[bytes], joint: str
                     ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Header stamps (ns) and the position of ``joint`` (rad for the roll; NaN where a message
-    does not name it or gives it no position; as given where not finite) in ``sensor_msgs/msg/JointState`` CDR payloads."""
+    does not name it or gives it no position) in ``sensor_msgs/msg/JointState`` CDR
+    payloads."""
     stamps = np.zeros(len(payloads), dtype=np.int64)
     positions = np.full(len(payloads), np.nan)
     for i, data in enumerate(payloads):
