@@ -18,7 +18,7 @@ SET_HELP = ("override in SI units: a design field (E=1.2e9, w_d=0.0014) or desig
             "steps.tolerance_n, steps.min_hold_s, steps.settle_s, steps.zero_n, "
             "markers.arc_lengths=0.015,0.033,0.053, markers.labels=m1,m2,m3, "
             "markers.ball_radius, markers.side_deg, align.tolerance_s, mape_threshold_m, "
-            "stations, deflection_axis=marker|body, solver.<setting>")
+            "stations, deflection_axis=marker|body, roll.tolerance_rad, solver.<setting>")
 
 
 def add_input_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,6 +34,12 @@ def add_input_arguments(parser: argparse.ArgumentParser) -> None:
                              "stamps within align.tolerance_s")
     parser.add_argument("--markers-topic", default="markers",
                         help="mocap4r2_msgs/msg/Markers topic (default: markers)")
+    parser.add_argument("--joint-states-topic", default="joint_states",
+                        help="sensor_msgs/msg/JointState topic holding the roll (default: "
+                             "joint_states; absent from a bag: roll 0 throughout)")
+    parser.add_argument("--roll-joint", default="roll",
+                        help="joint of --joint-states-topic the body rolls by, rad about the "
+                             "base +z axis (default: roll)")
     parser.add_argument("--design", metavar="NAME|FILE",
                         help="design preset or body file (.yaml) the model starts from (default: "
                              "paper-experiment); the same as --set design.preset=NAME")
@@ -55,10 +61,12 @@ def design_sets(args: argparse.Namespace) -> list[str]:
 
 
 def input_topics(args: argparse.Namespace) -> Topics:
-    """The topics ``--tension-topic`` (default ``tension``) and ``--markers-topic`` name."""
+    """The topics ``--tension-topic`` (default ``tension``), ``--markers-topic`` and
+    ``--joint-states-topic`` name, with ``--roll-joint``."""
     from tdcm_ros.metrics.api import Topics
 
-    return Topics(tuple(args.tension_topic or ("tension",)), args.markers_topic)
+    return Topics(tuple(args.tension_topic or ("tension",)), args.markers_topic,
+                  args.joint_states_topic, args.roll_joint)
 
 
 def register(subparsers: Any) -> None:

@@ -24,7 +24,7 @@ from tdcm_ros.metrics.geometry import DEFLECTION_AXES
 from tdcm_ros.metrics.options import OPTION_SPECS, EvaluateOptions, options_from_sets
 from tdcm_ros.metrics.plots import write_calibration_plots, write_plots
 from tdcm_ros.metrics.report import format_calibration, format_evaluation
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.series import MarkerSeries, RollSeries, TensionSeries
 from tdcm_ros.metrics.steps import STEP_SPECS, StepSettings, settings_for_hold
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.table import TableMetrics
@@ -42,6 +42,7 @@ __all__ = [
     "MarkersNotVisibleError",
     "MetricsError",
     "NoStepsError",
+    "RollSeries",
     "RunningEvaluation",
     "StepRecord",
     "StepSettings",

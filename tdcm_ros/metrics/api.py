@@ -40,10 +40,13 @@ ESTIMATED_REGISTRATION_NOTE = (
 @dataclass(frozen=True)
 class Topics:
     """Topic names read from the bags: ``tension`` one topic, or ``NAME=TOPIC`` values, one per
-    tendon of the body (:mod:`tdcm_ros.metrics.tension_topics`), and ``markers``."""
+    tendon of the body (:mod:`tdcm_ros.metrics.tension_topics`), ``markers``, and
+    ``joint_states`` whose joint ``roll_joint`` is the roll (rad; topic absent: roll 0)."""
 
     tension: str | tuple[str, ...] = "tension"
     markers: str = "markers"
+    joint_states: str = "joint_states"
+    roll_joint: str = "roll"
 
 
 def load_paths(paths: Sequence[str | Path], options: EvaluateOptions,
@@ -60,7 +63,9 @@ def load_paths(paths: Sequence[str | Path], options: EvaluateOptions,
         report_progress(progress, "reading bags", done, len(paths))
         sources.append(load_bag(path, labels=options.layout.labels, tension_topic=names.tension,
                                 markers_topic=names.markers, tendons=tendons,
-                                align_tolerance_s=options.align_tolerance_s))
+                                align_tolerance_s=options.align_tolerance_s,
+                                joint_states_topic=names.joint_states,
+                                roll_joint=names.roll_joint))
     report_progress(progress, "reading bags", len(paths), len(paths))
     return sources
 
@@ -72,7 +77,7 @@ def prepare(sources: Sequence[BagSource], options: EvaluateOptions,
     bag's ``/tf_static``, else an estimate from its zero-tension and largest-tension steps."""
     prepared = []
     for source in sources:
-        steps = measure_steps(source.tension, source.markers, options)
+        steps = measure_steps(source.tension, source.markers, options, source.roll)
         prepared.append((steps, choose_registration(
             steps, options, registration or source.registration)))
     return prepared

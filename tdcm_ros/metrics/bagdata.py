@@ -11,7 +11,11 @@
   position that is NaN or exactly ``(0, 0, 0)`` is an occluded marker, as mocap_node treats it
   (:func:`tdcm_ros.mocap.occlusion.visible`): missing, counted, never a measurement;
 - registration: the ``/tf_static`` transform whose child is ``tdcm_base`` and whose parent is the
-  markers' frame, if the bag has one.
+  markers' frame, if the bag has one;
+- roll: the position (rad about the base +z axis) of one joint of a ``sensor_msgs/msg/JointState``
+  topic (``joint_states``, joint ``roll``), if the bag has the topic (none: roll 0 throughout);
+  a message without a finite position for the joint is left out (counted in a warning), and a
+  topic without any leaves roll 0 (said in a warning).
 
 Stamps are the header stamps (s since the epoch); a topic whose header stamps are all zero uses
 the bag's log times instead (said in a warning). Messages are left out, counted in a warning:
@@ -43,11 +47,12 @@ from tdcm_ros.metrics.align import on_first_stamps
 from tdcm_ros.metrics.cdr import (
     float64_data,
     joint_efforts,
+    joint_positions,
     markers_frame,
     wrench_force_z,
 )
 from tdcm_ros.metrics.errors import MetricsError, TensionTopicError
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.series import MarkerSeries, RollSeries, TensionSeries
 from tdcm_ros.metrics.tension_topics import OPTION, TensionTopics, tension_topics
 from tdcm_ros.mocap import Registration, visible
 
@@ -67,8 +72,9 @@ BATCH = 8192
 
 @dataclass(frozen=True, eq=False)
 class BagSource:
-    """One bag's inputs: series, the registration it carries (or None), reading warnings and
-    the occluded marker positions (NaN or exactly zero) left out, per label."""
+    """One bag's inputs: series, the registration it carries (or None), reading warnings, the
+    occluded marker positions (NaN or exactly zero) left out, per label, and the roll (None:
+    no roll topic, roll 0 throughout)."""
 
     path: Path
     tension: TensionSeries
@@ -76,6 +82,7 @@ class BagSource:
     registration: Registration | None
     warnings: tuple[str, ...]
     occluded: dict[str, int] = field(default_factory=dict)
+    roll: RollSeries | None = None
 
 
 def _unique(stamps_ns: np.ndarray, digests: np.ndarray) -> np.ndarray:
@@ -362,14 +369,37 @@ def _registration(reader: BagReader, parent: str, warnings: list[str]) -> Regist
     return found
 
 
+def _roll(reader: BagReader, topic: str, joint: str, warnings: list[str]) -> RollSeries | None:
+    """The roll (rad) from the position of ``joint`` in the JointState topic ``topic``; None
+    when the bag has no such topic or it holds no finite position of ``joint``."""
+    name = next((t for t in (topic, "/" + topic.lstrip("/")) if reader.counts.get(t)), None)
+    if name is None:
+        return None
+    name = require_topic(reader, name, [JOINT_STATE_TYPE])
+    stamps_ns, from_log, unique, (positions,) = _read(
+        reader, name, lambda payloads: joint_positions(payloads, joint))
+    stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
+    rolls = positions if keep.all() else positions[keep]
+    finite = np.isfinite(rolls)
+    if not finite.any():
+        warnings.append(f"{name}: no finite position of joint {joint} (the roll) in "
+                        f"{rolls.size} messages; roll 0 assumed")
+        return None
+    if dropped := int((~finite).sum()):
+        warnings.append(f"{name}: {dropped} messages without a finite position of joint "
+                        f"{joint} (the roll) left out")
+    return RollSeries.of(stamps[finite], rolls[finite], f"{name} {joint} position")
+
+
 def load_bag(path: str | Path, *, labels: Sequence[str],
              tension_topic: str | Sequence[str] = "tension", markers_topic: str = "markers",
-             tendons: Sequence[str] = ("tendon_1",), align_tolerance_s: float = 0.02
-             ) -> BagSource:
+             tendons: Sequence[str] = ("tendon_1",), align_tolerance_s: float = 0.02,
+             joint_states_topic: str = "joint_states", roll_joint: str = "roll") -> BagSource:
     """Read one bag (rosbag2 folder or ``.mcap`` file) of a body whose tendons are ``tendons``
     (names, the body file's order; default: the paper's one); ``tension_topic`` one topic or
     ``NAME=TOPIC`` values (:func:`~tdcm_ros.metrics.tension_topics.tension_topics`), topics per
-    tendon aligned within ``align_tolerance_s`` (s). Errors are :class:`BagError` or
+    tendon aligned within ``align_tolerance_s`` (s); the roll from joint ``roll_joint`` of
+    ``joint_states_topic`` if present. Errors are :class:`BagError` or
     :class:`~tdcm_ros.metrics.errors.MetricsError` naming the file and topic."""
     topics = tension_topics(tension_topic, tendons)
     reader = open_bag(path)
@@ -377,4 +407,5 @@ def load_bag(path: str | Path, *, labels: Sequence[str],
     tension = _tensions(reader, topics, align_tolerance_s, warnings)
     markers, occluded = _markers(reader, markers_topic, labels, warnings)
     registration = _registration(reader, markers.frame_id, warnings)
-    return BagSource(Path(path), tension, markers, registration, tuple(warnings), occluded)
+    roll = _roll(reader, joint_states_topic, roll_joint, warnings)
+    return BagSource(Path(path), tension, markers, registration, tuple(warnings), occluded, roll)

@@ -3,13 +3,15 @@ friction from measured steps.
 
 Residuals: for every step and every marker visible in it, the model's marker point at the
 step's mean tension (one per tendon for a body with several) minus the measured mean position,
-all three coordinates, in ``tdcm_base`` (m). ``scipy.optimize.least_squares`` (trust region,
-bounds from the design field ranges) fits the design fields relative to their start values and
-``mu`` (the capstan friction coefficient, :class:`~tdcm_ros.model.FrictionTrack`) as it is.
-With friction (fitted, or ``options.friction_mu`` above 0) each recording's steps are solved
-in the order they happened, so loading and unloading steps at one level differ by the
+all three coordinates, in the step's bending plane (m; ``tdcm_base`` at roll 0, else turned by
+the step's roll, :func:`~tdcm_ros.metrics.evaluation.plane_markers`); a step whose roll moved
+(:func:`~tdcm_ros.metrics.evaluation.roll_note`) is left out. ``scipy.optimize.least_squares``
+(trust region, bounds from the design field ranges) fits the design fields relative to their
+start values and ``mu`` (the capstan friction coefficient, :class:`~tdcm_ros.model.FrictionTrack`)
+as it is. With friction (fitted, or ``options.friction_mu`` above 0) each recording's steps are
+solved in the order they happened, so loading and unloading steps at one level differ by the
 stick-slip hysteresis: that difference is what tells ``mu`` from ``E`` (with loading steps
-alone the two trade against each other; the correlation check below reports it).
+alone the two trade against each other; the checks below report it).
 
 Uncertainty: ``cov = s^2 (J^T J)^-1`` at the optimum with ``s^2 = |r|^2 / (m - n)``; the interval
 is ``value +- t_{(1+confidence)/2, m-n} sqrt(cov_ii)``. It assumes independent residuals of
@@ -36,6 +38,8 @@ from tdcm_ros.metrics.evaluation import (
     Evaluation,
     marker_points,
     model_tensions,
+    plane_markers,
+    roll_note,
     solve_tension,
 )
 from tdcm_ros.metrics.measure import MeasuredStep
@@ -164,8 +168,9 @@ def parse_fit(text: str) -> tuple[str, ...]:
 
 @dataclass(frozen=True, eq=False)
 class _Data:
-    """Measured marker points in ``tdcm_base`` (steps, k, 3) with their step tensions (steps, J)
-    N, a column per tendon, and the recording each step belongs to (steps,)."""
+    """Measured marker points in each step's bending plane (steps, k, 3) m with their step
+    tensions (steps, J) N, a column per tendon, and the recording each step belongs to (steps,);
+    steps whose roll moved left out."""
 
     tensions: Array
     markers: Array
@@ -179,8 +184,10 @@ class _Data:
         tensions, markers, sources = [], [], []
         for k, (steps, reg) in enumerate(prepared):
             for step in steps:
+                if roll_note(step, options):
+                    continue
                 tensions.append(model_tensions(step.tensions_n, options))
-                markers.append(reg.to_base(step.markers))
+                markers.append(plane_markers(step, reg))
                 sources.append(k)
         order = (np.arange(len(tensions)) if in_order
                  else np.argsort([max(t) for t in tensions], kind="stable"))

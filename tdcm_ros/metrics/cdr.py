@@ -1,6 +1,6 @@
 """Decoding of the evaluation's CDR payloads: ``geometry_msgs/msg/WrenchStamped`` vectorised (1 kHz
-tension bags), ``mocap4r2_msgs/msg/Markers``, ``std_msgs/msg/Float64`` and the tendon efforts of
-``sensor_msgs/msg/JointState``.
+tension bags), ``mocap4r2_msgs/msg/Markers``, ``std_msgs/msg/Float64`` and, of
+``sensor_msgs/msg/JointState``, the tendon efforts and one joint's position (the roll).
 
 WrenchStamped messages of equal length share one layout (same ``frame_id`` length), so each group is decoded
 with one NumPy view: encapsulation header (4 bytes), ``stamp.sec`` (int32), ``stamp.nanosec``
@@ -140,3 +140,19 @@ def joint_efforts(payloads: Sequence[bytes], names: Sequence[str], present: Coun
             if (j := column.get(name)) is not None:
                 efforts[i, j] = effort
     return stamps, efforts
+
+
+def joint_positions(payloads: Sequence[bytes], joint: str
+                    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Header stamps (ns) and the position of ``joint`` (rad for the roll; NaN where a message
+    does not name it or gives it no position) in ``sensor_msgs/msg/JointState`` CDR
+    payloads."""
+    stamps = np.zeros(len(payloads), dtype=np.int64)
+    positions = np.full(len(payloads), np.nan)
+    for i, data in enumerate(payloads):
+        msg = deserialize(data, "sensor_msgs/msg/JointState")
+        stamps[i] = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        names = list(msg.name)
+        if joint in names and (k := names.index(joint)) < len(msg.position):
+            positions[i] = float(msg.position[k])
+    return stamps, positions

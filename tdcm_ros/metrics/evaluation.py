@@ -1,12 +1,20 @@
 """Evaluation: measured steps against the model re-run at each step's mean tension (one per
 tendon for a body with several).
 
-Per step: the measured markers in ``tdcm_base``, the model's markers at the same surface points
-(:func:`tdcm_ros.model.surface_points`), both tip deflections and the shape error;
+Per step: the measured markers in its bending plane, the model's markers at the same surface
+points (:func:`tdcm_ros.model.surface_points`), both tip deflections and the shape error;
 then Table I (:mod:`tdcm_ros.metrics.table`) over the loading steps; the unloading steps
 (:mod:`tdcm_ros.metrics.steps`) get the same metrics separately. A step is *flagged* (left out of every metric,
-kept in the per-step table with a note) when its tip marker was never visible or the model has
-no solution at its tension.
+kept in the per-step table with a note) when its tip marker was never visible, the model has
+no solution at its tension or its roll moved more than ``roll.tolerance_rad`` within it.
+
+Roll: a step taken with the body rolled by ``phi`` (rad about the base +z axis, the step's mean
+roll, :mod:`tdcm_ros.metrics.measure`) bends in ``tdcm_base``'s x-z plane turned by ``phi``. Its
+measured markers are turned back by ``-phi`` (:func:`plane_markers`) into the planar model's
+frame, ``tdcm_base`` itself at roll 0, and compared there: the deflection along
+``deflection_axis`` and the shape error are those of the rolled bending plane, so a body at roll
+``phi`` scores as the same body at roll 0. A registration estimated from steps at a roll is
+turned to match (:func:`choose_registration`).
 
 Friction (``options.friction_mu`` above 0): a recording's steps are solved in the order they
 happened, each after the ones before it (:class:`~tdcm_ros.model.FrictionTrack`: stick-slip
@@ -31,7 +39,7 @@ from tdcm_ros.errors import TdcmError
 from tdcm_ros.metrics.geometry import deflection, measured_midline, station_distance
 from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.series import MarkerSeries, RollSeries, TensionSeries
 from tdcm_ros.metrics.steps import LOADING, UNLOADING
 from tdcm_ros.metrics.table import TableMetrics, table_metrics
 from tdcm_ros.mocap import (
@@ -46,6 +54,7 @@ from tdcm_ros.model import (
     inside_band,
     linearised_covariances,
     prediction_covariances,
+    roll_points,
     surface_points,
 )
 
@@ -124,9 +133,10 @@ TABLE_KEYS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m
 
 @dataclass(frozen=True, eq=False)
 class StepRecord:
-    """One step of the evaluation (SI units, frame ``tdcm_base``); ``trial`` counts from 1,
-    ``phase`` is ``loading`` or ``unloading``; ``tensions_n`` the step's mean tension by tendon
-    name (N, the body file's order)."""
+    """One step of the evaluation (SI units; markers and midlines in the step's bending plane:
+    ``tdcm_base`` turned by ``roll_rad`` about +z, :func:`plane_markers`); ``trial`` counts from
+    1, ``phase`` is ``loading`` or ``unloading``; ``tensions_n`` the step's mean tension by tendon
+    name (N, the body file's order); ``roll_rad`` its mean roll (rad)."""
 
     trial: int
     tensions_n: dict[str, float]
@@ -145,6 +155,7 @@ class StepRecord:
     phase: str = LOADING
     inside_band: NDArray[np.bool_] | None = None
     """Per visible marker: inside the predicted 95 % band (None: no band)."""
+    roll_rad: float = 0.0
 
     @property
     def usable(self) -> bool:
@@ -272,24 +283,58 @@ def registration_json(reg: Registration) -> dict[str, Any]:
 
 def choose_registration(steps: Sequence[MeasuredStep], options: EvaluateOptions,
                         given: Registration | None) -> Registration:
-    """``given`` if any, else estimated from the lowest step (at most ``steps.zero_n``) and the
-    highest step with every marker visible."""
+    """``given`` if any, else estimated from the highest step with every marker visible that
+    has a zero-tension step (at most ``steps.zero_n``) at its roll (within
+    ``roll.tolerance_rad``), and the lowest such zero-tension step; steps whose roll moved
+    (:func:`roll_note`) are left out. The estimate, made in their bending plane, is turned by
+    their roll into ``tdcm_base``."""
     if given is not None:
         return given
-    complete = [m for m in steps if not m.missing]
+    complete = [m for m in steps if not m.missing and not roll_note(m, options)]
     zero = [m for m in complete if m.tension_n <= options.steps.zero_n]
-    if not zero:
+
+    def at_roll_of(step: MeasuredStep) -> list[MeasuredStep]:
+        return [m for m in zero if abs(m.roll_rad - step.roll_rad) <= options.roll_tolerance_rad]
+
+    bent = max((m for m in complete if at_roll_of(m)), key=lambda m: m.tension_n, default=None)
+    if bent is None:
         raise RegistrationError(
             "no registration given (no /tf_static mocap -> tdcm_base) and no zero-tension step "
             f"(<= steps.zero_n = {options.steps.zero_n:g} N) with every marker visible to "
             "estimate it", parameter="registration", value=None,
             allowed="a mocap -> tdcm_base transform or a zero-tension hold")
-    rest = min(zero, key=lambda m: m.tension_n)
-    bent = max(complete, key=lambda m: m.tension_n)
+    rest = min(at_roll_of(bent), key=lambda m: m.tension_n)
     layout = options.layout
-    return estimate_registration(rest.markers, layout.s,
-                                 radius=layout.radius(options.design.R_outer),
-                                 side_rad=layout.side_rad, bent_markers=bent.markers)
+    plane = estimate_registration(rest.markers, layout.s,
+                                  radius=layout.radius(options.design.R_outer),
+                                  side_rad=layout.side_rad, bent_markers=bent.markers)
+    return rolled_registration(plane, bent.roll_rad)
+
+
+def rolled_registration(plane: Registration, roll_rad: float) -> Registration:
+    """``mocap`` -> ``tdcm_base`` from ``plane``, the registration onto the bending plane of a
+    body rolled by ``roll_rad`` (rad about +z): its rotation ``R`` becomes ``R R_z(-roll)``;
+    ``plane`` itself at roll 0."""
+    if roll_rad == 0.0:
+        return plane
+    rotation = roll_points(plane.rotation, roll_rad)  # each row turned: R R_z(-roll)
+    return Registration.from_matrix(rotation, plane.translation, method=plane.method,
+                                    residual_m=plane.residual_m)
+
+
+def plane_markers(step: MeasuredStep, registration: Registration) -> Array:
+    """The step's mean markers (k, 3) m in its bending plane: moved into ``tdcm_base`` and
+    turned back by its roll (-``roll_rad`` about +z), the frame of the planar model."""
+    return roll_points(registration.to_base(step.markers), -step.roll_rad)
+
+
+def roll_note(step: MeasuredStep, options: EvaluateOptions) -> str:
+    """Why the step is left out for its roll (it moved more than ``roll.tolerance_rad`` over
+    the step's frames), or ``""``."""
+    if step.roll_spread_rad <= options.roll_tolerance_rad:
+        return ""
+    return (f"roll moved {step.roll_spread_rad:.4g} rad within the step (allowed: at most "
+            f"roll.tolerance_rad = {options.roll_tolerance_rad:g} rad)")
 
 
 def model_tensions(tensions_n: Sequence[float], options: EvaluateOptions) -> tuple[float, ...]:
@@ -311,7 +356,7 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
     warm: SolveResult | None = None
     track = FrictionTrack(options.friction_mu)
     for measured in steps:
-        base = registration.to_base(measured.markers)
+        base = plane_markers(measured, registration)
         tensions = dict(zip(names, measured.tensions_n, strict=True))
         note, pred, inside = "", None, None
         try:
@@ -323,10 +368,12 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
             track.state.advance(pred.result)
         except TdcmError as error:
             note = f"model: {error}"
-        midline = measured_midline(base, options.layout, radius, at)
+        rolled = roll_note(measured, options)
         tip_seen = not np.isnan(base[-1, 0])
-        if not tip_seen:
-            note = note or f"tip marker {options.layout.labels[-1]} not visible"
+        note = note or rolled or (
+            "" if tip_seen else f"tip marker {options.layout.labels[-1]} not visible")
+        seen = tip_seen and not rolled  # one measurement at one roll
+        midline = measured_midline(base, options.layout, radius, at) if seen else None
         if note:
             warnings.append(f"trial {measured.step.trial + 1} step at "
                             f"{tensions_text(tensions)} left out: {note}")
@@ -335,14 +382,14 @@ def score_steps(steps: Sequence[MeasuredStep], registration: Registration,
             start_s=measured.step.start_s, end_s=measured.step.end_s, frames=measured.frames,
             measured_markers=base, predicted_markers=None if pred is None else pred.markers,
             measured_deflection_m=float(deflection(base[-1], offset, options.deflection_axis))
-            if tip_seen else None,
+            if seen else None,
             predicted_deflection_m=None if pred is None else float(
                 deflection(pred.markers[-1], offset, options.deflection_axis)),
             shape_error_m=None if pred is None or midline is None else station_distance(
                 midline, pred.midline),
             measured_midline=midline, predicted_midline=None if pred is None else pred.midline,
             missing=measured.missing, note=note, phase=measured.step.phase,
-            inside_band=inside))
+            inside_band=None if rolled else inside, roll_rad=measured.roll_rad))
     return records, warnings
 
 
@@ -363,11 +410,13 @@ def metrics_of(records: Sequence[StepRecord], options: EvaluateOptions, *,
 
 def evaluate_series(tension: TensionSeries, markers: MarkerSeries,
                     options: EvaluateOptions | None = None,
-                    registration: Registration | None = None) -> Evaluation:
+                    registration: Registration | None = None,
+                    roll: RollSeries | None = None) -> Evaluation:
     """Evaluate one recording given as arrays. ``registration`` maps the markers' frame to
-    ``tdcm_base``; ``None`` estimates it from the data (see :func:`.choose_registration`)."""
+    ``tdcm_base``; ``None`` estimates it from the data (see :func:`.choose_registration`).
+    ``roll``: the body's roll (``None``: 0 throughout)."""
     opts = options or EvaluateOptions()
-    steps = measure_steps(tension, markers, opts)
+    steps = measure_steps(tension, markers, opts, roll)
     return evaluate_steps(steps, choose_registration(steps, opts, registration), opts)
 
 

@@ -4,6 +4,13 @@ Each marker frame takes the tension sample nearest its stamp within ``align_tole
 frame belongs to the step holding that sample. Per step, each marker's position is the mean over
 the frames where it was visible; a marker never visible in a step leaves a NaN row and flags
 the step.
+
+Roll: each frame takes the roll at its stamp (:meth:`~tdcm_ros.metrics.series.RollSeries.at`;
+0 without a roll series); a step's roll is the mean over its frames (the frames its markers are
+averaged over) and its *roll spread* the largest minus the smallest of them. The evaluation
+leaves a step out whose spread exceeds ``roll.tolerance_rad``
+(:func:`tdcm_ros.metrics.evaluation.roll_note`) rather than average markers taken at different
+rolls.
 """
 
 from __future__ import annotations
@@ -17,7 +24,7 @@ from numpy.typing import NDArray
 from tdcm_ros.metrics.align import nearest_within
 from tdcm_ros.metrics.errors import MetricsError, NoStepsError
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.series import MarkerSeries, RollSeries, TensionSeries
 from tdcm_ros.metrics.steps import Step, detect_steps
 
 Array = NDArray[np.float64]
@@ -27,13 +34,16 @@ Array = NDArray[np.float64]
 class MeasuredStep:
     """A step with its mean tensions (N, one per tendon in the body's order) and mean marker
     positions (k, 3) m in the markers' frame (NaN rows: never visible in the step); ``frames``
-    marker frames fell in the step."""
+    marker frames fell in the step; its roll (rad, the mean over those frames) and roll spread
+    (rad, their largest minus smallest roll; see the module docstring)."""
 
     step: Step
     tensions_n: tuple[float, ...]
     markers: Array
     frames: int
     labels: tuple[str, ...]
+    roll_rad: float = 0.0
+    roll_spread_rad: float = 0.0
 
     @property
     def tension_n(self) -> float:
@@ -47,10 +57,11 @@ class MeasuredStep:
                      if np.isnan(row[0]))
 
 
-def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: EvaluateOptions
-                  ) -> list[MeasuredStep]:
-    """Detect the steps and average the markers over each (frame of ``markers``); ``tension``
-    has a column per tendon of ``options.design``, named as in its body file."""
+def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: EvaluateOptions,
+                  roll: RollSeries | None = None) -> list[MeasuredStep]:
+    """Detect the steps and average the markers (frame of ``markers``) and the roll (``None``:
+    0 throughout) over each; ``tension`` has a column per tendon of ``options.design``, named as
+    in its body file."""
     tendons = tuple(t.name for t in options.design.tendon_list())
     if (tension.names or tendons[:1]) != tendons:  # an unnamed series is the one tendon's
         raise MetricsError(
@@ -68,12 +79,14 @@ def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: Evalua
             f"{len(tension.stamps_s)} samples over {np.ptp(tension.stamps_s):.3g} s; adjust "
             "steps.tolerance_n / steps.min_hold_s", parameter="steps.min_hold_s",
             value=cfg.min_hold_s, allowed="a hold at least this long in the data")
-    return average_markers(tension, markers, steps, options)
+    return average_markers(tension, markers, steps, options, roll)
 
 
 def average_markers(tension: TensionSeries, markers: MarkerSeries, steps: Sequence[Step],
-                    options: EvaluateOptions) -> list[MeasuredStep]:
-    """Mean marker positions per step (steps index ``tension``'s samples)."""
+                    options: EvaluateOptions, roll: RollSeries | None = None
+                    ) -> list[MeasuredStep]:
+    """Mean marker positions and roll per step (steps index ``tension``'s samples; ``roll``
+    ``None``: 0 throughout)."""
     step_of_sample = np.full(tension.stamps_s.size, -1, dtype=np.int64)
     for k, step in enumerate(steps):
         step_of_sample[step.start:step.stop] = k
@@ -90,5 +103,20 @@ def average_markers(tension: TensionSeries, markers: MarkerSeries, steps: Sequen
     np.add.at(sums, frame_step[used], filled[used])
     with np.errstate(invalid="ignore", divide="ignore"):
         means = np.where(counts[:, :, None] > 0, sums / counts[:, :, None], np.nan)
-    return [MeasuredStep(step, step.means_n, means[k], int(frames[k]), markers.labels)
-            for k, step in enumerate(steps)]
+    rolls = _step_rolls(roll, markers.stamps_s[used], frame_step[used], n)
+    return [MeasuredStep(step, step.means_n, means[k], int(frames[k]), markers.labels,
+                         *rolls[k]) for k, step in enumerate(steps)]
+
+
+def _step_rolls(roll: RollSeries | None, stamps_s: Array, step_of_frame: NDArray[np.int64],
+                n: int) -> list[tuple[float, float]]:
+    """Per step of ``n``: the mean roll (rad) over its frames (stamps s, ``step_of_frame`` their
+    step) and the roll spread (rad); (0, 0) without ``roll`` or frames."""
+    if roll is None:
+        return [(0.0, 0.0)] * n
+    at = roll.at(stamps_s)
+    out = []
+    for k in range(n):
+        own = at[step_of_frame == k]
+        out.append((float(np.mean(own)), float(np.ptp(own))) if own.size else (0.0, 0.0))
+    return out

@@ -9,13 +9,15 @@ Names (SI units):
 - ``steps.<field>``: a :class:`~tdcm_ros.metrics.steps.StepSettings` field;
 - ``markers.labels`` / ``markers.arc_lengths`` (comma lists), ``markers.ball_radius`` (m),
   ``markers.side_deg``;
-- ``align.tolerance_s``, ``mape_threshold_m``, ``stations``, ``deflection_axis``;
+- ``align.tolerance_s``, ``mape_threshold_m``, ``stations``, ``deflection_axis``,
+  ``roll.tolerance_rad``;
 - ``friction.mu``: the tendon's capstan friction (a model file's ``friction`` section sets it
   with its design; :mod:`tdcm_ros.model.model_file`).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -60,6 +62,10 @@ class EvaluateOptions:
         "arc-length stations (from the base to the tip marker) of the shape error"))
     deflection_axis: str = spec_field("marker", choices=DEFLECTION_AXES, description=(
         "marker: distance from the tip marker's rest line; body: from the body axis"))
+    roll_tolerance_rad: float = spec_field(
+        0.02, name="roll.tolerance_rad", unit="rad", low=0.0, high=math.pi,
+        description="largest roll change (max - min over its marker frames) a step may hold; "
+                    "a step whose roll moves more is left out of the metrics")
     friction_mu: float = spec_field(0.0, name="friction.mu", low=0.0, high=10.0, description=(
         "capstan friction coefficient tendon/channel; above 0 each recording's steps are "
         "solved in the order they happened, with stick-slip friction"))

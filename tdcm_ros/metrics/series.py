@@ -1,4 +1,5 @@
-"""Time series the metrics work on: tension samples and labelled marker frames (SI units)."""
+"""Time series the metrics work on: tension samples, labelled marker frames and the body's roll
+(SI units)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tdcm_ros.errors import out_of_range
 from tdcm_ros.metrics.errors import MarkersNotVisibleError, MetricsError
+from tdcm_ros.model import InvalidRollError
 
 Array = NDArray[np.float64]
 
@@ -102,3 +105,33 @@ class MarkerSeries:
             f"frames{hint}; allowed: each marker visible in at least one frame",
             parameter="markers.labels" if present else "markers", value=never,
             allowed="visible in >= 1 frame")
+
+
+@dataclass(frozen=True, eq=False)
+class RollSeries:
+    """The body's roll about the base +z axis: ``stamps_s`` (n,) s ascending, ``roll_rad`` (n,)
+    rad, finite; held from each sample to the next (:meth:`at`)."""
+
+    stamps_s: Array
+    roll_rad: Array
+
+    @classmethod
+    def of(cls, stamps_s: ArrayLike, roll_rad: ArrayLike, parameter: str = "roll"
+           ) -> RollSeries:
+        """Validate and sort by stamp; a non-finite roll is an
+        :class:`~tdcm_ros.model.InvalidRollError` naming ``parameter`` and the value."""
+        t, order = _sorted_stamps("roll stamps", stamps_s)
+        x = np.asarray(roll_rad, dtype=float)
+        if x.shape != t.shape:
+            raise MetricsError(f"roll samples of shape {x.shape}; allowed: {t.shape}, one per "
+                               "stamp", parameter=parameter, value=x.shape, allowed=str(t.shape))
+        if not np.all(finite := np.isfinite(x)):
+            raise out_of_range(parameter, float(x[~finite][0]), "a finite real number "
+                               "(-inf, inf)", unit="rad", error=InvalidRollError)
+        return cls(t, x[order])
+
+    def at(self, stamps_s: ArrayLike) -> Array:
+        """The roll (rad) at each stamp (s): the latest sample at or before it, else the first
+        (as :class:`~tdcm_ros.model.RollHistory` pairs a stamp with its roll)."""
+        index = np.searchsorted(self.stamps_s, np.asarray(stamps_s, dtype=float), side="right")
+        return self.roll_rad[np.maximum(index - 1, 0)]

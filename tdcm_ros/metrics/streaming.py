@@ -15,10 +15,12 @@ Per-frame errors (:meth:`RunningEvaluation.sample_errors`) take the model at the
 nearest the frame's stamp from a :class:`~tdcm_ros.metrics.lookup.MarkerTable` (one tendon) or
 a :class:`~tdcm_ros.metrics.lookup.MarkerLattice` (several tendons).
 
-Roll (issue 18): the per-frame errors (:meth:`RunningEvaluation.sample_errors`) compare with
-the model rolled by the roll current at the frame's stamp (:meth:`RunningEvaluation.add_roll`,
-:class:`~tdcm_ros.model.RollHistory`). Table I (the steps, as offline) scores the planar model:
-it assumes the body at roll 0.
+Roll (issues 18, 33): the per-frame errors (:meth:`RunningEvaluation.sample_errors`) compare
+with the model rolled by the roll current at the frame's stamp (:meth:`RunningEvaluation.add_roll`,
+:class:`~tdcm_ros.model.RollHistory`, the last :data:`ROLL_SAMPLES` samples kept). A finished
+step takes the mean roll over its frames, each frame the roll at its stamp, and is scored in its
+bending plane as offline (:mod:`tdcm_ros.metrics.measure`, :mod:`tdcm_ros.metrics.evaluation`):
+a step whose roll moved more than ``roll.tolerance_rad`` is left out of Table I.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from tdcm_ros.metrics.evaluation import (
 from tdcm_ros.metrics.lookup import MarkerLattice, MarkerTable
 from tdcm_ros.metrics.measure import MeasuredStep, average_markers
 from tdcm_ros.metrics.options import EvaluateOptions
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.series import MarkerSeries, RollSeries, TensionSeries
 from tdcm_ros.metrics.steps import (
     assign_phases,
     assign_trials,
@@ -51,6 +53,9 @@ from tdcm_ros.mocap import Registration
 from tdcm_ros.model import RollHistory, roll_points
 
 Array = NDArray[np.float64]
+#: Roll samples kept (the newest): 655 s of a 100 Hz roll, 131 s at 500 Hz (the tension buffer
+#: keeps ``max_buffer_s``, 120 s by default).
+ROLL_SAMPLES = 65_536
 
 
 class RunningEvaluation:
@@ -74,7 +79,7 @@ class RunningEvaluation:
         self._x: list[tuple[float, ...]] = []
         self._frame_t: list[float] = []
         self._frames: list[Array] = []
-        self.rolls = RollHistory()
+        self.rolls = RollHistory(ROLL_SAMPLES)
         self.measured: list[MeasuredStep] = []
         self._dips: list[float] = []
         self._low_since_step = np.inf
@@ -171,7 +176,8 @@ class RunningEvaluation:
         if self._frames:
             markers = MarkerSeries.of(self._frame_t, self.options.layout.labels,
                                       np.asarray(self._frames))
-            new = average_markers(tension, markers, done, self.options)
+            roll = RollSeries.of(*self.rolls.samples()) if len(self.rolls) else None
+            new = average_markers(tension, markers, done, self.options, roll)
         else:
             empty = np.full((len(self.options.layout.labels), 3), np.nan)
             new = [MeasuredStep(s, s.means_n, empty, 0, self.options.layout.labels) for s in done]

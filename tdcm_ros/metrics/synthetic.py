@@ -8,7 +8,7 @@ Everything here is simulated; nothing is measured.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -16,9 +16,16 @@ from scipy.signal import lfilter
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.metrics.lookup import MarkerTable
-from tdcm_ros.metrics.series import MarkerSeries, TensionSeries
+from tdcm_ros.metrics.series import MarkerSeries, RollSeries, TensionSeries
 from tdcm_ros.mocap import Registration
-from tdcm_ros.model import Design, MarkerLayout, SolverSettings, solve, surface_points
+from tdcm_ros.model import (
+    Design,
+    MarkerLayout,
+    SolverSettings,
+    roll_points,
+    solve,
+    surface_points,
+)
 
 Array = NDArray[np.float64]
 PAPER_LEVELS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)
@@ -26,13 +33,15 @@ PAPER_LEVELS = (0.0, 4.0, 8.0, 12.0, 16.0, 20.0)
 
 @dataclass(frozen=True)
 class Recording:
-    """A simulated trial: measured tension, marker frames (``mocap``) and the true tension (N,
-    (n,) or (n, J) as the measured one)."""
+    """A simulated trial: measured tension, marker frames (``mocap``), the true tension (N,
+    (n,) or (n, J) as the measured one) and the roll (None: roll 0 throughout, no roll
+    samples)."""
 
     tension: TensionSeries
     markers: MarkerSeries
     true_tension_n: Array
     registration: Registration
+    roll: RollSeries | None = None
 
 
 def staircase(levels: Sequence[float] | Sequence[Sequence[float]] = PAPER_LEVELS, *,
@@ -104,3 +113,16 @@ def simulate(design: Design, *, registration: Registration | None = None,
     mocap[rng.random(base.shape[:2]) < occlusion] = np.nan
     return Recording(TensionSeries.of(stamps, measured, names if true.ndim > 1 else ()),
                      MarkerSeries.of(frame_s, layout.labels, mocap), true, reg)
+
+
+def rolled(recording: Recording, roll: RollSeries) -> Recording:
+    """``recording`` with the body rolled by ``roll`` (rad about the base +z axis): each marker
+    frame turned about ``tdcm_base``'s +z axis by the roll at its stamp, noise and all, and
+    ``roll`` its roll samples (frames at roll 0 kept as they are). A recording at roll 0 thus
+    gives the same frames in the bending plane at any roll."""
+    markers = recording.markers
+    reg = recording.registration
+    at = roll.at(markers.stamps_s)
+    turned = np.array([reg.to_mocap(roll_points(reg.to_base(frame), phi)) if phi else frame
+                       for frame, phi in zip(markers.positions, at.tolist(), strict=True)])
+    return replace(recording, markers=replace(markers, positions=turned), roll=roll)

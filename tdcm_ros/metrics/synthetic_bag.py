@@ -1,8 +1,9 @@
 """Write a simulated :class:`~tdcm_ros.metrics.synthetic.Recording` as a rosbag2 MCAP bag with the
 contract topics: ``/tension`` (WrenchStamped, force.z; for several tendons a JointState with an
 effort per tendon, by name, or a WrenchStamped topic per tendon), ``/markers``
-(mocap4r2_msgs/Markers in ``mocap``, occluded markers omitted) and, optionally, ``/tf_static``
-(``mocap`` -> ``tdcm_base``).
+(mocap4r2_msgs/Markers in ``mocap``, occluded markers omitted), optionally ``/tf_static``
+(``mocap`` -> ``tdcm_base``) and, for a recording with a roll, ``/joint_states`` (JointState:
+the position of joint ``roll``, rad).
 """
 
 from __future__ import annotations
@@ -56,12 +57,30 @@ def _joint_states(stamps_s: np.ndarray, tensions_n: np.ndarray, names: tuple[str
     return messages
 
 
+def _rolls(recording: Recording, topic: str, joint: str) -> list[tuple[int, str, bytes]]:
+    """JointState messages (log time ns, topic, CDR): the roll (rad) as ``joint``'s position;
+    none for a recording without a roll."""
+    if recording.roll is None:
+        return []
+    joints = msg_class(JOINT_STATE)
+    messages = []
+    for t, phi in zip(recording.roll.stamps_s.tolist(), recording.roll.roll_rad.tolist(),
+                      strict=True):
+        ns = EPOCH_NS + round(t * 1e9)
+        msg = joints(header=_header(ns, ""), name=[joint], position=np.array([phi]),
+                     velocity=np.empty(0), effort=np.empty(0))
+        messages.append((ns, topic, serialize(msg)))
+    return messages
+
+
 def write_recording(recording: Recording, path: str | Path, *, tf_static: bool = True,
                     tension_topic: str = "tension", markers_topic: str = "markers",
-                    tendon_topics: Mapping[str, str] | None = None) -> Path:
+                    tendon_topics: Mapping[str, str] | None = None,
+                    joint_states_topic: str = "joint_states", roll_joint: str = "roll") -> Path:
     """Write ``recording`` to the new bag folder ``path``; returns ``path``. A recording of
     several tendons goes to ``tension_topic`` as one JointState, or with ``tendon_topics``
-    (tendon name -> topic) to a WrenchStamped topic per tendon."""
+    (tendon name -> topic) to a WrenchStamped topic per tendon; its roll, if any, to
+    ``joint_states_topic`` as the position of ``roll_joint``."""
     marker, markers = msg_class("mocap4r2_msgs/msg/Marker"), msg_class("mocap4r2_msgs/msg/Markers")
     point = msg_class("geometry_msgs/msg/Point")
     tension = recording.tension
@@ -86,6 +105,9 @@ def write_recording(recording: Recording, path: str | Path, *, tf_static: bool =
             messages.append((EPOCH_NS, "/tf_static", serialize(_tf(recording))))
         for part in series.values():
             messages.extend(part)
+        if rolls := _rolls(recording, joint_states_topic, roll_joint):
+            bag.add_topic(joint_states_topic, JOINT_STATE)
+            messages.extend(rolls)
         frames = recording.markers
         labels = frames.labels
         for n, (t, rows) in enumerate(zip(frames.stamps_s.tolist(), frames.positions,

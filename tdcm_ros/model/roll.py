@@ -118,6 +118,10 @@ class StampedHistory:
         """Stamp of the newest value kept; ``None`` before any."""
         return self._stamps[-1] if self._stamps else None
 
+    def samples(self) -> tuple[list[float], list[float]]:
+        """The stamps and values kept, oldest first."""
+        return list(self._stamps), list(self._values)
+
     def add(self, stamp: float, value: float) -> bool:
         """Keep ``value`` at ``stamp``; False (not kept) when ``stamp`` is older than the latest
         kept one."""

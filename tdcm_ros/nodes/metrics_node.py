@@ -10,8 +10,9 @@ without a finite effort for every tendon is dropped and counted), ``markers``
 ``mocap_frame_id`` (``mocap``) to ``base_frame_id`` (``tdcm_base``), directly or through other
 frames (a base mounted on a robot: ``mocap -> world -> ... -> tool0 -> tdcm_base``), and
 ``joint_states`` (sensor_msgs/msg/JointState: the roll, joint ``roll.joint``, rad; 0 until one
-arrives). The per-frame errors compare at the roll current at the frame's stamp; Table I assumes
-roll 0 (see :mod:`tdcm_ros.metrics.streaming`).
+arrives). The per-frame errors compare at the roll current at the frame's stamp; a finished step
+is scored in its bending plane at its mean roll, and left out of Table I when its roll moved
+more than ``roll.tolerance_rad`` (see :mod:`tdcm_ros.metrics.streaming`).
 
 Publishes (frame ``base_frame_id`` after ``frame_prefix``, :mod:`tdcm_ros.nodes.frames`; SI
 units):

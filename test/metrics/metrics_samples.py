@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from tdcm_ros.metrics.synthetic import Recording, simulate
 from tdcm_ros.model import Design, named_design, preset
 
@@ -35,3 +37,8 @@ def pair_recording(design: Design = PAIR, **kw: object) -> Recording:
             "seed": 1}
     args.update(kw)
     return simulate(design, **args)
+
+
+def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle (rad) of the rotation between two rotation matrices (3, 3)."""
+    return float(np.arccos(np.clip((np.trace(a.T @ b) - 1.0) / 2.0, -1.0, 1.0)))

@@ -15,9 +15,10 @@ from tdcm_ros.bagio import from_dict
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.evaluation import evaluate_series
 from tdcm_ros.metrics.options import EvaluateOptions
+from tdcm_ros.metrics.series import RollSeries
 from tdcm_ros.metrics.streaming import RunningEvaluation
-from tdcm_ros.metrics.synthetic import Recording, simulate
-from tdcm_ros.model import MarkerLayout, preset, roll_points
+from tdcm_ros.metrics.synthetic import Recording, rolled, simulate
+from tdcm_ros.model import MarkerLayout, preset
 from tdcm_ros.nodes.metrics_node import MetricsNode
 from tdcm_ros.runtime.memory_port import MemoryPort
 
@@ -386,21 +387,14 @@ def test_node_maps_other_labels_and_midline_markers() -> None:
     assert table["n_steps"] == 3 and table["rmse_m"] < 2e-5
 
 
-def _rolled(rec: Recording, roll: float) -> Recording:
-    """``rec`` with the body rolled by ``roll`` (rad) about tdcm_base z: markers turned in base."""
-    base = rec.registration.to_base(rec.markers.positions.reshape(-1, 3))
-    turned = rec.registration.to_mocap(roll_points(base, roll))
-    markers = replace(rec.markers, positions=turned.reshape(rec.markers.positions.shape))
-    return replace(rec, markers=markers)
-
-
 @pytest.mark.parametrize("roll_sent", [True, False])
 def test_marker_errors_compare_at_the_measured_roll(recording: Recording, roll_sent: bool
                                                     ) -> None:
-    """The body rolled by 0.8 rad: with the roll on joint_states the per-frame errors stay at
-    the noise level; without it (the model at roll 0) they are millimetres."""
+    """The body rolled by 0.8 rad: with the roll on joint_states the per-frame errors and the
+    running Table I (steps scored in the rolled bending plane) stay at the noise level;
+    without it (the model at roll 0) they are millimetres."""
     roll = 0.8
-    rec = _rolled(recording, roll)
+    rec = rolled(recording, RollSeries.of([0.0], [roll]))
     port = metrics_port({"registration.source": "parameter",
                          "registration.translation": list(rec.registration.translation),
                          "registration.rotation": list(rec.registration.quaternion)})
@@ -414,8 +408,9 @@ def test_marker_errors_compare_at_the_measured_roll(recording: Recording, roll_s
     sizes = [np.linalg.norm([m.translation.x, m.translation.y, m.translation.z])
              for msg in port.published["metrics/marker_errors"] for m in msg.markers]
     assert len(sizes) > 0.9 * rec.markers.stamps_s.size
+    table = json.loads(port.published["metrics/table"][-1].data)
     if roll_sent:
-        assert np.median(sizes) < 3e-4
+        assert np.median(sizes) < 3e-4 and table["rmse_m"] < 2e-5
         assert node.counts["roll"] == 1 and node.counts["roll_non_finite"] == 1
     else:
-        assert np.median(sizes) > 2e-3
+        assert np.median(sizes) > 2e-3 and table["rmse_m"] > 5e-4
