@@ -853,6 +853,8 @@ BODY_LEVELS = {
     ("_segments", "f'{here} key'"): "segments[i]",
     ("_notch", "f'{where} key'"): "segments[i].notch",
     ("_given_section", "f'{where} key'"): "segments[i].notch.section",
+    ("_friction", "'friction key'"): "friction",
+    ("_uncertainty", "'uncertainty key'"): "uncertainty",
 }
 #: How the reader's local names read in the file (its ranges and conditions refer to other keys).
 BODY_NAMES = {"r_outer": "tube.R_outer", "modulus": "material.E", "low": "x_low",

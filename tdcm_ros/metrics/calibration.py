@@ -57,7 +57,7 @@ from tdcm_ros.model import (
     fittable_names,
     report_progress,
 )
-from tdcm_ros.model.friction import MAX_MU
+from tdcm_ros.model.loading import MAX_MU
 
 Array = NDArray[np.float64]
 MAX_CONDITION = 1e10

@@ -35,6 +35,10 @@ R_outer``; ``external``: through guides such as disks, any offset up to 0.5 m) a
 (default ``tendon_1``, ``tendon_2``, ...: :mod:`tdcm_ros.model.tendons`). The solver takes one
 tension per tendon.
 
+A *model file* is a body file with what a calibration adds (:mod:`tdcm_ros.model.model_file`):
+``friction: {mu: 0.3}`` (the capstan coefficient tendon/channel) and ``uncertainty`` (the fitted
+``parameters``, their ``values``, ``covariance`` and the fit's ``residual_m``).
+
 The solver takes band, cut and polygon notches, each with its own width and section, any
 tubes between them, and the tendons: :meth:`.BodySpec.design` gives that
 :class:`~tdcm_ros.model.design.Design` (per-notch values where the notches differ; a polygon
@@ -50,9 +54,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from tdcm_ros.errors import out_of_range, reject_unknown
 from tdcm_ros.model.design import MIN_SEGMENT_M, OFFSET_SLACK, Design, preset
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.loading import MAX_MU
 from tdcm_ros.model.material import LAWS, Material
 from tdcm_ros.model.profiles import (
     PROFILE_NAMES,
@@ -73,11 +80,10 @@ from tdcm_ros.model.tendons import (
     MAX_TENDONS,
     Tendon,
 )
+from tdcm_ros.model.uncertainty import InvalidUncertaintyError, ParameterCovariance
 from tdcm_ros.spec import Spec
 from tdcm_ros.yamlio import load_yaml
 
-#: A model file's keys besides the body's (:mod:`tdcm_ros.model.model_file` reads them).
-MODEL_KEYS = ("friction", "uncertainty")
 #: Most segments a body may expand to (``repeat`` included).
 MAX_SEGMENTS = 10_000
 #: A tendon's name: a ROS name token (it names its joint and topic).
@@ -161,6 +167,10 @@ class BodySpec:
     segments: tuple[Segment, ...]
     source: str
     material: Material
+    friction_mu: float = 0.0
+    """A model file's capstan friction coefficient (0: none)."""
+    uncertainty: ParameterCovariance | None = None
+    """A model file's fitted parameters' covariance (None: none)."""
 
     @property
     def routing(self) -> str:
@@ -244,7 +254,7 @@ def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
     """The checked :class:`BodySpec` of a body file's parsed YAML ``data``."""
     top = _mapping(data, "the body file", source)
     reject_unknown("body file key", top, ("tube", "material", "tendons", "segments", "mesh",
-                                          *MODEL_KEYS), error=InvalidDesignError)
+                                          "friction", "uncertainty"), error=InvalidDesignError)
     if "mesh" in top:
         for key in ("tube", "segments"):
             if key in top:
@@ -288,7 +298,44 @@ def body_from_mapping(data: Any, source: str = "body") -> BodySpec:
         else math.inf)
     tendons = _tendons(_required(top, "tendons", "", source), source, r_outer)
     return BodySpec(R_outer=r_outer, r_inner=r_inner, E=modulus, tendons=tendons,
-                    segments=tuple(segments), source=source, material=law_of)
+                    segments=tuple(segments), source=source, material=law_of,
+                    friction_mu=_friction(top.get("friction"), source),
+                    uncertainty=_uncertainty(top.get("uncertainty"), source))
+
+
+def _friction(section: Any, source: str) -> float:
+    """A model file's ``friction``: the capstan coefficient ``mu`` (0 without the section)."""
+    if section is None:
+        return 0.0
+    friction = _mapping(section, "friction", source)
+    reject_unknown("friction key", friction, ("mu",), error=InvalidDesignError)
+    return _number(friction, "mu", "friction.", source, low=0.0, high=MAX_MU)
+
+
+def _uncertainty(section: Any, source: str) -> ParameterCovariance | None:
+    """A model file's ``uncertainty`` (``tdcm calibrate --out``): the fitted ``parameters``,
+    their ``values``, ``covariance`` and the fit's ``residual_m``; None without the section."""
+    if section is None:
+        return None
+    entry = _mapping(section, "uncertainty", source)
+    reject_unknown("uncertainty key", entry, ("parameters", "values", "covariance",
+                                              "residual_m"), error=InvalidDesignError)
+    names = _list(_required(entry, "parameters", "uncertainty.", source),
+                  "uncertainty.parameters", source)
+    try:
+        values = np.array(_required(entry, "values", "uncertainty.", source), dtype=float)
+        covariance = np.array(_required(entry, "covariance", "uncertainty.", source),
+                              dtype=float)
+    except (TypeError, ValueError) as error:
+        raise InvalidDesignError(f"{source}: uncertainty.values and .covariance must be numbers "
+                                 f"({error})", parameter="uncertainty", value=section,
+                                 allowed="lists of numbers") from error
+    residual = _number(entry, "residual_m", "uncertainty.", source, low=0.0, high=1.0)
+    try:
+        return ParameterCovariance(tuple(str(n) for n in names), values, covariance, residual)
+    except InvalidUncertaintyError as error:
+        raise InvalidUncertaintyError(f"{source}: {error}", parameter=error.parameter,
+                                      value=error.value, allowed=error.allowed) from error
 
 
 def _tendons(items: Any, source: str, r_outer: float) -> tuple[Tendon, ...]:
@@ -508,7 +555,7 @@ def _required(entry: Mapping[str, Any], key: str, prefix: str, source: str) -> A
 
 #: Units of the body file's numbers that are not lengths in m.
 _UNITS = {"E": "Pa", "E_plateau": "Pa", "area": "m^2", "second_moment": "m^4",
-          "plateau_strain": "", "recoverable_strain": "", "stiffness": "N/m"}
+          "plateau_strain": "", "recoverable_strain": "", "stiffness": "N/m", "mu": ""}
 
 
 def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low: float,

@@ -33,15 +33,12 @@ from numpy.typing import NDArray
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.design import Design
-from tdcm_ros.model.loading import InvalidLoadingError, Loading
+from tdcm_ros.model.loading import MAX_MU, InvalidLoadingError, Loading
 from tdcm_ros.model.result import SolveResult
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.solver import DEFAULT_SETTINGS, solve
 
 Array = NDArray[np.float64]
-#: Largest capstan friction coefficient the estimator takes (that of
-#: :class:`~tdcm_ros.model.loading.Capstan`).
-MAX_MU = 10.0
 
 
 class FrictionState:

@@ -59,6 +59,8 @@ Array = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 MAX_STIFFNESS_FACTOR = 1e6
+#: Largest capstan friction coefficient tendon/channel.
+MAX_MU = 10.0
 
 
 class InvalidLoadingError(ModelError, InputError):
@@ -92,8 +94,8 @@ class Capstan:
     unloading: bool = False
 
     def __post_init__(self) -> None:
-        if not _is_real(self.mu) or not 0.0 <= self.mu <= 10.0:
-            raise out_of_range("mu", self.mu, "[0, 10]", error=InvalidLoadingError)
+        if not _is_real(self.mu) or not 0.0 <= self.mu <= MAX_MU:
+            raise out_of_range("mu", self.mu, f"[0, {MAX_MU:g}]", error=InvalidLoadingError)
 
     def __call__(self, s: Array, wrap_angle: Array, tension_base: float) -> Array:
         sign = 1.0 if self.unloading else -1.0

@@ -18,20 +18,11 @@ tension after the ones before it (:class:`~tdcm_ros.model.friction.FrictionTrack
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
 
-import numpy as np
-
-from tdcm_ros.errors import reject_unknown
-from tdcm_ros.model.body_file import body_file_text, body_from_mapping, is_body_file
+from tdcm_ros.model.body_file import body_file_text, is_body_file, read_body_file
 from tdcm_ros.model.design import Design, preset
-from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.friction import check_mu
-from tdcm_ros.model.uncertainty import InvalidUncertaintyError, ParameterCovariance
-from tdcm_ros.yamlio import load_yaml
+from tdcm_ros.model.uncertainty import ParameterCovariance
 
 
 @dataclass(frozen=True, eq=False)
@@ -65,59 +56,5 @@ def read_model(name: str) -> ModelSpec:
     """The model ``name`` names: a model (or body) file if it is one, else a preset."""
     if not is_body_file(name):
         return ModelSpec(preset(name))
-    try:
-        text = Path(name).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
-        raise InvalidDesignError(f"cannot read body file {name}: {error}", parameter="design",
-                                 value=name, allowed="a readable UTF-8 YAML file") from error
-    data = load_yaml(text, name, parameter="design", error=InvalidDesignError)
-    design = body_from_mapping(data, name).design()
-    return ModelSpec(design, _friction(data.get("friction"), name),
-                     _uncertainty(data.get("uncertainty"), name))
-
-
-def _friction(section: Any, source: str) -> float:
-    if section is None:
-        return 0.0
-    if not isinstance(section, dict):
-        raise InvalidDesignError(f"{source}: friction = {section!r} is not a mapping; allowed: "
-                                 "{mu: NUMBER}", parameter="friction", value=section,
-                                 allowed="{mu: NUMBER}")
-    reject_unknown("friction key", section, ("mu",), error=InvalidDesignError)
-    return check_mu(_real(section.get("mu", 0.0), "friction.mu", source),
-                    f"{source}: friction.mu")
-
-
-def _uncertainty(section: Any, source: str) -> ParameterCovariance | None:
-    if section is None:
-        return None
-    keys = ("parameters", "values", "covariance", "residual_m")
-    if not isinstance(section, dict) or any(k not in section for k in keys):
-        raise InvalidDesignError(f"{source}: uncertainty needs {', '.join(keys)}",
-                                 parameter="uncertainty", value=section, allowed=", ".join(keys))
-    reject_unknown("uncertainty key", section, keys, error=InvalidDesignError)
-    names = section["parameters"]
-    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
-        raise InvalidDesignError(f"{source}: uncertainty.parameters = {names!r}; allowed: a list "
-                                 "of names", parameter="uncertainty.parameters", value=names,
-                                 allowed="[NAME, ...]")
-    try:
-        values = np.array(section["values"], dtype=float)
-        covariance = np.array(section["covariance"], dtype=float)
-    except (TypeError, ValueError) as error:
-        raise InvalidDesignError(f"{source}: uncertainty values and covariance must be numbers "
-                                 f"({error})", parameter="uncertainty", value=section,
-                                 allowed="numbers") from error
-    try:
-        return ParameterCovariance(tuple(names), values, covariance,
-                                   _real(section["residual_m"], "uncertainty.residual_m", source))
-    except InvalidUncertaintyError as error:
-        raise InvalidUncertaintyError(f"{source}: {error}", parameter=error.parameter,
-                                      value=error.value, allowed=error.allowed) from error
-
-
-def _real(value: Any, key: str, source: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InvalidDesignError(f"{source}: {key} = {value!r} is not a finite number",
-                                 parameter=key, value=value, allowed="a finite number")
-    return float(value)
+    body = read_body_file(name)
+    return ModelSpec(body.design(), body.friction_mu, body.uncertainty)

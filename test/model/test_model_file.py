@@ -18,7 +18,6 @@ from tdcm_ros.model import (
     read_model,
 )
 from tdcm_ros.model.errors import InvalidDesignError
-from tdcm_ros.model.loading import InvalidLoadingError
 
 DESIGN = preset("paper-experiment").with_overrides(E=7.0123456789e8)
 COVARIANCE = ParameterCovariance(("E", "mu"), np.array([7.0123456789e8, 0.3012]),
@@ -52,7 +51,7 @@ def test_a_body_file_and_a_preset_are_models_without_friction_or_band(tmp_path: 
 
 @pytest.mark.parametrize(("section", "error", "parameter"), [
     ("friction: 0.3", InvalidDesignError, "friction"),
-    ("friction: {mu: -0.1}", InvalidLoadingError, "friction.mu"),
+    ("friction: {mu: -0.1}", InvalidDesignError, "friction.mu"),
     ("friction: {mu: .nan}", InvalidDesignError, "friction.mu"),
     ("friction: {mu: 0.1, nu: 2}", InvalidDesignError, "nu"),
     ("uncertainty: {parameters: [E]}", InvalidDesignError, "uncertainty"),
@@ -63,7 +62,7 @@ def test_a_body_file_and_a_preset_are_models_without_friction_or_band(tmp_path: 
     ("uncertainty: {parameters: [E], values: [1.0e9], covariance: [[-1.0]], residual_m: 0}",
      InvalidUncertaintyError, "uncertainty.covariance"),
     ("uncertainty: {parameters: [E], values: [1.0e9], covariance: [[1.0]], residual_m: -1}",
-     InvalidUncertaintyError, "uncertainty.residual_m"),
+     InvalidDesignError, "uncertainty.residual_m"),
 ])
 def test_a_bad_section_names_its_key(tmp_path: Path, section: str, error: type,
                                      parameter: str) -> None:
