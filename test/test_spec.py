@@ -233,7 +233,8 @@ def _settings_classes() -> list[type]:
 
 
 #: Fields that hold objects or groups, not parameters.
-NOT_PARAMETERS = {"profile", "tendons", "material", "design", "solver", "steps", "layout"}
+NOT_PARAMETERS = {"profile", "tendons", "material", "design", "solver", "steps", "layout",
+                  "uncertainty"}
 
 
 @pytest.mark.parametrize("cls", _settings_classes(), ids=lambda c: c.__name__)

@@ -33,7 +33,7 @@ def register(subparsers: Any) -> None:
         epilog="examples:\n"
                "  tdcm calibrate bags/paper_experiment\n"
                "  tdcm calibrate run.mcap --fit E --confidence 0.9 --json\n"
-               "  tdcm calibrate run.mcap --fit E,mu --hold-out 1 --out model.yaml\n"
+               "  tdcm calibrate friction_demo/bag --fit E,mu --hold-out 1 --out model.yaml\n"
                "  tdcm calibrate pair_run --design config/bodies/antagonistic_pair.yaml")
     add_input_arguments(parser)
     parser.add_argument("--fit", default="E", metavar="NAME[,NAME]",
@@ -78,10 +78,13 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _write(path: Path, text: str) -> None:
-    """Write the model file ``text`` to ``path``; a path that cannot be written is an
-    :class:`InputError` naming ``--out``."""
+    """Write the model file ``text`` to ``path`` whole (a reader sees the old file or the new
+    one, never part of it); a path that cannot be written is an :class:`InputError` naming
+    ``--out``."""
+    partial = path.with_name(f".{path.name}.partial")
     try:
-        path.write_text(text, encoding="utf-8")
+        partial.write_text(text, encoding="utf-8")
+        partial.replace(path)
     except OSError as error:
         raise InputError(f"--out = {str(path)!r} cannot be written: {error}", parameter="--out",
                          value=str(path), allowed="a writable file path") from error

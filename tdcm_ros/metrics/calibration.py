@@ -47,6 +47,7 @@ from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import (
     FIELD_SPECS,
+    MAX_MU,
     MU,
     Design,
     FrictionTrack,
@@ -57,7 +58,6 @@ from tdcm_ros.model import (
     fittable_names,
     report_progress,
 )
-from tdcm_ros.model.loading import MAX_MU
 
 Array = NDArray[np.float64]
 MAX_CONDITION = 1e10

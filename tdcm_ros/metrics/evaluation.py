@@ -134,7 +134,7 @@ TABLE_KEYS = ("mape_pct", "rmse_m", "mae_m", "shape_error_m", "deflection_mean_m
 @dataclass(frozen=True, eq=False)
 class StepRecord:
     """One step of the evaluation (SI units; markers and midlines in the step's bending plane:
-    ``tdcm_base`` turned by ``roll_rad`` about +z, :func:`plane_markers`); ``trial`` counts from
+    ``tdcm_base`` turned by ``roll_rad`` about +z, ``plane_markers``); ``trial`` counts from
     1, ``phase`` is ``loading`` or ``unloading``; ``tensions_n`` the step's mean tension by tendon
     name (N, the body file's order); ``roll_rad`` its mean roll (rad)."""
 

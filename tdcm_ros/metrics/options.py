@@ -12,7 +12,7 @@ Names (SI units):
 - ``align.tolerance_s``, ``mape_threshold_m``, ``stations``, ``deflection_axis``,
   ``roll.tolerance_rad``;
 - ``friction.mu``: the tendon's capstan friction (a model file's ``friction`` section sets it
-  with its design; :mod:`tdcm_ros.model.model_file`).
+  with its design; :class:`~tdcm_ros.model.ModelSpec`).
 """
 
 from __future__ import annotations

@@ -106,7 +106,8 @@ def format_calibration(cal: Calibration) -> str:
         lines += ["", f"fitted steps: {band_line(*band)}"]
     if (held := cal.held_out) is not None:
         h = held.metrics
-        lines += ["", (f"held out ({h.n_trials} trials, {len(held.records)} steps, not "
+        trials = f"{h.n_trials} trial{'' if h.n_trials == 1 else 's'}"
+        lines += ["", (f"held out ({trials}, {len(held.records)} steps, not "
                        f"fitted): MAPE {_metric(h.mape_pct, 1.0, '%')}, RMSE "
                        f"{_metric(h.rmse_m, 1e3, 'mm')}, shape error "
                        f"{_metric(h.shape_error_m, 1e3, 'mm')}")]

@@ -73,6 +73,7 @@ from tdcm_ros.model.inverse_design import (
 )
 from tdcm_ros.model.limits import check_tension
 from tdcm_ros.model.loading import (
+    MAX_MU,
     Capstan,
     InvalidLoadingError,
     Loading,
@@ -129,6 +130,7 @@ from tdcm_ros.model.uncertainty import (
     MU,
     InvalidUncertaintyError,
     ParameterCovariance,
+    band_half_widths,
     fittable_names,
     inside_band,
     linearised_covariances,
@@ -147,6 +149,7 @@ __all__ = [
     "FIELD_SPECS",
     "FREE_FIELDS",
     "MARKER_SPECS",
+    "MAX_MU",
     "MU",
     "PARAMETER_SPECS",
     "PRESETS",
@@ -210,6 +213,7 @@ __all__ = [
     "UnreachableTargetError",
     "Variable",
     "VariableSet",
+    "band_half_widths",
     "body_file_text",
     "body_from_mapping",
     "body_outline",

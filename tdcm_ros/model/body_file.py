@@ -35,7 +35,7 @@ R_outer``; ``external``: through guides such as disks, any offset up to 0.5 m) a
 (default ``tendon_1``, ``tendon_2``, ...: :mod:`tdcm_ros.model.tendons`). The solver takes one
 tension per tendon.
 
-A *model file* is a body file with what a calibration adds (:mod:`tdcm_ros.model.model_file`):
+A *model file* is a body file with what a calibration adds (:class:`~tdcm_ros.model.ModelSpec`):
 ``friction: {mu: 0.3}`` (the capstan coefficient tendon/channel) and ``uncertainty`` (the fitted
 ``parameters``, their ``values``, ``covariance`` and the fit's ``residual_m``).
 

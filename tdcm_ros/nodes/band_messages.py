@@ -30,12 +30,12 @@ from tdcm_ros.model import (
     Design,
     ParameterCovariance,
     SolveResult,
+    band_half_widths,
     linearised_covariances,
     prediction_covariances,
     roll_points,
     roll_quaternions,
 )
-from tdcm_ros.model.uncertainty import band_half_widths
 from tdcm_ros.nodes.shape_messages import header_msg, marker_msg
 
 Array = NDArray[np.float64]
@@ -111,9 +111,8 @@ def band_edges(spread: ShapeSpread, confidence: float) -> tuple[Array, Array]:
 def _band_marker(hdr: Any, edges: tuple[Array, Array], roll: float) -> Any:
     """The band as a ``TRIANGLE_LIST`` marker: two triangles per pair of samples."""
     outer, inner = (roll_points(edge, roll) for edge in edges)
-    corners = []
-    for i in range(len(outer) - 1):
-        corners += [outer[i], inner[i], outer[i + 1], inner[i], inner[i + 1], outer[i + 1]]
+    corners = np.stack([outer[:-1], inner[:-1], outer[1:], inner[:-1], inner[1:], outer[1:]],
+                       axis=1).reshape(-1, 3)
     point = msg_class("geometry_msgs/msg/Point")
     return marker_msg(hdr, BAND_NAMESPACE, 0, TRIANGLE_LIST, (1.0, 1.0, 1.0), BAND_COLOR,
-                      [point(x=p[0], y=p[1], z=p[2]) for p in np.asarray(corners).tolist()])
+                      [point(x=x, y=y, z=z) for x, y, z in corners.tolist()])

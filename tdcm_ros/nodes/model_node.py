@@ -68,6 +68,7 @@ import numpy as np
 from tdcm_ros.errors import InputError, PhysicsError, exact_number
 from tdcm_ros.model import (
     MARKER_SPECS,
+    MAX_MU,
     PARAMETER_SPECS,
     PRESETS,
     SOLVER_SPECS,
@@ -84,7 +85,6 @@ from tdcm_ros.model import (
     require_paper_tendon,
     warm_up,
 )
-from tdcm_ros.model.loading import MAX_MU
 from tdcm_ros.nodes.band_messages import shape_spread, uncertainty_messages
 from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix
 from tdcm_ros.nodes.joint_messages import (

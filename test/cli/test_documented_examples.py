@@ -61,13 +61,19 @@ def test_every_example_parses_and_is_of_a_known_kind(example: Example) -> None:
 def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A folder holding every file the offline examples name, as a checkout does: the sample
     bag (also as ``run.mcap``, ``trial1``, ``trial2``), ``config/``, ``bench/``, a scene file, a
-    bag from another lab and bags of the antagonistic pair (``pair_run``: one JointState;
-    ``pair_topics``: a WrenchStamped topic per tendon, ``/flexor`` and ``/extensor``)."""
+    bag from another lab, bags of the antagonistic pair (``pair_run``: one JointState;
+    ``pair_topics``: a WrenchStamped topic per tendon, ``/flexor`` and ``/extensor``), a bag of
+    the friction scene where its demo writes it (``friction_demo/bag``) and the model
+    calibrated on it (``model.yaml``)."""
+    from tdcm_ros.metrics.api import calibrate_paths
     from tdcm_ros.metrics.synthetic import simulate
     from tdcm_ros.metrics.synthetic_bag import write_recording
     from tdcm_ros.model import MarkerLayout
+    from tdcm_ros.scenes import load_scene
     from test.cli.test_foreign_bags_cli import DESIGN, LEVELS, VICON, write_foreign_bag
     from test.metrics.metrics_samples import pair_recording
+    from test.metrics.test_friction_calibration import UP_DOWN
+    from test.support.scene_recording import scene_recording
 
     folder = tmp_path_factory.mktemp("examples")
     sample = REPO / "bags" / "paper_experiment"
@@ -85,6 +91,10 @@ def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     write_recording(pair, folder / "pair_run")
     write_recording(pair, folder / "pair_topics",
                     tendon_topics={"flexor": "/flexor", "extensor": "/extensor"})
+    friction = scene_recording(load_scene("friction_hysteresis"), UP_DOWN, trials=3)
+    write_recording(friction, folder / "friction_demo" / "bag")
+    fit = calibrate_paths([folder / "friction_demo" / "bag"], ("E", "mu"))
+    (folder / "model.yaml").write_text(fit.model.text(), encoding="utf-8")
     return folder
 
 

@@ -11,8 +11,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from tdcm_ros.model import FrictionState, StickSlipTension
 from tdcm_ros.model import NotchContact as NotchContactLaw
-from tdcm_ros.model.friction import FrictionState, StickSlipTension
 from tdcm_ros.scenes.effects.base import Effect, EffectContext, register
 from tdcm_ros.scenes.errors import InvalidSceneError
 from tdcm_ros.scenes.params import Param
