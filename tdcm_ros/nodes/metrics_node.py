@@ -12,7 +12,11 @@ frames (a base mounted on a robot: ``mocap -> world -> ... -> tool0 -> tdcm_base
 ``joint_states`` (sensor_msgs/msg/JointState: the roll, joint ``roll.joint``, rad; 0 until one
 arrives). The per-frame errors compare at the roll current at the frame's stamp; a finished step
 is scored in its bending plane at its mean roll, and left out of Table I when its roll moved
-more than ``roll.tolerance_rad`` (see :mod:`tdcm_ros.metrics.streaming`).
+more than ``roll.tolerance_rad`` (see :mod:`tdcm_ros.metrics.streaming`). A model file
+(``design.file`` from ``tdcm calibrate --out``) sets ``friction.mu``'s default and its
+uncertainty: finished steps are then solved in order with stick-slip friction and
+``metrics/table`` carries ``band`` (the markers inside the predicted 95 % band); the per-frame
+errors stay those of the frictionless model (its lookup table).
 
 Publishes (frame ``base_frame_id`` after ``frame_prefix``, :mod:`tdcm_ros.nodes.frames`; SI
 units):
@@ -82,8 +86,9 @@ from tdcm_ros.model import (
     PRESETS,
     Design,
     InvalidRollError,
-    named_design,
+    ModelSpec,
     parameter_specs,
+    read_model,
     require_paper_tendon,
 )
 from tdcm_ros.nodes.frames import FRAME_PREFIX_SPECS, declare_frame_prefix, robot_frame
@@ -171,13 +176,16 @@ def _stamp_s(message: Any) -> float:
 
 
 def declare_design_and_layout(port: NodePort, node: str = "metrics_node", *,
-                              tendon_list: bool = False) -> tuple[Design, MarkerLayout]:
+                              tendon_list: bool = False
+                              ) -> tuple[Design, MarkerLayout, ModelSpec]:
     """The design (``design.preset`` then ``design.*``) and the marker layout (``markers.*``)
-    as read-only parameters of the node named ``node``; bad values raise InputError, and so
-    does a body with a tendon list unless ``tendon_list`` (the node takes a tension per
-    tendon)."""
+    as read-only parameters of the node named ``node``, and the model ``design.file`` or
+    ``design.preset`` names (a model file's friction and uncertainty); bad values raise
+    InputError, and so does a body with a tendon list unless ``tendon_list`` (the node takes a
+    tension per tendon)."""
     start = declare_specs(port, PRESET_SPECS, read_only=True)
-    base = named_design(str(start["design.file"]) or str(start["design.preset"]))
+    model = read_model(str(start["design.file"]) or str(start["design.preset"]))
+    base = model.design
     if not tendon_list:
         require_paper_tendon(base.tendons, f"{node} (one tension input)", "design.file")
     design = base.with_overrides(**declare_specs(
@@ -188,7 +196,7 @@ def declare_design_and_layout(port: NodePort, node: str = "metrics_node", *,
     fields.update(declare_specs(
         port, {"radial_offset": LAYOUT_SPECS["radial_offset"]}, prefix="markers.",
         defaults={"radial_offset": design.R_outer + fields["ball_radius"]}, read_only=True))
-    return design, MarkerLayout(**fields)
+    return design, MarkerLayout(**fields), model
 
 
 def marker_rows(message: Any, index: dict[str, int]) -> tuple[np.ndarray, int]:
@@ -285,10 +293,12 @@ class MetricsNode(NodeLogic):
     def _options(self) -> EvaluateOptions:
         """Evaluation options from the (read-only) parameters; bad values raise InputError."""
         port = self.port
-        design, layout = declare_design_and_layout(port, tendon_list=True)
+        design, layout, model = declare_design_and_layout(port, tendon_list=True)
         steps = StepSettings(**declare_specs(port, STEP_SPECS, prefix="steps.", read_only=True))
         return EvaluateOptions(design=design, steps=steps, layout=layout,
-                               **declare_specs(port, OPTION_SPECS, read_only=True))
+                               uncertainty=model.uncertainty,
+                               **declare_specs(port, OPTION_SPECS, read_only=True,
+                                               defaults={"friction_mu": model.friction_mu}))
 
     def _on_tension(self, message: Any) -> None:
         """Buffer a tension sample (N, one per tendon); one without a finite tension for every

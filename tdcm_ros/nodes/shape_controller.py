@@ -220,7 +220,8 @@ class ShapeControllerNode(NodeLogic):
         """``limits_on_timer``: read the driver's limits on the port's timer, not a thread
         (see :class:`LimitsReader`; for a :class:`MemoryPort` only)."""
         super().__init__(port)
-        design, layout = declare_design_and_layout(port, "shape_controller")
+        # the controller's model is frictionless: a model file's friction is not used here
+        design, layout, _ = declare_design_and_layout(port, "shape_controller")
         fixed = declare_specs(port, FIXED_SPECS, read_only=True)
         declare_specs(port, TUNABLE_SPECS)
         gain = GainSettings(float(fixed["gain.initial"]), float(fixed["gain.initial_std"]),

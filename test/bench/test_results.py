@@ -38,7 +38,7 @@ def _load() -> ModuleType:
 results = _load()
 
 #: The benches whose figures the docs quote: each takes --results (bench/<name>.py).
-CONVERTED = ("accuracy", "bench_bagio", "bench_batch", "bench_controller", "bench_design", "bench_effects",
+CONVERTED = ("accuracy", "bench_bagio", "bench_band", "bench_batch", "bench_controller", "bench_design", "bench_effects",
              "bench_evaluate", "bench_evaluate_memory", "bench_grids", "bench_inverse",
              "bench_latency", "bench_loading", "bench_material", "bench_mesh", "bench_pose",
              "bench_progress", "bench_roll", "bench_shape_design", "bench_solve", "bench_start",

@@ -142,3 +142,43 @@ def test_node_survives_its_peer_restarting(runtime, context, graph_env):
     finally:
         spawn_node.kill()
         spawn_node.wait()
+
+
+def test_a_model_files_tip_covariance_and_band_cross_the_wire(runtime, context, spawn,
+                                                              tmp_path):
+    """The uncertainty outputs (PoseWithCovarianceStamped, a Marker) reach a peer on each
+    runtime, equal to what the node builds in-process (test_model_node_uncertainty.py)."""
+    import yaml
+
+    from tdcm_ros.model import ModelSpec, ParameterCovariance
+
+    design = preset("paper-experiment").with_overrides(E=7.0e8)
+    covariance = ParameterCovariance(("E",), np.array([7.0e8]), np.array([[(7e6) ** 2]]), 1e-4)
+    model = tmp_path / "model.yaml"
+    model.write_text(ModelSpec(design, 0.0, covariance).text(), encoding="utf-8")
+    params = tmp_path / "params.yaml"
+    params.write_text(yaml.safe_dump({"model_node": {"ros__parameters": {
+        "design": {"file": str(model)}, "output": {"visual_rate_hz": 0.0}}}}))
+    spawn("tdcm_ros.runtime.run_node", MODEL, "--params", str(params))
+    probe = Probe(context)
+    port = context.create_port("band_probe")
+    tips: list[Any] = []
+    bands: list[Any] = []
+    port.create_subscription("tip_pose_with_covariance",
+                             "geometry_msgs/msg/PoseWithCovarianceStamped", tips.append)
+    port.create_subscription("shape_band", "visualization_msgs/msg/Marker", bands.append)
+    path = probe.midline_for(20.0)
+    stamp = (path.header.stamp.sec, path.header.stamp.nanosec)
+    def stamped(messages: list[Any]) -> Any:
+        return next((m for m in messages
+                     if (m.header.stamp.sec, m.header.stamp.nanosec) == stamp), None)
+
+    tip_msg = eventually(lambda: stamped(tips), 20.0, "the tip with covariance", spin=context)
+    band = eventually(lambda: stamped(bands), 20.0, "the band", spin=context)
+    assert band.ns == "tdcm_band" and len(band.points) == 6 * 53
+    expected = solve(design, 20.0)
+    got = tip_msg.pose.pose.position
+    assert np.allclose([got.x, got.y, got.z], expected.tip_position, atol=1e-12)
+    cov = np.reshape(tip_msg.pose.covariance, (6, 6))
+    # E moves the tip in x and z; y has the residual alone (0.1 mm)
+    assert cov[0, 0] > 1e-8 and cov[1, 1] == 1e-4**2

@@ -58,7 +58,7 @@ def test_shape_controller_refuses_a_body_with_a_tendon_list_naming_it() -> None:
     name = "shape_controller"
     with pytest.raises(InvalidDesignError, match=rf"design\.file: {name} \(one tension"):
         declare_design_and_layout(MemoryPort({"design.file": body}, name=name), name)
-    design, _ = declare_design_and_layout(MemoryPort({"design.file": body}, name="metrics_node"),
+    design, _, _ = declare_design_and_layout(MemoryPort({"design.file": body}, name="metrics_node"),
                                           tendon_list=True)
     assert [t.name for t in design.tendon_list()] == ["flexor", "extensor"]
 
@@ -66,7 +66,7 @@ def test_shape_controller_refuses_a_body_with_a_tendon_list_naming_it() -> None:
 def test_metrics_node_takes_the_same_file(tmp_path: Path) -> None:
     body = tmp_path / "fig2.yaml"
     body.write_text(body_file_text(preset("fig2-wn-2.5")), encoding="utf-8")
-    design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
+    design, _, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                      name="metrics_node"))
     assert design == preset("fig2-wn-2.5")
 
@@ -107,7 +107,7 @@ def test_a_per_notch_body_file_reaches_both_nodes_and_its_lists_are_not_paramete
     assert {"design.E", "design.w_n", "design.w_t"} <= names and "design.w_d" not in names
     assert port.store.set({"design.E": 2.0e9}).successful   # a uniform field is still a parameter
     assert node.design.w_d == design.w_d and node.design.E == 2.0e9
-    metrics_design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
+    metrics_design, _, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                              name="metrics_node"))
     assert metrics_design == design
 
@@ -128,7 +128,7 @@ def test_a_polygon_or_mesh_body_file_reaches_both_nodes_its_sections_not_paramet
                                                             midline.shape[0]))[0]
     assert midline[-1] == pytest.approx(expected[-1, [0, 2]], abs=1e-12)
     assert port.store.set({"design.E": 2.0e9}).successful and node.design.E == 2.0e9
-    metrics_design, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
+    metrics_design, _, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                              name="metrics_node"))
     assert metrics_design == node.design.with_overrides(E=1.85e9)
 

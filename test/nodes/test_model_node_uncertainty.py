@@ -158,3 +158,14 @@ def test_a_body_file_has_no_band_and_no_friction(tmp_path: Path) -> None:
     assert "tip_pose_with_covariance" not in node.publishers
     assert not port.messages("tip_pose_with_covariance") and not port.messages("shape_band")
     assert np.allclose(tip_of(port), solve(DESIGN, 15.0).tip_position, rtol=0.0, atol=1e-12)
+
+
+def test_metrics_node_takes_the_model_files_friction_and_band(model_file: str) -> None:
+    from tdcm_ros.nodes.metrics_node import MetricsNode
+
+    port = MemoryPort({"design.file": model_file}, name="metrics_node")
+    node = MetricsNode(port)
+    assert port.get_parameter("friction.mu") == MU
+    assert node.options.friction_mu == MU
+    assert node.options.uncertainty is not None
+    assert node.options.uncertainty.names == ("E", "mu")
