@@ -121,7 +121,7 @@ def calibration_figure(plt: Any, fit: Calibration) -> Any:
     """Tip deflection error per step before calibration (the nominal design) and after (the
     fitted one), per trial, with a sentence on what calibration did."""
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
-    fitted = ", ".join(f"{p.name} {p.initial:.4g} -> {p.value:.4g} {p.unit}"
+    fitted = ", ".join(f"{p.name} {p.initial:.4g} -> {p.value:.4g} {p.unit}".rstrip()
                        for p in fit.parameters)
     for k, trial in enumerate(sorted({r.trial for r in fit.before.records})):
         for evaluation, style, when in ((fit.before, "o--", "before"), (fit.after, "s-", "after")):
@@ -129,8 +129,9 @@ def calibration_figure(plt: Any, fit: Calibration) -> Any:
             ax.plot(tension, error * MM, style, color=f"C{k}", mfc="none" if when == "before"
                     else None, label=f"trial {trial}, {when} calibration")
     _error_axes(ax, fit.before)
+    unexplained = "noise" if any(p.name == "mu" for p in fit.parameters) else "friction, noise"
     ax.set_title("Calibration fits " + fitted + "; what error is left after it is what the fitted "
-                 "model cannot explain (friction, noise)", fontsize=FONT_SIZE, wrap=True)
+                 f"model cannot explain ({unexplained})", fontsize=FONT_SIZE, wrap=True)
     fig.tight_layout()
     return fig
 
