@@ -40,8 +40,11 @@ Issue 25 (each failed on the main of its filing):
   ``tension_setpoint`` key, with rmw_zenoh's attachment. Failure: the tendon tensions.
 - ``big_parameters``: multi-megabyte ``frame_id`` and ``schedule.levels`` set on the driver.
   Failure: accepted.
-- ``router_loss``: ``tdcm up --twin`` holds 8 N, its router is killed (SIGKILL). Failure: no
-  router comes back, or the tendon is not slack with the driver disarmed for the lost graph.
+- ``router_loss``: ``tdcm up --twin`` holds 8 N, its router is killed (SIGKILL). The driver's
+  guarantee: a graph gone for ``safety.graph_timeout_s`` (1 s) releases the tendon; a shorter
+  gap (``tdcm up`` restarts its router in ~0.2 s) holds it but is counted
+  (``graph_interruptions``) and warned about. Failure: neither within 30 s (the tendon held
+  with no interruption reported, or not slack after a loss), or no router comes back.
 - ``full_disk``: the bag writer under a random file-size limit. Failure: it crashes, or the bag
   does not read back as the messages it kept, with ``metadata.yaml``.
 """
@@ -684,8 +687,9 @@ def campaign_big_parameters(tries: int, rng: random.Random, tmp: Path) -> Failur
 
 
 def campaign_router_loss(tries: int, rng: random.Random, tmp: Path) -> Failures:
-    """``tdcm up --twin`` holding 8 N; ``kill -9`` of its router: the router comes back, the
-    driver reports itself disarmed for the lost graph and the tendon is slack."""
+    """``tdcm up --twin`` holding 8 N; ``kill -9`` of its router: the router comes back, and the
+    driver either reports the interruption (holding) or is disarmed for the lost graph with the
+    tendon slack (see the module docstring)."""
     failures: Failures = []
     for _ in range(tries):
         port = free_port()
@@ -730,13 +734,24 @@ def _router_loss_once(port: int) -> str:
             return "no router process of tdcm up found"
         os.kill(routers[0], signal.SIGKILL)
         truth.clear()
-        if wait_until(lambda: bool(truth) and truth[-1] < 0.3 and bool(states)
-                      and "graph lost" in states[-1].get("disarm_reason", ""),
-                      30.0, context.spin_for):
+        states.clear()
+
+        def released() -> bool:
+            return (bool(truth) and truth[-1] < 0.3 and bool(states)
+                    and "graph lost" in states[-1].get("disarm_reason", ""))
+
+        def reported() -> bool:
+            return (bool(truth) and abs(truth[-1] - 8.0) < 0.3 and bool(states)
+                    and int(states[-1].get("graph_interruptions", "0")) >= 1
+                    and states[-1].get("armed") == "true")
+
+        if wait_until(lambda: released() or reported(), 30.0, context.spin_for):
             return ""
+        last = states[-1] if states else {}
         return (f"after kill -9 of the router: true tension "
-                f"{truth[-1] if truth else 'not heard'} N, driver disarmed for "
-                f"{states[-1].get('disarm_reason') if states else 'not heard'}")
+                f"{truth[-1] if truth else 'not heard'} N, driver armed {last.get('armed')}, "
+                f"disarmed for {last.get('disarm_reason')!r}, graph interruptions "
+                f"{last.get('graph_interruptions')}")
     finally:
         context.close()
 
@@ -817,7 +832,7 @@ CAMPAIGNS: dict[str, tuple[Callable[[int, random.Random, Path], Failures], int, 
     "recorder": (campaign_recorder, 2, "a message lost at the head, inside or tail"),
     "wildcard_setpoints": (campaign_wildcard_setpoints, 200, "a wildcard key tensioned the tendon"),
     "big_parameters": (campaign_big_parameters, 6, "a multi-megabyte parameter accepted"),
-    "router_loss": (campaign_router_loss, 2, "tendon held, or no router, after kill -9"),
+    "router_loss": (campaign_router_loss, 2, "after kill -9: held unreported, or no router"),
     "full_disk": (campaign_full_disk, 10, "a crash, or the bag unreadable or miscounted"),
 }
 

@@ -101,7 +101,7 @@ def actuator(status: DriverStatus | None, *, tension_max: float, schedule_state:
         "disarms": status.disarms if status else 0,
         **{key: counts.get(key, 0) for key in ("clamped_setpoints", "rejected_setpoints",
                                                 "estops", "clamped_rolls", "rejected_rolls",
-                                                "graph_losses")},
+                                                "graph_losses", "graph_interruptions")},
         **_roll_values(status, roll_max),
         "last_warning": last_warning}
     if status is None:

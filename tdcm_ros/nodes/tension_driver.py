@@ -189,7 +189,8 @@ class TensionDriverNode(NodeLogic):
         self._clock = clock
         self.graph_timeout = float(fixed[GRAPH_TIMEOUT])
         self._graph_checked = self._graph_seen = clock()
-        self._graph_lost = False
+        self._graph_lost = self._graph_missing = False
+        self._hubs: frozenset[str] = frozenset()  # the routers at the last look that saw one
         if bool(port.get_parameter("enabled")):
             self.driver.enable()
         self.lifecycle: Lifecycle | None = None
@@ -455,20 +456,33 @@ class TensionDriverNode(NodeLogic):
     def _watch_graph(self) -> None:
         """Every :data:`GRAPH_CHECK_PERIOD_S` s: after ``safety.graph_timeout_s`` s without a
         graph (no zenoh router: no operator can reach the node, not even with an e-stop) the
-        driver releases the tendon and stays disarmed until ``clear_faults``."""
+        driver releases the tendon and stays disarmed until ``clear_faults``. A shorter gap,
+        seen by a look or by the routers being new ones (a router restarted between two looks),
+        holds the tendon but is counted (``graph_interruptions``) and warned about: what was
+        sent to the node meanwhile may be lost."""
         now = self._clock()
         if now - self._graph_checked < GRAPH_CHECK_PERIOD_S:
             return
         self._graph_checked = now
-        if self.port.graph_connected():
-            if self._graph_lost:
-                self.port.logger.warning("graph back; the tendon stays released until "
-                                         "clear_faults")
-            self._graph_seen, self._graph_lost = now, False
-        elif not self._graph_lost and now - self._graph_seen >= self.graph_timeout:
-            self._graph_lost = True
-            self.counts["graph_losses"] += 1
-            self.driver.disarm(f"graph lost: no zenoh router for {now - self._graph_seen:.1f} s")
+        hubs = self.port.graph_hubs()
+        if not hubs:
+            self._graph_missing = True
+            if not self._graph_lost and now - self._graph_seen >= self.graph_timeout:
+                self._graph_lost = True
+                self.counts["graph_losses"] += 1
+                self.driver.disarm(f"graph lost: no zenoh router for "
+                                   f"{now - self._graph_seen:.1f} s")
+            return
+        restarted = bool(self._hubs) and hubs.isdisjoint(self._hubs)
+        if self._graph_lost:
+            self.port.logger.warning("graph back; the tendon stays released until clear_faults")
+        elif self._graph_missing or restarted:
+            self.counts["graph_interruptions"] += 1
+            self._warn(f"graph interrupted for less than safety.graph_timeout_s = "
+                       f"{self.graph_timeout:g} s ({'a new router' if restarted else 'the router back'}"
+                       "): messages sent to the node meanwhile may be lost; the tendon is held")
+        self._graph_seen, self._graph_lost, self._graph_missing = now, False, False
+        self._hubs = hubs
 
     def _log_link(self, status: DriverStatus) -> None:
         if status.link is LinkState.CONNECTED and status.banner is not None:

@@ -95,7 +95,8 @@ class MemoryPort:
         self.timers: list[MemoryTimer] = []
         self.services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
         self.remote_services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
-        self.connected = True  #: what :meth:`graph_connected` answers (a test cuts the graph)
+        #: what :meth:`graph_hubs` answers (a test cuts the graph, or restarts its router)
+        self.hubs: frozenset[str] = frozenset({"memory"})
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
@@ -169,9 +170,9 @@ class MemoryPort:
         """The port's clock, ns since the UNIX epoch."""
         return self.clock_ns
 
-    def graph_connected(self) -> bool:
-        """:attr:`connected`."""
-        return self.connected
+    def graph_hubs(self) -> frozenset[str]:
+        """:attr:`hubs`."""
+        return self.hubs
 
     def deliver(self, topic: str, message: Any) -> None:
         """Hand ``message`` to the subscription on ``topic`` after a CDR round trip."""

@@ -160,9 +160,11 @@ class NodePort(Protocol):
         """Current time of the node's clock, ns since the UNIX epoch (with the ROS parameter
         ``use_sim_time``: the latest ``/clock``, 0 before the first)."""
 
-    def graph_connected(self) -> bool:
-        """False while the node is known to be cut off from the graph: on zenoh, no router is
-        connected to its session; on rclpy always True (DDS has no router to lose)."""
+    def graph_hubs(self) -> frozenset[str]:
+        """What connects the node to the graph: on zenoh the ids of the routers connected to its
+        session (empty: cut off from the graph); on rclpy ``{"dds"}`` always (DDS has no router
+        to lose). A restarted router has a new id, so a change shows even when no check saw the
+        graph gone."""
 
 
 class NodeLogic:

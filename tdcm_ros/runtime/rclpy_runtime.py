@@ -374,11 +374,13 @@ class RclpyNodePort:
         """The node clock (ROS time if ``use_sim_time``), ns."""
         return int(self.node.get_clock().now().nanoseconds)
 
-    def graph_connected(self) -> bool:
-        """Always True: DDS discovery has no router whose loss could be seen."""
-        return True
+    def graph_hubs(self) -> frozenset[str]:
+        """Always ``{"dds"}``: DDS discovery has no router whose loss could be seen."""
+        return DDS_HUBS
 
 
+#: What :meth:`RclpyNodePort.graph_hubs` answers.
+DDS_HUBS = frozenset({"dds"})
 #: The type checker holds the port to the protocol every node is written against.
 _CONTRACT: type[NodePort] = RclpyNodePort
 

@@ -648,9 +648,9 @@ class ZenohNodePort:
         """System time, ns since the UNIX epoch; with ``use_sim_time`` the latest ``/clock``."""
         return self._clock_ns if self.use_sim_time else time.time_ns()
 
-    def graph_connected(self) -> bool:
-        """True while a zenoh router is connected to the session (the graph's hub)."""
-        return self._context.router_connected()
+    def graph_hubs(self) -> frozenset[str]:
+        """The ids of the zenoh routers connected to the session (the graph's hubs)."""
+        return self._context.router_ids()
 
     def close(self) -> None:
         """Detach the ``/rosout`` handler; undeclare every endpoint (parameter services
@@ -683,9 +683,9 @@ class ZenohContext:
         """Next node/entity id (one counter per context, as in rmw_zenoh)."""
         return next(self._ids)
 
-    def router_connected(self) -> bool:
-        """True while at least one zenoh router is connected to the session."""
-        return any(True for _ in self.session.info.routers_zid())
+    def router_ids(self) -> frozenset[str]:
+        """The ids of the zenoh routers connected to the session (empty: none)."""
+        return frozenset(str(zid) for zid in self.session.info.routers_zid())
 
     def require_router(self) -> None:
         """``RuntimePortError`` saying why if the session reaches no router at the endpoint

@@ -606,18 +606,22 @@ def test_a_lost_graph_releases_after_the_timeout_and_stays_released_until_armed(
     again, clear_faults does. A loss shorter than the timeout changes nothing."""
     bench = make(**{"safety.graph_timeout_s": 0.5})
     bench.hold(8.0)
-    bench.port.connected = False
+    hubs = bench.port.hubs
+    bench.port.hubs = frozenset()
     bench.advance(0.3)
-    bench.port.connected = True
+    bench.port.hubs = hubs
     bench.advance(0.5)
     assert bench.state()["armed"] == "true" and bench.twin.core.mode is Mode.TENSION
-    bench.port.connected = False
+    assert bench.state()["graph_interruptions"] == "1"
+    assert "graph interrupted for less than safety.graph_timeout_s = 0.5 s (the router back)" \
+        in bench.state()["last_warning"]
+    bench.port.hubs = frozenset()
     bench.advance(0.45)
     assert bench.state()["armed"] == "true"  # not yet: 0.4 s seen lost at the last look
     bench.advance(0.2)
     assert bench.state()["armed"] == "false" and bench.state()["graph_losses"] == "1"
     assert "graph lost: no zenoh router for 0.5 s" in bench.state()["disarm_reason"]
-    bench.port.connected = True
+    bench.port.hubs = hubs
     bench.advance(0.2)
     assert "graph back; the tendon stays released until clear_faults" in bench.log.text
     released_until_armed(bench, "graph lost")
@@ -669,3 +673,21 @@ def test_joint_commands_set_tension_and_roll_as_ros2_control_sends_them(roll_ben
     bench.port.deliver("joint_commands", joint_command(["tendon"], [], [5.0]))
     bench.advance(0.005)
     assert bench.state()["target"] == "0.000"  # disarmed: refused, the tendon stays released
+
+
+def test_a_router_restarted_between_two_looks_is_an_interruption_not_a_loss(make) -> None:
+    """The router replaced faster than a look (tdcm up restarts it in ~0.2 s): the new router's
+    id tells; the tendon is held (the gap is below safety.graph_timeout_s), the interruption is
+    counted and warned about. A second router joining the first is no interruption."""
+    bench = make()
+    bench.hold(8.0)
+    bench.port.hubs = bench.port.hubs | {"router-b"}  # a second router joins the first
+    bench.advance(0.3)
+    assert bench.state()["graph_interruptions"] == "0"
+    bench.port.hubs = frozenset({"router-c"})  # both gone, a new one in their place
+    bench.advance(0.3)
+    state = bench.state()
+    assert state["graph_interruptions"] == "1" and state["graph_losses"] == "0"
+    assert state["armed"] == "true" and bench.twin.core.mode is Mode.TENSION
+    assert "(a new router): messages sent to the node meanwhile may be lost" in \
+        state["last_warning"]
