@@ -138,7 +138,7 @@ def run_list(args: argparse.Namespace) -> int:
 def run_echo(args: argparse.Namespace) -> int:
     """Print each message as a YAML document until Ctrl-C, ``--once`` or ``--count``."""
     from tdcm_ros.bagio import BagError, deserialize, to_dict
-    from tdcm_ros.runtime import resolve_topic
+    from tdcm_ros.runtime import QoS, resolve_topic
 
     if not args.wait_matching >= 0:
         raise InputError(f"--wait-matching = {args.wait_matching} s must be >= 0",
@@ -169,14 +169,26 @@ def run_echo(args: argparse.Namespace) -> int:
 
     try:
         watch = GraphWatch(context)
-        port.create_raw_subscription(args.topic, args.type, show)
-        context.spin_for(args.wait_matching)
-        if not context.executor.stop.is_set():
-            _check_published(watch, resolve_topic(args.topic), args.type, args.wait_matching)
-            context.spin()
+        topic = resolve_topic(args.topic)
+        seen = _wait_for_publishers(context, watch, topic, args.wait_matching)
+        # as ros2 topic echo: transient local when every publisher is (their latest message
+        # then reaches this late joiner), else the default, volatile
+        qos = QoS(durability="transient_local") if seen == {"transient_local"} else QoS()
+        _check_published(watch, topic, args.type, args.wait_matching)
+        port.create_raw_subscription(args.topic, args.type, show, qos)
+        context.spin()
     finally:
         context.close()
     return 0
+
+
+def _wait_for_publishers(context: Any, watch: Any, topic: str, wait_s: float) -> set[str]:
+    """Spin until a publisher of ``topic`` is seen or ``wait_s`` s passed; the durabilities
+    its publishers declare (empty: none seen)."""
+    deadline = time.monotonic() + wait_s
+    while not (seen := watch.publisher_durabilities(topic)) and time.monotonic() < deadline:
+        context.spin_for(min(0.05, max(deadline - time.monotonic(), 0.0)))
+    return seen
 
 
 def _check_published(watch: GraphWatch, topic: str, type_name: str | None, waited: float) -> None:

@@ -84,6 +84,14 @@ def qos_chunk(qos: QoS) -> str:
     return f"{rel}:{dur}:,{depth}:,:,:,,"
 
 
+def durability_of(chunk: str) -> str:
+    """The durability an endpoint token's QoS chunk (:func:`qos_chunk`) declares:
+    ``transient_local`` or ``volatile`` (rmw_zenoh's default where the field is empty)."""
+    field = chunk.split(":")[1] if chunk.count(":") >= 1 else ""
+    by_code = {str(code): name for name, code in _DURABILITY.items()}
+    return by_code.get(field, "volatile")
+
+
 @dataclass(frozen=True)
 class NodeIdentity:
     """Where a node lives: domain, zenoh session id, node id, enclave, namespace and name."""

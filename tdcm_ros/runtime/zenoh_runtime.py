@@ -803,6 +803,12 @@ class GraphWatch:
             topics.setdefault(token.topic, set()).add(token.type_name)
         return topics
 
+    def publisher_durabilities(self, topic: str) -> set[str]:
+        """The durabilities (``transient_local``, ``volatile``) the publishers of ``topic``
+        (fully qualified) declare; empty while none is seen."""
+        return {wire.durability_of(token.qos) for token in self._endpoints((wire.PUBLISHER,), "")
+                if token.topic == topic}
+
     def nodes(self, kinds: Collection[str], ignore_zid: str = "") -> dict[str, set[str]]:
         """Topic (or service) name -> fully qualified names of the nodes with an endpoint of
         ``kinds`` on it, leaving out those of the session ``ignore_zid``."""

@@ -280,3 +280,17 @@ def test_the_readme_example_header_auto_reaches_model_node_and_each_message_is_p
     assert first["wrench"]["force"]["z"] == 20.0 and first["header"]["stamp"]["sec"] > 0
     stamps = [yaml.safe_load(line.split(": ", 1)[1])["header"]["stamp"] for line in lines]
     assert len({(s["sec"], s["nanosec"]) for s in stamps}) == 40  # stamped at each publish
+
+
+def test_echo_of_a_transient_local_topic_prints_the_latest_message_it_missed(port, spawn: Spawn):
+    """As ros2 topic echo: every publisher transient local, so the tool subscribes so too and
+    gets the message published before it started (e.g. the controller's latched target)."""
+    from tdcm_ros.runtime import QoS
+
+    latched = port.create_publisher("latched", "std_msgs/msg/String",
+                                    QoS(depth=1, durability="transient_local"))
+    latched.publish(from_dict("std_msgs/msg/String", {"data": "sent before the tool"}))
+    echo = spawn("tdcm_ros.cli.main", "topic", "echo", "latched", "--once")
+    out, err = echo.communicate(timeout=20)
+    assert echo.returncode == 0, err.decode()
+    assert documents(out) == [{"data": "sent before the tool"}]
