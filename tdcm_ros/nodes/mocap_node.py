@@ -238,8 +238,10 @@ class MocapNode(NodeLogic):
         get = self.port.get_parameter
         path = str(get("csv.path"))
         if not path:
-            raise InputError("source 'csv' needs csv.path", parameter="csv.path", value="",
-                             allowed="a Vicon Nexus CSV export")
+            raise InputError("source 'csv' (the default) needs csv.path = a Vicon Nexus CSV "
+                             "export; for a live Vicon bridge set source = relabel (and "
+                             "relabel.input_topic), for the simulated world source = sim",
+                             parameter="csv.path", value="", allowed="a Vicon Nexus CSV export")
         trajectories = read_nexus_csv(path)
         if get("labelling.mode") == "name":
             self.name_map.require(trajectories.names, path)

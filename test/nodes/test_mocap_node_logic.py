@@ -396,3 +396,12 @@ def test_shipped_config_file_starts_the_node():
     relabel = mocap_port({**values, "source": "relabel"})
     MocapNode(relabel)
     assert "/vicon/markers" in relabel.subscriptions
+
+
+def test_on_its_defaults_the_node_says_which_source_to_choose() -> None:
+    """The default source is a CSV export, which needs its path: the error names the
+    parameter and the two other sources (a live bridge, the simulated world)."""
+    with pytest.raises(InputError) as caught:
+        MocapNode(MemoryPort({}, name="mocap_node"))
+    assert caught.value.parameter == "csv.path"
+    assert "source = relabel" in str(caught.value) and "source = sim" in str(caught.value)
