@@ -27,7 +27,7 @@ NODE_ORDER: tuple[str, ...] = ("model_node", "mocap_node", "metrics_node", "devi
 #: Topics the recorder writes: what evaluation needs, plus the live outputs worth replaying.
 RECORDED_TOPICS: tuple[str, ...] = (
     "tension", "sim/tension_true", "markers", "/tf_static", "tip_pose", "predicted_markers",
-    "midline", "device_state", "/diagnostics")
+    "midline", "tendon_states", "joint_states", "device_state", "/diagnostics")
 #: Topics the evaluation after the run reads.
 EVALUATED_TOPICS: tuple[str, ...] = ("tension", "markers", "/tf_static")
 #: A tracking run's nodes in start order: the shape controller instead of the metrics node.

@@ -39,6 +39,7 @@ BAG_TYPES = {
     "geometry_msgs/msg/WrenchStamped", "/markers": "mocap4r2_msgs/msg/Markers",
     "/tf_static": "tf2_msgs/msg/TFMessage", "/tip_pose": "geometry_msgs/msg/PoseStamped",
     "/predicted_markers": "geometry_msgs/msg/PoseArray", "/midline": "nav_msgs/msg/Path",
+    "/tendon_states": "sensor_msgs/msg/JointState", "/joint_states": "sensor_msgs/msg/JointState",
     "/device_state": "diagnostic_msgs/msg/DiagnosticStatus",
     "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray"}
 
