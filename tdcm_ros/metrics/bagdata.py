@@ -376,14 +376,15 @@ def _roll(reader: BagReader, topic: str, joint: str, warnings: list[str]) -> Rol
     if name is None:
         return None
     name = require_topic(reader, name, [JOINT_STATE_TYPE])
-    stamps_ns, from_log, unique, (positions,) = _read(
+    stamps_ns, from_log, unique, (positions, named) = _read(
         reader, name, lambda payloads: joint_positions(payloads, joint))
     stamps, keep = _usable(stamps_ns, from_log, unique, reader.path, name, warnings)
-    rolls = positions if keep.all() else positions[keep]
+    about = named if keep.all() else named[keep]  # messages of other joints are no roll samples
+    stamps, rolls = stamps[about], (positions if keep.all() else positions[keep])[about]
     finite = np.isfinite(rolls)
     if not finite.any():
         warnings.append(f"{name}: no finite position of joint {joint} (the roll) in "
-                        f"{rolls.size} messages; roll 0 assumed")
+                        f"{rolls.size} messages naming it; roll 0 assumed")
         return None
     if dropped := int((~finite).sum()):
         warnings.append(f"{name}: {dropped} messages without a finite position of joint "

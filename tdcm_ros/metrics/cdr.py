@@ -143,16 +143,20 @@ def joint_efforts(payloads: Sequence[bytes], names: Sequence[str], present: Coun
 
 
 def joint_positions(payloads: Sequence[bytes], joint: str
-                    ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
-    """Header stamps (ns) and the position of ``joint`` (rad for the roll; NaN where a message
-    does not name it or gives it no position) in ``sensor_msgs/msg/JointState`` CDR
-    payloads."""
+                    ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Header stamps (ns), the position of ``joint`` (rad for the roll; NaN where a message
+    names it without a position) and whether each message names ``joint`` at all, in
+    ``sensor_msgs/msg/JointState`` CDR payloads (a robot's ``joint_states`` has publishers of
+    other joints: their messages are not about this one)."""
     stamps = np.zeros(len(payloads), dtype=np.int64)
     positions = np.full(len(payloads), np.nan)
+    named = np.zeros(len(payloads), dtype=bool)
     for i, data in enumerate(payloads):
         msg = deserialize(data, "sensor_msgs/msg/JointState")
         stamps[i] = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
         names = list(msg.name)
-        if joint in names and (k := names.index(joint)) < len(msg.position):
-            positions[i] = float(msg.position[k])
-    return stamps, positions
+        if joint in names:
+            named[i] = True
+            if (k := names.index(joint)) < len(msg.position):
+                positions[i] = float(msg.position[k])
+    return stamps, positions, named
