@@ -31,6 +31,8 @@ MU = "mu"
 #: Relative forward-difference step of the point Jacobian (of the parameter's value, or of its
 #: standard deviation where that is larger: ``mu`` may be 0).
 JACOBIAN_STEP = 1e-3
+#: Draws a Monte Carlo check may make per sample it keeps (the rest fall outside the ranges).
+MAX_REDRAWS = 10
 #: Largest eigenvalue of a covariance allowed below zero, relative to its largest (rounding).
 PSD_TOLERANCE = 1e-9
 
@@ -146,12 +148,13 @@ def monte_carlo_covariances(points_at: PointsAt, design: Design, mu: float,
                             uncertainty: ParameterCovariance, samples: int,
                             rng: np.random.Generator) -> Array:
     """Each point's sample covariance (k, 3, 3) m^2 over ``samples`` parameter draws from
-    ``N(p, C_p)`` (draws outside a parameter's range, or ``mu < 0``, are drawn again)."""
+    ``N(p, C_p)`` (draws outside a parameter's range, or ``mu < 0``, are drawn again, at most
+    :data:`MAX_REDRAWS` times ``samples`` draws in all)."""
     if samples < 2:
         raise out_of_range("samples", samples, "[2, inf)", error=InvalidUncertaintyError)
     x0 = uncertainty.at(design, mu)
     points: list[Array] = []
-    while len(points) < samples:
+    for _ in range(MAX_REDRAWS * samples):
         draw = rng.multivariate_normal(x0, uncertainty.covariance)
         try:
             moved = with_values(design, mu, uncertainty.names, draw)
@@ -160,6 +163,14 @@ def monte_carlo_covariances(points_at: PointsAt, design: Design, mu: float,
         if moved[1] < 0.0:
             continue
         points.append(points_at(*moved))
+        if len(points) == samples:
+            break
+    else:
+        raise InvalidUncertaintyError(
+            f"only {len(points)} of {samples} parameter draws were valid designs in "
+            f"{MAX_REDRAWS * samples} draws; allowed: a covariance mostly inside the parameters' "
+            "ranges", parameter="uncertainty.covariance", value=uncertainty.covariance.tolist(),
+            allowed="draws inside the parameters' ranges")
     stack = np.asarray(points)
     centred = stack - stack.mean(axis=0)
     return np.einsum("ski,skj->kij", centred, centred) / (samples - 1)

@@ -119,3 +119,12 @@ def test_a_bad_covariance_names_its_key(kwargs: dict, parameter: str) -> None:
     with pytest.raises(InvalidUncertaintyError) as caught:
         fitted(**kwargs)
     assert caught.value.parameter == parameter and "allowed" in str(caught.value)
+
+
+def test_monte_carlo_of_draws_that_are_never_designs_stops_with_an_error() -> None:
+    """mu drawn around -1 (the band taken there) is never valid: a typed error after a bounded
+    number of draws, not a loop without end."""
+    hopeless = fitted(names=("mu",), values=(0.3,), covariance=[[1e-6]])
+    with pytest.raises(InvalidUncertaintyError, match="parameter draws were valid designs"):
+        monte_carlo_covariances(markers_after_loading, DESIGN, -1.0, hopeless, 5,
+                                np.random.default_rng(0))
