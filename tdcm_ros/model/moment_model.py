@@ -198,6 +198,7 @@ class ClosedForm:
         self._r_c_squared = float(grid.r_c) ** 2
         self._peak_c = float(self.cells.constrained_peak_c[0])  # Python floats: no warnings
         self.n_cells = grid.n_cells
+        self._buffer = one_size(self.n_cells, 0)  # iterate_one's buffer less the steps
 
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
         m_a, m_b = loads.closed_form(self.grid, shape, np.float64(level))
@@ -246,7 +247,7 @@ class ClosedForm:
         cells = self.cells
         n = self.n_cells
         budget = max(budget, 0)
-        out = np.empty(one_size(n, budget))
+        out = np.empty(self._buffer + budget)
         steps, status, gap = kernels().iterate_one(
             cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, level, x, out, tol,
             relaxation, slow, DIVERGENCE_GROWTH)
