@@ -64,21 +64,15 @@ class PlainRun(NamedTuple):
 
 
 class CompiledRun:
-    """A plain iteration as :func:`tdcm_ros.model.kernel.iterate_one` left it in its buffer
-    ``out`` (``n`` cells, ``budget`` steps at most): ``steps``, ``status`` and the last
-    shape's smallest notch gap ``min_gap`` (m); the iterate and the shape are views of
-    ``out``, made on use."""
+    """The iterate, shape and steps that :func:`tdcm_ros.model.kernel.iterate_one` left in
+    its buffer ``out`` after ``steps`` steps on ``n`` cells, as views made on use."""
 
-    __slots__ = ("budget", "min_gap", "n", "out", "status", "steps")
+    __slots__ = ("n", "out", "steps")
 
-    def __init__(self, out: Array, n: int, budget: int, steps: int, status: int,
-                 min_gap: float) -> None:
+    def __init__(self, out: Array, n: int, steps: int) -> None:
         self.out = out
         self.n = n
-        self.budget = budget
         self.steps = steps
-        self.status = status
-        self.min_gap = min_gap
 
     @property
     def x(self) -> Array:
@@ -104,7 +98,7 @@ class CompiledRun:
     @property
     def history(self) -> tuple[float, ...]:
         """The steps (m), one per iteration."""
-        start = self.out.size - self.budget
+        start = one_size(self.n, 0)
         return tuple(self.out[start:start + self.steps].tolist())
 
 
@@ -237,21 +231,21 @@ class ClosedForm:
 
     def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
               slow: float) -> PlainRun | None:
-        run = self.run(x, level, budget, tol, relaxation, slow)
-        return PlainRun(run.x, run.shape, list(run.history), run.status, run.min_gap)
+        out, steps, status, gap = self.run(x, level, max(budget, 0), tol, relaxation, slow)
+        run = CompiledRun(out, self.n_cells, steps)
+        return PlainRun(run.x, run.shape, list(run.history), status, gap)
 
     def run(self, x: Array | None, level: float, budget: int, tol: float, relaxation: float,
-            slow: float) -> CompiledRun:
-        """:meth:`plain` as the kernel left it: one compiled call into one new buffer, from
-        ``x`` (N m) or, where None, :meth:`start`."""
+            slow: float) -> tuple[Array, int, int, float]:
+        """:meth:`plain` as the kernel leaves it: one compiled call, from ``x`` (N m) or,
+        where None, :meth:`start`, for at most ``budget`` (>= 0) steps. Returns its buffer
+        (read by :class:`CompiledRun`), the steps taken, the status
+        (:mod:`tdcm_ros.model.kernel`) and the last shape's smallest notch gap (m)."""
         cells = self.cells
-        n = self.n_cells
-        budget = max(budget, 0)
         out = np.empty(self._buffer + budget)
-        steps, status, gap = kernels().iterate_one(
+        return (out, *kernels().iterate_one(
             cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, level, x, out, tol,
-            relaxation, slow, DIVERGENCE_GROWTH)
-        return CompiledRun(out, n, budget, steps, status, gap)
+            relaxation, slow, DIVERGENCE_GROWTH))
 
 
 class LiteralSum(ClosedForm):

@@ -16,12 +16,12 @@ from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape, quaternions_y
 from tdcm_ros.model.limits import closure_angles, notch_gaps
+from tdcm_ros.model.moment_model import CompiledRun
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.tendons import TendonLayout
 
 if TYPE_CHECKING:
     from tdcm_ros.model.loading import Loading
-    from tdcm_ros.model.moment_model import CompiledRun
 
 Array = NDArray[np.float64]
 
@@ -51,7 +51,7 @@ class SolveResult:
     Immutable: assigning or deleting a field raises ``dataclasses.FrozenInstanceError``; two
     results are equal only when they are the same object. A result of the compiled plain
     iteration (:meth:`of_run`) keeps the kernel's buffer and makes ``positions``, ``theta``,
-    ``cell_moments``, ``iterations`` and ``residual_history`` from it on first use.
+    ``cell_moments`` and ``residual_history`` from it on first use.
     """
 
     def __init__(self, design: Design, settings: SolverSettings, tension_n: float, s: Array,
@@ -70,10 +70,11 @@ class SolveResult:
             material_scale=material_scale)
 
     @classmethod
-    def of_run(cls, grid: Grid, settings: SolverSettings, tension_n: float, run: CompiledRun,
-               strategy: str, solve_time_s: float) -> SolveResult:
+    def of_run(cls, grid: Grid, settings: SolverSettings, tension_n: float, out: Array,
+               steps: int, strategy: str, solve_time_s: float) -> SolveResult:
         """The result of the paper's closed form at ``tension_n`` (N) whose compiled plain
-        iteration ``run`` converged, solved in ``solve_time_s`` (s)."""
+        iteration converged in ``steps`` steps into the buffer ``out``
+        (:class:`~tdcm_ros.model.moment_model.CompiledRun`), solved in ``solve_time_s`` (s)."""
         result = cls.__new__(cls)
         fields = result.__dict__  # one store per field: no keyword dict to build
         fields["design"] = grid.design
@@ -84,7 +85,8 @@ class SolveResult:
         fields["strategy"] = strategy
         fields["solve_time_s"] = solve_time_s
         fields["grid"] = grid
-        fields["_run"] = run
+        fields["_out"] = out
+        fields["iterations"] = steps
         return result
 
     def __setattr__(self, name: str, value: Any) -> None:
@@ -122,9 +124,9 @@ class SolveResult:
         return self._run.history
 
     @cached_property
-    def iterations(self) -> int:
-        """Number of iterations."""
-        return self._run.steps
+    def _run(self) -> CompiledRun:
+        """The kernel's buffer of a result of :meth:`of_run`, read."""
+        return CompiledRun(self._out, self.grid.n_cells, self.iterations)
 
     loading: Loading | None = None
     contact_scale: Array | None = None
@@ -142,7 +144,8 @@ class SolveResult:
         strategy: str
         solve_time_s: float
         grid: Grid
-        _run: CompiledRun
+        iterations: int
+        _out: Array
 
     @property
     def tensions_n(self) -> tuple[float, ...]:

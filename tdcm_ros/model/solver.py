@@ -183,10 +183,11 @@ def _solve_closed(design: Design, tension: float | Sequence[float], settings: So
     model.check_before(level)
     x0 = None if warm_start is None else _warm_guess(model.grid, settings, level, warm_start,
                                                       model)
-    run = model.run(x0, level, settings.max_iter, settings.tol, 1.0, SLOW_CONTRACTION)
-    if run.status != CONVERGED or not run.min_gap > 0.0:
+    out, steps, status, gap = model.run(x0, level, settings.max_iter, settings.tol, 1.0,
+                                        SLOW_CONTRACTION)
+    if status != CONVERGED or not gap > 0.0:
         return None
-    return SolveResult.of_run(model.grid, settings, level, run, AUTO_PLAN,
+    return SolveResult.of_run(model.grid, settings, level, out, steps, AUTO_PLAN,
                               perf_counter() - started)
 
 
