@@ -10,7 +10,11 @@ notches all differ (widths, backbones, tubes), the same body with one-sided cuts
 paper's tube with 8 polygon (tee) notches, timed
 interleaved in this process, as ratios to the preset. ``--baseline`` times another checkout of the package (e.g. main's NumPy
 path) in the same run: baseline and this checkout alternate in fresh processes for
-``--rounds`` rounds and the ratio of their medians is printed.
+``--rounds`` rounds and the ratio of their medians is printed. Issue 34: the same solve's
+compiled floor, ``bench/solve_reference.c`` (the kernel's fixed point in C, compiled here with
+gcc into a shared library and called through ctypes on the solve's own grid arrays, each
+solve timed inside C), interleaved with the package's solve; its tip must equal the
+package's to the last bit. Without gcc that part is skipped.
 Single-threaded: BLAS threads are pinned to one before NumPy loads. ``--results FILE`` also
 writes the printed figures as tables to a results file (``bench/results.py``).
 """
@@ -18,9 +22,12 @@ writes the printed figures as tables to a results file (``bench/results.py``).
 from __future__ import annotations
 
 import argparse
+import ctypes
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -32,6 +39,9 @@ from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import PRESETS, SolverSettings, preset, read_body_file, solve
 from tdcm_ros.model.design import Design
+from tdcm_ros.model.grid import build_grid
+from tdcm_ros.model.moment_model import DIVERGENCE_GROWTH
+from tdcm_ros.model.solver import DEFAULT_SETTINGS, SLOW_CONTRACTION
 
 REFERENCE = SolverSettings(cells_per_notch=256, cells_per_tube=32, quad_order=16, tol=1e-14)
 FINER = SolverSettings(cells_per_notch=512, cells_per_tube=64, quad_order=16, tol=1e-14)
@@ -95,6 +105,83 @@ def interleaved(designs: dict[str, Design], repeats: int, rounds: int = 5) -> di
     return {name: float(np.median(t)) for name, t in times.items()}
 
 
+C_SOURCE = Path(__file__).resolve().with_name("solve_reference.c")
+C_FLAGS = ("-O3", "-march=native", "-ffp-contract=off", "-shared", "-fPIC")
+"""No fused multiply-adds, no fast math: the C solve rounds as numba's kernel does."""
+
+
+class CReference:
+    """``bench/solve_reference.c`` built into ``workdir`` and bound to one design's grid at
+    one tension (N), with the default settings."""
+
+    def __init__(self, workdir: Path, design: Design, tension: float) -> None:
+        library = workdir / "solve_reference.so"
+        subprocess.run(["gcc", *C_FLAGS, "-o", str(library), str(C_SOURCE), "-lm"], check=True)
+        self.lib = ctypes.CDLL(str(library))
+        grid = build_grid(design, DEFAULT_SETTINGS)
+        cells = grid.cells
+        n, budget = grid.n_cells, DEFAULT_SETTINGS.max_iter
+        self.arrays = [np.ascontiguousarray(a[0]) for a in
+                       (cells.fc, cells.fq, cells.ic, cells.notch, cells.scal)]
+        self.x0 = np.full(2 * n, grid.r_c * tension)
+        self.x, self.theta, self.info = np.empty(2 * n), np.empty(n + 1), np.empty(3 + budget)
+        self.p, self.tangent = np.empty(n + 1, complex), np.empty(n + 1, complex)
+        pointer = ctypes.c_void_p
+        self.args = [ctypes.c_int(n), ctypes.c_int(cells.fq.shape[3]),
+                     ctypes.c_int(cells.notch.shape[2]),
+                     *(a.ctypes.data_as(pointer) for a in self.arrays), ctypes.c_double(tension),
+                     self.x0.ctypes.data_as(pointer), ctypes.c_double(DEFAULT_SETTINGS.tol),
+                     ctypes.c_double(SLOW_CONTRACTION), ctypes.c_double(DIVERGENCE_GROWTH),
+                     ctypes.c_int(budget),
+                     *(a.ctypes.data_as(pointer) for a in (self.x, self.p, self.theta,
+                                                           self.tangent, self.info))]
+
+    def tip(self) -> np.ndarray:
+        """The C solve's tip ``(x, 0, z)`` (m)."""
+        self.lib.tdcm_solve(*self.args)
+        return np.array([self.p[-1].imag, 0.0, self.p[-1].real])
+
+    def times(self, repeats: int) -> np.ndarray:
+        """Wall time (s) of each of ``repeats`` C solves, timed inside C."""
+        out = np.empty(repeats)
+        self.lib.tdcm_time(ctypes.c_int(repeats), out.ctypes.data_as(ctypes.c_void_p), *self.args)
+        return out
+
+
+def against_c(repeats: int, results: BenchResults, rounds: int = 5) -> None:
+    """The package's solve of paper-experiment at 20 N against the C floor, interleaved in
+    ``rounds`` rounds; prints both medians, their ratio and the bit check of the tips."""
+    if shutil.which("gcc") is None:
+        print("C reference: skipped (no gcc)")
+        return
+    design = preset("paper-experiment")
+    with tempfile.TemporaryDirectory() as workdir:
+        reference = CReference(Path(workdir), design, 20.0)
+        tip = reference.tip()
+        package: list[np.ndarray] = []
+        floor: list[np.ndarray] = []
+        for _ in range(rounds):
+            package.append(time_solves(max(repeats // rounds, 1)))
+            floor.append(reference.times(max(repeats // rounds, 1)))
+    mine = solve(design, 20.0).tip_position
+    same = bool(np.array_equal(tip, mine))
+    m, c = float(np.median(np.concatenate(package))), float(np.median(np.concatenate(floor)))
+    print(f"C reference (bench/solve_reference.c), interleaved, {rounds} rounds")
+    print(f"  package solve          {m * 1e6:8.2f} us")
+    print(f"  C solve (timed in C)   {c * 1e6:8.2f} us")
+    print(f"  ratio                  {m / c:8.2f}x   (target <= 1.5x, <= 5 us)")
+    print(f"  tips bit-identical     {same}  (C {tip.tolist()}, package {mine.tolist()})")
+    results.table(
+        "Single solve against its compiled floor (C), interleaved",
+        [Column("solve"), Column("median", "µs", ".2f"), Column("× the C floor", format=".2f")],
+        [["package: solve(paper-experiment, 20 N)", m * 1e6, m / c],
+         ["C: bench/solve_reference.c, timed in C", c * 1e6, 1.0]],
+        note=f"{rounds} interleaved rounds of {max(repeats // rounds, 1)} solves each; "
+             f"gcc {' '.join(C_FLAGS)}; tips bit-identical: {same}")
+    if not same:
+        raise SystemExit("C reference: the tip differs from the package's")
+
+
 def median_in(checkout: Path, repeats: int, jit: str = "1") -> float:
     """Median solve time (s) measured in a fresh process importing ``tdcm_ros`` from
     ``checkout`` (``jit``: the ``TDCM_JIT`` switch, ignored by checkouts without it)."""
@@ -140,6 +227,7 @@ def main() -> None:
     results = BenchResults("bench_solve")
     if args.baseline is not None:
         compare(args.baseline, args.repeats, args.rounds, results)
+    against_c(args.repeats, results)
     plain = median_in(Path(__file__).resolve().parents[1], max(args.repeats // 10, 20), "0")
     design = preset("paper-experiment")
     reference = solve(design, 20.0, settings=REFERENCE).tip_position

@@ -43,7 +43,7 @@ batch solver and the limit checks read the same numbers.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, fields
 from functools import cached_property, lru_cache
@@ -373,9 +373,20 @@ field (~1 us each, of a ~55 us solve)."""
 
 
 def clear_grid_cache() -> None:
-    """Forget every cached grid, so the next :func:`build_grid` builds (tests, benchmarks)."""
+    """Forget every cached grid, so the next :func:`build_grid` builds (tests, benchmarks),
+    and what :func:`on_clear` registered that holds one."""
     _last_grid.clear()
     _build_grid.cache_clear()
+    for forget in _on_clear:
+        forget()
+
+
+def on_clear(forget: Callable[[], None]) -> None:
+    """Have :func:`clear_grid_cache` call ``forget`` too (a cache holding grids elsewhere)."""
+    _on_clear.append(forget)
+
+
+_on_clear: list[Callable[[], None]] = []
 
 
 @lru_cache(maxsize=512)

@@ -227,7 +227,6 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
     previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps).
     """
     n = fc.shape[2]
-    budget = info.shape[1] - 3
     g = np.empty(2 * n)
     t_a = np.empty(n)
     new_p = np.empty(n + 1, np.complex128)
@@ -236,55 +235,67 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
     notch_gaps = np.empty(notch.shape[2])
     for j in range(x.shape[0]):
         row = rows[j]
-        r_c = scal[row, 0]
-        limit = 2.0 * scal[row, 2]
-        t_a[:] = tension[j]
-        xj = x[j]
-        pj = p[j]
-        integrate_row(fc[row], fq[row], xj[:n], xj[n:], t_a, t_a, pj, theta[j], tangent[j])
-        smallest = math.inf
-        status = EXHAUSTED
-        steps = 0
-        for k in range(budget):
-            moments_row(r_c, pj, tangent[j], t_a, t_a, ic[row], fc[row], g[:n], g[n:])
-            if relaxation != 1.0:
-                for i in range(2 * n):
-                    g[i] = xj[i] + relaxation * (g[i] - xj[i])
-            integrate_row(fc[row], fq[row], g[:n], g[n:], t_a, t_a, new_p, new_theta,
-                          new_tangent)
-            step = 0.0
-            for i in range(n + 1):
-                d = abs(new_p[i] - pj[i])
-                if not d <= step:
-                    step = d
-                    if math.isnan(d):
-                        break
-            if not math.isfinite(step):
-                status = NON_FINITE
-                break
-            info[j, 3 + k] = step
-            steps = k + 1
-            xj[:] = g
-            pj[:] = new_p
-            theta[j, :] = new_theta
-            tangent[j, :] = new_tangent
-            smallest = min(smallest, step)
-            if step <= tol:
-                status = CONVERGED
-                break
-            if step > limit or (k >= 5 and step > growth * smallest):
-                status = DIVERGING
-                break
-            if slow > 0.0 and k >= 1 and step > slow * info[j, 2 + k]:
-                status = SLOWED
-                break
-        gaps_row(scal[row, 1], pj, tangent[j], notch[row], notch_gaps)
-        least = math.inf
-        for k in range(notch_gaps.size):
-            least = min(least, notch_gaps[k])
-        info[j, 0] = steps
-        info[j, 1] = status
-        info[j, 2] = least
+        iterate_row(fc[row], fq[row], ic[row], notch[row], scal[row], tension[j], x[j], p[j],
+                    theta[j], tangent[j], tol, relaxation, slow, growth, info[j], g, t_a, new_p,
+                    new_theta, new_tangent, notch_gaps)
+
+
+def iterate_row(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: float,
+                x: Array, p: Complex, theta: Array, tangent: Complex, tol: float,
+                relaxation: float, slow: float, growth: float, info: Array, g: Array, t_a: Array,
+                new_p: Complex, new_theta: Array, new_tangent: Complex,
+                notch_gaps: Array) -> None:
+    """:func:`iterate` for one member: its design row's cell arrays, its tension (N), its
+    ``x`` (2n,), shape (n + 1,) and ``info`` (3 + budget,), with the scratch ``g`` (2n,),
+    ``t_a`` (n,), ``new_p``, ``new_theta``, ``new_tangent`` (n + 1,) and ``notch_gaps`` (K,)."""
+    n = fc.shape[1]
+    budget = info.shape[0] - 3
+    r_c = scal[0]
+    limit = 2.0 * scal[2]
+    t_a[:] = tension
+    integrate_row(fc, fq, x[:n], x[n:], t_a, t_a, p, theta, tangent)
+    smallest = math.inf
+    status = EXHAUSTED
+    steps = 0
+    for k in range(budget):
+        moments_row(r_c, p, tangent, t_a, t_a, ic, fc, g[:n], g[n:])
+        if relaxation != 1.0:
+            for i in range(2 * n):
+                g[i] = x[i] + relaxation * (g[i] - x[i])
+        integrate_row(fc, fq, g[:n], g[n:], t_a, t_a, new_p, new_theta, new_tangent)
+        step = 0.0
+        for i in range(n + 1):
+            d = abs(new_p[i] - p[i])
+            if not d <= step:
+                step = d
+                if math.isnan(d):
+                    break
+        if not math.isfinite(step):
+            status = NON_FINITE
+            break
+        info[3 + k] = step
+        steps = k + 1
+        x[:] = g
+        p[:] = new_p
+        theta[:] = new_theta
+        tangent[:] = new_tangent
+        smallest = min(smallest, step)
+        if step <= tol:
+            status = CONVERGED
+            break
+        if step > limit or (k >= 5 and step > growth * smallest):
+            status = DIVERGING
+            break
+        if slow > 0.0 and k >= 1 and step > slow * info[2 + k]:
+            status = SLOWED
+            break
+    gaps_row(scal[1], p, tangent, notch, notch_gaps)
+    least = math.inf
+    for k in range(notch_gaps.size):
+        least = min(least, notch_gaps[k])
+    info[0] = steps
+    info[1] = status
+    info[2] = least
 
 
 def iterate_strained(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
@@ -303,22 +314,36 @@ def iterate_strained(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, r
             strain[j] = peak_strain_row(strain_cells[row], s0[row], s1[row], x[j])
 
 
+def one_size(n: int, budget: int) -> int:
+    """Length of :func:`iterate_one`'s output buffer for ``n`` cells and ``budget`` steps."""
+    return 2 * n + 5 * (n + 1) + 3 + budget
+
+
 def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: float,
-                x0: Array, tol: float, relaxation: float, slow: float, growth: float,
-                budget: int) -> tuple[Array, Complex, Array, Complex, Array, int, float]:
-    """:func:`iterate` for one member (design row 0) at ``tension`` (N) from a copy of
-    ``x0`` (2n,), into new arrays: ``(x, p, theta, tangent, steps, status, smallest gap)``."""
-    nodes = fc.shape[2] + 1
-    x = x0.copy().reshape(1, x0.size)
-    p = np.empty((1, nodes), np.complex128)
-    theta = np.empty((1, nodes))
-    tangent = np.empty((1, nodes), np.complex128)
-    info = np.empty((1, 3 + budget))
-    iterate(fc, fq, ic, notch, scal, np.zeros(1, np.int64), np.full(1, tension), x, p, theta,
-            tangent, tol, relaxation, slow, growth, info)
-    count = int(info[0, 0])
-    return (x[0], p[0], theta[0], tangent[0], info[0, 3:3 + count].copy(), int(info[0, 1]),
-            info[0, 2])
+                x0: Array | None, out: Array, tol: float, relaxation: float, slow: float,
+                growth: float) -> tuple[int, int, float]:
+    """:func:`iterate` for one member (design row 0) at ``tension`` (N) from ``x0`` (2n,) N m,
+    or where None the tendon's own moment ``R_c T`` on the straight body, into the caller's
+    ``out`` (:func:`one_size`): the last iterate ``x`` (2n,) N m, the nodes ``p`` (m) and
+    ``tangent`` as (real, imag) pairs (2 (n + 1) each), ``theta`` (n + 1) rad, then
+    :func:`iterate`'s ``info`` (steps, status, smallest gap (m), the steps (m)); the budget
+    is what is left of ``out``. Returns that ``info``'s steps, status and smallest gap."""
+    n = fc.shape[2]
+    nodes = n + 1
+    x = out[:2 * n]
+    if x0 is None:
+        x[:] = scal[0, 0] * tension
+    else:
+        x[:] = x0
+    p = out[2 * n:2 * n + 2 * nodes].view(np.complex128)
+    tangent = out[2 * n + 2 * nodes:2 * n + 4 * nodes].view(np.complex128)
+    theta = out[2 * n + 4 * nodes:2 * n + 5 * nodes]
+    info = out[2 * n + 5 * nodes:]
+    iterate_row(fc[0], fq[0], ic[0], notch[0], scal[0], tension, x, p, theta, tangent, tol,
+                relaxation, slow, growth, info, np.empty(2 * n), np.empty(n),
+                np.empty(nodes, np.complex128), np.empty(nodes),
+                np.empty(nodes, np.complex128), np.empty(notch.shape[2]))
+    return int(info[0]), int(info[1]), info[2]
 
 
 def peak_strain_row(cells: Ints, s0: Array, s1: Array, x: Array) -> float:
@@ -355,5 +380,5 @@ def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: A
 
 
 KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
-           "peak_strain_row", "iterate", "iterate_strained", "iterate_one", "peak_strains")
+           "peak_strain_row", "iterate_row", "iterate", "iterate_strained", "iterate_one", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -24,6 +24,7 @@ from numpy.typing import NDArray
 from tdcm_ros.model import loads
 from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.grid import Grid
+from tdcm_ros.model.kernel import one_size
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import (
     check_closure,
@@ -36,6 +37,8 @@ Array = NDArray[np.float64]
 
 DIVERGENCE_GROWTH = 1e3
 """A step this many times the smallest one so far (after 5 steps) is divergence."""
+AUTO_PLAN = "picard+anderson"
+"""The name of ``acceleration="auto"``'s first strategy (a result's ``strategy``)."""
 
 class Plan(NamedTuple):
     """One convergence strategy: ``mode`` (``auto``, ``picard``, ``anderson``,
@@ -58,6 +61,45 @@ class PlainRun(NamedTuple):
     history: list[float]
     status: int
     min_gap: float
+
+
+class CompiledRun:
+    """The iterate, shape and steps that :func:`tdcm_ros.model.kernel.iterate_one` left in
+    its buffer ``out`` after ``steps`` steps on ``n`` cells, as views made on use."""
+
+    __slots__ = ("n", "out", "steps")
+
+    def __init__(self, out: Array, n: int, steps: int) -> None:
+        self.out = out
+        self.n = n
+        self.steps = steps
+
+    @property
+    def x(self) -> Array:
+        """The last iterate ``[m_a, m_b]`` (2n,) N m."""
+        return self.out[:2 * self.n]
+
+    @property
+    def p(self) -> NDArray[np.complex128]:
+        """The last shape's nodes ``z + i x`` (m)."""
+        return self.out[2 * self.n:4 * self.n + 2].view(np.complex128)
+
+    @property
+    def theta(self) -> Array:
+        """The last shape's tangent angles (rad)."""
+        return self.out[6 * self.n + 4:7 * self.n + 5]
+
+    @property
+    def shape(self) -> PlanarShape:
+        """The last iterate's shape: nodes (m), tangent angles (rad) and unit tangents."""
+        return PlanarShape(self.p, self.theta,
+                           self.out[4 * self.n + 2:6 * self.n + 4].view(np.complex128))
+
+    @property
+    def history(self) -> tuple[float, ...]:
+        """The steps (m), one per iteration."""
+        start = one_size(self.n, 0)
+        return tuple(self.out[start:start + self.steps].tolist())
 
 
 class MomentModel(Protocol):
@@ -127,7 +169,7 @@ def paper_plans(settings: SolverSettings) -> tuple[Plan, ...]:
     if settings.acceleration != "auto":
         mode = "picard" if settings.acceleration == "none" else settings.acceleration
         return (Plan(settings.acceleration, mode, budget),)
-    plans = [Plan("picard+anderson", "auto", budget), Plan("relaxation", "relaxation", budget)]
+    plans = [Plan(AUTO_PLAN, "auto", budget), Plan("relaxation", "relaxation", budget)]
     if settings.continuation_steps > 0:
         plans.append(Plan("continuation", "continuation", budget))
     return tuple(plans)
@@ -149,6 +191,8 @@ class ClosedForm:
         self.cells = grid.cells
         self._r_c_squared = float(grid.r_c) ** 2
         self._peak_c = float(self.cells.constrained_peak_c[0])  # Python floats: no warnings
+        self.n_cells = grid.n_cells
+        self._buffer = one_size(self.n_cells, 0)  # iterate_one's buffer less the steps
 
     def moments(self, shape: PlanarShape, x: Array, level: float, factor: float) -> Array:
         m_a, m_b = loads.closed_form(self.grid, shape, np.float64(level))
@@ -187,11 +231,21 @@ class ClosedForm:
 
     def plain(self, x: Array, level: float, budget: int, tol: float, relaxation: float,
               slow: float) -> PlainRun | None:
+        out, steps, status, gap = self.run(x, level, max(budget, 0), tol, relaxation, slow)
+        run = CompiledRun(out, self.n_cells, steps)
+        return PlainRun(run.x, run.shape, list(run.history), status, gap)
+
+    def run(self, x: Array | None, level: float, budget: int, tol: float, relaxation: float,
+            slow: float) -> tuple[Array, int, int, float]:
+        """:meth:`plain` as the kernel leaves it: one compiled call, from ``x`` (N m) or,
+        where None, :meth:`start`, for at most ``budget`` (>= 0) steps. Returns its buffer
+        (read by :class:`CompiledRun`), the steps taken, the status
+        (:mod:`tdcm_ros.model.kernel`) and the last shape's smallest notch gap (m)."""
         cells = self.cells
-        x, p, theta, tangent, steps, status, gap = kernels().iterate_one(
-            cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, level, x, tol, relaxation,
-            slow, DIVERGENCE_GROWTH, max(budget, 0))
-        return PlainRun(x, PlanarShape(p, theta, tangent), steps.tolist(), status, gap)
+        out = np.empty(self._buffer + budget)
+        return (out, *kernels().iterate_one(
+            cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, level, x, out, tol,
+            relaxation, slow, DIVERGENCE_GROWTH))
 
 
 class LiteralSum(ClosedForm):

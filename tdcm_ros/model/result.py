@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import FrozenInstanceError
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
@@ -16,6 +16,7 @@ from tdcm_ros.model.errors import ModelError
 from tdcm_ros.model.grid import Grid
 from tdcm_ros.model.kinematics import PlanarShape, quaternions_y
 from tdcm_ros.model.limits import closure_angles, notch_gaps
+from tdcm_ros.model.moment_model import CompiledRun
 from tdcm_ros.model.settings import SolverSettings
 from tdcm_ros.model.tendons import TendonLayout
 
@@ -25,7 +26,14 @@ if TYPE_CHECKING:
 Array = NDArray[np.float64]
 
 
-@dataclass(frozen=True, eq=False)
+FIELDS = ("design", "settings", "tension_n", "s", "positions", "theta", "cell_moments",
+          "iterations", "residual_history", "converged", "strategy", "solve_time_s", "grid",
+          "loading", "contact_scale", "tendon_tension", "tendon_tensions_n", "material_scale")
+"""A :class:`SolveResult`'s fields, in the order its constructor takes them."""
+_REPR_FIELDS = tuple(name for name in FIELDS if name not in (
+    "grid", "contact_scale", "tendon_tension", "material_scale"))
+
+
 class SolveResult:
     """Shape of the midline for one tension.
 
@@ -39,26 +47,105 @@ class SolveResult:
     ``cell_moments * contact_scale`` (:attr:`bend_moments`). With several tendons
     (``Design.tendons``) ``tendon_tensions_n`` holds each one's base tension (N) and
     ``tension_n`` the largest.
+
+    Immutable: assigning or deleting a field raises ``dataclasses.FrozenInstanceError``; two
+    results are equal only when they are the same object. A result of the compiled plain
+    iteration (:meth:`of_run`) keeps the kernel's buffer and makes ``positions``, ``theta``,
+    ``cell_moments`` and ``residual_history`` from it on first use.
     """
 
-    design: Design
-    settings: SolverSettings
-    tension_n: float
-    s: Array
-    positions: Array
-    theta: Array
-    cell_moments: Array
-    iterations: int
-    residual_history: tuple[float, ...]
-    converged: bool
-    strategy: str
-    solve_time_s: float
-    grid: Grid = field(repr=False)
+    def __init__(self, design: Design, settings: SolverSettings, tension_n: float, s: Array,
+                 positions: Array, theta: Array, cell_moments: Array, iterations: int,
+                 residual_history: tuple[float, ...], converged: bool, strategy: str,
+                 solve_time_s: float, grid: Grid, loading: Loading | None = None,
+                 contact_scale: Array | None = None, tendon_tension: Array | None = None,
+                 tendon_tensions_n: tuple[float, ...] = (),
+                 material_scale: Array | None = None) -> None:
+        vars(self).update(
+            design=design, settings=settings, tension_n=tension_n, s=s, positions=positions,
+            theta=theta, cell_moments=cell_moments, iterations=iterations,
+            residual_history=residual_history, converged=converged, strategy=strategy,
+            solve_time_s=solve_time_s, grid=grid, loading=loading, contact_scale=contact_scale,
+            tendon_tension=tendon_tension, tendon_tensions_n=tendon_tensions_n,
+            material_scale=material_scale)
+
+    @classmethod
+    def of_run(cls, grid: Grid, settings: SolverSettings, tension_n: float, out: Array,
+               steps: int, strategy: str, solve_time_s: float) -> SolveResult:
+        """The result of the paper's closed form at ``tension_n`` (N) whose compiled plain
+        iteration converged in ``steps`` steps into the buffer ``out``
+        (:class:`~tdcm_ros.model.moment_model.CompiledRun`), solved in ``solve_time_s`` (s)."""
+        result = cls.__new__(cls)
+        fields = result.__dict__  # one store per field: no keyword dict to build
+        fields["design"] = grid.design
+        fields["settings"] = settings
+        fields["tension_n"] = tension_n
+        fields["s"] = grid.s_nodes
+        fields["converged"] = True
+        fields["strategy"] = strategy
+        fields["solve_time_s"] = solve_time_s
+        fields["grid"] = grid
+        fields["_out"] = out
+        fields["iterations"] = steps
+        return result
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(" + ", ".join(
+            f"{name}={getattr(self, name)!r}" for name in _REPR_FIELDS) + ")"
+
+    @cached_property
+    def positions(self) -> Array:
+        """Node positions (n, 3) m in ``tdcm_base``: ``(x, 0, z)``."""
+        p = self._run.p
+        positions = np.zeros((p.size, 3))
+        positions[:, 0] = p.imag
+        positions[:, 2] = p.real
+        return positions
+
+    @cached_property
+    def theta(self) -> Array:
+        """Tangent angle at each node (rad, about +y)."""
+        return self._run.theta
+
+    @cached_property
+    def cell_moments(self) -> Array:
+        """Each cell's end moments (cells, 2) N m."""
+        return self._run.x.reshape(2, -1).T
+
+    @cached_property
+    def residual_history(self) -> tuple[float, ...]:
+        """The largest node displacement (m) of every iteration."""
+        return self._run.history
+
+    @cached_property
+    def _run(self) -> CompiledRun:
+        """The kernel's buffer of a result of :meth:`of_run`, read."""
+        return CompiledRun(self._out, self.grid.n_cells, self.iterations)
+
     loading: Loading | None = None
-    contact_scale: Array | None = field(default=None, repr=False)
-    tendon_tension: Array | None = field(default=None, repr=False)
+    contact_scale: Array | None = None
+    tendon_tension: Array | None = None
     tendon_tensions_n: tuple[float, ...] = ()
-    material_scale: Array | None = field(default=None, repr=False)
+    material_scale: Array | None = None
+    """The optional fields' defaults (a result of :meth:`of_run` has them)."""
+
+    if TYPE_CHECKING:  # the fields every result has (set by the constructors)
+        design: Design
+        settings: SolverSettings
+        tension_n: float
+        s: Array
+        converged: bool
+        strategy: str
+        solve_time_s: float
+        grid: Grid
+        iterations: int
+        _out: Array
 
     @property
     def tensions_n(self) -> tuple[float, ...]:
