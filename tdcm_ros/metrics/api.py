@@ -15,10 +15,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.bagdata import BagSource, load_bag
-from tdcm_ros.metrics.calibration import Calibration, calibrate_steps
 from tdcm_ros.metrics.evaluation import (
     Evaluation,
     choose_registration,
@@ -29,6 +29,9 @@ from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import Progress, report_progress
+
+if TYPE_CHECKING:
+    from tdcm_ros.metrics.calibration import Calibration
 
 ESTIMATED_REGISTRATION_NOTE = (
     "the intervals leave out the registration's error: it was estimated from the markers, so "
@@ -122,6 +125,9 @@ def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
     not fitted but evaluated with the fitted model (:attr:`.Calibration.held_out`: Table I and
     the band's coverage on steps the fit never saw). ``progress``: stages ``reading bags``,
     ``fitting NAMES`` (model evaluations) and ``Table I before and after`` (2)."""
+    # on use only: evaluating never loads the fit's scipy.optimize
+    from tdcm_ros.metrics.calibration import Calibration, calibrate_steps
+
     opts = options or EvaluateOptions()
     sources = load_paths(paths, opts, topics, progress)
     prepared, held = split_trials(sources, prepare(sources, opts, registration), hold_out)

@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from tdcm_ros.figures import save_figures
-from tdcm_ros.metrics.calibration import Calibration
 from tdcm_ros.metrics.evaluation import Evaluation
+
+if TYPE_CHECKING:  # the metrics face imports this module; calibration loads scipy.optimize
+    from tdcm_ros.metrics.calibration import Calibration
 
 MM = 1e3
 """Metres to millimetres (plots are in mm)."""
