@@ -43,6 +43,8 @@ from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 Array = NDArray[np.float64]
 _MEDIAN_PASSES = 4
+_STEADY_BLOCK = 1 << 16
+"""Samples whose steadiness is taken at a time (:func:`_steady`)."""
 #: A step's phase: reached from below (loading) or from above (unloading) within its trial.
 LOADING, UNLOADING = "loading", "unloading"
 
@@ -123,12 +125,23 @@ def _odd(n: int) -> int:
 
 
 def _steady(t: Array, smooth: Array, cfg: StepSettings) -> NDArray[np.bool_]:
-    """Samples where every column of ``smooth`` (n, J) spans at most ``2 tolerance_n``."""
+    """Samples where every column of ``smooth`` (n, J) spans at most ``2 tolerance_n`` over a
+    centred window of ``settle_s`` (edges: the end samples repeated).
+
+    Taken :data:`_STEADY_BLOCK` samples at a time, each with the half window either side: the
+    filters' line buffers then hold a block, not the series (they took three times the
+    series' bytes at once)."""
     dt = float(np.median(np.diff(t))) if t.size > 1 else cfg.settle_s
     window = _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
-    span = maximum_filter1d(smooth, window, axis=0, mode="nearest") - \
-        minimum_filter1d(smooth, window, axis=0, mode="nearest")
-    return np.all(span <= 2.0 * cfg.tolerance_n, axis=1)
+    half, n = window // 2, len(smooth)
+    steady = np.empty(n, dtype=bool)
+    for a in range(0, n, _STEADY_BLOCK):
+        b = min(a + _STEADY_BLOCK, n)
+        lo, hi = max(a - half, 0), min(b + half, n)
+        span = maximum_filter1d(smooth[lo:hi], window, axis=0, mode="nearest")
+        span -= minimum_filter1d(smooth[lo:hi], window, axis=0, mode="nearest")
+        steady[a:b] = np.all(span[a - lo:b - lo] <= 2.0 * cfg.tolerance_n, axis=1)
+    return steady
 
 
 def _longest_band(x: Array, tol: float) -> tuple[int, int]:
@@ -182,8 +195,9 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
     if t.size < 2:
         return []
     x = np.asarray(tension_n, dtype=float).reshape(t.size, -1)
-    smooth = np.column_stack([median_filter(column, size=cfg.despike_samples, mode="nearest")
-                              for column in x.T]) if cfg.despike_samples > 1 else x
+    # each column on its own (a window along axis 0), into one array: no per-column copies
+    smooth = median_filter(x, size=(cfg.despike_samples, 1), mode="nearest") \
+        if cfg.despike_samples > 1 else x
     ranges: list[tuple[int, int]] = []
     for lo, hi in _true_runs(_steady(t, smooth, cfg)):
         ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
