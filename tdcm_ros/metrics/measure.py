@@ -96,7 +96,9 @@ def average_markers(tension: TensionSeries, markers: MarkerSeries, steps: Sequen
     used = frame_step >= 0
     visible = markers.visible()[used]  # the frames in steps only: no copy of every frame
     np.add.at(counts, frame_step[used], visible)
-    np.add.at(sums, frame_step[used], np.where(visible[:, :, None], markers.positions[used], 0.0))
+    seen = markers.positions[used]  # a copy: the frames in steps, zero where not visible
+    seen[~visible] = 0.0
+    np.add.at(sums, frame_step[used], seen)
     with np.errstate(invalid="ignore", divide="ignore"):
         means = np.where(counts[:, :, None] > 0, sums / counts[:, :, None], np.nan)
     rolls = _step_rolls(roll, markers.stamps_s[used], frame_step[used], n)
