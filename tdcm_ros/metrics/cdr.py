@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import struct
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,25 +27,41 @@ def wrench_force_z(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArra
     """Header stamps (ns) and ``wrench.force.z`` (N) of WrenchStamped CDR payloads."""
     stamps = np.zeros(len(payloads), dtype=np.int64)
     force = np.zeros(len(payloads))
-    groups: dict[int, list[int]] = {}
-    for i, data in enumerate(payloads):
-        groups.setdefault(len(data) if data[:2] in _LITTLE else -1, []).append(i)
-    for size, rows in groups.items():
-        idx = np.asarray(rows)
-        if size < 0 or not _decode_group(payloads, idx, size, stamps, force):
-            for i in rows:
+    for rows, raw in _groups(payloads):
+        if raw is None or not _decode_group(raw, rows, stamps, force):
+            for i in rows.tolist():
                 msg = deserialize(payloads[i], _TYPE)
                 stamps[i] = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
                 force[i] = msg.wrench.force.z
     return stamps, force
 
 
-def _decode_group(payloads: Sequence[bytes], rows: NDArray[np.int64], size: int,
-                  stamps: NDArray[np.int64], force: NDArray[np.float64]) -> bool:
-    """Decode little-endian payloads of one ``size``; False when their layout disagrees."""
+def _groups(payloads: Sequence[bytes]
+            ) -> Iterator[tuple[NDArray[np.int64], NDArray[np.uint8] | None]]:
+    """Indices of the payloads of each length with their bytes (a row each), little-endian
+    ones; the rest in one group without bytes. A batch of one length, all little-endian (a
+    recorder's), is one group found without a Python pass over the payloads."""
+    sizes = np.fromiter(map(len, payloads), np.int64, len(payloads))
+    if sizes.size and sizes[0] >= 2 and np.all(sizes == sizes[0]):
+        raw = np.frombuffer(b"".join(payloads), dtype=np.uint8).reshape(sizes.size, -1)
+        if np.all((raw[:, 0] == 0) & ((raw[:, 1] == 1) | (raw[:, 1] == 3))):  # _LITTLE
+            yield np.arange(sizes.size), raw
+            return
+    groups: dict[int, list[int]] = {}
+    for i, data in enumerate(payloads):
+        groups.setdefault(len(data) if data[:2] in _LITTLE else -1, []).append(i)
+    for size, rows in groups.items():
+        yield np.asarray(rows), None if size < 0 else np.frombuffer(
+            b"".join(payloads[i] for i in rows), dtype=np.uint8).reshape(-1, size)
+
+
+def _decode_group(raw: NDArray[np.uint8], rows: NDArray[np.int64], stamps: NDArray[np.int64],
+                  force: NDArray[np.float64]) -> bool:
+    """Decode little-endian payloads of one length (``raw``: a row each, payloads ``rows``);
+    False when their layout disagrees."""
+    size = raw.shape[1]
     if size < 16:
         raise BagError(f"{_TYPE} payload of {size} bytes is too short")
-    raw = np.frombuffer(b"".join(payloads[i] for i in rows), dtype=np.uint8).reshape(-1, size)
     name_len = raw[:, 12:16].copy().view("<u4")[:, 0]
     if np.any(name_len != name_len[0]):
         return False
