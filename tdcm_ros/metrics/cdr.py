@@ -1,5 +1,6 @@
 """Decoding of the evaluation's CDR payloads: ``geometry_msgs/msg/WrenchStamped`` vectorised (1 kHz
-tension bags), ``mocap4r2_msgs/msg/Markers``, ``std_msgs/msg/Float64`` and, of
+tension bags), ``mocap4r2_msgs/msg/Markers`` (vectorised over frames of one layout,
+:func:`markers_groups`), ``std_msgs/msg/Float64`` and, of
 ``sensor_msgs/msg/JointState``, the tendon efforts and one joint's position (the roll).
 
 WrenchStamped messages of equal length share one layout (same ``frame_id`` length), so each group is decoded
@@ -94,7 +95,9 @@ def _string(data: bytes, pos: int) -> tuple[str, int]:
     return data[start:start + max(length - 1, 0)].decode("utf-8"), pos + 4 + length
 
 
-def _markers_le(data: bytes) -> MarkersFrame:
+def _markers_le(data: bytes) -> tuple[MarkersFrame, list[int]]:
+    """The frame of a little-endian Markers payload and the byte offset of each marker's
+    position in it."""
     sec, nsec = struct.unpack_from("<iI", data, 4)
     frame_id, pos = _string(data, 8)
     pos = _align(pos, 4) + 4  # frame_number
@@ -102,33 +105,77 @@ def _markers_le(data: bytes) -> MarkersFrame:
     pos += 4
     names: list[str] = []
     xyz: list[tuple[float, float, float]] = []
+    offsets: list[int] = []
     for _ in range(count):
         pos = _align(pos + 1, 4) + 4  # id_type (int8), marker_index (int32)
         name, pos = _string(data, pos)
         pos = _align(pos, 8)
+        offsets.append(4 + pos)
         xyz.append(_XYZ.unpack_from(data, 4 + pos))
         names.append(name)
         pos += 24
     if 4 + pos > len(data):
         raise BagError(f"{_MARKERS_TYPE} payload shorter than its content")
-    return sec * 1_000_000_000 + nsec, frame_id, names, xyz
+    return (sec * 1_000_000_000 + nsec, frame_id, names, xyz), offsets
 
 
 MarkersFrame = tuple[int, str, list[str], list[tuple[float, float, float]]]
 """Header stamp (ns), frame id, marker names and positions (m) of one Markers message."""
+MarkersGroup = tuple[NDArray[np.int64], NDArray[np.int64], str, list[str], NDArray[np.float64]]
+"""Indices of Markers payloads sharing one layout (frame id, marker names, order), their
+header stamps (ns), the frame id, the marker names and the positions (payloads, markers, 3) m."""
 
 
 def markers_frame(data: bytes) -> MarkersFrame:
     """Decode a ``mocap4r2_msgs/msg/Markers`` CDR payload (little-endian fast path)."""
     if data[:2] in _LITTLE:
         try:
-            return _markers_le(data)
+            return _markers_le(data)[0]
         except (struct.error, UnicodeDecodeError, BagError):
             pass
     msg = deserialize(data, _MARKERS_TYPE)
     return (msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec, msg.header.frame_id,
             [m.marker_name for m in msg.markers],
             [(m.translation.x, m.translation.y, m.translation.z) for m in msg.markers])
+
+
+def markers_groups(payloads: Sequence[bytes]) -> Iterator[MarkersGroup]:
+    """Markers payloads decoded a group at a time (:data:`MarkersGroup`): little-endian
+    payloads of one length whose bytes differ only in the stamp, the frame number and the
+    positions are read with NumPy views (a motion capture stream's frames); any other payload
+    is a group of its own (:func:`markers_frame`)."""
+    for rows, raw in _groups(payloads):
+        group = None if raw is None else _markers_group(payloads[int(rows[0])], rows, raw)
+        if group is not None:
+            yield group
+            continue
+        for i in rows.tolist():
+            stamp, frame, names, xyz = markers_frame(payloads[i])
+            yield (np.array([i]), np.array([stamp], dtype=np.int64), frame, names,
+                   np.array(xyz, dtype=float).reshape(1, len(names), 3))
+
+
+def _markers_group(first: bytes, rows: NDArray[np.int64], raw: NDArray[np.uint8]
+                   ) -> MarkersGroup | None:
+    """The group of the payloads ``raw`` (a row each, the first one ``first``) if they share
+    the first one's layout, else None."""
+    try:
+        (_, frame, names, _), offsets = _markers_le(first)
+    except (struct.error, UnicodeDecodeError, BagError):
+        return None
+    layout = np.ones(raw.shape[1], dtype=bool)
+    layout[4:12] = False  # header stamp
+    frame_number = 4 + _align(_string(first, 8)[1], 4)
+    layout[frame_number:frame_number + 4] = False
+    for offset in offsets:
+        layout[offset:offset + 24] = False
+    if not np.all(raw[:, layout] == raw[0, layout]):
+        return None
+    sec = raw[:, 4:8].copy().view("<i4")[:, 0].astype(np.int64)
+    nsec = raw[:, 8:12].copy().view("<u4")[:, 0].astype(np.int64)
+    xyz = np.stack([raw[:, o:o + 24].copy().view("<f8") for o in offsets], axis=1) \
+        if offsets else np.zeros((len(rows), 0, 3))
+    return rows, sec * 1_000_000_000 + nsec, frame, names, xyz
 
 
 def float64_data(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:

@@ -1,5 +1,6 @@
-"""The vectorised WrenchStamped decoder gives what the typestore decodes, for a batch of one
-layout (one view of all payloads) and for mixed lengths and byte orders (grouped)."""
+"""The vectorised WrenchStamped and Markers decoders give what the per-message decoders give:
+for a batch of one layout (one view of all payloads) and for mixed lengths, layouts and byte
+orders (grouped)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 from tdcm_ros.bagio import deserialize, from_dict, serialize, typestore
-from tdcm_ros.metrics.cdr import wrench_force_z
+from tdcm_ros.metrics.cdr import markers_frame, markers_groups, wrench_force_z
 
 TYPE = "geometry_msgs/msg/WrenchStamped"
 
@@ -35,3 +36,32 @@ def test_wrench_decoding_matches_the_typestore(payloads: list[bytes]) -> None:
     want_stamps, want_force = expected(payloads)
     assert stamps.tolist() == want_stamps
     np.testing.assert_array_equal(force, want_force)
+
+
+MARKERS = "mocap4r2_msgs/msg/Markers"
+
+
+def markers(i: int, names: list[str], little: bool = True) -> bytes:
+    message = from_dict(MARKERS, {
+        "header": {"stamp": {"sec": 1_700_000_000, "nanosec": 1000 * i}, "frame_id": "mocap"},
+        "frame_number": i, "markers": [
+            {"marker_name": name, "marker_index": k,
+             "translation": {"x": 0.001 * i, "y": -0.5 * k, "z": float(i + k)}}
+            for k, name in enumerate(names)]})
+    return serialize(message, MARKERS) if little else bytes(
+        typestore().serialize_cdr(message, MARKERS, little_endian=False))
+
+
+def test_markers_groups_decode_each_payload_as_markers_frame() -> None:
+    layouts = [["m1", "m2", "m3"], ["m2", "m1", "m3"], ["m1", "m3"], ["m1", "m1", "x9"], []]
+    payloads = [markers(i, layouts[i % len(layouts)], little=i % 11 != 4) for i in range(60)]
+    decoded: dict[int, tuple[int, str, list[str], list[list[float]]]] = {}
+    sizes = []
+    for at, stamps, frame, names, xyz in markers_groups(payloads):
+        sizes.append(len(at))
+        for row, i in enumerate(at.tolist()):
+            decoded[i] = (int(stamps[row]), frame, names, xyz[row].tolist())
+    want = {i: (s, f, n, [list(p) for p in x])
+            for i, (s, f, n, x) in enumerate(map(markers_frame, payloads))}
+    assert decoded == want
+    assert max(sizes) > 1  # payloads of one layout were decoded together
