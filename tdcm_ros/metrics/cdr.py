@@ -142,35 +142,53 @@ def markers_frame(data: bytes) -> MarkersFrame:
 def markers_groups(payloads: Sequence[bytes]) -> Iterator[MarkersGroup]:
     """Markers payloads decoded a group at a time (:data:`MarkersGroup`): little-endian
     payloads of one length whose bytes differ only in the stamp, the frame number and the
-    positions are read with NumPy views (a motion capture stream's frames); any other payload
-    is a group of its own (:func:`markers_frame`)."""
+    positions (a motion capture stream's frames with the same markers seen) are read with NumPy
+    views; a big-endian payload, or one the fast path cannot parse, is a group of its own
+    (:func:`markers_frame`)."""
     for rows, raw in _groups(payloads):
-        group = None if raw is None else _markers_group(payloads[int(rows[0])], rows, raw)
-        if group is not None:
-            yield group
+        if raw is None:
+            yield from (_markers_one(payloads, i) for i in rows.tolist())
             continue
-        for i in rows.tolist():
-            stamp, frame, names, xyz = markers_frame(payloads[i])
-            yield (np.array([i]), np.array([stamp], dtype=np.int64), frame, names,
-                   np.array(xyz, dtype=float).reshape(1, len(names), 3))
+        while rows.size:  # each pass takes the first payload's layout
+            found = _layout(payloads[int(rows[0])])
+            if found is None:
+                yield _markers_one(payloads, int(rows[0]))
+                same = np.arange(rows.size) == 0
+            else:
+                layout, (_, frame, names, _), offsets = found
+                same = np.all(raw[:, layout] == raw[0, layout], axis=1)
+                yield _markers_group(rows[same], raw[same], frame, names, offsets)
+            rows, raw = rows[~same], raw[~same]
 
 
-def _markers_group(first: bytes, rows: NDArray[np.int64], raw: NDArray[np.uint8]
-                   ) -> MarkersGroup | None:
-    """The group of the payloads ``raw`` (a row each, the first one ``first``) if they share
-    the first one's layout, else None."""
+def _markers_one(payloads: Sequence[bytes], i: int) -> MarkersGroup:
+    """The group of payload ``i`` alone (:func:`markers_frame`)."""
+    stamp, frame, names, xyz = markers_frame(payloads[i])
+    return (np.array([i]), np.array([stamp], dtype=np.int64), frame, names,
+            np.array(xyz, dtype=float).reshape(1, len(names), 3))
+
+
+def _layout(first: bytes) -> tuple[NDArray[np.bool_], MarkersFrame, list[int]] | None:
+    """Mask of the bytes of the little-endian Markers payload ``first`` that are neither the
+    stamp, the frame number nor a position, its frame and its positions' offsets; None when
+    the fast path cannot parse it."""
     try:
-        (_, frame, names, _), offsets = _markers_le(first)
+        frame, offsets = _markers_le(first)
     except (struct.error, UnicodeDecodeError, BagError):
         return None
-    layout = np.ones(raw.shape[1], dtype=bool)
+    layout = np.ones(len(first), dtype=bool)
     layout[4:12] = False  # header stamp
     frame_number = 4 + _align(_string(first, 8)[1], 4)
     layout[frame_number:frame_number + 4] = False
     for offset in offsets:
         layout[offset:offset + 24] = False
-    if not np.all(raw[:, layout] == raw[0, layout]):
-        return None
+    return layout, frame, offsets
+
+
+def _markers_group(rows: NDArray[np.int64], raw: NDArray[np.uint8], frame: str,
+                   names: list[str], offsets: list[int]) -> MarkersGroup:
+    """The group of the payloads ``raw`` (a row each, payloads ``rows``) of one layout: frame
+    id ``frame``, markers ``names`` with their positions at byte ``offsets``."""
     sec = raw[:, 4:8].copy().view("<i4")[:, 0].astype(np.int64)
     nsec = raw[:, 8:12].copy().view("<u4")[:, 0].astype(np.int64)
     xyz = np.stack([raw[:, o:o + 24].copy().view("<f8") for o in offsets], axis=1) \
