@@ -140,7 +140,9 @@ def calibration_figure(plt: Any, fit: Calibration) -> Any:
 def write_calibration_plots(fit: Calibration, directory: str | Path, *, option: str = "--out"
                             ) -> list[Path]:
     """Write ``calibration.png`` (:func:`.calibration_figure`) and ``shapes_calibrated.png``
-    (:func:`.shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
+    (:func:`.shapes_figure` of the fitted model) of ``fit`` (a
+    :class:`~tdcm_ros.metrics.calibration.Calibration`) into ``directory`` (created if
+    missing)."""
     fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
     return save_figures(directory, option, (
         ("calibration.png", lambda plt: calibration_figure(plt, fit)),
