@@ -11,7 +11,8 @@ before this change) and says whether both print the same JSON.
 
 Prints per bag: its size, the peak RSS, their ratio (the target is <= 3), the ratio of the peak
 above the import floor (a child importing the evaluation modules and nothing else) to the bag,
-and between consecutive bags the marginal ratio: extra peak RSS per extra bag byte.
+between consecutive bags the marginal ratio: extra peak RSS per extra bag byte, and the child's
+wall time from spawn to exit (the command end to end; one run, so noisy on a shared machine).
 ``--results FILE`` also writes the printed figures as tables to a results file
 (``bench/results.py``).
 """
@@ -50,11 +51,12 @@ def bags(folder: Path, minutes: list[float]) -> list[Path]:
     return found
 
 
-def measure(root: Path, bag: Path, out: Path) -> float:
-    """Peak RSS (MiB) of ``tdcm evaluate BAG --json`` on the checkout ``root``; JSON to ``out``."""
+def measure(root: Path, bag: Path, out: Path) -> tuple[float, float]:
+    """Wall time (s) and peak RSS (MiB) of ``tdcm evaluate BAG --json`` on the checkout
+    ``root``; JSON to ``out``."""
     command = [sys.executable, "-m", "tdcm_ros", "evaluate", str(bag), "--set", BENCH_SET, "--json"]
     with out.open("wb") as stream:
-        return run_once(command, root, stream)[1]
+        return run_once(command, root, stream)
 
 
 def report(name: str, root: Path, paths: list[Path], scratch: Path,
@@ -63,28 +65,31 @@ def report(name: str, root: Path, paths: list[Path], scratch: Path,
     outputs per bag."""
     floor = run_once([sys.executable, "-c", FLOOR], root)[1]
     print(f"{name} ({root}): import floor {floor:.1f} MiB")
-    print(f"  {'bag':<16} {'size MiB':>9} {'peak MiB':>9} {'peak/bag':>9} {'(peak-floor)/bag':>17}")
+    print(f"  {'bag':<16} {'size MiB':>9} {'peak MiB':>9} {'peak/bag':>9} {'(peak-floor)/bag':>17}"
+          f" {'wall s':>7}")
     outputs, previous = [], None
     rows: list[list[object]] = []
     for bag in paths:
         out = scratch / f"{name}_{bag.name}.json"
-        peak, size = measure(root, bag, out), bag_bytes(bag) / MIB
+        (wall, peak), size = measure(root, bag, out), bag_bytes(bag) / MIB
         outputs.append(out.read_text())
         verdict = "met" if peak / size <= TARGET_RATIO else "NOT met"
         print(f"  {bag.name:<16} {size:9.1f} {peak:9.1f} {peak / size:9.2f} "
-              f"{(peak - floor) / size:17.2f}   (target peak/bag <= {TARGET_RATIO:g}: {verdict})")
+              f"{(peak - floor) / size:17.2f} {wall:7.2f}   (target peak/bag <= {TARGET_RATIO:g}: "
+              f"{verdict})")
         marginal = None
         if previous is not None:
             marginal = (peak - previous[1]) / (size - previous[0])
             print(f"  {'':<16} marginal: {marginal:.2f} MiB "
                   f"of peak per MiB of bag from {previous[2]}")
-        rows.append([bag.name, size, peak, peak / size, (peak - floor) / size, marginal])
+        rows.append([bag.name, size, peak, peak / size, (peak - floor) / size, marginal, wall])
         previous = (size, peak, bag.name)
     results.table(
         f"Peak RSS of tdcm evaluate, {name} checkout",
         [Column("bag"), Column("size", "MiB", ".1f"), Column("peak RSS", "MiB", ".1f"),
          Column("peak / bag", format=".2f"), Column("(peak − import floor) / bag", format=".2f"),
-         Column("marginal: peak per bag from the previous bag", "MiB/MiB", ".2f")], rows,
+         Column("marginal: peak per bag from the previous bag", "MiB/MiB", ".2f"),
+         Column("wall time, one run", "s", ".2f")], rows,
         note=f"import floor (a child importing the evaluation modules and nothing else): "
              f"{floor:.1f} MiB; target peak / bag <= {TARGET_RATIO:g}")
     return outputs

@@ -40,7 +40,7 @@ ENTRY_POINTS = frozenset(f"tdcm_ros.{name}" for name in (  # besides scripts (py
     "runtime.wire", "device.constants",  # used as namespaces: wire.parse_token, c.TRIP_MN
 ))
 BUDGETS = {unit: frozenset() for layer in LAYERS for unit in layer} | {
-    "mocap": frozenset({"scipy"}), "metrics": frozenset({"scipy"}), "scenes": frozenset({"scipy"}),
+    "metrics": frozenset({"scipy"}), "scenes": frozenset({"scipy"}),
     "control": frozenset({"scipy"}),
     "bagio": frozenset({"rosbags"}), "recording": frozenset({"rosbags", "mcap"}),
     "demo": frozenset({"scipy", "rosbags", "mcap"}),

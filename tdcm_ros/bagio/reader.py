@@ -174,6 +174,16 @@ def _decompress(compression: str, data: bytes, size: int) -> bytes:
     raise _Damaged(f"unsupported chunk compression {compression!r}")
 
 
+def _may_hold(index: ChunkIndex, wanted: set[int] | None) -> bool:
+    """Whether the chunk of ``index`` may hold messages of the ``wanted`` channels (None: any).
+    Its index lists a message index for each channel the chunk holds, when the writer wrote
+    them (every writer here does; none listed: unknown, so it may); the summary holding the
+    list is checked by its CRC at open. Reading one sparse topic (``/tf_static``) then
+    decompresses and walks only its chunks, not every chunk of the bag."""
+    offsets = index.message_index_offsets
+    return wanted is None or not offsets or not wanted.isdisjoint(offsets)
+
+
 class _McapSource:
     """One MCAP file, read by a linear pass over its data section (chunks checked by CRC).
 
@@ -367,10 +377,11 @@ class _McapSource:
 
     def _units(self, buf: _FileBytes, wanted: set[int] | None) -> Iterator[Unit]:
         """Messages chunk by chunk, each unit complete and checked, up to the data end: the
-        summary's chunks (checked at open) if the file is complete, else a linear pass."""
+        summary's chunks (checked at open) if the file is complete, less those whose index
+        lists none of the ``wanted`` channels (:func:`_may_hold`), else a linear pass."""
         if self.complete:
             for index in self._chunks:
-                if index.chunk_start_offset not in self._skipped:
+                if index.chunk_start_offset not in self._skipped and _may_hold(index, wanted):
                     yield self._chunk(self._chunk_body(buf, index), wanted)
             return
         pos, end = len(MCAP_MAGIC), len(buf)

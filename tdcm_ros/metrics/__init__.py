@@ -8,7 +8,7 @@ Separate entry points, kept out of this face because they pull heavier libraries
 
 - :mod:`tdcm_ros.metrics.api` -- evaluate and calibrate bags (``evaluate_paths``,
   ``calibrate_paths``; reads MCAP);
-- :mod:`tdcm_ros.metrics.calibration` -- least-squares calibration (scipy.optimize, scipy.stats);
+- :mod:`tdcm_ros.metrics.calibration` -- least-squares calibration (scipy.optimize);
 - :mod:`tdcm_ros.metrics.synthetic`, :mod:`tdcm_ros.metrics.synthetic_bag` -- simulated
   recordings and bags for tests, benchmarks and demos.
 """

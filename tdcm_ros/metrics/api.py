@@ -15,10 +15,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tdcm_ros.errors import InputError
 from tdcm_ros.metrics.bagdata import BagSource, load_bag
-from tdcm_ros.metrics.calibration import Calibration, calibrate_steps
 from tdcm_ros.metrics.evaluation import (
     Evaluation,
     choose_registration,
@@ -29,6 +29,9 @@ from tdcm_ros.metrics.measure import MeasuredStep, measure_steps
 from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.mocap import Registration
 from tdcm_ros.model import Progress, report_progress
+
+if TYPE_CHECKING:
+    from tdcm_ros.metrics.calibration import Calibration
 
 ESTIMATED_REGISTRATION_NOTE = (
     "the intervals leave out the registration's error: it was estimated from the markers, so "
@@ -47,6 +50,20 @@ class Topics:
     markers: str = "markers"
     joint_states: str = "joint_states"
     roll_joint: str = "roll"
+
+
+@dataclass(frozen=True)
+class _BagNotes:
+    """What an evaluation reports of a bag besides its steps: its path, reading warnings and
+    occluded marker positions per label (a :class:`BagSource` without its series)."""
+
+    path: Path
+    warnings: tuple[str, ...]
+    occluded: dict[str, int]
+
+    @classmethod
+    def of(cls, source: BagSource) -> _BagNotes:
+        return cls(source.path, source.warnings, source.occluded)
 
 
 def load_paths(paths: Sequence[str | Path], options: EvaluateOptions,
@@ -86,10 +103,11 @@ def prepare(sources: Sequence[BagSource], options: EvaluateOptions,
 def evaluate_sources(sources: Sequence[BagSource], options: EvaluateOptions,
                      registration: Registration | None = None) -> Evaluation:
     """Evaluate loaded bags (see :func:`prepare` for the registration)."""
-    return _evaluate(sources, prepare(sources, options, registration), options)
+    return _evaluate([_BagNotes.of(s) for s in sources], prepare(sources, options, registration),
+                     options)
 
 
-def _evaluate(sources: Sequence[BagSource],
+def _evaluate(sources: Sequence[_BagNotes],
               prepared: Sequence[tuple[list[MeasuredStep], Registration]],
               options: EvaluateOptions) -> Evaluation:
     parts = []
@@ -107,9 +125,14 @@ def evaluate_paths(paths: Sequence[str | Path], options: EvaluateOptions | None 
                    progress: Progress | None = None) -> Evaluation:
     """Evaluate bags (rosbag2 folders or ``.mcap`` files) against the model of
     ``options.design``; see :class:`~tdcm_ros.metrics.evaluation.Evaluation`.
-    ``progress``: stage ``reading bags``."""
+    ``progress``: stage ``reading bags``. The bags' series are dropped once their steps are
+    measured: the model runs without them in memory."""
     opts = options or EvaluateOptions()
-    return evaluate_sources(load_paths(paths, opts, topics, progress), opts, registration)
+    sources = load_paths(paths, opts, topics, progress)
+    prepared = prepare(sources, opts, registration)
+    notes = [_BagNotes.of(s) for s in sources]
+    del sources
+    return _evaluate(notes, prepared, opts)
 
 
 def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
@@ -122,24 +145,30 @@ def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
     not fitted but evaluated with the fitted model (:attr:`.Calibration.held_out`: Table I and
     the band's coverage on steps the fit never saw). ``progress``: stages ``reading bags``,
     ``fitting NAMES`` (model evaluations) and ``Table I before and after`` (2)."""
+    # on use only: evaluating never loads the fit's scipy.optimize
+    from tdcm_ros.metrics.calibration import Calibration, calibrate_steps
+
     opts = options or EvaluateOptions()
     sources = load_paths(paths, opts, topics, progress)
-    prepared, held = split_trials(sources, prepare(sources, opts, registration), hold_out)
+    measured = prepare(sources, opts, registration)
+    notes = [_BagNotes.of(s) for s in sources]
+    del sources  # the fit needs the steps, not the series
+    prepared, held = split_trials(notes, measured, hold_out)
     fitted, params, corr, condition, rms, count, warnings = calibrate_steps(
         prepared, fit, opts, confidence=confidence, progress=progress)
-    notes = [ESTIMATED_REGISTRATION_NOTE] if any(
+    estimated = [ESTIMATED_REGISTRATION_NOTE] if any(
         reg.method == "estimated" for _, reg in prepared) else []
     report_progress(progress, "Table I before and after", 0, 2)
-    before = _evaluate(sources, prepared, opts)
+    before = _evaluate(notes, prepared, opts)
     report_progress(progress, "Table I before and after", 1, 2)
-    after = _evaluate(sources, prepared, fitted)
+    after = _evaluate(notes, prepared, fitted)
     report_progress(progress, "Table I before and after", 2, 2)
     return Calibration(tuple(params), confidence, corr, condition, rms, count, not warnings,
                        before, after, tuple(warnings),
-                       _evaluate(sources, held, fitted) if hold_out else None, tuple(notes))
+                       _evaluate(notes, held, fitted) if hold_out else None, tuple(estimated))
 
 
-def split_trials(sources: Sequence[BagSource],
+def split_trials(sources: Sequence[_BagNotes],
                  prepared: Sequence[tuple[list[MeasuredStep], Registration]], hold_out: int
                  ) -> tuple[list[tuple[list[MeasuredStep], Registration]],
                             list[tuple[list[MeasuredStep], Registration]]]:

@@ -48,7 +48,7 @@ from tdcm_ros.metrics.cdr import (
     float64_data,
     joint_efforts,
     joint_positions,
-    markers_frame,
+    markers_groups,
     wrench_force_z,
 )
 from tdcm_ros.metrics.errors import MetricsError, TensionTopicError
@@ -314,14 +314,14 @@ def _frames(payloads: Sequence[bytes], index: dict[str, int], frames: set[str],
     header = np.zeros(len(payloads), dtype=np.int64)
     rows = np.full((len(payloads), len(index), 3), np.nan)
     reported = np.zeros(rows.shape[:2], dtype=bool)
-    for n, data in enumerate(payloads):
-        header[n], frame, names, xyz = markers_frame(data)
+    for at, stamps, frame, names, xyz in markers_groups(payloads):
+        header[at] = stamps
         frames.add(frame)
-        present.update({name or "(unnamed)" for name in names})
-        for marker_name, p in zip(names, xyz, strict=True):
+        present.update({name or "(unnamed)": len(at) for name in names})  # once per frame
+        for marker_name, p in zip(names, xyz.transpose(1, 0, 2), strict=True):
             i = index.get(marker_name)
-            if i is not None:
-                rows[n, i], reported[n, i] = p, True
+            if i is not None:  # a name given twice in a frame: its last position
+                rows[at, i], reported[at, i] = p, True
     return header, rows, reported
 
 

@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
-from scipy.stats import t as student_t
+from scipy.special import stdtrit
 
 from tdcm_ros.errors import InputError, TdcmError, out_of_range
 from tdcm_ros.metrics.evaluation import (
@@ -282,7 +282,7 @@ def calibrate_steps(prepared: Sequence[tuple[Sequence[MeasuredStep], Registratio
         std = np.full(n, np.inf)
         corr = np.full((n, n), np.nan)
         np.fill_diagonal(corr, 1.0)
-    half = float(student_t.ppf(0.5 + confidence / 2.0, dof)) * std
+    half = float(stdtrit(dof, 0.5 + confidence / 2.0)) * std  # scipy.stats.t.ppf's own call
     values = fit.x * x0
     params = [FittedParameter(nm, unit, float(v0), float(v), float(sd), float(v - h),
                               float(v + h))

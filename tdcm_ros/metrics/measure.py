@@ -85,27 +85,37 @@ def measure_steps(tension: TensionSeries, markers: MarkerSeries, options: Evalua
 def average_markers(tension: TensionSeries, markers: MarkerSeries, steps: Sequence[Step],
                     options: EvaluateOptions, roll: RollSeries | None = None
                     ) -> list[MeasuredStep]:
-    """Mean marker positions and roll per step (steps index ``tension``'s samples; ``roll``
-    ``None``: 0 throughout)."""
-    step_of_sample = np.full(tension.stamps_s.size, -1, dtype=np.int64)
-    for k, step in enumerate(steps):
-        step_of_sample[step.start:step.stop] = k
+    """Mean marker positions and roll per step (steps index ``tension``'s samples, in time
+    order and disjoint, as :func:`detect_steps` finds them; ``roll`` ``None``: 0 throughout)."""
     nearest = nearest_within(markers.stamps_s, tension.stamps_s, options.align_tolerance_s)
-    frame_step = np.where(nearest >= 0, step_of_sample[np.maximum(nearest, 0)], -1)
-    visible = markers.visible()
-    filled = np.where(visible[:, :, None], markers.positions, 0.0)
+    frame_step = _step_of(nearest, steps)
     n = len(steps)
     counts = np.zeros((n, len(markers.labels)))
     sums = np.zeros((n, len(markers.labels), 3))
     frames = np.bincount(frame_step[frame_step >= 0], minlength=n)
     used = frame_step >= 0
-    np.add.at(counts, frame_step[used], visible[used])
-    np.add.at(sums, frame_step[used], filled[used])
+    visible = markers.visible()[used]  # the frames in steps only: no copy of every frame
+    np.add.at(counts, frame_step[used], visible)
+    seen = markers.positions[used]  # a copy: the frames in steps, zero where not visible
+    seen[~visible] = 0.0
+    np.add.at(sums, frame_step[used], seen)
     with np.errstate(invalid="ignore", divide="ignore"):
         means = np.where(counts[:, :, None] > 0, sums / counts[:, :, None], np.nan)
     rolls = _step_rolls(roll, markers.stamps_s[used], frame_step[used], n)
     return [MeasuredStep(step, step.means_n, means[k], int(frames[k]), markers.labels,
                          *rolls[k]) for k, step in enumerate(steps)]
+
+
+def _step_of(samples: NDArray[np.int64], steps: Sequence[Step]) -> NDArray[np.int64]:
+    """The step (index into ``steps``: in time order, disjoint ``[start, stop)``) holding each
+    tension sample index of ``samples``; -1 for an index in none or -1 (no sample)."""
+    if not steps:
+        return np.full(samples.shape, -1, dtype=np.int64)
+    starts = np.array([step.start for step in steps], dtype=np.int64)
+    stops = np.array([step.stop for step in steps], dtype=np.int64)
+    k = np.searchsorted(starts, samples, side="right") - 1
+    inside = (samples >= 0) & (k >= 0) & (samples < stops[np.maximum(k, 0)])
+    return np.where(inside, k, -1)
 
 
 def _step_rolls(roll: RollSeries | None, stamps_s: Array, step_of_frame: NDArray[np.int64],

@@ -11,13 +11,15 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from tdcm_ros.figures import save_figures
-from tdcm_ros.metrics.calibration import Calibration
 from tdcm_ros.metrics.evaluation import Evaluation
+
+if TYPE_CHECKING:  # the metrics face imports this module; calibration loads scipy.optimize
+    from tdcm_ros.metrics.calibration import Calibration
 
 MM = 1e3
 """Metres to millimetres (plots are in mm)."""
@@ -139,7 +141,9 @@ def calibration_figure(plt: Any, fit: Calibration) -> Any:
 def write_calibration_plots(fit: Calibration, directory: str | Path, *, option: str = "--out"
                             ) -> list[Path]:
     """Write ``calibration.png`` (:func:`.calibration_figure`) and ``shapes_calibrated.png``
-    (:func:`.shapes_figure` of the fitted model) into ``directory`` (created if missing)."""
+    (:func:`.shapes_figure` of the fitted model) of ``fit`` (a
+    :class:`~tdcm_ros.metrics.calibration.Calibration`) into ``directory`` (created if
+    missing)."""
     fitted = ", ".join(f"{p.name} = {p.value:.4g} {p.unit}" for p in fit.parameters)
     return save_figures(directory, option, (
         ("calibration.png", lambda plt: calibration_figure(plt, fit)),

@@ -70,12 +70,12 @@ class MarkerSeries:
            frame_id: str = "mocap") -> MarkerSeries:
         """Validate and sort by stamp; a position row with any non-finite value becomes NaN."""
         t, order = _sorted_stamps("marker stamps", stamps_s)
-        p = np.array(positions, dtype=float)
+        p = np.asarray(positions, dtype=float)
         if p.shape != (len(order), len(labels), 3):
             raise MetricsError(f"marker positions of shape {p.shape}; allowed: "
                                f"({len(order)}, {len(labels)}, 3)", parameter="markers",
                                value=p.shape, allowed=f"({len(order)}, {len(labels)}, 3)")
-        p = p[order]
+        p = p[order]  # the one copy: the caller's array is never changed
         p[~np.all(np.isfinite(p), axis=2)] = np.nan
         return cls(t, tuple(labels), p, frame_id)
 

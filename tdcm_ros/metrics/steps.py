@@ -43,6 +43,8 @@ from tdcm_ros.spec import check_fields, spec_field, specs_of
 
 Array = NDArray[np.float64]
 _MEDIAN_PASSES = 4
+_STEADY_BLOCK = 1 << 16
+"""Samples whose steadiness is taken at a time (:func:`_steady`)."""
 #: A step's phase: reached from below (loading) or from above (unloading) within its trial.
 LOADING, UNLOADING = "loading", "unloading"
 
@@ -123,12 +125,24 @@ def _odd(n: int) -> int:
 
 
 def _steady(t: Array, smooth: Array, cfg: StepSettings) -> NDArray[np.bool_]:
-    """Samples where every column of ``smooth`` (n, J) spans at most ``2 tolerance_n``."""
-    dt = float(np.median(np.diff(t))) if t.size > 1 else cfg.settle_s
+    """Samples where every column of ``smooth`` (n, J) spans at most ``2 tolerance_n`` over a
+    centred window of ``settle_s`` (edges: the end samples repeated).
+
+    Taken :data:`_STEADY_BLOCK` samples at a time, each with the half window either side: the
+    filters' line buffers then hold a block, not the series (they took three times the
+    series' bytes at once)."""
+    # the diffs are a temporary: the median may sort them in place (no second copy)
+    dt = float(np.median(np.diff(t), overwrite_input=True)) if t.size > 1 else cfg.settle_s
     window = _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
-    span = maximum_filter1d(smooth, window, axis=0, mode="nearest") - \
-        minimum_filter1d(smooth, window, axis=0, mode="nearest")
-    return np.all(span <= 2.0 * cfg.tolerance_n, axis=1)
+    half, n = window // 2, len(smooth)
+    steady = np.empty(n, dtype=bool)
+    for a in range(0, n, _STEADY_BLOCK):
+        b = min(a + _STEADY_BLOCK, n)
+        lo, hi = max(a - half, 0), min(b + half, n)
+        span = maximum_filter1d(smooth[lo:hi], window, axis=0, mode="nearest")
+        span -= minimum_filter1d(smooth[lo:hi], window, axis=0, mode="nearest")
+        steady[a:b] = np.all(span[a - lo:b - lo] <= 2.0 * cfg.tolerance_n, axis=1)
+    return steady
 
 
 def _longest_band(x: Array, tol: float) -> tuple[int, int]:
@@ -166,6 +180,18 @@ def _holds(t: Array, x: Array, lo: int, hi: int, cfg: StepSettings) -> list[tupl
     return found
 
 
+def _hold_ranges(t: Array, x: Array, cfg: StepSettings) -> list[tuple[int, int]]:
+    """Index ranges of the holds in the tensions ``x`` (n, J) N at stamps ``t`` (s), in time
+    order (steps 1-3 of the module docstring, on the despiked tensions: freed on return)."""
+    # each column on its own (a window along axis 0), into one array: no per-column copies
+    smooth = median_filter(x, size=(cfg.despike_samples, 1), mode="nearest") \
+        if cfg.despike_samples > 1 else x
+    ranges: list[tuple[int, int]] = []
+    for lo, hi in _true_runs(_steady(t, smooth, cfg)):
+        ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
+    return sorted(ranges)
+
+
 def sample_levels(tension_n: ArrayLike) -> Array:
     """Each sample's level (N): its largest tendon tension (``tension_n`` (n,) for one tendon or
     (n, J)); see the module docstring."""
@@ -182,12 +208,7 @@ def detect_steps(stamps_s: Array, tension_n: Array, settings: StepSettings | Non
     if t.size < 2:
         return []
     x = np.asarray(tension_n, dtype=float).reshape(t.size, -1)
-    smooth = np.column_stack([median_filter(column, size=cfg.despike_samples, mode="nearest")
-                              for column in x.T]) if cfg.despike_samples > 1 else x
-    ranges: list[tuple[int, int]] = []
-    for lo, hi in _true_runs(_steady(t, smooth, cfg)):
-        ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
-    ranges.sort()
+    ranges = _hold_ranges(t, x, cfg)
     medians = [tuple(float(np.median(column)) for column in x[a:b].T) for a, b in ranges]
     levels = sample_levels(x)
     previous_stops = [0, *(b for _, b in ranges)][:len(ranges)]

@@ -25,7 +25,6 @@ from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linear_sum_assignment
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.mocap.errors import LabelError
@@ -238,6 +237,9 @@ class ArcLengthLabeller:
         gap = np.linalg.norm(base[:, None, :] - self.label_points[None], axis=2)
         cost = np.where(gap <= self.max_distance,
                         np.abs(s[:, None] - self.arc_lengths[None]), _UNREACHABLE)
+        # scipy on use only: the mocap face imports this module
+        from scipy.optimize import linear_sum_assignment
+
         rows, cols = linear_sum_assignment(cost)
         chosen = {self.labels[c]: candidates[r] for r, c in zip(rows, cols, strict=True)
                   if cost[r, c] < _UNREACHABLE}

@@ -18,7 +18,6 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.mocap.errors import LabelError
@@ -49,6 +48,9 @@ def given_registration(translation: Sequence[float], *, quaternion: Sequence[flo
         if angles.shape != (3,) or not np.all(np.isfinite(angles)):
             raise out_of_range("registration.rpy", list(rpy), "3 finite angles", unit="rad",
                                error=RegistrationError)
+        # scipy on use only: the mocap face imports this module
+        from scipy.spatial.transform import Rotation
+
         quaternion = tuple(Rotation.from_euler("xyz", angles).as_quat())
     assert quaternion is not None  # given, or made from rpy: exactly one of them is (above)
     return Registration(tuple(translation), tuple(quaternion))

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import InputError, out_of_range
 
@@ -75,12 +74,18 @@ class Registration:
     def from_matrix(cls, rotation: ArrayLike, translation: ArrayLike, *, method: str = "given",
                     residual_m: float = 0.0) -> Registration:
         """From a rotation matrix (3, 3) (columns: base axes in ``mocap``) and a translation (m)."""
+        # scipy on use only: the mocap face imports this module
+        from scipy.spatial.transform import Rotation
+
         quat = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_quat()
         return cls(tuple(np.asarray(translation, dtype=float)), tuple(quat), method, residual_m)
 
     @property
     def rotation(self) -> Array:
         """Rotation matrix (3, 3) whose columns are the ``tdcm_base`` axes in ``mocap``."""
+        # scipy on use only: the mocap face imports this module
+        from scipy.spatial.transform import Rotation
+
         return Rotation.from_quat(self.quaternion).as_matrix()
 
     def to_base(self, points_mocap: ArrayLike) -> Array:

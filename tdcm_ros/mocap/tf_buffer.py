@@ -19,15 +19,17 @@ import bisect
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial.transform import Rotation
 
 from tdcm_ros.errors import InputError, out_of_range
 from tdcm_ros.mocap.errors import MocapError
 from tdcm_ros.mocap.registration import Registration, RegistrationError
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation
 
 Array = NDArray[np.float64]
 
@@ -66,6 +68,9 @@ class _Pose:
 
     @classmethod
     def identity(cls) -> _Pose:
+        # scipy on use only: the mocap face imports this module
+        from scipy.spatial.transform import Rotation
+
         return cls(Rotation.identity(), np.zeros(3))
 
 
@@ -115,6 +120,9 @@ class TransformBuffer:
         except RegistrationError as error:
             raise TransformLookupError(f"{edge_name}: {error}", parameter=edge_name,
                                        value=error.value, allowed=error.allowed) from error
+        # scipy on use only: the mocap face imports this module
+        from scipy.spatial.transform import Rotation
+
         edge = _Edge(parent, Rotation.from_quat(pose.quaternion), np.asarray(pose.translation))
         if static:
             self._dynamic.pop(child, None)
@@ -179,6 +187,9 @@ class TransformBuffer:
             return before
         f = (stamp_s - stamps[i - 1]) / (stamps[i] - stamps[i - 1])
         turn = (before.rotation.inv() * after.rotation).as_rotvec()
+        # scipy on use only: the mocap face imports this module
+        from scipy.spatial.transform import Rotation
+
         return _Edge(before.parent, before.rotation * Rotation.from_rotvec(f * turn),
                      before.translation + f * (after.translation - before.translation))
 
@@ -195,7 +206,7 @@ class TransformBuffer:
         """The pose of ``frame`` in itself and in each ancestor at ``stamp_s``, walking up until
         the root or a frame in ``stop``; an edge that cannot be read ends the walk, and its
         error is returned with the poses found below it."""
-        poses = {frame: _Pose(Rotation.identity(), np.zeros(3))}
+        poses = {frame: _Pose.identity()}
         name, pose = frame, poses[frame]
         while stop is None or name not in stop:
             try:

@@ -101,3 +101,15 @@ def test_settings_for_a_hold_shrink_only_below_the_defaults() -> None:
     t, x = staircase([0.0, 4.0, 8.0, 12.0], hold_s=1.0, trials=1, rate_hz=500.0, lag_s=0.05)
     assert len(detect_steps(t, x)) < 4
     assert [round(s.median_n) for s in detect_steps(t, x, short)] == [0, 4, 8, 12, 0]
+
+
+@pytest.mark.parametrize("block", [1, 37, 1000])
+def test_steadiness_taken_block_by_block_finds_the_same_steps(
+        monkeypatch: pytest.MonkeyPatch, block: int) -> None:
+    """The steadiness window (0.25 s: 125 samples) straddles the blocks' edges."""
+    rng = np.random.default_rng(3)
+    t, first = staircase([0.0, 4.0, 9.0, 13.0], hold_s=2.5, trials=2, rate_hz=500.0, lag_s=0.1)
+    x = np.column_stack([first, 0.5 * first]) + rng.normal(0.0, 0.05, (t.size, 2))
+    whole = detect_steps(t, x)  # the series fits in one block
+    monkeypatch.setattr("tdcm_ros.metrics.steps._STEADY_BLOCK", block)
+    assert len(whole) == 9 and detect_steps(t, x) == whole
