@@ -21,6 +21,7 @@ from tdcm_ros.model.grid import (
     gauss_legendre,
     partial_weights,
 )
+from tdcm_ros.model.grid_layout import Members
 from tdcm_ros.model.section import notched_moment
 
 PER_CELL = ("s_nodes", "is_notch", "notch_index", "shape", "seg_start", "seg_length", "u_a", "u_b",
@@ -188,6 +189,23 @@ def test_many_design_build_equals_each_single_build_bit_for_bit(designs, routing
         assert np.all(stack.constrained[m, pad]) and not np.any(stack.is_notch[m, pad])
         assert np.all(stack.notch_left_node[m, design.N:] == n)
     assert np.array_equal(stack.gauss_u, build_grid(designs[0], cfg).gauss_u)
+
+
+@settings(max_examples=25, deadline=None)
+@given(designs=st.lists(st.builds(
+    lambda n, w_n, w_d, w_o, r_inner: preset("paper-experiment").with_overrides(
+        N=n, w_n=w_n * MM, w_d=w_d * MM, w_o=min(w_o, 1.95 - w_d / 2) * MM,
+        r_inner=r_inner * MM),
+    st.integers(1, 9), st.floats(0.5, 3.0), st.floats(0.3, 3.8),
+    st.sampled_from([0.0, 0.2, 0.8, 1.9]), st.sampled_from([0.0, 1.55])), min_size=1,
+    max_size=5))
+def test_members_of_uniform_designs_equal_each_designs_own_faces_and_length(designs):
+    members = Members.of(designs)  # the vectorised uniform layout
+    for m, design in enumerate(designs):
+        assert members.length[m] == design.length
+        faces = members.notch_open[m]
+        assert np.array_equal(faces[:, :design.N], design.open_faces())
+        assert not np.any(faces[:, design.N:])
 
 
 def test_many_design_build_with_mixed_custom_profiles():
