@@ -546,7 +546,8 @@ def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
     ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
     gauss_u, gauss_w = gauss_legendre(quad_order)
     nested = partials == NESTED
-    weights = np.zeros((quad_order, 0)) if nested else partial_weights(quad_order)
+    weights, nodes = (np.zeros((quad_order, 0)), np.zeros(0, np.int64)) if nested else \
+        partial_weights(quad_order)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
     owner = members.shape_member
     design = np.concatenate([np.stack(
@@ -565,8 +566,8 @@ def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
 
     def integrate(part: slice) -> None:
         build.cell_integrals(shape[part], cell[part], design, custom_row[part],
-                             custom_table, gauss_u, gauss_w, matrix, weights, probe, fc[part],
-                             fq[part], strain[part])
+                             custom_table, gauss_u, gauss_w, matrix, weights, nodes, probe,
+                             fc[part], fq[part], strain[part])
 
     ends = np.linspace(0, count, workers + 1).astype(int)
     parts = [slice(int(a), int(b)) for a, b in pairwise(ends)]
@@ -633,16 +634,16 @@ def _integration_matrix(quad_order: int) -> Array:
 
 
 @lru_cache(maxsize=32)
-def partial_weights(quad_order: int) -> Array:
-    """The interpolated rule's weights ``W`` (Q, Q + PEAK_SAMPLES) on [0, 1]: ``int_0^{u_q} f
-    du = sum_j W[q, j] f(x_j)`` for every polynomial ``f`` of degree below the number of nodes
-    ``x_j`` used, the ``Q`` Gauss-Legendre points ``u_q`` then the even-numbered probes (every
-    other of the ``PEAK_SAMPLES`` equally spaced ones, 9 for 17) at least
-    ``PARTIAL_NODE_SPACING`` from every Gauss point (the odd ones and the others get weight 0):
-    for ``Q = 6`` 15 nodes, exact to degree 14 where the nested rule is to degree 11, with no
-    evaluation beyond the Gauss points and probes the cell needs anyway. Solved in the Legendre
-    basis; ``sum_j |W[q, j]|`` stays below 8 for every ``Q`` in 1-32 (rounding is not
-    amplified)."""
+def partial_weights(quad_order: int) -> tuple[Array, IntArray]:
+    """The interpolated rule: weights ``W`` (Q, K) on [0, 1] and its nodes (K,), numbered as
+    the cell's Gauss points (0 to Q - 1) then probes (Q on): ``int_0^{u_q} f du = sum_k
+    W[q, k] f(x_k)`` for every polynomial ``f`` of degree below K. The nodes are the ``Q``
+    Gauss-Legendre points ``u_q`` and the even-numbered probes (every other of the
+    ``PEAK_SAMPLES`` equally spaced ones, 9 of 17) at least ``PARTIAL_NODE_SPACING`` from every
+    Gauss point: for ``Q = 6`` 15 nodes, exact to degree 14 where the nested rule is to degree
+    11, with no evaluation beyond the Gauss points and probes the cell needs anyway. Solved in
+    the Legendre basis; ``sum_k |W[q, k]|`` stays below 8 for every ``Q`` in 1-32 (rounding is
+    not amplified)."""
     gauss_u, _ = gauss_legendre(quad_order)
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
     near = np.min(np.abs(probe[:, None] - gauss_u[None, :]), axis=1) < PARTIAL_NODE_SPACING
@@ -651,13 +652,12 @@ def partial_weights(quad_order: int) -> Array:
     legendre = np.polynomial.legendre
     basis = np.linalg.solve(legendre.legvander(2.0 * nodes - 1.0, nodes.size - 1),
                             np.eye(nodes.size))
-    on_nodes = 0.5 * legendre.legval(2.0 * gauss_u - 1.0,
-                                     legendre.legint(basis, lbnd=-1.0)).T
-    weights = np.zeros((quad_order, quad_order + PEAK_SAMPLES))
-    weights[:, :quad_order] = on_nodes[:, :quad_order]
-    weights[:, quad_order + np.flatnonzero(used)] = on_nodes[:, quad_order:]
-    weights.setflags(write=False)
-    return weights
+    on_nodes = np.ascontiguousarray(0.5 * legendre.legval(2.0 * gauss_u - 1.0,
+                                                          legendre.legint(basis, lbnd=-1.0)).T)
+    index = np.concatenate([np.arange(quad_order), quad_order + np.flatnonzero(used)])
+    on_nodes.setflags(write=False)
+    index.setflags(write=False)
+    return on_nodes, index
 
 
 @dataclass(frozen=True, eq=False)

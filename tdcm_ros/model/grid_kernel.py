@@ -230,7 +230,8 @@ def points(cell: Array, gauss_u: Array, probe: Array, nested: bool, out: Array) 
 
 def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
                    custom_table: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
-                   partial: Array, probe: Array, fc: Array, fq: Array, strain: Array) -> None:
+                   partial: Array, partial_node: Ints, probe: Array, fc: Array, fq: Array,
+                   strain: Array) -> None:
     """Every integral of each cell (module docstring) into ``fc`` (cells, 11) and ``fq``
     (cells, 13, Q); ``strain`` (cells, 2, probes) gets the bending-strain coefficients
     ``(1 - xi, xi) c fibre`` at the probes of notch cells (0 elsewhere; ``fibre`` from the
@@ -239,10 +240,10 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
 
     The partial integrals ``A0``, ``A1``, ``D_Q`` from the cell's start to each Gauss point
     take one of two rules: ``partial`` of shape (Q, 0) selects the *nested* one (a Q-point
-    Gauss rule on each ``[u_a, u_q]``: Q * Q more evaluations); ``partial`` of shape
-    (Q, Q + probes) is the *interpolated* one, weights on [0, 1] of the values at the Gauss
-    points then at the probes (:func:`tdcm_ros.model.grid.partial_weights`: no evaluation
-    beyond those).
+    Gauss rule on each ``[u_a, u_q]``: Q * Q more evaluations); ``partial`` of shape (Q, K)
+    is the *interpolated* one, weights on [0, 1] of the values at the nodes ``partial_node``
+    (K,), columns of the cell's Gauss points (0 to Q - 1) then probes (Q on)
+    (:func:`tdcm_ros.model.grid.partial_weights`: no evaluation beyond those).
 
     Where a notch's backbone is off the axis (``w_o``): ``XB_START``, ``XB_END`` are the
     centroid's offset ``x_bar`` at the cell's ends, about which its end moments are taken, and
@@ -295,7 +296,7 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
             _nested_partials(notch, d, seg_length, u_a, span, start, length, x_a, x_b,
                              gauss_u, gauss_w, custom[q_count:first], out)
         else:
-            _interpolated_partials(span, x_a, x_b, partial, node, out)
+            _interpolated_partials(span, x_a, x_b, partial, partial_node, node, out)
         _weights_and_chords(c[CHORD] != 0.0, c[SPAN] / total if total > 0.0 else 0.0,
                             gauss_w, matrix, out, fc[i])
         whole = 0.0
@@ -362,17 +363,19 @@ def _nested_partials(notch: bool, d: Array, seg_length: float, u_a: float, span:
         out[D_Q, q] = d0
 
 
-def _interpolated_partials(span: float, x_a: float, x_b: float, partial: Array, node: Array,
-                           out: Array) -> None:
+def _interpolated_partials(span: float, x_a: float, x_b: float, partial: Array,
+                           partial_node: Ints, node: Array, out: Array) -> None:
     """The interpolated rule: ``A0``, ``A1`` and ``D_Q`` (rad/(N m)) of one cell from its
     values at the Gauss points and probes ``node`` (rows ``N_JAC``, ``N_XI``, ``N_C``,
-    ``N_XB``) and the weights ``partial`` (Q, Q + probes) on [0, 1], into ``out``."""
+    ``N_XB``), of which the weights ``partial`` (Q, K) on [0, 1] take columns
+    ``partial_node`` (K,), into ``out``."""
     for q in range(partial.shape[0]):
         a0 = 0.0
         a1 = 0.0
         d0 = 0.0
-        for j in range(partial.shape[1]):
-            ds = span * partial[q, j] * node[N_JAC, j]
+        for k in range(partial.shape[1]):
+            j = partial_node[k]
+            ds = span * partial[q, k] * node[N_JAC, j]
             xi = node[N_XI, j]
             c_j = node[N_C, j]
             a0 += ds * (1.0 - xi) * c_j

@@ -21,7 +21,7 @@ from tdcm_ros.model.grid import (
     gauss_legendre,
     partial_weights,
 )
-from tdcm_ros.model.grid_layout import Members
+from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members
 from tdcm_ros.model.section import notched_moment
 
 PER_CELL = ("s_nodes", "is_notch", "notch_index", "shape", "seg_start", "seg_length", "u_a", "u_b",
@@ -220,11 +220,11 @@ def test_many_design_build_with_mixed_custom_profiles():
 
 @pytest.mark.parametrize("quad_order", range(1, 33))
 def test_interpolated_partial_weights_are_exact_and_do_not_amplify_rounding(quad_order):
-    weights = partial_weights(quad_order)
+    weights, index = partial_weights(quad_order)
     gauss_u, _ = gauss_legendre(quad_order)
-    nodes = np.concatenate([gauss_u, np.linspace(0.0, 1.0, weights.shape[1] - quad_order)])
-    used = np.any(weights != 0.0, axis=0)
-    degree = int(used.sum()) - 1
+    nodes = np.concatenate([gauss_u, np.linspace(0.0, 1.0, PEAK_SAMPLES)])[index]
+    assert np.array_equal(index[:quad_order], np.arange(quad_order))  # every Gauss point
+    degree = index.size - 1
     assert degree >= min(2 * quad_order - 1, 8)  # at least the nested rule's, up to 8
     assert np.max(np.sum(np.abs(weights), axis=1)) < 8.0
     for power in (0, degree // 2, degree):  # int_0^u x^p dx, polynomial of the rule's degree
