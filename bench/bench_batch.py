@@ -44,6 +44,8 @@ from results import BenchResults, Column, add_results_argument
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "NUMEXPR_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
 MM = 1e-3
+#: ``tdcm_ros.model.grid.INTERPOLATED``, spelled here: a baseline checkout may predate it.
+INTERPOLATED = "interpolated"
 
 
 def paper_like(count: int, rng: Any) -> list[Any]:
@@ -97,7 +99,6 @@ def workloads(args: argparse.Namespace) -> dict[str, tuple[int, Callable[[], obj
 
     from tdcm_ros.model import SolverSettings
     from tdcm_ros.model.batch import solve_batch
-    from tdcm_ros.model.grid import INTERPOLATED
 
     settings = SolverSettings()
     rng = np.random.default_rng(2024)
@@ -117,7 +118,7 @@ def workloads(args: argparse.Namespace) -> dict[str, tuple[int, Callable[[], obj
         "many2": (args.many, lambda: solve_batch(many, many_t, settings=settings, workers=2),
                   True),
         "manyi": (args.many, lambda: solve_batch(many, many_t, settings=settings,
-                                                 partials=INTERPOLATED), True),
+                                                 partials=INTERPOLATED), True),  # this checkout
     }
 
 
@@ -145,9 +146,8 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
 
     from tdcm_ros.model import SolverSettings, solve
     from tdcm_ros.model.batch import solve_batch
-    from tdcm_ros.model.grid import INTERPOLATED
 
-    if args.throughput_only:
+    if args.throughput_only:  # also in a baseline checkout: its API only
         measured = throughputs(args, ["space", "many"], 1)
         print(measured["space cpu"][0], measured["many cpu"][0])
         print(measured["space"][0], measured["many"][0])
@@ -286,12 +286,7 @@ def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
 
     from tdcm_ros.model import SolverSettings
     from tdcm_ros.model.batch import CHUNK, _KernelArrays, _Stack, solve_batch
-    from tdcm_ros.model.grid import (
-        INTERPOLATED,
-        NESTED,
-        _prototype_integrals,
-        grid_parts,
-    )
+    from tdcm_ros.model.grid import NESTED, _prototype_integrals, grid_parts
     from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members, cell_table, prototypes
 
     settings = SolverSettings()

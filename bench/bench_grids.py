@@ -32,14 +32,7 @@ from results import BenchResults, Column, add_results_argument
 
 from tdcm_ros.model import SolverSettings, preset
 from tdcm_ros.model.design import MM
-from tdcm_ros.model.grid import (
-    INTERPOLATED,
-    NESTED,
-    PARTIAL_RULES,
-    build_grid,
-    build_grids,
-    clear_grid_cache,
-)
+from tdcm_ros.model.grid import build_grid, build_grids, clear_grid_cache
 from tdcm_ros.model.grid_layout import PEAK_SAMPLES
 
 CASES = (("default (adaptive), paper", SolverSettings()),
@@ -98,7 +91,10 @@ def compare(args: argparse.Namespace, results: BenchResults) -> None:
 
 def rules(designs: list, repeat: int, results: BenchResults) -> None:
     """``build_grids`` grids per CPU second of every case under each partial-integral rule,
-    interleaved (best of ``repeat``), and their ratio."""
+    interleaved (best of ``repeat``), and their ratio (this checkout only: a ``--baseline``
+    one may predate the rules)."""
+    from tdcm_ros.model.grid import INTERPOLATED, NESTED, PARTIAL_RULES
+
     rows: list[list[object]] = []
     for label, settings in CASES:
         times: dict[str, list[float]] = {rule: [] for rule in PARTIAL_RULES}
