@@ -111,6 +111,7 @@ class Query(NamedTuple):
     k2_r: Array
     wa_r: Array
 
+NESTED, INTERPOLATED = "nested", "interpolated"
 #: Rules for the partial integrals ``A0``, ``A1``, ``D_Q`` from a cell's start to its Gauss
 #: points (:func:`tdcm_ros.model.grid_kernel.cell_integrals`): ``nested``, a Gauss rule on each
 #: ``[a, s_q]`` (Q * Q more compliance evaluations per cell: :func:`build_grid`, the single
@@ -118,7 +119,6 @@ class Query(NamedTuple):
 #: on the values the cell has at its Gauss points and probes (no further evaluation; a batch
 #: opts in with ``solve_batch(..., partials="interpolated")``: its answers then differ from the
 #: single solve's within the grid's accuracy, ``bench/grid_accuracy.py``).
-NESTED, INTERPOLATED = "nested", "interpolated"
 PARTIAL_RULES = (NESTED, INTERPOLATED)
 #: Nearest a probe may be to a Gauss point (in the cell's ``u`` on [0, 1]) to be a node of the
 #: interpolated rule (nearer, the interpolation's weights grow: :func:`partial_weights`).
