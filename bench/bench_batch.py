@@ -8,7 +8,10 @@ Workloads (default solver settings, whose tip error against a converged referenc
 - design space: ``designs`` paper-like designs (w_n x w_d around the paper's, fixed pitch,
   L = 53 mm) x ``tensions`` tensions in 0-20 N, grids already built (what a sweep costs once
   the design grid exists) and cold (grid building included);
-- many designs: one tension per design, grid building included (the worst case).
+- many designs: one tension per design, grid building included (the worst case); also with
+  the grids' partial integrals by the interpolated rule (``partials="interpolated"``: 25
+  compliance evaluations per notch cell instead of 61, tips within the grid's accuracy of the
+  single solve's; ``bench/grid_accuracy.py``).
 
 Both are also timed with two worker threads (``workers=2``). Every workload is timed in
 ``--rounds`` interleaved rounds (best of ``--repeat`` each): medians, spreads and the
@@ -19,8 +22,8 @@ many-design cases in the same run: it and this checkout alternate in fresh proce
 ``--rounds`` rounds and the per-round ratios are printed. ``--breakdown`` prints only the CPU
 time of the many-design case's steps.
 
-Tip error: the batch against single solves at the same settings (should be ~1e-17 m), and
-against converged single solves (128 cells per notch, 16 per tube, 12-point quadrature,
+Tip error: the batch against single solves at the same settings (should be ~1e-17 m; with
+interpolated partial integrals ~1e-10 m), and against converged single solves (128 cells per notch, 16 per tube, 12-point quadrature,
 tol 1e-14 m) on a sample of points. Timings are best of ``repeat``. ``--results FILE`` also
 writes the printed figures as tables to a results file (``bench/results.py``).
 """
@@ -41,6 +44,8 @@ from results import BenchResults, Column, add_results_argument
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                     "NUMEXPR_NUM_THREADS", "VECLIB_MAXIMUM_THREADS")
 MM = 1e-3
+#: ``tdcm_ros.model.grid.INTERPOLATED``, spelled here: a baseline checkout may predate it.
+INTERPOLATED = "interpolated"
 
 
 def paper_like(count: int, rng: Any) -> list[Any]:
@@ -112,6 +117,8 @@ def workloads(args: argparse.Namespace) -> dict[str, tuple[int, Callable[[], obj
         "many": (args.many, lambda: solve_batch(many, many_t, settings=settings), True),
         "many2": (args.many, lambda: solve_batch(many, many_t, settings=settings, workers=2),
                   True),
+        "manyi": (args.many, lambda: solve_batch(many, many_t, settings=settings,
+                                                 partials=INTERPOLATED), True),  # this checkout
     }
 
 
@@ -140,7 +147,7 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
     from tdcm_ros.model import SolverSettings, solve
     from tdcm_ros.model.batch import solve_batch
 
-    if args.throughput_only:
+    if args.throughput_only:  # also in a baseline checkout: its API only
         measured = throughputs(args, ["space", "many"], 1)
         print(measured["space cpu"][0], measured["many cpu"][0])
         print(measured["space"][0], measured["many"][0])
@@ -153,7 +160,8 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
                                (args.designs, args.tensions))
     count = tensions.size
     result = solve_batch(designs, tensions, settings=settings)
-    names = ["space", "space2", "cold", "many", "many2"]
+    interpolated = solve_batch(designs, tensions, settings=settings, partials=INTERPOLATED)
+    names = ["space", "space2", "cold", "many", "many2", "manyi"]
     measured = throughputs(args, names, args.rounds)
     single_n = 200
     pairs = [(designs[i % args.designs], float(tensions[0, (7 * i) % args.tensions]))
@@ -166,9 +174,14 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
     picks += [(i, args.tensions - 1) for i in range(min(4, args.designs))]
     same = max(float(np.max(np.abs(solve(designs[i], tensions[i, k], settings=settings)
                                    .tip_position - result.tip_position[i, k]))) for i, k in picks)
-    converged = [float(np.linalg.norm(solve(designs[i], tensions[i, k], settings=reference)
-                                      .tip_position - result.tip_position[i, k]))
-                 for i, k in picks]
+    fine = {(i, k): solve(designs[i], tensions[i, k], settings=reference).tip_position
+            for i, k in picks}
+    converged = [float(np.linalg.norm(fine[i, k] - result.tip_position[i, k])) for i, k in picks]
+    same_i = max(float(np.max(np.abs(solve(designs[i], tensions[i, k], settings=settings)
+                                     .tip_position - interpolated.tip_position[i, k])))
+                 for i, k in picks)
+    converged_i = [float(np.linalg.norm(fine[i, k] - interpolated.tip_position[i, k]))
+                   for i, k in picks]
 
     def per_round(two: str, one: str) -> list[float]:
         return [b / a for a, b in zip(measured[one], measured[two], strict=True)]
@@ -191,10 +204,16 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
           f"(per CPU second: {spread(measured['many cpu'])})")
     print(f"  two workers  : {spread(measured['many2'])}; per round "
           f"{ratio_spread(per_round('many2', 'many'))} one worker")
+    print(f"  interpolated partial integrals: {spread(measured['manyi'])} (per CPU second: "
+          f"{spread(measured['manyi cpu'])}); per round "
+          f"{ratio_spread(per_round('manyi', 'many'))} nested")
     print(f"single solve() loop          : {single_n / single_time:10.0f} solves/s")
     print(f"tip error vs single solve, same settings ({len(picks)} points): {same:.2e} m")
     print(f"tip error vs converged reference: max {max(converged) * 1e6:.3f} um, "
           f"median {np.median(converged) * 1e6:.3f} um (target <= 1 um)")
+    print(f"interpolated partial integrals: tip error vs single solve {same_i:.2e} m, vs "
+          f"converged reference max {max(converged_i) * 1e6:.3f} um, median "
+          f"{np.median(converged_i) * 1e6:.3f} um")
     if results is None:
         return
     space = f"design space {args.designs} designs × {args.tensions} tensions"
@@ -212,6 +231,8 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
          [f"{space}, incl. grids", 1, *stats(measured["cold"]), *stats(measured["cold cpu"])],
          [f"{many}, incl. grids", 1, *stats(measured["many"]), *stats(measured["many cpu"])],
          [f"{many}, incl. grids", 2, *stats(measured["many2"]), None, None, None],
+         [f"{many}, incl. grids, interpolated partial integrals", 1, *stats(measured["manyi"]),
+          *stats(measured["manyi cpu"])],
          [f"single solve() loop, {single_n} solves", 1, single_n / single_time, None, None, None,
           None, None]],
         note=f"settings: cells_per_notch={settings.cells_per_notch}, quad_order="
@@ -228,12 +249,21 @@ def run(args: argparse.Namespace, results: BenchResults | None = None) -> None:
         [[space, *stats(per_round("space2", "space"))],
          [many, *stats(per_round("many2", "many"))]])
     results.table(
+        "Interpolated partial integrals against nested, per round (wall)",
+        [Column("workload"), Column("interpolated / nested", format=".2f"),
+         Column("min", format=".2f"), Column("max", format=".2f")],
+        [[many, *stats(per_round("manyi", "many"))]])
+    results.table(
         "Tip error of the batch",
         [Column("against"), Column("points"), Column("max", "m", ".2e"),
          Column("median", "m", ".2e")],
         [["single solves, same settings", len(picks), same, None],
          [("converged single solves (128 cells per notch, 16 per tube, quadrature order 12, "
-           "tol 1e-14 m)"), len(picks), max(converged), float(np.median(converged))]])
+           "tol 1e-14 m)"), len(picks), max(converged), float(np.median(converged))],
+         ["interpolated partial integrals: single solves, same settings", len(picks), same_i,
+          None],
+         ["interpolated partial integrals: converged single solves", len(picks),
+          max(converged_i), float(np.median(converged_i))]])
 
 
 def throughput_in(checkout: Path, args: argparse.Namespace
@@ -256,7 +286,7 @@ def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
 
     from tdcm_ros.model import SolverSettings
     from tdcm_ros.model.batch import CHUNK, _KernelArrays, _Stack, solve_batch
-    from tdcm_ros.model.grid import _prototype_integrals, grid_parts
+    from tdcm_ros.model.grid import NESTED, _prototype_integrals, grid_parts
     from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members, cell_table, prototypes
 
     settings = SolverSettings()
@@ -281,28 +311,37 @@ def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
         ("Members.of (collect, check rigidity)", lambda: Members.of(many)),
         ("prototypes + cell_table (layout)",
          lambda: cell_table(prototypes(members, *layout), settings.routing)),
-        ("grid kernel (cell_integrals)", lambda: _prototype_integrals(proto, settings.quad_order)),
+        ("grid kernel (cell_integrals)",
+         lambda: _prototype_integrals(proto, settings.quad_order, NESTED)),
+        ("grid kernel, interpolated partial integrals",
+         lambda: _prototype_integrals(proto, settings.quad_order, INTERPOLATED)),
         ("kernel arrays + strain per chunk (gathers)", lambda: gathers(parts))]
     print(f"many designs {args.many} x 1: CPU time (process_time), best of {args.repeat}")
-    kernel_ms = 0.0
+    kernel_ms: dict[str, float] = {}
     rows = []
     for label, call in steps:
         call()
         ms = best_time(call, args.repeat, False, process_time) * 1e3
-        kernel_ms = ms if label.startswith("grid kernel") else kernel_ms
+        if label.startswith("grid kernel"):
+            kernel_ms[NESTED if "(" in label else INTERPOLATED] = ms
         print(f"  {label:<44} {ms:7.1f} ms")
         rows.append([label, ms])
     q = settings.quad_order
-    points = int(np.sum(proto.is_notch)) * (q + q * q + PEAK_SAMPLES + 2)
-    print(f"  grid kernel: {points / args.many:.0f} notch compliance points per design, "
-          f"{kernel_ms * 1e6 / points:.1f} ns each (tube cells included in the time), "
-          f"{kernel_ms * 1e3 / args.many:.1f} us per design")
+    cells = int(np.sum(proto.is_notch))
+    kernel_rows = []
+    for rule, per_cell in ((NESTED, q + q * q + PEAK_SAMPLES + 2),
+                           (INTERPOLATED, q + PEAK_SAMPLES + 2)):
+        points, ms = cells * per_cell, kernel_ms[rule]
+        print(f"  grid kernel, {rule}: {points / args.many:.0f} notch compliance points per "
+              f"design, {ms * 1e6 / points:.1f} ns each (tube cells included in the time), "
+              f"{ms * 1e3 / args.many:.1f} us per design")
+        kernel_rows.append([rule, points / args.many, ms * 1e6 / points, ms * 1e3 / args.many])
     results.table(f"Many designs ({args.many} × 1 tension): CPU time per step, best of "
                   f"{args.repeat}", [Column("step"), Column("CPU time", "ms", ".1f")], rows)
-    results.table("Grid kernel per design",
-                  [Column("notch compliance points per design", format=".0f"),
+    results.table("Grid kernel per design, by partial-integral rule",
+                  [Column("rule"), Column("notch compliance points per design", format=".0f"),
                    Column("per point", "ns", ".1f"), Column("per design", "µs", ".1f")],
-                  [[points / args.many, kernel_ms * 1e6 / points, kernel_ms * 1e3 / args.many]],
+                  kernel_rows,
                   note="tube cells included in the time")
 
 

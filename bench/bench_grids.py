@@ -8,8 +8,11 @@ different, so no cache helps; the grid cache is cleared before each single-desig
 Single-threaded; times are CPU time of the process (``time.process_time``), which other jobs
 on shared cores disturb far less than wall time. ``--baseline`` times ``build_grids`` of another checkout (e.g. main) in the
 same run: it and this checkout alternate in fresh processes for ``--rounds`` rounds and the
-per-round ratios are printed (median and range). ``--results FILE`` also writes the printed
-figures as tables to a results file (``bench/results.py``).
+per-round ratios are printed (median and range). The two rules for the cells' partial integrals
+(:data:`tdcm_ros.model.grid.PARTIAL_RULES`: ``nested``, the default and the single solve's, and
+``interpolated``, no compliance evaluation beyond each cell's Gauss points and probes) are
+timed against each other in the same process, interleaved. ``--results FILE`` also writes the
+printed figures as tables to a results file (``bench/results.py``).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from results import BenchResults, Column, add_results_argument
 from tdcm_ros.model import SolverSettings, preset
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.grid import build_grid, build_grids, clear_grid_cache
+from tdcm_ros.model.grid_layout import PEAK_SAMPLES
 
 CASES = (("default (adaptive), paper", SolverSettings()),
          ("default (adaptive), free", SolverSettings(routing="free")),
@@ -85,6 +89,42 @@ def compare(args: argparse.Namespace, results: BenchResults) -> None:
          Column("max", format=".2f")], rows)
 
 
+def rules(designs: list, repeat: int, results: BenchResults) -> None:
+    """``build_grids`` grids per CPU second of every case under each partial-integral rule,
+    interleaved (best of ``repeat``), and their ratio (this checkout only: a ``--baseline``
+    one may predate the rules)."""
+    from tdcm_ros.model.grid import INTERPOLATED, NESTED, PARTIAL_RULES
+
+    rows: list[list[object]] = []
+    for label, settings in CASES:
+        times: dict[str, list[float]] = {rule: [] for rule in PARTIAL_RULES}
+        for rule in PARTIAL_RULES:
+            build_grids(designs, settings, partials=rule)
+        for _ in range(repeat):
+            for rule in PARTIAL_RULES:
+                start = time.process_time()
+                build_grids(designs, settings, partials=rule)
+                times[rule].append(time.process_time() - start)
+        nested, interpolated = (len(designs) / min(times[r]) for r in (NESTED, INTERPOLATED))
+        q = settings.quad_order
+        print(f"{label:<28} nested {nested:8.0f}  interpolated {interpolated:8.0f} grids per CPU s"
+              f"  ratio {interpolated / nested:.2f}x  (points per notch cell "
+              f"{q + q * q + PEAK_SAMPLES + 2} -> {q + PEAK_SAMPLES + 2})")
+        rows.append([label, q + q * q + PEAK_SAMPLES + 2, nested, q + PEAK_SAMPLES + 2,
+                     interpolated, interpolated / nested])
+    rate = ",.0f"
+    results.table(
+        f"build_grids of {len(designs):,} designs by partial-integral rule, in one process",
+        [Column("grid"), Column("nested: points per notch cell"),
+         Column("nested: grids per CPU s", format=rate),
+         Column("interpolated: points per notch cell"),
+         Column("interpolated: grids per CPU s", format=rate),
+         Column("ratio", format=".2f")], rows,
+        note=f"CPU time of the process (process_time), best of {repeat}, the two rules "
+             "interleaved; nested is the default (the single solve's grid), interpolated is "
+             "solve_batch(..., partials='interpolated')")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--designs", type=int, default=2000)
@@ -134,6 +174,7 @@ def main() -> None:
          Column("ratio", format=".1f")], rows,
         note=f"CPU time of the process (process_time), best of {args.repeat}; the grid cache is "
              "cleared before each single-design pass")
+    rules(designs, args.repeat, results)
     if args.results:
         results.write(args.results)
 

@@ -45,6 +45,7 @@ from tdcm_ros.model.errors import (
     TensionRangeError,
 )
 from tdcm_ros.model.grid import (
+    NESTED,
     PEAK_SAMPLES,
     Grid,
     GridParts,
@@ -184,7 +185,8 @@ class _Stack:
 
 
 def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
-                settings: SolverSettings = DEFAULT_SETTINGS, workers: int = 1) -> BatchResult:
+                settings: SolverSettings = DEFAULT_SETTINGS, workers: int = 1,
+                partials: str = NESTED) -> BatchResult:
     """Solve every design at its tensions (N); ``tensions`` has shape ``(len(designs), ...)``,
     with a last axis of one tension per tendon where the designs list ``k > 1`` tendons
     (``(len(designs), ..., k)``).
@@ -193,16 +195,22 @@ def solve_batch(designs: Sequence[Design], tensions: ArrayLike, *,
     row of tensions (a design-space grid). Results have the members' shape (``tensions``'
     less the tendon axis).
     ``workers`` threads build the grids and iterate chunks of members at once (the compiled
-    kernels release the GIL); the answers do not depend on it. The same as
-    ``prepare_batch(designs, ...).solve(tensions)``.
+    kernels release the GIL); the answers do not depend on it. ``partials`` is the grid's
+    rule for its partial integrals (:data:`~tdcm_ros.model.grid.PARTIAL_RULES`): ``nested``
+    (the single solve's: the same answers), or ``interpolated`` (no compliance evaluation
+    beyond the Gauss points and probes, 25 instead of 61 per notch cell at the default
+    quadrature order: tips within ~1e-9 m of the single solve's at the default settings,
+    ``bench/grid_accuracy.py``). The same as ``prepare_batch(designs, ...).solve(tensions)``.
     """
-    return prepare_batch(designs, settings=settings, workers=workers).solve(tensions)
+    return prepare_batch(designs, settings=settings, workers=workers,
+                         partials=partials).solve(tensions)
 
 
 def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAULT_SETTINGS,
-                  workers: int = 1) -> BatchGrids:
-    """Build the grids of ``designs`` once, for :meth:`BatchGrids.solve` to solve them at any
-    tensions, as often as needed (a search that solves the same designs in rounds)."""
+                  workers: int = 1, partials: str = NESTED) -> BatchGrids:
+    """Build the grids of ``designs`` once (partial integrals by the rule ``partials``, see
+    :func:`solve_batch`), for :meth:`BatchGrids.solve` to solve them at any tensions, as often
+    as needed (a search that solves the same designs in rounds)."""
     designs = list(designs)
     for i, design in enumerate(designs):
         if not isinstance(design, Design):
@@ -221,7 +229,7 @@ def prepare_batch(designs: Sequence[Design], *, settings: SolverSettings = DEFAU
             parameter="workers", value=workers, allowed=f"integer in [1, {MAX_WORKERS}]")
     compiled = np.array([d for d, design in enumerate(designs) if _kernel_takes(design, settings)],
                         np.int64)
-    valid, parts, invalid = _grids([designs[d] for d in compiled], settings, workers)
+    valid, parts, invalid = _grids([designs[d] for d in compiled], settings, workers, partials)
     stacks = [] if parts is None else [(compiled[valid[rows]], stack)
                                        for rows, stack in _Stack.split(parts, settings)]
     single = np.setdiff1d(np.arange(len(designs)), compiled)
@@ -390,13 +398,14 @@ class _Outcome:
             iterations=self.iterations.reshape(shape), fallback=self.fallback.reshape(shape))
 
 
-def _grids(designs: list[Design], settings: SolverSettings, workers: int
+def _grids(designs: list[Design], settings: SolverSettings, workers: int, partials: str
            ) -> tuple[NDArray[np.int64], GridParts | None, dict[int, InvalidDesignError]]:
-    """The designs whose grids build, their grids built at once by ``workers`` threads, and
-    the others' errors (each design is checked alone only if the whole set is refused)."""
+    """The designs whose grids build, their grids built at once by ``workers`` threads (partial
+    integrals by the rule ``partials``), and the others' errors (each design is checked alone
+    only if the whole set is refused)."""
     valid = np.arange(len(designs))
     try:
-        return valid, grid_parts(designs, settings, workers) if designs else None, {}
+        return valid, grid_parts(designs, settings, workers, partials) if designs else None, {}
     except InvalidDesignError:
         pass
     kept, invalid = [], {}
@@ -408,7 +417,8 @@ def _grids(designs: list[Design], settings: SolverSettings, workers: int
             continue
         kept.append(d)
     valid = np.array(kept, np.int64)
-    parts = grid_parts([designs[d] for d in kept], settings, workers) if kept else None
+    parts = grid_parts([designs[d] for d in kept], settings, workers, partials) if kept \
+        else None
     return valid, parts, invalid
 
 

@@ -42,7 +42,7 @@ from tdcm_ros.model.profiles import (
     profile_from_name,
 )
 from tdcm_ros.model.section import tube_moment
-from tdcm_ros.model.sections import OFFSET_SLACK, keeps_wall
+from tdcm_ros.model.sections import OFFSET_SLACK, open_faces
 from tdcm_ros.model.tendons import Tendon, check_tendons
 from tdcm_ros.spec import Spec, check_fields, spec_field, specs_of, spelled_as
 
@@ -61,6 +61,12 @@ Lengths = float | tuple[float, ...]
 #: Notch profiles whose section carries no width profile to integrate a material law over.
 _WIDTHLESS_PROFILES = (SectionProfile, SlicedProfile)
 
+
+def uniform_length(w_base: Any, n: Any, w_n: Any, w_t: Any, w_tip: Any) -> Any:
+    """Eq. 1's total length ``L`` (m) of a uniform design (``n`` notches of width ``w_n``,
+    tubes ``w_t`` between them, m), of floats or of arrays of many designs (the same
+    floating-point operations either way)."""
+    return w_base + n * w_n + (n - 1) * w_t + w_tip
 
 @dataclass(frozen=True)
 class Design:
@@ -220,9 +226,7 @@ class Design:
         surface on the +x side (row 0) and the -x side (row 1), i.e. whether the cut opens there
         (the section's material, ``w_o +- w_d/2`` at the notch centre, does not keep the wall:
         :func:`tdcm_ros.model.sections.keeps_wall`)."""
-        w_d, w_o = self.per_notch("w_d"), self.per_notch("w_o")
-        return ~np.stack([keeps_wall(w_o + 0.5 * w_d, self.R_outer),
-                          keeps_wall(0.5 * w_d - w_o, self.R_outer)])
+        return open_faces(self.per_notch("w_d"), self.per_notch("w_o"), self.R_outer)
 
     def _count(self, name: str) -> int:
         """How many values a per-notch (N) or per-gap (N - 1) field holds when it is a list."""
@@ -271,8 +275,8 @@ class Design:
     def length(self) -> float:
         """Total length ``L`` (m), eq. 1 (sums of the per-notch values where there are lists)."""
         if self.is_uniform:
-            return self.w_base + self.N * self.uniform("w_n") + (self.N - 1) * self.uniform(
-                "w_t") + self.w_tip
+            return uniform_length(self.w_base, self.N, self.uniform("w_n"), self.uniform("w_t"),
+                                  self.w_tip)
         return float(self._ends()[-1] + self.w_tip)
 
     def notch_bounds(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

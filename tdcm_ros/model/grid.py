@@ -69,7 +69,7 @@ from tdcm_ros.model.cells import (
 )
 from tdcm_ros.model.compiled import grid_kernels
 from tdcm_ros.model.design import Design
-from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
 from tdcm_ros.model.grid_kernel import (
     CIRCULAR,
     CUSTOM,
@@ -110,6 +110,19 @@ class Query(NamedTuple):
     k1_r: Array
     k2_r: Array
     wa_r: Array
+
+NESTED, INTERPOLATED = "nested", "interpolated"
+#: Rules for the partial integrals ``A0``, ``A1``, ``D_Q`` from a cell's start to its Gauss
+#: points (:func:`tdcm_ros.model.grid_kernel.cell_integrals`): ``nested``, a Gauss rule on each
+#: ``[a, s_q]`` (Q * Q more compliance evaluations per cell: :func:`build_grid`, the single
+#: solve's grid, and the default of every build), and ``interpolated``, :func:`partial_weights`
+#: on the values the cell has at its Gauss points and probes (no further evaluation; a batch
+#: opts in with ``solve_batch(..., partials="interpolated")``: its answers then differ from the
+#: single solve's within the grid's accuracy, ``bench/grid_accuracy.py``).
+PARTIAL_RULES = (NESTED, INTERPOLATED)
+#: Nearest a probe may be to a Gauss point (in the cell's ``u`` on [0, 1]) to be a node of the
+#: interpolated rule (nearer, the interpolation's weights grow: :func:`partial_weights`).
+PARTIAL_NODE_SPACING = 0.005
 
 #: Distinct query station sets a grid keeps (see :meth:`Grid.query`).
 QUERY_CACHE_SIZE = 8
@@ -328,7 +341,8 @@ class Grid(CellArrays):
                           u_a=self.u_a[cells], u_b=self.u_of_s(cells, s), start=start,
                           length=self.length[cells], seg_length=self.seg_length[cells],
                           u_end=self.u_b[cells], span=s - self.s_nodes[cells])
-        fc, fq, _ = _integrals(self.members, self.shape[cells], cell, self.gauss_u.size)
+        fc, fq, _ = _integrals(self.members, self.shape[cells], cell, self.gauss_u.size,
+                               NESTED)
         fc, fq = fc[:-1], fq[:-1]
         k = grid_kernel
         w_r = fq[:, k.W_Q]
@@ -394,7 +408,7 @@ _on_clear: list[Callable[[], None]] = []
 def _build_grid(design: Design, routing: str, kind: str, cells_per_notch: int,
                 cells_per_tube: int, quad_order: int, compressible: bool) -> Grid:
     parts = GridParts.of(Members.of([design]), routing, kind, cells_per_notch,
-                         cells_per_tube, quad_order)
+                         cells_per_tube, quad_order, NESTED)
     grid = parts.stack(np.zeros(1, np.int64)).grid(0)
     if compressible:  # each Gauss point's shortening per newton: w_q / (E A)
         cells = np.arange(grid.n_cells)
@@ -425,12 +439,14 @@ class GridParts:
 
     @classmethod
     def of(cls, members: Members, routing: str, kind: str, cells_per_notch: int,
-           cells_per_tube: int, quad_order: int, workers: int = 1) -> GridParts:
+           cells_per_tube: int, quad_order: int, partials: str, workers: int = 1
+           ) -> GridParts:
         """Lay out and integrate every member's cells (``members`` already checked) with
-        ``workers`` threads."""
+        ``workers`` threads, the partial integrals by the rule ``partials``
+        (:data:`PARTIAL_RULES`)."""
         table = cell_table(prototypes(members, routing, kind, cells_per_notch, cells_per_tube),
                            routing)
-        fc, fq, strain = _prototype_integrals(table.prototypes, quad_order, workers)
+        fc, fq, strain = _prototype_integrals(table.prototypes, quad_order, partials, workers)
         return cls(members=members, table=table, proto_fc=fc, proto_fq=fq,
                    proto_strain=strain, gauss_u=gauss_legendre(quad_order)[0],
                    gauss_w=gauss_legendre(quad_order)[1])
@@ -513,15 +529,16 @@ class GridParts:
                      scal=scal)
 
 
-def _prototype_integrals(table: Prototypes, quad_order: int, workers: int = 1
+def _prototype_integrals(table: Prototypes, quad_order: int, partials: str, workers: int = 1
                          ) -> tuple[Array, Array, Array]:
     """:class:`GridParts`' ``proto_fc``, ``proto_fq``, ``proto_strain`` of every prototype cell
-    of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row;
-    ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
+    of ``table`` (``s_q``, ``peak_s`` from its segment's start), and the zero padding row, the
+    partial integrals by the rule ``partials``; ``workers`` threads share the cells (the
+    compiled kernel releases the GIL)."""
     cell = _cell_rows(is_notch=table.is_notch, chord=table.chord, u_a=table.u_a, u_b=table.u_b,
                       start=table.a, length=table.length, seg_length=table.seg_length,
                       u_end=table.u_b, span=table.length)
-    return _integrals(table.members, table.shape, cell, quad_order, workers)
+    return _integrals(table.members, table.shape, cell, quad_order, partials, workers)
 
 
 def _cell_rows(**columns: NDArray[Any]) -> Array:
@@ -533,11 +550,15 @@ def _cell_rows(**columns: NDArray[Any]) -> Array:
 
 
 def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
-               workers: int = 1) -> tuple[Array, Array, Array]:
+               partials: str, workers: int = 1) -> tuple[Array, Array, Array]:
     """:func:`tdcm_ros.model.grid_kernel.cell_integrals` of the cells ``cell`` (its columns)
     of notch shapes ``shape`` (rows of ``members``), followed by a zero row: ``fc``, ``fq``,
-    ``strain``; ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
+    ``strain``, the partial integrals by the rule ``partials`` (:data:`PARTIAL_RULES`);
+    ``workers`` threads share the cells (the compiled kernel releases the GIL)."""
     gauss_u, gauss_w = gauss_legendre(quad_order)
+    nested = partials == NESTED
+    weights, nodes = (np.zeros((quad_order, 0)), np.zeros(0, np.int64)) if nested else \
+        partial_weights(quad_order)
     kinds = np.array([_PROFILE_KIND.get(p.name, CUSTOM) for p in members.profiles], float)
     owner = members.shape_member
     design = np.concatenate([np.stack(
@@ -547,7 +568,7 @@ def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
     build = grid_kernels()
     probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
     custom_row, custom_table = _custom_table(members, shape, build, cell, design, gauss_u,
-                                             probe)
+                                             probe, nested)
     count = shape.size
     fc = np.zeros((count + 1, 11))
     fq = np.zeros((count + 1, 13, quad_order))
@@ -556,8 +577,8 @@ def _integrals(members: Members, shape: IntArray, cell: Array, quad_order: int,
 
     def integrate(part: slice) -> None:
         build.cell_integrals(shape[part], cell[part], design, custom_row[part],
-                             custom_table, gauss_u, gauss_w, matrix, probe, fc[part], fq[part],
-                             strain[part])
+                             custom_table, gauss_u, gauss_w, matrix, weights, nodes, probe,
+                             fc[part], fq[part], strain[part])
 
     ends = np.linspace(0, count, workers + 1).astype(int)
     parts = [slice(int(a), int(b)) for a, b in pairwise(ends)]
@@ -574,22 +595,23 @@ _PROFILE_KIND = {"circular": CIRCULAR, "rectangular": RECTANGULAR, "polygon": PR
 
 
 def _custom_table(members: Members, shape: IntArray, build: Any, cell: Array, design: Array,
-                  gauss_u: Array, probe: Array) -> tuple[IntArray, Array]:
+                  gauss_u: Array, probe: Array, nested: bool) -> tuple[IntArray, Array]:
     """For cells ``cell`` (of notch shapes ``shape``) in notches of user profiles
     (:data:`CUSTOM`) and of sections changing along the notch (:data:`TABULATED`): a row each
     of the custom table (-1 for the others) holding, at every evaluation point of
     :func:`tdcm_ros.model.grid_kernel.points`, ``h1`` (m; then two zeros), or ``1/(E I)``
-    (1/(N m^2)), ``x_bar`` (m) and the farthest fibre (m)."""
+    (1/(N m^2)), ``x_bar`` (m) and the farthest fibre (m); the nested points only for the
+    ``nested`` rule."""
     kind = design[shape, 0]
     is_notch = cell[:, grid_kernel.IS_NOTCH] != 0.0
     chosen = np.flatnonzero(((kind == CUSTOM) | (kind == TABULATED)) & is_notch)
     rows = np.full(shape.size, -1, np.int64)
-    size = gauss_u.size * (gauss_u.size + 1) + probe.size + 2
+    size = gauss_u.size * ((gauss_u.size if nested else 0) + 1) + probe.size + 2
     out = np.zeros((chosen.size, size, 3))
     if chosen.size:
         rows[chosen] = np.arange(chosen.size)
         u = np.empty((chosen.size, size))
-        build.points(np.ascontiguousarray(cell[chosen]), gauss_u, probe, u)
+        build.points(np.ascontiguousarray(cell[chosen]), gauss_u, probe, nested, u)
         chosen_shape = shape[chosen]
         custom = kind[chosen] == CUSTOM
         if np.any(custom):
@@ -620,6 +642,33 @@ def _integration_matrix(quad_order: int) -> Array:
                         dtype=np.float64)
     matrix.setflags(write=False)
     return matrix
+
+
+@lru_cache(maxsize=32)
+def partial_weights(quad_order: int) -> tuple[Array, IntArray]:
+    """The interpolated rule: weights ``W`` (Q, K) on [0, 1] and its nodes (K,), numbered as
+    the cell's Gauss points (0 to Q - 1) then probes (Q on): ``int_0^{u_q} f du = sum_k
+    W[q, k] f(x_k)`` for every polynomial ``f`` of degree below K. The nodes are the ``Q``
+    Gauss-Legendre points ``u_q`` and the even-numbered probes (every other of the
+    ``PEAK_SAMPLES`` equally spaced ones, 9 of 17) at least ``PARTIAL_NODE_SPACING`` from every
+    Gauss point: for ``Q = 6`` 15 nodes, exact to degree 14 where the nested rule is to degree
+    11, with no evaluation beyond the Gauss points and probes the cell needs anyway. Solved in
+    the Legendre basis; ``sum_k |W[q, k]|`` stays below 8 for every ``Q`` in 1-32 (rounding is
+    not amplified)."""
+    gauss_u, _ = gauss_legendre(quad_order)
+    probe = np.linspace(0.0, 1.0, PEAK_SAMPLES)
+    near = np.min(np.abs(probe[:, None] - gauss_u[None, :]), axis=1) < PARTIAL_NODE_SPACING
+    used = (np.arange(PEAK_SAMPLES) % 2 == 0) & ~near
+    nodes = np.concatenate([gauss_u, probe[used]])
+    legendre = np.polynomial.legendre
+    basis = np.linalg.solve(legendre.legvander(2.0 * nodes - 1.0, nodes.size - 1),
+                            np.eye(nodes.size))
+    on_nodes = np.ascontiguousarray(0.5 * legendre.legval(2.0 * gauss_u - 1.0,
+                                                          legendre.legint(basis, lbnd=-1.0)).T)
+    index = np.concatenate([np.arange(quad_order), quad_order + np.flatnonzero(used)])
+    on_nodes.setflags(write=False)
+    index.setflags(write=False)
+    return on_nodes, index
 
 
 @dataclass(frozen=True, eq=False)
@@ -662,17 +711,24 @@ class GridStack(CellArrays):
                     gauss_w=self.gauss_w, cells=cells, **per_cell)
 
 
-def build_grids(designs: Sequence[Design], settings: SolverSettings) -> GridStack:
-    """Grids of many designs at once (:class:`GridParts`); see :class:`GridStack`."""
-    return grid_parts(designs, settings).stack(np.arange(len(designs)))
+def build_grids(designs: Sequence[Design], settings: SolverSettings,
+                partials: str = NESTED) -> GridStack:
+    """Grids of many designs at once (:class:`GridParts`), the partial integrals by the rule
+    ``partials`` (:data:`PARTIAL_RULES`; ``nested``, the default, gives :func:`build_grid`'s
+    bits); see :class:`GridStack`."""
+    return grid_parts(designs, settings, partials=partials).stack(np.arange(len(designs)))
 
 
-def grid_parts(designs: Sequence[Design], settings: SolverSettings, workers: int = 1
-               ) -> GridParts:
+def grid_parts(designs: Sequence[Design], settings: SolverSettings, workers: int = 1,
+               partials: str = NESTED) -> GridParts:
     """The :class:`GridParts` of ``designs`` under ``settings``' grid (at least one design),
-    integrated by ``workers`` threads (the same values for any count)."""
+    integrated by ``workers`` threads (the same values for any count), the partial integrals
+    by the rule ``partials`` (:data:`PARTIAL_RULES`)."""
     if len(designs) == 0:
         raise out_of_range("number of designs", 0, "[1, inf)", error=InvalidDesignError)
+    if partials not in PARTIAL_RULES:
+        raise out_of_range("partials", partials, " or ".join(PARTIAL_RULES),
+                           error=InvalidSettingsError)
     return GridParts.of(Members.of(designs), settings.routing, settings.grid,
                         settings.cells_per_notch, settings.cells_per_tube, settings.quad_order,
-                        workers)
+                        partials, workers)

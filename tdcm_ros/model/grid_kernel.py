@@ -24,8 +24,9 @@ centroidal ``I`` (m^4), centroid ``x_bar`` (m) and farthest fibre (m) in the las
 columns, unused by the other kinds; ``sigma`` linear in ``u``) and :data:`TABULATED` (a
 section changing along the notch, given at every point: ``1/(E I)`` (1/(N m^2)), ``x_bar``
 and the farthest fibre (m) in ``custom[custom_row[i], p, :]``; ``sigma`` linear in ``u``).
-Every cell is evaluated at ``Q`` Gauss points, ``Q * Q`` nested points (``Q`` per Gauss
-point, for the partial integrals ``A0``, ``A1``), ``PEAK_SAMPLES`` equally spaced probes and
+Every cell is evaluated at ``Q`` Gauss points, under the *nested* rule ``Q * Q`` nested points
+(``Q`` per Gauss point, for the partial integrals ``A0``, ``A1``; the *interpolated* rule
+takes them from the other points' values instead), ``PEAK_SAMPLES`` equally spaced probes and
 its whole cell's two ends ``u_a``, ``u_end``, in that order (:func:`points`).
 """
 
@@ -54,6 +55,10 @@ C0, C1, C0_T, C1_T, C_START, C_END, PEAK_C, PEAK_S, XB_START, XB_END, D_CELL = r
 """Columns of the per-cell output ``fc`` (cells, 11)."""
 S_Q, W_Q, XI_Q, C_Q, A0, A1, A0_T, A1_T, XB_Q, K0, K1, D_Q, K2 = range(13)
 """Rows of the per-Gauss-point output ``fq`` (cells, 13, Q)."""
+N_JAC, N_XI, N_C, N_XB = range(4)
+NODE_ROWS = 4
+"""Rows of a cell's values at its Gauss points and probes (the interpolated rule's nodes):
+``ds/du`` (m), ``xi``, ``c`` (1/(N m^2)), ``x_bar`` (m)."""
 
 _NODES, _WEIGHTS = np.polynomial.legendre.leggauss(24)
 STRIP_NODES = 0.5 * (_NODES + 1.0)
@@ -202,20 +207,21 @@ def point(notch: bool, d: Array, seg_length: float, u: float, custom: Array
     return sigma, jac, 1.0 / (d[E] * inertia), x_bar, fibre
 
 
-def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
+def points(cell: Array, gauss_u: Array, probe: Array, nested: bool, out: Array) -> None:
     """Reference coordinates ``u`` of every evaluation point of each cell (cells, P): Gauss
-    points, nested points, probes, ends (module docstring)."""
+    points, nested points (only for the ``nested`` rule), probes, ends (module docstring)."""
     q_count = gauss_u.shape[0]
+    first = q_count + (q_count * q_count if nested else 0)
     for i in range(cell.shape[0]):
         u_a = cell[i, U_A]
         span = cell[i, U_B] - u_a
         for q in range(q_count):
             u_q = u_a + span * gauss_u[q]
             out[i, q] = u_q
-            inner = u_q - u_a
-            for k in range(q_count):
-                out[i, q_count + q * q_count + k] = u_a + inner * gauss_u[k]
-        first = q_count + q_count * q_count
+            if nested:
+                inner = u_q - u_a
+                for k in range(q_count):
+                    out[i, q_count + q * q_count + k] = u_a + inner * gauss_u[k]
         for k in range(probe.shape[0]):
             out[i, first + k] = u_a + span * probe[k]
         out[i, first + probe.shape[0]] = u_a
@@ -224,12 +230,20 @@ def points(cell: Array, gauss_u: Array, probe: Array, out: Array) -> None:
 
 def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
                    custom_table: Array, gauss_u: Array, gauss_w: Array, matrix: Array,
-                   probe: Array, fc: Array, fq: Array, strain: Array) -> None:
+                   partial: Array, partial_node: Ints, probe: Array, fc: Array, fq: Array,
+                   strain: Array) -> None:
     """Every integral of each cell (module docstring) into ``fc`` (cells, 11) and ``fq``
     (cells, 13, Q); ``strain`` (cells, 2, probes) gets the bending-strain coefficients
     ``(1 - xi, xi) c fibre`` at the probes of notch cells (0 elsewhere; ``fibre`` from the
     centroid to the farthest material, ``min(h1, R_outer)`` for the paper's section).
     ``matrix`` (Q, Q) is the Gauss points' partial-integration matrix on [0, 1].
+
+    The partial integrals ``A0``, ``A1``, ``D_Q`` from the cell's start to each Gauss point
+    take one of two rules: ``partial`` of shape (Q, 0) selects the *nested* one (a Q-point
+    Gauss rule on each ``[u_a, u_q]``: Q * Q more evaluations); ``partial`` of shape (Q, K)
+    is the *interpolated* one, weights on [0, 1] of the values at the nodes ``partial_node``
+    (K,), columns of the cell's Gauss points (0 to Q - 1) then probes (Q on)
+    (:func:`tdcm_ros.model.grid.partial_weights`: no evaluation beyond those).
 
     Where a notch's backbone is off the axis (``w_o``): ``XB_START``, ``XB_END`` are the
     centroid's offset ``x_bar`` at the cell's ends, about which its end moments are taken, and
@@ -241,8 +255,12 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
     (m/m): ``K0``, ``K1``, ``K2`` are ``w_q x_bar c`` times ``1 - xi``, ``xi`` and ``dx``, and
     its ds weight is ``w_q + m_a K0 + m_b K1 - T K2``."""
     q_count = gauss_u.shape[0]
-    first = q_count + q_count * q_count
-    no_custom = np.zeros((first + probe.shape[0] + 2, custom_table.shape[2]))
+    p_count = probe.shape[0]
+    nested = partial.shape[1] == 0
+    first = q_count + (q_count * q_count if nested else 0)
+    ends = first + p_count
+    no_custom = np.zeros((ends + 2, custom_table.shape[2]))
+    node = np.empty((NODE_ROWS, q_count + p_count))
     for i in range(cell.shape[0]):
         d = design[shape[i]]
         c = cell[i]
@@ -254,7 +272,6 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
         start = c[START]
         length = c[LENGTH]
         out = fq[i]
-        ends = first + probe.shape[0]
         _, _, fc[i, C_START], x_a, _ = point(notch, d, seg_length, u_a, custom[ends])
         _, _, fc[i, C_END], x_b, _ = point(notch, d, seg_length, c[U_END], custom[ends + 1])
         fc[i, XB_START] = x_a
@@ -269,21 +286,17 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
             out[XI_Q, q] = (sigma - start) / length
             out[C_Q, q] = c_q
             out[XB_Q, q] = x_bar
-            inner = u_q - u_a
-            a0 = 0.0
-            a1 = 0.0
-            d0 = 0.0
-            for k in range(q_count):
-                s_k, jac_k, c_k, x_k, _ = point(notch, d, seg_length, u_a + inner * gauss_u[k],
-                                                custom[q_count + q * q_count + k])
-                ds = inner * gauss_w[k] * jac_k
-                xi = (s_k - start) / length
-                a0 += ds * (1.0 - xi) * c_k
-                a1 += ds * xi * c_k
-                d0 += ds * c_k * (x_k - ((1.0 - xi) * x_a + xi * x_b))
-            out[A0, q] = a0
-            out[A1, q] = a1
-            out[D_Q, q] = d0
+            node[N_JAC, q] = jac
+            node[N_XI, q] = out[XI_Q, q]
+            node[N_C, q] = c_q
+            node[N_XB, q] = x_bar
+        _probes(notch, d, seg_length, u_a, span, start, length, probe, custom[first:ends],
+                q_count, node, fc[i], strain[i])
+        if nested:
+            _nested_partials(notch, d, seg_length, u_a, span, start, length, x_a, x_b,
+                             gauss_u, gauss_w, custom[q_count:first], out)
+        else:
+            _interpolated_partials(span, x_a, x_b, partial, partial_node, node, out)
         _weights_and_chords(c[CHORD] != 0.0, c[SPAN] / total if total > 0.0 else 0.0,
                             gauss_w, matrix, out, fc[i])
         whole = 0.0
@@ -297,18 +310,80 @@ def cell_integrals(shape: Ints, cell: Array, design: Array, custom_row: Ints,
             out[K2, q] = stretch * off
             whole += w_c * off
         fc[i, D_CELL] = whole
-        peak = -1.0
-        for k in range(probe.shape[0]):
-            s_k, _, c_k, _, fibre = point(notch, d, seg_length, u_a + span * probe[k],
-                                          custom[first + k])
-            if c_k > peak:
-                peak = c_k
-                fc[i, PEAK_C] = c_k
-                fc[i, PEAK_S] = s_k
-            weight = c_k * fibre
+
+
+def _probes(notch: bool, d: Array, seg_length: float, u_a: float, span: float, start: float,
+            length: float, probe: Array, custom: Array, column: int, node: Array, fc: Array,
+            strain: Array) -> None:
+    """One cell's values at its probes ``u_a + span probe[k]``: the peak compliance
+    ``PEAK_C`` (1/(N m^2)) and where it is ``PEAK_S`` (m from the segment start) into ``fc``,
+    the strain coefficients into ``strain`` (2, probes), and ``ds/du`` (m), ``xi``, ``c`` and
+    ``x_bar`` (m) into ``node[:, column + k]`` (``custom``: the probes' rows of the custom
+    table)."""
+    peak = -1.0
+    for k in range(probe.shape[0]):
+        s_k, jac_k, c_k, x_k, fibre = point(notch, d, seg_length, u_a + span * probe[k],
+                                            custom[k])
+        if c_k > peak:
+            peak = c_k
+            fc[PEAK_C] = c_k
+            fc[PEAK_S] = s_k
+        weight = c_k * fibre
+        xi = (s_k - start) / length
+        strain[0, k] = (1.0 - xi) * weight
+        strain[1, k] = xi * weight
+        node[N_JAC, column + k] = jac_k
+        node[N_XI, column + k] = xi
+        node[N_C, column + k] = c_k
+        node[N_XB, column + k] = x_k
+
+
+def _nested_partials(notch: bool, d: Array, seg_length: float, u_a: float, span: float,
+                     start: float, length: float, x_a: float, x_b: float, gauss_u: Array,
+                     gauss_w: Array, custom: Array, out: Array) -> None:
+    """The nested rule: ``A0``, ``A1`` (rad/(N m)) and ``D_Q`` (rad/(N m)) of one cell by a
+    Gauss rule on each ``[u_a, u_q]`` into ``out`` (``custom``: the nested points' rows of
+    the custom table)."""
+    q_count = gauss_u.shape[0]
+    for q in range(q_count):
+        inner = (u_a + span * gauss_u[q]) - u_a
+        a0 = 0.0
+        a1 = 0.0
+        d0 = 0.0
+        for k in range(q_count):
+            s_k, jac_k, c_k, x_k, _ = point(notch, d, seg_length, u_a + inner * gauss_u[k],
+                                            custom[q * q_count + k])
+            ds = inner * gauss_w[k] * jac_k
             xi = (s_k - start) / length
-            strain[i, 0, k] = (1.0 - xi) * weight
-            strain[i, 1, k] = xi * weight
+            a0 += ds * (1.0 - xi) * c_k
+            a1 += ds * xi * c_k
+            d0 += ds * c_k * (x_k - ((1.0 - xi) * x_a + xi * x_b))
+        out[A0, q] = a0
+        out[A1, q] = a1
+        out[D_Q, q] = d0
+
+
+def _interpolated_partials(span: float, x_a: float, x_b: float, partial: Array,
+                           partial_node: Ints, node: Array, out: Array) -> None:
+    """The interpolated rule: ``A0``, ``A1`` and ``D_Q`` (rad/(N m)) of one cell from its
+    values at the Gauss points and probes ``node`` (rows ``N_JAC``, ``N_XI``, ``N_C``,
+    ``N_XB``), of which the weights ``partial`` (Q, K) on [0, 1] take columns
+    ``partial_node`` (K,), into ``out``."""
+    for q in range(partial.shape[0]):
+        a0 = 0.0
+        a1 = 0.0
+        d0 = 0.0
+        for k in range(partial.shape[1]):
+            j = partial_node[k]
+            ds = span * partial[q, k] * node[N_JAC, j]
+            xi = node[N_XI, j]
+            c_j = node[N_C, j]
+            a0 += ds * (1.0 - xi) * c_j
+            a1 += ds * xi * c_j
+            d0 += ds * c_j * (node[N_XB, j] - ((1.0 - xi) * x_a + xi * x_b))
+        out[A0, q] = a0
+        out[A1, q] = a1
+        out[D_Q, q] = d0
 
 
 def _weights_and_chords(chord: bool, scale: float, gauss_w: Array, matrix: Array,
@@ -365,5 +440,6 @@ def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
 
 KERNELS = ("disc_strip_moment", "notched_inertia", "notched_inertias", "notch_compliance",
            "disc_strip", "offset_section", "geometry", "profile_points", "point", "points",
-           "_weights_and_chords", "cell_integrals", "gather")
+           "_weights_and_chords", "_probes", "_nested_partials",
+           "_interpolated_partials", "cell_integrals", "gather")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.model.design import Design
+from tdcm_ros.model.design import Design, uniform_length
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import (
     PRISMATIC_PROFILES,
@@ -34,6 +34,7 @@ from tdcm_ros.model.profiles import (
     SlicedProfile,
 )
 from tdcm_ros.model.section import notched_moment
+from tdcm_ros.model.sections import open_faces
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -132,8 +133,13 @@ class Members:
         layout = _uniform_layout(designs, n, w_base, w_tip, profiles) if uniform else \
             _general_layout(designs, n, profiles)
         notch_open = np.zeros((n.size, 2, int(n.max())), np.int64)
-        for m, design in enumerate(designs):
-            notch_open[m, :, :design.N] = design.open_faces()
+        if uniform:  # one notch shape per member: every notch opens alike
+            faces = open_faces(layout["shape_w_d"], layout["shape_w_o"], r_outer).T
+            notch_open[...] = faces[:, :, None] & (np.arange(notch_open.shape[2]) < n[:, None]
+                                                   )[:, None, :]
+        else:
+            for m, design in enumerate(designs):
+                notch_open[m, :, :design.N] = design.open_faces()
         kept = tuple(profiles.profiles)
         owner = layout["shape_member"]
         section = np.zeros((owner.size, 3))
@@ -146,11 +152,10 @@ class Members:
                       w_base=w_base, w_tip=w_tip, R_outer=r_outer, r_inner=r_inner,
                       R_c=column("R_c"), E=column("E"),
                       tube_moment=np.pi / 4.0 * (r_outer**4 - r_inner**4),
-                      length=np.array([d.length for d in designs], dtype=float),
                       notch_open=notch_open, shape_section=section, **layout)
-        for design in designs:
-            if any(isinstance(p, CustomProfile) for p in design.notch_profiles()):
-                _check_custom_profile(design)
+        custom = np.array([isinstance(p, CustomProfile) for p in kept], bool)
+        for m in np.unique(owner[custom[layout["profile_of"]]]):
+            _check_custom_profile(designs[m])
         _check_rigidity(members)
         return members
 
@@ -199,8 +204,8 @@ class _ProfileIndex:
 
 def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_tip: Array,
                     profiles: _ProfileIndex) -> dict[str, Any]:
-    """:class:`Members`' shape, kind and slot arrays of uniform designs, vectorised: one notch
-    shape per member, the kinds BASE, NOTCH, TUBE, TIP."""
+    """:class:`Members`' shape, kind and slot arrays and lengths (m) of uniform designs,
+    vectorised: one notch shape per member, the kinds BASE, NOTCH, TUBE, TIP."""
     count = n.size
     w_n = np.array([d.w_n for d in designs], dtype=float)
     w_t = np.array([d.w_t for d in designs], dtype=float)
@@ -220,12 +225,14 @@ def _uniform_layout(designs: tuple[Design, ...], n: IntArray, w_base: Array, w_t
             "kind_length": np.stack([w_base, w_n, np.where(n > 1, w_t, 0.0), w_tip], axis=1),
             "kind_is_notch": np.broadcast_to(np.arange(4) == NOTCH, (count, 4)),
             "kind_shape": np.repeat(every[:, None], 4, axis=1), "slot_kind": slot_kind,
-            "notch_left": left, "notch_right": left + w_n[:, None]}
+            "notch_left": left, "notch_right": left + w_n[:, None],
+            "length": uniform_length(w_base, n, w_n, w_t, w_tip)}
 
 
 def _general_layout(designs: tuple[Design, ...], n: IntArray, profiles: _ProfileIndex
                     ) -> dict[str, Any]:
-    """:class:`Members`' shape, kind and slot arrays of any designs (see :class:`Members`)."""
+    """:class:`Members`' shape, kind and slot arrays and lengths (m) of any designs (see
+    :class:`Members`)."""
     count, n_max = n.size, int(n.max())
     shapes: list[tuple[int, float, float, float, int]] = []
     kinds: list[list[tuple[float, bool, int]]] = []
@@ -270,7 +277,8 @@ def _general_layout(designs: tuple[Design, ...], n: IntArray, profiles: _Profile
             "kind_length": np.array([[k[0] for k in row] for row in padded], dtype=float),
             "kind_is_notch": np.array([[k[1] for k in row] for row in padded], dtype=bool),
             "kind_shape": np.array([[k[2] for k in row] for row in padded], np.int64),
-            "slot_kind": slot_kind, "notch_left": left_all, "notch_right": right_all}
+            "slot_kind": slot_kind, "notch_left": left_all, "notch_right": right_all,
+            "length": np.array([d.length for d in designs], dtype=float)}
 
 
 def per_row(values: NDArray[Any], u: Array) -> NDArray[Any]:

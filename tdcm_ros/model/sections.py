@@ -57,6 +57,16 @@ def keeps_wall(reach: ArrayLike, r_outer: ArrayLike) -> NDArray[np.bool_]:
     return np.asarray(np.asarray(reach) >= (1.0 - SURFACE_TOL) * np.asarray(r_outer))
 
 
+def open_faces(w_d: ArrayLike, w_o: ArrayLike, r_outer: ArrayLike) -> NDArray[np.bool_]:
+    """Whether a notch of backbone ``w_d`` (m) centred ``w_o`` (m) off the axis opens at the
+    outer surface of a tube of ``r_outer`` (m) on the +x side (first axis, row 0) and the -x
+    side (row 1): its section's material ``w_o +- w_d/2`` does not keep the wall there
+    (:func:`keeps_wall`); inputs broadcast."""
+    half = 0.5 * np.asarray(w_d)
+    offset = np.asarray(w_o)
+    return ~np.stack([keeps_wall(offset + half, r_outer), keeps_wall(half - offset, r_outer)])
+
+
 @dataclass(frozen=True, eq=False)
 class SectionProperties:
     """What a section gives the mechanics (SI units; see the module docstring)."""

@@ -85,6 +85,35 @@ def test_batch_equals_single_solves_on_random_designs(settings):
     assert sum(not d.is_uniform for d in designs) >= 5   # and holds per-notch designs
 
 
+CONVERGED = SolverSettings(cells_per_notch=32, cells_per_tube=8, quad_order=12, tol=1e-13,
+                           max_iter=1000)
+
+
+@pytest.mark.parametrize("settings", [SETTINGS[0], SETTINGS[1], SETTINGS[-1]],
+                         ids=["paper", "free", "coarse"])
+def test_interpolated_partials_stay_within_the_grids_accuracy_of_single_solves(settings):
+    # Default quadrature: within 2e-9 m of the single solve (nested partial integrals); a
+    # coarse one (order 2): the interpolated rule (degree 10) errs no more, worst member.
+    designs = random_designs(seed=7, count=12)
+    tensions = np.random.default_rng(3).uniform(0.0, 60.0, (12, 2))
+    result = solve_batch(designs, tensions, settings=settings, partials="interpolated")
+    errors: dict[str, list[float]] = {"batch": [], "single": []}
+    for i, design in enumerate(designs):
+        for k in range(tensions.shape[1]):
+            status, tip = single(design, tensions[i, k], settings)
+            assert result.status[i, k] == status, (i, k, result.message[i, k])
+            if tip is None:
+                continue
+            if settings.quad_order == SolverSettings().quad_order:
+                np.testing.assert_allclose(result.tip_position[i, k], tip, rtol=0, atol=2e-9)
+            else:
+                fine = solve(design, tensions[i, k], settings=CONVERGED).tip_position
+                errors["batch"].append(float(np.linalg.norm(result.tip_position[i, k] - fine)))
+                errors["single"].append(float(np.linalg.norm(tip - fine)))
+    if errors["batch"]:  # the worst member: no farther from the converged tip than the single
+        assert max(errors["batch"]) <= max(errors["single"]), errors
+
+
 def test_literal_loads_fall_back_to_single_solves():
     designs = [preset("paper-experiment"), preset("fig3-wd-1.2")]
     settings = SolverSettings(loads="literal")

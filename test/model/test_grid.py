@@ -6,12 +6,22 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scipy.integrate import quad
 
 from tdcm_ros.model import CustomProfile, SolverSettings, preset, solve
 from tdcm_ros.model.accuracy import converged_tip
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
-from tdcm_ros.model.grid import build_grid, build_grids, clear_grid_cache
+from tdcm_ros.model.grid import (
+    INTERPOLATED,
+    NESTED,
+    build_grid,
+    build_grids,
+    clear_grid_cache,
+    gauss_legendre,
+    partial_weights,
+)
+from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members
 from tdcm_ros.model.section import notched_moment
 
 PER_CELL = ("s_nodes", "is_notch", "notch_index", "shape", "seg_start", "seg_length", "u_a", "u_b",
@@ -159,7 +169,7 @@ per_notch_strategy = st.integers(2, 8).flatmap(lambda n: st.builds(
 def test_many_design_build_equals_each_single_build_bit_for_bit(designs, routing, kind,
                                                                quad_order):
     cfg = SolverSettings(routing=routing, grid=kind, quad_order=quad_order)
-    stack = build_grids(designs, cfg)
+    stack = build_grids(designs, cfg, partials=NESTED)
     width = int(stack.n_cells.max())
     for m, design in enumerate(designs):
         grid = build_grid(design, cfg)
@@ -181,19 +191,91 @@ def test_many_design_build_equals_each_single_build_bit_for_bit(designs, routing
     assert np.array_equal(stack.gauss_u, build_grid(designs[0], cfg).gauss_u)
 
 
+@settings(max_examples=25, deadline=None)
+@given(designs=st.lists(st.builds(
+    lambda n, w_n, w_d, w_o, r_inner: preset("paper-experiment").with_overrides(
+        N=n, w_n=w_n * MM, w_d=w_d * MM, w_o=min(w_o, 1.95 - w_d / 2) * MM,
+        r_inner=r_inner * MM),
+    st.integers(1, 9), st.floats(0.5, 3.0), st.floats(0.3, 3.8),
+    st.sampled_from([0.0, 0.2, 0.8, 1.9]), st.sampled_from([0.0, 1.55])), min_size=1,
+    max_size=5))
+def test_members_of_uniform_designs_equal_each_designs_own_faces_and_length(designs):
+    members = Members.of(designs)  # the vectorised uniform layout
+    for m, design in enumerate(designs):
+        assert members.length[m] == design.length
+        faces = members.notch_open[m]
+        assert np.array_equal(faces[:, :design.N], design.open_faces())
+        assert not np.any(faces[:, design.N:])
+
+
 def test_many_design_build_with_mixed_custom_profiles():
     base = preset("paper-experiment")
     designs = [base, base.with_overrides(profile=CustomProfile(lambda s: 0.0 * s + 1.0 * MM)),
                base.with_overrides(N=3, profile="rectangular")]
-    stack = build_grids(designs, SolverSettings())
+    stack = build_grids(designs, SolverSettings(), partials=NESTED)
     for m, design in enumerate(designs):
         grid = build_grid(design, SolverSettings())
         assert stack.A0[m, :grid.n_cells].tobytes() == grid.A0.tobytes()
 
 
+@pytest.mark.parametrize("quad_order", range(1, 33))
+def test_interpolated_partial_weights_are_exact_and_do_not_amplify_rounding(quad_order):
+    weights, index = partial_weights(quad_order)
+    gauss_u, _ = gauss_legendre(quad_order)
+    nodes = np.concatenate([gauss_u, np.linspace(0.0, 1.0, PEAK_SAMPLES)])[index]
+    assert np.array_equal(index[:quad_order], np.arange(quad_order))  # every Gauss point
+    degree = index.size - 1
+    assert degree >= min(2 * quad_order - 1, 8)  # at least the nested rule's, up to 8
+    assert np.max(np.sum(np.abs(weights), axis=1)) < 8.0
+    for power in (0, degree // 2, degree):  # int_0^u x^p dx, polynomial of the rule's degree
+        np.testing.assert_allclose(weights @ nodes**power, gauss_u**(power + 1) / (power + 1),
+                                   rtol=0.0, atol=1e-13)
+
+
+def circular_integrand(design, grid, cell):
+    """``(1 - xi) c ds/du`` and ``xi c ds/du`` (1/(N m)) of a notch cell of eq. 13's profile,
+    written out here (eq. 12's section by :func:`notched_moment`) as functions of ``u``."""
+    w_n, w_d = design.w_n, design.w_d
+    start = grid.s_nodes[cell] - grid.seg_start[cell]
+
+    def parts(u):
+        sigma = 0.5 * w_n * (1.0 - np.cos(np.pi * u))
+        jac = 0.5 * w_n * np.pi * np.sin(np.pi * u)
+        h1 = 0.5 * (w_n + w_d) - 0.5 * w_n * np.sin(np.pi * u)
+        c = 1.0 / (design.E * float(notched_moment(h1, design.R_outer, design.r_inner)))
+        xi = (sigma - start) / grid.length[cell]
+        return (1.0 - xi) * c * jac, xi * c * jac
+    return parts
+
+
+@settings(max_examples=12, deadline=None)
+@given(w_n=st.floats(0.8, 3.0), w_d=st.floats(0.6, 2.0), quad_order=st.sampled_from([4, 6, 8]))
+def test_interpolated_partial_integrals_are_as_accurate_as_nested_against_scipy(
+        w_n, w_d, quad_order):
+    design = preset("paper-experiment").with_overrides(N=1, w_n=w_n * MM, w_d=w_d * MM)
+    cfg = SolverSettings(quad_order=quad_order)
+    rules = {rule: build_grids([design], cfg, partials=rule) for rule in (NESTED, INTERPOLATED)}
+    grid = build_grid(design, cfg)
+    errors = {rule: 0.0 for rule in rules}  # relative to the cell's compliance int c ds
+    for cell in np.flatnonzero(grid.is_notch):
+        parts = circular_integrand(design, grid, cell)
+        u_a, u_b = grid.u_a[cell], grid.u_b[cell]
+        whole = grid.C0[cell] + grid.C1[cell]
+        for q, g in enumerate(gauss_legendre(quad_order)[0]):
+            for row, name in ((0, "A0"), (1, "A1")):
+                expected = quad(lambda u, row=row, f=parts: f(u)[row], u_a, u_a + (u_b - u_a) * g,
+                                epsabs=0.0, epsrel=1e-13, limit=200)[0]
+                for rule, stack in rules.items():
+                    got = getattr(stack, name)[0, cell, q]
+                    errors[rule] = max(errors[rule], abs(got - expected) / whole)
+    assert errors[INTERPOLATED] <= max(2.0 * errors[NESTED], 1e-12), errors
+
+
 def test_many_design_build_rejects_bad_input_naming_it():
     with pytest.raises(InvalidDesignError, match="number of designs = 0"):
         build_grids([], SolverSettings())
+    with pytest.raises(InvalidSettingsError, match="partials = 'gauss'"):
+        build_grids([preset("paper-experiment")], SolverSettings(), partials="gauss")
     soft = preset("paper-experiment").with_overrides(E=1e-300)
     with pytest.raises(InvalidDesignError, match="E\\*I") as info:
         build_grids([preset("paper-experiment"), soft], SolverSettings())

@@ -53,17 +53,18 @@ def parts_arrays(parts):
     return (parts.proto_fc, parts.proto_fq, parts.proto_strain)
 
 
+@pytest.mark.parametrize("partials", ["nested", "interpolated"])
 @pytest.mark.parametrize("routing", ["paper", "free"])
-def test_plain_and_compiled_builds_agree_to_1e_15(routing, monkeypatch):
+def test_plain_and_compiled_builds_agree_to_1e_15(routing, partials, monkeypatch):
     cfg = SolverSettings(routing=routing)
     for key in ("wanted", "chosen", "build"):
         monkeypatch.setitem(compiled._state, key, compiled._state[key])
     compiled.use_compiled(False)
     assert compiled.grid_kernels() is compiled.GRID_PLAIN
-    plain = parts_arrays(grid_parts(designs(), cfg))
+    plain = parts_arrays(grid_parts(designs(), cfg, partials=partials))
     compiled.use_compiled(True)
     assert compiled.grid_kernels() is not compiled.GRID_PLAIN
-    fast = parts_arrays(grid_parts(designs(), cfg))
+    fast = parts_arrays(grid_parts(designs(), cfg, partials=partials))
     for a, b in zip(plain, fast, strict=True):
         scale = np.max(np.abs(a), axis=0, keepdims=True)
         assert np.all(np.abs(a - b) <= 1e-15 * scale)
@@ -72,10 +73,11 @@ def test_plain_and_compiled_builds_agree_to_1e_15(routing, monkeypatch):
 def test_threads_give_the_same_bits():
     many = [preset("paper-experiment").with_overrides(w_n=w * MM)
             for w in np.linspace(1.0, 2.5, 9)] + designs()
-    one = parts_arrays(grid_parts(many, SolverSettings()))
-    two = parts_arrays(grid_parts(many, SolverSettings(), workers=3))
-    for a, b in zip(one, two, strict=True):
-        assert a.tobytes() == b.tobytes()
+    for partials in ("nested", "interpolated"):
+        one = parts_arrays(grid_parts(many, SolverSettings(), partials=partials))
+        two = parts_arrays(grid_parts(many, SolverSettings(), workers=3, partials=partials))
+        for a, b in zip(one, two, strict=True):
+            assert a.tobytes() == b.tobytes()
 
 
 def test_plain_build_never_imports_numba():
