@@ -17,10 +17,9 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import BagError, deserialize
+from tdcm_ros.bagio import CDR_LITTLE_ENDIAN, BagError, cdr_align, deserialize
 
 _TYPE = "geometry_msgs/msg/WrenchStamped"
-_LITTLE = (b"\x00\x01", b"\x00\x03")  # CDR_LE, PL_CDR_LE
 
 
 def wrench_force_z(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
@@ -29,7 +28,7 @@ def wrench_force_z(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArra
     force = np.zeros(len(payloads))
     groups: dict[int, list[int]] = {}
     for i, data in enumerate(payloads):
-        groups.setdefault(len(data) if data[:2] in _LITTLE else -1, []).append(i)
+        groups.setdefault(len(data) if data[:2] in CDR_LITTLE_ENDIAN else -1, []).append(i)
     for size, rows in groups.items():
         idx = np.asarray(rows)
         if size < 0 or not _decode_group(payloads, idx, size, stamps, force):
@@ -66,13 +65,8 @@ _I32 = struct.Struct("<i")
 _XYZ = struct.Struct("<3d")
 
 
-def _align(pos: int, size: int) -> int:
-    """Round ``pos`` (bytes after the encapsulation header) up to a multiple of ``size``."""
-    return pos + (-pos) % size
-
-
 def _string(data: bytes, pos: int) -> tuple[str, int]:
-    pos = _align(pos, 4)
+    pos = cdr_align(pos, 4)
     (length,) = _U32.unpack_from(data, 4 + pos)
     start = 4 + pos + 4
     return data[start:start + max(length - 1, 0)].decode("utf-8"), pos + 4 + length
@@ -81,15 +75,15 @@ def _string(data: bytes, pos: int) -> tuple[str, int]:
 def _markers_le(data: bytes) -> MarkersFrame:
     sec, nsec = struct.unpack_from("<iI", data, 4)
     frame_id, pos = _string(data, 8)
-    pos = _align(pos, 4) + 4  # frame_number
+    pos = cdr_align(pos, 4) + 4  # frame_number
     (count,) = _U32.unpack_from(data, 4 + pos)
     pos += 4
     names: list[str] = []
     xyz: list[tuple[float, float, float]] = []
     for _ in range(count):
-        pos = _align(pos + 1, 4) + 4  # id_type (int8), marker_index (int32)
+        pos = cdr_align(pos + 1, 4) + 4  # id_type (int8), marker_index (int32)
         name, pos = _string(data, pos)
-        pos = _align(pos, 8)
+        pos = cdr_align(pos, 8)
         xyz.append(_XYZ.unpack_from(data, 4 + pos))
         names.append(name)
         pos += 24
@@ -104,7 +98,7 @@ MarkersFrame = tuple[int, str, list[str], list[tuple[float, float, float]]]
 
 def markers_frame(data: bytes) -> MarkersFrame:
     """Decode a ``mocap4r2_msgs/msg/Markers`` CDR payload (little-endian fast path)."""
-    if data[:2] in _LITTLE:
+    if data[:2] in CDR_LITTLE_ENDIAN:
         try:
             return _markers_le(data)
         except (struct.error, UnicodeDecodeError, BagError):
