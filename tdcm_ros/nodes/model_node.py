@@ -295,7 +295,7 @@ class ModelNode(NodeLogic):
         (unless ``tf.tendon`` is off)."""
         if not self.tf_names["tf.tendon"]:
             return
-        self.tf_static.publish(tendon_tf(
+        self.tf_static.publish_cdr(tendon_tf(
             self.design, stamp_ns=self.port.now_ns(), parent=self.prefix + frame_id,
             child=self.prefix + str(self.tf_names["tf.tendon_frame_id"])))
 
@@ -418,7 +418,7 @@ class ModelNode(NodeLogic):
         frame_id = self.prefix + str(self.port.get_parameter("frame_id"))
         roll = self.rolls.at(stamp_ns)
         drawn = self._draw_due(stamp_ns)
-        for topic, message in midline_messages(
+        for topic, data in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),
                 marker_s=np.minimum(np.asarray(self.port.get_parameter("markers.arc_lengths"),
@@ -426,7 +426,7 @@ class ModelNode(NodeLogic):
                 marker_radius=radius,
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
                 roll=roll, drawn=drawn):
-            self.publishers[topic].publish(message)  # midline first: sent before the rest is built
+            self.publishers[topic].publish_cdr(data)  # midline first: sent before the rest is built
         self.publishers["tendon_states"].publish(
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
@@ -435,7 +435,7 @@ class ModelNode(NodeLogic):
                 stamp_ns, self.joint_names, joint_positions(result)[1:].tolist()))
             self._publish_uncertainty(result, tension, stamp_ns, frame_id, roll)
         self.track.state.advance(result)  # after the band: it moves the parameters on this history
-        self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
+        self.tf.publish_cdr(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                 tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
                                 station_prefix=self.prefix
                                 + str(self.tf_names["tf.station_prefix"]),
