@@ -1,7 +1,8 @@
 """``NodePort.call_soon`` on both runtimes, as model_node's live path uses it: a callback queued
 by a subscription's callback runs on the same thread after it, every input is either taken or
-counted as skipped, and the newest is taken. (How many of a burst coalesce depends on when the
-transport hands them over; the exact order is the MemoryPort's and the zenoh executor's tests.)"""
+counted as skipped, the newest is taken, and a failing one is logged while the node goes on.
+(How many of a burst coalesce depends on when the transport hands them over; the exact order
+is the MemoryPort's and the zenoh executor's tests.)"""
 
 from __future__ import annotations
 
@@ -47,17 +48,23 @@ class Newest(NodeLogic):
         self.pending = None
 
 
+def fails() -> None:
+    raise RuntimeError("a failing call_soon callback")
+
+
 def burst(context: Any) -> None:
     node = Newest(context.create_port("newest"))
     publisher = context.create_port("numbers").create_publisher(
         "numbers", "std_msgs/msg/Int32", QoS(depth=COUNT))
     eventually(publisher.matched, 10.0, "the subscription to match", spin=context)
+    node.port.call_soon(fails)  # logged and counted: the loop goes on
     for k in range(COUNT):
         publisher.publish(from_dict("std_msgs/msg/Int32", {"data": k}))
     eventually(lambda: node.taken[-1:] == [COUNT - 1], 10.0, "the newest number taken",
                spin=context, detail=lambda: node.taken)
     assert len(node.taken) + node.skipped == COUNT and node.taken == sorted(node.taken)
     assert len(node.threads) == 1  # the subscription's and call_soon's: one callback thread
+    assert list(node.port.guard.failures) == ["call_soon fails"]  # type: ignore[attr-defined]
 
 
 def test_zenoh_call_soon_runs_after_the_callback_and_takes_the_newest(router: Any) -> None:
