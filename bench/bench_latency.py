@@ -3,9 +3,11 @@
 Run: ``python bench/bench_latency.py [--runtime zenoh|rclpy|both] [--rates 100 500 1000]
 [--duration 10] [--results FILE]`` or ``python bench/bench_latency.py --soak [--soak-duration 60]
 [--soak-rate 1000] [--results FILE]``.
-``--runtime`` defaults to ``both`` when rclpy is importable, else ``zenoh``; with ``both`` the
-runtimes are interleaved per rate (zenoh 100, rclpy 100, zenoh 500, ...) in the same run, and a
-table of rclpy/zenoh ratios of p50 and p99 per rate follows.
+``--runtime`` defaults to ``both``: the runtimes are interleaved per rate (zenoh 100, rclpy 100,
+zenoh 500, ...) in the same run, and a table of rclpy/zenoh ratios of p50 and p99 per rate
+follows. Where rclpy is not importable (run it with the ROS virtual environment's Python,
+``.ros/venv``, which ``bash .ci/ros.sh --prepare`` builds, its workspace sourced) the bench says
+so and measures zenoh alone.
 
 Per phase (one runtime, one rate) it starts a fresh stack, each its own process, as ``tdcm up``
 does: on zenoh a private router (``tdcm_ros.runtime.router``) and ``model_node --runtime zenoh``;
@@ -19,13 +21,16 @@ thing in the callback: on zenoh a session subscriber's callback (zenoh's thread)
 subscription's callback (``RclpyNodePort.create_raw_subscription``, run by this process's
 executor, so it includes this process's executor delay); the stamp is parsed from the CDR bytes.
 Per phase it prints p50, p99 and max latency (ms), delivered/sent (inputs that produced a
-midline; the rest were coalesced by the keep-latest node or lost), the coalesced inputs the node
-reports on ``/diagnostics``, ``lost`` (sent minus every input the node's ``/diagnostics``
-counters account for: solved, coalesced, dropped, model errors; so inputs that never reached its
+midline; the rest were coalesced by the keep-latest node or lost), the coalesced inputs (newer
+ones arrived during a solve: the node's cumulative ``coalesced`` counter), ``lost`` (sent minus
+every tension the node's cumulative counters account for: solved, coalesced, dropped
+(``dropped_<reason>``) and failed solves (``model_<kind>``); so inputs that never reached its
 callback, e.g. beyond its subscription's depth of 100), the one-hop transport latency (``hop``:
 publisher -> this process's listener on ``tension``, the same measurement without the node),
-model_node's CPU (all its threads, so above 100 % is possible) and the 1-min load average (the
-figures are only as good as an idle machine). ``--soak`` also samples model_node's RSS
+model_node's CPU (all its threads, so above 100 % is possible) and that CPU per solve (ms), and
+the 1-min load average (the figures are only as good as an idle machine). The counters are the
+union of the values of every ``model_node: ...`` status of one ``/diagnostics`` array (input
+and solver), taken before and after the phase. ``--soak`` also samples model_node's RSS
 (``VmRSS``) once a second and prints start, end and max RSS and the least-squares slope, per runtime.
 ``--results FILE`` also writes the printed figures as tables to a results file (``bench/results.py``).
 """
@@ -59,6 +64,8 @@ MODEL = "tdcm_ros.nodes.model_node:ModelNode"
 TENSION_N = 12.0
 TENSION_TYPE = "geometry_msgs/msg/WrenchStamped"
 RUNTIMES = ("zenoh", "rclpy")
+NO_RCLPY = ("run this with the ROS virtual environment's Python, .ros/venv/bin/python, which "
+            "`bash .ci/ros.sh --prepare` builds, its .ros/ws/install/setup.bash sourced")
 _STAMP = struct.Struct("<iI")  # header.stamp (sec, nanosec) right after the 4-byte CDR header
 _CDR_LE = b"\x00\x01"          # little-endian plain CDR encapsulation
 
@@ -190,7 +197,7 @@ class Bench:
         self.lock = threading.Lock()
         self.received: list[tuple[int, int]] = []   # (receive ns, stamp ns) of each midline
         self.inputs: list[tuple[int, int]] = []     # the same for each `tension` (one hop)
-        self.counters: dict[str, int] = {}
+        self.counters: dict[str, int] = {}  # of the newest /diagnostics array
         self.diag_ns = 0
         self.context = open_context(runtime)
         port = self.context.create_port("bench_latency")
@@ -252,11 +259,10 @@ class Bench:
         return on_sample
 
     def _on_diagnostics(self, message: Any) -> None:
-        for status in message.status:
-            if status.name.startswith("model_node"):
-                self.counters = {v.key: int(v.value) for v in status.values if v.value.isdigit()}
-                self.diag_ns = message.header.stamp.sec * 1_000_000_000 + \
-                    message.header.stamp.nanosec
+        if counters := node_counters(message):
+            self.counters = counters
+            self.diag_ns = message.header.stamp.sec * 1_000_000_000 + \
+                message.header.stamp.nanosec
 
     def fresh_counters(self, after_ns: int) -> dict[str, int]:
         """Counters from a ``/diagnostics`` published after ``after_ns``."""
@@ -298,11 +304,9 @@ class Bench:
             hop = np.array([(recv - stamp) / 1e6 for recv, stamp in self.inputs])
         latencies = np.array([(recv - stamp) / 1e6 for recv, stamp in samples])
         delta = {key: value - before.get(key, 0) for key, value in after.items()}
-        accounted = sum(value for key, value in delta.items()
-                        if key in ("solved", "coalesced") or key.startswith(("dropped_", "model_")))
         return Phase(self.runtime, rate, summary["sent"], latencies, hop,
                      delta.get("coalesced", 0), delta.get("solved", 0),
-                     summary["sent"] - accounted,
+                     summary["sent"] - accounted_inputs(delta),
                      (load0, os.getloadavg()[0]), cpu_s(self.node.pid) - cpu0,
                      summary["elapsed_s"], rss)
 
@@ -320,16 +324,30 @@ class Bench:
                     child.wait()
 
 
+def node_counters(message: Any) -> dict[str, int]:
+    """The counters of every ``model_node: ...`` status of a ``/diagnostics`` array (input and
+    solver: each status holds some of them), by key."""
+    return {v.key: int(v.value) for status in message.status
+            if status.name.startswith("model_node: ") for v in status.values if v.value.isdigit()}
+
+
+def accounted_inputs(counters: dict[str, int]) -> int:
+    """Tensions model_node's cumulative counters account for: solved, coalesced, dropped and
+    failed solves (not the windowed ``*_in_window``, the rolls ``dropped_roll_*`` nor the band's
+    failures ``model_band_*``, which are no inputs of their own)."""
+    return sum(value for key, value in counters.items()
+               if not key.endswith("_in_window") and not key.startswith(("dropped_roll_",
+                                                                          "model_band_"))
+               and (key in ("solved", "coalesced") or key.startswith(("dropped_", "model_"))))
+
+
 @contextmanager
-def bench(runtime: str, period: float | None) -> Iterator[Bench]:
+def bench(runtime: str) -> Iterator[Bench]:
     """A running :class:`Bench`: model_node draws its midline for every solve
-    (``output.visual_rate_hz`` 0, so each input has an output to time), with
-    ``process_period_s`` overridden when given."""
+    (``output.visual_rate_hz`` 0, so each input has an output to time)."""
     with tempfile.TemporaryDirectory() as tmp:
         params = Path(tmp) / "model_node.yaml"
         lines = ["model_node:", "  ros__parameters:", "    output:", "      visual_rate_hz: 0.0"]
-        if period is not None:
-            lines.append(f"    process_period_s: {period}")
         params.write_text("\n".join(lines) + "\n")
         runner = Bench(runtime, params)
         try:
@@ -338,10 +356,10 @@ def bench(runtime: str, period: float | None) -> Iterator[Bench]:
             runner.close()
 
 
-def measure(runtime: str, rate: float, duration: float, warmup: float, period: float | None,
+def measure(runtime: str, rate: float, duration: float, warmup: float,
             sample_rss: bool = False) -> Phase:
     """One phase on a fresh stack: warm up at 100 Hz (not reported), then ``rate`` Hz."""
-    with bench(runtime, period) as runner:
+    with bench(runtime) as runner:
         if warmup > 0:
             runner.run(100.0, warmup)
         return runner.run(rate, duration, sample_rss)
@@ -356,15 +374,22 @@ def row(phase: Phase) -> str:
            if len(phase.hop_ms) else f"{'-':>5} {'-':>5}")
     return (f"{phase.runtime:>7} {phase.rate:7.0f} {figures} {delivered:7d}/{phase.sent:<7d} "
             f"{phase.coalesced:9d} {phase.lost:5d} {hop} "
-            f"{phase.cpu_node / phase.elapsed_s * 100:7.0f}% "
+            f"{phase.cpu_node / phase.elapsed_s * 100:7.0f}% {cpu_per_solve_ms(phase):9.3f} "
             f"{phase.load[0]:5.2f}->{phase.load[1]:.2f}")
+
+
+def cpu_per_solve_ms(phase: Phase) -> float:
+    """model_node's CPU (all threads) over the phase per solve (ms): what one input that is
+    solved costs it, receiving the coalesced ones included."""
+    return phase.cpu_node / phase.solved * 1e3 if phase.solved else float("nan")
 
 
 PHASE_COLUMNS = [Column("runtime"), Column("rate", "Hz", ",.0f"), Column("p50", "ms", ".2f"),
                  Column("p99", "ms", ".2f"), Column("max", "ms", ".2f"), Column("delivered"),
                  Column("sent"), Column("coalesced"), Column("lost"),
                  Column("hop p50", "ms", ".2f"), Column("hop p99", "ms", ".2f"),
-                 Column("node CPU", "% of a core", ".0f"), Column("load average", format=".2f"),
+                 Column("node CPU", "% of a core", ".0f"),
+                 Column("node CPU per solve", "ms", ".3f"), Column("load average", format=".2f"),
                  Column("→ at the end", format=".2f")]
 """The columns of :func:`phase_row`: the figures :func:`row` prints."""
 
@@ -378,12 +403,13 @@ def phase_row(phase: Phase) -> list[object]:
             len(lat), phase.sent, phase.coalesced, phase.lost,
             *((float(np.percentile(hop, 50)), float(np.percentile(hop, 99))) if len(hop)
               else (None, None)),
-            phase.cpu_node / phase.elapsed_s * 100, phase.load[0], phase.load[1]]
+            phase.cpu_node / phase.elapsed_s * 100, cpu_per_solve_ms(phase), phase.load[0],
+            phase.load[1]]
 
 
 HEADER = (f"{'runtime':>7} {'rate Hz':>7} {'p50 ms':>7} {'p99 ms':>7} {'max ms':>8} "
           f"{'delivered/sent':>15} {'coalesced':>9} {'lost':>5} {'hop p50':>5} {'p99':>5} "
-          f"{'node CPU':>8} load1")
+          f"{'node CPU':>8} {'CPU/solve':>9} load1")
 
 
 def ratio_table(phases: list[Phase]) -> list[list[object]]:
@@ -442,7 +468,7 @@ def fmt_load() -> str:
     return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
-def describe(runtimes: list[str], period: float | None) -> str:
+def describe(runtimes: list[str]) -> str:
     """Header line: date, CPUs, load average, runtimes (and the rclpy RMW and domain)."""
     parts = [datetime.now().astimezone().isoformat(timespec="seconds"),
              f"{os.cpu_count()} CPUs, load average {fmt_load()}",
@@ -455,16 +481,15 @@ def describe(runtimes: list[str], period: float | None) -> str:
                      f"ROS_AUTOMATIC_DISCOVERY_RANGE "
                      f"{os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE', '(unset)')}")
     parts.append(f"tension {TENSION_N} N, paper-experiment, model_node's defaults but "
-                 "output.visual_rate_hz 0 (a midline per solve)"
-                 + (f", process_period_s {period}" if period else ""))
+                 "output.visual_rate_hz 0 (a midline per solve)")
     return "; ".join(parts)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runtime", choices=[*RUNTIMES, "both"], default=None,
-                        help="runtime(s) to measure (default: both when rclpy is importable, "
-                             "else zenoh)")
+                        help="runtime(s) to measure (default: both; zenoh alone, said so, "
+                             "where rclpy is not importable)")
     parser.add_argument("--rates", type=float, nargs="+", default=[100.0, 500.0, 1000.0],
                         help="input rates (Hz)")
     parser.add_argument("--duration", type=float, default=10.0, help="seconds per rate")
@@ -473,8 +498,6 @@ def main() -> None:
     parser.add_argument("--soak", action="store_true", help="memory soak instead of the rates")
     parser.add_argument("--soak-rate", type=float, default=1000.0, help="soak input rate (Hz)")
     parser.add_argument("--soak-duration", type=float, default=60.0, help="soak length (s)")
-    parser.add_argument("--period", type=float, default=None,
-                        help="override model_node's process_period_s (s)")
     parser.add_argument("--publish", nargs=2, type=float, metavar=("RATE", "DURATION"),
                         help=argparse.SUPPRESS)
     add_results_argument(parser, "bench_latency")
@@ -482,19 +505,21 @@ def main() -> None:
     if args.publish:
         publish(args.runtime or "zenoh", *args.publish, wait=20.0)
         return
-    choice = args.runtime or ("both" if rclpy_available() else "zenoh")
-    runtimes = list(RUNTIMES) if choice == "both" else [choice]
+    runtimes = list(RUNTIMES) if args.runtime in (None, "both") else [args.runtime]
     if "rclpy" in runtimes and not rclpy_available():
-        parser.error("--runtime rclpy/both needs rclpy (source ROS 2 or use its Python)")
+        if args.runtime is not None:
+            parser.error(f"--runtime {args.runtime} needs rclpy ({NO_RCLPY})")
+        print(f"rclpy is not importable ({NO_RCLPY}): measuring zenoh only", flush=True)
+        runtimes = ["zenoh"]
     if min([*args.rates, args.soak_rate]) <= 0 or min(args.duration, args.soak_duration) <= 0:
         parser.error("rates and durations must be > 0")
     results = BenchResults("bench_latency")
-    described = describe(runtimes, args.period)
+    described = describe(runtimes)
     print(described, flush=True)
     if args.soak:
         for runtime in runtimes:
             phase = measure(runtime, args.soak_rate, args.soak_duration, args.warmup,
-                            args.period, sample_rss=True)
+                            sample_rss=True)
             print(f"soak ({runtime}): {args.soak_rate:g} Hz for {args.soak_duration:g} s")
             print(HEADER)
             print(row(phase))
@@ -508,7 +533,7 @@ def main() -> None:
     phases = []
     for rate in args.rates:
         for runtime in runtimes:
-            phases.append(measure(runtime, rate, args.duration, args.warmup, args.period))
+            phases.append(measure(runtime, rate, args.duration, args.warmup))
             print(row(phases[-1]), flush=True)
     ratios = ratio_table(phases) if len(runtimes) > 1 else []
     end = fmt_load()
@@ -517,10 +542,12 @@ def main() -> None:
         f"Tension → midline latency, {args.duration:g} s per rate",
         PHASE_COLUMNS, [phase_row(phase) for phase in phases],
         note=f"{described}; load average at the end {end}. Delivered: inputs that produced a "
-             "midline; coalesced: inputs the keep-latest node replaced (its /diagnostics); "
-             "lost: sent minus every input its counters account for; hop: publisher → this "
+             "midline; coalesced: inputs replaced by a newer one that arrived during a solve "
+             "(the node's cumulative /diagnostics counter); lost: sent minus every input its "
+             "counters account for (solved, coalesced, dropped, failed); hop: publisher → this "
              "bench's own listener on tension (the machine's own stalls); node CPU: all of "
-             "model_node's threads; load average: 1 min, at the start and end of the phase.")
+             "model_node's threads, and per solve; load average: 1 min, at the start and end "
+             "of the phase.")
     if ratios:
         results.table("rclpy/zenoh ratio (same run, interleaved per rate)", RATIO_COLUMNS, ratios)
     if args.results:

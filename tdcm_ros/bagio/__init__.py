@@ -1,9 +1,17 @@
 """One message model for every carrier: the rosbags Jazzy typestore plus ``msg_defs/``.
 
 ``serialize``/``deserialize`` move CDR bytes; ``type_hash`` gives the REP-2016 RIHS01 hash
-that rmw_zenoh puts in its key expressions (``service_type_hash`` for ``pkg/srv/Name``).
+that rmw_zenoh puts in its key expressions (``service_type_hash`` for ``pkg/srv/Name``);
+:class:`CdrWriter` writes the same bytes directly where building message objects costs too much.
 """
 
+from tdcm_ros.bagio.cdr import (
+    CDR_LITTLE_ENDIAN,
+    CdrWriter,
+    cdr_align,
+    cdr_header,
+    cdr_string,
+)
 from tdcm_ros.bagio.convert import from_dict, prepare_codec, to_dict
 from tdcm_ros.bagio.errors import BagError
 from tdcm_ros.bagio.services import normalize_service_type
@@ -20,7 +28,12 @@ from tdcm_ros.bagio.typestore import (
 )
 
 __all__ = [
+    "CDR_LITTLE_ENDIAN",
     "BagError",
+    "CdrWriter",
+    "cdr_align",
+    "cdr_header",
+    "cdr_string",
     "deserialize",
     "from_dict",
     "message_definition",

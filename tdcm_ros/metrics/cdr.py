@@ -18,10 +18,9 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import BagError, deserialize
+from tdcm_ros.bagio import CDR_LITTLE_ENDIAN, BagError, cdr_align, deserialize
 
 _TYPE = "geometry_msgs/msg/WrenchStamped"
-_LITTLE = (b"\x00\x01", b"\x00\x03")  # CDR_LE, PL_CDR_LE
 
 
 def wrench_force_z(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
@@ -45,12 +44,12 @@ def _groups(payloads: Sequence[bytes]
     sizes = np.fromiter(map(len, payloads), np.int64, len(payloads))
     if sizes.size and sizes[0] >= 2 and np.all(sizes == sizes[0]):
         raw = np.frombuffer(b"".join(payloads), dtype=np.uint8).reshape(sizes.size, -1)
-        if np.all((raw[:, 0] == 0) & ((raw[:, 1] == 1) | (raw[:, 1] == 3))):  # _LITTLE
+        if np.all((raw[:, 0] == 0) & ((raw[:, 1] == 1) | (raw[:, 1] == 3))):  # CDR_LITTLE_ENDIAN
             yield np.arange(sizes.size), raw
             return
     groups: dict[int, list[int]] = {}
     for i, data in enumerate(payloads):
-        groups.setdefault(len(data) if data[:2] in _LITTLE else -1, []).append(i)
+        groups.setdefault(len(data) if data[:2] in CDR_LITTLE_ENDIAN else -1, []).append(i)
     for size, rows in groups.items():
         yield np.asarray(rows), None if size < 0 else np.frombuffer(
             b"".join(payloads[i] for i in rows), dtype=np.uint8).reshape(-1, size)
@@ -83,13 +82,8 @@ _I32 = struct.Struct("<i")
 _XYZ = struct.Struct("<3d")
 
 
-def _align(pos: int, size: int) -> int:
-    """Round ``pos`` (bytes after the encapsulation header) up to a multiple of ``size``."""
-    return pos + (-pos) % size
-
-
 def _string(data: bytes, pos: int) -> tuple[str, int]:
-    pos = _align(pos, 4)
+    pos = cdr_align(pos, 4)
     (length,) = _U32.unpack_from(data, 4 + pos)
     start = 4 + pos + 4
     return data[start:start + max(length - 1, 0)].decode("utf-8"), pos + 4 + length
@@ -100,16 +94,16 @@ def _markers_le(data: bytes) -> tuple[MarkersFrame, list[int]]:
     position in it."""
     sec, nsec = struct.unpack_from("<iI", data, 4)
     frame_id, pos = _string(data, 8)
-    pos = _align(pos, 4) + 4  # frame_number
+    pos = cdr_align(pos, 4) + 4  # frame_number
     (count,) = _U32.unpack_from(data, 4 + pos)
     pos += 4
     names: list[str] = []
     xyz: list[tuple[float, float, float]] = []
     offsets: list[int] = []
     for _ in range(count):
-        pos = _align(pos + 1, 4) + 4  # id_type (int8), marker_index (int32)
+        pos = cdr_align(pos + 1, 4) + 4  # id_type (int8), marker_index (int32)
         name, pos = _string(data, pos)
-        pos = _align(pos, 8)
+        pos = cdr_align(pos, 8)
         offsets.append(4 + pos)
         xyz.append(_XYZ.unpack_from(data, 4 + pos))
         names.append(name)
@@ -128,7 +122,7 @@ header stamps (ns), the frame id, the marker names and the positions (payloads, 
 
 def markers_frame(data: bytes) -> MarkersFrame:
     """Decode a ``mocap4r2_msgs/msg/Markers`` CDR payload (little-endian fast path)."""
-    if data[:2] in _LITTLE:
+    if data[:2] in CDR_LITTLE_ENDIAN:
         try:
             return _markers_le(data)[0]
         except (struct.error, UnicodeDecodeError, BagError):
@@ -178,7 +172,7 @@ def _layout(first: bytes) -> tuple[NDArray[np.bool_], MarkersFrame, list[int]] |
         return None
     layout = np.ones(len(first), dtype=bool)
     layout[4:12] = False  # header stamp
-    frame_number = 4 + _align(_string(first, 8)[1], 4)
+    frame_number = 4 + cdr_align(_string(first, 8)[1], 4)
     layout[frame_number:frame_number + 4] = False
     for offset in offsets:
         layout[offset:offset + 24] = False

@@ -52,11 +52,10 @@ def _segments(design: Design) -> list[tuple[float, float, int | None]]:
     ends = design.segment_ends()
     starts = np.concatenate([[0.0], ends[:-1]])
     left, _ = design.notch_bounds()
-    out = []
-    for start, end in zip(starts, ends, strict=True):
-        hit = np.flatnonzero(np.isclose(left, start, rtol=0.0, atol=1e-12))
-        out.append((float(start), float(end), int(hit[0]) if hit.size else None))
-    return out
+    hits = np.isclose(left[None, :], starts[:, None], rtol=0.0, atol=1e-12)  # segment x notch
+    first = hits.argmax(axis=1) if left.size else np.zeros(len(starts), dtype=int)
+    return [(start, end, int(k) if row.any() else None) for start, end, k, row
+            in zip(starts.tolist(), ends.tolist(), first.tolist(), hits, strict=True)]
 
 
 def joint_names(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "") -> list[str]:
@@ -70,19 +69,20 @@ def joint_names(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "") -
 def joint_positions(result: SolveResult, roll: float = 0.0) -> Array:
     """The positions (rad, m) of :func:`joint_names`' joints that put the chain in
     ``result``'s shape, rolled by ``roll`` (rad)."""
-    design = result.design
+    bounds = np.array([(start, end) for start, end, _ in _segments(result.design)])
+    # the nodes nearest each segment's start and end (the first of equals, as argmin)
+    nearest = np.argmin(np.abs(result.s[None, None, :] - bounds[:, :, None]), axis=2).tolist()
+    x, z, thetas = (result.positions[:, 0].tolist(), result.positions[:, 2].tolist(),
+                    result.theta.tolist())
     out = [roll]
-    for start, end, _ in _segments(design):
-        i = int(np.argmin(np.abs(result.s - start)))
-        j = int(np.argmin(np.abs(result.s - end)))
-        dx, dz = result.positions[j, 0] - result.positions[i, 0], \
-            result.positions[j, 2] - result.positions[i, 2]
-        theta = float(result.theta[i])
+    for i, j in nearest:
+        dx, dz = x[j] - x[i], z[j] - z[i]
+        theta = thetas[i]
         # the chord in the segment's start frame (+z along the tangent, +x toward the tendon)
         along = dz * math.cos(theta) + dx * math.sin(theta)
         across = dx * math.cos(theta) - dz * math.sin(theta)
         turn = math.atan2(across, along)
-        out += [turn, math.hypot(dx, dz), float(result.theta[j]) - theta - turn]
+        out += [turn, math.hypot(dx, dz), thetas[j] - theta - turn]
     return np.array(out)
 
 

@@ -37,8 +37,8 @@ Friction (``friction.mu``, default a model file's ``friction`` section, else 0):
 tension is solved after the ones before it under stick-slip capstan friction
 (:class:`~tdcm_ros.model.FrictionTrack`), so the shape follows the direction of the tension's
 change (loading or unloading); coalesced inputs are skipped by the history too (a reversal
-within one processing period is missed), and a change of the design or of ``friction.mu``
-restarts it from a slack tendon.
+among the inputs that arrive during one solve is missed), and a change of the design or of
+``friction.mu`` restarts it from a slack tendon.
 
 Uncertainty (a model file's ``uncertainty`` section, written by ``tdcm calibrate --out``): on
 every solve that is drawn (``output.visual_rate_hz``) the node carries the fit's covariance to
@@ -47,9 +47,10 @@ publishes ``tip_pose_with_covariance`` (``geometry_msgs/msg/PoseWithCovarianceSt
 ``shape_band`` (``visualization_msgs/msg/Marker``, the ``band.confidence`` band of the midline).
 Without the section neither topic is advertised.
 
-Keep-latest: the subscription only stores the newest valid tension; a timer solves it, warm
-started from the previous shape, so a burst never builds a queue (skipped inputs are counted
-as coalesced). Bad inputs (non-finite, negative, above ``input.tension_max``, older than
+Keep-latest, on arrival: a valid tension is solved as soon as the node's callback thread is
+free (:meth:`~tdcm_ros.runtime.NodePort.call_soon`), warm started from the previous shape; the
+tensions that arrive meanwhile (during a solve) are kept newest only, and the newest is solved
+next, so a burst never builds a queue (skipped inputs are counted as coalesced). Bad inputs (non-finite, negative, above ``input.tension_max``, older than
 ``input.max_age_s``, stamped more than ``input.max_future_s`` ahead, or a WrenchStamped with a
 zero stamp) and model limits are dropped, counted and reported on ``/diagnostics``.
 """
@@ -131,7 +132,6 @@ FIXED_SPECS = by_name(
          "friction.mu's default and its uncertainty turns on the band", default="", kind="str"),
     Spec("roll.joint", description="joint of `joint_states` the body rolls by (rad about "
          "the base +z axis)", default="roll", kind="str"),
-    Spec("process_period_s", "s", "solver timer period", 0.001, low=1e-4, high=1.0),
     Spec("diagnostics_period_s", "s", "diagnostics period", 1.0, low=0.05, high=60.0))
 #: Parameters a client may change at run time, besides the design and solver groups.
 TUNABLE_SPECS = by_name(
@@ -221,7 +221,6 @@ class ModelNode(NodeLogic):
         declare_specs(port, self.design_specs, prefix="design.", defaults=self.base.to_dict())
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
         declare_specs(port, TUNABLE_SPECS, defaults={"friction.mu": model.friction_mu})
-        period = float(fixed["process_period_s"])
         diag_period = float(fixed["diagnostics_period_s"])
         self.design, self.settings = self._config({})
         self.track = FrictionTrack(float(port.get_parameter("friction.mu")))
@@ -260,7 +259,6 @@ class ModelNode(NodeLogic):
         self.last_problem = ""
         self.last_failure = ""
         self._drop_warnings = Throttled(clock=lambda: self.port.now_ns() / 1e9)
-        port.create_timer(period, self.process)
         self.diagnostics = Diagnostics(port, diag_period)
         self.dropped, self.failed = self.diagnostics.window(), self.diagnostics.window()
         self.diagnostics.add("input", "tdcm_model", self.check_input)
@@ -295,7 +293,7 @@ class ModelNode(NodeLogic):
         (unless ``tf.tendon`` is off)."""
         if not self.tf_names["tf.tendon"]:
             return
-        self.tf_static.publish(tendon_tf(
+        self.tf_static.publish_cdr(tendon_tf(
             self.design, stamp_ns=self.port.now_ns(), parent=self.prefix + frame_id,
             child=self.prefix + str(self.tf_names["tf.tendon_frame_id"])))
 
@@ -324,8 +322,10 @@ class ModelNode(NodeLogic):
                 self.port.logger.warning("dropped tension %r N: %s%s", tension,
                                          self._why_dropped(reason, stamp_ns or 0, now), suffix)
             return
-        if self.pending is not None:
+        if self.pending is not None:  # a solve is queued already: it takes this one instead
             self.counts["coalesced"] += 1
+        else:
+            self.port.call_soon(self.process)
         self.pending = (tension, now if stamp_ns is None else stamp_ns)
 
     def _on_joint_states(self, message: Any) -> None:
@@ -398,7 +398,7 @@ class ModelNode(NodeLogic):
         return True
 
     def process(self) -> None:
-        """Solve the newest pending tension and publish the shape."""
+        """Solve the newest pending tension, if any, and publish the shape."""
         if self.pending is None:
             return
         tension, stamp_ns = self.pending
@@ -418,7 +418,7 @@ class ModelNode(NodeLogic):
         frame_id = self.prefix + str(self.port.get_parameter("frame_id"))
         roll = self.rolls.at(stamp_ns)
         drawn = self._draw_due(stamp_ns)
-        for topic, message in midline_messages(
+        for topic, data in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
                 samples=int(self.port.get_parameter("output.samples")),
                 marker_s=np.minimum(np.asarray(self.port.get_parameter("markers.arc_lengths"),
@@ -426,7 +426,7 @@ class ModelNode(NodeLogic):
                 marker_radius=radius,
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
                 roll=roll, drawn=drawn):
-            self.publishers[topic].publish(message)  # midline first: sent before the rest is built
+            self.publishers[topic].publish_cdr(data)  # midline first: sent before the rest is built
         self.publishers["tendon_states"].publish(
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
@@ -435,11 +435,11 @@ class ModelNode(NodeLogic):
                 stamp_ns, self.joint_names, joint_positions(result)[1:].tolist()))
             self._publish_uncertainty(result, tension, stamp_ns, frame_id, roll)
         self.track.state.advance(result)  # after the band: it moves the parameters on this history
-        self.tf.publish(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
-                                tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
-                                station_prefix=self.prefix
-                                + str(self.tf_names["tf.station_prefix"]),
-                                stations=int(self.tf_names["tf.stations"]), roll=roll))
+        self.tf.publish_cdr(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
+                                    tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
+                                    station_prefix=self.prefix
+                                    + str(self.tf_names["tf.station_prefix"]),
+                                    stations=int(self.tf_names["tf.stations"]), roll=roll))
 
     def _publish_uncertainty(self, result: SolveResult, tension: float | tuple[float, ...],
                              stamp_ns: int, frame_id: str, roll: float) -> None:

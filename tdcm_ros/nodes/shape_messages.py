@@ -1,10 +1,13 @@
-"""Build the model node's ROS messages (rosbags objects) from a :class:`SolveResult`.
+"""Build the model node's ROS messages from a :class:`SolveResult`, as CDR bytes.
 
 All poses are in the frame given as ``frame_id`` (``tdcm_base`` by default, see doc/explanation/frames.md),
 positions in m, orientations as quaternions of the body frame (z axis = midline tangent), the
 planar shape turned by the roll (rad) about the base +z axis (:mod:`tdcm_ros.model.roll`).
-Messages are built from the typestore classes directly (not through ``from_dict``), one
-``pose_at`` call per result: the model node does this for every input (see bench_latency.py).
+The model node does this for every input (see bench_latency.py), so the pose messages
+(``Path``, ``PoseArray``, ``PoseStamped``) are written as CDR straight from the pose arrays
+(:class:`~tdcm_ros.bagio.CdrWriter`, the bytes rosbags would give), one ``pose_at`` call per
+result; the marker messages are built from the typestore classes (not through ``from_dict``)
+and serialised.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import from_dict, msg_class
+from tdcm_ros.bagio import CdrWriter, cdr_header, from_dict, msg_class, serialize
 from tdcm_ros.model import SolveResult, offset_points, roll_poses
 
 Array = NDArray[np.float64]
@@ -42,14 +45,42 @@ def header_msg(stamp_ns: int, frame_id: str) -> Any:
         frame_id=frame_id)
 
 
-def _poses(positions: Array, quats: Array) -> list[Any]:
-    """``geometry_msgs/Pose`` objects for positions (k, 3) m and quaternions (k, 4) xyzw."""
+def _pose_rows(positions: Array, quats: Array) -> Array:
+    """``geometry_msgs/Pose`` fields in CDR order (k, 7): position (m), then quaternion xyzw."""
+    return np.hstack([positions, quats])
+
+
+def pose_stamped_cdr(hdr: bytes, pose: Array) -> bytes:
+    """CDR of a ``geometry_msgs/PoseStamped``: header ``hdr`` (:func:`cdr_header`), ``pose`` (7,)
+    as :func:`_pose_rows` orders it."""
+    writer = CdrWriter()
+    writer.records(hdr, pose[None])
+    return writer.data()
+
+
+def path_cdr(hdr: bytes, poses: Array) -> bytes:
+    """CDR of a ``nav_msgs/Path``: header ``hdr``, one ``PoseStamped`` of that header per row of
+    ``poses`` (k, 7)."""
+    writer = CdrWriter()
+    writer.raw(hdr)
+    writer.uint32(len(poses))
+    writer.records(hdr, poses)
+    return writer.data()
+
+
+def pose_array_cdr(hdr: bytes, poses: Array) -> bytes:
+    """CDR of a ``geometry_msgs/PoseArray``: header ``hdr``, a pose per row of ``poses`` (k, 7)."""
+    writer = CdrWriter()
+    writer.raw(hdr)
+    writer.uint32(len(poses))
+    writer.records(b"", poses)
+    return writer.data()
+
+
+def _points(poses: Array) -> list[Any]:
+    """``geometry_msgs/Point`` objects of the positions (m) of ``poses`` (k, 7)."""
     point = msg_class("geometry_msgs/msg/Point")
-    quaternion = msg_class("geometry_msgs/msg/Quaternion")
-    pose = msg_class("geometry_msgs/msg/Pose")
-    return [pose(position=point(x=p[0], y=p[1], z=p[2]),
-                 orientation=quaternion(x=q[0], y=q[1], z=q[2], w=q[3]))
-            for p, q in zip(positions.tolist(), quats.tolist(), strict=True)]
+    return [point(x=x, y=y, z=z) for x, y, z in poses[:, :3].tolist()]
 
 
 @lru_cache(maxsize=16)
@@ -71,38 +102,31 @@ def marker_msg(hdr: Any, ns: str, marker_id: int, marker_type: int,
 
 def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, samples: int,
                      marker_s: Array, marker_radius: float, marker_side_rad: float,
-                     roll: float = 0.0, drawn: bool = True) -> Iterator[tuple[str, Any]]:
-    """``(topic, message)`` for ``midline``, ``midline_poses``, ``tip_pose``,
+                     roll: float = 0.0, drawn: bool = True) -> Iterator[tuple[str, bytes]]:
+    """``(topic, CDR bytes)`` for ``midline``, ``midline_poses``, ``tip_pose``,
     ``predicted_markers`` and ``body_markers``, in that order, each built when the previous one
     has been taken (so ``midline`` can be sent before the rest exist), the shape rolled by
-    ``roll`` (rad); ``drawn=False``: ``tip_pose`` alone (nothing else is built). The messages
-    share sub-objects (header, poses): serialise them, do not modify them."""
+    ``roll`` (rad); ``drawn=False``: ``tip_pose`` alone (nothing else is built)."""
+    hdr = cdr_header(stamp_ns, frame_id)
     if not drawn:
         position, quat = roll_poses(result.tip_position[None], result.tip_quaternion[None], roll)
-        yield "tip_pose", msg_class("geometry_msgs/msg/PoseStamped")(
-            header=header_msg(stamp_ns, frame_id), pose=_poses(position, quat)[0])
+        yield "tip_pose", pose_stamped_cdr(hdr, _pose_rows(position, quat)[0])
         return
     s = np.linspace(0.0, result.design.length, samples)
     planar, planar_quats = result.pose_at(np.concatenate([s, np.asarray(marker_s, dtype=float)]))
     planar[samples:] = offset_points(planar[samples:], planar_quats[samples:], marker_radius,
                                      marker_side_rad)
     # midline, markers and tip turned in one call: rows [0, samples), [samples, -1), -1
-    positions, quats = roll_poses(np.vstack([planar, result.tip_position]),
-                                  np.vstack([planar_quats, result.tip_quaternion]), roll)
-    hdr = header_msg(stamp_ns, frame_id)
-    pose_stamped = msg_class("geometry_msgs/msg/PoseStamped")
-    pose_array = msg_class("geometry_msgs/msg/PoseArray")
-    poses = _poses(positions[:samples], quats[:samples])
-    yield "midline", msg_class("nav_msgs/msg/Path")(
-        header=hdr, poses=[pose_stamped(header=hdr, pose=pose) for pose in poses])
-    yield "midline_poses", pose_array(header=hdr, poses=poses)
-    tip = _poses(positions[-1:], quats[-1:])[0]
-    yield "tip_pose", pose_stamped(header=hdr, pose=tip)
-    markers = _poses(positions[samples:-1], quats[samples:-1])
-    yield "predicted_markers", pose_array(header=hdr, poses=markers)
-    body = marker_msg(hdr, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
-                   (0.85, 0.85, 0.9, 0.8), [p.position for p in poses])
-    spheres = marker_msg(hdr, "tdcm_predicted_markers", 1, 7, (0.002, 0.002, 0.002),
-                      (1.0, 0.2, 0.8, 1.0), [p.position for p in markers])
-    yield "body_markers", msg_class("visualization_msgs/msg/MarkerArray")(
-        markers=[body, spheres])
+    poses = _pose_rows(*roll_poses(np.vstack([planar, result.tip_position]),
+                                   np.vstack([planar_quats, result.tip_quaternion]), roll))
+    yield "midline", path_cdr(hdr, poses[:samples])
+    yield "midline_poses", pose_array_cdr(hdr, poses[:samples])
+    yield "tip_pose", pose_stamped_cdr(hdr, poses[-1])
+    yield "predicted_markers", pose_array_cdr(hdr, poses[samples:-1])
+    header_object = header_msg(stamp_ns, frame_id)
+    body = marker_msg(header_object, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
+                      (0.85, 0.85, 0.9, 0.8), _points(poses[:samples]))
+    spheres = marker_msg(header_object, "tdcm_predicted_markers", 1, 7, (0.002, 0.002, 0.002),
+                         (1.0, 0.2, 0.8, 1.0), _points(poses[samples:-1]))
+    yield "body_markers", serialize(msg_class("visualization_msgs/msg/MarkerArray")(
+        markers=[body, spheres]), "visualization_msgs/msg/MarkerArray")

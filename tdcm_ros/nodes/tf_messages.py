@@ -1,4 +1,5 @@
-"""``tf2_msgs/msg/TFMessage`` builders (rosbags objects) for the model node's TF tree.
+"""``tf2_msgs/msg/TFMessage`` builders (CDR bytes, :class:`~tdcm_ros.bagio.CdrWriter`) for the
+model node's TF tree.
 
 The tree under ``base`` (``tdcm_base`` by default, REP 103, SI units; see doc/explanation/frames.md):
 
@@ -16,12 +17,10 @@ The tendon frame stays where it is at roll 0: it is static, and the tension's di
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import msg_class
+from tdcm_ros.bagio import CdrWriter, cdr_header, cdr_string
 from tdcm_ros.model import Design, SolveResult, roll_poses
 
 Array = NDArray[np.float64]
@@ -31,24 +30,20 @@ TENDON_ROTATION = (1.0, 0.0, 0.0, 0.0)
 
 
 def _transforms(stamp_ns: int, parent: str, children: list[str], positions: Array,
-                quaternions: Array) -> Any:
-    """A ``TFMessage`` of ``parent -> children[i]`` at positions (k, 3) m and quaternions
-    (k, 4) ``(x, y, z, w)``, all stamped ``stamp_ns`` (ns since the epoch)."""
-    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
-    header = msg_class("std_msgs/msg/Header")(
-        stamp=msg_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec), frame_id=parent)
-    vector = msg_class("geometry_msgs/msg/Vector3")
-    quaternion = msg_class("geometry_msgs/msg/Quaternion")
-    transform = msg_class("geometry_msgs/msg/Transform")
-    stamped = msg_class("geometry_msgs/msg/TransformStamped")
-    return msg_class(TF_TYPE)(transforms=[
-        stamped(header=header, child_frame_id=child,
-                transform=transform(translation=vector(x=p[0], y=p[1], z=p[2]),
-                                    rotation=quaternion(x=q[0], y=q[1], z=q[2], w=q[3])))
-        for child, p, q in zip(children, positions.tolist(), quaternions.tolist(), strict=True)])
+                quaternions: Array) -> bytes:
+    """CDR of a ``TFMessage`` of ``parent -> children[i]`` at positions (k, 3) m and
+    quaternions (k, 4) ``(x, y, z, w)``, all stamped ``stamp_ns`` (ns since the epoch)."""
+    hdr = cdr_header(stamp_ns, parent)
+    hdr += bytes((-len(hdr)) % 4)  # child_frame_id is a string: 4-aligned
+    writer = CdrWriter()
+    writer.uint32(len(children))
+    # TransformStamped: header, child_frame_id, then translation and rotation as in a Pose
+    writer.records([hdr + cdr_string(child) for child in children],
+                   np.hstack([positions, quaternions]))
+    return writer.data()
 
 
-def tendon_tf(design: Design, *, stamp_ns: int, parent: str, child: str) -> Any:
+def tendon_tf(design: Design, *, stamp_ns: int, parent: str, child: str) -> bytes:
     """The static ``parent -> child`` transform of the tendon frame (see the module docstring)."""
     return _transforms(stamp_ns, parent, [child], np.array([[design.R_c, 0.0, 0.0]]),
                        np.array([TENDON_ROTATION]))
@@ -60,7 +55,7 @@ def station_lengths(length: float, stations: int) -> Array:
 
 
 def body_tf(result: SolveResult, *, stamp_ns: int, parent: str, tip: str,
-            station_prefix: str, stations: int, roll: float = 0.0) -> Any:
+            station_prefix: str, stations: int, roll: float = 0.0) -> bytes:
     """``parent -> tip`` and, for ``stations > 0``, ``parent -> <station_prefix><k>``, the
     shape rolled by ``roll`` (rad) about the base +z axis."""
     children = [tip]

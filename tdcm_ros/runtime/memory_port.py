@@ -4,20 +4,27 @@ in-process, with no zenoh and no rclpy (tests, examples, offline replays).
 Parameters are checked by the same :class:`ParameterStore` as both runtimes. Messages make a CDR
 round trip on the way in (:meth:`MemoryPort.deliver`) and out (``publish``), as a transport
 would carry them, and are kept per topic as the node names it (not resolved). Timers fire only
-when the clock is moved with :meth:`MemoryPort.advance`::
+when the clock is moved with :meth:`MemoryPort.advance`. A callback queued with ``call_soon``
+runs when the callback under way returns, as on an idle executor; messages delivered inside
+:meth:`MemoryPort.burst` arrive together, as while the node is busy, and those callbacks run
+after them::
 
     port = MemoryPort({"period": 0.1}, name="talker")
     node = Talker(port)
     port.advance(1.0)                      # ten ticks
     port.messages("chatter")
     port.call("~/reset")                   # a service the node serves, as the node names it
+    with port.burst():                     # (a node subscribing to "in") both arrive
+        port.deliver("in", first)          # while the node is busy
+        port.deliver("in", second)
 """
 
 from __future__ import annotations
 
 import logging
-from collections import defaultdict
-from collections.abc import Callable
+from collections import defaultdict, deque
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from tdcm_ros.bagio import deserialize, from_dict, normalize_service_type, serialize
@@ -97,6 +104,8 @@ class MemoryPort:
         self.remote_services: dict[str, tuple[str, Callable[[Any], Any]]] = {}
         #: what :meth:`graph_hubs` answers (a test cuts the graph, or restarts its router)
         self.hubs: frozenset[str] = frozenset({"memory"})
+        self._soon: deque[Callable[[], None]] = deque()  # queued by call_soon
+        self._held = 0  # callbacks (and bursts) under way: call_soon's wait for them
 
     def declare_parameter(self, name: str, default: P, *, description: str = "",
                           range: tuple[float, float] | None = None,
@@ -139,7 +148,8 @@ class MemoryPort:
         the request and of the response, as a transport would carry them."""
         if name not in self.services:
             raise RuntimePortError(f"no service {name!r}; served: {sorted(self.services)}")
-        return _answer(*self.services[name], request)
+        with self.burst():
+            return _answer(*self.services[name], request)
 
     def add_remote_service(self, name: str, type_name: str,
                            handler: Callable[[Any], Any]) -> None:
@@ -166,6 +176,34 @@ class MemoryPort:
         self.timers.append(timer)
         return timer
 
+    def call_soon(self, callback: Callable[[], None]) -> None:
+        """Run ``callback`` once the callback (or :meth:`burst`) under way ends; at once if
+        none is."""
+        self._soon.append(callback)
+        self._run_soon()
+
+    @contextmanager
+    def burst(self) -> Iterator[None]:
+        """Hold the callbacks of :meth:`call_soon` until the block ends, as a busy executor
+        would: messages delivered in it all reach their subscriptions first."""
+        self._held += 1
+        try:
+            yield
+        finally:
+            self._held -= 1
+        self._run_soon()
+
+    def _run_soon(self) -> None:
+        """The queued :meth:`call_soon` callbacks in order, unless a callback is under way."""
+        if self._held:
+            return
+        self._held += 1  # one queued now waits for the one running
+        try:
+            while self._soon:
+                self._soon.popleft()()
+        finally:
+            self._held -= 1
+
     def now_ns(self) -> int:
         """The port's clock, ns since the UNIX epoch."""
         return self.clock_ns
@@ -180,7 +218,8 @@ class MemoryPort:
             raise RuntimePortError(f"no subscription on {topic!r}; subscribed: "
                                    f"{sorted(self.subscriptions)}")
         type_name, callback, _ = self.subscriptions[topic]
-        callback(deserialize(serialize(message, type_name), type_name))
+        with self.burst():
+            callback(deserialize(serialize(message, type_name), type_name))
 
     def advance(self, seconds: float) -> None:
         """Move the clock forward by ``seconds`` (s), firing the timers due in time order."""
@@ -192,7 +231,8 @@ class MemoryPort:
             timer = min(live, key=lambda t: t.due_ns)
             self.clock_ns = timer.due_ns
             timer.due_ns += timer.period_ns
-            timer.callback()
+            with self.burst():
+                timer.callback()
         self.clock_ns = end
 
     def messages(self, topic: str) -> list[Any]:

@@ -156,6 +156,12 @@ class NodePort(Protocol):
     def create_timer(self, period: float, callback: Callable[[], None]) -> Timer:
         """Call ``callback`` every ``period`` seconds."""
 
+    def call_soon(self, callback: Callable[[], None]) -> None:
+        """Call ``callback`` once on the node's callback thread, after the callbacks already
+        due: messages received before this call are delivered first, so a node that keeps
+        only the newest input of a burst processes it once. Safe from any thread; a failing
+        callback is logged like any other."""
+
     def now_ns(self) -> int:
         """Current time of the node's clock, ns since the UNIX epoch (with the ROS parameter
         ``use_sim_time``: the latest ``/clock``, 0 before the first)."""

@@ -21,6 +21,7 @@ import logging
 import os
 import threading
 import time
+from collections import deque
 from collections.abc import Callable, Collection, Mapping, Sequence
 from typing import Any
 
@@ -191,6 +192,8 @@ class RclpyNodePort:
         self._clients_lock = threading.Lock()
         self.guard = CallbackGuard(node.get_fully_qualified_name(), self.logger,
                                    self.create_publisher, self.now_ns)
+        self._soon: deque[Callable[[], None]] = deque()  # call_soon's, run by _wake
+        self._wake = node.create_guard_condition(self._run_soon)
         node.add_pre_set_parameters_callback(self._widen)
         node.add_on_set_parameters_callback(self._on_set)
         if SIM_TIME in self._overrides:  # a --params file is read here, not by rcl
@@ -369,6 +372,19 @@ class RclpyNodePort:
                              value=period, allowed="> 0 s")
         return self.node.create_timer(period, self.guard.wrap(
             f"timer {getattr(callback, '__qualname__', period)}", callback))
+
+    def call_soon(self, callback: Callable[[], None]) -> None:
+        """Queue ``callback`` and trigger the node's guard condition: the executor runs it on
+        its next wait, after the subscriptions ready in that wait (rclpy takes a node's
+        subscriptions before its guard conditions)."""
+        self._soon.append(self.guard.wrap(
+            f"call_soon {getattr(callback, '__qualname__', callback)}", callback))
+        self._wake.trigger()
+
+    def _run_soon(self) -> None:
+        """The callbacks queued before this wake-up, in order (later ones trigger another)."""
+        for _ in range(len(self._soon)):
+            self._soon.popleft()()
 
     def now_ns(self) -> int:
         """The node clock (ROS time if ``use_sim_time``), ns."""

@@ -641,6 +641,12 @@ class ZenohNodePort:
         return self._context.executor.add_timer(period, self.guard.wrap(
             f"timer {getattr(callback, '__qualname__', period)}", callback))
 
+    def call_soon(self, callback: Callable[[], None]) -> None:
+        """Queue ``callback`` on the executor thread behind the tasks queued already (each
+        sample received posts its delivery as it arrives)."""
+        self._context.executor.post(self.guard.wrap(
+            f"call_soon {getattr(callback, '__qualname__', callback)}", callback))
+
     def _on_clock(self, message: Any) -> None:
         self._clock_ns = int(message.clock.sec) * 1_000_000_000 + int(message.clock.nanosec)
 

@@ -31,7 +31,7 @@ def stamp(message: Any) -> int:
 
 
 class Node:
-    """model_node on a MemoryPort; :meth:`send` delivers a tension and runs the solver tick."""
+    """model_node on a MemoryPort; :meth:`send` delivers a tension (solved on arrival)."""
 
     def __init__(self, overrides: dict[str, Any] | None = None) -> None:
         self.port = MemoryPort(overrides, name="model_node")
@@ -42,7 +42,7 @@ class Node:
         (every solve publishes one; the midline is drawn at ``output.visual_rate_hz``)."""
         before = len(self.port.messages("tip_pose"))
         self.port.deliver("tension", wrench(tension, stamp_ns))
-        self.port.advance(0.001)  # one process_period_s
+        self.port.advance(0.001)
         tips = self.port.messages("tip_pose")[before:]
         assert len(tips) <= 1
         return bool(tips) and stamp(tips[0]) == stamp_ns

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from tdcm_ros.bagio import deserialize, serialize
+from tdcm_ros.bagio import deserialize
 from tdcm_ros.model import preset, solve, surface_points
 from tdcm_ros.nodes.shape_messages import midline_messages
 
@@ -22,9 +22,9 @@ def build(tension: float, stamp_ns: int, samples: int = 54) -> dict:
     messages = midline_messages(result, stamp_ns=stamp_ns, frame_id="tdcm_base", samples=samples,
                                 marker_s=ARCS, marker_radius=result.design.R_outer + 0.001,
                                 marker_side_rad=math.pi)
-    # Through CDR, as a subscriber sees them.
-    return {"result": result, **{topic: deserialize(serialize(message, TYPES[topic]), TYPES[topic])
-                                 for topic, message in messages}}
+    # CDR bytes, as a subscriber gets them.
+    return {"result": result, **{topic: deserialize(data, TYPES[topic])
+                                 for topic, data in messages}}
 
 
 def xyz(poses) -> np.ndarray:
@@ -60,9 +60,9 @@ def test_successive_builds_do_not_share_headers_or_points():
     """The marker templates are cached: a later build must not change an earlier one."""
     def raw(tension: float, stamp_ns: int, samples: int) -> dict:
         result = solve(preset("paper-experiment"), tension)
-        return dict(midline_messages(result, stamp_ns=stamp_ns, frame_id=f"f{samples}",
-                                     samples=samples, marker_s=ARCS, marker_radius=0.0,
-                                     marker_side_rad=0.0))
+        return {topic: deserialize(data, TYPES[topic]) for topic, data in midline_messages(
+            result, stamp_ns=stamp_ns, frame_id=f"f{samples}", samples=samples, marker_s=ARCS,
+            marker_radius=0.0, marker_side_rad=0.0)}
 
     first = raw(4.0, 1_000_000_000, 54)
     tip_x = first["body_markers"].markers[0].points[-1].x

@@ -92,3 +92,64 @@ def test_services_answer_through_a_cdr_round_trip() -> None:
     assert port.call("~/reset").message == "reset 1"
     with pytest.raises(RuntimePortError, match=r"no service 'reset'; served: \['~/reset'\]"):
         port.call("reset")
+
+
+class Newest(NodeLogic):
+    """Keeps the newest ``in`` and publishes it on ``out`` from ``call_soon``: the keep-latest
+    pattern of model_node."""
+
+    default_name = "newest"
+
+    def __init__(self, port: NodePort) -> None:
+        super().__init__(port)
+        self.out = port.create_publisher("out", "std_msgs/msg/String")
+        port.create_subscription("in", "std_msgs/msg/String", self.on_in)
+        self.pending: str | None = None
+        self.skipped = 0
+        self.order: list[str] = []
+
+    def on_in(self, message) -> None:
+        self.order.append(f"in {message.data}")
+        if self.pending is None:
+            self.port.call_soon(self.flush)
+        else:
+            self.skipped += 1
+        self.pending = message.data
+
+    def flush(self) -> None:
+        self.order.append(f"flush {self.pending}")
+        self.out.publish(from_dict("std_msgs/msg/String", {"data": self.pending}))
+        self.pending = None
+
+
+def text(data: str):
+    return from_dict("std_msgs/msg/String", {"data": data})
+
+
+def test_call_soon_runs_once_the_callback_returns_and_a_burst_first_delivers_all() -> None:
+    port = MemoryPort()
+    node = Newest(port)
+    port.deliver("in", text("a"))  # an idle node: processed on arrival
+    assert node.order == ["in a", "flush a"]
+    with port.burst():  # three arrive while the node is busy: the newest is processed once
+        for data in "bcd":
+            port.deliver("in", text(data))
+        assert [m.data for m in port.messages("out")] == ["a"]
+    assert node.order[2:] == ["in b", "in c", "in d", "flush d"]
+    assert [m.data for m in port.messages("out")] == ["a", "d"] and node.skipped == 2
+
+
+def test_a_callback_queued_by_call_soon_waits_for_the_one_running() -> None:
+    port = MemoryPort()
+    order: list[str] = []
+
+    def first() -> None:
+        order.append("first starts")
+        port.call_soon(lambda: order.append("second"))
+        order.append("first ends")
+
+    port.call_soon(first)
+    assert order == ["first starts", "first ends", "second"]
+    port.create_timer(1.0, lambda: port.call_soon(lambda: order.append("after the tick")))
+    port.advance(1.0)
+    assert order[-1] == "after the tick"

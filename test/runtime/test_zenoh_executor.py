@@ -79,3 +79,20 @@ def test_a_timer_on_time_keeps_its_grid() -> None:
         clock.now = now_ms * MS
         executor.spin_once(0.0)
     assert calls == [12 * MS, 14 * MS, 17 * MS, 18 * MS]
+
+
+def test_a_task_posted_by_a_task_runs_after_those_queued_before_it() -> None:
+    """What ``call_soon`` relies on: each sample received posts its delivery as it arrives, so
+    a solve the first delivery of a burst posts runs after the burst's other deliveries."""
+    executor = zenoh_runtime._Executor(Clock())
+    ran: list[str] = []
+
+    def deliver(k: int) -> None:
+        ran.append(f"in {k}")
+        if k == 0:
+            executor.post(lambda: ran.append("solve"))
+
+    for k in range(3):
+        executor.post(lambda k=k: deliver(k))
+    executor.spin_once(0.0)
+    assert ran == ["in 0", "in 1", "in 2", "solve"]

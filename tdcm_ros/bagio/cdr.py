@@ -1,0 +1,95 @@
+"""CDR written directly, for hot paths: the bytes :func:`~tdcm_ros.bagio.serialize` gives for
+the same message, without building message objects.
+
+Little-endian plain CDR (XCDR1) as rosbags and the rmw layers write it: a 4-byte encapsulation
+header, then each primitive aligned to its size counted from the end of that header, padding
+bytes zero. :class:`CdrWriter` appends the pieces a message is made of; a run of records that
+each end in float64 fields (``geometry_msgs/Pose``, ``PoseStamped``, ``TransformStamped``)
+is written with NumPy in one go (:meth:`CdrWriter.records`).
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: Encapsulation header of little-endian plain CDR (``CDR_LE``, options 0).
+ENCAPSULATION = b"\x00\x01\x00\x00"
+#: First two bytes of the little-endian encapsulations (``CDR_LE``, ``PL_CDR_LE``).
+CDR_LITTLE_ENDIAN = (b"\x00\x01", b"\x00\x03")
+_U32 = struct.Struct("<I")
+_STAMP = struct.Struct("<iI")
+
+
+def cdr_align(pos: int, size: int) -> int:
+    """Round ``pos`` (bytes after the encapsulation header) up to a multiple of ``size``."""
+    return pos + (-pos) % size
+
+
+def cdr_string(text: str) -> bytes:
+    """A CDR ``string`` at a 4-aligned position: byte length with the NUL (uint32), UTF-8, NUL."""
+    data = text.encode("utf-8")
+    return _U32.pack(len(data) + 1) + data + b"\x00"
+
+
+def cdr_header(stamp_ns: int, frame_id: str) -> bytes:
+    """A ``std_msgs/Header`` at a 4-aligned position: ``stamp`` (sec int32, nanosec uint32) of
+    ``stamp_ns`` (ns since the epoch) and ``frame_id``."""
+    return _STAMP.pack(*divmod(stamp_ns, 1_000_000_000)) + cdr_string(frame_id)
+
+
+class CdrWriter:
+    """Appends CDR pieces after the encapsulation header; :meth:`data` gives the message."""
+
+    def __init__(self) -> None:
+        self._parts = [ENCAPSULATION]
+        self._pos = 0  # bytes after the encapsulation header
+
+    def _pad(self, size: int) -> None:
+        padding = (-self._pos) % size
+        if padding:
+            self._parts.append(bytes(padding))
+            self._pos += padding
+
+    def raw(self, data: bytes, alignment: int = 4) -> None:
+        """``data`` (a run of pieces starting with a ``alignment``-byte field) after padding."""
+        self._pad(alignment)
+        self._parts.append(data)
+        self._pos += len(data)
+
+    def header(self, stamp_ns: int, frame_id: str) -> None:
+        """A ``std_msgs/Header`` (see :func:`cdr_header`)."""
+        self.raw(cdr_header(stamp_ns, frame_id))
+
+    def uint32(self, value: int) -> None:
+        """A ``uint32`` (a sequence's length, too)."""
+        self.raw(_U32.pack(value))
+
+    def records(self, prefix: bytes | Sequence[bytes], values: NDArray[np.float64]) -> None:
+        """A sequence's ``k`` elements (its length is the caller's), element ``i`` made of
+        ``prefix`` (one for all, or ``prefix[i]``; pieces of 4-byte alignment, e.g. a header)
+        then the float64 row ``values[i]`` (shape (k, m), aligned to 8)."""
+        rows = np.ascontiguousarray(values, dtype="<f8")
+        if not isinstance(prefix, bytes):
+            for head, row in zip(prefix, rows, strict=True):
+                self.raw(head)
+                self.raw(row.tobytes(), 8)
+            return
+        if not len(rows):
+            return
+        self.raw(prefix)
+        self.raw(rows[0].tobytes(), 8)  # the rest start 8-aligned: one layout for all
+        if len(rows) > 1:
+            lead = prefix + bytes((-len(prefix)) % 8)
+            block = np.empty((len(rows) - 1, len(lead) + rows.shape[1] * 8), dtype=np.uint8)
+            block[:, :len(lead)] = np.frombuffer(lead, dtype=np.uint8)
+            block[:, len(lead):] = rows[1:].view(np.uint8)
+            self._parts.append(block.tobytes())
+            self._pos += block.size
+
+    def data(self) -> bytes:
+        """The message's bytes, encapsulation header first."""
+        return b"".join(self._parts)
