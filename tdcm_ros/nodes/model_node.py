@@ -427,11 +427,11 @@ class ModelNode(NodeLogic):
                 marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
                 roll=roll, drawn=drawn):
             self.publishers[topic].publish_cdr(data)  # midline first: sent before the rest is built
-        self.publishers["tendon_states"].publish(
+        self.publishers["tendon_states"].publish_cdr(
             tendon_states(stamp_ns, result.tendons.names, result.actuator_strokes_m.tolist(),
                           result.tensions_n))
         if drawn:
-            self.joint_states.publish(body_joint_states(
+            self.joint_states.publish_cdr(body_joint_states(
                 stamp_ns, self.joint_names, joint_positions(result)[1:].tolist()))
             self._publish_uncertainty(result, tension, stamp_ns, frame_id, roll)
         self.track.state.advance(result)  # after the band: it moves the parameters on this history
