@@ -24,7 +24,7 @@ from tdcm_ros.errors import InputError
 from tdcm_ros.yamlio import load_yaml
 
 if TYPE_CHECKING:
-    from tdcm_ros.runtime.zenoh_runtime import GraphWatch
+    from tdcm_ros.runtime.zenoh_runtime import GraphWatch, ZenohContext
 
 TOOL_NODE = "_tdcm_topic"
 NOT_RECEIVED_EXIT = 1
@@ -182,7 +182,8 @@ def run_echo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _wait_for_publishers(context: Any, watch: Any, topic: str, wait_s: float) -> set[str]:
+def _wait_for_publishers(context: ZenohContext, watch: GraphWatch, topic: str,
+                         wait_s: float) -> set[str]:
     """Spin until a publisher of ``topic`` is seen or ``wait_s`` s passed; the durabilities
     its publishers declare (empty: none seen)."""
     deadline = time.monotonic() + wait_s

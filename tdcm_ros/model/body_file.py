@@ -570,17 +570,20 @@ def _number(entry: Mapping[str, Any], key: str, prefix: str, source: str, *, low
                             error=InvalidDesignError))
 
 
+def yaml_number(value: float) -> str:
+    """``value`` in its shortest round-trip form, with a ``.`` before any exponent (``1.0e-05``:
+    YAML 1.1 readers take ``1e-05`` for a string)."""
+    text = repr(float(value))
+    return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
+
+
 def body_file_text(design: Design, routing: str = "paper") -> str:
     """The body file of ``design`` whose tendons without their own routing have ``routing``
     (the paper's one tendon: ``R_c`` on +x): reading it back gives
     ``design`` bit for bit (every number written as its shortest round-trip form). A uniform
     design is written with ``repeat``, a per-notch one segment by segment."""
-    def number(value: float) -> str:
-        text = repr(float(value))
-        return text.replace("e", ".0e", 1) if "e" in text and "." not in text else text
-
     def points(ring: Sequence[tuple[float, float]]) -> str:
-        return "[" + ", ".join(f"[{number(x)}, {number(y)}]" for x, y in ring) + "]"
+        return "[" + ", ".join(f"[{yaml_number(x)}, {yaml_number(y)}]" for x, y in ring) + "]"
 
     def notch(width: float, band: float, offset: float, profile: NotchProfile) -> str:
         if isinstance(profile, SlicedProfile):
@@ -589,52 +592,52 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
                 "form; allowed: the body file naming the mesh", parameter="profile",
                 value=profile.name, allowed="band, cut, polygon or section notches")
         if isinstance(profile, SectionProfile):
-            numbers = ", ".join(f"{key}: {number(getattr(profile, key))}"
+            numbers = ", ".join(f"{key}: {yaml_number(getattr(profile, key))}"
                                 for key in GIVEN_SECTION_KEYS)
-            return f"{{width: {number(width)}, section: {{{numbers}}}}}"
+            return f"{{width: {yaml_number(width)}, section: {{{numbers}}}}}"
         if isinstance(profile, PolygonProfile):
             holes = (", holes: [" + ", ".join(points(h) for h in profile.holes) + "]"
                      if profile.holes else "")
-            return f"{{width: {number(width)}, polygon: {points(profile.shell)}{holes}}}"
-        at = f", offset: {number(offset)}" if offset != 0.0 else ""
-        return f"{{width: {number(width)}, band: {number(band)}{at}, profile: {profile.name}}}"
+            return f"{{width: {yaml_number(width)}, polygon: {points(profile.shell)}{holes}}}"
+        at = f", offset: {yaml_number(offset)}" if offset != 0.0 else ""
+        return f"{{width: {yaml_number(width)}, band: {yaml_number(band)}{at}, profile: {profile.name}}}"
 
     def material() -> str:
         law = design.material
-        keys = [f"E: {number(design.E)}"]
+        keys = [f"E: {yaml_number(design.E)}"]
         if not law.is_linear:
-            keys += ["law: bilinear", f"plateau_strain: {number(law.plateau_strain)}",
-                     f"E_plateau: {number(law.E_plateau)}"]
+            keys += ["law: bilinear", f"plateau_strain: {yaml_number(law.plateau_strain)}",
+                     f"E_plateau: {yaml_number(law.E_plateau)}"]
         if math.isfinite(law.recoverable_strain):
-            keys.append(f"recoverable_strain: {number(law.recoverable_strain)}")
+            keys.append(f"recoverable_strain: {yaml_number(law.recoverable_strain)}")
         return ", ".join(keys)
 
     def tendon(one: Tendon) -> str:
-        keys = [f"offset: {number(one.offset)}"]
+        keys = [f"offset: {yaml_number(one.offset)}"]
         if one.routing or not design.tendons:
             keys.append(f"routing: {one.routing or routing}")
         if one.anchor is not None:
-            keys.append(f"anchor: {number(one.anchor)}")
+            keys.append(f"anchor: {yaml_number(one.anchor)}")
         if one.guides != "internal":
             keys.append(f"guides: {one.guides}")
         if one.stiffness is not None:
-            keys.append(f"stiffness: {number(one.stiffness)}")
+            keys.append(f"stiffness: {yaml_number(one.stiffness)}")
         if one.slack != 0.0:
-            keys.append(f"slack: {number(one.slack)}")
+            keys.append(f"slack: {yaml_number(one.slack)}")
         return "  - {" + ", ".join([*keys, f"name: {one.name}"] if design.tendons else keys) + "}"
 
-    lines = [f"tube: {{R_outer: {number(design.R_outer)}, r_inner: {number(design.r_inner)}}}",
+    lines = [f"tube: {{R_outer: {yaml_number(design.R_outer)}, r_inner: {yaml_number(design.r_inner)}}}",
              f"material: {{{material()}}}", "tendons:",
              *(tendon(one) for one in design.tendon_list()), "segments:"]
     if design.w_base > 0.0:
-        lines.append(f"  - tube: {number(design.w_base)}")
+        lines.append(f"  - tube: {yaml_number(design.w_base)}")
     if design.is_uniform:
         one = notch(design.uniform("w_n"), design.uniform("w_d"), design.uniform("w_o"),
                     design.uniform_profile())
         if design.N > 1:
             lines += [f"  - repeat: {design.N - 1}", "    segments:", f"      - notch: {one}"]
             if design.uniform("w_t") > 0.0:
-                lines.append(f"      - tube: {number(design.uniform('w_t'))}")
+                lines.append(f"      - tube: {yaml_number(design.uniform('w_t'))}")
         lines.append(f"  - notch: {one}")
     else:
         gaps = [*design.per_notch("w_t").tolist(), 0.0]
@@ -643,9 +646,9 @@ def body_file_text(design: Design, routing: str = "paper") -> str:
                 design.per_notch("w_o").tolist(), design.notch_profiles(), gaps, strict=True):
             lines.append(f"  - notch: {notch(width, band, offset, profile)}")
             if gap > 0.0:
-                lines.append(f"  - tube: {number(gap)}")
+                lines.append(f"  - tube: {yaml_number(gap)}")
     if design.w_tip > 0.0:
-        lines.append(f"  - tube: {number(design.w_tip)}")
+        lines.append(f"  - tube: {yaml_number(design.w_tip)}")
     return "\n".join(lines) + "\n"
 
 

@@ -20,7 +20,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tdcm_ros.model.body_file import body_file_text, is_body_file, read_body_file
+from tdcm_ros.model.body_file import (
+    body_file_text,
+    is_body_file,
+    read_body_file,
+    yaml_number,
+)
 from tdcm_ros.model.design import Design, preset
 from tdcm_ros.model.uncertainty import ParameterCovariance
 
@@ -36,19 +41,16 @@ class ModelSpec:
 
     def text(self) -> str:
         """The model file: the design's body file with ``friction`` and ``uncertainty``."""
-        def number(value: float) -> str:
-            return repr(float(value))
-
         lines = [body_file_text(self.design).rstrip("\n")]
         if self.friction_mu:
-            lines.append(f"friction: {{mu: {number(self.friction_mu)}}}")
+            lines.append(f"friction: {{mu: {yaml_number(self.friction_mu)}}}")
         if self.uncertainty is not None:
             u = self.uncertainty
-            rows = ", ".join("[" + ", ".join(number(v) for v in row) + "]"
+            rows = ", ".join("[" + ", ".join(yaml_number(v) for v in row) + "]"
                              for row in u.covariance.tolist())
             lines += ["uncertainty:", f"  parameters: [{', '.join(u.names)}]",
-                      f"  values: [{', '.join(number(v) for v in u.values.tolist())}]",
-                      f"  covariance: [{rows}]", f"  residual_m: {number(u.residual_m)}"]
+                      f"  values: [{', '.join(yaml_number(v) for v in u.values.tolist())}]",
+                      f"  covariance: [{rows}]", f"  residual_m: {yaml_number(u.residual_m)}"]
         return "\n".join(lines) + "\n"
 
 

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
-from tdcm_ros.bagio import from_dict, serialize, to_dict
+from mcap.writer import Writer
+
+from tdcm_ros.bagio import from_dict, serialize, to_dict, typestore
 from tdcm_ros.bagio.writer import BagWriter
 
 T0 = 1_700_000_000_000_000_000  #: ns, log time of the first message
@@ -40,3 +43,20 @@ def chunked_bags(messages: list[Message], folder: Path
         out[compression] = ((path / f"{compression}_0.mcap").read_bytes(),
                             [(t, s, to_dict(m)) for t, s, _, m in messages])
     return out
+
+
+def write_mcap(path: Path, messages: list[Message], **writer_options: Any) -> Path:
+    """``messages`` as a ros2-profile MCAP at ``path`` written by the mcap library's own
+    ``Writer`` with ``writer_options`` (layouts the package's writer never makes)."""
+    with path.open("wb") as stream:
+        writer = Writer(stream, **writer_options)
+        writer.start(profile="ros2", library="test")
+        channels: dict[str, int] = {}
+        for topic, stamp, msgtype, message in messages:
+            if topic not in channels:
+                definition = typestore().generate_msgdef(msgtype, ros_version=2)[0]
+                schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
+                channels[topic] = writer.register_channel(topic, "cdr", schema)
+            writer.add_message(channels[topic], stamp, serialize(message, msgtype), stamp)
+        writer.finish()
+    return path

@@ -7,12 +7,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from mcap.writer import IndexType, Writer
+from mcap.writer import IndexType
 
-from tdcm_ros.bagio import serialize, to_dict, typestore
+from tdcm_ros.bagio import serialize, to_dict
 from tdcm_ros.bagio.reader import _McapSource, open_bag
 from tdcm_ros.bagio.writer import BagWriter
-from test.bagio.bagio_samples import Message, sample_messages
+from test.bagio.bagio_samples import Message, sample_messages, write_mcap
 
 MESSAGES = sample_messages(300, 50)  # 6 Markers among 300 tensions: markers in few chunks
 MARKERS = [(t, s, to_dict(m)) for t, s, _, m in MESSAGES if t == "/markers"]
@@ -48,18 +48,7 @@ def test_a_sparse_topic_reads_only_the_chunks_holding_it(
 
 def write_without_message_indexes(path: Path, messages: list[Message]) -> Path:
     """An MCAP in 1 KiB chunks with chunk indexes but no message indexes."""
-    with path.open("wb") as stream:
-        writer = Writer(stream, chunk_size=1024, index_types=IndexType.CHUNK)
-        writer.start(profile="ros2", library="test")
-        channels: dict[str, int] = {}
-        for topic, stamp, msgtype, message in messages:
-            if topic not in channels:
-                definition = typestore().generate_msgdef(msgtype, ros_version=2)[0]
-                schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
-                channels[topic] = writer.register_channel(topic, "cdr", schema)
-            writer.add_message(channels[topic], stamp, serialize(message, msgtype), stamp)
-        writer.finish()
-    return path
+    return write_mcap(path, messages, chunk_size=1024, index_types=IndexType.CHUNK)
 
 
 def test_without_message_indexes_every_chunk_is_read(

@@ -9,11 +9,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from mcap.reader import SeekingReader
-from mcap.writer import Writer
 
-from tdcm_ros.bagio import BagError, serialize, to_dict, typestore
+from tdcm_ros.bagio import BagError, to_dict
 from tdcm_ros.bagio.reader import open_bag
-from test.bagio.bagio_samples import chunked_bags, sample_messages
+from test.bagio.bagio_samples import chunked_bags, sample_messages, write_mcap
 
 N = 300
 
@@ -31,18 +30,8 @@ def bag_bytes() -> dict[str, tuple[bytes, list[tuple[str, int, object]]]]:
 
 def _unchunked(path: Path, expected: list[tuple[str, int, str, object]]) -> bytes:
     """An MCAP of loose message records (no chunks, no summary repeats of channels)."""
-    with path.open("wb") as stream:
-        writer = Writer(stream, use_chunking=False, repeat_channels=False, repeat_schemas=False)
-        writer.start(profile="ros2", library="test")
-        channels: dict[str, int] = {}
-        for topic, stamp, msgtype, message in expected:
-            if topic not in channels:
-                definition = typestore().generate_msgdef(msgtype, ros_version=2)[0]
-                schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
-                channels[topic] = writer.register_channel(topic, "cdr", schema)
-            writer.add_message(channels[topic], stamp, serialize(message, msgtype), stamp)
-        writer.finish()
-    return path.read_bytes()
+    return write_mcap(path, expected, use_chunking=False, repeat_channels=False,
+                      repeat_schemas=False).read_bytes()
 
 
 @settings(max_examples=120,

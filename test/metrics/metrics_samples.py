@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.synthetic import Recording, simulate
 from tdcm_ros.model import Design, named_design, preset
 
@@ -42,3 +43,24 @@ def pair_recording(design: Design = PAIR, **kw: object) -> Recording:
 def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
     """Angle (rad) of the rotation between two rotation matrices (3, 3)."""
     return float(np.arccos(np.clip((np.trace(a.T @ b) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+def stream(rec: Recording, running: RunningEvaluation, every_s: float = 0.5) -> None:
+    """Feed ``rec`` into ``running`` in stamp order (tension samples, and before each the roll
+    samples, if any, and marker frames stamped at or before it), updating every ``every_s``
+    (s) of tension stamps and once at the end."""
+    frames, fi, ri, next_update = rec.markers.stamps_s, 0, 0, every_s
+    roll_s, roll_rad = ((rec.roll.stamps_s, rec.roll.roll_rad) if rec.roll is not None
+                        else (np.empty(0), np.empty(0)))
+    for t, x in zip(rec.tension.stamps_s, rec.tension.tension_n, strict=True):
+        running.add_tension(t, x)
+        while ri < roll_s.size and roll_s[ri] <= t:
+            running.add_roll(roll_s[ri], roll_rad[ri])
+            ri += 1
+        while fi < frames.size and frames[fi] <= t:
+            running.add_markers(frames[fi], rec.markers.positions[fi])
+            fi += 1
+        if t >= next_update:
+            running.update()
+            next_update += every_s
+    running.update()

@@ -14,7 +14,7 @@ from tdcm_ros.metrics.options import EvaluateOptions
 from tdcm_ros.metrics.series import RollSeries
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.synthetic import Recording, rolled
-from test.metrics.metrics_samples import DESIGN, rotation_angle, small_recording
+from test.metrics.metrics_samples import DESIGN, rotation_angle, small_recording, stream
 
 OPTS = EvaluateOptions(design=DESIGN)
 REC = cast(Recording, small_recording())
@@ -22,26 +22,6 @@ REC = cast(Recording, small_recording())
 #: trial 2 on (6 s).
 ROLL = RollSeries.of([0.0, *np.linspace(2.0, 4.0, 101), 6.0],
                      [0.0, *np.linspace(0.0, 0.3, 101), 0.6])
-
-
-def stream(rec: Recording, running: RunningEvaluation, every_s: float = 0.5) -> None:
-    """Feed ``rec`` (tension, roll and marker samples in stamp order), updating every
-    ``every_s`` (s) of tension stamps and once at the end."""
-    assert rec.roll is not None
-    frames, rolls = rec.markers.stamps_s, rec.roll.stamps_s
-    fi, ri, next_update = 0, 0, every_s
-    for t, x in zip(rec.tension.stamps_s, rec.tension.tension_n, strict=True):
-        running.add_tension(t, x)
-        while ri < rolls.size and rolls[ri] <= t:
-            running.add_roll(rolls[ri], rec.roll.roll_rad[ri])
-            ri += 1
-        while fi < frames.size and frames[fi] <= t:
-            running.add_markers(frames[fi], rec.markers.positions[fi])
-            fi += 1
-        if t >= next_update:
-            running.update()
-            next_update += every_s
-    running.update()
 
 
 @pytest.mark.parametrize("estimate", [False, True], ids=["registration-given", "estimated"])

@@ -13,7 +13,7 @@ from tdcm_ros.metrics.lookup import MarkerLattice
 from tdcm_ros.metrics.options import options_from_sets
 from tdcm_ros.metrics.streaming import RunningEvaluation
 from tdcm_ros.metrics.synthetic import Recording
-from test.metrics.metrics_samples import PAIR_BODY, PAIR_LEVELS, pair_recording
+from test.metrics.metrics_samples import PAIR_BODY, PAIR_LEVELS, pair_recording, stream
 
 OPTIONS = options_from_sets([f"design.preset={PAIR_BODY}"])
 #: m. Measured: over 50 random tension vectors in [0, 16]**2 N the lattice (0.1 N per tendon,
@@ -22,20 +22,10 @@ OPTIONS = options_from_sets([f"design.preset={PAIR_BODY}"])
 LATTICE_M = 2e-8
 
 
-def stream(rec: Recording, every_s: float = 0.5) -> RunningEvaluation:
-    """Feed ``rec`` into a running evaluation of the pair in stamp order, updating every
-    ``every_s`` (s) of tension stamps and once at the end."""
+def stream_pair(rec: Recording) -> RunningEvaluation:
+    """A running evaluation of the pair fed ``rec`` (:func:`stream`)."""
     running = RunningEvaluation(OPTIONS, rec.registration)
-    frames, fi, next_update = rec.markers.stamps_s, 0, every_s
-    for t, x in zip(rec.tension.stamps_s, rec.tension.tension_n, strict=True):
-        running.add_tension(t, x)
-        while fi < frames.size and frames[fi] <= t:
-            running.add_markers(frames[fi], rec.markers.positions[fi])
-            fi += 1
-        if t >= next_update:
-            running.update()
-            next_update += every_s
-    running.update()
+    stream(rec, running)
     return running
 
 
@@ -79,7 +69,7 @@ def test_the_running_steps_of_a_pair_are_the_offline_ones(noise: bool) -> None:
     rec = pair_recording(**({"tension_noise_n": 0.03, "marker_noise_m": 5e-5, "lag_s": 0.1,
                              "occlusion": 0.1} if noise else {}))
     offline = evaluate_series(rec.tension, rec.markers, OPTIONS, registration=rec.registration)
-    running = stream(rec)
+    running = stream_pair(rec)
     assert_same_steps(running, offline)
     assert running.metrics == offline.metrics
 
