@@ -53,6 +53,11 @@ tensions that arrive meanwhile (during a solve) are kept newest only, and the ne
 next, so a burst never builds a queue (skipped inputs are counted as coalesced). Bad inputs (non-finite, negative, above ``input.tension_max``, older than
 ``input.max_age_s``, stamped more than ``input.max_future_s`` ahead, or a WrenchStamped with a
 zero stamp) and model limits are dropped, counted and reported on ``/diagnostics``.
+
+Parameters: a change is checked as a whole (the design with the solver settings, the markers
+against the design's length) and, once accepted, replaces the node's configuration
+(:class:`~tdcm_ros.nodes.model_config.ModelConfig`) in one step; each input reads that
+snapshot, never a parameter by name.
 """
 
 from __future__ import annotations
@@ -66,7 +71,7 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.errors import InputError, PhysicsError, exact_number
+from tdcm_ros.errors import InputError, PhysicsError
 from tdcm_ros.model import (
     MARKER_SPECS,
     MAX_MU,
@@ -79,7 +84,6 @@ from tdcm_ros.model import (
     RollHistory,
     SolveResult,
     SolverSettings,
-    joint_names,
     joint_positions,
     parameter_specs,
     read_model,
@@ -95,6 +99,7 @@ from tdcm_ros.nodes.joint_messages import (
     tendon_states,
 )
 from tdcm_ros.nodes.joint_states import joint_position
+from tdcm_ros.nodes.model_config import ModelConfig
 from tdcm_ros.nodes.shape_messages import midline_messages, stamp_ns_of
 from tdcm_ros.nodes.tf_messages import TF_TYPE, body_tf, tendon_tf
 from tdcm_ros.runtime import (
@@ -117,8 +122,6 @@ from tdcm_ros.spec import Spec, by_name
 TENSION_TYPES = ("geometry_msgs/msg/WrenchStamped", "std_msgs/msg/Float64", JOINT_STATE)
 #: Rolls kept to pair with tensions: over a second at the driver's telemetry rate.
 ROLL_HISTORY = 2048
-#: m: a marker arc length up to this far past the tip (a length rounded in a file) is the tip.
-TIP_TOLERANCE_M = 1e-9
 #: Parameters fixed at start, besides the design and solver groups.
 FIXED_SPECS = by_name(
     Spec("input.tension_type", description="message type on `tension`: WrenchStamped "
@@ -222,9 +225,8 @@ class ModelNode(NodeLogic):
         declare_specs(port, SOLVER_SPECS, prefix="solver.")
         declare_specs(port, TUNABLE_SPECS, defaults={"friction.mu": model.friction_mu})
         diag_period = float(fixed["diagnostics_period_s"])
-        self.design, self.settings = self._config({})
-        self.track = FrictionTrack(float(port.get_parameter("friction.mu")))
-        self.joint_names = joint_names(self.design)[1:]  # the URDF's, less the driver's roll
+        self.config = self._config({})
+        self.track = FrictionTrack(self.config.mu)
         port.add_on_set_parameters(self._on_set)
         warm_up()  # compile the solver's kernel now, not on the first message
 
@@ -244,7 +246,7 @@ class ModelNode(NodeLogic):
                                                QoS(depth=1, durability="transient_local"))
         self.tf = port.create_publisher("/tf", TF_TYPE, QoS(depth=100))
         self.joint_states = port.create_publisher("joint_states", JOINT_STATE, qos)
-        self._publish_tendon_tf(str(port.get_parameter("frame_id")))
+        self._publish_tendon_tf()
         # A deep queue so every input is seen (and counted); the callback only stores the newest.
         port.create_subscription("tension", self.tension_type, self._on_tension,
                                  overridable_qos(port, "tension", QoS(depth=100)))
@@ -264,37 +266,30 @@ class ModelNode(NodeLogic):
         self.diagnostics.add("input", "tdcm_model", self.check_input)
         self.diagnostics.add("solver", "tdcm_model", self.check_solver)
 
-    def _config(self, changes: Mapping[str, Any]) -> tuple[Design, SolverSettings]:
-        """Design and settings from the current parameters with ``changes`` applied."""
+    def _config(self, changes: Mapping[str, Any]) -> ModelConfig:
+        """The configuration of the current parameters with ``changes`` (by full name) applied."""
         design = self.base.with_overrides(**read_specs(self.port, self.design_specs, prefix="design.",
                                                   changes=changes))
         settings = SolverSettings(**read_specs(self.port, SOLVER_SPECS, prefix="solver.",
                                                changes=changes))
-        arcs = changes.get("markers.arc_lengths", self.port.get_parameter("markers.arc_lengths"))
-        end = design.length + TIP_TOLERANCE_M
-        if not arcs or any(not 0.0 <= float(s) <= end for s in arcs):
-            allowed = (f"values in [0, {exact_number(design.length)}] m (up to "
-                       f"{TIP_TOLERANCE_M:g} m past the tip: at the tip)")
-            raise InputError(f"markers.arc_lengths = {arcs!r} out of range; allowed: {allowed}",
-                             parameter="markers.arc_lengths", value=arcs, allowed=allowed)
-        return design, settings
+        return ModelConfig.of(design, settings,
+                              read_specs(self.port, TUNABLE_SPECS, changes=changes), self.prefix)
 
     def _on_set(self, changes: Mapping[str, Any]) -> None:
-        """Validate a runtime change as a whole; raising keeps the old values."""
-        self.design, self.settings = self._config(changes)
-        self.joint_names = joint_names(self.design)[1:]
-        self.track = FrictionTrack(float(changes.get("friction.mu",
-                                                     self.port.get_parameter("friction.mu"))))
+        """Validate a runtime change as a whole and swap the configuration; raising keeps the
+        old values."""
+        self.config = self._config(changes)
+        self.track = FrictionTrack(self.config.mu)
         self.previous = None
-        self._publish_tendon_tf(str(changes.get("frame_id", self.port.get_parameter("frame_id"))))
+        self._publish_tendon_tf()
 
-    def _publish_tendon_tf(self, frame_id: str) -> None:
+    def _publish_tendon_tf(self) -> None:
         """Send the static ``frame_id -> tf.tendon_frame_id`` transform of the current design
         (unless ``tf.tendon`` is off)."""
         if not self.tf_names["tf.tendon"]:
             return
         self.tf_static.publish_cdr(tendon_tf(
-            self.design, stamp_ns=self.port.now_ns(), parent=self.prefix + frame_id,
+            self.config.design, stamp_ns=self.port.now_ns(), parent=self.config.frame_id,
             child=self.prefix + str(self.tf_names["tf.tendon_frame_id"])))
 
     def _on_tension(self, message: Any) -> None:
@@ -307,8 +302,7 @@ class ModelNode(NodeLogic):
             tension = float(message.wrench.force.z)
             stamp_ns = stamp_ns_of(message)
         elif self.tension_type == JOINT_STATE:
-            tension, missing = tendon_efforts(message,
-                                              [t.name for t in self.design.tendon_list()])
+            tension, missing = tendon_efforts(message, self.config.tendon_names)
             reason = "missing_tendon" if missing else ""
             stamp_ns = stamp_ns_of(message)
         else:
@@ -346,21 +340,21 @@ class ModelNode(NodeLogic):
 
     def _why_dropped(self, reason: str, stamp_ns: int, now_ns: int) -> str:
         """A dropped tension's reason in words, with the parameter that decides it."""
-        get = self.port.get_parameter
+        config = self.config
         if reason == "unstamped":
             return ("header.stamp is 0 (never set): stamp it (tdcm topic pub: {header: auto}), or "
                     "send std_msgs/msg/Float64 with input.tension_type")
         if reason == "stale":
             return (f"stamped {(now_ns - stamp_ns) / 1e9:.3g} s before the node's clock, older "
-                    f"than input.max_age_s = {get('input.max_age_s'):g} s (a bag replay needs "
+                    f"than input.max_age_s = {config.max_age_s:g} s (a bag replay needs "
                     f"tdcm bag play --clock and use_sim_time: true on the node)")
         if reason == "future":
             return (f"stamped {(stamp_ns - now_ns) / 1e9:.3g} s after the node's clock, more than "
-                    f"input.max_future_s = {get('input.max_future_s'):g} s")
+                    f"input.max_future_s = {config.max_future_s:g} s")
         if reason == "above_max":
-            return f"above input.tension_max = {get('input.tension_max'):g} N"
+            return f"above input.tension_max = {config.tension_max_n:g} N"
         if reason == "missing_tendon":
-            names = ", ".join(t.name for t in self.design.tendon_list())
+            names = ", ".join(config.tendon_names)
             return f"the JointState has no effort for every tendon ({names})"
         return f"{reason.replace('_', '-')} tension"
 
@@ -370,29 +364,29 @@ class ModelNode(NodeLogic):
         a type without a header) is dropped at ``now_ns``, or ``""``. A zero header stamp was
         never set: its age is unknown, so it is dropped as ``unstamped``."""
         values = tension if isinstance(tension, tuple) else (tension,)
+        config = self.config
         if not all(math.isfinite(value) for value in values):
             return "non_finite"
         if any(value < 0.0 for value in values):
             return "negative"
-        if max(values) > float(self.port.get_parameter("input.tension_max")):
+        if max(values) > config.tension_max_n:
             return "above_max"
         if stamp_ns is None:
             return ""
         if stamp_ns == 0:
             return "unstamped"
-        if stamp_ns - now_ns > float(self.port.get_parameter("input.max_future_s")) * 1e9:
+        if stamp_ns - now_ns > config.max_future_s * 1e9:
             return "future"
-        max_age = float(self.port.get_parameter("input.max_age_s"))
-        if max_age > 0.0 and now_ns - stamp_ns > max_age * 1e9:
+        if config.max_age_s > 0.0 and now_ns - stamp_ns > config.max_age_s * 1e9:
             return "stale"
         return ""
 
     def _draw_due(self, stamp_ns: int) -> bool:
         """Whether the solve stamped ``stamp_ns`` is drawn (``output.visual_rate_hz``): the first,
         one ``1 / rate`` s of stamps after the last drawn, or one stamped before it."""
-        rate = float(self.port.get_parameter("output.visual_rate_hz"))
+        period = self.config.visual_period_ns
         last = self.drawn_ns
-        if rate > 0.0 and last is not None and 0 <= stamp_ns - last < round(1e9 / rate):
+        if period and last is not None and 0 <= stamp_ns - last < period:
             return False
         self.drawn_ns = stamp_ns
         return True
@@ -403,8 +397,9 @@ class ModelNode(NodeLogic):
             return
         tension, stamp_ns = self.pending
         self.pending = None
+        config = self.config
         try:
-            result = self.track.solve_at(self.design, tension, settings=self.settings,
+            result = self.track.solve_at(config.design, tension, settings=config.settings,
                                          warm_start=self.previous)
         except (PhysicsError, InputError) as error:
             self.counts[f"model_{error.kind}"] += 1
@@ -412,19 +407,13 @@ class ModelNode(NodeLogic):
             return
         self.previous = result
         self.counts["solved"] += 1
-        placement = self.port.get_parameter("markers.placement")
-        radius = (self.design.R_outer + float(self.port.get_parameter("markers.ball_radius"))
-                  if placement == "surface" else 0.0)
-        frame_id = self.prefix + str(self.port.get_parameter("frame_id"))
+        frame_id = config.frame_id
         roll = self.rolls.at(stamp_ns)
         drawn = self._draw_due(stamp_ns)
         for topic, data in midline_messages(
                 result, stamp_ns=stamp_ns, frame_id=frame_id,
-                samples=int(self.port.get_parameter("output.samples")),
-                marker_s=np.minimum(np.asarray(self.port.get_parameter("markers.arc_lengths"),
-                                               dtype=float), self.design.length),
-                marker_radius=radius,
-                marker_side_rad=math.radians(float(self.port.get_parameter("markers.side_deg"))),
+                samples=config.samples, marker_s=config.marker_s,
+                marker_radius=config.marker_radius_m, marker_side_rad=config.marker_side_rad,
                 roll=roll, drawn=drawn):
             self.publishers[topic].publish_cdr(data)  # midline first: sent before the rest is built
         self.publishers["tendon_states"].publish_cdr(
@@ -432,8 +421,8 @@ class ModelNode(NodeLogic):
                           result.tensions_n))
         if drawn:
             self.joint_states.publish_cdr(body_joint_states(
-                stamp_ns, self.joint_names, joint_positions(result)[1:].tolist()))
-            self._publish_uncertainty(result, tension, stamp_ns, frame_id, roll)
+                stamp_ns, config.joint_names, joint_positions(result)[1:].tolist()))
+            self._publish_uncertainty(result, tension, stamp_ns, config, roll)
         self.track.state.advance(result)  # after the band: it moves the parameters on this history
         self.tf.publish_cdr(body_tf(result, stamp_ns=stamp_ns, parent=frame_id,
                                     tip=self.prefix + str(self.tf_names["tf.tip_frame_id"]),
@@ -442,27 +431,26 @@ class ModelNode(NodeLogic):
                                     stations=int(self.tf_names["tf.stations"]), roll=roll))
 
     def _publish_uncertainty(self, result: SolveResult, tension: float | tuple[float, ...],
-                             stamp_ns: int, frame_id: str, roll: float) -> None:
+                             stamp_ns: int, config: ModelConfig, roll: float) -> None:
         """The tip with covariance and the band of ``result`` (a model file's uncertainty);
         a moved parameter the model cannot solve skips them, counted as a solver failure."""
         if self.uncertainty is None:
             return
-        samples = int(self.port.get_parameter("output.samples"))
 
         def resolve(design: Design, mu: float) -> SolveResult:
-            return self.track.solve_at(design, tension, mu=mu, settings=self.settings,
+            return self.track.solve_at(design, tension, mu=mu, settings=config.settings,
                                        warm_start=result)
 
         try:
             spread = shape_spread(result, self.track.mu, self.uncertainty,
-                                  np.linspace(0.0, self.design.length, samples), resolve)
+                                  np.linspace(0.0, config.design.length, config.samples), resolve)
         except (PhysicsError, InputError) as error:
             self.counts[f"model_band_{error.kind}"] += 1
             self.last_failure = f"band at tension {_shown(tension)} N: {error}"
             return
         for topic, message in uncertainty_messages(
-                spread, result, stamp_ns=stamp_ns, frame_id=frame_id, roll=roll,
-                confidence=float(self.port.get_parameter("band.confidence"))):
+                spread, result, stamp_ns=stamp_ns, frame_id=config.frame_id, roll=roll,
+                confidence=config.band_confidence):
             self.publishers[topic].publish(message)
 
     def check_input(self) -> Status:

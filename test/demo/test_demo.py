@@ -217,7 +217,7 @@ def test_a_per_notch_or_polygon_scene_reaches_the_nodes_as_a_body_file(tmp_path:
     given = make_plan(scene, "paper_experiment", tmp_path).node_overrides()["model_node"]
     assert "design.w_d" not in given and given["design.E"] == design.E
     node = ModelNode(MemoryPort(given, name="model_node"))
-    assert node.design == design
+    assert node.config.design == design
 
 
 def test_demo_rejects_a_bad_set_before_the_run(tmp_path: Path,

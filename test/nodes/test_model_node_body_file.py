@@ -85,9 +85,9 @@ def test_the_profile_is_a_parameter_as_the_body_file_gives_it(tmp_path: Path) ->
     assert not np.array_equal(from_file, midline_at({"design.preset": "fig3-wd-1.52"}, 12.0))
     port = MemoryPort({"design.preset": "fig3-wd-1.52"}, name="model_node")
     node = ModelNode(port)
-    assert node.design.profile.name == "circular"
+    assert node.config.design.profile.name == "circular"
     assert port.store.set({"design.profile": "rectangular"}).successful
-    assert node.design.profile.name == "rectangular"
+    assert node.config.design.profile.name == "rectangular"
     assert not port.store.set({"design.profile": "oval"}).successful
 
 
@@ -102,11 +102,11 @@ def test_a_per_notch_body_file_reaches_both_nodes_and_its_lists_are_not_paramete
     assert midline[-1] == pytest.approx(expected[-1, [0, 2]], abs=1e-12)   # the tip
     port = MemoryPort({"design.file": str(body)}, name="model_node")
     node = ModelNode(port)
-    assert node.design == design
+    assert node.config.design == design
     names = set(port.store.specs)
     assert {"design.E", "design.w_n", "design.w_t"} <= names and "design.w_d" not in names
     assert port.store.set({"design.E": 2.0e9}).successful   # a uniform field is still a parameter
-    assert node.design.w_d == design.w_d and node.design.E == 2.0e9
+    assert node.config.design.w_d == design.w_d and node.config.design.E == 2.0e9
     metrics_design, _, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                              name="metrics_node"))
     assert metrics_design == design
@@ -124,13 +124,13 @@ def test_a_polygon_or_mesh_body_file_reaches_both_nodes_its_sections_not_paramet
     assert "design.E" in names  # (a mesh's widths differ in their last bits: per notch)
     assert not names & {"design.profile", "design.w_d", "design.w_o"}
     midline = midline_at({"design.file": str(body)}, 5.0)
-    expected = solve(node.design, 5.0).pose_at(np.linspace(0.0, node.design.length,
+    expected = solve(node.config.design, 5.0).pose_at(np.linspace(0.0, node.config.design.length,
                                                             midline.shape[0]))[0]
     assert midline[-1] == pytest.approx(expected[-1, [0, 2]], abs=1e-12)
-    assert port.store.set({"design.E": 2.0e9}).successful and node.design.E == 2.0e9
+    assert port.store.set({"design.E": 2.0e9}).successful and node.config.design.E == 2.0e9
     metrics_design, _, _ = declare_design_and_layout(MemoryPort({"design.file": str(body)},
                                                              name="metrics_node"))
-    assert metrics_design == node.design.with_overrides(E=1.85e9)
+    assert metrics_design == node.config.design.with_overrides(E=1.85e9)
 
 
 def test_a_body_with_several_tendons_takes_a_joint_state_of_tensions_by_name() -> None:

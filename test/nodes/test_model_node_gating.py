@@ -192,7 +192,7 @@ def test_a_marker_rounded_past_the_tip_is_the_tip_and_a_refused_bound_is_printed
 
     base = design_preset("paper-experiment")
     n = Node({"design.w_t": base.w_t * (1 - 1e-12), "markers.arc_lengths": [0.02, base.length]})
-    length = n.node.design.length
+    length = n.node.config.design.length
     assert length < base.length
     assert n.send(20.0, n.port.now_ns())
     with pytest.raises(InputError) as error:
