@@ -14,18 +14,20 @@ one extra solve per fitted parameter) and adds the fit's residual variance to ea
 - ``shape_band`` (``visualization_msgs/msg/Marker``, a ``TRIANGLE_LIST`` in namespace
   ``tdcm_band``): the ``confidence`` band of the midline in the bending plane, each sample
   widened by its interval along the in-plane normal.
+
+Both are written as CDR straight from the arrays (:class:`~tdcm_ros.bagio.CdrWriter`,
+:func:`~tdcm_ros.nodes.shape_messages.marker_cdr`), the bytes rosbags would give.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import msg_class
+from tdcm_ros.bagio import CdrWriter, cdr_header
 from tdcm_ros.model import (
     Design,
     ParameterCovariance,
@@ -36,13 +38,13 @@ from tdcm_ros.model import (
     roll_points,
     roll_quaternions,
 )
-from tdcm_ros.nodes.shape_messages import header_msg, marker_msg
+from tdcm_ros.nodes.shape_messages import TRIANGLE_LIST, MarkerStyle, marker_cdr
 
 Array = NDArray[np.float64]
 BAND_NAMESPACE = "tdcm_band"
 #: RGBA of the band (translucent blue).
 BAND_COLOR = (0.2, 0.5, 1.0, 0.35)
-TRIANGLE_LIST = 11  #: visualization_msgs/Marker type
+BAND_STYLE = MarkerStyle(BAND_NAMESPACE, 0, TRIANGLE_LIST, (1.0, 1.0, 1.0), BAND_COLOR)
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,10 +78,10 @@ def shape_spread(result: SolveResult, mu: float, uncertainty: ParameterCovarianc
 
 def uncertainty_messages(spread: ShapeSpread, result: SolveResult, *, stamp_ns: int,
                          frame_id: str, roll: float, confidence: float
-                         ) -> Iterator[tuple[str, Any]]:
-    """``(topic, message)`` for ``tip_pose_with_covariance`` and ``shape_band`` (see the
+                         ) -> Iterator[tuple[str, bytes]]:
+    """``(topic, CDR bytes)`` for ``tip_pose_with_covariance`` and ``shape_band`` (see the
     module docstring), turned by ``roll`` (rad about +z)."""
-    hdr = header_msg(stamp_ns, frame_id)
+    hdr = cdr_header(stamp_ns, frame_id)
     turn = roll_points(np.eye(3), roll).T  # R: a point p turns to R p
     tip = roll_points(result.tip_position, roll)
     quat = roll_quaternions(result.tip_quaternion, roll)
@@ -87,14 +89,10 @@ def uncertainty_messages(spread: ShapeSpread, result: SolveResult, *, stamp_ns: 
     covariance[:3, :3] = turn @ spread.covariances[-1] @ turn.T
     normal_axis = turn @ np.array([0.0, 1.0, 0.0])  # the bending plane's normal: the tip bends about it
     covariance[3:, 3:] = spread.tip_angle_variance * np.outer(normal_axis, normal_axis)
-    point, quaternion = msg_class("geometry_msgs/msg/Point"), msg_class(
-        "geometry_msgs/msg/Quaternion")
-    pose = msg_class("geometry_msgs/msg/Pose")(
-        position=point(x=tip[0], y=tip[1], z=tip[2]),
-        orientation=quaternion(x=quat[0], y=quat[1], z=quat[2], w=quat[3]))
-    yield "tip_pose_with_covariance", msg_class("geometry_msgs/msg/PoseWithCovarianceStamped")(
-        header=hdr, pose=msg_class("geometry_msgs/msg/PoseWithCovariance")(
-            pose=pose, covariance=covariance.ravel()))
+    writer = CdrWriter()  # PoseWithCovarianceStamped: header, then float64s from the pose on
+    writer.raw(hdr)
+    writer.raw(np.concatenate([tip, quat, covariance.ravel()]).astype("<f8").tobytes(), 8)
+    yield "tip_pose_with_covariance", writer.data()
     yield "shape_band", _band_marker(hdr, band_edges(spread, confidence), roll)
 
 
@@ -108,11 +106,10 @@ def band_edges(spread: ShapeSpread, confidence: float) -> tuple[Array, Array]:
     return spread.points + half * normal, spread.points - half * normal
 
 
-def _band_marker(hdr: Any, edges: tuple[Array, Array], roll: float) -> Any:
-    """The band as a ``TRIANGLE_LIST`` marker: two triangles per pair of samples."""
+def _band_marker(hdr: bytes, edges: tuple[Array, Array], roll: float) -> bytes:
+    """The band as a ``TRIANGLE_LIST`` marker (CDR, header ``hdr``): two triangles per pair
+    of samples."""
     outer, inner = (roll_points(edge, roll) for edge in edges)
     corners = np.stack([outer[:-1], inner[:-1], outer[1:], inner[:-1], inner[1:], outer[1:]],
                        axis=1).reshape(-1, 3)
-    point = msg_class("geometry_msgs/msg/Point")
-    return marker_msg(hdr, BAND_NAMESPACE, 0, TRIANGLE_LIST, (1.0, 1.0, 1.0), BAND_COLOR,
-                      [point(x=x, y=y, z=z) for x, y, z in corners.tolist()])
+    return marker_cdr(hdr, BAND_STYLE, corners)

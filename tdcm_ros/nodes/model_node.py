@@ -448,10 +448,10 @@ class ModelNode(NodeLogic):
             self.counts[f"model_band_{error.kind}"] += 1
             self.last_failure = f"band at tension {_shown(tension)} N: {error}"
             return
-        for topic, message in uncertainty_messages(
+        for topic, data in uncertainty_messages(
                 spread, result, stamp_ns=stamp_ns, frame_id=config.frame_id, roll=roll,
                 confidence=config.band_confidence):
-            self.publishers[topic].publish(message)
+            self.publishers[topic].publish_cdr(data)
 
     def check_input(self) -> Status:
         """WARN while a tension was dropped within the window (it recovers), else OK; the

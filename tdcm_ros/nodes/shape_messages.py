@@ -4,23 +4,23 @@ All poses are in the frame given as ``frame_id`` (``tdcm_base`` by default, see 
 positions in m, orientations as quaternions of the body frame (z axis = midline tangent), the
 planar shape turned by the roll (rad) about the base +z axis (:mod:`tdcm_ros.model.roll`).
 The model node does this for every input (see bench_latency.py), so the pose messages
-(``Path``, ``PoseArray``, ``PoseStamped``) are written as CDR straight from the pose arrays
+(``Path``, ``PoseArray``, ``PoseStamped``) and the markers (``visualization_msgs/Marker``,
+:func:`write_marker`) are written as CDR straight from the arrays
 (:class:`~tdcm_ros.bagio.CdrWriter`, the bytes rosbags would give), one ``pose_at`` call per
-result; the marker messages are built from the typestore classes (not through ``from_dict``)
-and serialised.
+result.
 """
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Iterator
-from dataclasses import replace
-from functools import lru_cache
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import CdrWriter, cdr_header, from_dict, msg_class, serialize
+from tdcm_ros.bagio import CdrWriter, cdr_header, cdr_string
 from tdcm_ros.model import SolveResult, offset_points, roll_poses
 
 Array = NDArray[np.float64]
@@ -35,14 +35,6 @@ def header(stamp_ns: int, frame_id: str) -> dict[str, Any]:
 def stamp_ns_of(message: Any) -> int:
     """The header stamp of ``message`` (ns since the epoch; 0 when never set)."""
     return int(message.header.stamp.sec) * 1_000_000_000 + int(message.header.stamp.nanosec)
-
-
-def header_msg(stamp_ns: int, frame_id: str) -> Any:
-    """A ``std_msgs/Header`` message object for ``stamp_ns`` (ns since the epoch)."""
-    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
-    return msg_class("std_msgs/msg/Header")(
-        stamp=msg_class("builtin_interfaces/msg/Time")(sec=sec, nanosec=nanosec),
-        frame_id=frame_id)
 
 
 def _pose_rows(positions: Array, quats: Array) -> Array:
@@ -77,27 +69,80 @@ def pose_array_cdr(hdr: bytes, poses: Array) -> bytes:
     return writer.data()
 
 
-def _points(poses: Array) -> list[Any]:
-    """``geometry_msgs/Point`` objects of the positions (m) of ``poses`` (k, 7)."""
-    point = msg_class("geometry_msgs/msg/Point")
-    return [point(x=x, y=y, z=z) for x, y, z in poses[:, :3].tolist()]
+LINE_STRIP, SPHERE_LIST, TRIANGLE_LIST = 4, 7, 11  #: ``visualization_msgs/Marker`` types
+_IDS = struct.Struct("<3i")  # id, type, action (ADD: 0)
+_POSE_SCALE = struct.Struct("<10d")  # pose (identity), scale
+_LOOK = struct.Struct("<4fiI?")  # color, lifetime (0: forever), frame_locked
+_IDENTITY = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
 
 
-@lru_cache(maxsize=16)
-def _marker_template(ns: str, marker_id: int, marker_type: int, scale: tuple[float, float, float],
-                     color: tuple[float, float, float, float]) -> Any:
-    return from_dict("visualization_msgs/msg/Marker", {
-        "ns": ns, "id": marker_id, "type": marker_type, "action": 0,
-        "pose": {"orientation": {"w": 1.0}}, "scale": dict(zip("xyz", scale, strict=True)),
-        "color": dict(zip("rgba", color, strict=True)), "frame_locked": True})
+def _empty_marker_tail() -> bytes:
+    """A ``Marker``'s fields after ``points``, all empty, at a 4-aligned position (they align
+    to 4 at most, so the bytes are the same at any such position)."""
+    writer = CdrWriter()
+    writer.uint32(0)  # colors
+    writer.raw(cdr_string(""))  # texture_resource
+    writer.header(0, "")  # texture (sensor_msgs/CompressedImage): header,
+    writer.raw(cdr_string(""))  # format
+    writer.uint32(0)  # and data
+    writer.uint32(0)  # uv_coordinates
+    writer.raw(cdr_string(""))  # text
+    writer.raw(cdr_string(""))  # mesh_resource
+    writer.raw(cdr_string(""))  # mesh_file (visualization_msgs/MeshFile): filename
+    writer.uint32(0)  # and data
+    writer.raw(b"\x00", 1)  # mesh_use_embedded_materials
+    return writer.data()[4:]
 
 
-def marker_msg(hdr: Any, ns: str, marker_id: int, marker_type: int,
-            scale: tuple[float, float, float], color: tuple[float, float, float, float],
-            points: list[Any]) -> Any:
-    """A ``visualization_msgs/Marker``: a cached template with this header and points."""
-    return replace(_marker_template(ns, marker_id, marker_type, scale, color), header=hdr,
-                   points=points)
+_MARKER_TAIL = _empty_marker_tail()
+
+
+@dataclass(frozen=True)
+class MarkerStyle:
+    """What a ``visualization_msgs/Marker`` of the model node keeps from one message to the
+    next: namespace, id, type (e.g. :data:`LINE_STRIP`), scale (m) and color (RGBA, 0..1)."""
+
+    ns: str
+    marker_id: int
+    marker_type: int
+    scale: tuple[float, float, float]
+    color: tuple[float, float, float, float]
+
+
+def write_marker(writer: CdrWriter, hdr: bytes, style: MarkerStyle, points: Array) -> None:
+    """A ``visualization_msgs/Marker`` (Jazzy) to ``writer``: header ``hdr``
+    (:func:`cdr_header`), ``style``, action ADD, identity pose, lifetime 0, frame locked, the
+    ``points`` (k, 3) m; no per-point colors, texture, uv coordinates, text or mesh."""
+    writer.raw(hdr)
+    writer.raw(cdr_string(style.ns))
+    writer.raw(_IDS.pack(style.marker_id, style.marker_type, 0))
+    writer.raw(_POSE_SCALE.pack(*_IDENTITY, *style.scale), 8)
+    writer.raw(_LOOK.pack(*style.color, 0, 0, True))
+    writer.uint32(len(points))
+    writer.records(b"", points)
+    writer.raw(_MARKER_TAIL)
+
+
+def marker_cdr(hdr: bytes, style: MarkerStyle, points: Array) -> bytes:
+    """CDR of one ``visualization_msgs/Marker`` (see :func:`write_marker`)."""
+    writer = CdrWriter()
+    write_marker(writer, hdr, style, points)
+    return writer.data()
+
+
+def marker_array_cdr(hdr: bytes, markers: list[tuple[MarkerStyle, Array]]) -> bytes:
+    """CDR of a ``visualization_msgs/MarkerArray``: a marker of header ``hdr`` per
+    ``(style, points)`` (see :func:`write_marker`)."""
+    writer = CdrWriter()
+    writer.uint32(len(markers))
+    for style, points in markers:
+        write_marker(writer, hdr, style, points)
+    return writer.data()
+
+
+#: The predicted markers as spheres (``body_markers``' second marker).
+PREDICTED_MARKERS = MarkerStyle("tdcm_predicted_markers", 1, SPHERE_LIST, (0.002, 0.002, 0.002),
+                                (1.0, 0.2, 0.8, 1.0))
 
 
 def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, samples: int,
@@ -123,10 +168,7 @@ def midline_messages(result: SolveResult, *, stamp_ns: int, frame_id: str, sampl
     yield "midline_poses", pose_array_cdr(hdr, poses[:samples])
     yield "tip_pose", pose_stamped_cdr(hdr, poses[-1])
     yield "predicted_markers", pose_array_cdr(hdr, poses[samples:-1])
-    header_object = header_msg(stamp_ns, frame_id)
-    body = marker_msg(header_object, "tdcm_body", 0, 4, (2.0 * result.design.R_outer, 0.0, 0.0),
-                      (0.85, 0.85, 0.9, 0.8), _points(poses[:samples]))
-    spheres = marker_msg(header_object, "tdcm_predicted_markers", 1, 7, (0.002, 0.002, 0.002),
-                         (1.0, 0.2, 0.8, 1.0), _points(poses[samples:-1]))
-    yield "body_markers", serialize(msg_class("visualization_msgs/msg/MarkerArray")(
-        markers=[body, spheres]), "visualization_msgs/msg/MarkerArray")
+    body = MarkerStyle("tdcm_body", 0, LINE_STRIP, (2.0 * result.design.R_outer, 0.0, 0.0),
+                       (0.85, 0.85, 0.9, 0.8))
+    yield "body_markers", marker_array_cdr(hdr, [(body, poses[:samples, :3]),
+                                                 (PREDICTED_MARKERS, poses[samples:-1, :3])])

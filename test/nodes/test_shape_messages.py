@@ -57,7 +57,7 @@ def test_midline_first_stamped_and_equal_to_the_solution():
 
 
 def test_successive_builds_do_not_share_headers_or_points():
-    """The marker templates are cached: a later build must not change an earlier one."""
+    """A later build must not change an earlier one (no header or points shared)."""
     def raw(tension: float, stamp_ns: int, samples: int) -> dict:
         result = solve(preset("paper-experiment"), tension)
         return {topic: deserialize(data, TYPES[topic]) for topic, data in midline_messages(
