@@ -285,17 +285,11 @@ def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
     import numpy as np
 
     from tdcm_ros.model import SolverSettings
-    from tdcm_ros.model.batch import CHUNK, _KernelArrays, _Stack, solve_batch
+    from tdcm_ros.model.batch import _Stack, prepare_batch, solve_batch
     from tdcm_ros.model.grid import NESTED, _prototype_integrals, grid_parts
     from tdcm_ros.model.grid_layout import PEAK_SAMPLES, Members, cell_table, prototypes
 
     settings = SolverSettings()
-
-    def gathers(parts: Any) -> None:
-        """Every chunk's kernel arrays, each dropped after use as in ``solve_batch``."""
-        for _, stack in _Stack.split(parts, settings):
-            for k in range(0, stack.rows.size, CHUNK):
-                _KernelArrays.of(parts, stack.rows[k:k + CHUNK])
 
     rng = np.random.default_rng(2024)
     paper_like(args.designs, rng)
@@ -306,6 +300,7 @@ def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
               settings.cells_per_tube)
     proto = prototypes(members, *layout)
     parts = grid_parts(many, settings)
+    prepared = prepare_batch(many, settings=settings)
     steps: list[tuple[str, Callable[[], object]]] = [
         ("solve_batch, all of it", lambda: solve_batch(many, many_t, settings=settings)),
         ("Members.of (collect, check rigidity)", lambda: Members.of(many)),
@@ -315,7 +310,8 @@ def breakdown(args: argparse.Namespace, results: BenchResults) -> None:
          lambda: _prototype_integrals(proto, settings.quad_order, NESTED)),
         ("grid kernel, interpolated partial integrals",
          lambda: _prototype_integrals(proto, settings.quad_order, INTERPOLATED)),
-        ("kernel arrays + strain per chunk (gathers)", lambda: gathers(parts))]
+        ("stacks' index tables (kernel_indices)", lambda: _Stack.split(parts, settings)),
+        ("iteration (BatchGrids.solve, grids built)", lambda: prepared.solve(many_t))]
     print(f"many designs {args.many} x 1: CPU time (process_time), best of {args.repeat}")
     kernel_ms: dict[str, float] = {}
     rows = []

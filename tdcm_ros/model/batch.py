@@ -2,8 +2,10 @@
 
 Every design's grid is built at once (:func:`~tdcm_ros.model.grid.grid_parts`, compiled;
 a :class:`~tdcm_ros.model.grid.Grid` object is built only for a member whose limit check
-needs its error message); designs of one cell count are stacked as
-:class:`~tdcm_ros.model.cells.Cells` (a leading member axis) and every member
+needs its error message); designs of one cell count form a stack, whose members the
+compiled iteration reads through per-design index tables into the prototype cells' integrals
+(:func:`~tdcm_ros.model.kernel.iterate_prototypes`: each design's cells laid out in cache as it
+is iterated, no gathered copy of every design's), and every member
 runs the kernels of :func:`tdcm_ros.model.solve` itself (:mod:`tdcm_ros.model.kernel`:
 closed-form loads, initial moment ``R_c T``, stop when no node moves more than ``tol``):
 plain (or, for ``acceleration="relaxation"``, damped) iteration runs in the kernel; a member that ``solve`` would hand to Anderson mixing, relaxation or
@@ -29,14 +31,13 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tdcm_ros.model import grid_kernel
-from tdcm_ros.model.cells import Cells
-from tdcm_ros.model.compiled import grid_kernels, kernels
+from tdcm_ros.model.cells import FC_FIELDS, FQ_FIELDS
+from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import (
     InvalidDesignError,
@@ -49,7 +50,7 @@ from tdcm_ros.model.grid import (
     PEAK_SAMPLES,
     Grid,
     GridParts,
-    arm_weighted,
+    KernelIndices,
     build_grid,
     grid_parts,
 )
@@ -107,37 +108,20 @@ class BatchResult:
 
 
 @dataclass(frozen=True, eq=False)
-class _KernelArrays:
-    """What the compiled iteration reads for some designs: their :class:`Cells`, and per
-    design its notch cells ``notch_cells`` (-1: padding) and the strain coefficients
-    ``strain0``/``strain1`` (designs, notch cells, samples) giving the bending strain at
-    ``PEAK_SAMPLES`` points of every notch cell as ``|m_a S0 + m_b S1|``."""
-
-    cells: Cells
-    notch_cells: NDArray[np.int64]
-    strain0: Array
-    strain1: Array
-
-    @classmethod
-    def of(cls, parts: GridParts, rows: NDArray[np.int64]) -> _KernelArrays:
-        """Gathered from the prototype cells of designs ``rows`` of ``parts``."""
-        return cls(parts.cells(rows), *_strain_coefficients(parts, rows))
-
-
-@dataclass(frozen=True, eq=False)
 class _Stack:
     """Designs ``rows`` of ``parts``, all of one cell count; per design its tendon offset
     ``r_c`` (m) and largest compliance where the tendon follows the body
-    ``constrained_peak_c`` (1/(N m^2)), for the screening before iterating. The kernel
-    arrays are gathered per chunk of members (:meth:`arrays`), or once for the whole stack
-    when it has at most ``CHUNK`` designs (a design-space sweep)."""
+    ``constrained_peak_c`` (1/(N m^2)), for the screening before iterating, and what the
+    compiled iteration reads besides the prototype cells' integrals (``indices``, built once
+    with the stack: :func:`~tdcm_ros.model.kernel.iterate_prototypes` lays each design's
+    numbers out in cache as it iterates it)."""
 
     parts: GridParts
     rows: NDArray[np.int64]
     settings: SolverSettings
     r_c: Array
     constrained_peak_c: Array
-    _whole: dict[str, _KernelArrays] = field(default_factory=dict)
+    indices: KernelIndices
 
     @classmethod
     def split(cls, parts: GridParts, settings: SolverSettings
@@ -147,28 +131,15 @@ class _Stack:
         proto = parts.table.prototypes
         peak = np.zeros(counts.size)
         follows = ~proto.chord
-        fc = parts.proto_fc[:-1][follows]
-        np.maximum.at(peak, proto.member[follows], arm_weighted(
-            fc[:, grid_kernel.PEAK_C], fc[:, grid_kernel.XB_START], fc[:, grid_kernel.XB_END],
-            parts.members.R_c[proto.member[follows]]))
+        np.maximum.at(peak, proto.member[follows], parts.arm_weighted_peaks[:-1][follows])
         out = []
         for count in np.unique(counts):
             rows = np.flatnonzero(counts == count)
             out.append((rows, cls(parts=parts, rows=rows, settings=settings,
                                   r_c=parts.members.R_c[rows],
-                                  constrained_peak_c=peak[rows])))
+                                  constrained_peak_c=peak[rows],
+                                  indices=parts.kernel_indices(rows))))
         return out
-
-    def arrays(self, local: NDArray[np.int64]) -> tuple[_KernelArrays, NDArray[np.int64]]:
-        """The kernel arrays holding designs ``local`` (rows of this stack), and each one's
-        row in them."""
-        if self.rows.size <= CHUNK:
-            whole = self._whole.get("all")
-            if whole is None:
-                whole = self._whole.setdefault("all", _KernelArrays.of(self.parts, self.rows))
-            return whole, local
-        distinct, inverse = np.unique(local, return_inverse=True)
-        return _KernelArrays.of(self.parts, self.rows[distinct]), inverse.astype(np.int64)
 
     def grid(self, row: int) -> Grid:
         """The :class:`Grid` of design ``row`` (built on demand, for an error message)."""
@@ -177,10 +148,14 @@ class _Stack:
     def strain(self, rows: NDArray[np.int64], x: Array) -> Array:
         """Largest notch bending strain of members of design ``rows`` from their cell end
         moments ``x = [m_a, m_b]`` (N m)."""
-        arrays, at = self.arrays(rows)
+        indices = self.indices
+        build = kernels()
+        coefficients = np.empty((rows.size, 2, indices.notch_proto.shape[1], PEAK_SAMPLES))
+        build.gather(indices.notch_proto[rows], np.arange(2), self.parts.proto_strain,
+                     coefficients)
         out = np.empty(rows.size)
-        kernels().peak_strains(at, arrays.notch_cells, arrays.strain0, arrays.strain1,
-                               np.ascontiguousarray(x), out)
+        build.peak_strains(np.arange(rows.size), indices.notch_cells[rows], coefficients[:, 0],
+                           coefficients[:, 1], np.ascontiguousarray(x), out)
         return out
 
 
@@ -422,31 +397,6 @@ def _grids(designs: list[Design], settings: SolverSettings, workers: int, partia
     return valid, parts, invalid
 
 
-def _strain_coefficients(parts: GridParts, rows: NDArray[np.int64]
-                         ) -> tuple[NDArray[np.int64], Array, Array]:
-    """For designs ``rows``: their notch cells (padded with -1) and ``S0``, ``S1`` (designs,
-    notch cells, samples): strain ``|m_a S0 + m_b S1|`` at ``PEAK_SAMPLES`` points of every
-    notch cell (``(1 - xi | xi) c min(h1, R_outer)``, the grid kernel's coefficients of the
-    cell's prototype)."""
-    cell, proto, valid = parts.cells_of(rows)
-    notch = valid & parts.table.is_notch[cell]
-    member, cells = np.nonzero(notch)
-    count = np.sum(notch, axis=1)
-    slot = np.arange(member.size) - np.repeat(np.cumsum(count) - count, count)
-    width = int(count.max(initial=0))
-    notch_cells = np.full((rows.size, width), -1, np.int64)
-    notch_cells[member, slot] = cells
-    source = np.full((rows.size, width), parts.proto_fc.shape[0] - 1, np.int64)
-    source[member, slot] = proto[member, cells]
-    build = grid_kernels()
-    out = []
-    for k in range(2):
-        coefficients = np.empty((rows.size, 1, width, PEAK_SAMPLES))
-        build.gather(source, np.array([k]), parts.proto_strain, coefficients)
-        out.append(coefficients[:, 0])
-    return notch_cells, out[0], out[1]
-
-
 def _screen_group(out: _Outcome, design_ids: NDArray[np.int64], local: NDArray[np.int64],
                   stack: _Stack, settings: SolverSettings
                   ) -> list[tuple[NDArray[np.int64], _Stack, NDArray[np.int64]]]:
@@ -491,9 +441,8 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
     """
     mode = settings.acceleration
     budget = 1 if mode == "anderson" else settings.max_iter
-    arrays, at = st.arrays(rows)
-    cells = arrays.cells
-    n = cells.n_cells
+    indices, parts = st.indices, st.parts
+    n = indices.cell_proto.shape[1]
     tension = out.tensions[members]
     x = np.empty((members.size, 2 * n))
     x[...] = (st.r_c[rows] * tension)[:, None]
@@ -502,11 +451,12 @@ def _iterate(out: _Outcome, members: NDArray[np.int64], st: _Stack, rows: NDArra
     tangent = np.empty((members.size, n + 1), np.complex128)
     info = np.empty((members.size, 3 + budget))
     strain = np.empty(members.size)
-    kernels().iterate_strained(
-        cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, at, tension, x, p, theta,
-        tangent, settings.tol, settings.relaxation if mode == "relaxation" else 1.0,
-        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, arrays.notch_cells,
-        arrays.strain0, arrays.strain1, strain)
+    kernels().iterate_prototypes(
+        parts.proto_fc[..., None], parts.proto_fq, parts.proto_strain, FC_FIELDS, FQ_FIELDS,
+        indices.cell_proto, indices.ic, indices.notch, indices.scal, indices.notch_cells,
+        indices.notch_proto, rows, tension, x, p, theta, tangent, settings.tol,
+        settings.relaxation if mode == "relaxation" else 1.0,
+        SLOW_CONTRACTION if mode == "auto" else 0.0, DIVERGENCE_GROWTH, info, strain)
     done = info[:, 1] == CONVERGED
     out.pending.extend((int(members[i]), st, int(rows[i])) for i in np.flatnonzero(~done))
     out.iterations[members[done]] = info[done, 0].astype(np.int64)

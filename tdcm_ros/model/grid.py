@@ -67,7 +67,7 @@ from tdcm_ros.model.cells import (
     W_A_ROW,
     Cells,
 )
-from tdcm_ros.model.compiled import grid_kernels
+from tdcm_ros.model.compiled import grid_kernels, kernels
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError, InvalidSettingsError
 from tdcm_ros.model.grid_kernel import (
@@ -492,41 +492,75 @@ class GridParts:
             seg_start=seg_start, seg_length=laid(table.seg_length, 0.0),
             u_a=laid(table.u_a, 0.0), u_b=laid(table.u_b, 0.0),
             gauss_u=self.gauss_u, gauss_w=self.gauss_w, **fq, **fc, **strain,
-            cells=self._cells(rows, cell, proto, valid))
+            cells=self.cells(rows))
 
     def cells(self, rows: IntArray) -> Cells:
         """The kernel's arrays of members ``rows``, laid out straight from their prototype
         cells (:meth:`stack` holds the same, with its other arrays)."""
-        return self._cells(rows, *self.cells_of(rows))
-
-    def _cells(self, rows: IntArray, cell: IntArray, proto: IntArray,
-               valid: NDArray[np.bool_]) -> Cells:
-        """:meth:`cells` from the slots :meth:`cells_of` gave for ``rows``."""
-        table, members = self.table, self.members
-        build = grid_kernels()
-        fc = np.empty((rows.size, FC_ROWS, cell.shape[1], 1))
-        build.gather(proto, FC_FIELDS, self.proto_fc[..., None], fc)
-        fq = np.empty((rows.size, FQ_ROWS, cell.shape[1], self.gauss_u.size))
-        build.gather(proto, FQ_FIELDS, self.proto_fq, fq)
+        indices = self.kernel_indices(rows)
+        build = kernels()
+        fc = np.empty((rows.size, FC_ROWS, indices.cell_proto.shape[1], 1))
+        build.gather(indices.cell_proto, FC_FIELDS, self.proto_fc[..., None], fc)
+        fq = np.empty((rows.size, FQ_ROWS, indices.cell_proto.shape[1], self.gauss_u.size))
+        build.gather(indices.cell_proto, FQ_FIELDS, self.proto_fq, fq)
         fq[:, W_A_ROW] = 0.0  # a rigid midline (see _build_grid)
-        tip = table.count[rows][:, None]
-        constrained = np.where(valid, table.constrained[cell], True)
-        ic = np.stack([np.where(valid, table.chord_start_node[cell], tip),
-                       np.where(valid, table.chord_end_node[cell], tip),
-                       constrained], axis=1).astype(np.int64)
-        notches = int(members.N[rows].max())
-        fc_of = self.proto_fc[proto]
-        peak = np.where(constrained, arm_weighted(
-            fc_of[..., grid_kernel.PEAK_C], fc_of[..., grid_kernel.XB_START],
-            fc_of[..., grid_kernel.XB_END], members.R_c[rows][:, None]), 0.0)
+        return Cells(fc=fc[..., 0], fq=fq, ic=indices.ic, notch=indices.notch,
+                     scal=indices.scal)
+
+    def kernel_indices(self, rows: IntArray) -> KernelIndices:
+        """The :class:`KernelIndices` of members ``rows``, padded to the most cells and
+        notches among them (the compiled :func:`~tdcm_ros.model.grid_kernel.member_cells`)."""
+        table, members = self.table, self.members
+        width = int(table.count[rows].max())
+        pad = self.proto_fc.shape[0] - 1
+        cell_proto = np.empty((rows.size, width), np.int64)
+        ic = np.empty((rows.size, 3, width), np.int64)
+        notch_width = int(self.notch_cell_counts[rows].max(initial=0))
+        notch_cells = np.empty((rows.size, notch_width), np.int64)
+        notch_proto = np.empty((rows.size, notch_width), np.int64)
+        grid_kernels().member_cells(rows, table.first, table.count, table.prototype,
+                                    table.is_notch, table.constrained, table.chord_start_node,
+                                    table.chord_end_node, pad, cell_proto, ic, notch_cells,
+                                    notch_proto)
+        peak = np.where(ic[:, 2] != 0, self.arm_weighted_peaks[cell_proto], 0.0)
         scal = np.stack([members.R_c[rows], members.R_outer[rows], members.length[rows],
                          np.max(peak, axis=1, initial=0.0)], axis=1)
-        return Cells(fc=fc[..., 0], fq=fq, ic=ic,
-                     notch=np.concatenate([np.stack([table.notch_left_node[rows, :notches],
-                                                     table.notch_right_node[rows, :notches]],
-                                                    axis=1),
-                                           members.notch_open[rows][:, :, :notches]], axis=1),
-                     scal=scal)
+        notches = int(members.N[rows].max())
+        notch = np.concatenate([np.stack([table.notch_left_node[rows, :notches],
+                                          table.notch_right_node[rows, :notches]], axis=1),
+                                members.notch_open[rows][:, :, :notches]], axis=1)
+        return KernelIndices(cell_proto, ic, notch, scal, notch_cells, notch_proto)
+
+    @cached_property
+    def notch_cell_counts(self) -> IntArray:
+        """Notch cells per member."""
+        table = self.table
+        return np.bincount(table.member[table.is_notch], minlength=table.count.size)
+
+    @cached_property
+    def arm_weighted_peaks(self) -> Array:
+        """Per prototype cell its peak compliance weighted by its arm (:func:`arm_weighted`,
+        1/(N m^2), with its member's ``R_c``), 0 in the padding row."""
+        fc, member = self.proto_fc, self.table.prototypes.member
+        out = np.zeros(fc.shape[0])
+        out[:-1] = arm_weighted(fc[:-1, grid_kernel.PEAK_C], fc[:-1, grid_kernel.XB_START],
+                                fc[:-1, grid_kernel.XB_END], self.members.R_c[member])
+        return out
+
+
+class KernelIndices(NamedTuple):
+    """What a kernel reads of members of :class:`GridParts` besides the prototype cells'
+    integrals, padded to ``W`` cells and ``K`` notches: per member each cell's prototype cell
+    ``cell_proto`` (M, W; the zero row in padding), :class:`~tdcm_ros.model.cells.Cells`'
+    ``ic``, ``notch``, ``scal``, and its notch cells ``notch_cells`` (M, notch cells; -1 in
+    padding) with their prototype cells ``notch_proto``."""
+
+    cell_proto: IntArray
+    ic: IntArray
+    notch: IntArray
+    scal: Array
+    notch_cells: IntArray
+    notch_proto: IntArray
 
 
 def _prototype_integrals(table: Prototypes, quad_order: int, partials: str, workers: int = 1

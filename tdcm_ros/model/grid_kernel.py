@@ -1,4 +1,5 @@
-"""The compliance integrals of grid cells, one loop over cells for one design or many.
+"""The compliance integrals of grid cells, one loop over cells for one design or many, and the
+loops that lay the cells out member by member (:func:`lay_cells`, :func:`member_cells`).
 
 Plain Python on NumPy arrays and scalars, in the subset numba compiles:
 :mod:`tdcm_ros.model.compiled` runs these functions as they are (``TDCM_JIT=0``) or compiled,
@@ -39,6 +40,7 @@ from numpy.typing import NDArray
 
 Array = NDArray[np.float64]
 Ints = NDArray[np.int64]
+Flags = NDArray[np.bool_]
 
 CIRCULAR = 0
 RECTANGULAR = 1
@@ -425,21 +427,89 @@ def _weights_and_chords(chord: bool, scale: float, gauss_w: Array, matrix: Array
             out[A0_T + term, q] = partial if chord else 0.0
 
 
-def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
-    """``out[m, f, j, :] = source[index[m, j], fields[f], :]``: prototype cells' values
-    (source (P, F, Q)) laid out per member (out (M, len(fields), W, Q)), field-major as
-    :mod:`tdcm_ros.model.kernel` reads them."""
-    for m in range(index.shape[0]):
-        for f in range(fields.shape[0]):
-            field = fields[f]
-            for j in range(index.shape[1]):
-                p = index[m, j]
-                for q in range(out.shape[3]):
-                    out[m, f, j, q] = source[p, field, q]
+def lay_cells(seg_counts: Ints, slot_kind: Ints, kind_first: Ints, kind_is_notch: Flags,
+              start: Array, shape_first: Ints, proto_shape: Ints, proto_a: Array,
+              proto_seg_length: Array, proto_u_a: Array, proto_u_b: Array, follows: bool,
+              ints: Ints, floats: Array, flags: Flags) -> None:
+    """Every member's segments end to end, each a copy of its kind's prototype cells: the
+    cells of :class:`tdcm_ros.model.grid_layout.CellTable`, flat (members one after another,
+    base to tip).
+
+    Per member ``m`` and slot ``s`` (base, then notch ``i`` and the tube after it):
+    ``seg_counts`` its cells (0 for an absent segment), ``slot_kind`` its segment kind,
+    ``start`` its start along the body (m); per member and kind ``kind_first`` its first
+    prototype cell, ``kind_is_notch``; per member ``shape_first`` (its first notch shape); per
+    prototype cell its notch shape and its ``a`` (from the segment start), ``seg_length``,
+    ``u_a``, ``u_b``; ``follows``: the tendon follows the body in notches (else in tubes).
+    Writes per cell ``ints`` (6, cells): member, prototype, shape (within the member; 0 in
+    tubes), notch index (-1 in tubes), chord start and end node (its segment's end nodes,
+    within the member); ``floats`` (5, cells): segment start, segment length (m), ``u_a``,
+    ``u_b``, start along the body ``a`` (m); ``flags`` (2, cells): is a notch, the tendon
+    follows the body there."""
+    c = 0
+    for m in range(seg_counts.shape[0]):
+        node = 0
+        for s in range(seg_counts.shape[1]):
+            kind = slot_kind[m, s]
+            notch = kind_is_notch[m, kind]
+            size = seg_counts[m, s]
+            begin = start[m, s]
+            for j in range(size):
+                p = kind_first[m, kind] + j
+                ints[0, c] = m
+                ints[1, c] = p
+                ints[2, c] = proto_shape[p] - shape_first[m] if notch else 0
+                ints[3, c] = (s - 1) // 2 if notch else -1
+                ints[4, c] = node
+                ints[5, c] = node + size
+                floats[0, c] = begin
+                floats[1, c] = proto_seg_length[p]
+                floats[2, c] = proto_u_a[p]
+                floats[3, c] = proto_u_b[p]
+                floats[4, c] = begin if j == 0 else begin + proto_a[p]
+                flags[0, c] = notch
+                flags[1, c] = notch == follows
+                c += 1
+            node += size
+
+
+def member_cells(rows: Ints, first: Ints, count: Ints, prototype: Ints, is_notch: Flags,
+                 constrained: Flags, chord_start: Ints, chord_end: Ints, pad: int,
+                 cell_proto: Ints, ic: Ints, notch_cells: Ints, notch_proto: Ints) -> None:
+    """For members ``rows`` of a flat cell table (their cells ``first`` on, ``count`` of them;
+    per cell its ``prototype``, ``is_notch``, ``constrained``, chord start and end node),
+    padded to ``W = cell_proto.shape[1]`` cells: each slot's prototype cell ``cell_proto`` (R,
+    W; ``pad``, the zero row, in padding), the iteration's ``ic`` (R, 3, W: chord start and end
+    node, 1 where the tendon follows the body; in padding the tip node twice and 1), and its
+    notch cells ``notch_cells`` (R, notch cells; -1 in padding) with their prototypes
+    ``notch_proto`` (``pad`` in padding)."""
+    for r in range(rows.shape[0]):
+        m = rows[r]
+        tip = count[m]
+        k = 0
+        for j in range(cell_proto.shape[1]):
+            if j < tip:
+                c = first[m] + j
+                cell_proto[r, j] = prototype[c]
+                ic[r, 0, j] = chord_start[c]
+                ic[r, 1, j] = chord_end[c]
+                ic[r, 2, j] = 1 if constrained[c] else 0
+                if is_notch[c]:
+                    notch_cells[r, k] = j
+                    notch_proto[r, k] = prototype[c]
+                    k += 1
+            else:
+                cell_proto[r, j] = pad
+                ic[r, 0, j] = tip
+                ic[r, 1, j] = tip
+                ic[r, 2, j] = 1
+        for j in range(k, notch_cells.shape[1]):
+            notch_cells[r, j] = -1
+            notch_proto[r, j] = pad
 
 
 KERNELS = ("disc_strip_moment", "notched_inertia", "notched_inertias", "notch_compliance",
            "disc_strip", "offset_section", "geometry", "profile_points", "point", "points",
            "_weights_and_chords", "_probes", "_nested_partials",
-           "_interpolated_partials", "cell_integrals", "gather")
+           "_interpolated_partials", "cell_integrals", "lay_cells", "member_cells")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.model.compiled import grid_kernels
 from tdcm_ros.model.design import Design, uniform_length
 from tdcm_ros.model.errors import InvalidDesignError
 from tdcm_ros.model.profiles import (
@@ -406,7 +407,8 @@ def prototypes(members: Members, routing: str, kind: str, cells_per_notch: int,
 
 
 def cell_table(proto: Prototypes, routing: str) -> CellTable:
-    """Lay every member's segments end to end, each a copy of its kind's prototype cells."""
+    """Lay every member's segments end to end, each a copy of its kind's prototype cells (the
+    compiled :func:`~tdcm_ros.model.grid_kernel.lay_cells`)."""
     members = proto.members
     m_count = members.N.size
     n_max = int(members.N.max())
@@ -418,32 +420,26 @@ def cell_table(proto: Prototypes, routing: str) -> CellTable:
     start[:, 1::2] = members.notch_left
     start[:, 2::2] = members.notch_right
     slot_kind = members.slot_kind
-    rows = np.arange(m_count)[:, None]
-    seg_counts = proto.count[rows, slot_kind]
+    seg_counts = proto.count[np.arange(m_count)[:, None], slot_kind]
     seg_counts[:, 1:] *= np.repeat(has, 2, axis=1)
-
-    flat = seg_counts.ravel()
-    segment = np.repeat(np.arange(flat.size), flat)
-    member = segment // slots
-    slot = segment % slots
-    j = np.arange(segment.size) - (np.cumsum(flat) - flat)[segment]
-    kind = slot_kind[member, slot]
-    prototype = proto.first[member, kind] + j
     count = seg_counts.sum(axis=1)
+    total = int(count.sum())
+    ints = np.empty((6, total), np.int64)
+    floats = np.empty((5, total))
+    flags = np.empty((2, total), bool)
+    grid_kernels().lay_cells(seg_counts, slot_kind, proto.first, members.kind_is_notch, start,
+                             members.shape_first, proto.shape, proto.a, proto.seg_length,
+                             proto.u_a, proto.u_b, _tendon_follows_notches(routing), ints,
+                             floats, flags)
     seg_first = np.cumsum(seg_counts, axis=1) - seg_counts
-    is_notch = members.kind_is_notch[member, kind]
-    seg_start = start[member, slot]
-    chord_start = seg_first[member, slot]
     tip = count[:, None]
+    member, prototype, shape, notch_index, chord_start, chord_end = ints
+    seg_start, seg_length, u_a, u_b, a = floats
     return CellTable(
-        prototypes=proto, member=member, prototype=prototype,
-        shape=np.where(is_notch, proto.shape[prototype] - members.shape_first[member], 0),
-        count=count, first=np.cumsum(count) - count, is_notch=is_notch,
-        notch_index=np.where(is_notch, (slot - 1) // 2, -1), seg_start=seg_start,
-        seg_length=proto.seg_length[prototype], u_a=proto.u_a[prototype],
-        u_b=proto.u_b[prototype], a=np.where(j == 0, seg_start, seg_start + proto.a[prototype]),
-        constrained=is_notch == _tendon_follows_notches(routing), chord_start_node=chord_start,
-        chord_end_node=chord_start + seg_counts[member, slot],
+        prototypes=proto, member=member, prototype=prototype, shape=shape, count=count,
+        first=np.cumsum(count) - count, is_notch=flags[0], notch_index=notch_index,
+        seg_start=seg_start, seg_length=seg_length, u_a=u_a, u_b=u_b, a=a,
+        constrained=flags[1], chord_start_node=chord_start, chord_end_node=chord_end,
         notch_left_node=np.where(has, seg_first[:, 1::2], tip),
         notch_right_node=np.where(has, seg_first[:, 1::2] + seg_counts[:, 1::2], tip))
 

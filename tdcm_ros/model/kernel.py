@@ -210,6 +210,13 @@ def gaps(scal: Array, p: Complex, tangent: Complex, notch: Ints, out: Array) -> 
         gaps_row(scal[j, 1], p[j], tangent[j], notch[j], out[j])
 
 
+def row_scratch(n: int, notches: int) -> tuple[Array, Array, Complex, Array, Complex, Array]:
+    """:func:`iterate_row`'s scratch for ``n`` cells and ``notches`` notches: ``g`` (2n,),
+    ``t_a`` (n,), ``new_p``, ``new_theta``, ``new_tangent`` (n + 1,), ``notch_gaps``."""
+    return (np.empty(2 * n), np.empty(n), np.empty(n + 1, np.complex128), np.empty(n + 1),
+            np.empty(n + 1, np.complex128), np.empty(notches))
+
+
 def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
             tension: Array, x: Array, p: Complex, theta: Array, tangent: Complex, tol: float,
             relaxation: float, slow: float, growth: float, info: Array) -> None:
@@ -226,13 +233,8 @@ def iterate(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints
     smallest step after 5 steps), ``SLOWED`` (``slow > 0`` and a step > ``slow`` x the
     previous one), ``EXHAUSTED`` (``budget = info.shape[1] - 3`` steps).
     """
-    n = fc.shape[2]
-    g = np.empty(2 * n)
-    t_a = np.empty(n)
-    new_p = np.empty(n + 1, np.complex128)
-    new_theta = np.empty(n + 1)
-    new_tangent = np.empty(n + 1, np.complex128)
-    notch_gaps = np.empty(notch.shape[2])
+    g, t_a, new_p, new_theta, new_tangent, notch_gaps = row_scratch(fc.shape[2],
+                                                                    notch.shape[2])
     for j in range(x.shape[0]):
         row = rows[j]
         iterate_row(fc[row], fq[row], ic[row], notch[row], scal[row], tension[j], x[j], p[j],
@@ -298,20 +300,66 @@ def iterate_row(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tensio
     info[2] = least
 
 
-def iterate_strained(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, rows: Ints,
-                     tension: Array, x: Array, p: Complex, theta: Array, tangent: Complex,
-                     tol: float, relaxation: float, slow: float, growth: float, info: Array,
-                     strain_cells: Ints, s0: Array, s1: Array, strain: Array) -> None:
-    """:func:`iterate`, then for every converged member ``j`` its peak notch strain
-    ``strain[j]`` (:func:`peak_strain_row` over ``strain_cells``, ``s0``, ``s1`` of design
-    row ``rows[j]``, as :func:`peak_strains`) in the same compiled call; the others' entries
-    are left untouched."""
-    iterate(fc, fq, ic, notch, scal, rows, tension, x, p, theta, tangent, tol, relaxation,
-            slow, growth, info)
+def lay_out(cells: Ints, fields: Ints, source: Array, out: Array) -> None:
+    """``out[f, j, :] = source[cells[j], fields[f], :]``: one design's rows ``fields`` of a
+    prototype-cell table ``source`` (P, F, Q) laid out along its cells (``cells``: each one's
+    prototype), field-major as the iteration reads them (``out`` (len(fields), W, Q))."""
+    for f in range(fields.shape[0]):
+        field = fields[f]
+        for j in range(cells.shape[0]):
+            row = cells[j]
+            for q in range(out.shape[2]):
+                out[f, j, q] = source[row, field, q]
+
+
+def gather(index: Ints, fields: Ints, source: Array, out: Array) -> None:
+    """:func:`lay_out` of every member: ``out[m, f, j, :] = source[index[m, j], fields[f],
+    :]`` (``out`` (M, len(fields), W, Q))."""
+    for m in range(index.shape[0]):
+        lay_out(index[m], fields, source, out[m])
+
+
+def iterate_prototypes(proto_fc: Array, proto_fq: Array, proto_strain: Array, fc_fields: Ints,
+                       fq_fields: Ints, cell_proto: Ints, ic: Ints, notch: Ints, scal: Array,
+                       notch_cells: Ints, notch_proto: Ints, rows: Ints, tension: Array,
+                       x: Array, p: Complex, theta: Array, tangent: Complex, tol: float,
+                       relaxation: float, slow: float, growth: float, info: Array,
+                       strain: Array) -> None:
+    """:func:`iterate` of members ``j`` of design rows ``rows[j]`` whose cell arrays are read
+    from prototype-cell tables (a batch of many designs, :class:`tdcm_ros.model.grid.GridParts`),
+    then each converged member's peak notch strain ``strain[j]`` (:func:`peak_strain_row`; the
+    others' entries are left untouched).
+
+    Per design row: ``cell_proto`` (W,) each cell's prototype, ``ic``, ``notch``, ``scal`` as
+    :func:`iterate` reads them, ``notch_cells`` (notch cells; -1 padding) and ``notch_proto``
+    their prototypes. The prototype tables: ``proto_fc`` (P, F, 1) and ``proto_fq`` (P, G, Q),
+    of which rows ``fc_fields``, ``fq_fields`` are the iteration's ``fc`` and ``fq`` rows (its
+    last ``fq`` row, ``W_A``, is zero: a rigid midline), and ``proto_strain`` (P, 2, samples),
+    the strain coefficients ``S0``, ``S1``. A design's rows are laid out (:func:`lay_out`) into
+    scratch arrays small enough to stay in cache when its first member comes, and kept for the
+    members of the same row that follow it (members ordered by design lay each out once)."""
+    n = cell_proto.shape[1]
+    fc = np.empty(fc_fields.shape[0] * n)
+    fc_rows = fc.reshape((fc_fields.shape[0], n))
+    fc_out = fc.reshape((fc_fields.shape[0], n, 1))
+    fq = np.zeros((fq_fields.shape[0] + 1, n, proto_fq.shape[2]))
+    coefficients = np.empty((2, notch_proto.shape[1], proto_strain.shape[2]))
+    both = np.arange(2)
+    g, t_a, new_p, new_theta, new_tangent, notch_gaps = row_scratch(n, notch.shape[2])
+    last = -1
     for j in range(x.shape[0]):
+        row = rows[j]
+        if row != last:
+            lay_out(cell_proto[row], fc_fields, proto_fc, fc_out)
+            lay_out(cell_proto[row], fq_fields, proto_fq, fq)
+            lay_out(notch_proto[row], both, proto_strain, coefficients)
+            last = row
+        iterate_row(fc_rows, fq, ic[row], notch[row], scal[row], tension[j], x[j], p[j],
+                    theta[j], tangent[j], tol, relaxation, slow, growth, info[j], g, t_a, new_p,
+                    new_theta, new_tangent, notch_gaps)
         if info[j, 1] == CONVERGED:
-            row = rows[j]
-            strain[j] = peak_strain_row(strain_cells[row], s0[row], s1[row], x[j])
+            strain[j] = peak_strain_row(notch_cells[row], coefficients[0], coefficients[1],
+                                        x[j])
 
 
 def one_size(n: int, budget: int) -> int:
@@ -380,5 +428,6 @@ def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: A
 
 
 KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
-           "peak_strain_row", "iterate_row", "iterate", "iterate_strained", "iterate_one", "peak_strains")
+           "peak_strain_row", "iterate_row", "row_scratch", "iterate", "lay_out", "gather",
+           "iterate_prototypes", "iterate_one", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

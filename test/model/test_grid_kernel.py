@@ -6,6 +6,9 @@ import math
 import os
 import subprocess
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import fields
 
 import numpy as np
 import pytest
@@ -16,6 +19,7 @@ from scipy.integrate import quad
 from tdcm_ros.model import CustomProfile, SolverSettings, compiled, grid_kernel, preset
 from tdcm_ros.model.design import MM
 from tdcm_ros.model.grid import grid_parts
+from tdcm_ros.model.grid_layout import cell_table
 from tdcm_ros.model.section import notched_moment
 
 E = 1.7e9
@@ -91,3 +95,67 @@ def test_plain_build_never_imports_numba():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                          check=True)
     assert out.stdout.split()[-1] == "False"
+
+
+@contextmanager
+def build(compiled_build: bool) -> Iterator[None]:
+    """Inside, the compiled or the plain build of every kernel; the choice ends with it."""
+    saved = dict(compiled._state)
+    compiled.use_compiled(compiled_build)
+    try:
+        yield
+    finally:
+        compiled._state.update(saved)
+
+
+@st.composite
+def design_sets(draw: st.DrawFn) -> list:
+    """One to four designs: uniform or notch by notch (own widths, profile, backbone offset),
+    with or without a base, tip and tubes between notches."""
+    base = preset("paper-experiment")
+    out = []
+    for _ in range(draw(st.integers(1, 4))):
+        n = draw(st.integers(1, 6))
+        per_notch = draw(st.booleans())
+
+        def values(low: float, high: float, n: int = n, per_notch: bool = per_notch):
+            one = st.floats(low, high)
+            return [draw(one) * MM for _ in range(n)] if per_notch else draw(one) * MM
+
+        profile = st.sampled_from(["circular", "rectangular"])
+        out.append(base.with_overrides(
+            N=n, w_n=values(0.4, 3.0), w_d=values(0.6, 2.4),
+            w_o=values(0.0, 0.5) if draw(st.booleans()) else 0.0,
+            profile=[draw(profile) for _ in range(n)] if per_notch else draw(profile),
+            w_t=draw(st.sampled_from([0.0, 2.0])) * MM,
+            w_tip=draw(st.sampled_from([0.0, 4.0])) * MM,
+            w_base=draw(st.sampled_from([0.0, 5.0])) * MM))
+    return out
+
+
+@settings(max_examples=40, deadline=None)
+@given(designs=design_sets(), routing=st.sampled_from(["paper", "free"]),
+       grid=st.sampled_from(["adaptive", "uniform"]))
+def test_compiled_layout_and_gathers_equal_the_plain_build_bit_for_bit(designs, routing, grid):
+    """The cell layout (``grid_kernel.lay_cells``), the members' index tables
+    (``grid_kernel.member_cells``) and the kernel arrays laid out from the prototype cells
+    (``kernel.gather``) of the compiled build are the plain build's, bit for bit."""
+    pytest.importorskip("numba")
+    parts = grid_parts(designs, SolverSettings(routing=routing, grid=grid))
+    rows = np.arange(len(designs))[::-1].copy()
+    found = []
+    for flag in (False, True):
+        with build(flag):
+            assert compiled.is_compiled() == flag
+            table = cell_table(parts.table.prototypes, routing)
+            cells = parts.stack(rows).cells
+            found.append([getattr(table, f.name) for f in fields(table)
+                          if f.name != "prototypes"] + list(parts.kernel_indices(rows)) +
+                         [cells.fc, cells.fq, cells.ic, cells.notch, cells.scal])
+    table_fields = [getattr(parts.table, f.name) for f in fields(parts.table)
+                    if f.name != "prototypes"]
+    plain, fast = found
+    assert len(plain) == len(fast) == len(table_fields) + 11
+    for a, b, c in zip(plain, fast, table_fields + fast[len(table_fields):], strict=True):
+        assert a.dtype == b.dtype and a.shape == b.shape
+        assert a.tobytes() == b.tobytes() == c.tobytes()

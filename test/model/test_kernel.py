@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tdcm_ros.model import SolverSettings, compiled, kernel, preset, solve
+from tdcm_ros.model.cells import FC_FIELDS, FQ_FIELDS
 from tdcm_ros.model.grid import build_grid
 from tdcm_ros.model.kinematics import integrate
 from tdcm_ros.model.limits import notch_gaps
@@ -212,35 +213,62 @@ def test_one_shot_picks_the_plain_build_only_inside_and_only_if_unchosen(monkeyp
         assert compiled.is_compiled()  # a loaded build is kept
 
 
+def iterate_both_ways(code, parts, rows, tension, budget):
+    """``iterate_prototypes`` reading ``parts``' prototype tables by index, and ``iterate`` on
+    the same members' gathered cells (:meth:`GridParts.stack`) followed by ``peak_strains``
+    on their gathered strain coefficients: (x, p, theta, tangent, info, strain) of each."""
+    indices = parts.kernel_indices(np.arange(parts.members.N.size))
+    cells = parts.stack(np.arange(parts.members.N.size)).cells
+    n = cells.n_cells
+    out = []
+    for way in ("indexed", "gathered"):
+        m = rows.size
+        x = np.ascontiguousarray(np.broadcast_to((cells.r_c[rows] * tension)[:, None],
+                                                 (m, 2 * n)))
+        shape = [np.empty((m, n + 1), complex), np.empty((m, n + 1)),
+                 np.empty((m, n + 1), complex)]
+        info = np.zeros((m, 3 + budget))
+        strain = np.full(m, np.nan)
+        if way == "indexed":
+            code.iterate_prototypes(parts.proto_fc[..., None], parts.proto_fq,
+                                    parts.proto_strain, FC_FIELDS, FQ_FIELDS,
+                                    indices.cell_proto, indices.ic, indices.notch, indices.scal,
+                                    indices.notch_cells, indices.notch_proto, rows, tension, x,
+                                    *shape, 1e-10, 1.0, 0.3, 1e3, info, strain)
+        else:
+            code.iterate(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows, tension,
+                         x, *shape, 1e-10, 1.0, 0.3, 1e3, info)
+            coefficients = np.empty((cells.members, 2, indices.notch_proto.shape[1],
+                                     parts.proto_strain.shape[2]))
+            code.gather(indices.notch_proto, np.arange(2), parts.proto_strain, coefficients)
+            done = np.flatnonzero(info[:, 1] == kernel.CONVERGED)
+            found = np.empty(done.size)
+            code.peak_strains(rows[done], indices.notch_cells, coefficients[:, 0],
+                              coefficients[:, 1], x[done], found)
+            strain[done] = found
+        out.append((x, *shape, info, strain))
+    return out
+
+
 @pytest.mark.parametrize("build", ["plain", "compiled"])
-def test_iterate_strained_adds_the_peak_strain_of_converged_members_only(build):
-    from tdcm_ros.model.batch import _strain_coefficients
+@pytest.mark.parametrize("routing", ["paper", "free"])
+def test_iterate_prototypes_is_iterate_on_the_gathered_cells_bit_for_bit(build, routing):
+    """The batch's iteration reads each design's cells from the prototype tables through its
+    index tables (padding included: three cell counts, one off-axis design) and lays them out
+    per design as its members come, in any order: the same bits as the iteration on a stack
+    of gathered cells, and the peak strain of converged members only."""
     from tdcm_ros.model.grid import grid_parts
 
     code = kernel if build == "plain" else compiled.kernels()
     base = preset("paper-experiment")
-    designs = [base.with_overrides(N=n, w_n=w) for n, w in ((2, 1e-3), (5, 2e-3), (8, 1.5e-3))]
-    parts = grid_parts(designs, SolverSettings())
-    cells = parts.stack(np.arange(3)).cells
-    notch_cells, s0, s1 = _strain_coefficients(parts, np.arange(3))
-    rows = np.array([0, 1, 2, 2], np.int64)
-    tension = np.array([15.0, 3.0, 9.0, 20.0])
-    n = cells.n_cells
+    designs = [base.with_overrides(N=n, w_n=w, w_o=o)
+               for n, w, o in ((2, 1e-3, 0.0), (5, 2e-3, 0.0), (8, 1.5e-3, 0.0), (3, 1e-3, 3e-4))]
+    parts = grid_parts(designs, SolverSettings(routing=routing))
+    rows = np.array([0, 1, 2, 2, 3, 1, 0], np.int64)
+    tension = np.array([15.0, 3.0, 9.0, 20.0, 12.0, 7.0, 1.0])
     for budget, converges in ((200, True), (0, False)):
-        x = np.ascontiguousarray(np.broadcast_to((cells.r_c[rows] * tension)[:, None],
-                                                 (4, 2 * n)))
-        shape = [np.empty((4, n + 1), complex), np.empty((4, n + 1)),
-                 np.empty((4, n + 1), complex)]
-        info = np.empty((4, 3 + budget))
-        strain = np.full(4, np.nan)
-        code.iterate_strained(cells.fc, cells.fq, cells.ic, cells.notch, cells.scal, rows,
-                              tension, x, *shape, 1e-10, 1.0, 0.3, 1e3, info, notch_cells,
-                              s0, s1, strain)
-        assert np.all((info[:, 1] == kernel.CONVERGED) == converges)
-        if converges:
-            separate = np.empty(4)
-            code.peak_strains(rows, notch_cells, s0, s1, x, separate)
-            np.testing.assert_array_equal(strain, separate)
-            assert np.all(strain > 0.0)
-        else:
-            assert np.all(np.isnan(strain))
+        indexed, gathered = iterate_both_ways(code, parts, rows, tension, budget)
+        for mine, theirs in zip(indexed, gathered, strict=True):
+            assert mine.tobytes() == theirs.tobytes()
+        assert np.all((indexed[4][:, 1] == kernel.CONVERGED) == converges)
+        assert np.all(indexed[5] > 0.0) if converges else np.all(np.isnan(indexed[5]))
