@@ -1,6 +1,7 @@
 """Hazards in evaluated bags: occluded markers (NaN, exactly zero), duplicated messages, a corrupt
 chunk (evaluate and ``bag info`` warn the same) and implausible stamps; reading in batches gives
-the messages decoded one by one, whatever the batch size."""
+the messages decoded one by one, whatever the batch size; the tension and the markers are read in
+one pass, their errors in the order reading them in turn gave."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
 from tdcm_ros.metrics import bagdata
 from tdcm_ros.metrics.bagdata import BagSource, load_bag
+from tdcm_ros.metrics.errors import MetricsError
 from tdcm_ros.metrics.synthetic_bag import write_recording
 from test.metrics.metrics_samples import TRUE_E, small_recording
 
@@ -247,3 +249,41 @@ def test_a_float64_tension_topic_is_read_as_model_node_takes_it(clean: Path,
 def test_a_missing_tension_topic_names_the_option_that_sets_it(clean: Path) -> None:
     with pytest.raises(BagError, match=r"no topic '/force'.*evaluate --tension-topic"):
         load_bag(clean, labels=LABELS, tension_topic="/force")
+
+
+def test_the_tension_and_the_markers_are_read_in_one_pass(
+        clean: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every chunk holds both: one pass decompresses and walks each once, not once per topic."""
+    asked: list[list[str]] = []
+    raw_messages = BagReader.raw_messages
+
+    def recording(self: BagReader, topics: list[str] | None = None):  # type: ignore[no-untyped-def]
+        asked.append(sorted(topics or []))
+        return raw_messages(self, topics)
+
+    monkeypatch.setattr(BagReader, "raw_messages", recording)
+    load_bag(clean, labels=LABELS)
+    assert ["/markers", "/tension"] in asked
+    assert not any(topics in (["/markers"], ["/tension"]) for topics in asked)
+
+
+def _broken_markers(topic: str, stamp: int, data: bytes) -> list[tuple[int, bytes]]:
+    return [(stamp, data[:12] if topic == "/markers" else data)]
+
+
+def test_a_topic_error_comes_where_reading_the_topics_in_turn_raised_it(
+        clean: Path, tmp_path: Path) -> None:
+    """Read in one pass, the tension's errors still come before the markers' (the markers'
+    decoding error is kept until the tension is done), and a missing markers topic is said
+    once the tension is read."""
+    broken = _rewrite(clean, tmp_path / "broken", _broken_markers)
+    with pytest.raises(BagError, match="cannot deserialise 12 bytes as mocap4r2_msgs"):
+        load_bag(broken, labels=LABELS)
+    both = _rewrite(broken, tmp_path / "both", _with_tension_sec(lambda _n: 2**31 - 1))
+    with pytest.raises(MetricsError, match="/tension: all .* stamps are implausible"):
+        load_bag(both, labels=LABELS)
+    absurd = _rewrite(clean, tmp_path / "absurd", _with_tension_sec(lambda _n: 2**31 - 1))
+    with pytest.raises(MetricsError, match="/tension: all .* stamps are implausible"):
+        load_bag(absurd, labels=LABELS, markers_topic="/nosuch")
+    with pytest.raises(BagError, match="no topic '/nosuch'"):
+        load_bag(clean, labels=LABELS, markers_topic="/nosuch")
