@@ -80,6 +80,8 @@ _Read = tuple[np.ndarray, bool, np.ndarray, list[np.ndarray]]
 """A topic read (:meth:`_Reading.result`): stamps (ns since the epoch), whether they are the log
 times, the mask of the messages that are not duplicates and the value arrays."""
 _T = TypeVar("_T")
+_SECONDS_BLOCK = 1 << 16
+"""Stamps converted from ns to s at a time (:func:`_seconds`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,13 +115,15 @@ def _unique(stamps_ns: np.ndarray, digests: np.ndarray) -> np.ndarray:
     return keep
 
 
-def _plausible(stamps_ns: np.ndarray, path: Path, topic: str, warnings: list[str]
-               ) -> np.ndarray:
-    """Mask of the messages whose stamps are plausible (see the module docstring)."""
-    t = stamps_ns * 1e-9
-    keep = (t > 0.0) & (np.abs(t) < MAX_STAMP_S)
+def _plausible(t: np.ndarray, path: Path, topic: str, warnings: list[str]) -> np.ndarray:
+    """Mask of the messages whose stamps ``t`` (s since the epoch) are plausible (see the module
+    docstring). One temporary of the stamps' size at a time."""
+    keep = (t > 0.0) & (t < MAX_STAMP_S)
     if keep.any():
-        keep &= np.abs(t - np.median(t[keep])) <= FAR_S
+        # t[keep] is a copy of its own: its median may sort it in place
+        off = t - np.median(t[keep], overwrite_input=True)
+        keep &= np.abs(off, out=off) <= FAR_S
+        del off
     allowed = f"(0, 2^31 - 1) s since the epoch, within {FAR_S:g} s of the topic's median stamp"
     bad = t[~keep]
     if keep.any() and bad.size:
@@ -254,6 +258,16 @@ def _run(reader: BagReader, plan: _Plan[_T]) -> _T:
     return plan.finish()
 
 
+def _seconds(stamps_ns: np.ndarray) -> np.ndarray:
+    """The stamps ``stamps_ns`` (int64, ns) as float64 seconds, written over their own buffer a
+    block at a time (a ufunc writing over its input copies it whole first): ``stamps_ns`` is
+    spent."""
+    seconds = stamps_ns.view(np.float64)
+    for a in range(0, len(stamps_ns), _SECONDS_BLOCK):
+        seconds[a:a + _SECONDS_BLOCK] = stamps_ns[a:a + _SECONDS_BLOCK] * 1e-9
+    return seconds
+
+
 def _usable(stamps_ns: np.ndarray, from_log: bool, unique: np.ndarray, path: Path, topic: str,
             warnings: list[str]) -> tuple[np.ndarray, np.ndarray]:
     """The stamps (s since the epoch) of the messages kept, neither duplicated (``unique``, which
@@ -264,10 +278,10 @@ def _usable(stamps_ns: np.ndarray, from_log: bool, unique: np.ndarray, path: Pat
         warnings.append(f"{topic}: {dropped} duplicated messages (same stamp and payload as an "
                         "earlier one) left out")
     keep = unique
-    keep[keep] = _plausible(stamps_ns if keep.all() else stamps_ns[keep], path, topic, warnings)
-    stamps = (stamps_ns if keep.all() else stamps_ns[keep]).astype(np.float64)
-    stamps *= 1e-9
-    return stamps, keep
+    stamps = _seconds(stamps_ns if keep.all() else stamps_ns[keep])
+    plausible = _plausible(stamps, path, topic, warnings)
+    keep[keep] = plausible
+    return (stamps if plausible.all() else stamps[plausible]), keep
 
 
 def _tension_series(stamps: np.ndarray, force: np.ndarray) -> TensionSeries:

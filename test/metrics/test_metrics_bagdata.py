@@ -287,3 +287,13 @@ def test_a_topic_error_comes_where_reading_the_topics_in_turn_raised_it(
         load_bag(absurd, labels=LABELS, markers_topic="/nosuch")
     with pytest.raises(BagError, match="no topic '/nosuch'"):
         load_bag(clean, labels=LABELS, markers_topic="/nosuch")
+
+
+def test_stamps_become_seconds_in_their_own_buffer_exactly_as_a_product() -> None:
+    """Block by block over the ns buffer: the same floats as ``stamps_ns * 1e-9``."""
+    stamps_ns = np.random.default_rng(0).integers(1, 2**62, size=3 * bagdata._SECONDS_BLOCK + 7)
+    expected = stamps_ns * 1e-9
+    buffer = stamps_ns.copy()
+    seconds = bagdata._seconds(buffer)
+    assert seconds.dtype == np.float64 and np.shares_memory(seconds, buffer)
+    assert seconds.tobytes() == expected.tobytes()
