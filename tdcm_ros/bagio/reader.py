@@ -48,7 +48,7 @@ MCAP_MAGIC = b"\x89MCAP0\r\n"
 SQLITE_MAGIC = b"SQLite format 3\x00"
 METADATA_FILE = "metadata.yaml"
 
-RawMessage = tuple[int, str, bytes]  # (log time ns, topic, CDR bytes)
+RawMessage = tuple[str, int, bytes]  # (topic, log time ns, CDR bytes)
 
 
 @dataclass(frozen=True)
@@ -73,6 +73,7 @@ def _describe(error: BaseException) -> str:
 
 _RECORD = struct.Struct("<BQ")  # opcode, record length
 _MESSAGE = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
+_MESSAGE_HEAD = struct.Struct("<BQHIQ")  # a message record's opcode, length, channel, sequence, log
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _INDEX = struct.Struct("<HI")  # message index: channel id, byte length of its (time, offset) pairs
 _FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offset start, crc
@@ -274,16 +275,23 @@ class _McapSource:
     def _records(self, block: bytes, wanted: set[int] | None) -> Unit:
         """Messages of a block of records (a chunk's content or one top-level record)."""
         out: Unit = []
+        append, channels = out.append, self._channels
+        head, head_end, data_start = _MESSAGE_HEAD.unpack_from, _MESSAGE_HEAD.size, \
+            _RECORD.size + _MESSAGE.size
         pos, end = 0, len(block)
         while pos < end:
-            op, length = _RECORD.unpack_from(block, pos)
+            if whole := pos + head_end <= end:  # most records are messages: one unpack
+                op, length, channel, _, log_time = head(block, pos)
+            else:
+                (op, length), channel, log_time = _RECORD.unpack_from(block, pos), 0, 0
             body, after = pos + 9, pos + 9 + length
             if after > end:
                 raise _Damaged(f"a record (opcode {op:#x}) runs {after - end} bytes past its chunk")
             if op == _OP_MESSAGE:
-                channel, _, log_time, _ = _MESSAGE.unpack_from(block, body)
-                if channel in self._channels and (wanted is None or channel in wanted):
-                    out.append((log_time, channel, block[body + _MESSAGE.size:after]))
+                if not whole:  # its head runs past the block: struct.error, as damage
+                    channel, _, log_time, _ = _MESSAGE.unpack_from(block, body)
+                if channel in channels and (wanted is None or channel in wanted):
+                    append((log_time, channel, block[pos + data_start:after]))
             elif op == _OP_SCHEMA:
                 schema = Schema.read(ReadDataStream(io.BytesIO(block[body:after])))
                 self._schemas.setdefault(schema.id, schema)
@@ -426,7 +434,7 @@ class _McapSource:
                              f"the data section were read")
 
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
-        """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""
+        """Messages of ``topics`` as (topic, log time, bytes), in log-time order."""
         wanted = {cid for cid, ch in self._channels.items()
                   if ch.topic in topics and self._types[cid] == self.topics[ch.topic].msgtype}
         if not wanted:
@@ -438,8 +446,7 @@ class _McapSource:
                 units = iter([sorted(itertools.chain.from_iterable(self._until_cut(units)),
                                      key=itemgetter(0))])
             for unit in self._until_cut(units):
-                for stamp, channel, data in unit:
-                    yield stamp, names[channel], data
+                yield from [(names[channel], stamp, data) for stamp, channel, data in unit]
 
     def _until_cut(self, units: Iterator[Unit]) -> Iterator[Unit]:
         """``units`` up to the damage; an error if the file claimed to be complete."""
@@ -482,13 +489,13 @@ class _RosbagsSource:
             if self._reader.message_count else None)
 
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
-        """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""
+        """Messages of ``topics`` as (topic, log time, bytes), in log-time order."""
         connections = [c for c in self._reader.connections if c.topic in topics]
         if not connections:
             return
         try:
             for connection, stamp, data in self._reader.messages(connections=connections):
-                yield stamp, connection.topic, bytes(data)
+                yield connection.topic, stamp, bytes(data)
         except Exception as error:  # sqlite3/rosbags errors on a damaged database
             raise BagError(f"{self.path}: corrupt storage ({_describe(error)})") from error
 
@@ -585,9 +592,7 @@ class BagReader:
         """(topic, log time ns, CDR bytes) of ``topics`` (default all), in log-time order."""
         wanted = self._wanted(topics)
         streams = [source.raw(wanted) for source in self._sources]
-        merged = streams[0] if len(streams) == 1 else heapq.merge(*streams, key=lambda m: m[0])
-        for stamp, topic, data in merged:
-            yield topic, stamp, data
+        yield from streams[0] if len(streams) == 1 else heapq.merge(*streams, key=itemgetter(1))
 
     def messages(self, topics: Sequence[str] | None = None) -> Iterator[tuple[str, int, Any]]:
         """(topic, log time ns, rosbags message) of ``topics`` (default all), in log-time order."""
