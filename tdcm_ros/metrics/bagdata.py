@@ -21,8 +21,9 @@ Stamps are the header stamps (s since the epoch); a topic whose header stamps ar
 the bag's log times instead (said in a warning). Messages are left out, counted in a warning:
 
 - duplicates: the same topic, stamp and payload bytes as an earlier message (payloads are
-  compared by a keyed 64-bit hash, :func:`hash`, as they are decoded: two different payloads
-  under one stamp collide with probability 2^-64);
+  compared by a keyed 64-bit hash, :func:`hash`: two different payloads under one stamp collide
+  with probability 2^-64; only the messages whose stamp another message shares are hashed, in a
+  second read of their topic, so a bag without shared stamps is read once and holds no hashes);
 - implausible stamps: at or before 0 s, at or beyond 2^31 - 1 s (the int32 ``sec`` maximum), or more
   than :data:`FAR_S` from the median stamp of the topic's other messages. A topic with no
   plausible stamp at all is an error naming it, the count and a stamp.
@@ -99,17 +100,19 @@ class BagSource:
     roll: RollSeries | None = None
 
 
-def _unique(stamps_ns: np.ndarray, digests: np.ndarray) -> np.ndarray:
+def _unique(stamps_ns: np.ndarray, digests: Callable[[list[int]], list[int]]) -> np.ndarray:
     """Mask of the messages kept: each is dropped that repeats an earlier one's stamp (ns) and
-    payload (its ``digests`` entry, see the module docstring)."""
-    keep = np.ones(len(digests), dtype=bool)
+    payload (see the module docstring); ``digests`` gives the payload hashes of the messages at
+    the positions asked for (only those whose stamp is shared)."""
+    keep = np.ones(len(stamps_ns), dtype=bool)
     if np.all(np.diff(stamps_ns) > 0):  # strictly increasing: no stamp is shared
         return keep
     order = np.argsort(stamps_ns, kind="stable")
     equal = np.flatnonzero(np.diff(stamps_ns[order]) == 0)  # positions equal to the next
+    shared = order[np.union1d(equal, equal + 1)].tolist()  # only stamps shared, in order
     seen: set[tuple[int, int]] = set()
-    for n in order[np.union1d(equal, equal + 1)].tolist():  # only stamps shared, in order
-        key = (int(stamps_ns[n]), int(digests[n]))
+    for n, digest in zip(shared, digests(shared), strict=True):
+        key = (int(stamps_ns[n]), digest)
         keep[n] = key not in seen
         seen.add(key)
     return keep
@@ -163,17 +166,19 @@ class _Column:
 
 class _Reading:
     """One topic decoded batch by batch (:func:`_read_all`): header stamps, log times (kept only
-    while every header stamp is zero), payload hashes and the decoded values. A decoding error
+    while every header stamp is zero) and the decoded values. A decoding error
     stops the topic's decoding and is raised by :meth:`result`: with several topics read in one
     pass, each topic's error comes when its result is taken, in the order reading the topics
     one after the other gives."""
 
     def __init__(self, reader: BagReader, name: str, decode: _Decode) -> None:
         self.name = name
-        self._path = reader.path
+        self._reader = reader
         self._decode = decode
         self._capacity = reader.counts.get(name, 0)
-        self._header, self._log, self._digests = (_Column(self._capacity) for _ in range(3))
+        self._header, self._log = _Column(self._capacity), _Column(self._capacity)
+        self.read_with: list[str] = [name]
+        """The topics of the pass that reads this one (:func:`_read_all`)."""
         self._values: list[_Column] = []
         self._from_log = True
         self._error: TdcmError | None = None
@@ -192,7 +197,6 @@ class _Reading:
         for column, rows in zip(self._values, decoded, strict=True):
             column.extend(rows)
         self._header.extend(header_ns)
-        self._digests.extend(np.fromiter(map(hash, payloads), np.int64, len(payloads)))
         self._from_log = self._from_log and not header_ns.any()
         if self._from_log:
             self._log.extend(np.fromiter((log_ns for _, log_ns, _ in batch), np.int64,
@@ -209,12 +213,24 @@ class _Reading:
             raise self._error
         stamps_ns = (self._log if self._from_log else self._header).array()
         if not stamps_ns.size:
-            raise BagError(f"{self._path}: topic {self.name} has no readable messages")
-        read = (stamps_ns, self._from_log, _unique(stamps_ns, self._digests.array()),
+            raise BagError(f"{self._reader.path}: topic {self.name} has no readable messages")
+        read = (stamps_ns, self._from_log, _unique(stamps_ns, self._digests),
                 [c.array() for c in self._values])
-        self._header, self._log, self._digests = (_Column(0) for _ in range(3))
+        self._header, self._log = _Column(0), _Column(0)
         self._values = []
         return read
+
+    def _digests(self, positions: list[int]) -> list[int]:
+        """Hashes of the payloads of this topic's messages at ``positions`` (0-based, in the
+        order read), read again in a pass over the same topics as the first (the same order)."""
+        wanted = set(positions)
+        found: dict[int, int] = {}
+        messages = (data for topic, _, data in self._reader.raw_messages(self.read_with)
+                    if topic == self.name)
+        for n, data in enumerate(messages):
+            if n in wanted:
+                found[n] = hash(data)
+        return [found[n] for n in positions]
 
 
 def _read_all(reader: BagReader, readings: Sequence[_Reading]) -> None:
@@ -222,6 +238,8 @@ def _read_all(reader: BagReader, readings: Sequence[_Reading]) -> None:
     by_name: dict[str, list[_Reading]] = {}
     for reading in readings:
         by_name.setdefault(reading.name, []).append(reading)
+    for reading in readings:
+        reading.read_with = list(by_name)
     messages = reader.raw_messages(list(by_name))
     while batch := list(itertools.islice(messages, BATCH)):
         parts: dict[str, list[tuple[str, int, bytes]]] = {name: [] for name in by_name}

@@ -297,3 +297,37 @@ def test_stamps_become_seconds_in_their_own_buffer_exactly_as_a_product() -> Non
     seconds = bagdata._seconds(buffer)
     assert seconds.dtype == np.float64 and np.shares_memory(seconds, buffer)
     assert seconds.tobytes() == expected.tobytes()
+
+
+def test_a_shared_stamp_with_another_payload_is_no_duplicate(
+        clean: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each /tension message followed by an exact copy and by one with another force under the
+    same stamp: the copies are dropped, the others kept. Only the messages whose stamp is shared
+    are hashed, in a second read; a bag without shared stamps is read once."""
+
+    def copy_and_other(topic: str, stamp: int, data: bytes) -> list[tuple[int, bytes]]:
+        if topic != "/tension":
+            return [(stamp, data)]
+        msg = deserialize(data, "geometry_msgs/msg/WrenchStamped")
+        msg.wrench.force.z += 1.0
+        other = serialize(msg, "geometry_msgs/msg/WrenchStamped")
+        return [(stamp, data), (stamp, data), (stamp, other)]
+
+    path = _rewrite(clean, tmp_path / "shared", copy_and_other)
+    count = open_bag(clean).counts["/tension"]
+    reads: list[list[str]] = []
+    raw_messages = BagReader.raw_messages
+
+    def recording(self: BagReader, topics: list[str] | None = None):  # type: ignore[no-untyped-def]
+        reads.append(sorted(topics or []))
+        return raw_messages(self, topics)
+
+    monkeypatch.setattr(BagReader, "raw_messages", recording)
+    source = load_bag(path, labels=LABELS)
+    assert source.tension.stamps_s.size == 2 * count
+    assert f"/tension: {count} duplicated messages (same stamp and payload as an earlier one) " \
+        "left out" in source.warnings
+    assert reads.count(["/markers", "/tension"]) == 2  # the pass, and the hashes of /tension
+    reads.clear()
+    load_bag(clean, labels=LABELS)
+    assert reads.count(["/markers", "/tension"]) == 1
