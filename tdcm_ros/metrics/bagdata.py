@@ -31,12 +31,12 @@ the bag's log times instead (said in a warning). Messages are left out, counted 
 A topic is read in batches of :data:`BATCH` messages, each decoded into arrays and its payloads
 dropped, so memory holds a few numbers per message rather than the bag's bytes. The tension (one
 topic) and the markers are read in one pass over the bag: every chunk holding both is
-decompressed and walked once, not once per topic.
+decompressed once, not once per topic, and its messages are taken by the chunk's message index
+(:meth:`~tdcm_ros.bagio.reader.BagReader.raw_blocks`), not one by one.
 """
 
 from __future__ import annotations
 
-import itertools
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -74,8 +74,8 @@ MAX_STAMP_S = 2.0**31 - 1.0
 FAR_S = 86_400.0
 """Stamps farther than this (s) from the median stamp of their topic are implausible."""
 BATCH = 8192
-"""Messages read at a time (their payloads are decoded a topic at a time, then dropped)."""
-_Decode = Callable[[list[bytes]], tuple[np.ndarray, ...]]
+"""Messages of a topic decoded at a time, at most (their payloads are then dropped)."""
+_Decode = Callable[[Sequence[bytes]], tuple[np.ndarray, ...]]
 """Payloads of one topic -> their header stamps (ns) and value arrays (one row per message)."""
 _Read = tuple[np.ndarray, bool, np.ndarray, list[np.ndarray]]
 """A topic read (:meth:`_Reading.result`): stamps (ns since the epoch), whether they are the log
@@ -183,11 +183,11 @@ class _Reading:
         self._from_log = True
         self._error: TdcmError | None = None
 
-    def add(self, batch: Sequence[tuple[str, int, bytes]]) -> None:
-        """Decode messages (topic, log time ns, CDR payload) of this topic, in log-time order."""
+    def add(self, log_ns: np.ndarray, payloads: Sequence[bytes]) -> None:
+        """Decode messages of this topic, in log-time order: their log times (ns) and CDR
+        payloads."""
         if self._error is not None:
             return
-        payloads = [cdr for _, _, cdr in batch]
         try:
             header_ns, *decoded = self._decode(payloads)
         except TdcmError as error:
@@ -199,8 +199,7 @@ class _Reading:
         self._header.extend(header_ns)
         self._from_log = self._from_log and not header_ns.any()
         if self._from_log:
-            self._log.extend(np.fromiter((log_ns for _, log_ns, _ in batch), np.int64,
-                                         len(batch)))
+            self._log.extend(log_ns)
 
     @property
     def failed(self) -> bool:
@@ -240,17 +239,9 @@ def _read_all(reader: BagReader, readings: Sequence[_Reading]) -> None:
         by_name.setdefault(reading.name, []).append(reading)
     for reading in readings:
         reading.read_with = list(by_name)
-    messages = reader.raw_messages(list(by_name))
-    while batch := list(itertools.islice(messages, BATCH)):
-        parts: dict[str, list[tuple[str, int, bytes]]] = {name: [] for name in by_name}
-        if len(parts) == 1:
-            parts[next(iter(parts))] = batch
-        else:
-            for message in batch:
-                parts[message[0]].append(message)
-        for name, part in parts.items():
-            for reading in by_name[name] if part else ():
-                reading.add(part)
+    for topic, log_ns, payloads in reader.raw_blocks(list(by_name), BATCH):
+        for reading in by_name[topic]:
+            reading.add(log_ns, payloads)
         if all(reading.failed for reading in readings):
             return
 

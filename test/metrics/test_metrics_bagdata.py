@@ -253,18 +253,28 @@ def test_a_missing_tension_topic_names_the_option_that_sets_it(clean: Path) -> N
 
 def test_the_tension_and_the_markers_are_read_in_one_pass(
         clean: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Every chunk holds both: one pass decompresses and walks each once, not once per topic."""
-    asked: list[list[str]] = []
-    raw_messages = BagReader.raw_messages
-
-    def recording(self: BagReader, topics: list[str] | None = None):  # type: ignore[no-untyped-def]
-        asked.append(sorted(topics or []))
-        return raw_messages(self, topics)
-
-    monkeypatch.setattr(BagReader, "raw_messages", recording)
+    """Every chunk holds both: one pass decompresses and reads each once, not once per topic."""
+    asked = _record_reads(monkeypatch)
     load_bag(clean, labels=LABELS)
-    assert ["/markers", "/tension"] in asked
-    assert not any(topics in (["/markers"], ["/tension"]) for topics in asked)
+    assert asked == [("blocks", ["/markers", "/tension"])]
+
+
+def _record_reads(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, list[str]]]:
+    """The (method, topics) of each ``raw_blocks`` and ``raw_messages`` call from now on (the
+    /tf_static read aside)."""
+    asked: list[tuple[str, list[str]]] = []
+    for name, method in (("blocks", "raw_blocks"), ("messages", "raw_messages")):
+        original = getattr(BagReader, method)
+
+        def recording(self: BagReader, topics: list[str] | None = None, *args: object,
+                      _name: str = name, _original: Callable = original
+                      ) -> object:
+            if topics != ["/tf_static"]:
+                asked.append((_name, sorted(topics or [])))
+            return _original(self, topics, *args)
+
+        monkeypatch.setattr(BagReader, method, recording)
+    return asked
 
 
 def _broken_markers(topic: str, stamp: int, data: bytes) -> list[tuple[int, bytes]]:
@@ -315,19 +325,13 @@ def test_a_shared_stamp_with_another_payload_is_no_duplicate(
 
     path = _rewrite(clean, tmp_path / "shared", copy_and_other)
     count = open_bag(clean).counts["/tension"]
-    reads: list[list[str]] = []
-    raw_messages = BagReader.raw_messages
-
-    def recording(self: BagReader, topics: list[str] | None = None):  # type: ignore[no-untyped-def]
-        reads.append(sorted(topics or []))
-        return raw_messages(self, topics)
-
-    monkeypatch.setattr(BagReader, "raw_messages", recording)
+    reads = _record_reads(monkeypatch)
     source = load_bag(path, labels=LABELS)
     assert source.tension.stamps_s.size == 2 * count
     assert f"/tension: {count} duplicated messages (same stamp and payload as an earlier one) " \
         "left out" in source.warnings
-    assert reads.count(["/markers", "/tension"]) == 2  # the pass, and the hashes of /tension
+    both = ["/markers", "/tension"]
+    assert reads == [("blocks", both), ("messages", both)]  # the pass, the hashes of /tension
     reads.clear()
     load_bag(clean, labels=LABELS)
-    assert reads.count(["/markers", "/tension"]) == 1
+    assert reads == [("blocks", both)]
