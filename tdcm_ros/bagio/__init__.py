@@ -8,6 +8,7 @@ that rmw_zenoh puts in its key expressions (``service_type_hash`` for ``pkg/srv/
 from tdcm_ros.bagio.cdr import (
     CDR_LITTLE_ENDIAN,
     CdrWriter,
+    PayloadRows,
     cdr_align,
     cdr_header,
     cdr_string,
@@ -31,6 +32,7 @@ __all__ = [
     "CDR_LITTLE_ENDIAN",
     "BagError",
     "CdrWriter",
+    "PayloadRows",
     "cdr_align",
     "cdr_header",
     "cdr_string",

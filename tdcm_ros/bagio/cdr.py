@@ -5,13 +5,15 @@ Little-endian plain CDR (XCDR1) as rosbags and the rmw layers write it: a 4-byte
 header, then each primitive aligned to its size counted from the end of that header, padding
 bytes zero. :class:`CdrWriter` appends the pieces a message is made of; a run of records that
 each end in float64 fields (``geometry_msgs/Pose``, ``PoseStamped``, ``TransformStamped``)
-is written with NumPy in one go (:meth:`CdrWriter.records`).
+is written with NumPy in one go (:meth:`CdrWriter.records`). :class:`PayloadRows` holds payloads
+of one length read from a bag as the rows of one array.
 """
 
 from __future__ import annotations
 
 import struct
 from collections.abc import Sequence
+from typing import overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -93,3 +95,29 @@ class CdrWriter:
     def data(self) -> bytes:
         """The message's bytes, encapsulation header first."""
         return b"".join(self._parts)
+
+
+class PayloadRows(Sequence[bytes]):
+    """CDR payloads of one length as the rows of an (n, length) uint8 array, as a bag reader
+    gives a chunk's messages of one topic (:meth:`~tdcm_ros.bagio.reader.BagReader.raw_blocks`):
+    a sequence of bytes (each made when asked for) whose :attr:`rows` NumPy decoders read at
+    once."""
+
+    def __init__(self, rows: NDArray[np.uint8]) -> None:
+        if rows.ndim != 2:
+            raise ValueError(f"payload rows of shape {rows.shape}; allowed: (n, length)")
+        self.rows = rows
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    @overload
+    def __getitem__(self, index: int) -> bytes: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> PayloadRows: ...
+
+    def __getitem__(self, index: int | slice) -> bytes | PayloadRows:
+        if isinstance(index, slice):
+            return PayloadRows(self.rows[index])
+        return self.rows[index].tobytes()

@@ -10,6 +10,10 @@ chunk that fails its CRC, size or record checks (a flipped byte) is skipped: eve
 checked when it is opened, so ``warnings`` (what ``tdcm bag info`` prints) names each skipped
 chunk before any message is read, and reading leaves the same chunks out.
 
+:meth:`BagReader.raw_blocks` reads a complete MCAP file by its chunks' message indexes rather than
+record by record: a chunk's messages of a topic at a time, each index entry checked against the
+record it points to (no CRC covers the indexes; a chunk whose index does not match is walked).
+
 Topic arguments may omit the leading ``/`` (``tension`` = ``/tension``). Times are ns since the
 UNIX epoch. Every failure is a :class:`~tdcm_ros.bagio.errors.BagError` naming the file.
 """
@@ -29,6 +33,7 @@ from pathlib import Path
 from typing import IO, Any
 
 import lz4.frame
+import numpy as np
 import yaml
 import zstandard
 from mcap.data_stream import ReadDataStream
@@ -38,6 +43,7 @@ from mcap.records import Channel, ChunkIndex, Schema
 from mcap.summary import Summary
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
+from tdcm_ros.bagio.cdr import PayloadRows
 from tdcm_ros.bagio.errors import BagError
 from tdcm_ros.bagio.qos import parse_profiles, recorded_qos
 from tdcm_ros.bagio.typestore import typestore
@@ -48,7 +54,8 @@ MCAP_MAGIC = b"\x89MCAP0\r\n"
 SQLITE_MAGIC = b"SQLite format 3\x00"
 METADATA_FILE = "metadata.yaml"
 
-RawMessage = tuple[int, str, bytes]  # (log time ns, topic, CDR bytes)
+RawMessage = tuple[str, int, bytes]  # (topic, log time ns, CDR bytes)
+RawBlock = tuple[str, np.ndarray, Sequence[bytes]]  # topic, log times ns (int64), CDR payloads
 
 
 @dataclass(frozen=True)
@@ -73,6 +80,7 @@ def _describe(error: BaseException) -> str:
 
 _RECORD = struct.Struct("<BQ")  # opcode, record length
 _MESSAGE = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
+_MESSAGE_HEAD = struct.Struct("<BQHIQ")  # a message record's opcode, length, channel, sequence, log
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _INDEX = struct.Struct("<HI")  # message index: channel id, byte length of its (time, offset) pairs
 _FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offset start, crc
@@ -80,6 +88,7 @@ _OP_FOOTER, _OP_SCHEMA, _OP_CHANNEL, _OP_MESSAGE, _OP_CHUNK, _OP_INDEX, _OP_DATA
     2, 3, 4, 5, 6, 7, 15
 
 Unit = list[tuple[int, int, bytes]]  # (log time ns, channel id, data) of one chunk or record
+_HEAD_BYTES = np.arange(_RECORD.size + _MESSAGE.size)  # a message record's head, from its start
 
 
 class _Damaged(Exception):
@@ -184,6 +193,26 @@ def _may_hold(index: ChunkIndex, wanted: set[int] | None) -> bool:
     return wanted is None or not offsets or not wanted.isdisjoint(offsets)
 
 
+def _payloads(content: bytes, data: np.ndarray, start: np.ndarray, end: np.ndarray
+              ) -> Sequence[bytes]:
+    """The payloads ``content[start:end]`` (``data``: its bytes as an array): the rows of one
+    array when they have one length, else bytes each."""
+    lengths = end - start
+    if len(lengths) and np.all(lengths == lengths[0]):
+        return PayloadRows(data[start[:, None] + np.arange(int(lengths[0]))])
+    return [content[a:b] for a, b in zip(start.tolist(), end.tolist(), strict=True)]
+
+
+def _unit_blocks(unit: Unit, names: dict[int, str]) -> list[RawBlock]:
+    """The messages of a walked chunk, a block per topic, in log-time order."""
+    unit.sort(key=itemgetter(0))
+    parts: dict[str, list[tuple[int, bytes]]] = {}
+    for log_time, channel, data in unit:
+        parts.setdefault(names[channel], []).append((log_time, data))
+    return [(topic, np.fromiter((t for t, _ in part), np.int64, len(part)),
+             [data for _, data in part]) for topic, part in parts.items()]
+
+
 class _McapSource:
     """One MCAP file, read by a linear pass over its data section (chunks checked by CRC).
 
@@ -205,6 +234,7 @@ class _McapSource:
         self._last_end = -1
         self._chunks: list[ChunkIndex] = []
         self._skipped: set[int] = set()  # byte offsets of the chunks left out as damaged
+        self._channel_counts: dict[int, int] = {}  # messages per channel, by the statistics
         self.ordered = True  # units (chunks, loose messages) do not overlap in time
         self.time_range: tuple[int, int] | None = None  # first and last log time (ns) read
         with path.open("rb") as stream:
@@ -218,6 +248,7 @@ class _McapSource:
             for channel in summary.channels.values():
                 self._declare(channel)
                 self.counts[channel.topic] += counts.get(channel.id, 0)
+            self._channel_counts = dict(counts)
             self._chunks = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
             for index in self._chunks:
                 self._note_range(index.message_start_time, index.message_end_time)
@@ -274,16 +305,23 @@ class _McapSource:
     def _records(self, block: bytes, wanted: set[int] | None) -> Unit:
         """Messages of a block of records (a chunk's content or one top-level record)."""
         out: Unit = []
+        append, channels = out.append, self._channels
+        head, head_end, data_start = _MESSAGE_HEAD.unpack_from, _MESSAGE_HEAD.size, \
+            _RECORD.size + _MESSAGE.size
         pos, end = 0, len(block)
         while pos < end:
-            op, length = _RECORD.unpack_from(block, pos)
+            if whole := pos + head_end <= end:  # most records are messages: one unpack
+                op, length, channel, _, log_time = head(block, pos)
+            else:
+                (op, length), channel, log_time = _RECORD.unpack_from(block, pos), 0, 0
             body, after = pos + 9, pos + 9 + length
             if after > end:
                 raise _Damaged(f"a record (opcode {op:#x}) runs {after - end} bytes past its chunk")
             if op == _OP_MESSAGE:
-                channel, _, log_time, _ = _MESSAGE.unpack_from(block, body)
-                if channel in self._channels and (wanted is None or channel in wanted):
-                    out.append((log_time, channel, block[body + _MESSAGE.size:after]))
+                if not whole:  # its head runs past the block: struct.error, as damage
+                    channel, _, log_time, _ = _MESSAGE.unpack_from(block, body)
+                if channel in channels and (wanted is None or channel in wanted):
+                    append((log_time, channel, block[pos + data_start:after]))
             elif op == _OP_SCHEMA:
                 schema = Schema.read(ReadDataStream(io.BytesIO(block[body:after])))
                 self._schemas.setdefault(schema.id, schema)
@@ -425,10 +463,125 @@ class _McapSource:
         self.warnings.append(f"{self.path}: no usable MCAP summary; all {messages} messages of "
                              f"the data section were read")
 
+    def _wanted(self, topics: set[str]) -> set[int]:
+        """The channels of ``topics`` whose type is their topic's."""
+        return {cid for cid, ch in self._channels.items()
+                if ch.topic in topics and self._types[cid] == self.topics[ch.topic].msgtype}
+
+    def blocks(self, topics: set[str], size: int) -> Iterator[RawBlock] | None:
+        """Messages of ``topics`` located by the chunks' message indexes instead of a walk
+        through every record: (topic, log times, payloads) blocks of at most ``size`` messages of
+        one chunk, each topic's in log-time order (as :meth:`raw` gives them). None where the
+        file does not allow it: not complete, with chunks that overlap in time, were skipped or
+        list no message index, or indexes that do not list as many messages as the statistics
+        count (a chunk whose index does not match its records is walked instead)."""
+        wanted = self._wanted(topics)
+        if not wanted or not self.complete or not self.ordered or self._skipped:
+            return None
+        chunks = [index for index in self._chunks if _may_hold(index, wanted)]
+        listed = dict.fromkeys(wanted, 0)
+        with self.path.open("rb") as stream:
+            buf = _FileBytes(stream)
+            for index in chunks:
+                if not index.message_index_offsets:
+                    return None
+                for channel in wanted & index.message_index_offsets.keys():
+                    if (count := self._index_size(buf, index, channel)) is None:
+                        return None
+                    listed[channel] += count // 16  # (u64 time, u64 offset) pairs
+        if any(listed[c] != self._channel_counts.get(c) for c in wanted):
+            return None
+        return self._blocks(chunks, wanted, size)
+
+    def _index_size(self, buf: _FileBytes, index: ChunkIndex, channel: int) -> int | None:
+        """Bytes of the (time, offset) pairs in ``channel``'s message index record of the chunk
+        of ``index``; None if the record is not one."""
+        offset = index.message_index_offsets[channel]
+        try:
+            op, length = buf.unpack(_RECORD, offset)
+            found, size = buf.unpack(_INDEX, offset + _RECORD.size)
+        except struct.error:
+            return None
+        good = op == _OP_INDEX and found == channel and size % 16 == 0 and \
+            length == _INDEX.size + size
+        return size if good else None
+
+    def _blocks(self, chunks: list[ChunkIndex], wanted: set[int], size: int
+                ) -> Iterator[RawBlock]:
+        names = {cid: self._channels[cid].topic for cid in wanted}
+        with self.path.open("rb") as stream:
+            buf = _FileBytes(stream)
+            try:
+                for index in chunks:
+                    content = self._content(self._chunk_body(buf, index))[0]
+                    found = self._located(buf, index, content, wanted)
+                    if found is None:  # the index does not match the records: walk them
+                        found = _unit_blocks(self._records(content, wanted), names)
+                    for topic, log, payloads in found:
+                        for a in range(0, len(log), size):
+                            yield topic, log[a:a + size], payloads[a:a + size]
+            except _DAMAGE as error:
+                raise BagError(f"{self.path}: corrupt data section, changed since it was opened "
+                               f"({_describe(error)})") from error
+
+    def _located(self, buf: _FileBytes, index: ChunkIndex, content: bytes, wanted: set[int]
+                 ) -> list[RawBlock] | None:
+        """The messages of the ``wanted`` channels in a chunk's records ``content``, a block per
+        topic, where the chunk's message indexes give them: each entry a message record of its
+        channel and log time inside the chunk, no two overlapping; None otherwise."""
+        data = np.frombuffer(content, np.uint8)
+        found: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = {}
+        for channel in sorted(wanted & index.message_index_offsets.keys()):
+            entries = self._entries(buf, index, channel, data)
+            if entries is None:
+                return None
+            found.setdefault(self._channels[channel].topic, []).append(entries)
+        if not found:
+            return []
+        starts = np.concatenate([start for parts in found.values() for _, start, _ in parts])
+        ends = np.concatenate([end for parts in found.values() for _, _, end in parts])
+        order = np.argsort(starts, kind="stable")
+        if np.any(ends[order][:-1] > starts[order][1:]):
+            return None
+        blocks: list[RawBlock] = []
+        for topic, parts in found.items():
+            log, start, end = (np.concatenate(column) for column in zip(*parts, strict=True))
+            order = np.lexsort((start, log))  # by log time, then file order: as the walk sorts
+            log, start, end = log[order], start[order], end[order]
+            blocks.append((topic, log, _payloads(content, data, start + _HEAD_BYTES.size, end)))
+        return blocks
+
+    def _entries(self, buf: _FileBytes, index: ChunkIndex, channel: int, data: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Log times, record starts and record ends (bytes into the chunk's records ``data``)
+        of ``channel``'s messages in its message index of the chunk of ``index``; None unless
+        each is a whole message record of the channel at that log time."""
+        size = self._index_size(buf, index, channel)
+        if size is None:
+            return None
+        at = index.message_index_offsets[channel] + _RECORD.size + _INDEX.size
+        if len(listed := buf[at:at + size]) != size:
+            return None
+        pairs = np.frombuffer(listed, "<u8").reshape(-1, 2)
+        if len(pairs) and int(pairs[:, 1].max()) + _HEAD_BYTES.size > len(data):
+            return None
+        start = pairs[:, 1].astype(np.int64)
+        head = data[start[:, None] + _HEAD_BYTES]  # each record's opcode, length, message head
+        length = head[:, 1:9].copy().view("<u8")[:, 0]
+        if not (np.all(head[:, 0] == _OP_MESSAGE)
+                and np.all(head[:, 9:11].copy().view("<u2")[:, 0] == channel)
+                and np.all(head[:, 15:23].copy().view("<u8")[:, 0] == pairs[:, 0])
+                and np.all(length >= _MESSAGE.size)
+                and np.all(length <= len(data))):
+            return None
+        end = start + _RECORD.size + length.astype(np.int64)
+        if np.any(end > len(data)):
+            return None
+        return pairs[:, 0].astype(np.int64), start, end
+
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
-        """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""
-        wanted = {cid for cid, ch in self._channels.items()
-                  if ch.topic in topics and self._types[cid] == self.topics[ch.topic].msgtype}
+        """Messages of ``topics`` as (topic, log time, bytes), in log-time order."""
+        wanted = self._wanted(topics)
         if not wanted:
             return
         names = {cid: self._channels[cid].topic for cid in wanted}
@@ -438,8 +591,7 @@ class _McapSource:
                 units = iter([sorted(itertools.chain.from_iterable(self._until_cut(units)),
                                      key=itemgetter(0))])
             for unit in self._until_cut(units):
-                for stamp, channel, data in unit:
-                    yield stamp, names[channel], data
+                yield from [(names[channel], stamp, data) for stamp, channel, data in unit]
 
     def _until_cut(self, units: Iterator[Unit]) -> Iterator[Unit]:
         """``units`` up to the damage; an error if the file claimed to be complete."""
@@ -482,13 +634,13 @@ class _RosbagsSource:
             if self._reader.message_count else None)
 
     def raw(self, topics: set[str]) -> Iterator[RawMessage]:
-        """Messages of ``topics`` as (log time, topic, bytes), in log-time order."""
+        """Messages of ``topics`` as (topic, log time, bytes), in log-time order."""
         connections = [c for c in self._reader.connections if c.topic in topics]
         if not connections:
             return
         try:
             for connection, stamp, data in self._reader.messages(connections=connections):
-                yield stamp, connection.topic, bytes(data)
+                yield connection.topic, stamp, bytes(data)
         except Exception as error:  # sqlite3/rosbags errors on a damaged database
             raise BagError(f"{self.path}: corrupt storage ({_describe(error)})") from error
 
@@ -585,9 +737,27 @@ class BagReader:
         """(topic, log time ns, CDR bytes) of ``topics`` (default all), in log-time order."""
         wanted = self._wanted(topics)
         streams = [source.raw(wanted) for source in self._sources]
-        merged = streams[0] if len(streams) == 1 else heapq.merge(*streams, key=lambda m: m[0])
-        for stamp, topic, data in merged:
-            yield topic, stamp, data
+        yield from streams[0] if len(streams) == 1 else heapq.merge(*streams, key=itemgetter(1))
+
+    def raw_blocks(self, topics: Sequence[str] | None, size: int) -> Iterator[RawBlock]:
+        """(topic, log times ns (int64 array), CDR payloads) of ``topics`` (None: all), at most
+        ``size`` messages a block, each topic's messages in the order :meth:`raw_messages`
+        gives (topics interleave in no set order). One complete MCAP file is read by its chunks'
+        message indexes, not message by message: a chunk's payloads of one topic and one length
+        come as :class:`~tdcm_ros.bagio.cdr.PayloadRows`."""
+        wanted = self._wanted(topics)
+        only = self._sources[0] if len(self._sources) == 1 else None
+        if isinstance(only, _McapSource) and (blocks := only.blocks(wanted, size)) is not None:
+            yield from blocks
+            return
+        messages = self.raw_messages(topics)
+        while batch := list(itertools.islice(messages, size)):
+            parts: dict[str, list[tuple[str, int, bytes]]] = {}
+            for message in batch:
+                parts.setdefault(message[0], []).append(message)
+            for topic, part in parts.items():
+                yield (topic, np.fromiter((t for _, t, _ in part), np.int64, len(part)),
+                       [data for _, _, data in part])
 
     def messages(self, topics: Sequence[str] | None = None) -> Iterator[tuple[str, int, Any]]:
         """(topic, log time ns, rosbags message) of ``topics`` (default all), in log-time order."""

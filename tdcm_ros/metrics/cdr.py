@@ -18,7 +18,13 @@ from collections.abc import Iterator, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from tdcm_ros.bagio import CDR_LITTLE_ENDIAN, BagError, cdr_align, deserialize
+from tdcm_ros.bagio import (
+    CDR_LITTLE_ENDIAN,
+    BagError,
+    PayloadRows,
+    cdr_align,
+    deserialize,
+)
 
 _TYPE = "geometry_msgs/msg/WrenchStamped"
 
@@ -40,13 +46,17 @@ def _groups(payloads: Sequence[bytes]
             ) -> Iterator[tuple[NDArray[np.int64], NDArray[np.uint8] | None]]:
     """Indices of the payloads of each length with their bytes (a row each), little-endian
     ones; the rest in one group without bytes. A batch of one length, all little-endian (a
-    recorder's), is one group found without a Python pass over the payloads."""
-    sizes = np.fromiter(map(len, payloads), np.int64, len(payloads))
-    if sizes.size and sizes[0] >= 2 and np.all(sizes == sizes[0]):
-        raw = np.frombuffer(b"".join(payloads), dtype=np.uint8).reshape(sizes.size, -1)
-        if np.all((raw[:, 0] == 0) & ((raw[:, 1] == 1) | (raw[:, 1] == 3))):  # CDR_LITTLE_ENDIAN
-            yield np.arange(sizes.size), raw
-            return
+    recorder's), is one group found without a Python pass over the payloads (nor a copy:
+    :class:`~tdcm_ros.bagio.PayloadRows` are read as they are)."""
+    raw = payloads.rows if isinstance(payloads, PayloadRows) else None
+    if raw is None:
+        sizes = np.fromiter(map(len, payloads), np.int64, len(payloads))
+        if sizes.size and sizes[0] >= 2 and np.all(sizes == sizes[0]):
+            raw = np.frombuffer(b"".join(payloads), dtype=np.uint8).reshape(sizes.size, -1)
+    if raw is not None and len(raw) and raw.shape[1] >= 2 and np.all(
+            (raw[:, 0] == 0) & ((raw[:, 1] == 1) | (raw[:, 1] == 3))):  # CDR_LITTLE_ENDIAN
+        yield np.arange(len(raw)), raw
+        return
     groups: dict[int, list[int]] = {}
     for i, data in enumerate(payloads):
         groups.setdefault(len(data) if data[:2] in CDR_LITTLE_ENDIAN else -1, []).append(i)

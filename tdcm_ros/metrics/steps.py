@@ -124,16 +124,20 @@ def _odd(n: int) -> int:
     return max(1, n | 1)
 
 
-def _steady(t: Array, smooth: Array, cfg: StepSettings) -> NDArray[np.bool_]:
+def _settle_window(t: Array, cfg: StepSettings) -> int:
+    """Samples (odd) in ``settle_s`` at the median spacing of the stamps ``t`` (s)."""
+    # the diffs are a temporary: the median may sort them in place (no second copy)
+    dt = float(np.median(np.diff(t), overwrite_input=True)) if t.size > 1 else cfg.settle_s
+    return _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
+
+
+def _steady(smooth: Array, window: int, cfg: StepSettings) -> NDArray[np.bool_]:
     """Samples where every column of ``smooth`` (n, J) spans at most ``2 tolerance_n`` over a
-    centred window of ``settle_s`` (edges: the end samples repeated).
+    centred ``window`` of samples (edges: the end samples repeated).
 
     Taken :data:`_STEADY_BLOCK` samples at a time, each with the half window either side: the
     filters' line buffers then hold a block, not the series (they took three times the
     series' bytes at once)."""
-    # the diffs are a temporary: the median may sort them in place (no second copy)
-    dt = float(np.median(np.diff(t), overwrite_input=True)) if t.size > 1 else cfg.settle_s
-    window = _odd(round(cfg.settle_s / dt) if dt > 0 else 1)
     half, n = window // 2, len(smooth)
     steady = np.empty(n, dtype=bool)
     for a in range(0, n, _STEADY_BLOCK):
@@ -183,11 +187,12 @@ def _holds(t: Array, x: Array, lo: int, hi: int, cfg: StepSettings) -> list[tupl
 def _hold_ranges(t: Array, x: Array, cfg: StepSettings) -> list[tuple[int, int]]:
     """Index ranges of the holds in the tensions ``x`` (n, J) N at stamps ``t`` (s), in time
     order (steps 1-3 of the module docstring, on the despiked tensions: freed on return)."""
+    window = _settle_window(t, cfg)  # before the despiked copy: their temporaries never meet
     # each column on its own (a window along axis 0), into one array: no per-column copies
     smooth = median_filter(x, size=(cfg.despike_samples, 1), mode="nearest") \
         if cfg.despike_samples > 1 else x
     ranges: list[tuple[int, int]] = []
-    for lo, hi in _true_runs(_steady(t, smooth, cfg)):
+    for lo, hi in _true_runs(_steady(smooth, window, cfg)):
         ranges.extend(_holds(t, smooth, int(lo), int(hi), cfg))
     return sorted(ranges)
 

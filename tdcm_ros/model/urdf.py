@@ -25,7 +25,6 @@ includes under its tool link.
 from __future__ import annotations
 
 import math
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,6 +44,15 @@ BEND_LIMIT_RAD = math.pi
 #: joints are driven by the model, not by motors: nominal values.
 NOMINAL_EFFORT = 1.0
 NOMINAL_VELOCITY = 10.0
+
+
+def _quoteattr(text: str) -> str:
+    """:func:`xml.sax.saxutils.quoteattr`, imported on first use: that module pulls in
+    ``urllib.request`` and ``ssl`` (about 2 MiB and 10 ms) for every process that imports the
+    model face, ``tdcm evaluate`` included, which writes no URDF."""
+    from xml.sax.saxutils import quoteattr
+
+    return quoteattr(text)
 
 
 def _segments(design: Design) -> list[tuple[float, float, int | None]]:
@@ -92,7 +100,7 @@ def body_urdf(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "",
     _check_names(name, base_link)
     return "\n".join([
         '<?xml version="1.0"?>', _comment(design, name),
-        f"<robot name={quoteattr(prefix + name)}>",
+        f"<robot name={_quoteattr(prefix + name)}>",
         *_chain(design, name, prefix, base_link), "</robot>"]) + "\n"
 
 
@@ -104,14 +112,14 @@ def body_xacro(design: Design, *, name: str = DEFAULT_NAME, base_link: str = "td
     ``prefix``."""
     _check_names(name, base_link)
     prefix = "${prefix}"
-    mount = (f"  <joint name={quoteattr(f'{prefix}{name}_mount')} type=\"fixed\">\n"
+    mount = (f"  <joint name={_quoteattr(f'{prefix}{name}_mount')} type=\"fixed\">\n"
              "    <parent link=\"${parent}\"/>\n"
-             f"    <child link={quoteattr(prefix + base_link)}/>\n"
+             f"    <child link={_quoteattr(prefix + base_link)}/>\n"
              "    <origin xyz=\"${xyz}\" rpy=\"${rpy}\"/>\n  </joint>")
     return "\n".join([
         '<?xml version="1.0"?>', _comment(design, name),
         '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">',
-        (f"  <xacro:macro name={quoteattr(name)} "
+        (f"  <xacro:macro name={_quoteattr(name)} "
          "params=\"parent prefix:='' xyz:='0 0 0' rpy:='0 0 0'\">"),
         *_chain(design, name, prefix, base_link), mount, "  </xacro:macro>", "</robot>"]) + "\n"
 
@@ -131,8 +139,8 @@ def _comment(design: Design, name: str) -> str:
 def _chain(design: Design, name: str, prefix: str, base_link: str) -> list[str]:
     """The links and joints from ``base_link`` through the roll joint to the tip."""
     segments = _segments(design)
-    lines = [f"  <link name={quoteattr(prefix + base_link)}/>",
-             f"  <link name={quoteattr(f'{prefix}{name}_rolled')}/>",
+    lines = [f"  <link name={_quoteattr(prefix + base_link)}/>",
+             f"  <link name={_quoteattr(f'{prefix}{name}_rolled')}/>",
              _joint(prefix + ROLL_JOINT, "revolute", prefix + base_link, f"{prefix}{name}_rolled",
                     "0 0 1", -math.pi, math.pi)]
     parent = f"{prefix}{name}_rolled"
@@ -140,9 +148,9 @@ def _chain(design: Design, name: str, prefix: str, base_link: str) -> list[str]:
         length = end - start
         turn, chord = f"{prefix}{name}_seg{k}_turned", f"{prefix}{name}_seg{k}_along"
         link = f"{prefix}{name}_tip" if k == len(segments) - 1 else f"{prefix}{name}_seg{k}"
-        lines += [f"  <link name={quoteattr(turn)}>", _visual(design, length, notch),
-                  "  </link>", f"  <link name={quoteattr(chord)}/>",
-                  f"  <link name={quoteattr(link)}/>",
+        lines += [f"  <link name={_quoteattr(turn)}>", _visual(design, length, notch),
+                  "  </link>", f"  <link name={_quoteattr(chord)}/>",
+                  f"  <link name={_quoteattr(link)}/>",
                   _joint(f"{prefix}{name}_seg{k}_turn", "revolute", parent, turn, "0 1 0",
                          -BEND_LIMIT_RAD, BEND_LIMIT_RAD),
                   _joint(f"{prefix}{name}_seg{k}_chord", "prismatic", turn, chord, "0 0 1", 0.0,
@@ -155,8 +163,8 @@ def _chain(design: Design, name: str, prefix: str, base_link: str) -> list[str]:
 
 def _joint(name: str, kind: str, parent: str, child: str, axis: str, low: float,
            high: float) -> str:
-    return (f"  <joint name={quoteattr(name)} type=\"{kind}\">\n"
-            f"    <parent link={quoteattr(parent)}/>\n    <child link={quoteattr(child)}/>\n"
+    return (f"  <joint name={_quoteattr(name)} type=\"{kind}\">\n"
+            f"    <parent link={_quoteattr(parent)}/>\n    <child link={_quoteattr(child)}/>\n"
             f"    <origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>\n    <axis xyz=\"{axis}\"/>\n"
             f"    <limit lower=\"{low!r}\" upper=\"{high!r}\" effort=\"{NOMINAL_EFFORT!r}\" "
             f"velocity=\"{NOMINAL_VELOCITY!r}\"/>\n  </joint>")

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from mcap.writer import Writer
 
 from tdcm_ros.bagio import from_dict, serialize, to_dict, typestore
@@ -60,3 +62,22 @@ def write_mcap(path: Path, messages: list[Message], **writer_options: Any) -> Pa
             writer.add_message(channels[topic], stamp, serialize(message, msgtype), stamp)
         writer.finish()
     return path
+
+
+def messages_by_topic(messages: Iterable[tuple[str, int, bytes]]
+                      ) -> dict[str, list[tuple[int, bytes]]]:
+    """``BagReader.raw_messages`` output as (log time, payload) per topic, in order."""
+    out: dict[str, list[tuple[int, bytes]]] = {}
+    for topic, stamp, data in messages:
+        out.setdefault(topic, []).append((stamp, data))
+    return out
+
+
+def blocks_by_topic(blocks: Iterable[tuple[str, np.ndarray, Sequence[bytes]]]
+                    ) -> dict[str, list[tuple[int, bytes]]]:
+    """``BagReader.raw_blocks`` output the same way."""
+    out: dict[str, list[tuple[int, bytes]]] = {}
+    for topic, stamps, payloads in blocks:
+        assert stamps.dtype == np.int64 and len(stamps) == len(payloads)
+        out.setdefault(topic, []).extend(zip(stamps.tolist(), payloads, strict=True))
+    return out

@@ -1,5 +1,6 @@
 """``tdcm evaluate`` imports only what it uses (issue 34): evaluating a bag loads neither the
-calibration (scipy.optimize's fit, a t quantile) nor scipy.stats, matplotlib or numba."""
+calibration (scipy.optimize's fit, a t quantile) nor scipy.stats, matplotlib or numba, nor the
+URDF writer's XML quoting (xml.sax pulls urllib.request and ssl)."""
 
 from __future__ import annotations
 
@@ -12,7 +13,8 @@ import tdcm_ros
 
 ROOT = Path(tdcm_ros.__file__).parents[1]
 BAG = ROOT / "bags" / "paper_experiment"
-NOT_ON_THE_PATH = ("scipy.stats", "tdcm_ros.metrics.calibration", "matplotlib", "numba")
+NOT_ON_THE_PATH = ("scipy.stats", "tdcm_ros.metrics.calibration", "matplotlib", "numba",
+                   "xml.sax", "urllib.request", "ssl")
 PROBE = f"""
 import contextlib, io, json, sys
 from tdcm_ros.cli.main import main

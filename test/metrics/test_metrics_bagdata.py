@@ -1,6 +1,7 @@
 """Hazards in evaluated bags: occluded markers (NaN, exactly zero), duplicated messages, a corrupt
 chunk (evaluate and ``bag info`` warn the same) and implausible stamps; reading in batches gives
-the messages decoded one by one, whatever the batch size."""
+the messages decoded one by one, whatever the batch size; the tension and the markers are read in
+one pass, their errors in the order reading them in turn gave."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from tdcm_ros.bagio.writer import BagWriter
 from tdcm_ros.cli.main import main
 from tdcm_ros.metrics import bagdata
 from tdcm_ros.metrics.bagdata import BagSource, load_bag
+from tdcm_ros.metrics.errors import MetricsError
 from tdcm_ros.metrics.synthetic_bag import write_recording
 from test.metrics.metrics_samples import TRUE_E, small_recording
 
@@ -247,3 +249,89 @@ def test_a_float64_tension_topic_is_read_as_model_node_takes_it(clean: Path,
 def test_a_missing_tension_topic_names_the_option_that_sets_it(clean: Path) -> None:
     with pytest.raises(BagError, match=r"no topic '/force'.*evaluate --tension-topic"):
         load_bag(clean, labels=LABELS, tension_topic="/force")
+
+
+def test_the_tension_and_the_markers_are_read_in_one_pass(
+        clean: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every chunk holds both: one pass decompresses and reads each once, not once per topic."""
+    asked = _record_reads(monkeypatch)
+    load_bag(clean, labels=LABELS)
+    assert asked == [("blocks", ["/markers", "/tension"])]
+
+
+def _record_reads(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, list[str]]]:
+    """The (method, topics) of each ``raw_blocks`` and ``raw_messages`` call from now on (the
+    /tf_static read aside)."""
+    asked: list[tuple[str, list[str]]] = []
+    for name, method in (("blocks", "raw_blocks"), ("messages", "raw_messages")):
+        original = getattr(BagReader, method)
+
+        def recording(self: BagReader, topics: list[str] | None = None, *args: object,
+                      _name: str = name, _original: Callable = original
+                      ) -> object:
+            if topics != ["/tf_static"]:
+                asked.append((_name, sorted(topics or [])))
+            return _original(self, topics, *args)
+
+        monkeypatch.setattr(BagReader, method, recording)
+    return asked
+
+
+def _broken_markers(topic: str, stamp: int, data: bytes) -> list[tuple[int, bytes]]:
+    return [(stamp, data[:12] if topic == "/markers" else data)]
+
+
+def test_a_topic_error_comes_where_reading_the_topics_in_turn_raised_it(
+        clean: Path, tmp_path: Path) -> None:
+    """Read in one pass, the tension's errors still come before the markers' (the markers'
+    decoding error is kept until the tension is done), and a missing markers topic is said
+    once the tension is read."""
+    broken = _rewrite(clean, tmp_path / "broken", _broken_markers)
+    with pytest.raises(BagError, match="cannot deserialise 12 bytes as mocap4r2_msgs"):
+        load_bag(broken, labels=LABELS)
+    both = _rewrite(broken, tmp_path / "both", _with_tension_sec(lambda _n: 2**31 - 1))
+    with pytest.raises(MetricsError, match="/tension: all .* stamps are implausible"):
+        load_bag(both, labels=LABELS)
+    absurd = _rewrite(clean, tmp_path / "absurd", _with_tension_sec(lambda _n: 2**31 - 1))
+    with pytest.raises(MetricsError, match="/tension: all .* stamps are implausible"):
+        load_bag(absurd, labels=LABELS, markers_topic="/nosuch")
+    with pytest.raises(BagError, match="no topic '/nosuch'"):
+        load_bag(clean, labels=LABELS, markers_topic="/nosuch")
+
+
+def test_stamps_become_seconds_in_their_own_buffer_exactly_as_a_product() -> None:
+    """Block by block over the ns buffer: the same floats as ``stamps_ns * 1e-9``."""
+    stamps_ns = np.random.default_rng(0).integers(1, 2**62, size=3 * bagdata._SECONDS_BLOCK + 7)
+    expected = stamps_ns * 1e-9
+    buffer = stamps_ns.copy()
+    seconds = bagdata._seconds(buffer)
+    assert seconds.dtype == np.float64 and np.shares_memory(seconds, buffer)
+    assert seconds.tobytes() == expected.tobytes()
+
+
+def test_a_shared_stamp_with_another_payload_is_no_duplicate(
+        clean: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each /tension message followed by an exact copy and by one with another force under the
+    same stamp: the copies are dropped, the others kept. Only the messages whose stamp is shared
+    are hashed, in a second read; a bag without shared stamps is read once."""
+
+    def copy_and_other(topic: str, stamp: int, data: bytes) -> list[tuple[int, bytes]]:
+        if topic != "/tension":
+            return [(stamp, data)]
+        msg = deserialize(data, "geometry_msgs/msg/WrenchStamped")
+        msg.wrench.force.z += 1.0
+        other = serialize(msg, "geometry_msgs/msg/WrenchStamped")
+        return [(stamp, data), (stamp, data), (stamp, other)]
+
+    path = _rewrite(clean, tmp_path / "shared", copy_and_other)
+    count = open_bag(clean).counts["/tension"]
+    reads = _record_reads(monkeypatch)
+    source = load_bag(path, labels=LABELS)
+    assert source.tension.stamps_s.size == 2 * count
+    assert f"/tension: {count} duplicated messages (same stamp and payload as an earlier one) " \
+        "left out" in source.warnings
+    both = ["/markers", "/tension"]
+    assert reads == [("blocks", both), ("messages", both)]  # the pass, the hashes of /tension
+    reads.clear()
+    load_bag(clean, labels=LABELS)
+    assert reads == [("blocks", both)]
