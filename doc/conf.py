@@ -39,7 +39,7 @@ autodoc_typehints = "description"
 # The build is offline (no intersphinx): references to other projects' types stay plain text.
 nitpick_ignore_regex = [
     # third-party types in annotations and docstrings
-    (r"py:.*", r"(numpy|scipy|serial|trimesh|rosbags|zenoh)(\..*)?|NDArray|ArrayLike"),
+    (r"py:.*", r"(numpy|np|scipy|serial|trimesh|rosbags|zenoh)(\..*)?|NDArray|ArrayLike"),
     # the standard library's, likewise
     (r"py:.*", r"(collections|collections\.abc|pathlib|typing)\..*"),
     # the package's aliases of NumPy arrays (Array = NDArray[np.float64], ...) and its type

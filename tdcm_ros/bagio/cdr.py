@@ -99,9 +99,9 @@ class CdrWriter:
 
 class PayloadRows(Sequence[bytes]):
     """CDR payloads of one length as the rows of an (n, length) uint8 array, as a bag reader
-    gives a chunk's messages of one topic (:meth:`~tdcm_ros.bagio.reader.BagReader.raw_blocks`):
-    a sequence of bytes (each made when asked for) whose :attr:`rows` NumPy decoders read at
-    once."""
+    gives a chunk's messages of one topic (``BagReader.raw_blocks`` of
+    ``tdcm_ros.bagio.reader``): a sequence of bytes (each made when asked for) whose ``rows``
+    NumPy decoders read at once."""
 
     def __init__(self, rows: NDArray[np.uint8]) -> None:
         if rows.ndim != 2:
