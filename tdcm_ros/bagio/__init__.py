@@ -12,6 +12,7 @@ from tdcm_ros.bagio.cdr import (
     cdr_align,
     cdr_header,
     cdr_string,
+    cdr_strings,
 )
 from tdcm_ros.bagio.convert import from_dict, prepare_codec, to_dict
 from tdcm_ros.bagio.errors import BagError
@@ -36,6 +37,7 @@ __all__ = [
     "cdr_align",
     "cdr_header",
     "cdr_string",
+    "cdr_strings",
     "deserialize",
     "from_dict",
     "message_definition",

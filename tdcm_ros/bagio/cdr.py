@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Sequence
+from functools import lru_cache
 from typing import overload
 
 import numpy as np
@@ -35,6 +36,20 @@ def cdr_string(text: str) -> bytes:
     """A CDR ``string`` at a 4-aligned position: byte length with the NUL (uint32), UTF-8, NUL."""
     data = text.encode("utf-8")
     return _U32.pack(len(data) + 1) + data + b"\x00"
+
+
+@lru_cache(maxsize=64)
+def cdr_strings(texts: tuple[str, ...]) -> bytes:
+    """A CDR ``string[]`` at a 4-aligned position: its length (uint32), then each string 4-aligned
+    (see :func:`cdr_string`); cached: a node sends the same names with every message."""
+    parts, pos = [_U32.pack(len(texts))], 4
+    for text in texts:
+        if padding := (-pos) % 4:
+            parts.append(bytes(padding))
+            pos += padding
+        parts.append(item := cdr_string(text))
+        pos += len(item)
+    return b"".join(parts)
 
 
 def cdr_header(stamp_ns: int, frame_id: str) -> bytes:

@@ -66,6 +66,22 @@ def _segments(design: Design) -> list[tuple[float, float, int | None]]:
             in zip(starts.tolist(), ends.tolist(), first.tolist(), hits, strict=True)]
 
 
+def _segment_nodes(design: Design, s: Array) -> list[list[int]]:
+    """Per segment of ``design``, the indices of the nodes ``s`` (m) nearest its start and end
+    (the first of equals, as argmin); kept for the last pair, by identity (a node draws the same
+    design on the same cached grid again and again)."""
+    last = _last_segment_nodes.get("pair")
+    if last is not None and last[0] is design and last[1] is s:
+        return last[2]
+    bounds = np.array([(start, end) for start, end, _ in _segments(design)])
+    nearest = np.argmin(np.abs(s[None, None, :] - bounds[:, :, None]), axis=2).tolist()
+    _last_segment_nodes["pair"] = (design, s, nearest)
+    return nearest
+
+
+_last_segment_nodes: dict[str, tuple[Design, Array, list[list[int]]]] = {}
+
+
 def joint_names(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "") -> list[str]:
     """The chain's joint names, roll first, then each segment's turn, chord and bend."""
     out = [prefix + ROLL_JOINT]
@@ -77,9 +93,7 @@ def joint_names(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "") -
 def joint_positions(result: SolveResult, roll: float = 0.0) -> Array:
     """The positions (rad, m) of :func:`joint_names`' joints that put the chain in
     ``result``'s shape, rolled by ``roll`` (rad)."""
-    bounds = np.array([(start, end) for start, end, _ in _segments(result.design)])
-    # the nodes nearest each segment's start and end (the first of equals, as argmin)
-    nearest = np.argmin(np.abs(result.s[None, None, :] - bounds[:, :, None]), axis=2).tolist()
+    nearest = _segment_nodes(result.design, result.s)
     x, z, thetas = (result.positions[:, 0].tolist(), result.positions[:, 2].tolist(),
                     result.theta.tolist())
     out = [roll]

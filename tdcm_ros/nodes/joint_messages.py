@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.bagio import CdrWriter, cdr_string, from_dict
+from tdcm_ros.bagio import CdrWriter, cdr_strings, from_dict
 from tdcm_ros.nodes.shape_messages import header
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -72,9 +72,7 @@ def joint_state_cdr(stamp_ns: int, names: Sequence[str], position: Sequence[floa
     these fields (rad or m, rad/s or m/s, N m or N), stamped ``stamp_ns`` (ns since the epoch)."""
     cdr = CdrWriter()
     cdr.header(stamp_ns, frame_id)
-    cdr.uint32(len(names))
-    for name in names:
-        cdr.raw(cdr_string(name))
+    cdr.raw(cdr_strings(tuple(names)))
     for values in (position, velocity, effort):
         array = np.asarray(values, dtype="<f8")
         cdr.uint32(array.size)
