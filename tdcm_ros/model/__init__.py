@@ -45,6 +45,7 @@ from tdcm_ros.model.errors import (
     ModelError,
     ModelLimitError,
     NotchClosureError,
+    StrainLimitError,
     TendonSingularityError,
     TensionRangeError,
 )
@@ -205,6 +206,7 @@ __all__ = [
     "StampedHistory",
     "StickSlipTension",
     "StopAngleTarget",
+    "StrainLimitError",
     "Tendon",
     "TendonSingularityError",
     "TensionProfile",

@@ -46,6 +46,17 @@ class TendonSingularityError(ModelLimitError):
         self.rc_kappa = rc_kappa
 
 
+class StrainLimitError(ModelLimitError):
+    """A notch's peak strain passed the material's recoverable strain."""
+
+    kind = "strain_limit"
+
+    def __init__(self, message: str, *, notch: int, strain: float) -> None:
+        super().__init__(message)
+        self.notch = notch
+        self.strain = strain
+
+
 class NotchClosureError(ModelLimitError):
     """A notch bent so far that its faces touch (contact is not part of the base model)."""
 

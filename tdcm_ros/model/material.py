@@ -19,7 +19,7 @@ plateau. Sections given by their numbers or by a mesh's slices carry no width pr
 take the linear law only.
 
 ``recoverable_strain`` (default none): the largest strain the material recovers from; a
-solution past it raises :class:`StrainLimitError`.
+solution past it raises :class:`~tdcm_ros.model.errors.StrainLimitError`.
 
 :class:`~tdcm_ros.model.material_model.MaterialLaw` is the moment model that applies it.
 """
@@ -30,20 +30,9 @@ import math
 from dataclasses import dataclass
 
 from tdcm_ros.errors import out_of_range
-from tdcm_ros.model.errors import InvalidDesignError, ModelLimitError
+from tdcm_ros.model.errors import InvalidDesignError
 
 LAWS = ("linear", "bilinear")
-
-
-class StrainLimitError(ModelLimitError):
-    """A notch's peak strain passed the material's recoverable strain."""
-
-    kind = "strain_limit"
-
-    def __init__(self, message: str, *, notch: int, strain: float) -> None:
-        super().__init__(message)
-        self.notch = notch
-        self.strain = strain
 
 
 @dataclass(frozen=True)

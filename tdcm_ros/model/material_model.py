@@ -24,9 +24,10 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
+from tdcm_ros.model.errors import StrainLimitError
 from tdcm_ros.model.grid import Grid, gauss_legendre
 from tdcm_ros.model.kinematics import PlanarShape
-from tdcm_ros.model.material import Material, StrainLimitError
+from tdcm_ros.model.material import Material
 from tdcm_ros.model.moment_model import MomentModel, PlainRun, Plan
 from tdcm_ros.model.profiles import PolygonProfile
 from tdcm_ros.model.sections import material_edges, plateau_excess

@@ -21,7 +21,8 @@ from tdcm_ros.model import (
     read_body_file,
     solve,
 )
-from tdcm_ros.model.material import Material, StrainLimitError
+from tdcm_ros.model.errors import StrainLimitError
+from tdcm_ros.model.material import Material
 
 PAPER = preset("paper-experiment")
 

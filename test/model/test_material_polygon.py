@@ -28,7 +28,8 @@ from tdcm_ros.model import (
     read_body_file,
     solve,
 )
-from tdcm_ros.model.material import Material, StrainLimitError
+from tdcm_ros.model.errors import StrainLimitError
+from tdcm_ros.model.material import Material
 from tdcm_ros.model.profiles import PolygonProfile, SectionProfile
 from tdcm_ros.model.sections import (
     BandSection,
