@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from tdcm_ros.errors import out_of_range
 from tdcm_ros.model.design import Design
 from tdcm_ros.model.errors import InvalidDesignError
+from tdcm_ros.model.grid import on_clear
 from tdcm_ros.model.result import SolveResult
 
 Array = NDArray[np.float64]
@@ -69,7 +70,8 @@ def _segments(design: Design) -> list[tuple[float, float, int | None]]:
 def _segment_nodes(design: Design, s: Array) -> list[list[int]]:
     """Per segment of ``design``, the indices of the nodes ``s`` (m) nearest its start and end
     (the first of equals, as argmin); kept for the last pair, by identity (a node draws the same
-    design on the same cached grid again and again)."""
+    design on the same cached grid again and again; :func:`~tdcm_ros.model.grid.clear_grid_cache`
+    forgets it)."""
     last = _last_segment_nodes.get("pair")
     if last is not None and last[0] is design and last[1] is s:
         return last[2]
@@ -80,6 +82,7 @@ def _segment_nodes(design: Design, s: Array) -> list[list[int]]:
 
 
 _last_segment_nodes: dict[str, tuple[Design, Array, list[list[int]]]] = {}
+on_clear(_last_segment_nodes.clear)
 
 
 def joint_names(design: Design, *, name: str = DEFAULT_NAME, prefix: str = "") -> list[str]:
