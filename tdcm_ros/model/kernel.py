@@ -362,9 +362,19 @@ def iterate_prototypes(proto_fc: Array, proto_fq: Array, proto_strain: Array, fc
                                         x[j])
 
 
+def one_offsets(n: int) -> tuple[int, int, int, int, int]:
+    """Where :func:`iterate_one`'s output buffer for ``n`` cells puts its parts: the starts of
+    ``p``, ``tangent``, ``theta``, ``info`` and of its steps (``x`` is everything before ``p``)."""
+    p = 2 * n
+    tangent = p + 2 * (n + 1)
+    theta = tangent + 2 * (n + 1)
+    info = theta + n + 1
+    return p, tangent, theta, info, info + 3
+
+
 def one_size(n: int, budget: int) -> int:
     """Length of :func:`iterate_one`'s output buffer for ``n`` cells and ``budget`` steps."""
-    return 2 * n + 5 * (n + 1) + 3 + budget
+    return one_offsets(n)[4] + budget
 
 
 def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tension: float,
@@ -377,20 +387,19 @@ def iterate_one(fc: Array, fq: Array, ic: Ints, notch: Ints, scal: Array, tensio
     :func:`iterate`'s ``info`` (steps, status, smallest gap (m), the steps (m)); the budget
     is what is left of ``out``. Returns that ``info``'s steps, status and smallest gap."""
     n = fc.shape[2]
-    nodes = n + 1
-    x = out[:2 * n]
+    p_at, tangent_at, theta_at, info_at, _ = one_offsets(n)
+    x = out[:p_at]
     if x0 is None:
         x[:] = scal[0, 0] * tension
     else:
         x[:] = x0
-    p = out[2 * n:2 * n + 2 * nodes].view(np.complex128)
-    tangent = out[2 * n + 2 * nodes:2 * n + 4 * nodes].view(np.complex128)
-    theta = out[2 * n + 4 * nodes:2 * n + 5 * nodes]
-    info = out[2 * n + 5 * nodes:]
+    p = out[p_at:tangent_at].view(np.complex128)
+    tangent = out[tangent_at:theta_at].view(np.complex128)
+    theta = out[theta_at:info_at]
+    info = out[info_at:]
+    g, t_a, new_p, new_theta, new_tangent, notch_gaps = row_scratch(n, notch.shape[2])
     iterate_row(fc[0], fq[0], ic[0], notch[0], scal[0], tension, x, p, theta, tangent, tol,
-                relaxation, slow, growth, info, np.empty(2 * n), np.empty(n),
-                np.empty(nodes, np.complex128), np.empty(nodes),
-                np.empty(nodes, np.complex128), np.empty(notch.shape[2]))
+                relaxation, slow, growth, info, g, t_a, new_p, new_theta, new_tangent, notch_gaps)
     return int(info[0]), int(info[1]), info[2]
 
 
@@ -429,5 +438,5 @@ def peak_strains(rows: Ints, cells: Ints, s0: Array, s1: Array, x: Array, out: A
 
 KERNELS = ("unit", "integrate_row", "moments_row", "gaps_row", "integrate", "moments", "gaps",
            "peak_strain_row", "iterate_row", "row_scratch", "iterate", "lay_out", "gather",
-           "iterate_prototypes", "iterate_one", "peak_strains")
+           "iterate_prototypes", "one_offsets", "iterate_one", "peak_strains")
 """The functions :mod:`tdcm_ros.model.compiled` compiles, callees before callers."""

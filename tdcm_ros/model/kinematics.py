@@ -45,6 +45,14 @@ class PlanarShape:
         """z coordinates (m)."""
         return self.p.real
 
+    @property
+    def positions(self) -> Array:
+        """Node positions (..., n, 3) m in ``tdcm_base``: ``(x, 0, z)``."""
+        positions = np.zeros((*self.p.shape, 3))
+        positions[..., 0] = self.p.imag
+        positions[..., 2] = self.p.real
+        return positions
+
 
 def integrate(grid: Grid | Cells, m_a: Array, m_b: Array,
               tension: float | Array = 0.0, axis_tension: float | Array | None = None

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from tdcm_ros.model import loads
 from tdcm_ros.model.compiled import kernels
 from tdcm_ros.model.grid import Grid
-from tdcm_ros.model.kernel import one_size
+from tdcm_ros.model.kernel import one_offsets, one_size
 from tdcm_ros.model.kinematics import PlanarShape
 from tdcm_ros.model.limits import (
     check_closure,
@@ -77,28 +77,30 @@ class CompiledRun:
     @property
     def x(self) -> Array:
         """The last iterate ``[m_a, m_b]`` (2n,) N m."""
-        return self.out[:2 * self.n]
+        return self.out[:one_offsets(self.n)[0]]
 
     @property
     def p(self) -> NDArray[np.complex128]:
         """The last shape's nodes ``z + i x`` (m)."""
-        return self.out[2 * self.n:4 * self.n + 2].view(np.complex128)
+        p_at, tangent_at, *_ = one_offsets(self.n)
+        return self.out[p_at:tangent_at].view(np.complex128)
 
     @property
     def theta(self) -> Array:
         """The last shape's tangent angles (rad)."""
-        return self.out[6 * self.n + 4:7 * self.n + 5]
+        _, _, theta_at, info_at, _ = one_offsets(self.n)
+        return self.out[theta_at:info_at]
 
     @property
     def shape(self) -> PlanarShape:
         """The last iterate's shape: nodes (m), tangent angles (rad) and unit tangents."""
-        return PlanarShape(self.p, self.theta,
-                           self.out[4 * self.n + 2:6 * self.n + 4].view(np.complex128))
+        _, tangent_at, theta_at, _, _ = one_offsets(self.n)
+        return PlanarShape(self.p, self.theta, self.out[tangent_at:theta_at].view(np.complex128))
 
     @property
     def history(self) -> tuple[float, ...]:
         """The steps (m), one per iteration."""
-        start = one_size(self.n, 0)
+        start = one_offsets(self.n)[4]
         return tuple(self.out[start:start + self.steps].tolist())
 
 

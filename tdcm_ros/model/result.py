@@ -102,11 +102,7 @@ class SolveResult:
     @cached_property
     def positions(self) -> Array:
         """Node positions (n, 3) m in ``tdcm_base``: ``(x, 0, z)``."""
-        p = self._run.p
-        positions = np.zeros((p.size, 3))
-        positions[:, 0] = p.imag
-        positions[:, 2] = p.real
-        return positions
+        return self._run.shape.positions
 
     @cached_property
     def theta(self) -> Array:

@@ -508,9 +508,7 @@ def _result(grid: Grid, settings: SolverSettings, tension: float, run: _Run, str
     """The result of the strategy run ``run`` (its ``history``: every step of the solve)."""
     shape = run.shape
     contact_scale, tendon_tension = model.extras(run.x, shape, tension)
-    positions = np.zeros((grid.s_nodes.size, 3))
-    positions[:, 0] = shape.p.imag
-    positions[:, 2] = shape.p.real
+    positions = shape.positions
     tendons = model.inner if isinstance(model, MaterialLaw) else model
     tensions = tuple(tendons.tensions(tension).tolist()) if isinstance(tendons, TendonSet) else ()
     material = None

@@ -38,6 +38,7 @@ NODE, PUBLISHER, SUBSCRIPTION, SERVICE, CLIENT = "NN", "MP", "MS", "SS", "SC"
 RMW_ZENOH_DEFAULT_DEPTH = 42
 _RELIABILITY = {"reliable": 1, "best_effort": 2}
 _DURABILITY = {"transient_local": 1, "volatile": 2}
+_DURABILITY_BY_CODE = {str(code): name for name, code in _DURABILITY.items()}
 _ATTACHMENT = struct.Struct("<qqB16s")
 #: QoS of service servers and clients (``rmw_qos_profile_services_default``: reliable,
 #: volatile, keep-last 10), as their tokens carry it.
@@ -87,9 +88,8 @@ def qos_chunk(qos: QoS) -> str:
 def durability_of(chunk: str) -> str:
     """The durability an endpoint token's QoS chunk (:func:`qos_chunk`) declares:
     ``transient_local`` or ``volatile`` (rmw_zenoh's default where the field is empty)."""
-    field = chunk.split(":")[1] if chunk.count(":") >= 1 else ""
-    by_code = {str(code): name for name, code in _DURABILITY.items()}
-    return by_code.get(field, "volatile")
+    fields = chunk.split(":")
+    return _DURABILITY_BY_CODE.get(fields[1] if len(fields) > 1 else "", "volatile")
 
 
 @dataclass(frozen=True)
