@@ -128,11 +128,18 @@ def evaluate_paths(paths: Sequence[str | Path], options: EvaluateOptions | None 
     ``progress``: stage ``reading bags``. The bags' series are dropped once their steps are
     measured: the model runs without them in memory."""
     opts = options or EvaluateOptions()
+    notes, prepared = _measured(paths, opts, topics, registration, progress)
+    return _evaluate(notes, prepared, opts)
+
+
+def _measured(paths: Sequence[str | Path], opts: EvaluateOptions, topics: Topics | None,
+              registration: Registration | None, progress: Progress | None
+              ) -> tuple[list[_BagNotes], list[tuple[list[MeasuredStep], Registration]]]:
+    """Each bag's notes and its measured steps with their registration (:func:`prepare`); the
+    bags' series are dropped on return: the model runs without them in memory."""
     sources = load_paths(paths, opts, topics, progress)
     prepared = prepare(sources, opts, registration)
-    notes = [_BagNotes.of(s) for s in sources]
-    del sources
-    return _evaluate(notes, prepared, opts)
+    return [_BagNotes.of(s) for s in sources], prepared
 
 
 def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
@@ -149,10 +156,7 @@ def calibrate_paths(paths: Sequence[str | Path], fit: Sequence[str] = ("E",),
     from tdcm_ros.metrics.calibration import Calibration, calibrate_steps
 
     opts = options or EvaluateOptions()
-    sources = load_paths(paths, opts, topics, progress)
-    measured = prepare(sources, opts, registration)
-    notes = [_BagNotes.of(s) for s in sources]
-    del sources  # the fit needs the steps, not the series
+    notes, measured = _measured(paths, opts, topics, registration, progress)
     prepared, held = split_trials(notes, measured, hold_out)
     fitted, params, corr, condition, rms, count, warnings = calibrate_steps(
         prepared, fit, opts, confidence=confidence, progress=progress)

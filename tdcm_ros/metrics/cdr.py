@@ -76,19 +76,24 @@ def _decode_group(raw: NDArray[np.uint8], rows: NDArray[np.int64], stamps: NDArr
     if np.any(name_len != name_len[0]):
         return False
     body = 12 + int(name_len[0])  # end of frame_id, relative to the CDR body
-    start = 4 + ((body + 7) // 8) * 8 + 16  # force.z: third float64 after alignment
+    start = 4 + cdr_align(body, 8) + 16  # force.z: third float64 after alignment
     if start + 8 > size:
         return False
-    sec = raw[:, 4:8].copy().view("<i4")[:, 0].astype(np.int64)
-    nsec = raw[:, 8:12].copy().view("<u4")[:, 0].astype(np.int64)
-    stamps[rows] = sec * 1_000_000_000 + nsec
+    stamps[rows] = _header_stamps(raw)
     force[rows] = raw[:, start:start + 8].copy().view("<f8")[:, 0]
     return True
 
 
+def _header_stamps(raw: NDArray[np.uint8]) -> NDArray[np.int64]:
+    """The header stamps (ns since the epoch) of little-endian payloads of one length (a row
+    each) that start with a ``std_msgs/Header``."""
+    sec = raw[:, 4:8].copy().view("<i4")[:, 0].astype(np.int64)
+    nsec = raw[:, 8:12].copy().view("<u4")[:, 0].astype(np.int64)
+    return sec * 1_000_000_000 + nsec
+
+
 _MARKERS_TYPE = "mocap4r2_msgs/msg/Markers"
 _U32 = struct.Struct("<I")
-_I32 = struct.Struct("<i")
 _XYZ = struct.Struct("<3d")
 
 
@@ -193,11 +198,9 @@ def _markers_group(rows: NDArray[np.int64], raw: NDArray[np.uint8], frame: str,
                    names: list[str], offsets: list[int]) -> MarkersGroup:
     """The group of the payloads ``raw`` (a row each, payloads ``rows``) of one layout: frame
     id ``frame``, markers ``names`` with their positions at byte ``offsets``."""
-    sec = raw[:, 4:8].copy().view("<i4")[:, 0].astype(np.int64)
-    nsec = raw[:, 8:12].copy().view("<u4")[:, 0].astype(np.int64)
     xyz = np.stack([raw[:, o:o + 24].copy().view("<f8") for o in offsets], axis=1) \
         if offsets else np.zeros((len(rows), 0, 3))
-    return rows, sec * 1_000_000_000 + nsec, frame, names, xyz
+    return rows, _header_stamps(raw), frame, names, xyz
 
 
 def float64_data(payloads: Sequence[bytes]) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
