@@ -13,6 +13,7 @@ from tdcm_ros.bagio.cdr import (
     cdr_header,
     cdr_string,
     cdr_strings,
+    joint_state_cdr,
 )
 from tdcm_ros.bagio.convert import from_dict, prepare_codec, to_dict
 from tdcm_ros.bagio.errors import BagError
@@ -40,6 +41,7 @@ __all__ = [
     "cdr_strings",
     "deserialize",
     "from_dict",
+    "joint_state_cdr",
     "message_definition",
     "msg_class",
     "normalize_service_type",

@@ -136,3 +136,19 @@ class PayloadRows(Sequence[bytes]):
         if isinstance(index, slice):
             return PayloadRows(self.rows[index])
         return self.rows[index].tobytes()
+
+
+def joint_state_cdr(stamp_ns: int, names: Sequence[str], position: Sequence[float],
+                    velocity: Sequence[float], effort: Sequence[float], frame_id: str = ""
+                    ) -> bytes:
+    """The CDR :func:`~tdcm_ros.bagio.serialize` gives for a ``sensor_msgs/msg/JointState`` of
+    these fields (rad or m, rad/s or m/s, N m or N), stamped ``stamp_ns`` (ns since the epoch)."""
+    cdr = CdrWriter()
+    cdr.header(stamp_ns, frame_id)
+    cdr.raw(cdr_strings(tuple(names)))
+    for values in (position, velocity, effort):
+        array = np.asarray(values, dtype="<f8")
+        cdr.uint32(array.size)
+        if array.size:
+            cdr.raw(array.tobytes(), 8)
+    return cdr.data()

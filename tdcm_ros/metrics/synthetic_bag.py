@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tdcm_ros.bagio import msg_class, serialize
+from tdcm_ros.bagio import joint_state_cdr, msg_class, serialize
 from tdcm_ros.bagio.writer import BagWriter, OfferedQos
 from tdcm_ros.metrics.synthetic import Recording
 
@@ -47,13 +47,10 @@ def _wrenches(stamps_s: np.ndarray, tension_n: np.ndarray, topic: str
 def _joint_states(stamps_s: np.ndarray, tensions_n: np.ndarray, names: tuple[str, ...],
                   topic: str) -> list[tuple[int, str, bytes]]:
     """JointState messages (log time ns, topic, CDR): an effort (N) per tendon ``names``."""
-    joints = msg_class(JOINT_STATE)
     messages = []
     for t, row in zip(stamps_s.tolist(), tensions_n, strict=True):
         ns = EPOCH_NS + round(t * 1e9)
-        msg = joints(header=_header(ns, ""), name=list(names), position=np.empty(0),
-                     velocity=np.empty(0), effort=np.array(row, dtype=np.float64))
-        messages.append((ns, topic, serialize(msg)))
+        messages.append((ns, topic, joint_state_cdr(ns, names, (), (), row)))
     return messages
 
 
@@ -62,14 +59,11 @@ def _rolls(recording: Recording, topic: str, joint: str) -> list[tuple[int, str,
     none for a recording without a roll."""
     if recording.roll is None:
         return []
-    joints = msg_class(JOINT_STATE)
     messages = []
     for t, phi in zip(recording.roll.stamps_s.tolist(), recording.roll.roll_rad.tolist(),
                       strict=True):
         ns = EPOCH_NS + round(t * 1e9)
-        msg = joints(header=_header(ns, ""), name=[joint], position=np.array([phi]),
-                     velocity=np.empty(0), effort=np.empty(0))
-        messages.append((ns, topic, serialize(msg)))
+        messages.append((ns, topic, joint_state_cdr(ns, (joint,), (phi,), (), ())))
     return messages
 
 

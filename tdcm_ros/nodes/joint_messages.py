@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from tdcm_ros.bagio import CdrWriter, cdr_strings, from_dict
+from tdcm_ros.bagio import from_dict, joint_state_cdr
 from tdcm_ros.nodes.shape_messages import header
 
 JOINT_STATE = "sensor_msgs/msg/JointState"
@@ -63,22 +63,6 @@ def tendon_states(stamp_ns: int, names: Sequence[str], strokes_m: Sequence[float
     its tension (N), stamped ``stamp_ns``, no frame. Written directly: model_node sends one per
     input (through rosbags' objects it cost ~100 µs)."""
     return joint_state_cdr(stamp_ns, names, strokes_m, (), tensions_n)
-
-
-def joint_state_cdr(stamp_ns: int, names: Sequence[str], position: Sequence[float],
-                    velocity: Sequence[float], effort: Sequence[float], frame_id: str = ""
-                    ) -> bytes:
-    """The CDR :func:`~tdcm_ros.bagio.serialize` gives for a ``sensor_msgs/msg/JointState`` of
-    these fields (rad or m, rad/s or m/s, N m or N), stamped ``stamp_ns`` (ns since the epoch)."""
-    cdr = CdrWriter()
-    cdr.header(stamp_ns, frame_id)
-    cdr.raw(cdr_strings(tuple(names)))
-    for values in (position, velocity, effort):
-        array = np.asarray(values, dtype="<f8")
-        cdr.uint32(array.size)
-        if array.size:
-            cdr.raw(array.tobytes(), 8)
-    return cdr.data()
 
 
 def tendon_efforts(message: Any, tendons: Sequence[str]
